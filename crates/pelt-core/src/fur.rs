@@ -1,0 +1,368 @@
+//! The unified shell-and-fin structure (the paper's contribution) and the separated structure of
+//! Lengyel et al. 2001 it is measured against.
+//!
+//! One shared vertex array `NV[i*V + j] = BV_j + G_j * (i / L) * length_j` (layer `i = 0..=L`,
+//! base vertex `j`, growing vector `G_j`) serves both the shells (every layer repeats the base
+//! triangles, offset by `i*V`) and the fins (the quad `(i,a) (i,b) (i+1,b) (i+1,a)` on every edge
+//! `(a, b)` and every `i < L`). Nothing is replicated per layer: the GPU holds this array once,
+//! plus the base triangles and the edge list.
+
+use glam::{Quat, Vec3};
+
+use crate::mesh::Mesh;
+use crate::rng;
+
+/// The largest layer count Pelt accepts (the paper uses 16 and 32).
+pub const MAX_LAYERS: u32 = 128;
+
+/// Bytes of one shared-vertex position on the GPU (three packed `f32`).
+pub const POSITION_BYTES: u64 = 12;
+/// Bytes of one full vertex of the separated structure: position, normal (3 x f32 each) and uv.
+pub const SEPARATED_VERTEX_BYTES: u64 = 12 + 12 + 8;
+/// Bytes of one index.
+pub const INDEX_BYTES: u64 = 4;
+
+/// Errors from building a fur structure.
+#[derive(Debug, thiserror::Error, PartialEq)]
+pub enum FurError {
+    #[error("layers must be between 1 and {MAX_LAYERS}, got {0}")]
+    Layers(u32),
+    #[error("fur length must be finite and not negative, got {0}")]
+    Length(f32),
+    #[error("the length map has {got} entries but the mesh has {expected} vertices")]
+    LengthMapSize { expected: usize, got: usize },
+}
+
+/// How long the fur is.
+#[derive(Clone, Debug, PartialEq)]
+pub enum FurLength {
+    /// The same length (world units) everywhere.
+    Constant(f32),
+    /// One length per base vertex (world units), e.g. painted or read from a map.
+    PerVertex(Vec<f32>),
+}
+
+/// Which way the fur grows from each base vertex.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct GrowthDirection {
+    /// Each direction is tilted away from the normal by up to this angle (radians), seeded.
+    pub random_angle_rad: f32,
+    /// Seed for the random tilt.
+    pub seed: u64,
+    /// A world-space combing direction; only its part along the surface matters.
+    pub comb: Vec3,
+    /// How far the fur leans into the comb: 0 = along the normal, 1 = flat along the surface.
+    pub comb_blend: f32,
+}
+
+impl Default for GrowthDirection {
+    fn default() -> Self {
+        Self { random_angle_rad: 0.0, seed: 0, comb: Vec3::ZERO, comb_blend: 0.0 }
+    }
+}
+
+impl GrowthDirection {
+    /// The growing vector for a vertex with unit normal `normal` (always a unit vector on the
+    /// outside of the surface).
+    #[must_use]
+    pub fn apply(&self, vertex: usize, normal: Vec3) -> Vec3 {
+        let mut direction = normal;
+        let along_surface = self.comb - normal * self.comb.dot(normal);
+        if let Some(tangent) = along_surface.try_normalize() {
+            // Keep a little of the normal so combed fur never lies exactly in the surface.
+            let blend = self.comb_blend.clamp(0.0, 1.0) * 0.95;
+            direction = (normal * (1.0 - blend) + tangent * blend).normalize();
+        }
+        if self.random_angle_rad > 0.0 {
+            let bits = rng::hash(self.seed, vertex as u64, 0x6469_7265, 0);
+            let turn = rng::unit_f32(bits) * std::f32::consts::TAU;
+            let tilt = rng::unit_f32(rng::mix64(bits)) * self.random_angle_rad.min(1.4);
+            let (u, v) = direction.any_orthonormal_pair();
+            let axis = u * turn.cos() + v * turn.sin();
+            direction = (Quat::from_axis_angle(axis, tilt) * direction).normalize();
+        }
+        // Never below the surface, whatever the tilt and comb add up to.
+        let height = direction.dot(normal);
+        if height < MIN_HEIGHT {
+            let tangent = (direction - normal * height).normalize_or_zero();
+            direction = normal * MIN_HEIGHT + tangent * (1.0 - MIN_HEIGHT * MIN_HEIGHT).sqrt();
+        }
+        direction
+    }
+}
+
+/// The least cosine between a growing vector and its normal: fur always leaves the surface.
+const MIN_HEIGHT: f32 = 0.1;
+
+/// Everything needed to grow the unified structure on a mesh.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FurParams {
+    /// Number of shells `L` above the base (layer 0 is the base surface, layer `L` the tips).
+    pub layers: u32,
+    pub length: FurLength,
+    pub direction: GrowthDirection,
+}
+
+/// The unified shell-and-fin structure on one base mesh.
+#[derive(Clone, Debug)]
+pub struct FurStructure {
+    /// The base surface (layer 0): triangles for the shells, edges for the fins.
+    pub mesh: Mesh,
+    /// `L`: the number of shells above the base.
+    pub layers: u32,
+    /// Unit growing vector per base vertex.
+    pub directions: Vec<Vec3>,
+    /// Fur length per base vertex (world units).
+    pub lengths: Vec<f32>,
+    /// The shared vertex array `NV`, `(L + 1) * V` entries, layer-major: `NV[i*V + j]`.
+    pub positions: Vec<Vec3>,
+}
+
+impl FurStructure {
+    /// Grows the rest pose on `mesh` (the paper's steps 1-6).
+    ///
+    /// # Errors
+    /// [`FurError`] for a layer count outside `1..=MAX_LAYERS`, a negative or non-finite
+    /// length, or a length map of the wrong size.
+    pub fn new(mesh: Mesh, params: &FurParams) -> Result<Self, FurError> {
+        if params.layers == 0 || params.layers > MAX_LAYERS {
+            return Err(FurError::Layers(params.layers));
+        }
+        let v = mesh.vertex_count();
+        let lengths = match &params.length {
+            FurLength::Constant(l) => vec![*l; v],
+            FurLength::PerVertex(map) if map.len() == v => map.clone(),
+            FurLength::PerVertex(map) => return Err(FurError::LengthMapSize { expected: v, got: map.len() }),
+        };
+        if let Some(bad) = lengths.iter().find(|l| !l.is_finite() || **l < 0.0) {
+            return Err(FurError::Length(*bad));
+        }
+        let directions: Vec<Vec3> =
+            mesh.normals.iter().enumerate().map(|(j, n)| params.direction.apply(j, *n)).collect();
+        let layers = params.layers;
+        let mut positions = Vec::with_capacity((layers as usize + 1) * v);
+        for i in 0..=layers {
+            let fraction = i as f32 / layers as f32;
+            positions.extend(
+                mesh.positions.iter().zip(&directions).zip(&lengths).map(|((bv, g), l)| *bv + *g * (fraction * l)),
+            );
+        }
+        Ok(Self { mesh, layers, directions, lengths, positions })
+    }
+
+    /// `V`, the base vertex count (the stride between layers).
+    #[must_use]
+    pub fn vertex_count(&self) -> usize {
+        self.mesh.vertex_count()
+    }
+
+    /// Index of `NV[layer * V + vertex]` in the shared array.
+    #[must_use]
+    #[inline]
+    pub fn index(&self, layer: u32, vertex: u32) -> u32 {
+        layer * self.vertex_count() as u32 + vertex
+    }
+
+    /// The shared-vertex indices of base triangle `t` in shell `layer`.
+    #[must_use]
+    pub fn shell_triangle(&self, layer: u32, t: usize) -> [u32; 3] {
+        self.mesh.triangles[t].map(|j| self.index(layer, j))
+    }
+
+    /// The fin quad on `edge` between layers `layer` and `layer + 1`:
+    /// `(i,a) (i,b) (i+1,b) (i+1,a)`.
+    ///
+    /// # Panics
+    /// If `layer >= L`.
+    #[must_use]
+    pub fn fin_quad(&self, edge: usize, layer: u32) -> [u32; 4] {
+        assert!(layer < self.layers, "fin quads join layer i to i + 1 < L + 1");
+        let [a, b] = self.mesh.edges[edge];
+        [self.index(layer, a), self.index(layer, b), self.index(layer + 1, b), self.index(layer + 1, a)]
+    }
+
+    /// Counts and GPU bytes of this unified structure.
+    #[must_use]
+    pub fn footprint(&self) -> Footprint {
+        Footprint::unified(&self.mesh, self.layers)
+    }
+}
+
+/// The separated structure of Lengyel et al.: shells plus fins as geometry of their own.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct SeparatedStructure {
+    pub layers: u32,
+    /// Faces per fin: 2 (one quad, Lengyel) or `N` (the paper compares `N = 30`).
+    pub fin_faces: u32,
+}
+
+impl SeparatedStructure {
+    /// Counts and GPU bytes of this structure on `mesh`.
+    #[must_use]
+    pub fn footprint(&self, mesh: &Mesh) -> Footprint {
+        Footprint::separated(mesh, self.layers, self.fin_faces)
+    }
+}
+
+/// Vertex and face counts and GPU bytes of one structure on one mesh.
+///
+/// The vertex counts follow the paper's Table 2: unified `V(L+1)`; separated `V(L+1) + N*E` with
+/// `N` faces per fin. GPU bytes follow the layouts Pelt draws:
+/// - unified: positions `12 * V(L+1)`; attributes the base normals `12V` plus uvs (`8` per
+///   triangle corner, when the mesh has them); indices the base triangles `3F` and the edges `2E`
+///   plus each edge's two faces `2E` (for the silhouette test), 4 bytes each;
+/// - separated: every vertex a full vertex (position, normal, uv: 32 bytes), split here into
+///   positions (12) and attributes (20); indices one shell index buffer `3F` reused per layer
+///   with a base-vertex offset, and `3N` per fin.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
+pub struct Footprint {
+    pub vertices: u64,
+    /// Shell faces (`F * L`, the base is drawn once more as the opaque skin) plus fin faces.
+    pub faces: u64,
+    pub shell_faces: u64,
+    pub fin_faces: u64,
+    pub position_bytes: u64,
+    pub attribute_bytes: u64,
+    pub index_bytes: u64,
+}
+
+impl Footprint {
+    fn unified(mesh: &Mesh, layers: u32) -> Self {
+        let (v, f, e, l) = counts(mesh, layers);
+        let vertices = v * (l + 1);
+        let uv_bytes = if mesh.corner_uvs.is_some() { 3 * f * 8 } else { 0 };
+        let shell_faces = f * l;
+        let fin_faces = 2 * l * e;
+        Self {
+            vertices,
+            faces: shell_faces + fin_faces,
+            shell_faces,
+            fin_faces,
+            position_bytes: vertices * POSITION_BYTES,
+            attribute_bytes: v * 12 + uv_bytes,
+            index_bytes: (3 * f + 2 * e + 2 * e) * INDEX_BYTES,
+        }
+    }
+
+    fn separated(mesh: &Mesh, layers: u32, faces_per_fin: u32) -> Self {
+        let (v, f, e, l) = counts(mesh, layers);
+        let n = u64::from(faces_per_fin);
+        let vertices = v * (l + 1) + n * e;
+        let shell_faces = f * l;
+        let fin_faces = n * e;
+        Self {
+            vertices,
+            faces: shell_faces + fin_faces,
+            shell_faces,
+            fin_faces,
+            position_bytes: vertices * POSITION_BYTES,
+            attribute_bytes: vertices * (SEPARATED_VERTEX_BYTES - POSITION_BYTES),
+            index_bytes: (3 * f + 3 * n * e) * INDEX_BYTES,
+        }
+    }
+
+    /// All GPU bytes of the structure.
+    #[must_use]
+    pub fn total_bytes(&self) -> u64 {
+        self.position_bytes + self.attribute_bytes + self.index_bytes
+    }
+
+    /// How much `self` saves against `other`, in percent of `other` (`key` picks the measure).
+    #[must_use]
+    pub fn savings_percent(&self, other: &Self, key: impl Fn(&Self) -> u64) -> f64 {
+        let theirs = key(other) as f64;
+        if theirs == 0.0 { 0.0 } else { 100.0 * (theirs - key(self) as f64) / theirs }
+    }
+}
+
+fn counts(mesh: &Mesh, layers: u32) -> (u64, u64, u64, u64) {
+    (mesh.vertex_count() as u64, mesh.triangles.len() as u64, mesh.edges.len() as u64, u64::from(layers))
+}
+
+#[cfg(test)]
+mod tests {
+    use proptest::prelude::*;
+
+    use super::*;
+    use crate::mesh::builtin::Builtin;
+
+    fn grow(builtin: Builtin, layers: u32, direction: GrowthDirection) -> FurStructure {
+        let (mesh, _) = builtin.mesh();
+        FurStructure::new(mesh, &FurParams { layers, length: FurLength::Constant(0.3), direction }).unwrap()
+    }
+
+    #[test]
+    fn box_matches_table_2() {
+        let fur = grow(Builtin::Box, 16, GrowthDirection::default());
+        assert_eq!(fur.positions.len(), 5_032);
+        let two = SeparatedStructure { layers: 16, fin_faces: 2 }.footprint(&fur.mesh);
+        let thirty = SeparatedStructure { layers: 16, fin_faces: 30 }.footprint(&fur.mesh);
+        assert_eq!(fur.footprint().vertices, 5_032);
+        assert_eq!(two.vertices, 6_796);
+        assert_eq!(thirty.vertices, 31_492);
+        let vertices = |f: &Footprint| f.vertices;
+        let saved_vs_two = fur.footprint().savings_percent(&two, vertices);
+        let saved_vs_thirty = fur.footprint().savings_percent(&thirty, vertices);
+        assert!((saved_vs_two - 25.96).abs() < 0.01, "{saved_vs_two}");
+        assert!((saved_vs_thirty - 84.02).abs() < 0.01, "{saved_vs_thirty}");
+        // Unified fins: 2L triangles per edge.
+        assert_eq!(fur.footprint().fin_faces, 2 * 16 * 882);
+    }
+
+    #[test]
+    fn bad_params_are_errors() {
+        let (mesh, _) = Builtin::Box.mesh();
+        let params = |layers, length| FurParams { layers, length, direction: GrowthDirection::default() };
+        assert_eq!(
+            FurStructure::new(mesh.clone(), &params(0, FurLength::Constant(1.0))).unwrap_err(),
+            FurError::Layers(0)
+        );
+        assert!(FurStructure::new(mesh.clone(), &params(4, FurLength::Constant(-1.0))).is_err());
+        assert!(FurStructure::new(mesh.clone(), &params(4, FurLength::Constant(f32::NAN))).is_err());
+        assert!(FurStructure::new(mesh, &params(4, FurLength::PerVertex(vec![1.0; 3]))).is_err());
+    }
+
+    #[test]
+    fn fin_quads_join_neighbouring_layers_of_one_edge() {
+        let fur = grow(Builtin::Torus, 5, GrowthDirection::default());
+        let v = fur.vertex_count() as u32;
+        for (e, &[a, b]) in fur.mesh.edges.iter().enumerate().step_by(37) {
+            for i in 0..fur.layers {
+                let q = fur.fin_quad(e, i);
+                assert_eq!(q, [i * v + a, i * v + b, (i + 1) * v + b, (i + 1) * v + a]);
+                assert!(q.iter().all(|&k| (k as usize) < fur.positions.len()));
+            }
+        }
+    }
+
+    proptest! {
+        #[test]
+        fn every_shared_vertex_lies_on_its_base_ray(
+            layers in 1u32..40,
+            random_deg in 0.0f32..60.0,
+            comb_blend in 0.0f32..1.0,
+            seed in any::<u64>(),
+            which in 0usize..5,
+        ) {
+            let direction = GrowthDirection {
+                random_angle_rad: random_deg.to_radians(),
+                seed,
+                comb: Vec3::new(0.3, -1.0, 0.2),
+                comb_blend,
+            };
+            let fur = grow(Builtin::ALL[which], layers, direction);
+            let v = fur.vertex_count();
+            prop_assert_eq!(fur.positions.len(), v * (layers as usize + 1));
+            for j in (0..v).step_by(7) {
+                let g = fur.directions[j];
+                prop_assert!((g.length() - 1.0).abs() < 1e-5);
+                prop_assert!(g.dot(fur.mesh.normals[j]) > 0.0, "fur grows outward");
+                for i in 0..=layers {
+                    let expected = fur.mesh.positions[j] + g * (i as f32 / layers as f32 * fur.lengths[j]);
+                    let got = fur.positions[fur.index(i, j as u32) as usize];
+                    prop_assert!(got.distance(expected) < 1e-5);
+                }
+            }
+        }
+    }
+}

@@ -1,0 +1,16 @@
+//! Pelt's core: everything about fur that needs no GPU.
+//!
+//! Data flows one way through the modules:
+//! [`mesh`] (import and repair) -> [`fur`] (the unified shell-and-fin structure) ->
+//! [`texture`] (seeded shell and fin textures) -> [`sim`] (gravity, wind, touch) -> the renderer
+//! in `pelt-render`. [`preset`] holds everything about one fur in one TOML file.
+
+pub mod fur;
+pub mod mesh;
+pub mod preset;
+pub mod rng;
+pub mod sim;
+pub mod texture;
+
+pub use fur::{FurParams, FurStructure, GrowthDirection, SeparatedStructure};
+pub use mesh::{ImportOptions, Mesh, MeshError, MeshReport, builtin::Builtin};

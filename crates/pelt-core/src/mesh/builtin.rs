@@ -1,0 +1,216 @@
+//! Meshes built into Pelt, so every command works with no files at all.
+
+use std::f32::consts::{PI, TAU};
+use std::fmt;
+use std::path::Path;
+
+use glam::{Vec2, Vec3};
+
+use super::{ImportOptions, Mesh, MeshReport, RawMesh};
+
+/// The Stanford bunny (low resolution), embedded. Credits in `assets/CREDITS.md`.
+const BUNNY_OBJ: &str = include_str!("../../../../assets/meshes/bunny.obj");
+
+/// A mesh Pelt can build without a file.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum Builtin {
+    /// The paper's Box: a cube with an 8 x 8 vertex grid per face (296 vertices, 588 triangles).
+    Box,
+    /// The Stanford bunny (1,839 vertices, 3,674 triangles).
+    Bunny,
+    /// A UV sphere of radius 1.
+    Sphere,
+    /// A 2 x 2 plane facing +Y (open: it has a boundary).
+    Plane,
+    /// A torus around +Y.
+    Torus,
+}
+
+impl Builtin {
+    /// Every built-in mesh.
+    pub const ALL: [Self; 5] = [Self::Box, Self::Bunny, Self::Sphere, Self::Plane, Self::Torus];
+
+    /// The name used on the command line.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Box => "box",
+            Self::Bunny => "bunny",
+            Self::Sphere => "sphere",
+            Self::Plane => "plane",
+            Self::Torus => "torus",
+        }
+    }
+
+    /// Looks a built-in up by its name.
+    #[must_use]
+    pub fn from_name(name: &str) -> Option<Self> {
+        Self::ALL.into_iter().find(|b| b.name() == name)
+    }
+
+    /// Builds the mesh.
+    ///
+    /// # Panics
+    /// Never for the shipped built-ins: their data is fixed and tested.
+    #[must_use]
+    pub fn mesh(self) -> (Mesh, MeshReport) {
+        let source = format!("builtin:{}", self.name());
+        let source = Path::new(&source);
+        let options = ImportOptions::default();
+        let result = match self {
+            Self::Bunny => Mesh::from_obj_str(BUNNY_OBJ, source, &options),
+            Self::Box => Mesh::from_raw(grid_box(8), source, &options),
+            Self::Sphere => Mesh::from_raw(uv_sphere(48, 24), source, &options),
+            Self::Plane => Mesh::from_raw(plane(16), source, &options),
+            Self::Torus => Mesh::from_raw(torus(64, 24, 1.0, 0.4), source, &options),
+        };
+        result.expect("built-in meshes are valid")
+    }
+}
+
+impl fmt::Display for Builtin {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// A cube of side 2 with `n x n` vertices per face (shared along the cube's edges after welding).
+fn grid_box(n: u32) -> RawMesh {
+    let mut raw = RawMesh { uvs: Some(Vec::new()), ..RawMesh::default() };
+    // (normal, u axis, v axis) with u x v = normal so faces wind counter-clockwise from outside.
+    let faces = [
+        (Vec3::X, Vec3::NEG_Z, Vec3::Y),
+        (Vec3::NEG_X, Vec3::Z, Vec3::Y),
+        (Vec3::Y, Vec3::X, Vec3::NEG_Z),
+        (Vec3::NEG_Y, Vec3::X, Vec3::Z),
+        (Vec3::Z, Vec3::X, Vec3::Y),
+        (Vec3::NEG_Z, Vec3::NEG_X, Vec3::Y),
+    ];
+    let step = 1.0 / (n - 1) as f32;
+    for (normal, u_axis, v_axis) in faces {
+        let base = raw.positions.len() as u32;
+        for row in 0..n {
+            for col in 0..n {
+                let (u, v) = (col as f32 * step, row as f32 * step);
+                raw.positions.push(normal + u_axis * (2.0 * u - 1.0) + v_axis * (2.0 * v - 1.0));
+                if let Some(uvs) = &mut raw.uvs {
+                    uvs.push(Vec2::new(u, 1.0 - v));
+                }
+            }
+        }
+        push_grid(&mut raw.triangles, base, n, n);
+    }
+    raw
+}
+
+/// Two triangles per cell of a `columns x rows` vertex grid laid out row by row.
+fn push_grid(triangles: &mut Vec<[u32; 3]>, base: u32, columns: u32, rows: u32) {
+    for row in 0..rows - 1 {
+        for col in 0..columns - 1 {
+            let i = base + row * columns + col;
+            let (right, up) = (i + 1, i + columns);
+            triangles.push([i, right, up + 1]);
+            triangles.push([i, up + 1, up]);
+        }
+    }
+}
+
+fn uv_sphere(segments: u32, rings: u32) -> RawMesh {
+    let mut raw = RawMesh { uvs: Some(Vec::new()), normals: Some(Vec::new()), ..RawMesh::default() };
+    for ring in 0..=rings {
+        let v = ring as f32 / rings as f32;
+        let polar = PI * (1.0 - v);
+        for segment in 0..=segments {
+            let u = segment as f32 / segments as f32;
+            let azimuth = TAU * u;
+            let p = Vec3::new(polar.sin() * azimuth.cos(), polar.cos(), -polar.sin() * azimuth.sin());
+            raw.positions.push(p);
+            raw.normals.as_mut().unwrap().push(p);
+            raw.uvs.as_mut().unwrap().push(Vec2::new(u, 1.0 - v));
+        }
+    }
+    // Rows run from the south pole up; triangles that collapse at the poles are dropped (and
+    // counted) by the repair step.
+    push_grid(&mut raw.triangles, 0, segments + 1, rings + 1);
+    raw
+}
+
+fn plane(n: u32) -> RawMesh {
+    let mut raw = RawMesh { uvs: Some(Vec::new()), ..RawMesh::default() };
+    for row in 0..n {
+        for col in 0..n {
+            let (u, v) = (col as f32 / (n - 1) as f32, row as f32 / (n - 1) as f32);
+            raw.positions.push(Vec3::new(2.0 * u - 1.0, 0.0, 1.0 - 2.0 * v));
+            raw.uvs.as_mut().unwrap().push(Vec2::new(u, 1.0 - v));
+        }
+    }
+    push_grid(&mut raw.triangles, 0, n, n);
+    raw
+}
+
+fn torus(segments: u32, sides: u32, major_radius: f32, minor_radius: f32) -> RawMesh {
+    let mut raw = RawMesh { uvs: Some(Vec::new()), ..RawMesh::default() };
+    for side in 0..=sides {
+        let v = side as f32 / sides as f32;
+        let phi = TAU * v;
+        for segment in 0..=segments {
+            let u = segment as f32 / segments as f32;
+            let theta = -TAU * u;
+            let ring = major_radius + minor_radius * phi.cos();
+            raw.positions.push(Vec3::new(ring * theta.cos(), minor_radius * phi.sin(), ring * theta.sin()));
+            raw.uvs.as_mut().unwrap().push(Vec2::new(u, v));
+        }
+    }
+    push_grid(&mut raw.triangles, 0, segments + 1, sides + 1);
+    raw
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn paper_box_has_the_papers_counts() {
+        let (mesh, report) = Builtin::Box.mesh();
+        assert_eq!((mesh.vertex_count(), mesh.triangles.len(), mesh.edges.len()), (296, 588, 882));
+        assert!(report.is_closed_manifold(), "{report}");
+    }
+
+    #[test]
+    fn bunny_matches_the_asset_readme() {
+        let (mesh, report) = Builtin::Bunny.mesh();
+        assert_eq!((mesh.vertex_count(), mesh.triangles.len()), (1839, 3674));
+        assert!(report.is_closed_manifold(), "{report}");
+    }
+
+    #[test]
+    fn every_builtin_is_clean_and_outward_facing() {
+        for builtin in Builtin::ALL {
+            let (mesh, report) = builtin.mesh();
+            assert_eq!(report.inconsistent_winding_edges, 0, "{builtin}");
+            assert_eq!(report.non_manifold_edges, 0, "{builtin}");
+            if builtin != Builtin::Plane {
+                assert_eq!(report.boundary_edges, 0, "{builtin}: {report}");
+                assert_eq!(mesh.edges.len() * 2, mesh.triangles.len() * 3, "E = 3F/2 on {builtin}");
+                // Outward winding: a closed mesh wound counter-clockwise has positive volume.
+                let volume: f32 = mesh
+                    .triangles
+                    .iter()
+                    .map(|t| {
+                        let [a, b, c] = t.map(|i| mesh.positions[i as usize]);
+                        a.dot(b.cross(c)) / 6.0
+                    })
+                    .sum();
+                assert!(volume > 0.0, "{builtin} is wound inside out");
+            }
+            // Smooth vertex normals agree with the winding.
+            let agree = (0..mesh.triangles.len())
+                .filter(|&t| {
+                    let n = mesh.face_normal(t);
+                    mesh.triangles[t].iter().all(|&i| mesh.normals[i as usize].dot(n) > 0.0)
+                })
+                .count();
+            assert!(agree * 10 >= mesh.triangles.len() * 9, "{builtin}: winding and normals disagree");
+        }
+    }
+}

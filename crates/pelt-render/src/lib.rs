@@ -1,0 +1,1 @@
+//! Pelt's wgpu renderer (filled by the renderer issue).

@@ -1,0 +1,39 @@
+//! The mesh arguments every command shares: a file, or a built-in.
+
+use std::path::PathBuf;
+
+use anyhow::Context as _;
+use pelt_core::{Builtin, ImportOptions, Mesh, MeshReport};
+
+/// Which mesh to grow fur on.
+#[derive(Debug, Clone, clap::Args)]
+pub struct MeshArgs {
+    /// A mesh file (.obj, .gltf, .glb).
+    #[arg(value_name = "MESH", conflicts_with = "builtin")]
+    pub mesh: Option<PathBuf>,
+    /// A built-in mesh: box, bunny, sphere, plane, torus.
+    #[arg(long, value_name = "NAME")]
+    pub builtin: Option<String>,
+    /// Keep duplicate positions apart instead of welding them (fins need welded adjacency).
+    #[arg(long)]
+    pub no_weld: bool,
+}
+
+#[expect(dead_code, reason = "the commands call it as they land")]
+impl MeshArgs {
+    /// Loads the chosen mesh; with neither a file nor `--builtin`, `default`.
+    pub fn load(&self, default: Builtin) -> anyhow::Result<(Mesh, MeshReport)> {
+        let options = ImportOptions { weld: !self.no_weld, ..ImportOptions::default() };
+        match (&self.mesh, &self.builtin) {
+            (Some(path), _) => Ok(Mesh::load(path, &options)?),
+            (None, Some(name)) => {
+                let builtin = Builtin::from_name(name).with_context(|| {
+                    let names: Vec<_> = Builtin::ALL.iter().map(|b| b.name()).collect();
+                    format!("unknown built-in mesh {name:?}; choose one of {}", names.join(", "))
+                })?;
+                Ok(builtin.mesh())
+            }
+            (None, None) => Ok(default.mesh()),
+        }
+    }
+}
