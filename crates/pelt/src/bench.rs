@@ -1,9 +1,140 @@
-//! `pelt bench`.
+//! `pelt bench`: the report that puts Pelt's figures beside the paper's.
+//!
+//! Memory (the paper's Table 2) is computed for every model; frame time, simulation and texture
+//! generation are measured. Criterion benches stay the fine-grained tools; this is the summary
+//! a reader (or CI) runs in one go.
+
+mod models;
+mod report;
+mod system;
+mod table2;
+
+use std::path::PathBuf;
+use std::time::Instant;
+
+use anyhow::Context as _;
+
+use self::models::{MODELS, Model};
+use self::report::{Machine, RenderFigures, Report, ResultRow, SimFigures, SkippedModel, TextureFigures};
+use self::table2::Table2Row;
 
 /// Arguments of `pelt bench`.
 #[derive(Debug, clap::Args)]
-pub struct Args {}
+pub struct Args {
+    /// A reduced set for CI: Table 2 on every model, timings on the Box only, few frames.
+    #[arg(long)]
+    pub quick: bool,
+    /// Write every figure as JSON (stable keys, see BENCHMARKS.md).
+    #[arg(long, value_name = "FILE")]
+    pub json: Option<PathBuf>,
+    /// Write the report as Markdown tables.
+    #[arg(long, value_name = "FILE")]
+    pub md: Option<PathBuf>,
+    /// Only these models (box, bunny, spot, skirt, women); repeat for several. Default: all.
+    #[arg(long = "model", value_name = "NAME")]
+    pub models: Vec<String>,
+    /// The folder with the mesh files (default: `assets/meshes`).
+    #[arg(long, value_name = "DIR")]
+    pub meshes: Option<PathBuf>,
+}
 
-pub fn run(_args: &Args) -> anyhow::Result<()> {
-    anyhow::bail!("`pelt bench` is not built yet")
+/// The layer counts the paper's comparison is made at.
+const LAYER_COUNTS: [u32; 2] = [16, 32];
+
+/// How much work each measurement does.
+#[derive(Clone, Copy, Debug)]
+struct Plan {
+    quick: bool,
+}
+
+impl Plan {
+    /// Whether `model` gets timings (Table 2 is computed for all).
+    fn times(self, model: &str) -> bool {
+        !self.quick || model == "box"
+    }
+}
+
+pub fn run(args: &Args) -> anyhow::Result<()> {
+    let started = Instant::now();
+    for name in &args.models {
+        anyhow::ensure!(
+            MODELS.iter().any(|m| m.key == name),
+            "unknown model {name:?}; choose from {}",
+            MODELS.iter().map(|m| m.key).collect::<Vec<_>>().join(", ")
+        );
+    }
+    let plan = Plan { quick: args.quick };
+    let meshes_dir = models::meshes_dir(args.meshes.as_deref());
+
+    let mut results = Vec::new();
+    let mut skipped_models = Vec::new();
+    for spec in MODELS.into_iter().filter(|m| args.models.is_empty() || args.models.iter().any(|n| n == m.key)) {
+        eprintln!("pelt bench: {} ({})", spec.key, spec.paper_model);
+        let model = match Model::load(spec, &meshes_dir) {
+            Ok(model) => model,
+            Err(error) => {
+                eprintln!("pelt bench: skipping {}: {error:#}", spec.key);
+                skipped_models.push(SkippedModel { model: spec.key, reason: format!("{error:#}") });
+                continue;
+            }
+        };
+        for layers in LAYER_COUNTS {
+            results.push(measure(&model, layers, plan)?);
+        }
+    }
+
+    let report = Report {
+        pelt_version: env!("CARGO_PKG_VERSION"),
+        date_utc: system::utc_now(),
+        command: std::env::args().collect::<Vec<_>>().join(" "),
+        quick: args.quick,
+        build_profile: if cfg!(debug_assertions) { "debug" } else { "release" },
+        machine: Machine {
+            cpu: system::cpu_name(),
+            cpu_threads: system::cpu_threads(),
+            memory_bytes: system::total_memory_bytes(),
+            os: std::env::consts::OS,
+        },
+        adapter: None,
+        adapter_unavailable_reason: Some(RENDERER_MISSING.to_owned()),
+        paper_savings_vs_2_percent: table2::PAPER_SAVINGS_VS_2_PERCENT,
+        paper_savings_vs_30_percent: table2::PAPER_SAVINGS_VS_30_PERCENT,
+        results,
+        skipped_models,
+        peak_rss_bytes: system::peak_rss_bytes(),
+        wall_time_s: started.elapsed().as_secs_f64(),
+    };
+
+    let markdown = report.to_markdown();
+    println!("{markdown}");
+    if let Some(path) = &args.json {
+        let json = serde_json::to_string_pretty(&report)?;
+        std::fs::write(path, json + "\n").with_context(|| format!("cannot write {}", path.display()))?;
+    }
+    if let Some(path) = &args.md {
+        std::fs::write(path, markdown).with_context(|| format!("cannot write {}", path.display()))?;
+    }
+    Ok(())
+}
+
+const RENDERER_MISSING: &str = "the renderer is not in this build yet (branch wip-render)";
+const SIMULATION_MISSING: &str = "the simulation is not in this build yet (branch wip-sim)";
+const TEXTURES_MISSING: &str = "texture generation is not in this build yet (branch wip-tex)";
+const QUICK_SKIPS: &str = "--quick times the Box only";
+
+/// Every figure for one model at one layer count.
+fn measure(model: &Model, layers: u32, plan: Plan) -> anyhow::Result<ResultRow> {
+    let table2 = Table2Row::compute(model, layers)?;
+    let timed = plan.times(model.spec.key);
+    let skip = |missing: &str| Some(if timed { missing } else { QUICK_SKIPS }.to_owned());
+    Ok(ResultRow {
+        model: model.spec.key,
+        paper_model: model.spec.paper_model,
+        mesh: model.source(),
+        layers,
+        table2: (&table2).into(),
+        render: RenderFigures { render_unavailable_reason: skip(RENDERER_MISSING), ..RenderFigures::default() },
+        sim: SimFigures { sim_unavailable_reason: skip(SIMULATION_MISSING), ..SimFigures::default() },
+        texture: TextureFigures { texture_unavailable_reason: skip(TEXTURES_MISSING), ..TextureFigures::default() },
+    })
 }

@@ -1,0 +1,101 @@
+//! The paper's kinds of model and where Pelt gets a stand-in for each.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::Context as _;
+use pelt_core::{Builtin, ImportOptions, Mesh};
+
+/// Where a mesh comes from.
+#[derive(Clone, Copy, Debug)]
+pub enum MeshSource {
+    Builtin(Builtin),
+    /// A file name under the assets' `meshes/` folder.
+    Asset(&'static str),
+}
+
+impl MeshSource {
+    pub fn describe(self) -> String {
+        match self {
+            Self::Builtin(builtin) => format!("builtin:{builtin}"),
+            Self::Asset(file) => format!("assets/meshes/{file}"),
+        }
+    }
+
+    fn load(self, meshes_dir: &Path) -> anyhow::Result<Mesh> {
+        match self {
+            Self::Builtin(builtin) => Ok(builtin.mesh().0),
+            Self::Asset(file) => {
+                let path = meshes_dir.join(file);
+                let (mesh, _) = Mesh::load(&path, &ImportOptions::default())
+                    .with_context(|| format!("cannot load {}", path.display()))?;
+                Ok(mesh)
+            }
+        }
+    }
+}
+
+/// One row kind of the paper's Table 2 and the mesh(es) standing in for it.
+#[derive(Clone, Copy, Debug)]
+pub struct ModelSpec {
+    /// Stable key in the JSON report.
+    pub key: &'static str,
+    /// The paper's name for the model this stands in for.
+    pub paper_model: &'static str,
+    /// The mesh the fur grows on.
+    pub fur: MeshSource,
+    /// A mesh drawn without fur under the furred one (the paper's "Women (with shawl)").
+    pub body: Option<MeshSource>,
+}
+
+/// The paper's five models, in its Table 2 order.
+pub const MODELS: [ModelSpec; 5] = [
+    ModelSpec { key: "box", paper_model: "Box", fur: MeshSource::Builtin(Builtin::Box), body: None },
+    ModelSpec { key: "bunny", paper_model: "Bunny", fur: MeshSource::Builtin(Builtin::Bunny), body: None },
+    ModelSpec { key: "spot", paper_model: "Boar", fur: MeshSource::Asset("spot.obj"), body: None },
+    ModelSpec { key: "skirt", paper_model: "Shawl", fur: MeshSource::Asset("skirthelper.obj"), body: None },
+    ModelSpec {
+        key: "women",
+        paper_model: "Women (with shawl)",
+        fur: MeshSource::Asset("skirthelper.obj"),
+        body: Some(MeshSource::Asset("female_generic.obj")),
+    },
+];
+
+/// A model's meshes, loaded.
+#[derive(Debug)]
+pub struct Model {
+    pub spec: ModelSpec,
+    /// The furred mesh.
+    pub fur: Mesh,
+    /// The un-furred body, if any.
+    pub body: Option<Mesh>,
+}
+
+impl Model {
+    pub fn load(spec: ModelSpec, meshes_dir: &Path) -> anyhow::Result<Self> {
+        let fur = spec.fur.load(meshes_dir)?;
+        let body = spec.body.map(|body| body.load(meshes_dir)).transpose()?;
+        Ok(Self { spec, fur, body })
+    }
+
+    /// The mesh sources, as the report names them (`fur` or `body + fur`).
+    pub fn source(&self) -> String {
+        match self.spec.body {
+            Some(body) => format!("{} + {}", body.describe(), self.spec.fur.describe()),
+            None => self.spec.fur.describe(),
+        }
+    }
+}
+
+/// The folder holding the meshes: `explicit`, else `assets/meshes` under the working directory,
+/// else the workspace's own (so `cargo run` and the tests work from any crate folder).
+pub fn meshes_dir(explicit: Option<&Path>) -> PathBuf {
+    if let Some(dir) = explicit {
+        return dir.to_path_buf();
+    }
+    let local = PathBuf::from("assets/meshes");
+    if local.is_dir() {
+        return local;
+    }
+    PathBuf::from(concat!(env!("CARGO_MANIFEST_DIR"), "/../../assets/meshes"))
+}

@@ -1,0 +1,360 @@
+//! The report: its JSON shape (stable keys, documented in BENCHMARKS.md) and its Markdown form.
+
+use std::fmt::Write as _;
+
+use super::table2::{PAPER_SAVINGS_VS_2_PERCENT, PAPER_SAVINGS_VS_30_PERCENT, Table2Row, savings_percent};
+
+/// Everything one `pelt bench` run measured.
+#[derive(Debug, serde::Serialize)]
+pub struct Report {
+    pub pelt_version: &'static str,
+    pub date_utc: String,
+    /// The command line as run.
+    pub command: String,
+    pub quick: bool,
+    /// `release` or `debug`: timings from a debug build are not comparable.
+    pub build_profile: &'static str,
+    pub machine: Machine,
+    /// The GPU adapter the frame times were taken on; null when none was found.
+    pub adapter: Option<Adapter>,
+    pub adapter_unavailable_reason: Option<String>,
+    /// The paper's claims, for the savings to be read against (constants, not measured).
+    pub paper_savings_vs_2_percent: f64,
+    pub paper_savings_vs_30_percent: f64,
+    /// One object per model and layer count.
+    pub results: Vec<ResultRow>,
+    /// Models whose meshes could not be loaded.
+    pub skipped_models: Vec<SkippedModel>,
+    /// Peak resident memory of the whole run (`VmHWM`); null where the OS does not say.
+    pub peak_rss_bytes: Option<u64>,
+    pub wall_time_s: f64,
+}
+
+#[derive(Debug, serde::Serialize)]
+pub struct Machine {
+    pub cpu: String,
+    pub cpu_threads: usize,
+    pub memory_bytes: Option<u64>,
+    pub os: &'static str,
+}
+
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct Adapter {
+    pub name: String,
+    pub backend: String,
+    pub device_type: String,
+    pub driver: String,
+}
+
+#[derive(Debug, serde::Serialize)]
+pub struct SkippedModel {
+    pub model: &'static str,
+    pub reason: String,
+}
+
+/// One model at one layer count.
+#[derive(Debug, serde::Serialize)]
+pub struct ResultRow {
+    pub model: &'static str,
+    pub paper_model: &'static str,
+    pub mesh: String,
+    pub layers: u32,
+    #[serde(flatten)]
+    pub table2: Table2Figures,
+    #[serde(flatten)]
+    pub render: RenderFigures,
+    #[serde(flatten)]
+    pub sim: SimFigures,
+    #[serde(flatten)]
+    pub texture: TextureFigures,
+}
+
+/// The Table 2 part: counts and bytes, all computed.
+#[derive(Debug, serde::Serialize)]
+pub struct Table2Figures {
+    /// Base vertices of everything drawn (the paper's "vertices").
+    pub vertices: u64,
+    /// Base triangles of everything drawn (the paper's "faces").
+    pub faces: u64,
+    /// Base vertices and edges of the furred mesh (a body, if any, grows no fur).
+    pub fur_vertices: u64,
+    pub fur_edges: u64,
+    /// The unified structure's vertices: `V(L+1)` (plus the body's).
+    pub shared_vertices: u64,
+    /// The separated structure's: `V(L+1) + 2E` and `V(L+1) + 30E` (plus the body's).
+    pub separated2_vertices: u64,
+    pub separated30_vertices: u64,
+    pub unified_faces: u64,
+    pub separated2_faces: u64,
+    pub separated30_faces: u64,
+    /// GPU bytes (positions, attributes, indices; the layouts in `pelt_core::fur::Footprint`).
+    pub unified_bytes: u64,
+    pub separated2_bytes: u64,
+    pub separated30_bytes: u64,
+    /// Vertices saved, the paper's measure (its claim: about 25% and 85%).
+    pub savings_vs_2_percent: f64,
+    pub savings_vs_30_percent: f64,
+    /// GPU bytes saved.
+    pub bytes_savings_vs_2_percent: f64,
+    pub bytes_savings_vs_30_percent: f64,
+}
+
+impl From<&Table2Row> for Table2Figures {
+    fn from(row: &Table2Row) -> Self {
+        let body_faces = row.body_faces;
+        Self {
+            vertices: row.vertices,
+            faces: row.faces,
+            fur_vertices: row.fur_vertices,
+            fur_edges: row.fur_edges,
+            shared_vertices: row.shared_vertices(),
+            separated2_vertices: row.separated2_vertices(),
+            separated30_vertices: row.separated30_vertices(),
+            unified_faces: row.unified.faces + body_faces,
+            separated2_faces: row.separated2.faces + body_faces,
+            separated30_faces: row.separated30.faces + body_faces,
+            unified_bytes: row.unified_bytes(),
+            separated2_bytes: row.separated2_bytes(),
+            separated30_bytes: row.separated30_bytes(),
+            savings_vs_2_percent: savings_percent(row.shared_vertices(), row.separated2_vertices()),
+            savings_vs_30_percent: savings_percent(row.shared_vertices(), row.separated30_vertices()),
+            bytes_savings_vs_2_percent: savings_percent(row.unified_bytes(), row.separated2_bytes()),
+            bytes_savings_vs_30_percent: savings_percent(row.unified_bytes(), row.separated30_bytes()),
+        }
+    }
+}
+
+/// Median GPU frame times in milliseconds, same scene, three structures, two sizes.
+#[derive(Debug, Default, serde::Serialize)]
+pub struct RenderFigures {
+    pub frame_ms_unified_1280x720: Option<f64>,
+    pub frame_ms_separated2_1280x720: Option<f64>,
+    pub frame_ms_separated30_1280x720: Option<f64>,
+    pub frame_ms_unified_256x256: Option<f64>,
+    pub frame_ms_separated2_256x256: Option<f64>,
+    pub frame_ms_separated30_256x256: Option<f64>,
+    /// Frames each median was taken over.
+    pub render_frames: Option<u32>,
+    pub render_unavailable_reason: Option<String>,
+}
+
+/// Simulation throughput and its CPU cost per drawn frame.
+#[derive(Debug, Default, serde::Serialize)]
+pub struct SimFigures {
+    /// Non-root nodes moved per second (`V * L` per step), O(L) bend.
+    pub sim_node_updates_per_sec: Option<f64>,
+    /// The same with the paper's literal O(L^2) loop.
+    pub sim_literal_node_updates_per_sec: Option<f64>,
+    /// CPU per drawn frame at 120 Hz drawing: 30 Hz simulation plus interpolation ...
+    pub sim_cpu_ms_per_frame_interpolated: Option<f64>,
+    /// ... against simulating every drawn frame.
+    pub sim_cpu_ms_per_frame_every_frame: Option<f64>,
+    pub sim_unavailable_reason: Option<String>,
+}
+
+/// Shell and fin texture generation.
+#[derive(Debug, Default, serde::Serialize)]
+pub struct TextureFigures {
+    pub texture_generation_ms: Option<f64>,
+    /// Shell tile size `S` (texels per side) the time is for.
+    pub texture_size_texels: Option<u32>,
+    pub texture_unavailable_reason: Option<String>,
+}
+
+/// The paper's Table 2 (GeForce 8800 GTX, 16 layers), quoted for the side-by-side table:
+/// model, vertices, faces, unified, separated 2-face, separated 30-face, fps.
+const PAPER_TABLE_2: [(&str, &str, &str, &str, &str, &str, &str); 5] = [
+    ("Box", "296", "588", "5,032", "6,796", "31,492", "10,993 (as printed)"),
+    ("Bunny", "2,520", "5,036", "42,840", "57,948", "275,460", "14.4"),
+    ("Boar", "2,976", "5,688", "31,632", "42,174", "189,762", "20.42"),
+    ("Shawl", "261", "420", "4,176", "5,536", "24,576", "149.72"),
+    ("Women (with shawl)", "18,324", "35,639", "22,500", "23,860", "42,900", "64.87"),
+];
+
+impl Report {
+    /// The report as Markdown: run facts, Table 2 beside the paper's, timings, and why any
+    /// figure is missing.
+    pub fn to_markdown(&self) -> String {
+        let mut md = String::new();
+        let _ = writeln!(md, "- date: {}", self.date_utc);
+        let _ = writeln!(md, "- command: `{}`", self.command);
+        let _ =
+            writeln!(md, "- build: {}{}", self.build_profile, if self.quick { " (--quick: reduced set)" } else { "" });
+        let memory = self.machine.memory_bytes.map_or(String::new(), |b| format!(", {}", gib(b)));
+        let _ = writeln!(
+            md,
+            "- machine: {} ({} threads{memory}, {})",
+            self.machine.cpu, self.machine.cpu_threads, self.machine.os
+        );
+        match (&self.adapter, &self.adapter_unavailable_reason) {
+            (Some(a), _) => {
+                let _ = writeln!(md, "- adapter: {} ({}, {}, driver {})", a.name, a.backend, a.device_type, a.driver);
+            }
+            (None, reason) => {
+                let _ = writeln!(md, "- adapter: none ({})", reason.as_deref().unwrap_or("not searched"));
+            }
+        }
+        let peak = self.peak_rss_bytes.map_or_else(|| "not reported by this OS".to_owned(), mib);
+        let _ = writeln!(md, "- peak resident memory: {peak}; wall time {:.1} s", self.wall_time_s);
+        for skipped in &self.skipped_models {
+            let _ = writeln!(md, "- skipped {}: {}", skipped.model, skipped.reason);
+        }
+
+        let _ = writeln!(md, "\n### Memory: the paper's Table 2, measured\n");
+        let _ = writeln!(
+            md,
+            "| model | paper's | L | vertices | faces | fin edges | unified (shared) | separated, 2-face fins | separated, 30-face fins | saved vs 2 (paper ~{PAPER_SAVINGS_VS_2_PERCENT}%) | saved vs 30 (paper ~{PAPER_SAVINGS_VS_30_PERCENT}%) | GPU bytes unified / sep-2 / sep-30 | bytes saved vs 2 / vs 30 |"
+        );
+        let _ = writeln!(md, "|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
+        for r in &self.results {
+            let t = &r.table2;
+            let _ = writeln!(
+                md,
+                "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {:.1}% | {:.1}% | {} / {} / {} | {:.1}% / {:.1}% |",
+                r.model,
+                r.paper_model,
+                r.layers,
+                thousands(t.vertices),
+                thousands(t.faces),
+                thousands(t.fur_edges),
+                thousands(t.shared_vertices),
+                thousands(t.separated2_vertices),
+                thousands(t.separated30_vertices),
+                t.savings_vs_2_percent,
+                t.savings_vs_30_percent,
+                kib(t.unified_bytes),
+                kib(t.separated2_bytes),
+                kib(t.separated30_bytes),
+                t.bytes_savings_vs_2_percent,
+                t.bytes_savings_vs_30_percent,
+            );
+        }
+        let _ = writeln!(md, "\nThe paper's Table 2 (GeForce 8800 GTX, L = 16), for comparison:\n");
+        let _ = writeln!(
+            md,
+            "| model | vertices | faces | unified (shared) | separated, 2-face fins | separated, 30-face fins | fps |"
+        );
+        let _ = writeln!(md, "|---|---:|---:|---:|---:|---:|---:|");
+        for (model, v, f, unified, two, thirty, fps) in PAPER_TABLE_2 {
+            let _ = writeln!(md, "| {model} | {v} | {f} | {unified} | {two} | {thirty} | {fps} |");
+        }
+
+        let _ = writeln!(md, "\n### Frame time (median ms, GPU work waited for)\n");
+        let _ = writeln!(
+            md,
+            "| model | L | unified 1280x720 | sep-2 1280x720 | sep-30 1280x720 | unified 256x256 | sep-2 256x256 | sep-30 256x256 | frames |"
+        );
+        let _ = writeln!(md, "|---|---:|---:|---:|---:|---:|---:|---:|---:|");
+        for r in &self.results {
+            let f = &r.render;
+            let _ = writeln!(
+                md,
+                "| {} | {} | {} | {} | {} | {} | {} | {} | {} |",
+                r.model,
+                r.layers,
+                ms(f.frame_ms_unified_1280x720),
+                ms(f.frame_ms_separated2_1280x720),
+                ms(f.frame_ms_separated30_1280x720),
+                ms(f.frame_ms_unified_256x256),
+                ms(f.frame_ms_separated2_256x256),
+                ms(f.frame_ms_separated30_256x256),
+                f.render_frames.map_or_else(|| "-".to_owned(), |n| n.to_string()),
+            );
+        }
+        notes(&mut md, self.results.iter().map(|r| (r, r.render.render_unavailable_reason.as_deref())));
+
+        let _ = writeln!(md, "\n### Simulation (CPU) and texture generation\n");
+        let _ = writeln!(
+            md,
+            "| model | L | node updates/s, O(L) | node updates/s, literal O(L^2) | CPU ms per drawn frame, 30 Hz sim + interpolation | CPU ms per drawn frame, sim every frame | texture generation ms |"
+        );
+        let _ = writeln!(md, "|---|---:|---:|---:|---:|---:|---:|");
+        for r in &self.results {
+            let s = &r.sim;
+            let _ = writeln!(
+                md,
+                "| {} | {} | {} | {} | {} | {} | {} |",
+                r.model,
+                r.layers,
+                rate(s.sim_node_updates_per_sec),
+                rate(s.sim_literal_node_updates_per_sec),
+                ms(s.sim_cpu_ms_per_frame_interpolated),
+                ms(s.sim_cpu_ms_per_frame_every_frame),
+                ms(r.texture.texture_generation_ms),
+            );
+        }
+        notes(
+            &mut md,
+            self.results.iter().flat_map(|r| {
+                [(r, r.sim.sim_unavailable_reason.as_deref()), (r, r.texture.texture_unavailable_reason.as_deref())]
+            }),
+        );
+        md
+    }
+}
+
+/// Lists why figures are missing, each reason once, with the rows it applies to.
+fn notes<'a>(md: &mut String, reasons: impl Iterator<Item = (&'a ResultRow, Option<&'a str>)>) {
+    let mut grouped: Vec<(&str, Vec<String>)> = Vec::new();
+    for (row, reason) in reasons {
+        let Some(reason) = reason else { continue };
+        let label = format!("{} L={}", row.model, row.layers);
+        match grouped.iter_mut().find(|(r, _)| *r == reason) {
+            Some((_, rows)) => rows.push(label),
+            None => grouped.push((reason, vec![label])),
+        }
+    }
+    if !grouped.is_empty() {
+        md.push('\n');
+    }
+    for (reason, rows) in grouped {
+        let _ = writeln!(md, "- not measured ({}): {reason}", rows.join(", "));
+    }
+}
+
+fn ms(value: Option<f64>) -> String {
+    value.map_or_else(|| "-".to_owned(), |v| if v < 1.0 { format!("{v:.3}") } else { format!("{v:.2}") })
+}
+
+fn rate(value: Option<f64>) -> String {
+    value.map_or_else(|| "-".to_owned(), |v| format!("{:.1} M", v / 1e6))
+}
+
+fn kib(bytes: u64) -> String {
+    format!("{:.1} KiB", bytes as f64 / 1024.0)
+}
+
+fn mib(bytes: u64) -> String {
+    format!("{:.1} MiB", bytes as f64 / (1024.0 * 1024.0))
+}
+
+fn gib(bytes: u64) -> String {
+    format!("{:.1} GiB", bytes as f64 / (1024.0 * 1024.0 * 1024.0))
+}
+
+/// `31492` -> `31,492`, as the paper prints counts.
+fn thousands(n: u64) -> String {
+    let digits = n.to_string();
+    let mut out = String::with_capacity(digits.len() + digits.len() / 3);
+    for (i, c) in digits.chars().enumerate() {
+        if i > 0 && (digits.len() - i).is_multiple_of(3) {
+            out.push(',');
+        }
+        out.push(c);
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn thousands_groups_digits() {
+        assert_eq!(thousands(0), "0");
+        assert_eq!(thousands(296), "296");
+        assert_eq!(thousands(5_032), "5,032");
+        assert_eq!(thousands(275_460), "275,460");
+        assert_eq!(thousands(1_234_567), "1,234,567");
+    }
+}

@@ -1,0 +1,94 @@
+//! The paper's Table 2: counts and GPU bytes of the unified structure against the separated
+//! structure with 2-face and 30-face fins.
+
+use pelt_core::fur::FurLength;
+use pelt_core::fur::{Footprint, INDEX_BYTES, SEPARATED_VERTEX_BYTES};
+use pelt_core::{FurParams, FurStructure, GrowthDirection, Mesh, SeparatedStructure};
+
+use super::models::Model;
+
+/// Faces per fin of the paper's second baseline.
+pub const MANY_FIN_FACES: u32 = 30;
+
+/// What the paper claims the unified structure saves (vertices), for the report to sit beside.
+pub const PAPER_SAVINGS_VS_2_PERCENT: f64 = 25.0;
+pub const PAPER_SAVINGS_VS_30_PERCENT: f64 = 85.0;
+
+/// One model at one layer count.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Table2Row {
+    /// Base vertices of every mesh drawn (the body included), as the paper counts them.
+    pub vertices: u64,
+    /// Base triangles of every mesh drawn.
+    pub faces: u64,
+    /// Edges of the furred mesh (each carries a fin).
+    pub fur_edges: u64,
+    /// Base vertices of the furred mesh.
+    pub fur_vertices: u64,
+    pub unified: Footprint,
+    pub separated2: Footprint,
+    pub separated30: Footprint,
+    /// What an un-furred body adds to every structure: its vertices, triangles and GPU bytes.
+    pub body_vertices: u64,
+    pub body_faces: u64,
+    pub body_bytes: u64,
+}
+
+impl Table2Row {
+    /// # Errors
+    /// A layer count the fur structure refuses.
+    pub fn compute(model: &Model, layers: u32) -> anyhow::Result<Self> {
+        let fur = &model.fur;
+        let (body_vertices, body_faces, body_bytes) = model.body.as_ref().map_or((0, 0, 0), plain_mesh);
+        Ok(Self {
+            vertices: fur.vertex_count() as u64 + body_vertices,
+            faces: fur.triangles.len() as u64 + body_faces,
+            fur_edges: fur.edges.len() as u64,
+            fur_vertices: fur.vertex_count() as u64,
+            unified: unified_footprint(fur, layers)?,
+            separated2: SeparatedStructure { layers, fin_faces: 2 }.footprint(fur),
+            separated30: SeparatedStructure { layers, fin_faces: MANY_FIN_FACES }.footprint(fur),
+            body_vertices,
+            body_faces,
+            body_bytes,
+        })
+    }
+
+    /// Vertices of the whole scene drawn with the unified structure (`V(L+1)`, plus a body).
+    pub fn shared_vertices(&self) -> u64 {
+        self.unified.vertices + self.body_vertices
+    }
+    pub fn separated2_vertices(&self) -> u64 {
+        self.separated2.vertices + self.body_vertices
+    }
+    pub fn separated30_vertices(&self) -> u64 {
+        self.separated30.vertices + self.body_vertices
+    }
+    pub fn unified_bytes(&self) -> u64 {
+        self.unified.total_bytes() + self.body_bytes
+    }
+    pub fn separated2_bytes(&self) -> u64 {
+        self.separated2.total_bytes() + self.body_bytes
+    }
+    pub fn separated30_bytes(&self) -> u64 {
+        self.separated30.total_bytes() + self.body_bytes
+    }
+}
+
+/// The unified footprint, as the structure itself reports it (growing it is cheap next to loading).
+fn unified_footprint(mesh: &Mesh, layers: u32) -> anyhow::Result<Footprint> {
+    let params = FurParams { layers, length: FurLength::Constant(0.0), direction: GrowthDirection::default() };
+    Ok(FurStructure::new(mesh.clone(), &params)?.footprint())
+}
+
+/// `100 * (theirs - ours) / theirs`.
+pub fn savings_percent(ours: u64, theirs: u64) -> f64 {
+    if theirs == 0 { 0.0 } else { 100.0 * (theirs as f64 - ours as f64) / theirs as f64 }
+}
+
+/// Vertices, triangles and GPU bytes of a mesh drawn plainly (full vertices, one index buffer).
+fn plain_mesh(mesh: &Mesh) -> (u64, u64, u64) {
+    let vertices = mesh.vertex_count() as u64;
+    let faces = mesh.triangles.len() as u64;
+    (vertices, faces, vertices * SEPARATED_VERTEX_BYTES + 3 * faces * INDEX_BYTES)
+}

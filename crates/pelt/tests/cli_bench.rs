@@ -1,0 +1,155 @@
+//! CI smoke test of `pelt bench --quick`: every documented key is there, the counts follow the
+//! paper's Table 2 formulas, and every time is a positive finite number or null with a reason.
+
+use std::process::Command;
+
+use serde_json::Value;
+
+const TOP_LEVEL_KEYS: [&str; 14] = [
+    "pelt_version",
+    "date_utc",
+    "command",
+    "quick",
+    "build_profile",
+    "machine",
+    "adapter",
+    "adapter_unavailable_reason",
+    "paper_savings_vs_2_percent",
+    "paper_savings_vs_30_percent",
+    "results",
+    "skipped_models",
+    "peak_rss_bytes",
+    "wall_time_s",
+];
+
+const COUNT_KEYS: [&str; 14] = [
+    "vertices",
+    "faces",
+    "fur_vertices",
+    "fur_edges",
+    "shared_vertices",
+    "separated2_vertices",
+    "separated30_vertices",
+    "unified_faces",
+    "separated2_faces",
+    "separated30_faces",
+    "unified_bytes",
+    "separated2_bytes",
+    "separated30_bytes",
+    "layers",
+];
+
+const PERCENT_KEYS: [&str; 4] =
+    ["savings_vs_2_percent", "savings_vs_30_percent", "bytes_savings_vs_2_percent", "bytes_savings_vs_30_percent"];
+
+/// Measured figures, grouped by the key that says why they are null when they are.
+const MEASURED_KEYS: [(&str, &[&str]); 3] = [
+    (
+        "render_unavailable_reason",
+        &[
+            "frame_ms_unified_1280x720",
+            "frame_ms_separated2_1280x720",
+            "frame_ms_separated30_1280x720",
+            "frame_ms_unified_256x256",
+            "frame_ms_separated2_256x256",
+            "frame_ms_separated30_256x256",
+            "render_frames",
+        ],
+    ),
+    (
+        "sim_unavailable_reason",
+        &[
+            "sim_node_updates_per_sec",
+            "sim_literal_node_updates_per_sec",
+            "sim_cpu_ms_per_frame_interpolated",
+            "sim_cpu_ms_per_frame_every_frame",
+        ],
+    ),
+    ("texture_unavailable_reason", &["texture_generation_ms", "texture_size_texels"]),
+];
+
+fn count(row: &Value, key: &str) -> u64 {
+    row[key].as_u64().unwrap_or_else(|| panic!("{key} is not a count in {row}"))
+}
+
+#[test]
+fn quick_bench_writes_every_key_with_sane_values() {
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR"));
+    let json_path = dir.join(format!("bench-quick-{}.json", std::process::id()));
+    let md_path = dir.join(format!("bench-quick-{}.md", std::process::id()));
+    let output = Command::new(env!("CARGO_BIN_EXE_pelt"))
+        .args(["bench", "--quick", "--json"])
+        .arg(&json_path)
+        .arg("--md")
+        .arg(&md_path)
+        .output()
+        .expect("pelt runs");
+    assert!(output.status.success(), "pelt bench failed: {}", String::from_utf8_lossy(&output.stderr));
+    let report: Value = serde_json::from_str(&std::fs::read_to_string(&json_path).unwrap()).unwrap();
+    let markdown = std::fs::read_to_string(&md_path).unwrap();
+    assert!(markdown.contains("Table 2"), "{markdown}");
+
+    for key in TOP_LEVEL_KEYS {
+        assert!(report.get(key).is_some(), "missing top-level key {key}");
+    }
+    assert_eq!(report["quick"], true);
+    assert!(report["skipped_models"].as_array().unwrap().is_empty(), "{}", report["skipped_models"]);
+    if report["adapter"].is_null() {
+        assert!(report["adapter_unavailable_reason"].as_str().is_some_and(|r| !r.is_empty()));
+    } else {
+        assert!(report["adapter"]["name"].is_string());
+    }
+    if cfg!(target_os = "linux") {
+        assert!(report["peak_rss_bytes"].as_u64().is_some_and(|b| b > 1 << 20));
+    }
+
+    let results = report["results"].as_array().unwrap();
+    let models: Vec<&str> = results.iter().map(|r| r["model"].as_str().unwrap()).collect();
+    for model in ["box", "bunny", "spot", "skirt", "women"] {
+        assert_eq!(models.iter().filter(|m| **m == model).count(), 2, "{model} at 16 and 32 layers");
+    }
+    for row in results {
+        for key in COUNT_KEYS {
+            count(row, key);
+        }
+        // Table 2's formulas: unified V(L+1), separated V(L+1) + N*E; a body counts once in each.
+        let layers = count(row, "layers");
+        let body = count(row, "vertices") - count(row, "fur_vertices");
+        let shared = count(row, "fur_vertices") * (layers + 1) + body;
+        assert_eq!(count(row, "shared_vertices"), shared, "{row}");
+        assert_eq!(count(row, "separated2_vertices"), shared + 2 * count(row, "fur_edges"), "{row}");
+        assert_eq!(count(row, "separated30_vertices"), shared + 30 * count(row, "fur_edges"), "{row}");
+        assert!(count(row, "unified_bytes") < count(row, "separated2_bytes"), "{row}");
+        assert!(count(row, "separated2_bytes") < count(row, "separated30_bytes"), "{row}");
+        for key in PERCENT_KEYS {
+            let percent = row[key].as_f64().unwrap_or_else(|| panic!("{key} in {row}"));
+            assert!(percent > 0.0 && percent < 100.0, "{key} = {percent}");
+        }
+        let expected = 100.0 * (2 * count(row, "fur_edges")) as f64 / count(row, "separated2_vertices") as f64;
+        assert!((row["savings_vs_2_percent"].as_f64().unwrap() - expected).abs() < 1e-9);
+
+        for (reason_key, keys) in MEASURED_KEYS {
+            let reason = &row[reason_key];
+            for key in keys {
+                let value = row.get(*key).unwrap_or_else(|| panic!("missing key {key}"));
+                match value.as_f64() {
+                    Some(v) => assert!(v.is_finite() && v > 0.0, "{key} = {v} in {row}"),
+                    None => {
+                        assert!(value.is_null(), "{key} = {value}");
+                        assert!(reason.as_str().is_some_and(|r| !r.is_empty()), "{key} is null without {reason_key}");
+                    }
+                }
+            }
+        }
+    }
+
+    let box16 = results.iter().find(|r| r["model"] == "box" && r["layers"] == 16).unwrap();
+    assert_eq!(count(box16, "vertices"), 296);
+    assert_eq!(count(box16, "faces"), 588);
+    assert_eq!(count(box16, "shared_vertices"), 5_032);
+    assert_eq!(count(box16, "separated2_vertices"), 6_796);
+    assert_eq!(count(box16, "separated30_vertices"), 31_492);
+
+    let _ = std::fs::remove_file(json_path);
+    let _ = std::fs::remove_file(md_path);
+}
