@@ -92,3 +92,47 @@ fn plain_mesh(mesh: &Mesh) -> (u64, u64, u64) {
     let faces = mesh.triangles.len() as u64;
     (vertices, faces, vertices * SEPARATED_VERTEX_BYTES + 3 * faces * INDEX_BYTES)
 }
+
+#[cfg(test)]
+mod tests {
+    use pelt_core::Builtin;
+
+    use super::super::models::{MODELS, MeshSource};
+    use super::*;
+
+    fn model(fur: Builtin, body: Option<Builtin>) -> Model {
+        let spec = MODELS[0];
+        Model { spec, fur: fur.mesh().0, body: body.map(|b| b.mesh().0) }
+    }
+
+    #[test]
+    fn box_reproduces_the_papers_row() {
+        let row = Table2Row::compute(&model(Builtin::Box, None), 16).unwrap();
+        assert_eq!((row.vertices, row.faces, row.fur_edges), (296, 588, 882));
+        assert_eq!(row.shared_vertices(), 5_032);
+        assert_eq!(row.separated2_vertices(), 6_796);
+        assert_eq!(row.separated30_vertices(), 31_492);
+        let saved = savings_percent(row.shared_vertices(), row.separated2_vertices());
+        assert!((saved - 25.96).abs() < 0.01, "{saved}");
+        assert!(row.unified_bytes() < row.separated2_bytes());
+    }
+
+    #[test]
+    fn a_body_counts_once_in_every_structure() {
+        let alone = Table2Row::compute(&model(Builtin::Plane, None), 16).unwrap();
+        let dressed = Table2Row::compute(&model(Builtin::Plane, Some(Builtin::Sphere)), 16).unwrap();
+        let (sphere, _) = Builtin::Sphere.mesh();
+        let v = sphere.vertex_count() as u64;
+        assert_eq!(dressed.vertices, alone.vertices + v);
+        assert_eq!(dressed.shared_vertices(), alone.shared_vertices() + v);
+        assert_eq!(dressed.separated2_vertices(), alone.separated2_vertices() + v);
+        assert_eq!(dressed.separated30_vertices(), alone.separated30_vertices() + v);
+        let body_bytes = dressed.unified_bytes() - alone.unified_bytes();
+        assert_eq!(body_bytes, v * 32 + sphere.triangles.len() as u64 * 12);
+        assert_eq!(dressed.separated30_bytes() - alone.separated30_bytes(), body_bytes);
+        // The body dilutes the savings, as in the paper's Women row.
+        let saved = |r: &Table2Row| savings_percent(r.shared_vertices(), r.separated2_vertices());
+        assert!(saved(&dressed) < saved(&alone));
+        assert!(matches!(MODELS[4].body, Some(MeshSource::Asset(_))));
+    }
+}
