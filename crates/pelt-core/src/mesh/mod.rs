@@ -86,6 +86,8 @@ pub struct MeshReport {
     /// Whether the mesh has texture coordinates (none are generated when the file has none).
     pub has_uvs: bool,
     pub boundary_edges: usize,
+    /// Connected chains of boundary edges: the holes and open rims (0 on a closed mesh).
+    pub boundary_loops: usize,
     pub non_manifold_edges: usize,
     /// Edges whose two faces traverse them in the same direction (flipped winding).
     pub inconsistent_winding_edges: usize,
@@ -124,8 +126,8 @@ impl fmt::Display for MeshReport {
         writeln!(f, "  normals {normals}; uvs {uvs}")?;
         write!(
             f,
-            "  {} boundary edges, {} non-manifold edges, {} edges with inconsistent winding",
-            self.boundary_edges, self.non_manifold_edges, self.inconsistent_winding_edges
+            "  {} boundary edges in {} loops, {} non-manifold edges, {} edges with inconsistent winding",
+            self.boundary_edges, self.boundary_loops, self.non_manifold_edges, self.inconsistent_winding_edges
         )
     }
 }
@@ -175,6 +177,20 @@ impl Mesh {
     /// As [`Mesh::load`]; `name` stands in for the file name in messages.
     pub fn from_obj_str(text: &str, name: &Path, options: &ImportOptions) -> Result<(Self, MeshReport), MeshError> {
         let raw = obj::parse(text, name)?;
+        Self::from_raw(raw, name, options)
+    }
+
+    /// Parses glTF 2.0 held in memory (`.gltf` JSON with embedded `data:` buffers, or `.glb`).
+    ///
+    /// # Errors
+    /// As [`Mesh::load`]; `name` stands in for the file name in messages. Buffers in external
+    /// files cannot be read this way.
+    pub fn from_gltf_slice(
+        bytes: &[u8],
+        name: &Path,
+        options: &ImportOptions,
+    ) -> Result<(Self, MeshReport), MeshError> {
+        let raw = gltf::parse(bytes, name, None)?;
         Self::from_raw(raw, name, options)
     }
 
@@ -281,6 +297,7 @@ impl Mesh {
         };
 
         let topology = Topology::build(&triangles);
+        let boundary_loops = topology.boundary_loops();
         let mesh =
             Mesh { positions, normals, corner_uvs, triangles, edges: topology.edges, edge_faces: topology.edge_faces };
         let report = MeshReport {
@@ -294,6 +311,7 @@ impl Mesh {
             normals: normal_source,
             has_uvs: mesh.corner_uvs.is_some(),
             boundary_edges: topology.boundary_edges,
+            boundary_loops,
             non_manifold_edges: topology.non_manifold_edges,
             inconsistent_winding_edges: topology.inconsistent_winding_edges,
             vertices: mesh.positions.len(),
@@ -412,6 +430,34 @@ impl Topology {
             start = end;
         }
         topology
+    }
+}
+
+impl Topology {
+    /// Connected components of the boundary edges (a hole or an open rim is one loop).
+    #[must_use]
+    pub fn boundary_loops(&self) -> usize {
+        fn root(parent: &mut HashMap<u32, u32>, mut v: u32) -> u32 {
+            while let Some(&p) = parent.get(&v).filter(|&&p| p != v) {
+                // Path halving keeps the chains short.
+                let grandparent = parent.get(&p).copied().unwrap_or(p);
+                parent.insert(v, grandparent);
+                v = grandparent;
+            }
+            v
+        }
+        let mut parent: HashMap<u32, u32> = HashMap::new();
+        let boundary = self.edges.iter().zip(&self.edge_faces).filter(|(_, faces)| faces[1] == NO_FACE);
+        for ([a, b], _) in boundary {
+            parent.entry(*a).or_insert(*a);
+            parent.entry(*b).or_insert(*b);
+            let (ra, rb) = (root(&mut parent, *a), root(&mut parent, *b));
+            if ra != rb {
+                parent.insert(ra.max(rb), ra.min(rb));
+            }
+        }
+        let vertices: Vec<u32> = parent.keys().copied().collect();
+        vertices.into_iter().filter(|&v| root(&mut parent, v) == v).count()
     }
 }
 
@@ -584,6 +630,7 @@ mod tests {
         let (mesh, report) = Mesh::from_raw(fan, Path::new("fan"), &ImportOptions::default()).unwrap();
         assert_eq!(report.non_manifold_edges, 1);
         assert_eq!(report.boundary_edges, 6);
+        assert_eq!(report.boundary_loops, 1, "the fan's rim is one chain through vertices 0 and 1");
         assert_eq!(mesh.edges.len(), 7, "fins are still built for every edge");
     }
 }

@@ -19,7 +19,8 @@ pub(super) fn parse(text: &str, file: &Path) -> Result<RawMesh, MeshError> {
     let mut reader = BufReader::new(text.as_bytes());
     // Materials are not needed: colour comes from the fur preset.
     let (models, _materials) = tobj::load_obj_buf(&mut reader, &options, |_| Ok(Default::default())).map_err(|e| {
-        MeshError::Parse { file: file.to_path_buf(), line: find_bad_line(text), message: e.to_string() }
+        let (line, message) = diagnose(text).map_or((None, e.to_string()), |(line, why)| (Some(line), why));
+        MeshError::Parse { file: file.to_path_buf(), line, message }
     })?;
 
     let mut raw = RawMesh::default();
@@ -48,21 +49,60 @@ pub(super) fn parse(text: &str, file: &Path) -> Result<RawMesh, MeshError> {
     Ok(raw)
 }
 
-/// tobj reports no line numbers; find the first line whose numbers do not parse, for the message.
-fn find_bad_line(text: &str) -> Option<usize> {
-    text.lines().enumerate().find_map(|(n, line)| {
+/// tobj reports no line numbers; find the first line that is wrong, and say what is wrong with
+/// it, for the message.
+fn diagnose(text: &str) -> Option<(usize, String)> {
+    // Elements defined so far, for checking (and resolving relative) face indices.
+    let (mut positions, mut uvs, mut normals) = (0_i64, 0_i64, 0_i64);
+    for (n, line) in text.lines().enumerate() {
         let mut words = line.split_whitespace();
-        let expected = match words.next()? {
-            "v" | "vn" => 3,
-            "vt" => 1,
-            "f" => 3,
-            _ => return None,
-        };
+        let Some(keyword) = words.next() else { continue };
         let values: Vec<&str> = words.collect();
-        let is_bad = values.len() < expected
-            || values.iter().any(|w| {
-                w.split('/').next().is_none_or(|first| first.parse::<f64>().is_err() && first.parse::<i64>().is_err())
-            });
-        is_bad.then_some(n + 1)
-    })
+        let bad = |message: String| Some((n + 1, message));
+        match keyword {
+            "v" | "vn" | "vt" => {
+                let expected = if keyword == "vt" { 1 } else { 3 };
+                if values.len() < expected {
+                    return bad(format!("`{keyword}` needs {expected} numbers, found {}", values.len()));
+                }
+                if let Some(word) = values.iter().find(|w| w.parse::<f32>().is_err()) {
+                    return bad(format!("`{keyword}`: {word:?} is not a number"));
+                }
+                match keyword {
+                    "v" => positions += 1,
+                    "vt" => uvs += 1,
+                    _ => normals += 1,
+                }
+            }
+            "f" => {
+                if values.len() < 3 {
+                    return bad(format!("a face needs at least 3 corners, found {}", values.len()));
+                }
+                for corner in &values {
+                    for (k, (part, count, what)) in corner
+                        .split('/')
+                        .zip([(positions, "vertex"), (uvs, "texture coordinate"), (normals, "normal")])
+                        .map(|(part, (count, what))| (part, count, what))
+                        .enumerate()
+                    {
+                        if part.is_empty() && k > 0 {
+                            continue;
+                        }
+                        let Ok(index) = part.parse::<i64>() else {
+                            return bad(format!("face corner {corner:?}: {part:?} is not an index"));
+                        };
+                        // 1-based, or negative: relative to the end of the list so far.
+                        let resolved = if index < 0 { count + index + 1 } else { index };
+                        if index == 0 || resolved < 1 || resolved > count {
+                            return bad(format!(
+                                "face corner {corner:?} uses {what} {index}, but only {count} are defined above it"
+                            ));
+                        }
+                    }
+                }
+            }
+            _ => {}
+        }
+    }
+    None
 }
