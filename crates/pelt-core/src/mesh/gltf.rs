@@ -17,7 +17,7 @@ use super::{MeshError, RawMesh};
 const MAX_NODE_DEPTH: usize = 256;
 
 pub(super) fn load(path: &Path) -> Result<RawMesh, MeshError> {
-    let bytes = std::fs::read(path).map_err(|source| MeshError::Io { file: path.to_path_buf(), source })?;
+    let bytes = std::fs::read(path).map_err(|error| MeshError::Io { file: path.to_path_buf(), error })?;
     parse(&bytes, path, path.parent())
 }
 

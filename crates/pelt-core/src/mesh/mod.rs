@@ -20,8 +20,9 @@ pub const NO_FACE: u32 = u32::MAX;
 /// Errors from reading or validating a mesh. Each names the file (or built-in) it came from.
 #[derive(Debug, thiserror::Error)]
 pub enum MeshError {
-    #[error("{}: cannot read the file: {source}", file.display())]
-    Io { file: PathBuf, source: std::io::Error },
+    // The cause is part of the message (not a `source`) so it is printed exactly once.
+    #[error("{}: cannot read the file: {error}", file.display())]
+    Io { file: PathBuf, error: std::io::Error },
     #[error("{}: unknown mesh format {extension:?} (Pelt reads .obj, .gltf and .glb)", file.display())]
     UnknownFormat { file: PathBuf, extension: String },
     #[error("{}{}: {message}", file.display(), line.map(|l| format!(":{l}")).unwrap_or_default())]
@@ -160,7 +161,7 @@ impl Mesh {
         if !path.exists() {
             return Err(MeshError::Io {
                 file: path.to_path_buf(),
-                source: std::io::Error::new(std::io::ErrorKind::NotFound, "no such file"),
+                error: std::io::Error::new(std::io::ErrorKind::NotFound, "no such file"),
             });
         }
         let raw = match extension.as_str() {

@@ -9,7 +9,7 @@ use glam::{Vec2, Vec3};
 use super::{MeshError, RawMesh};
 
 pub(super) fn load(path: &Path) -> Result<RawMesh, MeshError> {
-    let text = std::fs::read(path).map_err(|source| MeshError::Io { file: path.to_path_buf(), source })?;
+    let text = std::fs::read(path).map_err(|error| MeshError::Io { file: path.to_path_buf(), error })?;
     let text = String::from_utf8_lossy(&text);
     parse(&text, path)
 }
