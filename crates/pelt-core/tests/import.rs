@@ -59,6 +59,7 @@ fn real_meshes_import_with_their_published_counts() {
         assert_eq!(mesh.corner_uvs.as_ref().map(Vec::len), expected.has_uvs.then_some(expected.triangles), "{name}");
         assert_eq!(report.non_manifold_edges, 0, "{name}: {report}");
         assert_eq!(report.inconsistent_winding_edges, 0, "{name}: {report}");
+        assert_eq!(report.reoriented_triangles, 0, "{name} is consistently wound as shipped: {report}");
         // None of these files carry normals, so all are computed, unit length.
         assert_eq!(report.normals, NormalSource::Computed, "{name}");
         assert!(mesh.normals.iter().all(|n| (n.length() - 1.0).abs() < 1e-4), "{name}");
@@ -268,6 +269,7 @@ mod gltf_scenes {
         let (mesh, report) = import(&tetrahedron(nodes, r#"[{"nodes":[0]}]"#)).unwrap();
         assert_eq!(mesh.positions[1], Vec3::new(-1.0, 0.0, 0.0));
         assert!(report.is_closed_manifold(), "{report}");
+        assert_eq!(report.reoriented_triangles, 0, "the loader itself undid the mirroring");
         assert!(signed_volume(&mesh) > 0.0, "mirrored but still wound outward");
         let centre = Vec3::new(-0.25, 0.25, 0.25);
         for (p, n) in mesh.positions.iter().zip(&mesh.normals) {
@@ -413,5 +415,30 @@ mod arbitrary_input {
                 prop_assert!(result.is_err());
             }
         }
+    }
+}
+
+#[test]
+fn a_real_mesh_with_scrambled_winding_is_repaired_to_the_original() {
+    let (original, _) = load(&asset("spot.obj"));
+    let mut raw = pelt_core::mesh::RawMesh {
+        positions: original.positions.clone(),
+        triangles: original.triangles.clone(),
+        ..Default::default()
+    };
+    // Flip every third triangle, and the first one too, so the seed of the walk is wrong.
+    let mut flipped = 0;
+    for (t, tri) in raw.triangles.iter_mut().enumerate() {
+        if t % 3 == 0 {
+            tri.swap(1, 2);
+            flipped += 1;
+        }
+    }
+    let (mesh, report) = Mesh::from_raw(raw, Path::new("scrambled spot"), &ImportOptions::default()).unwrap();
+    assert_eq!(report.reoriented_triangles, flipped);
+    assert!(report.is_closed_manifold(), "{report}");
+    for (repaired, original) in mesh.triangles.iter().zip(&original.triangles) {
+        let rotations = [*original, [original[1], original[2], original[0]], [original[2], original[0], original[1]]];
+        assert!(rotations.contains(repaired), "{repaired:?} is wound like {original:?}");
     }
 }
