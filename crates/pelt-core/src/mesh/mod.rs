@@ -85,6 +85,9 @@ pub struct MeshReport {
     pub welded_vertices: usize,
     pub dropped_zero_area_triangles: usize,
     pub dropped_repeated_index_triangles: usize,
+    /// Triangles over the same three vertices as an earlier one, either winding (double-sided
+    /// or doubled geometry would make every edge non-manifold and draw its fins twice).
+    pub dropped_duplicate_triangles: usize,
     pub dropped_unreferenced_vertices: usize,
     /// Triangles flipped to agree with their neighbours (or to turn a closed part outward).
     pub reoriented_triangles: usize,
@@ -121,8 +124,11 @@ impl fmt::Display for MeshReport {
         writeln!(f, "  welded {} duplicate vertices", self.welded_vertices)?;
         writeln!(
             f,
-            "  dropped {} zero-area and {} repeated-index triangles, {} unreferenced vertices",
-            self.dropped_zero_area_triangles, self.dropped_repeated_index_triangles, self.dropped_unreferenced_vertices
+            "  dropped {} zero-area, {} repeated-index and {} duplicate triangles, {} unreferenced vertices",
+            self.dropped_zero_area_triangles,
+            self.dropped_repeated_index_triangles,
+            self.dropped_duplicate_triangles,
+            self.dropped_unreferenced_vertices
         )?;
         writeln!(f, "  flipped {} triangles to a consistent, outward winding", self.reoriented_triangles)?;
         let normals = match self.normals {
@@ -244,6 +250,8 @@ impl Mesh {
         let area_epsilon = (diagonal * 1e-7).powi(2);
         let mut dropped_repeated = 0;
         let mut dropped_zero_area = 0;
+        let mut dropped_duplicate = 0;
+        let mut seen = std::collections::HashSet::with_capacity(raw.triangles.len());
         let mut kept: Vec<([u32; 3], usize)> = Vec::with_capacity(raw.triangles.len());
         for (t, tri) in raw.triangles.iter().enumerate() {
             let w = tri.map(|i| canonical[i as usize]);
@@ -254,6 +262,12 @@ impl Mesh {
             let [a, b, c] = w.map(|i| raw.positions[i as usize]);
             if (b - a).cross(c - a).length_squared() * 0.25 <= area_epsilon {
                 dropped_zero_area += 1;
+                continue;
+            }
+            let mut corners = w;
+            corners.sort_unstable();
+            if !seen.insert(corners) {
+                dropped_duplicate += 1;
                 continue;
             }
             kept.push((w, t));
@@ -322,6 +336,7 @@ impl Mesh {
             welded_vertices,
             dropped_zero_area_triangles: dropped_zero_area,
             dropped_repeated_index_triangles: dropped_repeated,
+            dropped_duplicate_triangles: dropped_duplicate,
             dropped_unreferenced_vertices: dropped_unreferenced,
             reoriented_triangles,
             normals: normal_source,
@@ -815,5 +830,16 @@ mod tests {
         assert_eq!(mesh.triangles.len(), 2 * segments as usize);
         assert_eq!(report.inconsistent_winding_edges, 1, "{report}");
         assert_eq!(report.boundary_loops, 1, "a Moebius strip has a single rim");
+    }
+
+    #[test]
+    fn duplicate_and_double_sided_triangles_are_dropped() {
+        let mut m = tetrahedron();
+        m.triangles.push([2, 1, 0]); // the back side of triangle 0
+        m.triangles.push([1, 3, 0]); // triangle 1 again, rotated
+        let (mesh, report) = Mesh::from_raw(m, Path::new("t"), &ImportOptions::default()).unwrap();
+        assert_eq!(report.dropped_duplicate_triangles, 2);
+        assert_eq!(mesh.triangles.len(), 4);
+        assert!(report.is_closed_manifold(), "{report}");
     }
 }
