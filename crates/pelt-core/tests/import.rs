@@ -198,43 +198,69 @@ mod gltf_scenes {
         out
     }
 
-    /// A glTF document with one buffer (`positions` as f32, then `indices` as u16), a POSITION
-    /// accessor, an index accessor (when `indices` is not empty), one mesh with one primitive of
-    /// `mode`, and the given `nodes` / `scenes` JSON.
-    fn document(positions: &[[f32; 3]], indices: &[u16], mode: u32, nodes: &str, scenes: &str) -> Vec<u8> {
-        let mut bin: Vec<u8> = positions.iter().flatten().flat_map(|v| v.to_le_bytes()).collect();
-        let positions_len = bin.len();
-        bin.extend(indices.iter().flat_map(|i| i.to_le_bytes()));
-        bin.resize(bin.len().next_multiple_of(4), 0);
+    /// A glTF document with one mesh of one primitive of `mode`: a POSITION accessor, an index
+    /// accessor (when `indices` is not empty) and a NORMAL accessor (when `normals` is not
+    /// empty), each in a buffer of its own, plus the given `nodes` / `scenes` JSON.
+    fn document_with_normals(
+        positions: &[[f32; 3]],
+        normals: &[[f32; 3]],
+        indices: &[u16],
+        mode: u32,
+        nodes: &str,
+        scenes: &str,
+    ) -> Vec<u8> {
+        let (mut buffers, mut views, mut accessors, mut attributes) = (vec![], vec![], vec![], String::new());
+        let mut add = |bytes: Vec<u8>, accessor: String| {
+            let k = buffers.len();
+            buffers.push(format!(
+                r#"{{"byteLength":{},"uri":"data:application/octet-stream;base64,{}"}}"#,
+                bytes.len(),
+                base64(&bytes)
+            ));
+            views.push(format!(r#"{{"buffer":{k},"byteLength":{}}}"#, bytes.len()));
+            accessors.push(accessor.replace("VIEW", &k.to_string()));
+            k
+        };
+        let floats = |values: &[[f32; 3]]| values.iter().flatten().flat_map(|v| v.to_le_bytes()).collect::<Vec<u8>>();
         let (min, max) = positions.iter().fold(([f32::MAX; 3], [f32::MIN; 3]), |(lo, hi), p| {
             (std::array::from_fn(|k| lo[k].min(p[k])), std::array::from_fn(|k| hi[k].max(p[k])))
         });
-        let index_parts = if indices.is_empty() {
-            (String::new(), String::new(), String::new())
-        } else {
-            (
-                format!(r#",{{"buffer":0,"byteOffset":{positions_len},"byteLength":{}}}"#, indices.len() * 2),
-                format!(r#",{{"bufferView":1,"componentType":5123,"count":{},"type":"SCALAR"}}"#, indices.len()),
-                r#","indices":1"#.to_owned(),
-            )
-        };
-        let (index_view, index_accessor, index_ref) = index_parts;
+        let count = positions.len();
+        let vec3 = format!(r#"{{"bufferView":VIEW,"componentType":5126,"count":{count},"type":"VEC3""#);
+        let k = add(floats(positions), format!(r#"{vec3},"min":{min:?},"max":{max:?}}}"#));
+        attributes.push_str(&format!(r#""POSITION":{k}"#));
+        if !normals.is_empty() {
+            let k = add(floats(normals), format!("{vec3}}}"));
+            attributes.push_str(&format!(r#","NORMAL":{k}"#));
+        }
+        let mut index_ref = String::new();
+        if !indices.is_empty() {
+            let mut bytes: Vec<u8> = indices.iter().flat_map(|i| i.to_le_bytes()).collect();
+            bytes.resize(bytes.len().next_multiple_of(4), 0);
+            let accessor =
+                format!(r#"{{"bufferView":VIEW,"componentType":5123,"count":{},"type":"SCALAR"}}"#, indices.len());
+            index_ref = format!(r#","indices":{}"#, add(bytes, accessor));
+        }
         format!(
             r#"{{
   "asset": {{"version": "2.0"}},
-  "buffers": [{{"byteLength": {len}, "uri": "data:application/octet-stream;base64,{data}"}}],
-  "bufferViews": [{{"buffer":0,"byteOffset":0,"byteLength":{positions_len}}}{index_view}],
-  "accessors": [{{"bufferView":0,"componentType":5126,"count":{count},"type":"VEC3","min":{min:?},"max":{max:?}}}{index_accessor}],
-  "meshes": [{{"name":"tet","primitives":[{{"attributes":{{"POSITION":0}},"mode":{mode}{index_ref}}}]}}],
+  "buffers": [{}],
+  "bufferViews": [{}],
+  "accessors": [{}],
+  "meshes": [{{"name":"tet","primitives":[{{"attributes":{{{attributes}}},"mode":{mode}{index_ref}}}]}}],
   "nodes": {nodes},
   "scenes": {scenes},
   "scene": 0
 }}"#,
-            len = bin.len(),
-            data = base64(&bin),
-            count = positions.len(),
+            buffers.join(","),
+            views.join(","),
+            accessors.join(","),
         )
         .into_bytes()
+    }
+
+    fn document(positions: &[[f32; 3]], indices: &[u16], mode: u32, nodes: &str, scenes: &str) -> Vec<u8> {
+        document_with_normals(positions, &[], indices, mode, nodes, scenes)
     }
 
     fn tetrahedron(nodes: &str, scenes: &str) -> Vec<u8> {
@@ -251,6 +277,23 @@ mod gltf_scenes {
         assert_eq!(base64(b"foob"), "Zm9vYg==");
         assert_eq!(base64(b"fooba"), "Zm9vYmE=");
         assert_eq!(base64(b"foobar"), "Zm9vYmFy");
+    }
+
+    #[test]
+    fn file_normals_follow_a_non_uniform_scale() {
+        // A quad in the plane x + y = 1, its normals along (1, 1, 0); scaled by 4 along y it lies
+        // in 4x + y = 4, whose normal is (4, 1, 0) / sqrt(17), not the scaled (1, 4, 0).
+        let quad = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 1.0, 1.0], [1.0, 0.0, 1.0]];
+        let normal = Vec3::new(1.0, 1.0, 0.0).normalize().to_array();
+        let nodes = r#"[{"mesh":0,"scale":[1,4,1]}]"#;
+        let bytes = document_with_normals(&quad, &[normal; 4], &[0, 1, 2, 0, 2, 3], 4, nodes, r#"[{"nodes":[0]}]"#);
+        let (mesh, report) = import(&bytes).unwrap();
+        assert_eq!(report.normals, NormalSource::File);
+        let expected = Vec3::new(4.0, 1.0, 0.0).normalize();
+        for n in &mesh.normals {
+            assert!(n.distance(expected) < 1e-5, "{n} should be {expected}");
+        }
+        assert!(mesh.face_normal(0).distance(expected) < 1e-5, "winding agrees with the normals");
     }
 
     #[test]
