@@ -450,6 +450,23 @@ mod arbitrary_input {
         }
 
         #[test]
+        fn a_corrupted_glb_imports_or_errors(
+            edits in proptest::collection::vec((0.0f64..1.0, any::<u8>(), any::<bool>()), 1..6),
+        ) {
+            let mut bytes = std::fs::read(asset("Fox.glb")).unwrap();
+            // Half of the edits land in the JSON chunk (the first few kilobytes), where they do most harm.
+            let json_end = 20 + u32::from_le_bytes(bytes[12..16].try_into().unwrap()) as usize;
+            for (at, value, in_json) in edits {
+                let limit = if in_json { json_end } else { bytes.len() };
+                let index = ((at * limit as f64) as usize).min(bytes.len() - 1);
+                bytes[index] = value;
+            }
+            if let Ok((mesh, report)) = Mesh::from_gltf_slice(&bytes, Path::new("fox.glb"), &ImportOptions::default()) {
+                check_invariants(&mesh, &report);
+            }
+        }
+
+        #[test]
         fn any_bytes_as_gltf_error_cleanly(bytes in proptest::collection::vec(any::<u8>(), 0..200)) {
             let mut glb = b"glTF\x02\x00\x00\x00".to_vec();
             glb.extend(&bytes);
@@ -484,4 +501,24 @@ fn a_real_mesh_with_scrambled_winding_is_repaired_to_the_original() {
         let rotations = [*original, [original[1], original[2], original[0]], [original[2], original[0], original[1]]];
         assert!(rotations.contains(repaired), "{repaired:?} is wound like {original:?}");
     }
+}
+
+#[test]
+fn obj_relative_indices_to_missing_elements_are_errors() {
+    // tobj 4.0.5 overflows (and panics) on these; the importer must refuse them first.
+    for (text, expected) in [
+        ("v 0 0 0\nf -1/-2 -1 -1\n", "texture coordinate -2"),
+        ("v 0 0 0\nvt 0 0\nf -1/-1/-3 -1 -1\n", "normal -3"),
+        ("v 0 0 0\nf 1 -2 1\n", "vertex -2"),
+        ("v 0 0 0\nf 0 1 1\n", "vertex 0"),
+        ("v 0 0 0\nv 1 0 0\nf 1 2\n", "at least 3 corners"),
+    ] {
+        let err = Mesh::from_obj_str(text, Path::new("relative.obj"), &ImportOptions::default()).unwrap_err();
+        let message = err.to_string();
+        assert!(message.contains(expected) && message.starts_with("relative.obj:"), "{text:?}: {message}");
+    }
+    // Inline comments are not numbers.
+    let text = "v 0 0 0 # origin\nv 1 0 0\nv 0 1 0\nf 1 2 3 # the only face\n";
+    let (mesh, _) = Mesh::from_obj_str(text, Path::new("comments.obj"), &ImportOptions::default()).unwrap();
+    assert_eq!(mesh.triangles.len(), 1);
 }

@@ -24,6 +24,18 @@ pub(super) fn load(path: &Path) -> Result<RawMesh, MeshError> {
 /// Parses `.gltf` JSON or `.glb` bytes. External buffers are looked up next to `base`; without
 /// a `base` only embedded (GLB or `data:` URI) buffers can be read.
 pub(super) fn parse(bytes: &[u8], file: &Path, base: Option<&Path>) -> Result<RawMesh, MeshError> {
+    // The `gltf` crate's validation indexes unchecked in places (gltf-json 1.4.1 panics on a
+    // primitive whose attribute map is emptied, for one); a broken file must stay an error.
+    std::panic::catch_unwind(|| parse_unguarded(bytes, file, base)).unwrap_or_else(|_| {
+        Err(MeshError::Parse {
+            file: file.to_path_buf(),
+            line: None,
+            message: "the glTF reader failed on malformed content".to_owned(),
+        })
+    })
+}
+
+fn parse_unguarded(bytes: &[u8], file: &Path, base: Option<&Path>) -> Result<RawMesh, MeshError> {
     let error = |message: String| MeshError::Parse { file: file.to_path_buf(), line: None, message };
     let gltf::Gltf { document, blob } =
         gltf::Gltf::from_slice(bytes).map_err(|e| error(format!("not valid glTF: {e}")))?;

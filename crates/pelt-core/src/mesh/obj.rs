@@ -16,12 +16,29 @@ pub(super) fn load(path: &Path) -> Result<RawMesh, MeshError> {
 
 pub(super) fn parse(text: &str, file: &Path) -> Result<RawMesh, MeshError> {
     let options = tobj::LoadOptions { single_index: true, triangulate: true, ignore_points: true, ignore_lines: true };
+    let error = |line, message| MeshError::Parse { file: file.to_path_buf(), line, message };
+    // Checked here first: tobj reports no line numbers, and panics (index arithmetic overflow)
+    // on some malformed relative indices.
+    if let Some((line, message)) = diagnose(text) {
+        return Err(error(Some(line), message));
+    }
+    // tobj takes an inline comment (`v 0 0 0 # origin`) for more numbers; cut them, keeping the
+    // line count so line numbers in messages stay right.
+    let uncommented: String;
+    let text = if text.lines().any(|line| line.trim_start().find('#').is_some_and(|at| at > 0)) {
+        uncommented =
+            text.lines().map(|line| line.split('#').next().unwrap_or_default()).collect::<Vec<_>>().join("\n");
+        &uncommented
+    } else {
+        text
+    };
     let mut reader = BufReader::new(text.as_bytes());
     // Materials are not needed: colour comes from the fur preset.
-    let (models, _materials) = tobj::load_obj_buf(&mut reader, &options, |_| Ok(Default::default())).map_err(|e| {
-        let (line, message) = diagnose(text).map_or((None, e.to_string()), |(line, why)| (Some(line), why));
-        MeshError::Parse { file: file.to_path_buf(), line, message }
-    })?;
+    let load = || tobj::load_obj_buf(&mut reader, &options, |_| Ok(Default::default()));
+    // Should tobj still panic on something `diagnose` let through, the file is bad, not Pelt.
+    let (models, _materials) = std::panic::catch_unwind(std::panic::AssertUnwindSafe(load))
+        .map_err(|_| error(None, "the OBJ parser (tobj) failed on this file".to_owned()))?
+        .map_err(|e| error(None, e.to_string()))?;
 
     let mut raw = RawMesh::default();
     let every_model_has_normals = models.iter().all(|m| !m.mesh.normals.is_empty());
@@ -49,13 +66,14 @@ pub(super) fn parse(text: &str, file: &Path) -> Result<RawMesh, MeshError> {
     Ok(raw)
 }
 
-/// tobj reports no line numbers; find the first line that is wrong, and say what is wrong with
-/// it, for the message.
+/// Finds the first malformed `v`, `vt`, `vn` or `f` line (numbers that do not parse, too few
+/// of them, face indices outside what is defined above) and says what is wrong with it.
 fn diagnose(text: &str) -> Option<(usize, String)> {
     // Elements defined so far, for checking (and resolving relative) face indices.
     let (mut positions, mut uvs, mut normals) = (0_i64, 0_i64, 0_i64);
     for (n, line) in text.lines().enumerate() {
-        let mut words = line.split_whitespace();
+        let content = line.split('#').next().unwrap_or_default();
+        let mut words = content.split_whitespace();
         let Some(keyword) = words.next() else { continue };
         let values: Vec<&str> = words.collect();
         let bad = |message: String| Some((n + 1, message));
