@@ -178,28 +178,54 @@ impl Simulation {
     }
 
     /// Moves the roots with a deforming base mesh: new base positions and normals (one per base
-    /// vertex). Each strand's rest shape turns with the rotation from its rest normal to the new
-    /// normal, so fur stays attached at the same angle. Takes effect from the next step.
+    /// vertex). Each strand's rest shape turns with the shortest rotation from its rest normal
+    /// to the new normal, so fur stays attached at the same angle to the surface. A normal alone
+    /// cannot say how the surface twisted about it: fur that leans (random or combed growth)
+    /// keeps its lean's world heading; use [`Simulation::set_base_rotations`] when the full
+    /// rotation is known (skinning). Takes effect from the next step.
     ///
     /// # Errors
     /// [`SimError::Size`] for arrays of the wrong length, [`SimError::NonFinite`] for NaN or
     /// infinite entries; nothing changes then.
     pub fn set_base(&mut self, positions: &[Vec3], normals: &[Vec3]) -> Result<(), SimError> {
-        let v = self.vertex_count;
-        for (what, values) in [("the base positions", positions), ("the base normals", normals)] {
-            if values.len() != v {
-                return Err(SimError::Size { what, expected: v, got: values.len() });
-            }
-            if let Some(bad) = values.iter().find(|p| !p.is_finite()) {
-                return Err(SimError::NonFinite { what, value: bad.to_string() });
-            }
-        }
+        self.check_base(positions, normals, "the base normals")?;
         self.roots.copy_from_slice(positions);
         for ((frame, rest), normal) in self.frames.iter_mut().zip(&self.rest_normals).zip(normals) {
             *frame = match (rest.try_normalize(), normal.try_normalize()) {
                 (Some(rest), Some(normal)) => Quat::from_rotation_arc(rest, normal),
                 _ => Quat::IDENTITY,
             };
+        }
+        Ok(())
+    }
+
+    /// Like [`Simulation::set_base`], with each strand's full rotation from its rest frame (for
+    /// a skinned base: the rotation part of each vertex's skinning transform).
+    ///
+    /// # Errors
+    /// As [`Simulation::set_base`]; zero-length rotations are errors too.
+    pub fn set_base_rotations(&mut self, positions: &[Vec3], rotations: &[Quat]) -> Result<(), SimError> {
+        let as_vectors: Vec<Vec3> = rotations.iter().map(|q| Vec3::new(q.x, q.y, q.z) + Vec3::splat(q.w)).collect();
+        self.check_base(positions, &as_vectors, "the base rotations")?;
+        if let Some(bad) = rotations.iter().find(|q| q.length_squared() == 0.0) {
+            return Err(SimError::NonFinite { what: "the base rotations", value: bad.to_string() });
+        }
+        self.roots.copy_from_slice(positions);
+        for (frame, rotation) in self.frames.iter_mut().zip(rotations) {
+            *frame = rotation.normalize();
+        }
+        Ok(())
+    }
+
+    fn check_base(&self, positions: &[Vec3], frames: &[Vec3], what_frames: &'static str) -> Result<(), SimError> {
+        let v = self.vertex_count;
+        for (what, values) in [("the base positions", positions), (what_frames, frames)] {
+            if values.len() != v {
+                return Err(SimError::Size { what, expected: v, got: values.len() });
+            }
+            if let Some(bad) = values.iter().find(|p| !p.is_finite()) {
+                return Err(SimError::NonFinite { what, value: bad.to_string() });
+            }
         }
         Ok(())
     }
