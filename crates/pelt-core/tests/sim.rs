@@ -37,10 +37,6 @@ fn worst_length_error(fur: &FurStructure, positions: &[Vec3]) -> f32 {
     worst
 }
 
-fn strand(nodes_layer_major: &[Vec3], v: usize, j: usize, layers: usize) -> Vec<Vec3> {
-    (0..=layers).map(|i| nodes_layer_major[i * v + j]).collect()
-}
-
 /// A straight strand of `layers` segments along `direction`, total length `length`.
 fn straight(layers: usize, direction: Vec3, length: f32) -> Vec<Vec3> {
     vec![direction.normalize() * (length / layers as f32); layers]
@@ -431,7 +427,7 @@ fn picking_hits_the_right_triangle() {
                 let point = Vec3::new(x, 0.0, z);
                 let total = area(a, b, c);
                 let (wa, wb, wc) = (area(point, b, c) / total, area(a, point, c) / total, area(a, b, point) / total);
-                (total != 0.0 && wa >= 0.0 && wb >= 0.0 && wc >= 0.0).then(|| wa * a.y + wb * b.y + wc * c.y)
+                (total != 0.0 && wa >= 0.0 && wb >= 0.0 && wc >= 0.0).then_some(wa * a.y + wb * b.y + wc * c.y)
             })
             .fold(f32::MIN, f32::max);
         assert!((top.point.y - highest).abs() < 1e-3, "({x}, {z}): {} vs {highest}", top.point.y);
