@@ -490,3 +490,33 @@ fn shipped_scenes_drive_the_bunny() {
         assert!(sim.touch().is_none(), "{name}: every stroke ends");
     }
 }
+
+#[test]
+fn batched_simulation_matches_the_per_strand_bend() {
+    // 1,839 strands: not a multiple of the batch width, so the padded lanes are exercised too.
+    let fur = grow(Builtin::Bunny, 12, 0.6);
+    let params = SimParams { wind: windy(), gravity_strength: 2.0, ..SimParams::default() };
+    let mut sim = Simulation::new(&fur, &params).unwrap();
+    let v = fur.vertex_count();
+    let map: Vec<f32> = (0..v).map(|j| 0.5 + (j % 13) as f32).collect();
+    sim.set_stability_map(Some(map.clone())).unwrap();
+    assert!(sim.set_stability_map(Some(vec![1.0; 3])).is_err());
+    assert!(sim.set_stability_map(Some(vec![0.0; v])).is_err());
+    sim.field_mut().values_mut()[7] = Vec3::new(0.0, 0.0, 1e9);
+    sim.advance_to(2.0);
+    let mut current = vec![Vec3::ZERO; fur.positions.len()];
+    sim.write_lerp(1.0, &mut current);
+    let gravity = Vec3::NEG_Y * 2.0;
+    let layers = 12;
+    let mut nodes = vec![Vec3::ZERO; layers + 1];
+    for j in 0..v {
+        let segments: Vec<Vec3> =
+            (0..layers).map(|k| fur.positions[(k + 1) * v + j] - fur.positions[k * v + j]).collect();
+        let force = gravity + sim.external_field()[j];
+        bend_strand(fur.positions[j], Quat::IDENTITY, &segments, force, map[j], &mut nodes);
+        for (i, node) in nodes.iter().enumerate() {
+            let got = current[i * v + j];
+            assert!(got.distance(*node) <= 1e-5 * node.length().max(1.0), "strand {j} node {i}: {got} vs {node}");
+        }
+    }
+}

@@ -29,7 +29,7 @@ pub const BEND_GAIN: f32 = 8.0;
 
 /// Below this sine of the angle between a segment and the force, the two count as parallel (or
 /// opposite) and nothing turns: the rotation axis is undefined there.
-const PARALLEL_SINE: f32 = 1e-7;
+pub(crate) const PARALLEL_SINE: f32 = 1e-7;
 
 /// The fraction of the angle to the force that node `layers - remaining` turns by:
 /// `min(1, force_magnitude * remaining * BEND_GAIN / (layers^2 * stability))`.
@@ -67,11 +67,52 @@ fn rotation_toward(direction: Vec3, force_direction: Vec3, weight: f32) -> Optio
     if sine <= PARALLEL_SINE || weight <= 0.0 {
         return None;
     }
-    // atan2 is acos(dot) with the argument clamp built in, and accurate near 0 and pi.
-    let angle = sine.atan2(direction.dot(force_direction));
-    let (half_sin, half_cos) = (0.5 * angle * weight).sin_cos();
+    let angle = angle_from_sin_cos(sine, direction.dot(force_direction));
+    let (half_sin, half_cos) = sin_cos_quarter_turn(0.5 * angle * weight);
     let axis = axis * (half_sin / sine);
     Some(Quat::from_xyzw(axis.x, axis.y, axis.z, half_cos))
+}
+
+/// The angle in `[0, pi]` with this sine (`>= 0`) and cosine: `atan2(sine, cosine)`, which is
+/// the paper's `acos(dot)` with its argument clamp built in and accurate near 0 and pi.
+///
+/// A polynomial (Abramowitz and Stegun 4.4.49, error below 1e-7 rad) rather than libm: it is
+/// branch-free arithmetic, so the batched kernel vectorises it, and the scalar and batched paths
+/// share one definition.
+#[must_use]
+#[inline]
+pub(crate) fn angle_from_sin_cos(sine: f32, cosine: f32) -> f32 {
+    let (a, b) = (sine, cosine.abs());
+    let steep = a > b;
+    let (numerator, denominator) = if steep { (b, a) } else { (a, b) };
+    let t = if denominator > 0.0 { numerator / denominator } else { 0.0 };
+    let t2 = t * t;
+    let mut p = 0.002_866_225_7_f32;
+    for c in [-0.016_165_737, 0.042_909_614, -0.075_289_64, 0.106_562_64, -0.142_089, 0.199_935_51, -0.333_331_45] {
+        p = p * t2 + c;
+    }
+    let mut angle = t + t * t2 * p;
+    if steep {
+        angle = std::f32::consts::FRAC_PI_2 - angle;
+    }
+    if cosine < 0.0 { std::f32::consts::PI - angle } else { angle }
+}
+
+/// `(sin x, cos x)` for `x` in `[0, pi/2]` by Taylor polynomials (error below 1e-7); branch
+/// free for the same reason as [`angle_from_sin_cos`].
+#[must_use]
+#[inline]
+pub(crate) fn sin_cos_quarter_turn(x: f32) -> (f32, f32) {
+    let x2 = x * x;
+    let sine = x
+        * (1.0
+            + x2 * (-1.0 / 6.0
+                + x2 * (1.0 / 120.0 + x2 * (-1.0 / 5040.0 + x2 * (1.0 / 362_880.0 - x2 / 39_916_800.0)))));
+    let cosine = 1.0
+        + x2 * (-0.5
+            + x2 * (1.0 / 24.0
+                + x2 * (-1.0 / 720.0 + x2 * (1.0 / 40320.0 + x2 * (-1.0 / 3_628_800.0 + x2 / 479_001_600.0)))));
+    (sine, cosine)
 }
 
 /// Bends one strand in O(L) with a running quaternion; writes its `L + 1` nodes to `nodes`.
@@ -153,6 +194,22 @@ mod tests {
         let tip_direction = (nodes[16] - nodes[15]).normalize();
         let turned_deg = tip_direction.angle_between(Vec3::X).to_degrees();
         assert!((25.0..50.0).contains(&turned_deg), "tip turned {turned_deg} degrees");
+    }
+
+    #[test]
+    fn polynomial_trig_matches_libm() {
+        for i in 0..=10_000 {
+            let angle = i as f32 / 10_000.0 * std::f32::consts::PI;
+            let (s, c) = angle.sin_cos();
+            let got = angle_from_sin_cos(s.max(0.0), c);
+            assert!((got - angle).abs() < 1e-6, "{angle}: {got}");
+            let half = angle * 0.5;
+            let (ps, pc) = sin_cos_quarter_turn(half);
+            assert!((ps - half.sin()).abs() < 1e-6 && (pc - half.cos()).abs() < 1e-6, "{half}");
+        }
+        assert_eq!(angle_from_sin_cos(0.0, 1.0), 0.0);
+        assert_eq!(angle_from_sin_cos(0.0, -1.0), std::f32::consts::PI);
+        assert_eq!(angle_from_sin_cos(0.0, 0.0), 0.0);
     }
 
     #[test]

@@ -13,6 +13,7 @@
 //! with no velocity. So a state at time `t` never depends on earlier states, which makes every
 //! step deterministic, parallel over strands, and cheap to jump to any time.
 
+mod batch;
 pub mod bend;
 pub mod field;
 pub mod pick;

@@ -6,7 +6,7 @@ use std::time::Instant;
 use glam::{Quat, Vec3};
 use rayon::prelude::*;
 
-use super::bend::bend_strand;
+use super::batch::{LANES, StrandInputs, VecLanes, bend_batch};
 use super::field::{ForceField, Touch};
 use super::pick::{Hit, pick};
 use super::{ParamError, SimParams, WindParams};
@@ -27,13 +27,15 @@ pub enum SimError {
     Stability { vertex: usize, value: f32 },
 }
 
-/// Strands per parallel task: enough work to pay for the task, small enough to balance.
-const STRANDS_PER_TASK: usize = 64;
+/// Batches of [`LANES`] strands per parallel task: enough work to pay for the task, small
+/// enough to balance.
+const BATCHES_PER_TASK: usize = 8;
 
 /// The fur simulation over the shared vertex array of one [`FurStructure`].
 ///
-/// Internally every state is strand-major (`L + 1` nodes of strand `j` at `j * (L + 1)`) so one
-/// strand is one contiguous run; [`Simulation::positions`] is layer-major like
+/// Internally strands go in batches of 8, structure of arrays (node `i` of batch `b` is one
+/// `[x, y, z]` of 8 lanes at `b * (L + 1) + i`) so the bend runs as SIMD over 8 strands and each
+/// batch is one contiguous run; [`Simulation::positions`] is layer-major like
 /// [`FurStructure::positions`] (`NV[i * V + j]`), ready to upload.
 ///
 /// Time: state `n` is the pose at `n / rate_hz` seconds. With interpolation, at render time `t`
@@ -46,8 +48,8 @@ pub struct Simulation {
     params: SimParams,
     layers: u32,
     vertex_count: usize,
-    /// Rest segments, strand-major: segment `k` of strand `j` at `j * L + k`.
-    rest_segments: Vec<Vec3>,
+    /// Rest segments of batch `b` (lanes = strands `8b..8b + 8`, zero past `V`) at `b * L + k`.
+    rest_segments: Vec<VecLanes>,
     rest_normals: Vec<Vec3>,
     roots: Vec<Vec3>,
     /// Rotation of each strand's rest frame into the current base frame (from `set_base`).
@@ -59,8 +61,9 @@ pub struct Simulation {
     touch: Option<Touch>,
     /// The external field (wind + field + touch) of the newest state.
     external: Vec<Vec3>,
-    previous: Vec<Vec3>,
-    current: Vec<Vec3>,
+    /// States, batch-major like `rest_segments` with `L + 1` nodes per batch.
+    previous: Vec<VecLanes>,
+    current: Vec<VecLanes>,
     /// Layer-major `lerp(previous, current, alpha)` for the last render time.
     output: Vec<Vec3>,
     step_index: i64,
@@ -90,14 +93,21 @@ impl Simulation {
         if fur.mesh.normals.len() != v {
             return Err(SimError::Size { what: "the base normals", expected: v, got: fur.mesh.normals.len() });
         }
-        let mut rest_segments = Vec::with_capacity(v * layers);
+        let batches = v.div_ceil(LANES);
+        let mut rest_segments = vec![[[0.0; LANES]; 3]; batches * layers];
         for j in 0..v {
-            rest_segments.extend((0..layers).map(|k| fur.positions[(k + 1) * v + j] - fur.positions[k * v + j]));
+            for k in 0..layers {
+                let segment = fur.positions[(k + 1) * v + j] - fur.positions[k * v + j];
+                for c in 0..3 {
+                    rest_segments[j / LANES * layers + k][c][j % LANES] = segment[c];
+                }
+            }
         }
         let roots = fur.positions[..v].to_vec();
         let (centre, radius) = bounding_sphere(&roots);
         debug_assert!(centre.is_finite());
         let nodes = v * (layers + 1);
+        let batch_nodes = batches * (layers + 1);
         let mut simulation = Self {
             params: params.clone(),
             layers: fur.layers,
@@ -111,8 +121,8 @@ impl Simulation {
             field: ForceField::new(v),
             touch: None,
             external: vec![Vec3::ZERO; v],
-            previous: vec![Vec3::ZERO; nodes],
-            current: vec![Vec3::ZERO; nodes],
+            previous: vec![[[0.0; LANES]; 3]; batch_nodes],
+            current: vec![[[0.0; LANES]; 3]; batch_nodes],
             output: vec![Vec3::ZERO; nodes],
             step_index: 0,
             time_secs: 0.0,
@@ -369,9 +379,12 @@ impl Simulation {
         }
         let (previous, current) = (&self.previous, &self.current);
         out.par_chunks_mut(v).enumerate().for_each(|(i, row)| {
-            for (j, position) in row.iter_mut().enumerate() {
-                let k = j * nodes + i;
-                *position = previous[k] * (1.0 - alpha) + current[k] * alpha;
+            for (b, positions) in row.chunks_mut(LANES).enumerate() {
+                let (a, c) = (&previous[b * nodes + i], &current[b * nodes + i]);
+                for (lane, position) in positions.iter_mut().enumerate() {
+                    let lerp = |axis: usize| a[axis][lane] * (1.0 - alpha) + c[axis][lane] * alpha;
+                    *position = Vec3::new(lerp(0), lerp(1), lerp(2));
+                }
             }
         });
     }
@@ -434,13 +447,25 @@ impl Simulation {
         self.external = external;
         let gravity = self.params.gravity_direction.normalize_or_zero() * self.params.gravity_strength;
         let layers = self.layers as usize;
+        let v = self.vertex_count;
         let stability = self.params.stability;
         let (roots, frames, rest, external, map) =
             (&self.roots, &self.frames, &self.rest_segments, &self.external, self.stability_map.as_deref());
-        self.current.par_chunks_mut(layers + 1).enumerate().with_min_len(STRANDS_PER_TASK).for_each(|(j, nodes)| {
-            let strand_stability = map.map_or(stability, |m| m[j]);
-            let segments = &rest[j * layers..(j + 1) * layers];
-            bend_strand(roots[j], frames[j], segments, gravity + external[j], strand_stability, nodes);
+        self.current.par_chunks_mut(layers + 1).enumerate().with_min_len(BATCHES_PER_TASK).for_each(|(b, nodes)| {
+            let inputs: [StrandInputs; LANES] = std::array::from_fn(|lane| {
+                let j = b * LANES + lane;
+                if j < v {
+                    StrandInputs {
+                        root: roots[j],
+                        frame: frames[j],
+                        force: gravity + external[j],
+                        stability: map.map_or(stability, |m| m[j]),
+                    }
+                } else {
+                    StrandInputs::default()
+                }
+            });
+            bend_batch(&inputs, &rest[b * layers..(b + 1) * layers], nodes);
         });
         self.last_step_secs = started.elapsed().as_secs_f64();
         self.steps_taken += 1;
