@@ -229,9 +229,14 @@ fn touch_changes_the_field_only_within_its_radius_and_release_restores_it() {
     let mut after = before.clone();
     let time = 0.37;
     sim.evaluate_field(time, &mut before);
-    let point = fur.mesh.positions[500];
     let radius = 1.2;
-    sim.touch_begin(point, radius).unwrap();
+    let above = fur.mesh.positions[500] + fur.mesh.normals[500] * 3.0;
+    assert!(sim.touch_ray(&fur.mesh.triangles, above, Vec3::Y, radius).unwrap().is_none(), "a miss begins nothing");
+    assert!(sim.touch().is_none());
+    let hit = sim.touch_ray(&fur.mesh.triangles, above, -fur.mesh.normals[500], radius).unwrap().unwrap();
+    let point = hit.point;
+    assert!(point.distance(fur.mesh.positions[500]) < 0.5, "{point}");
+    assert_eq!(sim.touch().unwrap().point, point);
     sim.touch_drag(point + Vec3::new(0.0, -2.0, 0.0)).unwrap();
     sim.evaluate_field(time, &mut during);
     let mut changed = 0;

@@ -291,6 +291,23 @@ impl Simulation {
         Ok(())
     }
 
+    /// Picks the base mesh (current roots, `triangles` from [`FurStructure::mesh`]) with a ray
+    /// and begins a touch of `radius` at the hit; `None` (and no touch) on a miss.
+    ///
+    /// # Errors
+    /// [`SimError::TouchRadius`] for a radius that is not finite and positive.
+    pub fn touch_ray(
+        &mut self,
+        triangles: &[[u32; 3]],
+        ray_origin: Vec3,
+        ray_direction: Vec3,
+        radius: f32,
+    ) -> Result<Option<Hit>, SimError> {
+        let Some(hit) = self.pick(triangles, ray_origin, ray_direction) else { return Ok(None) };
+        self.touch_begin(hit.point, radius)?;
+        Ok(Some(hit))
+    }
+
     /// Drags the touch in progress to `point`: the interaction vector becomes `point - hit`.
     /// Does nothing without a touch in progress.
     ///
