@@ -31,6 +31,9 @@ pub enum SimError {
 /// enough to balance.
 const BATCHES_PER_TASK: usize = 8;
 
+/// Strands per parallel task of the interpolation (a multiple of [`LANES`]).
+const LERP_STRANDS_PER_TASK: usize = 32 * LANES;
+
 /// The fur simulation over the shared vertex array of one [`FurStructure`].
 ///
 /// Internally strands go in batches of 8, structure of arrays (node `i` of batch `b` is one
@@ -395,12 +398,25 @@ impl Simulation {
             return;
         }
         let (previous, current) = (&self.previous, &self.current);
-        out.par_chunks_mut(v).enumerate().for_each(|(i, row)| {
-            for (b, positions) in row.chunks_mut(LANES).enumerate() {
-                let (a, c) = (&previous[b * nodes + i], &current[b * nodes + i]);
-                for (lane, position) in positions.iter_mut().enumerate() {
-                    let lerp = |axis: usize| a[axis][lane] * (1.0 - alpha) + c[axis][lane] * alpha;
-                    *position = Vec3::new(lerp(0), lerp(1), lerp(2));
+        // Each task owns a run of whole batches and writes their slice of every layer row, so it
+        // reads its batches' memory once, front to back, instead of once per row.
+        let mut pieces: Vec<Vec<&mut [Vec3]>> =
+            (0..v.div_ceil(LERP_STRANDS_PER_TASK)).map(|_| Vec::with_capacity(nodes)).collect();
+        for row in out.chunks_mut(v) {
+            for (piece, task) in row.chunks_mut(LERP_STRANDS_PER_TASK).zip(&mut pieces) {
+                task.push(piece);
+            }
+        }
+        pieces.into_par_iter().enumerate().for_each(|(t, rows)| {
+            let first_batch = t * LERP_STRANDS_PER_TASK / LANES;
+            for (i, row) in rows.into_iter().enumerate() {
+                for (bb, positions) in row.chunks_mut(LANES).enumerate() {
+                    let k = (first_batch + bb) * nodes + i;
+                    let (a, c) = (&previous[k], &current[k]);
+                    for (lane, position) in positions.iter_mut().enumerate() {
+                        let lerp = |axis: usize| a[axis][lane] * (1.0 - alpha) + c[axis][lane] * alpha;
+                        *position = Vec3::new(lerp(0), lerp(1), lerp(2));
+                    }
                 }
             }
         });

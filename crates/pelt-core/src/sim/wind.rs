@@ -101,13 +101,24 @@ impl WindParams {
     }
 }
 
-/// A seeded random vector in `[-1, 1]^3` for one vertex and tick.
+/// A seeded random vector in `[-1, 1]^3` for one vertex and tick (21 random bits per axis from
+/// one hash: plenty for a shake, and a third of the hashing).
 fn random_vector(seed: u64, vertex: u64, tick: u64) -> Vec3 {
     let bits = rng::hash(seed ^ 0x6A69_7474_6572, vertex, tick, 0);
-    let x = rng::unit_f32(bits);
-    let y = rng::unit_f32(rng::mix64(bits));
-    let z = rng::unit_f32(rng::mix64(bits ^ 0x5A5A));
-    Vec3::new(x, y, z) * 2.0 - 1.0
+    let axis = |shift: u32| ((bits >> shift) & 0x1F_FFFF) as f32 * (2.0 / 2_097_152.0) - 1.0;
+    Vec3::new(axis(0), axis(21), axis(42))
+}
+
+/// One `mix64` per lattice corner: the coordinates are spread by odd constants first, which is
+/// enough for value noise and a quarter of the cost of [`rng::hash`] (the wind is evaluated for
+/// every vertex every step).
+#[inline]
+fn corner_bits(seed: u64, x: i64, y: i64, z: i64) -> u64 {
+    rng::mix64(
+        seed ^ (x as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15)
+            ^ (y as u64).wrapping_mul(0xC2B2_AE3D_27D4_EB4F)
+            ^ (z as u64).wrapping_mul(0x1656_67B1_9E37_79F9),
+    )
 }
 
 fn smoothstep(t: f32) -> f32 {
@@ -122,8 +133,9 @@ pub fn value_noise3(seed: u64, point: DVec3) -> f32 {
     let cell = point.floor();
     let fraction = (point - cell).as_vec3();
     let [x, y, z] = [cell.x as i64, cell.y as i64, cell.z as i64];
+    let seed = rng::mix64(seed);
     let corner = |dx: i64, dy: i64, dz: i64| {
-        let bits = rng::hash(seed, x.wrapping_add(dx) as u64, y.wrapping_add(dy) as u64, z.wrapping_add(dz) as u64);
+        let bits = corner_bits(seed, x.wrapping_add(dx), y.wrapping_add(dy), z.wrapping_add(dz));
         rng::unit_f32(bits) * 2.0 - 1.0
     };
     let (u, v, w) = (smoothstep(fraction.x), smoothstep(fraction.y), smoothstep(fraction.z));
