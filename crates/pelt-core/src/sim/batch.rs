@@ -65,6 +65,25 @@ fn angle(sine: &Lanes, cosine: &Lanes) -> Lanes {
     map(|i| super::bend::angle_from_sin_cos(sine[i], cosine[i]))
 }
 
+/// One rest segment of every strand of a batch, split into unit direction and length so the
+/// kernel needs no square root or division for it.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct RestSegment {
+    pub direction: VecLanes,
+    pub length: Lanes,
+}
+
+impl RestSegment {
+    /// Sets the segment of strand `lane`.
+    pub fn set(&mut self, lane: usize, segment: Vec3) {
+        let direction = segment.normalize_or_zero();
+        for c in 0..3 {
+            self.direction[c][lane] = direction[c];
+        }
+        self.length[lane] = if direction == Vec3::ZERO { 0.0 } else { segment.length() };
+    }
+}
+
 /// Per-strand inputs of one batch.
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct StrandInputs {
@@ -80,9 +99,13 @@ impl Default for StrandInputs {
     }
 }
 
-/// Bends a batch of strands: `segments` holds the `L` rest segments (`segments[k]` one
-/// `VecLanes`), `nodes` receives the `L + 1` nodes.
-pub(crate) fn bend_batch(inputs: &[StrandInputs; LANES], segments: &[VecLanes], nodes: &mut [VecLanes]) {
+/// Bends a batch of strands: `segments` holds the `L` rest segments, `nodes` receives the
+/// `L + 1` nodes.
+///
+/// The running quaternion is the scalar path's; the turned segment itself is computed in the
+/// plane of segment and force (`d cos(theta) + e sin(theta)`, `e` the unit normal to `d` toward
+/// the force), which is cheaper than a second quaternion rotation and equal up to rounding.
+pub(crate) fn bend_batch(inputs: &[StrandInputs; LANES], segments: &[RestSegment], nodes: &mut [VecLanes]) {
     debug_assert_eq!(nodes.len(), segments.len() + 1);
     let layers = segments.len() as u32;
     let l = layers as f32;
@@ -94,11 +117,8 @@ pub(crate) fn bend_batch(inputs: &[StrandInputs; LANES], segments: &[VecLanes], 
     let mut node: VecLanes = std::array::from_fn(|c| map(|i| inputs[i].root[c]));
     nodes[0] = node;
     for (k, (segment, out)) in segments.iter().zip(&mut nodes[1..]).enumerate() {
-        let mut current = rotate(&turned, segment);
-        let length_squared = dot(&current, &current);
-        let length = map(|i| length_squared[i].sqrt());
-        let inverse = map(|i| if length[i] > 0.0 { 1.0 / length[i] } else { 0.0 });
-        let direction: VecLanes = std::array::from_fn(|c| map(|i| current[c][i] * inverse[i]));
+        let direction = rotate(&turned, &segment.direction);
+        let length = segment.length;
         // bend_weight, in its operation order.
         let share = (layers - k as u32) as f32 * BEND_GAIN / (l * l);
         let weight = map(|i| {
@@ -128,9 +148,17 @@ pub(crate) fn bend_batch(inputs: &[StrandInputs; LANES], segments: &[VecLanes], 
             1.0 / (x * x + y * y + z * z + w * w).sqrt()
         });
         turned = std::array::from_fn(|c| map(|i| if active[i] { product[c][i] * norm[i] } else { turned[c][i] }));
-        let rotated = rotate(&turned, segment);
-        current = std::array::from_fn(|c| map(|i| if active[i] { rotated[c][i] } else { current[c][i] }));
-        node = std::array::from_fn(|c| map(|i| node[c][i] + current[c][i]));
+        // Full-angle sine and cosine from the half angle; `sin / sine` scales `f - d cos(a)`
+        // (length `sine`) to the unit normal `e`.
+        let cos_full = map(|i| if active[i] { 1.0 - 2.0 * half_sin[i] * half_sin[i] } else { 1.0 });
+        let toward = map(|i| 2.0 * half_cos[i] * scale[i]);
+        node = std::array::from_fn(|c| {
+            map(|i| {
+                let d = direction[c][i];
+                let turned_d = d * cos_full[i] + (force[c][i] - d * cosine[i]) * toward[i];
+                node[c][i] + turned_d * length[i]
+            })
+        });
         *out = node;
     }
 }

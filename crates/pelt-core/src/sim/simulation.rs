@@ -6,7 +6,7 @@ use std::time::Instant;
 use glam::{Quat, Vec3};
 use rayon::prelude::*;
 
-use super::batch::{LANES, StrandInputs, VecLanes, bend_batch};
+use super::batch::{LANES, RestSegment, StrandInputs, VecLanes, bend_batch};
 use super::field::{ForceField, Touch};
 use super::pick::{Hit, pick};
 use super::{ParamError, SimParams, WindParams};
@@ -52,7 +52,7 @@ pub struct Simulation {
     layers: u32,
     vertex_count: usize,
     /// Rest segments of batch `b` (lanes = strands `8b..8b + 8`, zero past `V`) at `b * L + k`.
-    rest_segments: Vec<VecLanes>,
+    rest_segments: Vec<RestSegment>,
     rest_normals: Vec<Vec3>,
     roots: Vec<Vec3>,
     /// Rotation of each strand's rest frame into the current base frame (from `set_base`).
@@ -97,13 +97,11 @@ impl Simulation {
             return Err(SimError::Size { what: "the base normals", expected: v, got: fur.mesh.normals.len() });
         }
         let batches = v.div_ceil(LANES);
-        let mut rest_segments = vec![[[0.0; LANES]; 3]; batches * layers];
+        let mut rest_segments = vec![RestSegment::default(); batches * layers];
         for j in 0..v {
             for k in 0..layers {
                 let segment = fur.positions[(k + 1) * v + j] - fur.positions[k * v + j];
-                for c in 0..3 {
-                    rest_segments[j / LANES * layers + k][c][j % LANES] = segment[c];
-                }
+                rest_segments[j / LANES * layers + k].set(j % LANES, segment);
             }
         }
         let roots = fur.positions[..v].to_vec();
