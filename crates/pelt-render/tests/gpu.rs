@@ -196,3 +196,16 @@ fn separated_structure_renders_the_same_scene() {
         assert_eq!(separated.gpu_bytes(), expected_vertices * 32 + fur.mesh.triangles.len() as u64 * 12);
     }
 }
+
+/// `PELT_TEST_BACKEND` (CI runs the suite on lavapipe and on llvmpipe) really picks that backend.
+#[test]
+fn adapter_uses_the_requested_backend() {
+    let headless = headless(8, 8);
+    let backend = headless.gpu.adapter.get_info().backend;
+    match std::env::var("PELT_TEST_BACKEND").as_deref() {
+        Ok("gl") => assert_eq!(backend, wgpu::Backend::Gl),
+        Ok("vulkan") => assert_eq!(backend, wgpu::Backend::Vulkan),
+        _ => assert_ne!(backend, wgpu::Backend::Noop),
+    }
+    eprintln!("adapter: {}", headless.gpu.summary());
+}
