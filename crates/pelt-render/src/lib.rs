@@ -12,9 +12,8 @@
 //!
 //! Shell tile coordinates: meshes with uvs use them (scaled so a tile covers the same world size
 //! as without uvs); meshes without uvs use a triplanar projection of the rest root positions with
-//! sharp blend weights. Either way [`RenderSettings::texels_per_radius`] sets the strand size
-//! relative to the mesh's bounding radius, so any mesh, at any texture resolution, gets a sensible
-//! density.
+//! sharp blend weights. Either way [`RenderSettings::tiles_per_radius`] sets the strand density
+//! relative to the mesh's bounding radius, so any mesh gets a sensible density.
 
 mod camera;
 mod error;

@@ -53,9 +53,10 @@ pub struct RenderSettings {
     pub fin_fade_cos: f32,
     /// Shells fade where the surface turns below this |cos| to the view.
     pub shell_fade_cos: f32,
-    /// Shell texels across the mesh's bounding radius: strands get the same size relative to the
-    /// mesh whatever its size and whatever the texture's resolution.
-    pub texels_per_radius: f32,
+    /// Shell texture tiles across the mesh's bounding radius, so strands have the same density
+    /// relative to the mesh whatever its size. (A larger tile holds more, finer strands: the
+    /// texture's resolution sets how fine the fur is, as in the paper's "resizing".)
+    pub tiles_per_radius: f32,
     /// Linear RGB clear colour.
     pub background: Vec3,
 }
@@ -75,7 +76,7 @@ impl Default for RenderSettings {
             root_occlusion: 0.3,
             fin_fade_cos: 0.2,
             shell_fade_cos: 0.25,
-            texels_per_radius: 200.0,
+            tiles_per_radius: 0.4,
             background: Vec3::new(0.045, 0.05, 0.06),
         }
     }
@@ -499,7 +500,7 @@ impl Renderer {
             shininess: settings.shininess,
         };
         queue.write_buffer(&self.globals, 0, bytemuck::bytes_of(&globals));
-        let tiles_per_radius = self.textures.tiles_per_radius(settings);
+        let tiles_per_radius = settings.tiles_per_radius;
         self.fur.write_uniform(queue, tiles_per_radius, self.textures.shell_slices);
         for plain in &self.plain {
             plain.write_uniform(queue, tiles_per_radius, self.textures.shell_slices);
@@ -539,10 +540,6 @@ impl Renderer {
             pass.set_index_buffer(fur.fin_indices.slice(..), wgpu::IndexFormat::Uint32);
             pass.draw_indexed(0..6 * fur.layers, 0, 0..fur.edge_count);
         }
-    }
-
-    pub(crate) fn textures(&self) -> &GpuTextures {
-        &self.textures
     }
 
     pub(crate) fn globals_layout(&self) -> &wgpu::BindGroupLayout {

@@ -229,7 +229,7 @@ impl SeparatedRenderer {
         camera: &Camera,
         settings: &RenderSettings,
     ) {
-        let tiles_per_world = self.unified.textures().tiles_per_radius(settings) / self.radius;
+        let tiles_per_world = settings.tiles_per_radius / self.radius;
         let uniform = SeparatedUniform {
             tiles_per_world,
             layers: self.layers,

@@ -11,8 +11,6 @@ pub(crate) struct GpuTextures {
     pub shell: wgpu::TextureView,
     pub fin: wgpu::TextureView,
     pub shell_slices: u32,
-    /// Shell tile side in texels.
-    pub size: u32,
     /// Alpha-weighted mean strand colour of the root slice, linear RGB.
     pub root_colour: glam::Vec3,
 }
@@ -34,20 +32,7 @@ impl GpuTextures {
             ..wgpu::TextureViewDescriptor::default()
         });
         let fin = fin.create_view(&wgpu::TextureViewDescriptor::default());
-        Ok(Self {
-            shell,
-            fin,
-            shell_slices: textures.layers,
-            size: textures.size,
-            root_colour: root_colour(textures, slice_bytes),
-        })
-    }
-}
-
-impl GpuTextures {
-    /// Shell tiles across the mesh's bounding radius.
-    pub fn tiles_per_radius(&self, settings: &crate::RenderSettings) -> f32 {
-        settings.texels_per_radius / self.size as f32
+        Ok(Self { shell, fin, shell_slices: textures.layers, root_colour: root_colour(textures, slice_bytes) })
     }
 }
 

@@ -25,7 +25,7 @@ fn render(headless: &Headless, renderer: &Renderer, camera: &Camera, settings: &
 fn golden_bunny_still() {
     let fur = builtin_fur(Builtin::Bunny, 16);
     let headless = headless(SIZE, SIZE);
-    let renderer = headless.renderer(&fur, &strand_textures(128, 16, BROWN_ROOT, BROWN_TIP)).expect("renderer");
+    let renderer = headless.renderer(&fur, &strand_textures(256, 16, BROWN_ROOT, BROWN_TIP)).expect("renderer");
     check_golden("bunny-still", &render(&headless, &renderer, &framed(&fur, 1.0), &settings()));
 }
 
@@ -33,7 +33,7 @@ fn golden_bunny_still() {
 fn golden_box() {
     let fur = builtin_fur(Builtin::Box, 16);
     let headless = headless(SIZE, SIZE);
-    let textures = strand_textures(128, 16, [40, 40, 44], [235, 235, 240]);
+    let textures = strand_textures(256, 16, [40, 40, 44], [235, 235, 240]);
     let renderer = headless.renderer(&fur, &textures).expect("renderer");
     check_golden("box", &render(&headless, &renderer, &framed(&fur, 1.0), &settings()));
 }
@@ -43,7 +43,7 @@ fn golden_tryon() {
     let body = load_asset("female_generic.obj");
     let garment = grow(load_asset("skirthelper.obj"), 16, 0.12);
     let headless = headless(SIZE, SIZE);
-    let textures = strand_textures(128, 16, [30, 20, 45], [150, 110, 190]);
+    let textures = strand_textures(256, 16, [30, 20, 45], [150, 110, 190]);
     let mut renderer = headless.renderer(&garment, &textures).expect("renderer");
     renderer.add_plain_mesh(&headless.gpu.device, &body, Vec3::new(0.6, 0.45, 0.38)).expect("body");
     let (centre, radius) = garment.mesh.bounding_sphere();
@@ -57,7 +57,7 @@ fn golden_tryon() {
 fn fins_change_silhouette_pixels_only() {
     let fur = builtin_fur(Builtin::Sphere, 16);
     let headless = headless(SIZE, SIZE);
-    let renderer = headless.renderer(&fur, &strand_textures(128, 16, BROWN_ROOT, BROWN_TIP)).expect("renderer");
+    let renderer = headless.renderer(&fur, &strand_textures(256, 16, BROWN_ROOT, BROWN_TIP)).expect("renderer");
     let camera = framed(&fur, 1.0);
     let with_fins = render(&headless, &renderer, &camera, &settings());
     let without = render(&headless, &renderer, &camera, &RenderSettings { fins: false, ..settings() });
@@ -101,7 +101,7 @@ fn fur_coverage(image: &image::RgbaImage, background: [u8; 3]) -> f64 {
 #[test]
 fn more_layers_raise_fur_coverage() {
     let headless = headless(SIZE, SIZE);
-    let textures = strand_textures(128, 16, BROWN_ROOT, BROWN_TIP);
+    let textures = strand_textures(256, 16, BROWN_ROOT, BROWN_TIP);
     let fur_only = RenderSettings { skin: false, fins: false, ..settings() };
     let mut coverage = Vec::new();
     let mut camera = None;
@@ -133,7 +133,7 @@ fn centroid_x(image: &image::RgbaImage, background: [u8; 3]) -> f64 {
 fn bent_shared_vertices_move_fur_pixels_that_way() {
     let fur = builtin_fur(Builtin::Sphere, 16);
     let headless = headless(SIZE, SIZE);
-    let renderer = headless.renderer(&fur, &strand_textures(128, 16, BROWN_ROOT, BROWN_TIP)).expect("renderer");
+    let renderer = headless.renderer(&fur, &strand_textures(256, 16, BROWN_ROOT, BROWN_TIP)).expect("renderer");
     let camera = Camera::orbit(Vec3::ZERO, 0.0, 0.0, 5.0);
     let fur_only = RenderSettings { skin: false, ..settings() };
     let background = background(&headless, &renderer, &camera);
@@ -157,7 +157,7 @@ fn bent_shared_vertices_move_fur_pixels_that_way() {
 fn alpha_to_coverage_draws_the_same_fur() {
     let fur = builtin_fur(Builtin::Torus, 16);
     let headless = headless(SIZE, SIZE);
-    let renderer = headless.renderer(&fur, &strand_textures(128, 16, BROWN_ROOT, BROWN_TIP)).expect("renderer");
+    let renderer = headless.renderer(&fur, &strand_textures(256, 16, BROWN_ROOT, BROWN_TIP)).expect("renderer");
     let camera = framed(&fur, 1.0);
     let background = background(&headless, &renderer, &camera);
     let blended = render(&headless, &renderer, &camera, &settings());
@@ -175,7 +175,7 @@ fn alpha_to_coverage_draws_the_same_fur() {
 fn separated_structure_renders_the_same_scene() {
     let fur = builtin_fur(Builtin::Box, 16);
     let headless = headless(SIZE, SIZE);
-    let textures = strand_textures(128, 16, BROWN_ROOT, BROWN_TIP);
+    let textures = strand_textures(256, 16, BROWN_ROOT, BROWN_TIP);
     let unified = headless.renderer(&fur, &textures).expect("renderer");
     let camera = framed(&fur, 1.0);
     let background = background(&headless, &unified, &camera);
