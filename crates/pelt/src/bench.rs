@@ -6,6 +6,7 @@
 
 mod models;
 mod report;
+mod sim;
 mod system;
 mod table2;
 
@@ -13,6 +14,9 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use anyhow::Context as _;
+use pelt_core::fur::FurLength;
+use pelt_core::sim::SimParams;
+use pelt_core::{FurParams, FurStructure, GrowthDirection};
 
 use self::models::{MODELS, Model};
 use self::report::{Machine, RenderFigures, Report, ResultRow, SimFigures, SkippedModel, TextureFigures};
@@ -51,6 +55,15 @@ impl Plan {
     /// Whether `model` gets timings (Table 2 is computed for all).
     fn times(self, model: &str) -> bool {
         !self.quick || model == "box"
+    }
+
+    fn sim_budget(self) -> sim::SimBudget {
+        if self.quick {
+            sim::SimBudget { min_bend_secs: 0.05, drawn_frames: 24 }
+        } else {
+            // 4 s of simulated time: 120 steps at 30 Hz under 480 drawn frames.
+            sim::SimBudget { min_bend_secs: 0.5, drawn_frames: 480 }
+        }
     }
 }
 
@@ -118,7 +131,6 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
 }
 
 const RENDERER_MISSING: &str = "the renderer is not in this build yet (branch wip-render)";
-const SIMULATION_MISSING: &str = "the simulation is not in this build yet (branch wip-sim)";
 const TEXTURES_MISSING: &str = "texture generation is not in this build yet (branch wip-tex)";
 const QUICK_SKIPS: &str = "--quick times the Box only";
 
@@ -127,6 +139,13 @@ fn measure(model: &Model, layers: u32, plan: Plan) -> anyhow::Result<ResultRow> 
     let table2 = Table2Row::compute(model, layers)?;
     let timed = plan.times(model.spec.key);
     let skip = |missing: &str| Some(if timed { missing } else { QUICK_SKIPS }.to_owned());
+    let sim = if timed {
+        eprintln!("pelt bench:   {} L={layers}: simulation", model.spec.key);
+        let fur = grow(model, layers)?;
+        sim::measure(&fur, &SimParams::default(), plan.sim_budget())?
+    } else {
+        SimFigures { sim_unavailable_reason: skip(""), ..SimFigures::default() }
+    };
     Ok(ResultRow {
         model: model.spec.key,
         paper_model: model.spec.paper_model,
@@ -134,7 +153,15 @@ fn measure(model: &Model, layers: u32, plan: Plan) -> anyhow::Result<ResultRow> 
         layers,
         table2: (&table2).into(),
         render: RenderFigures { render_unavailable_reason: skip(RENDERER_MISSING), ..RenderFigures::default() },
-        sim: SimFigures { sim_unavailable_reason: skip(SIMULATION_MISSING), ..SimFigures::default() },
+        sim,
         texture: TextureFigures { texture_unavailable_reason: skip(TEXTURES_MISSING), ..TextureFigures::default() },
     })
+}
+
+/// The fur every timing uses: the furred mesh at `layers`, fur 8% of its bounding radius long.
+fn grow(model: &Model, layers: u32) -> anyhow::Result<FurStructure> {
+    let radius = model.fur.bounding_sphere().1;
+    let params =
+        FurParams { layers, length: FurLength::Constant(0.08 * radius), direction: GrowthDirection::default() };
+    Ok(FurStructure::new(model.fur.clone(), &params)?)
 }
