@@ -5,6 +5,7 @@
 //! a reader (or CI) runs in one go.
 
 mod models;
+mod render;
 mod report;
 mod sim;
 mod system;
@@ -57,6 +58,21 @@ impl Plan {
         !self.quick || model == "box"
     }
 
+    /// Whether `model` at `layers` gets frame times: a software rasteriser takes about a second
+    /// a frame at 1280x720, so `--quick` draws the Box at 16 layers only.
+    fn renders(self, model: &str, layers: u32) -> bool {
+        self.times(model) && (!self.quick || layers == LAYER_COUNTS[0])
+    }
+
+    fn render_budget(self) -> render::RenderBudget {
+        if self.quick {
+            render::RenderBudget { warmup_frames: 1, min_frames: 3, max_frames: 3, max_secs_per_case: 0.0 }
+        } else {
+            // Enough frames for a stable median on a GPU; at least 5 where a frame takes a second.
+            render::RenderBudget { warmup_frames: 2, min_frames: 5, max_frames: 101, max_secs_per_case: 2.0 }
+        }
+    }
+
     fn sim_budget(self) -> sim::SimBudget {
         if self.quick {
             sim::SimBudget { min_bend_secs: 0.05, drawn_frames: 24 }
@@ -79,6 +95,18 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let plan = Plan { quick: args.quick };
     let meshes_dir = models::meshes_dir(args.meshes.as_deref());
 
+    // One GPU for the whole run; without one the frame times are null with the reason.
+    let gpu = match render::Bench::open() {
+        Ok(gpu) => {
+            eprintln!("pelt bench: adapter {}", gpu.adapter().name);
+            Ok(gpu)
+        }
+        Err(error) => {
+            eprintln!("pelt bench: no GPU adapter, frame times will be null: {error:#}");
+            Err(format!("no GPU adapter: {error:#}"))
+        }
+    };
+
     let mut results = Vec::new();
     let mut skipped_models = Vec::new();
     for spec in MODELS.into_iter().filter(|m| args.models.is_empty() || args.models.iter().any(|n| n == m.key)) {
@@ -92,7 +120,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             }
         };
         for layers in LAYER_COUNTS {
-            results.push(measure(&model, layers, plan)?);
+            results.push(measure(&model, layers, plan, gpu.as_ref())?);
         }
     }
 
@@ -108,8 +136,8 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             memory_bytes: system::total_memory_bytes(),
             os: std::env::consts::OS,
         },
-        adapter: None,
-        adapter_unavailable_reason: Some(RENDERER_MISSING.to_owned()),
+        adapter: gpu.as_ref().ok().map(render::Bench::adapter),
+        adapter_unavailable_reason: gpu.as_ref().err().cloned(),
         paper_savings_vs_2_percent: table2::PAPER_SAVINGS_VS_2_PERCENT,
         paper_savings_vs_30_percent: table2::PAPER_SAVINGS_VS_30_PERCENT,
         results,
@@ -130,29 +158,51 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     Ok(())
 }
 
-const RENDERER_MISSING: &str = "the renderer is not in this build yet (branch wip-render)";
 const TEXTURES_MISSING: &str = "texture generation is not in this build yet (branch wip-tex)";
 const QUICK_SKIPS: &str = "--quick times the Box only";
+const QUICK_DRAWS: &str = "--quick draws the Box at 16 layers only";
 
 /// Every figure for one model at one layer count.
-fn measure(model: &Model, layers: u32, plan: Plan) -> anyhow::Result<ResultRow> {
+fn measure(model: &Model, layers: u32, plan: Plan, gpu: Result<&render::Bench, &String>) -> anyhow::Result<ResultRow> {
     let table2 = Table2Row::compute(model, layers)?;
     let timed = plan.times(model.spec.key);
     let skip = |missing: &str| Some(if timed { missing } else { QUICK_SKIPS }.to_owned());
-    let sim = if timed {
-        eprintln!("pelt bench:   {} L={layers}: simulation", model.spec.key);
-        let fur = grow(model, layers)?;
-        sim::measure(&fur, &SimParams::default(), plan.sim_budget())?
-    } else {
-        SimFigures { sim_unavailable_reason: skip(""), ..SimFigures::default() }
+    if !timed {
+        return Ok(ResultRow {
+            model: model.spec.key,
+            paper_model: model.spec.paper_model,
+            mesh: model.source(),
+            layers,
+            table2: (&table2).into(),
+            render: RenderFigures { render_unavailable_reason: skip(""), ..RenderFigures::default() },
+            sim: SimFigures { sim_unavailable_reason: skip(""), ..SimFigures::default() },
+            texture: TextureFigures { texture_unavailable_reason: skip(""), ..TextureFigures::default() },
+        });
+    }
+    let fur = grow(model, layers)?;
+    let textures: Option<pelt_core::texture::FurTextures> = None;
+    let render = match (gpu, &textures) {
+        _ if !plan.renders(model.spec.key, layers) => {
+            RenderFigures { render_unavailable_reason: Some(QUICK_DRAWS.to_owned()), ..RenderFigures::default() }
+        }
+        (Ok(gpu), Some(textures)) => {
+            eprintln!("pelt bench:   {} L={layers}: frame time", model.spec.key);
+            gpu.measure(&fur, textures, plan.render_budget())?
+        }
+        (Err(reason), _) => {
+            RenderFigures { render_unavailable_reason: Some(reason.clone()), ..RenderFigures::default() }
+        }
+        (_, None) => RenderFigures { render_unavailable_reason: skip(TEXTURES_MISSING), ..RenderFigures::default() },
     };
+    eprintln!("pelt bench:   {} L={layers}: simulation", model.spec.key);
+    let sim = sim::measure(&fur, &SimParams::default(), plan.sim_budget())?;
     Ok(ResultRow {
         model: model.spec.key,
         paper_model: model.spec.paper_model,
         mesh: model.source(),
         layers,
         table2: (&table2).into(),
-        render: RenderFigures { render_unavailable_reason: skip(RENDERER_MISSING), ..RenderFigures::default() },
+        render,
         sim,
         texture: TextureFigures { texture_unavailable_reason: skip(TEXTURES_MISSING), ..TextureFigures::default() },
     })

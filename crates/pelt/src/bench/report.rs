@@ -300,7 +300,8 @@ fn notes<'a>(md: &mut String, reasons: impl Iterator<Item = (&'a ResultRow, Opti
         let Some(reason) = reason else { continue };
         let label = format!("{} L={}", row.model, row.layers);
         match grouped.iter_mut().find(|(r, _)| *r == reason) {
-            Some((_, rows)) => rows.push(label),
+            Some((_, rows)) if !rows.contains(&label) => rows.push(label),
+            Some(_) => {}
             None => grouped.push((reason, vec![label])),
         }
     }

@@ -1,0 +1,161 @@
+//! Frame time of the unified structure against the separated one (2-face and 30-face fins) on
+//! the same scene, on whatever adapter is found.
+
+use std::time::{Duration, Instant};
+
+use anyhow::Context as _;
+use pelt_core::FurStructure;
+use pelt_core::texture::FurTextures;
+use pelt_render::{
+    Backend, Camera, Gpu, HEADLESS_FORMAT, RenderSettings, RenderTargets, Renderer, SeparatedRenderer, TargetFormat,
+};
+
+use super::report::{Adapter, RenderFigures};
+use super::table2::MANY_FIN_FACES;
+
+/// The two frame sizes: a typical window and a small one where vertex work dominates.
+pub const SIZES: [(u32, u32); 2] = [(1280, 720), (256, 256)];
+
+/// How many frames each median is taken over.
+#[derive(Clone, Copy, Debug)]
+pub struct RenderBudget {
+    /// Frames drawn and thrown away first (pipeline compilation, first uploads).
+    pub warmup_frames: u32,
+    pub min_frames: u32,
+    pub max_frames: u32,
+    /// Stop after `min_frames` once this much time is spent on one structure at one size.
+    pub max_secs_per_case: f64,
+}
+
+/// A GPU opened once for the whole run.
+pub struct Bench {
+    gpu: Gpu,
+}
+
+impl std::fmt::Debug for Bench {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("Bench").field("adapter", &self.gpu.summary()).finish()
+    }
+}
+
+impl Bench {
+    /// Opens the best adapter (`WGPU_BACKEND` chooses the API when set).
+    pub fn open() -> anyhow::Result<Self> {
+        Ok(Self { gpu: Gpu::new(Backend::Auto)? })
+    }
+
+    pub fn adapter(&self) -> Adapter {
+        let info = self.gpu.adapter.get_info();
+        Adapter {
+            name: info.name,
+            backend: format!("{:?}", info.backend),
+            device_type: format!("{:?}", info.device_type),
+            driver: format!("{} {}", info.driver, info.driver_info).trim().to_owned(),
+        }
+    }
+
+    /// Median frame times of the three structures at both sizes.
+    pub fn measure(
+        &self,
+        fur: &FurStructure,
+        textures: &FurTextures,
+        budget: RenderBudget,
+    ) -> anyhow::Result<RenderFigures> {
+        let (device, queue) = (&self.gpu.device, &self.gpu.queue);
+        let format = TargetFormat::msaa(HEADLESS_FORMAT);
+        let unified = Renderer::new(device, queue, format, fur, textures).context("building the unified renderer")?;
+        let separated2 = SeparatedRenderer::new(device, queue, format, fur, textures, 2)
+            .context("building the separated renderer (2-face fins)")?;
+        let separated30 = SeparatedRenderer::new(device, queue, format, fur, textures, MANY_FIN_FACES)
+            .context("building the separated renderer (30-face fins)")?;
+        let settings = RenderSettings::default();
+        let (centre, radius) = fur.mesh.bounding_sphere();
+        let radius = radius + fur.lengths.iter().copied().fold(0.0, f32::max);
+
+        let mut medians = [[0.0; 3]; SIZES.len()];
+        let mut frames_measured = u32::MAX;
+        for ((width, height), row) in SIZES.into_iter().zip(&mut medians) {
+            let targets = RenderTargets::new(device, format, width, height)?;
+            let output = device.create_texture(&wgpu_output_descriptor(width, height));
+            let view = output.create_view(&Default::default());
+            let camera = Camera::framing(centre, radius, 35.0, 20.0, targets.aspect_ratio());
+            let cases: [&dyn Fn(&mut wgpu::CommandEncoder); 3] = [
+                &|encoder| unified.render(queue, encoder, &targets, &view, &camera, &settings),
+                &|encoder| separated2.render(queue, encoder, &targets, &view, &camera, &settings),
+                &|encoder| separated30.render(queue, encoder, &targets, &view, &camera, &settings),
+            ];
+            for (case, median) in cases.iter().zip(row.iter_mut()) {
+                let times = self.time_frames(case, budget)?;
+                frames_measured = frames_measured.min(times.len() as u32);
+                *median = median_ms(&times);
+            }
+        }
+        let [[u_large, s2_large, s30_large], [u_small, s2_small, s30_small]] = medians;
+        Ok(RenderFigures {
+            frame_ms_unified_1280x720: Some(u_large),
+            frame_ms_separated2_1280x720: Some(s2_large),
+            frame_ms_separated30_1280x720: Some(s30_large),
+            frame_ms_unified_256x256: Some(u_small),
+            frame_ms_separated2_256x256: Some(s2_small),
+            frame_ms_separated30_256x256: Some(s30_small),
+            render_frames: Some(frames_measured),
+            render_unavailable_reason: None,
+        })
+    }
+
+    /// Records, submits and waits for frames one at a time: each time is one frame's CPU
+    /// recording plus all of its GPU work.
+    fn time_frames(
+        &self,
+        record: &dyn Fn(&mut wgpu::CommandEncoder),
+        budget: RenderBudget,
+    ) -> anyhow::Result<Vec<Duration>> {
+        let device = &self.gpu.device;
+        let frame = || -> anyhow::Result<Duration> {
+            let started = Instant::now();
+            let mut encoder = device.create_command_encoder(&Default::default());
+            record(&mut encoder);
+            self.gpu.queue.submit([encoder.finish()]);
+            device.poll(wgpu::PollType::wait_indefinitely()).context("waiting for the GPU")?;
+            Ok(started.elapsed())
+        };
+        for _ in 0..budget.warmup_frames {
+            frame()?;
+        }
+        let started = Instant::now();
+        let mut times = Vec::new();
+        while times.len() < budget.max_frames as usize
+            && (times.len() < budget.min_frames as usize || started.elapsed().as_secs_f64() < budget.max_secs_per_case)
+        {
+            times.push(frame()?);
+        }
+        Ok(times)
+    }
+}
+
+fn wgpu_output_descriptor(width: u32, height: u32) -> wgpu::TextureDescriptor<'static> {
+    wgpu::TextureDescriptor {
+        label: Some("pelt bench output"),
+        size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: HEADLESS_FORMAT,
+        usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
+        view_formats: &[],
+    }
+}
+
+/// The median of `times` in milliseconds (the mean of the middle two for an even count).
+fn median_ms(times: &[Duration]) -> f64 {
+    let mut ms: Vec<f64> = times.iter().map(|t| t.as_secs_f64() * 1000.0).collect();
+    ms.sort_by(f64::total_cmp);
+    let n = ms.len();
+    if n == 0 {
+        f64::NAN
+    } else if n % 2 == 1 {
+        ms[n / 2]
+    } else {
+        0.5 * (ms[n / 2 - 1] + ms[n / 2])
+    }
+}
