@@ -54,6 +54,7 @@ const MEASURED_KEYS: [(&str, &[&str]); 3] = [
             "frame_ms_separated2_256x256",
             "frame_ms_separated30_256x256",
             "render_frames",
+            "upload_ms_per_frame",
         ],
     ),
     (

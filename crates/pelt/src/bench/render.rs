@@ -90,6 +90,10 @@ impl Bench {
                 *median = median_ms(&times);
             }
         }
+        // The per-frame upload an animated unified fur adds: the whole shared vertex array.
+        unified.update_positions(queue, &fur.positions)?;
+        let upload_times = self
+            .time_frames(&|_| unified.update_positions(queue, &fur.positions).expect("checked just above"), budget)?;
         let [[u_large, s2_large, s30_large], [u_small, s2_small, s30_small]] = medians;
         Ok(RenderFigures {
             frame_ms_unified_1280x720: Some(u_large),
@@ -99,6 +103,7 @@ impl Bench {
             frame_ms_separated2_256x256: Some(s2_small),
             frame_ms_separated30_256x256: Some(s30_small),
             render_frames: Some(frames_measured),
+            upload_ms_per_frame: Some(median_ms(&upload_times)),
             render_unavailable_reason: None,
         })
     }
