@@ -96,7 +96,6 @@ pub fn downsample_rgba8(rgba: &[u8], width: u32, height: u32, count: u32) -> Vec
                 let mut colour = [0u32; 3];
                 let mut alpha = 0u32;
                 let mut plain = [0u32; 3];
-                let mut taps = 0u32;
                 for (dx, dy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
                     let (sx, sy) = ((2 * x + dx).min(w - 1), (2 * y + dy).min(h - 1));
                     let p = &image[(sy * w + sx) * 4..(sy * w + sx) * 4 + 4];
@@ -106,14 +105,13 @@ pub fn downsample_rgba8(rgba: &[u8], width: u32, height: u32, count: u32) -> Vec
                         plain[c] += u32::from(p[c]);
                     }
                     alpha += a;
-                    taps += 1;
                 }
                 for c in 0..3 {
                     // Fully transparent blocks keep their plain mean so filtering never bleeds black.
-                    let value = if alpha > 0 { (colour[c] + alpha / 2) / alpha } else { (plain[c] + taps / 2) / taps };
+                    let value = (colour[c] + alpha / 2).checked_div(alpha).unwrap_or((plain[c] + 2) / 4);
                     out.push(value as u8);
                 }
-                out.push(((alpha + taps / 2) / taps) as u8);
+                out.push(((alpha + 2) / 4) as u8);
             }
         }
     }
@@ -133,10 +131,10 @@ mod tests {
     #[test]
     fn downsample_weights_colour_by_alpha() {
         // One opaque red texel among three transparent green ones stays pure red, quarter alpha.
-        let mut rgba = vec![0, 255, 0, 0].repeat(4);
+        let mut rgba = [0, 255, 0, 0].repeat(4);
         rgba[0..4].copy_from_slice(&[255, 0, 0, 255]);
         assert_eq!(downsample_rgba8(&rgba, 2, 2, 1), vec![255, 0, 0, 64]);
-        let transparent = vec![0, 255, 0, 0].repeat(4);
+        let transparent = [0, 255, 0, 0].repeat(4);
         assert_eq!(downsample_rgba8(&transparent, 2, 2, 1), vec![0, 255, 0, 0]);
     }
 

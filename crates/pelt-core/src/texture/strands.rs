@@ -231,6 +231,7 @@ pub(super) fn draw_slice(params: &TextureParams, strands: &[Strand], t: f32, col
         let Some((inner, outer)) = strand.profile(t, params.taper, params.root_blur) else { continue };
         let centre = strand.centre(t);
         let rgb = colour(strand, t);
+        let outer_squared = outer * outer;
         let (x0, x1) = ((centre.x - outer).floor() as i64, (centre.x + outer).ceil() as i64);
         let (y0, y1) = ((centre.y - outer).floor() as i64, (centre.y + outer).ceil() as i64);
         for y in y0..y1 {
@@ -239,7 +240,11 @@ pub(super) fn draw_slice(params: &TextureParams, strands: &[Strand], t: f32, col
             let row = (y & mask) as usize * size;
             for x in x0..x1 {
                 let dx = x as f32 + 0.5 - centre.x;
-                let a = coverage((dx * dx + dy * dy).sqrt(), inner, outer);
+                let distance_squared = dx * dx + dy * dy;
+                if distance_squared >= outer_squared {
+                    continue;
+                }
+                let a = coverage(distance_squared.sqrt(), inner, outer);
                 if a > 0.0 {
                     let texel = &mut texels[row + (x & mask) as usize];
                     texel.transmission *= 1.0 - a;
