@@ -84,7 +84,7 @@ fn root_coverage_grows_with_density() {
 }
 
 #[test]
-fn larger_tiles_hold_more_strands_at_the_same_density() {
+fn coverage_follows_density_not_tile_size() {
     // Same density, four times the texels: about four times the strands, each the same size in
     // texels, so the same coverage but finer strands relative to the tile.
     let strands = |size| {
