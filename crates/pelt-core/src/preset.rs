@@ -108,7 +108,8 @@ impl Preset {
     /// # Errors
     /// [`PresetError`] naming the file (and the key) for a missing file, bad TOML, unknown keys,
     /// wrong types, values out of range and referenced images that do not exist.
-    pub fn load(path: &Path) -> Result<Self, PresetError> {
+    pub fn load(path: impl AsRef<Path>) -> Result<Self, PresetError> {
+        let path = path.as_ref();
         let text =
             std::fs::read_to_string(path).map_err(|source| PresetError::Io { file: path.to_path_buf(), source })?;
         let preset = Self::from_toml_str(&text, path)?;

@@ -73,7 +73,7 @@ fn every_shipped_preset_loads_and_they_differ() {
 
 #[test]
 fn a_shipped_preset_generates_with_its_pattern() {
-    let mut preset = Preset::load(&presets_folder().join("spotted.toml")).unwrap();
+    let mut preset = Preset::load(presets_folder().join("spotted.toml")).unwrap();
     preset.texture.size = 64;
     preset.layers = 4;
     let textures = preset.generate_textures().unwrap();
@@ -97,14 +97,14 @@ fn surface_and_gradient_images_resolve_next_to_the_preset() {
         format!("{small}[colour]\nmode = \"surface\"\nsurface = \"skin.png\"\n"),
     )
     .unwrap();
-    let textures = Preset::load(&folder.join("surface.toml")).unwrap().generate_textures().unwrap();
+    let textures = Preset::load(folder.join("surface.toml")).unwrap().generate_textures().unwrap();
     let surface = textures.surface.expect("surface mode passes the image on");
     assert_eq!((surface.width, surface.height), (2, 2));
     assert_eq!(&surface.pixels[0..4], &[200, 100, 50, 255]);
 
     std::fs::write(folder.join("dye.toml"), format!("{small}[colour]\nmode = \"height\"\ngradient = \"dye.png\"\n"))
         .unwrap();
-    let textures = Preset::load(&folder.join("dye.toml")).unwrap().generate_textures().unwrap();
+    let textures = Preset::load(folder.join("dye.toml")).unwrap().generate_textures().unwrap();
     let red_share = |k: u32| {
         let (red, blue) = textures
             .slice(k)
@@ -186,7 +186,7 @@ fn out_of_range_values_name_the_key_and_the_range() {
 #[test]
 fn missing_files_are_errors_naming_them() {
     let folder = scratch("missing");
-    let missing = PresetError::to_string(&Preset::load(&folder.join("nowhere.toml")).unwrap_err());
+    let missing = PresetError::to_string(&Preset::load(folder.join("nowhere.toml")).unwrap_err());
     assert!(missing.contains("nowhere.toml"), "{missing}");
 
     let preset = folder.join("spots.toml");

@@ -31,6 +31,10 @@ fn layout_and_sizes() {
     assert_eq!(mips.len(), 6);
     assert_eq!(mips[0].len(), (32 * 32 * 4 * LAYERS) as usize);
     assert_eq!(mips[5].len(), (4 * LAYERS) as usize);
+    let fin_mips = textures.fin_mips();
+    assert_eq!(fin_mips.len(), 6);
+    assert_eq!(fin_mips[0].len(), (32 * 16 * 4) as usize);
+    assert_eq!(fin_mips[5].len(), 4);
     // Alpha-weighted filtering keeps the mean coverage of the slice.
     let mean_alpha =
         |bytes: &[u8]| bytes.chunks_exact(4).map(|p| f64::from(p[3])).sum::<f64>() / (bytes.len() / 4) as f64 / 255.0;

@@ -1,5 +1,6 @@
 //! `pelt textures`: a preset's shell slices, fin texture and a contact sheet as PNGs.
 
+use std::io::Write as _;
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
@@ -47,18 +48,22 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let sheet = textures.contact_sheet(SHEET_TILE_MAX, SHEET_BACKGROUND);
     save(&args.out.join("contact_sheet.png"), &sheet.pixels, sheet.width, sheet.height)?;
 
-    println!(
-        "{}: {} slices of {0}x{0} texels and a {}x{} fin in {:.0} ms (seed {})",
-        preset.file().display(),
-        textures.layers,
-        textures.fin_width,
-        textures.fin_height,
-        generation_secs * 1000.0,
-        preset.texture.seed,
-    );
     let coverage: Vec<String> = (0..textures.layers).map(|k| format!("{:.2}", textures.coverage(k))).collect();
-    println!("coverage root to tip: {}", coverage.join(" "));
-    println!("wrote {}", args.out.display());
+    // Written, not printed: a closed pipe (`| head`) is an error to report, not a panic.
+    let mut out = std::io::stdout().lock();
+    writeln!(
+        out,
+        "{file}: {layers} slices of {size}x{size} texels and a {fin_width}x{fin_height} fin in {ms:.0} ms (seed {seed})",
+        file = preset.file().display(),
+        layers = textures.layers,
+        size = textures.size,
+        fin_width = textures.fin_width,
+        fin_height = textures.fin_height,
+        ms = generation_secs * 1000.0,
+        seed = preset.texture.seed,
+    )?;
+    writeln!(out, "coverage root to tip: {}", coverage.join(" "))?;
+    writeln!(out, "wrote {}", args.out.display())?;
     Ok(())
 }
 

@@ -105,6 +105,20 @@ impl FurTextures {
         levels
     }
 
+    /// The fin mip chain below level 0, like [`Self::shell_mips`] (down to one texel high).
+    #[must_use]
+    pub fn fin_mips(&self) -> Vec<Vec<u8>> {
+        let mut levels: Vec<Vec<u8>> = Vec::new();
+        let (mut width, mut height) = (self.fin_width, self.fin_height);
+        while width > 1 || height > 1 {
+            let previous = levels.last().unwrap_or(&self.fin);
+            let next = downsample_rgba8(previous, width, height, 1);
+            levels.push(next);
+            (width, height) = ((width / 2).max(1), (height / 2).max(1));
+        }
+        levels
+    }
+
     /// Every slice, root first, left to right in rows of 8, composited over `background` so
     /// alpha shows; tiles larger than `max_tile` are mip-filtered down to it.
     #[must_use]
