@@ -24,7 +24,7 @@ use crate::texture::{self, ColourMode, ColourParams, FurTextures, ImageRgba8, Te
 /// Why a preset could not be read, checked or used. Every message starts with the file.
 #[derive(Debug, thiserror::Error)]
 pub enum PresetError {
-    #[error("{file}: cannot read the preset: {source}")]
+    #[error("{file}: cannot read or write the preset: {source}")]
     Io { file: PathBuf, source: std::io::Error },
     /// TOML syntax, wrong types and unknown keys: toml's own message, with the line and key.
     #[error("{file}: {message}")]
@@ -147,6 +147,17 @@ impl Preset {
     /// [`PresetError::Write`] if a value cannot be written (e.g. a non-finite number).
     pub fn to_toml_string(&self) -> Result<String, PresetError> {
         toml::to_string(self).map_err(|e| PresetError::Write(e.to_string()))
+    }
+
+    /// Writes the preset as TOML to `path` (e.g. from an authoring tool). Image paths are written
+    /// as they are, so keep them relative to the new file's folder.
+    ///
+    /// # Errors
+    /// [`PresetError::Write`] or [`PresetError::Io`] naming the file.
+    pub fn save(&self, path: impl AsRef<Path>) -> Result<(), PresetError> {
+        let path = path.as_ref();
+        let text = self.to_toml_string()?;
+        std::fs::write(path, text).map_err(|source| PresetError::Io { file: path.to_path_buf(), source })
     }
 
     /// The file this preset was read from (or a placeholder name).

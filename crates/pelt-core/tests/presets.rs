@@ -44,7 +44,7 @@ fn round_trip_through_toml_and_a_file() {
     assert_eq!(Preset::from_toml_str(&text, "memory.toml").unwrap(), preset);
 
     let file = scratch("round_trip").join("fur.toml");
-    std::fs::write(&file, &text).unwrap();
+    preset.save(&file).unwrap();
     let loaded = Preset::load(&file).unwrap();
     assert_eq!(loaded, preset);
     assert_eq!(loaded.file(), file);
