@@ -34,7 +34,7 @@ pub const MAX_TILE_SIZE: u32 = 2048;
 ///
 /// Every size is a power of two and alpha is straight, so a mip chain is a repeated
 /// [`downsample_rgba8`] (alpha-weighted 2x2 box): see [`FurTextures::shell_mips`].
-#[derive(Clone, Debug, PartialEq, Eq)]
+#[derive(Clone, PartialEq, Eq)]
 pub struct FurTextures {
     /// Shell tiles are `size x size` texels and wrap seamlessly.
     pub size: u32,
@@ -53,6 +53,19 @@ pub struct FurTextures {
     /// grey per-strand brightness; the renderer multiplies it by this image sampled with the
     /// mesh's corner UVs. `None` in the other modes (the RGB is the final strand colour).
     pub surface: Option<ImageRgba8>,
+}
+
+// Sizes only: the derived form would print megabytes of texels.
+impl std::fmt::Debug for FurTextures {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("FurTextures")
+            .field("size", &self.size)
+            .field("layers", &self.layers)
+            .field("shell_bytes", &self.shell.len())
+            .field("fin_size", &(self.fin_width, self.fin_height))
+            .field("surface", &self.surface)
+            .finish()
+    }
 }
 
 impl FurTextures {
