@@ -15,9 +15,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use anyhow::Context as _;
-use pelt_core::fur::FurLength;
-use pelt_core::sim::SimParams;
-use pelt_core::{FurParams, FurStructure, GrowthDirection};
+use pelt_core::{FurStructure, Preset};
 
 use self::models::{MODELS, Model};
 use self::report::{Machine, RenderFigures, Report, ResultRow, SimFigures, SkippedModel, TextureFigures};
@@ -158,60 +156,56 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     Ok(())
 }
 
-const TEXTURES_MISSING: &str = "texture generation is not in this build yet (branch wip-tex)";
 const QUICK_SKIPS: &str = "--quick times the Box only";
 const QUICK_DRAWS: &str = "--quick draws the Box at 16 layers only";
 
 /// Every figure for one model at one layer count.
 fn measure(model: &Model, layers: u32, plan: Plan, gpu: Result<&render::Bench, &String>) -> anyhow::Result<ResultRow> {
-    let table2 = Table2Row::compute(model, layers)?;
-    let timed = plan.times(model.spec.key);
-    let skip = |missing: &str| Some(if timed { missing } else { QUICK_SKIPS }.to_owned());
-    if !timed {
-        return Ok(ResultRow {
+    let row = |render, sim, texture| -> anyhow::Result<ResultRow> {
+        Ok(ResultRow {
             model: model.spec.key,
             paper_model: model.spec.paper_model,
             mesh: model.source(),
             layers,
-            table2: (&table2).into(),
-            render: RenderFigures { render_unavailable_reason: skip(""), ..RenderFigures::default() },
-            sim: SimFigures { sim_unavailable_reason: skip(""), ..SimFigures::default() },
-            texture: TextureFigures { texture_unavailable_reason: skip(""), ..TextureFigures::default() },
-        });
+            table2: (&Table2Row::compute(model, layers)?).into(),
+            render,
+            sim,
+            texture,
+        })
+    };
+    if !plan.times(model.spec.key) {
+        let reason = || Some(QUICK_SKIPS.to_owned());
+        return row(
+            RenderFigures { render_unavailable_reason: reason(), ..RenderFigures::default() },
+            SimFigures { sim_unavailable_reason: reason(), ..SimFigures::default() },
+            TextureFigures { texture_unavailable_reason: reason(), ..TextureFigures::default() },
+        );
     }
-    let fur = grow(model, layers)?;
-    let textures: Option<pelt_core::texture::FurTextures> = None;
-    let render = match (gpu, &textures) {
-        _ if !plan.renders(model.spec.key, layers) => {
+
+    // Everything timed uses the default preset at this layer count.
+    let mut preset = Preset::default();
+    preset.layers = layers;
+    let fur = FurStructure::new(model.fur.clone(), &preset.fur_params(&model.fur))?;
+    let key = model.spec.key;
+    eprintln!("pelt bench:   {key} L={layers}: textures");
+    let started = Instant::now();
+    let textures = preset.generate_textures()?;
+    let texture = TextureFigures {
+        texture_generation_ms: Some(started.elapsed().as_secs_f64() * 1000.0),
+        texture_size_texels: Some(textures.size),
+        texture_unavailable_reason: None,
+    };
+    let render = match gpu {
+        _ if !plan.renders(key, layers) => {
             RenderFigures { render_unavailable_reason: Some(QUICK_DRAWS.to_owned()), ..RenderFigures::default() }
         }
-        (Ok(gpu), Some(textures)) => {
-            eprintln!("pelt bench:   {} L={layers}: frame time", model.spec.key);
-            gpu.measure(&fur, textures, plan.render_budget())?
+        Ok(gpu) => {
+            eprintln!("pelt bench:   {key} L={layers}: frame time");
+            gpu.measure(&fur, &textures, plan.render_budget())?
         }
-        (Err(reason), _) => {
-            RenderFigures { render_unavailable_reason: Some(reason.clone()), ..RenderFigures::default() }
-        }
-        (_, None) => RenderFigures { render_unavailable_reason: skip(TEXTURES_MISSING), ..RenderFigures::default() },
+        Err(reason) => RenderFigures { render_unavailable_reason: Some(reason.clone()), ..RenderFigures::default() },
     };
-    eprintln!("pelt bench:   {} L={layers}: simulation", model.spec.key);
-    let sim = sim::measure(&fur, &SimParams::default(), plan.sim_budget())?;
-    Ok(ResultRow {
-        model: model.spec.key,
-        paper_model: model.spec.paper_model,
-        mesh: model.source(),
-        layers,
-        table2: (&table2).into(),
-        render,
-        sim,
-        texture: TextureFigures { texture_unavailable_reason: skip(TEXTURES_MISSING), ..TextureFigures::default() },
-    })
-}
-
-/// The fur every timing uses: the furred mesh at `layers`, fur 8% of its bounding radius long.
-fn grow(model: &Model, layers: u32) -> anyhow::Result<FurStructure> {
-    let radius = model.fur.bounding_sphere().1;
-    let params =
-        FurParams { layers, length: FurLength::Constant(0.08 * radius), direction: GrowthDirection::default() };
-    Ok(FurStructure::new(model.fur.clone(), &params)?)
+    eprintln!("pelt bench:   {key} L={layers}: simulation");
+    let sim = sim::measure(&fur, &preset.simulation, plan.sim_budget())?;
+    row(render, sim, texture)
 }
