@@ -249,3 +249,21 @@ fn adapter_uses_the_requested_backend() {
     }
     eprintln!("adapter: {}", headless.gpu.summary());
 }
+
+/// Surface colour mode: grey strands take the mesh texture's colour at their roots.
+#[test]
+fn surface_colour_tints_strands_by_the_mesh_uvs() {
+    let fur = builtin_fur(Builtin::Sphere, 16);
+    assert!(fur.mesh.corner_uvs.is_some(), "the sphere has uvs");
+    let mut textures = strand_textures(256, 16, [180, 180, 180], [255, 255, 255]);
+    // Red and blue stripes across u (around the sphere), each 1/8 of the way round.
+    let pixels = (0..8).flat_map(|x| if x % 2 == 0 { [230, 20, 20, 255] } else { [20, 20, 230, 255] }).collect();
+    textures.surface = Some(pelt_core::texture::ImageRgba8 { width: 8, height: 1, pixels });
+    let headless = headless(SIZE, SIZE);
+    let renderer = headless.renderer(&fur, &textures).expect("renderer");
+    let camera = Camera::orbit(Vec3::ZERO, 0.0, 0.0, 5.0);
+    let image = render(&headless, &renderer, &camera, &settings());
+    let reddish = image.pixels().filter(|p| i32::from(p.0[0]) > i32::from(p.0[2]) + 40).count();
+    let bluish = image.pixels().filter(|p| i32::from(p.0[2]) > i32::from(p.0[0]) + 40).count();
+    assert!(reddish > 500 && bluish > 500, "red {reddish} and blue {bluish} pixels");
+}
