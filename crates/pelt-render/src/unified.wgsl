@@ -73,8 +73,10 @@ fn surface_varyings(vertex: u32, corner: u32, layer: u32) -> Varyings {
     out.tangent = strand_tangent(layer, vertex);
     out.tile_position = shared_vertex(0u, vertex) * object.tiles_per_world;
     if object.has_uvs != 0u {
-        out.uv = corner_uvs[corner] * object.tiles_per_uv;
+        out.surface_uv = corner_uvs[corner];
+        out.uv = out.surface_uv * object.tiles_per_uv;
     } else {
+        out.surface_uv = vec2<f32>(0.0);
         out.uv = vec2<f32>(0.0);
     }
     out.layer = layer;
@@ -165,6 +167,15 @@ fn vs_fin(@builtin(vertex_index) index: u32, @builtin(instance_index) edge: u32)
     out.uv = vec2<f32>(offset + f32(side) * distance(root_a, root_b) * object.tiles_per_world, f32(layer) / f32(max(object.layers, 1u)));
     out.layer = 0u;
     out.slice = 0;
+    // The surface uv of this end of the edge, from its corner in the first face.
+    out.surface_uv = vec2<f32>(0.0);
+    if object.has_uvs != 0u {
+        for (var k = 0u; k < 3u; k++) {
+            if topology[3u * face_a + k] == vertex {
+                out.surface_uv = corner_uvs[3u * face_a + k];
+            }
+        }
+    }
     out.height = out.uv.y;
     out.fade = 1.0 - smoothstep(0.0, globals.fin_fade_cos, edge_on);
     if out.fade <= 0.0 {
