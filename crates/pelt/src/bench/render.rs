@@ -28,14 +28,9 @@ pub struct RenderBudget {
 }
 
 /// A GPU opened once for the whole run.
+#[derive(Debug)]
 pub struct Bench {
     gpu: Gpu,
-}
-
-impl std::fmt::Debug for Bench {
-    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        f.debug_struct("Bench").field("adapter", &self.gpu.summary()).finish()
-    }
 }
 
 impl Bench {
@@ -162,5 +157,18 @@ fn median_ms(times: &[Duration]) -> f64 {
         ms[n / 2]
     } else {
         0.5 * (ms[n / 2 - 1] + ms[n / 2])
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn median_of_odd_and_even_counts() {
+        let ms = |v: &[u64]| v.iter().map(|&m| Duration::from_millis(m)).collect::<Vec<_>>();
+        assert!((median_ms(&ms(&[9, 1, 5])) - 5.0).abs() < 1e-9);
+        assert!((median_ms(&ms(&[4, 1, 3, 100])) - 3.5).abs() < 1e-9);
+        assert!(median_ms(&[]).is_nan());
     }
 }
