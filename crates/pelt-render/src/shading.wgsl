@@ -1,0 +1,169 @@
+// Shared by every fur pipeline: the frame's globals, the fur textures and the lighting.
+// `unified.wgsl` and `separated.wgsl` are appended to this file to make one module each.
+
+struct Globals {
+    clip_from_world: mat4x4<f32>,
+    camera_position: vec3<f32>,
+    // 1 when shells and fins use alpha-to-coverage (straight colour out), 0 when blended.
+    alpha_to_coverage: u32,
+    // Unit vector toward the key light.
+    light_direction: vec3<f32>,
+    ambient: f32,
+    light_colour: vec3<f32>,
+    specular: f32,
+    // Fur colour at the roots (linear RGB); the opaque skin uses it.
+    root_colour: vec4<f32>,
+    // |cos| between the view and a fin's faces below which the fin is fully shown.
+    fin_fade_cos: f32,
+    // |cos| between the view and the surface below which shells fade out.
+    shell_fade_cos: f32,
+    // Light left at the roots by self-shadowing (1 = none).
+    root_occlusion: f32,
+    shininess: f32,
+    // 1 when strand colours are grey brightness to be multiplied by the surface texture.
+    has_surface: u32,
+    padding_0: u32,
+    padding_1: u32,
+    padding_2: u32,
+}
+
+@group(0) @binding(0) var<uniform> globals: Globals;
+@group(0) @binding(1) var shell_texture: texture_2d_array<f32>;
+@group(0) @binding(2) var fin_texture: texture_2d<f32>;
+@group(0) @binding(3) var shell_sampler: sampler;
+@group(0) @binding(4) var fin_sampler: sampler;
+// The mesh's colour texture (surface colour mode), else 1x1 white.
+@group(0) @binding(5) var surface_texture: texture_2d<f32>;
+
+struct Varyings {
+    @builtin(position) clip_position: vec4<f32>,
+    @location(0) world_position: vec3<f32>,
+    // Rest normal of the base surface (stable while the fur moves).
+    @location(1) normal: vec3<f32>,
+    // Strand direction from the simulated shared vertices.
+    @location(2) tangent: vec3<f32>,
+    // Shells: rest root position in tiles (triplanar lookup). Fins: unused.
+    @location(3) tile_position: vec3<f32>,
+    // Shells: mesh uv in tiles. Fins: (along the edge in tiles, height).
+    @location(4) uv: vec2<f32>,
+    // Shell layer (1..=L); 0 for the skin and fins.
+    @location(5) @interpolate(flat) layer: u32,
+    // 0 at the roots, 1 at the tips.
+    @location(6) height: f32,
+    // Opacity from the view angle (fin and shell fading).
+    @location(7) fade: f32,
+    // Shell texture slice.
+    @location(8) @interpolate(flat) slice: i32,
+    // The mesh uv at the strand's root (surface colour mode).
+    @location(9) surface_uv: vec2<f32>,
+}
+
+fn safe_normalize(v: vec3<f32>, fallback: vec3<f32>) -> vec3<f32> {
+    let length_squared = dot(v, v);
+    if length_squared > 1e-20 {
+        return v * inverseSqrt(length_squared);
+    }
+    return fallback;
+}
+
+// Shells fade where the surface is seen edge-on (where the sheets would show).
+fn shell_fade(normal: vec3<f32>, world_position: vec3<f32>) -> f32 {
+    let to_camera = safe_normalize(globals.camera_position - world_position, normal);
+    let facing = abs(dot(normal, to_camera));
+    return mix(0.5, 1.0, smoothstep(0.0, globals.shell_fade_cos, facing));
+}
+
+// Darkening toward the roots: strands shadow each other deeper in the coat.
+fn occlusion(height: f32) -> f32 {
+    return mix(globals.root_occlusion, 1.0, pow(clamp(height, 0.0, 1.0), 0.7));
+}
+
+// Kajiya-Kay hair lighting around the strand tangent, gated by the surface normal so the side
+// of the body facing away from the light stays dark.
+fn hair_lighting(albedo: vec3<f32>, tangent: vec3<f32>, normal: vec3<f32>, world_position: vec3<f32>, height: f32) -> vec3<f32> {
+    let to_light = globals.light_direction;
+    let to_camera = safe_normalize(globals.camera_position - world_position, normal);
+    let t_dot_l = dot(tangent, to_light);
+    let diffuse = sqrt(max(1.0 - t_dot_l * t_dot_l, 0.0));
+    let half_vector = safe_normalize(to_light + to_camera, to_light);
+    let t_dot_h = dot(tangent, half_vector);
+    let specular = pow(sqrt(max(1.0 - t_dot_h * t_dot_h, 0.0)), globals.shininess);
+    let lit_side = smoothstep(-0.25, 0.6, dot(normal, to_light));
+    let ao = occlusion(height);
+    let light = globals.light_colour * lit_side;
+    let colour = albedo * (globals.ambient + light * diffuse * 0.85) * ao;
+    // The highlight takes some of the strand's colour, as light scattered in hair does.
+    let highlight = mix(vec3<f32>(1.0), albedo / max(max(albedo.r, albedo.g), max(albedo.b, 1e-3)), 0.5);
+    return colour + light * highlight * (specular * globals.specular * ao * height);
+}
+
+// Lambert with a soft terminator for surfaces without fur (the skin, plain meshes).
+fn surface_lighting(albedo: vec3<f32>, normal: vec3<f32>) -> vec3<f32> {
+    let wrapped = max(dot(normal, globals.light_direction) * 0.7 + 0.3, 0.0);
+    return albedo * (globals.ambient + globals.light_colour * wrapped);
+}
+
+fn shell_texel(in: Varyings) -> vec4<f32> {
+    let slice = in.slice;
+    // `uses_mesh_uvs` reads a uniform (defined by the appended module), so sampling stays in
+    // uniform control flow.
+    if uses_mesh_uvs() {
+        return textureSample(shell_texture, shell_sampler, in.uv, slice);
+    }
+    // Triplanar: three axis-aligned projections of the tile, blended with sharp weights so the
+    // strands stay crisp and only narrow bands mix two projections.
+    let weights_raw = pow(abs(in.normal), vec3<f32>(6.0));
+    let weights = weights_raw / max(weights_raw.x + weights_raw.y + weights_raw.z, 1e-6);
+    let p = in.tile_position;
+    let x = textureSample(shell_texture, shell_sampler, p.yz, slice);
+    let y = textureSample(shell_texture, shell_sampler, p.zx, slice);
+    let z = textureSample(shell_texture, shell_sampler, p.xy, slice);
+    return x * weights.x + y * weights.y + z * weights.z;
+}
+
+// Surface colour mode: the mesh's texture at the strand's root tints the strand's brightness.
+fn surface_tint(uv: vec2<f32>) -> vec3<f32> {
+    let colour = textureSample(surface_texture, shell_sampler, uv).rgb;
+    return select(vec3<f32>(1.0), colour, globals.has_surface != 0u);
+}
+
+fn fur_output(colour: vec3<f32>, alpha: f32) -> vec4<f32> {
+    if globals.alpha_to_coverage != 0u {
+        return vec4<f32>(colour, alpha);
+    }
+    // Premultiplied for the (One, OneMinusSrcAlpha) blend.
+    return vec4<f32>(colour * alpha, alpha);
+}
+
+@fragment
+fn fs_skin(in: Varyings) -> @location(0) vec4<f32> {
+    let normal = normalize(in.normal);
+    let albedo = globals.root_colour.rgb * surface_tint(in.surface_uv);
+    let colour = surface_lighting(albedo, normal) * globals.root_occlusion;
+    return vec4<f32>(colour, 1.0);
+}
+
+@fragment
+fn fs_shell(in: Varyings) -> @location(0) vec4<f32> {
+    let texel = shell_texel(in);
+    let alpha = texel.a * in.fade;
+    let normal = normalize(in.normal);
+    let albedo = texel.rgb * surface_tint(in.surface_uv);
+    let colour = hair_lighting(albedo, normalize(in.tangent), normal, in.world_position, in.height);
+    return fur_output(colour, alpha);
+}
+
+@fragment
+fn fs_fin(in: Varyings) -> @location(0) vec4<f32> {
+    // Fin texture rows run from the tips (v = 0) to the roots (v = 1).
+    let texel = textureSample(fin_texture, fin_sampler, vec2<f32>(in.uv.x, 1.0 - in.uv.y));
+    // Several fins overlap along a silhouette; thinning them keeps the fringe from reading as a
+    // solid band, most of all at the roots where the shells already cover.
+    let alpha = texel.a * in.fade * mix(0.15, 0.6, in.height);
+    let normal = normalize(in.normal);
+    // Seen from the side the roots are less hidden than from above: lift the occlusion.
+    let height = sqrt(in.height);
+    let albedo = texel.rgb * surface_tint(in.surface_uv);
+    let colour = hair_lighting(albedo, normalize(in.tangent), normal, in.world_position, height);
+    return fur_output(colour, alpha);
+}

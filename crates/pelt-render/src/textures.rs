@@ -1,0 +1,170 @@
+//! Uploading [`FurTextures`]: the shell slices as one 2D array texture and the fin texture, both
+//! with mipmaps (pelt-core's alpha-weighted filter) so distant fur averages out instead of
+//! sparkling.
+
+use pelt_core::texture::{FurTextures, downsample_rgba8};
+
+use crate::RenderError;
+
+/// The fur textures on the GPU.
+#[derive(Debug)]
+pub(crate) struct GpuTextures {
+    pub shell: wgpu::TextureView,
+    pub fin: wgpu::TextureView,
+    pub shell_slices: u32,
+    /// The mesh's colour texture (surface colour mode), else 1x1 white.
+    pub surface: wgpu::TextureView,
+    pub has_surface: bool,
+    /// Alpha-weighted mean strand colour of the root slice, linear RGB.
+    pub root_colour: glam::Vec3,
+}
+
+impl GpuTextures {
+    pub fn new(device: &wgpu::Device, queue: &wgpu::Queue, textures: &FurTextures) -> Result<Self, RenderError> {
+        validate(textures)?;
+        let slice_bytes = textures.size as usize * textures.size as usize * 4;
+        let shell = upload(
+            device,
+            queue,
+            "pelt shell slices",
+            (textures.size, textures.size),
+            textures.shell.chunks_exact(slice_bytes).collect(),
+        );
+        let fin = upload(device, queue, "pelt fin", (textures.fin_width, textures.fin_height), vec![&textures.fin]);
+        let shell = shell.create_view(&wgpu::TextureViewDescriptor {
+            dimension: Some(wgpu::TextureViewDimension::D2Array),
+            ..wgpu::TextureViewDescriptor::default()
+        });
+        let fin = fin.create_view(&wgpu::TextureViewDescriptor::default());
+        let white = [255_u8; 4];
+        let (surface_size, surface_pixels): ((u32, u32), &[u8]) = match &textures.surface {
+            Some(image) => ((image.width, image.height), &image.pixels),
+            None => ((1, 1), &white),
+        };
+        let surface = upload(device, queue, "pelt surface colour", surface_size, vec![surface_pixels])
+            .create_view(&wgpu::TextureViewDescriptor::default());
+        Ok(Self {
+            shell,
+            fin,
+            shell_slices: textures.layers,
+            surface,
+            has_surface: textures.surface.is_some(),
+            root_colour: root_colour(textures, slice_bytes),
+        })
+    }
+}
+
+fn validate(textures: &FurTextures) -> Result<(), RenderError> {
+    let bad = |message: String| Err(RenderError::Textures(message));
+    if textures.size == 0 || textures.layers == 0 || textures.fin_width == 0 || textures.fin_height == 0 {
+        return bad(format!(
+            "empty texture: shell {0}x{0}x{1}, fin {2}x{3}",
+            textures.size, textures.layers, textures.fin_width, textures.fin_height
+        ));
+    }
+    let shell_bytes = textures.size as usize * textures.size as usize * textures.layers as usize * 4;
+    if textures.shell.len() != shell_bytes {
+        return bad(format!("shell has {} bytes, expected {shell_bytes}", textures.shell.len()));
+    }
+    let fin_bytes = textures.fin_width as usize * textures.fin_height as usize * 4;
+    if textures.fin.len() != fin_bytes {
+        return bad(format!("fin has {} bytes, expected {fin_bytes}", textures.fin.len()));
+    }
+    if let Some(surface) = &textures.surface {
+        let bytes = surface.width as usize * surface.height as usize * 4;
+        if surface.width == 0 || surface.height == 0 || surface.pixels.len() != bytes {
+            return bad(format!(
+                "surface image {}x{} has {} bytes",
+                surface.width,
+                surface.height,
+                surface.pixels.len()
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Creates an sRGB texture with one array layer per slice and a full mip chain.
+fn upload(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    label: &str,
+    (width, height): (u32, u32),
+    slices: Vec<&[u8]>,
+) -> wgpu::Texture {
+    let mip_level_count = 32 - width.max(height).leading_zeros();
+    let texture = device.create_texture(&wgpu::TextureDescriptor {
+        label: Some(label),
+        size: wgpu::Extent3d { width, height, depth_or_array_layers: slices.len() as u32 },
+        mip_level_count,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: wgpu::TextureFormat::Rgba8UnormSrgb,
+        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+        view_formats: &[],
+    });
+    for (layer, slice) in slices.into_iter().enumerate() {
+        let mut level = slice.to_vec();
+        let (mut w, mut h) = (width, height);
+        for mip_level in 0..mip_level_count {
+            queue.write_texture(
+                wgpu::TexelCopyTextureInfo {
+                    texture: &texture,
+                    mip_level,
+                    origin: wgpu::Origin3d { x: 0, y: 0, z: layer as u32 },
+                    aspect: wgpu::TextureAspect::All,
+                },
+                &level,
+                wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(4 * w), rows_per_image: Some(h) },
+                wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
+            );
+            level = downsample_rgba8(&level, w, h, 1);
+            (w, h) = ((w / 2).max(1), (h / 2).max(1));
+        }
+    }
+    texture
+}
+
+fn srgb_to_linear(value: f32) -> f32 {
+    if value <= 0.04045 { value / 12.92 } else { ((value + 0.055) / 1.055).powf(2.4) }
+}
+
+/// The colour of the fur at the roots: the first slice's strands, weighted by coverage.
+fn root_colour(textures: &FurTextures, slice_bytes: usize) -> glam::Vec3 {
+    for slice in textures.shell.chunks_exact(slice_bytes) {
+        let (mut sum, mut weight) = (glam::Vec3::ZERO, 0.0);
+        for texel in slice.chunks_exact(4) {
+            let alpha = f32::from(texel[3]) / 255.0;
+            let rgb = glam::Vec3::new(texel[0].into(), texel[1].into(), texel[2].into()) / 255.0;
+            sum += rgb.map(srgb_to_linear) * alpha;
+            weight += alpha;
+        }
+        if weight > 0.0 {
+            return sum / weight;
+        }
+    }
+    glam::Vec3::splat(0.2)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn wrong_sizes_are_errors() {
+        let textures = FurTextures {
+            size: 4,
+            layers: 2,
+            shell: vec![0; 4 * 4 * 4],
+            fin_width: 2,
+            fin_height: 2,
+            fin: vec![0; 16],
+            surface: None,
+        };
+        assert!(matches!(validate(&textures), Err(RenderError::Textures(_))));
+        let textures = FurTextures { shell: vec![0; 4 * 4 * 4 * 2], ..textures };
+        assert!(validate(&textures).is_ok());
+        let surface = pelt_core::texture::ImageRgba8 { width: 2, height: 2, pixels: vec![0; 12] };
+        assert!(validate(&FurTextures { surface: Some(surface), ..textures }).is_err());
+    }
+}

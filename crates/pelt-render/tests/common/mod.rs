@@ -1,0 +1,192 @@
+//! Test helpers: a small procedural strand texture (the real generator lives in pelt-core's
+//! presets; this one only has to look like strands), scenes and image comparison.
+
+#![allow(dead_code, reason = "each test binary uses a different part of the helpers")]
+
+use std::path::{Path, PathBuf};
+
+use glam::Vec3;
+use pelt_core::fur::FurLength;
+use pelt_core::texture::FurTextures;
+use pelt_core::{Builtin, FurParams, FurStructure, GrowthDirection, Mesh};
+use pelt_render::{Backend, Camera, Headless, RenderSettings};
+
+fn hash(x: u32, y: u32, salt: u32) -> u32 {
+    let mut h = x.wrapping_mul(0x8da6_b343) ^ y.wrapping_mul(0xd816_3841) ^ salt.wrapping_mul(0xcb1a_b31f);
+    h = (h ^ (h >> 15)).wrapping_mul(0x2c1b_3c6d);
+    h ^ (h >> 12)
+}
+
+fn unit(x: u32, y: u32, salt: u32) -> f32 {
+    (hash(x, y, salt) & 0xffff) as f32 / 65536.0
+}
+
+/// Shell slices with round strands that taper and lean, plus a matching fin texture.
+pub fn strand_textures(size: u32, layers: u32, root: [u8; 3], tip: [u8; 3]) -> FurTextures {
+    let mut shell = vec![0_u8; (size * size * layers * 4) as usize];
+    let mut fin_columns = Vec::new();
+    for y in 0..size {
+        for x in 0..size {
+            if unit(x, y, 1) > 0.22 {
+                continue;
+            }
+            let length = 0.7 + 0.3 * unit(x, y, 2);
+            let lean = (unit(x, y, 3) - 0.5, unit(x, y, 4) - 0.5);
+            // The fin shows a thin slab of the tile from the side.
+            if y < size / 12 {
+                fin_columns.push((x, length));
+            }
+            for k in 0..layers {
+                let t = (k + 1) as f32 / layers as f32;
+                if t > length {
+                    break;
+                }
+                let radius = 1.3 * (1.0 - 0.6 * t / length);
+                let (cx, cy) = (x as f32 + lean.0 * 3.0 * t, y as f32 + lean.1 * 3.0 * t);
+                let colour = |c: usize| (f32::from(root[c]) + (f32::from(tip[c]) - f32::from(root[c])) * t) as u8;
+                for dy in -2..=2 {
+                    for dx in -2..=2 {
+                        let (px, py) = (cx.round() as i32 + dx, cy.round() as i32 + dy);
+                        let distance = ((px as f32 - cx).powi(2) + (py as f32 - cy).powi(2)).sqrt();
+                        let alpha = (radius - distance + 0.5).clamp(0.0, 1.0);
+                        if alpha <= 0.0 {
+                            continue;
+                        }
+                        let (px, py) = (px.rem_euclid(size as i32) as u32, py.rem_euclid(size as i32) as u32);
+                        let k4 = ((k * size * size + py * size + px) * 4) as usize;
+                        let a = (alpha * 255.0) as u8;
+                        if a > shell[k4 + 3] {
+                            shell[k4..k4 + 4].copy_from_slice(&[colour(0), colour(1), colour(2), a]);
+                        }
+                    }
+                }
+            }
+        }
+    }
+    let (fin_width, fin_height) = (size, 32);
+    let mut fin = vec![0_u8; (fin_width * fin_height * 4) as usize];
+    for (x, length) in fin_columns {
+        for row in 0..fin_height {
+            // Row 0 holds the tips.
+            let t = 1.0 - (row as f32 + 0.5) / fin_height as f32;
+            if t > length {
+                continue;
+            }
+            let colour = |c: usize| (f32::from(root[c]) + (f32::from(tip[c]) - f32::from(root[c])) * t) as u8;
+            // Two texels wide at the root, one at the tip.
+            let width = if t < 0.5 * length { 2 } else { 1 };
+            for dx in 0..width {
+                let k = ((row * fin_width + (x + dx) % fin_width) * 4) as usize;
+                fin[k..k + 4].copy_from_slice(&[colour(0), colour(1), colour(2), 230]);
+            }
+        }
+    }
+    FurTextures { size, layers, shell, fin_width, fin_height, fin, surface: None }
+}
+
+pub const BROWN_ROOT: [u8; 3] = [70, 45, 28];
+pub const BROWN_TIP: [u8; 3] = [200, 160, 120];
+
+/// Fur of `length_fraction` of the bounding radius on `mesh`.
+pub fn grow(mesh: Mesh, layers: u32, length_fraction: f32) -> FurStructure {
+    let radius = mesh.bounding_sphere().1;
+    let params = FurParams {
+        layers,
+        length: FurLength::Constant(radius * length_fraction),
+        direction: GrowthDirection::default(),
+    };
+    FurStructure::new(mesh, &params).expect("valid fur")
+}
+
+pub fn builtin_fur(builtin: Builtin, layers: u32) -> FurStructure {
+    grow(builtin.mesh().0, layers, 0.08)
+}
+
+/// The headless target every GPU test uses: fails (never skips) without an adapter.
+pub fn headless(width: u32, height: u32) -> Headless {
+    let backend = std::env::var("PELT_TEST_BACKEND").map_or(Backend::Auto, |name| name.parse().expect("backend"));
+    match Headless::new(backend, width, height) {
+        Ok(headless) => headless,
+        Err(error) => panic!("GPU tests need an adapter (CI uses lavapipe): {error}"),
+    }
+}
+
+pub fn framed(fur: &FurStructure, aspect_ratio: f32) -> Camera {
+    let (centre, radius) = fur.mesh.bounding_sphere();
+    let length = fur.lengths.iter().copied().fold(0.0, f32::max);
+    Camera::framing(centre, radius + length, 30.0, 15.0, aspect_ratio)
+}
+
+pub fn settings() -> RenderSettings {
+    RenderSettings::default()
+}
+
+pub fn asset(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets/meshes").join(name)
+}
+
+pub fn out_dir() -> PathBuf {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("pelt-render");
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    dir
+}
+
+/// Whether a pixel differs from the background (anything drawn).
+pub fn covered(pixel: &image::Rgba<u8>, background: [u8; 3]) -> bool {
+    pixel.0[..3].iter().zip(background).any(|(a, b)| a.abs_diff(b) > 6)
+}
+
+/// Per-pixel difference: the largest channel difference.
+pub fn pixel_difference(a: &image::Rgba<u8>, b: &image::Rgba<u8>) -> u8 {
+    a.0.iter().zip(b.0).map(|(x, y)| x.abs_diff(y)).max().unwrap_or(0)
+}
+
+pub fn light_direction() -> Vec3 {
+    RenderSettings::default().light_from_view
+}
+
+/// Golden images live beside the tests and were rendered on lavapipe (Vulkan, CPU).
+///
+/// The comparison allows small differences: llvmpipe (GL) and hardware GPUs place MSAA samples
+/// and filter textures slightly differently, which moves strand edges by a fraction of a pixel.
+/// Lavapipe reproduces its own references exactly.
+const GOLDEN_MEAN_LIMIT: f64 = 3.0;
+const GOLDEN_P99_LIMIT: u8 = 64;
+
+/// Compares `image` with `tests/golden/{name}.png`; `PELT_UPDATE_GOLDEN=1` rewrites it. On a
+/// mismatch writes `{name}-actual.png` and `{name}-diff.png` next to it and panics.
+pub fn check_golden(name: &str, image: &image::RgbaImage) {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/golden");
+    let path = dir.join(format!("{name}.png"));
+    if std::env::var("PELT_UPDATE_GOLDEN").is_ok_and(|v| v == "1") {
+        std::fs::create_dir_all(&dir).expect("golden dir");
+        image.save(&path).expect("write golden");
+        return;
+    }
+    let golden = image::open(&path)
+        .unwrap_or_else(|error| panic!("{}: {error} (PELT_UPDATE_GOLDEN=1 writes it)", path.display()))
+        .to_rgba8();
+    assert_eq!(golden.dimensions(), image.dimensions(), "{name}: size");
+    let mut differences: Vec<u8> = golden.pixels().zip(image.pixels()).map(|(a, b)| pixel_difference(a, b)).collect();
+    let mean = differences.iter().map(|&d| f64::from(d)).sum::<f64>() / differences.len() as f64;
+    let diff = image::RgbaImage::from_fn(image.width(), image.height(), |x, y| {
+        let d = differences[(y * image.width() + x) as usize].saturating_mul(4);
+        image::Rgba([d, d, d, 255])
+    });
+    differences.sort_unstable();
+    let p99 = differences[differences.len() * 99 / 100];
+    if mean > GOLDEN_MEAN_LIMIT || p99 > GOLDEN_P99_LIMIT {
+        image.save(dir.join(format!("{name}-actual.png"))).expect("write actual");
+        diff.save(dir.join(format!("{name}-diff.png"))).expect("write diff");
+        panic!(
+            "{name}: differs from the golden image (mean {mean:.2} > {GOLDEN_MEAN_LIMIT} or 99th percentile {p99} > \
+             {GOLDEN_P99_LIMIT}); see {name}-actual.png and {name}-diff.png in {}",
+            dir.display()
+        );
+    }
+}
+
+/// Loads one of the repository's meshes.
+pub fn load_asset(name: &str) -> Mesh {
+    Mesh::load(&asset(name), &pelt_core::ImportOptions::default()).expect("asset mesh").0
+}

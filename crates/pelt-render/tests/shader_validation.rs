@@ -1,0 +1,35 @@
+//! Every WGSL module the renderer builds parses and validates with naga (no GPU needed).
+
+fn validate(name: &str, source: &str) {
+    let module =
+        naga::front::wgsl::parse_str(source).unwrap_or_else(|error| panic!("{name}: {}", error.emit_to_string(source)));
+    naga::valid::Validator::new(naga::valid::ValidationFlags::all(), naga::valid::Capabilities::empty())
+        .validate(&module)
+        .unwrap_or_else(|error| panic!("{name}: {}", error.emit_to_string(source)));
+}
+
+#[test]
+fn unified_module_validates() {
+    validate("shading.wgsl + unified.wgsl", &pelt_render::unified_shader_source());
+}
+
+#[test]
+fn separated_module_validates() {
+    validate("shading.wgsl + separated.wgsl", &pelt_render::separated_shader_source());
+}
+
+#[test]
+fn every_wgsl_file_is_part_of_a_validated_module() {
+    let sources = [pelt_render::unified_shader_source(), pelt_render::separated_shader_source()];
+    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    let mut checked = 0;
+    for entry in std::fs::read_dir(&dir).expect("src dir") {
+        let path = entry.expect("entry").path();
+        if path.extension().is_some_and(|e| e == "wgsl") {
+            let text = std::fs::read_to_string(&path).expect("read");
+            assert!(sources.iter().any(|s| s.contains(&text)), "{} is in no validated module", path.display());
+            checked += 1;
+        }
+    }
+    assert_eq!(checked, 3, "shading, unified and separated");
+}
