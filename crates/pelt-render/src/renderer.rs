@@ -74,7 +74,7 @@ impl Default for RenderSettings {
             specular: 0.2,
             shininess: 40.0,
             root_occlusion: 0.3,
-            fin_fade_cos: 0.2,
+            fin_fade_cos: 0.1,
             shell_fade_cos: 0.25,
             tiles_per_radius: 0.4,
             background: Vec3::new(0.045, 0.05, 0.06),

@@ -159,7 +159,7 @@ fn fs_fin(in: Varyings) -> @location(0) vec4<f32> {
     let texel = textureSample(fin_texture, fin_sampler, vec2<f32>(in.uv.x, 1.0 - in.uv.y));
     // Several fins overlap along a silhouette; thinning them keeps the fringe from reading as a
     // solid band, most of all at the roots where the shells already cover.
-    let alpha = texel.a * in.fade * mix(0.35, 0.8, in.height);
+    let alpha = texel.a * in.fade * mix(0.15, 0.6, in.height);
     let normal = normalize(in.normal);
     // Seen from the side the roots are less hidden than from above: lift the occlusion.
     let height = sqrt(in.height);

@@ -26,9 +26,11 @@ const PLAIN_COLOUR: Vec3 = Vec3::new(0.62, 0.46, 0.38);
 const LIGHT_WIND: Vec3 = Vec3::new(0.35, 0.0, 0.1);
 
 /// Arguments of `pelt render`.
-///
-/// `--builtin tryon` renders a body with fur only on its garment.
 #[derive(Debug, clap::Args)]
+#[command(after_help = "\
+With no arguments: the built-in bunny, the default fur and a light breeze, to pelt.png.
+`--builtin tryon` renders a body (plain) wearing a furry garment; with your own meshes:
+`pelt render GARMENT.obj --plain-mesh BODY.obj`.")]
 pub struct Args {
     #[command(flatten)]
     mesh: MeshArgs,
@@ -50,8 +52,8 @@ pub struct Args {
     /// Image size, WIDTHxHEIGHT.
     #[arg(long, default_value = "1280x720", value_parser = parse_size)]
     size: (u32, u32),
-    /// Camera as azimuth,elevation (degrees) and distance (world units); framed automatically
-    /// from the mesh's bounding sphere when not given.
+    /// Camera as azimuth,elevation (degrees) and distance (world units) around the meshes'
+    /// centre; without it the camera frames the meshes automatically.
     #[arg(long, value_name = "AZIMUTH,ELEVATION,DISTANCE", value_parser = parse_vec3, allow_hyphen_values = true)]
     camera: Option<Vec3>,
     /// Wind x,y,z (direction and strength; 0,0,0 for none). Default: the preset's, or a light breeze.
