@@ -19,7 +19,6 @@ pub struct MeshArgs {
     pub no_weld: bool,
 }
 
-#[expect(dead_code, reason = "the commands call it as they land")]
 impl MeshArgs {
     /// Loads the chosen mesh; with neither a file nor `--builtin`, `default`.
     pub fn load(&self, default: Builtin) -> anyhow::Result<(Mesh, MeshReport)> {

@@ -1,0 +1,615 @@
+//! The window and its frame loop (winit's `ApplicationHandler`).
+
+use std::path::PathBuf;
+use std::sync::Arc;
+use std::time::Instant;
+
+use anyhow::Context as _;
+use glam::Vec2;
+use pelt_core::fur::FurLength;
+use pelt_core::{Builtin, FurParams, FurStructure, GrowthDirection, Mesh, SeparatedStructure};
+use winit::application::ApplicationHandler;
+use winit::event::WindowEvent;
+use winit::event_loop::ActiveEventLoop;
+use winit::window::{Window, WindowId};
+
+use super::Args;
+use super::camera::OrbitCamera;
+use super::capture::FrameCopy;
+use super::fur::{FurView, interim_textures};
+use super::gpu::{self, Acquired, WindowSurface};
+use super::panel::{self, Changes, MeshChoice, Requests, Settings};
+use super::viewport::Viewport;
+
+/// Time step of `--screenshot-after` runs, so they repeat exactly.
+const FIXED_FRAME_SECS: f64 = 1.0 / 60.0;
+/// Consecutive frames without a swap-chain texture before a scripted run gives up.
+const MAX_SKIPPED_FRAMES: u32 = 600;
+
+/// The application: created before the event loop, the window and GPU once it resumes.
+pub struct App {
+    window_size: [u32; 2],
+    screenshot_after: Option<(u32, PathBuf)>,
+    model: Model,
+    running: Option<Running>,
+    error: Option<anyhow::Error>,
+}
+
+impl std::fmt::Debug for App {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("App").field("running", &self.running.is_some()).finish_non_exhaustive()
+    }
+}
+
+/// What needs the window: the GPU, egui's input state and renderer, the 3D target.
+struct Running {
+    window: Arc<Window>,
+    gpu: pelt_render::Gpu,
+    surface: WindowSurface,
+    egui_ctx: egui::Context,
+    egui_state: egui_winit::State,
+    egui_renderer: egui_wgpu::Renderer,
+    viewport: Viewport,
+    fur: FurView,
+    /// False while minimised or hidden: no redraws are asked for.
+    visible: bool,
+}
+
+/// Everything that is not the window: settings, fur, camera, timings.
+struct Model {
+    settings: Settings,
+    mesh_choices: Vec<MeshChoice>,
+    /// The mesh from the command line, kept to switch back to.
+    file_mesh: Option<Mesh>,
+    structure: FurStructure,
+    camera: OrbitCamera,
+    /// Frame the fur once the 3D view's size is known.
+    frame_pending: bool,
+    /// Size of the 3D view in physical pixels, from the last panel pass.
+    viewport_px: [u32; 2],
+    clock: Clock,
+    frame_time_secs: f64,
+    sim_time_secs: f64,
+    frames_drawn: u32,
+    skipped_frames: u32,
+    screenshots_saved: u32,
+    screenshot_pending: bool,
+    quit: bool,
+    panel_hidden: bool,
+    status: String,
+}
+
+/// Wall-clock time, or exactly `FIXED_FRAME_SECS` per frame for repeatable runs.
+#[allow(dead_code, reason = "touch and the simulation use it as they land in this branch")]
+struct Clock {
+    fixed: bool,
+    start: Instant,
+    last: Instant,
+    frame_index: u64,
+}
+
+#[allow(dead_code, reason = "touch and the simulation use it as they land in this branch")]
+impl Clock {
+    /// Seconds since the previous tick.
+    fn tick(&mut self) -> f64 {
+        self.frame_index += 1;
+        if self.fixed {
+            return FIXED_FRAME_SECS;
+        }
+        let now = Instant::now();
+        let delta = now - self.last;
+        self.last = now;
+        delta.as_secs_f64()
+    }
+
+    fn now_secs(&self) -> f64 {
+        if self.fixed { self.frame_index as f64 * FIXED_FRAME_SECS } else { self.start.elapsed().as_secs_f64() }
+    }
+}
+
+impl App {
+    pub fn new(args: &Args, mesh: Mesh, mesh_source: String) -> anyhow::Result<Self> {
+        let mut mesh_choices: Vec<MeshChoice> = Builtin::ALL.into_iter().map(MeshChoice::Builtin).collect();
+        let (choice, file_mesh) = match (&args.mesh.mesh, &args.mesh.builtin) {
+            (Some(path), _) => {
+                let name = path.file_name().map_or(mesh_source, |n| n.to_string_lossy().into_owned());
+                mesh_choices.push(MeshChoice::File(name.clone()));
+                (MeshChoice::File(name), Some(mesh.clone()))
+            }
+            (None, Some(name)) => (MeshChoice::Builtin(Builtin::from_name(name).unwrap_or(Builtin::Bunny)), None),
+            (None, None) => (MeshChoice::Builtin(Builtin::Bunny), None),
+        };
+        let settings = Settings::new(choice);
+        let structure = grow(mesh, &settings)?;
+        let now = Instant::now();
+        let model = Model {
+            settings,
+            mesh_choices,
+            file_mesh,
+            structure,
+            camera: OrbitCamera::default(),
+            frame_pending: true,
+            viewport_px: [1, 1],
+            clock: Clock { fixed: args.screenshot_after.is_some(), start: now, last: now, frame_index: 0 },
+            frame_time_secs: 0.0,
+            sim_time_secs: 0.0,
+            frames_drawn: 0,
+            skipped_frames: 0,
+            screenshots_saved: 0,
+            screenshot_pending: false,
+            quit: false,
+            panel_hidden: false,
+            status: String::new(),
+        };
+        let screenshot_after = args.screenshot_after.zip(args.out.clone());
+        Ok(Self { window_size: args.size, screenshot_after, model, running: None, error: None })
+    }
+
+    /// The error that ended the event loop, if any.
+    pub fn finish(self) -> anyhow::Result<()> {
+        match self.error {
+            Some(error) => Err(error),
+            None => Ok(()),
+        }
+    }
+
+    fn fail(&mut self, event_loop: &ActiveEventLoop, error: anyhow::Error) {
+        self.error.get_or_insert(error);
+        event_loop.exit();
+    }
+
+    fn start(&mut self, event_loop: &ActiveEventLoop) -> anyhow::Result<Running> {
+        let [width, height] = self.window_size;
+        let attributes = Window::default_attributes()
+            .with_title("Pelt")
+            .with_inner_size(winit::dpi::LogicalSize::new(width, height))
+            .with_min_inner_size(winit::dpi::LogicalSize::new(320, 240));
+        let window = Arc::new(event_loop.create_window(attributes).context("creating the window")?);
+        let (gpu, surface) = gpu::open(&window, event_loop.owned_display_handle())?;
+        let egui_ctx = egui::Context::default();
+        egui_ctx.set_visuals(egui::Visuals::dark());
+        let max_texture_side = gpu.device.limits().max_texture_dimension_2d as usize;
+        let egui_state = egui_winit::State::new(
+            egui_ctx.clone(),
+            egui::ViewportId::ROOT,
+            &window,
+            Some(window.scale_factor() as f32),
+            window.theme(),
+            Some(max_texture_side),
+        );
+        let mut egui_renderer =
+            egui_wgpu::Renderer::new(&gpu.device, surface.config.format, egui_wgpu::RendererOptions::default());
+        let viewport = Viewport::new(&gpu.device, &mut egui_renderer, [1, 1])?;
+        let fur = FurView::new(&gpu, &self.model.structure, &interim_textures(16))?;
+        Ok(Running { window, gpu, surface, egui_ctx, egui_state, egui_renderer, viewport, fur, visible: true })
+    }
+
+    /// One frame: the panel pass, the fur, egui on top, present; a screenshot when due.
+    fn redraw(&mut self) -> anyhow::Result<()> {
+        let Some(running) = self.running.as_mut() else { return Ok(()) };
+        let model = &mut self.model;
+        let frame_secs = model.clock.tick();
+        model.frame_time_secs = smooth(model.frame_time_secs, frame_secs);
+
+        let raw_input = running.egui_state.take_egui_input(&running.window);
+        let texture_id = running.viewport.texture_id;
+        let mut outcome = (Changes::default(), Requests::default());
+        let mut full_output = running.egui_ctx.run_ui(raw_input, |ui| outcome = model.ui(ui, texture_id));
+        // egui's texture changes apply whether or not this frame gets drawn.
+        let mut textures_delta = std::mem::take(&mut full_output.textures_delta);
+        for (id, deltas) in &textures_delta.set {
+            for delta in deltas {
+                running.egui_renderer.update_texture(&running.gpu.device, &running.gpu.queue, *id, delta);
+            }
+        }
+        for id in &textures_delta.free {
+            running.egui_renderer.free_texture(id);
+        }
+        textures_delta.clear();
+        running.egui_state.handle_platform_output(&running.window, full_output.platform_output);
+        if model.apply(outcome.0)? {
+            running.fur.set_structure(&running.gpu, &model.structure)?;
+        }
+        if outcome.1.screenshot {
+            model.screenshot_pending = true;
+        }
+        if outcome.1.frame {
+            model.frame_pending = true;
+        }
+
+        let frame = match running.surface.acquire(&running.gpu)? {
+            Acquired::Frame(frame) => frame,
+            Acquired::Skip => {
+                model.skipped_frames += 1;
+                if self.screenshot_after.is_some() && model.skipped_frames > MAX_SKIPPED_FRAMES {
+                    anyhow::bail!("the window gave no frame to draw into {MAX_SKIPPED_FRAMES} times in a row");
+                }
+                return Ok(());
+            }
+        };
+        model.skipped_frames = 0;
+        let gpu = &running.gpu;
+        running.viewport.resize(&gpu.device, &mut running.egui_renderer, model.viewport_px)?;
+
+        let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
+        running.fur.draw(gpu, &mut encoder, &running.viewport, &model.camera);
+
+        let screen = egui_wgpu::ScreenDescriptor {
+            size_in_pixels: [frame.texture.width(), frame.texture.height()],
+            pixels_per_point: full_output.pixels_per_point,
+        };
+        let paint_jobs = running.egui_ctx.tessellate(full_output.shapes, full_output.pixels_per_point);
+        let callback_buffers =
+            running.egui_renderer.update_buffers(&gpu.device, &gpu.queue, &mut encoder, &paint_jobs, &screen);
+
+        let is_last_scripted_frame =
+            self.screenshot_after.as_ref().is_some_and(|(after, _)| model.frames_drawn + 1 >= *after);
+        let capture = model.screenshot_pending || is_last_scripted_frame;
+        let frame_view = frame.texture.create_view(&wgpu::TextureViewDescriptor::default());
+        draw_egui(&mut encoder, &running.egui_renderer, &frame_view, &paint_jobs, &screen);
+        let copy = if !capture {
+            None
+        } else if running.surface.can_copy_frame() {
+            Some(FrameCopy::encode(&gpu.device, &mut encoder, &frame.texture))
+        } else {
+            // The swap chain cannot be read: draw the same frame again into a readable copy.
+            let offscreen = gpu.device.create_texture(&wgpu::TextureDescriptor {
+                label: Some("screenshot"),
+                size: frame.texture.size(),
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: frame.texture.format(),
+                usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+                view_formats: &[],
+            });
+            let view = offscreen.create_view(&wgpu::TextureViewDescriptor::default());
+            draw_egui(&mut encoder, &running.egui_renderer, &view, &paint_jobs, &screen);
+            Some(FrameCopy::encode(&gpu.device, &mut encoder, &offscreen))
+        };
+        gpu.queue.submit(callback_buffers.into_iter().chain([encoder.finish()]));
+        running.window.pre_present_notify();
+        gpu.queue.present(frame);
+        model.frames_drawn += 1;
+
+        if let Some(copy) = copy {
+            let image = copy.read(&gpu.device)?;
+            if is_last_scripted_frame && let Some((_, path)) = &self.screenshot_after {
+                image.save(path).with_context(|| format!("writing {}", path.display()))?;
+                model.quit = true;
+            }
+            if model.screenshot_pending {
+                model.screenshot_pending = false;
+                model.screenshots_saved += 1;
+                let path = PathBuf::from(format!("pelt-view-{:03}.png", model.screenshots_saved));
+                model.status = match image.save(&path) {
+                    Ok(()) => format!("saved {}", path.display()),
+                    Err(error) => format!("could not save {}: {error}", path.display()),
+                };
+            }
+        }
+        Ok(())
+    }
+}
+
+impl ApplicationHandler for App {
+    fn resumed(&mut self, event_loop: &ActiveEventLoop) {
+        if self.running.is_some() {
+            return;
+        }
+        match self.start(event_loop) {
+            Ok(running) => {
+                running.window.request_redraw();
+                self.running = Some(running);
+            }
+            Err(error) => self.fail(event_loop, error),
+        }
+    }
+
+    fn window_event(&mut self, event_loop: &ActiveEventLoop, _window_id: WindowId, event: WindowEvent) {
+        let Some(running) = self.running.as_mut() else { return };
+        let response = running.egui_state.on_window_event(&running.window, &event);
+        match event {
+            WindowEvent::CloseRequested | WindowEvent::Destroyed => event_loop.exit(),
+            WindowEvent::Resized(size) => {
+                running.surface.resize(&running.gpu, size.width, size.height);
+                running.visible = size.width > 0 && size.height > 0;
+                running.window.request_redraw();
+            }
+            WindowEvent::Occluded(occluded) => {
+                running.visible = !occluded;
+                if running.visible {
+                    running.window.request_redraw();
+                }
+            }
+            WindowEvent::RedrawRequested => {
+                if let Err(error) = self.redraw() {
+                    self.fail(event_loop, error);
+                } else if self.model.quit {
+                    event_loop.exit();
+                }
+            }
+            _ => {
+                if response.repaint {
+                    running.window.request_redraw();
+                }
+            }
+        }
+    }
+
+    fn about_to_wait(&mut self, _event_loop: &ActiveEventLoop) {
+        // The fur moves all the time (gravity settles, wind blows): draw continuously while
+        // visible; scripted runs draw regardless, since Xvfb windows may report as occluded.
+        if let Some(running) = &self.running
+            && (running.visible || self.screenshot_after.is_some())
+        {
+            running.window.request_redraw();
+        }
+    }
+
+    fn exiting(&mut self, _event_loop: &ActiveEventLoop) {
+        // Drop GPU resources while the window (and display connection) still exists.
+        self.running = None;
+    }
+}
+
+impl Model {
+    /// The panel, the 3D view with its overlay, and the shortcuts.
+    fn ui(&mut self, ui: &mut egui::Ui, texture_id: egui::TextureId) -> (Changes, Requests) {
+        let mut outcome = (Changes::default(), Requests::default());
+        let shortcuts = self.shortcuts(ui.ctx());
+        outcome.1.frame |= shortcuts.frame;
+        outcome.1.screenshot |= shortcuts.screenshot;
+        if !self.panel_hidden {
+            egui::Panel::right("settings").resizable(true).default_size(320.0).min_size(260.0).show(ui, |ui| {
+                outcome = panel::show(ui, &mut self.settings, &self.mesh_choices, &self.status);
+            });
+        }
+        outcome.0.simulation |= shortcuts.simulation;
+        egui::CentralPanel::no_frame().show(ui, |ui| self.view_3d(ui, texture_id));
+        outcome
+    }
+
+    /// Keys that act anywhere except while typing into a text field.
+    fn shortcuts(&mut self, ctx: &egui::Context) -> ShortcutOutcome {
+        let mut outcome = ShortcutOutcome::default();
+        if ctx.egui_wants_keyboard_input() {
+            return outcome;
+        }
+        let none = egui::Modifiers::NONE;
+        let command = egui::Modifiers::COMMAND;
+        ctx.input_mut(|input| {
+            let settings = &mut self.settings;
+            outcome.frame = input.consume_key(none, egui::Key::F);
+            if input.consume_key(none, egui::Key::R) {
+                self.camera = OrbitCamera::default();
+                outcome.frame = true;
+            }
+            if input.consume_key(none, egui::Key::Space) {
+                settings.simulate = !settings.simulate;
+                outcome.simulation = true;
+            }
+            for (key, toggle) in [
+                (egui::Key::Num1, &mut settings.draw.skin),
+                (egui::Key::Num2, &mut settings.draw.shells),
+                (egui::Key::Num3, &mut settings.draw.fins),
+                (egui::Key::O, &mut settings.overlay),
+            ] {
+                if input.consume_key(none, key) {
+                    *toggle = !*toggle;
+                }
+            }
+            if input.consume_key(none, egui::Key::H) {
+                self.panel_hidden = !self.panel_hidden;
+            }
+            outcome.screenshot = input.consume_key(command, egui::Key::P);
+            self.quit |= input.consume_key(command, egui::Key::Q);
+        });
+        outcome
+    }
+}
+
+#[derive(Debug, Default)]
+struct ShortcutOutcome {
+    frame: bool,
+    screenshot: bool,
+    simulation: bool,
+}
+
+impl Model {
+    /// The fur image, camera controls and the overlay.
+    fn view_3d(&mut self, ui: &mut egui::Ui, texture_id: egui::TextureId) {
+        let rect = ui.max_rect();
+        let pixels_per_point = ui.ctx().pixels_per_point();
+        self.viewport_px =
+            [rect.width(), rect.height()].map(|points| (points * pixels_per_point).round().max(1.0) as u32);
+        let response = ui.allocate_rect(rect, egui::Sense::click_and_drag());
+        let painter = ui.painter_at(rect);
+        let full_uv = egui::Rect::from_min_max(egui::pos2(0.0, 0.0), egui::pos2(1.0, 1.0));
+        painter.image(texture_id, rect, full_uv, egui::Color32::WHITE);
+
+        let size = Vec2::new(rect.width(), rect.height()).max(Vec2::ONE);
+        if self.frame_pending {
+            self.frame(size.x / size.y);
+            self.frame_pending = false;
+        }
+        let modifiers = ui.input(|input| input.modifiers);
+        let delta = response.drag_delta();
+        let drag = Vec2::new(delta.x, delta.y);
+        let primary = response.dragged_by(egui::PointerButton::Primary);
+        if response.dragged_by(egui::PointerButton::Middle) || (primary && modifiers.shift) {
+            self.camera.pan(drag, size.y);
+        } else if response.dragged_by(egui::PointerButton::Secondary) || primary {
+            self.camera.orbit(drag);
+        }
+        if response.hovered() {
+            let scroll = ui.input(|input| input.smooth_scroll_delta.y);
+            if scroll != 0.0 {
+                // egui reports about 50 points per wheel notch.
+                self.camera.zoom(scroll / 50.0);
+            }
+        }
+        if self.settings.overlay {
+            self.overlay(&painter, rect);
+        }
+    }
+
+    /// Frame time, simulation time, what is drawn and what it costs on the GPU.
+    fn overlay(&self, painter: &egui::Painter, rect: egui::Rect) {
+        let draw = self.settings.draw;
+        let footprint = if draw.unified {
+            self.structure.footprint()
+        } else {
+            SeparatedStructure { layers: self.structure.layers, fin_faces: 2 }.footprint(&self.structure.mesh)
+        };
+        let mesh = &self.structure.mesh;
+        let base_vertices = mesh.vertex_count() as u64;
+        let vertices = if draw.shells || draw.fins { footprint.vertices } else { base_vertices * u64::from(draw.skin) };
+        let faces = mesh.triangles.len() as u64 * u64::from(draw.skin)
+            + footprint.shell_faces * u64::from(draw.shells)
+            + footprint.fin_faces * u64::from(draw.fins);
+        let frame_ms = self.frame_time_secs * 1e3;
+        let fps = if self.frame_time_secs > 0.0 { 1.0 / self.frame_time_secs } else { 0.0 };
+        let text = format!(
+            "frame    {frame_ms:6.2} ms  ({fps:.0} fps)\nsim      {:6.2} ms\nvertices {:>9}\nfaces    {:>9}\nGPU      {:>9}  {}\nmesh     {}  L = {}",
+            self.sim_time_secs * 1e3,
+            thousands(vertices),
+            thousands(faces),
+            bytes(footprint.total_bytes()),
+            if draw.unified { "unified" } else { "separated" },
+            self.settings.mesh.label(),
+            self.structure.layers,
+        );
+        let galley = painter.layout_no_wrap(text, egui::FontId::monospace(12.0), egui::Color32::from_gray(225));
+        let origin = rect.left_top() + egui::vec2(12.0, 12.0);
+        painter.rect_filled(
+            egui::Rect::from_min_size(origin, galley.size()).expand(6.0),
+            4.0,
+            egui::Color32::from_black_alpha(150),
+        );
+        painter.galley(origin, galley, egui::Color32::WHITE);
+        let hint = "left-drag: pat  ·  right-drag: orbit  ·  middle or Shift: pan  ·  wheel: zoom  ·  F: frame";
+        painter.text(
+            rect.center_bottom() - egui::vec2(0.0, 12.0),
+            egui::Align2::CENTER_BOTTOM,
+            hint,
+            egui::FontId::proportional(12.0),
+            egui::Color32::from_gray(150),
+        );
+    }
+
+    /// Looks at the whole fur (mesh plus its longest strand).
+    fn frame(&mut self, aspect: f32) {
+        let (center, radius) = self.structure.mesh.bounding_sphere();
+        let longest = self.structure.lengths.iter().copied().fold(0.0, f32::max);
+        self.camera.frame(center, radius + longest, aspect);
+    }
+
+    /// Rebuilds what the panel's changes touch; true when the structure is new.
+    fn apply(&mut self, changes: Changes) -> anyhow::Result<bool> {
+        if changes.mesh {
+            let mesh = match &self.settings.mesh {
+                MeshChoice::Builtin(builtin) => builtin.mesh().0,
+                MeshChoice::File(_) => self.file_mesh.clone().context("the command-line mesh is gone")?,
+            };
+            self.structure = grow(mesh, &self.settings)?;
+            self.frame_pending = true;
+        } else if changes.structure {
+            self.structure = grow(self.structure.mesh.clone(), &self.settings)?;
+        }
+        Ok(changes.mesh || changes.structure)
+    }
+}
+
+/// Grows the rest pose of the fur on `mesh`.
+fn grow(mesh: Mesh, settings: &Settings) -> anyhow::Result<FurStructure> {
+    let radius = mesh.bounding_sphere().1;
+    let params = FurParams {
+        layers: settings.layers,
+        length: FurLength::Constant(settings.length_per_radius * radius),
+        direction: GrowthDirection {
+            random_angle_rad: settings.random_angle_deg.to_radians(),
+            seed: settings.direction_seed,
+            comb: settings.comb,
+            comb_blend: settings.comb_blend,
+        },
+    };
+    Ok(FurStructure::new(mesh, &params)?)
+}
+
+/// Exponential moving average, so the overlay's numbers are readable.
+fn smooth(previous: f64, sample: f64) -> f64 {
+    if previous == 0.0 { sample } else { previous * 0.9 + sample * 0.1 }
+}
+
+fn thousands(value: u64) -> String {
+    let digits = value.to_string();
+    let mut out = String::new();
+    for (i, digit) in digits.chars().enumerate() {
+        if i > 0 && (digits.len() - i).is_multiple_of(3) {
+            out.push(',');
+        }
+        out.push(digit);
+    }
+    out
+}
+
+fn bytes(value: u64) -> String {
+    let value = value as f64;
+    if value >= 1024.0 * 1024.0 {
+        format!("{:.2} MiB", value / (1024.0 * 1024.0))
+    } else {
+        format!("{:.1} KiB", value / 1024.0)
+    }
+}
+
+/// Draws egui (panel, the 3D image, overlay) into `target`.
+fn draw_egui(
+    encoder: &mut wgpu::CommandEncoder,
+    renderer: &egui_wgpu::Renderer,
+    target: &wgpu::TextureView,
+    paint_jobs: &[egui::ClippedPrimitive],
+    screen: &egui_wgpu::ScreenDescriptor,
+) {
+    let mut pass = encoder
+        .begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("egui"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: target,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations { load: wgpu::LoadOp::Clear(wgpu::Color::BLACK), store: wgpu::StoreOp::Store },
+            })],
+            depth_stencil_attachment: None,
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        })
+        .forget_lifetime();
+    renderer.render(&mut pass, paint_jobs, screen);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn overlay_numbers_read_well() {
+        assert_eq!(thousands(0), "0");
+        assert_eq!(thousands(5_032), "5,032");
+        assert_eq!(thousands(1_234_567), "1,234,567");
+        assert_eq!(bytes(2048), "2.0 KiB");
+        assert_eq!(bytes(3 * 1024 * 1024), "3.00 MiB");
+    }
+
+    #[test]
+    fn growing_scales_the_length_with_the_mesh() {
+        let (mesh, _) = Builtin::Sphere.mesh();
+        let radius = mesh.bounding_sphere().1;
+        let mut settings = Settings::new(MeshChoice::Builtin(Builtin::Sphere));
+        settings.length_per_radius = 0.25;
+        let fur = grow(mesh, &settings).unwrap();
+        assert!(fur.lengths.iter().all(|l| (l - 0.25 * radius).abs() < 1e-5));
+        assert_eq!(fur.layers, settings.layers);
+    }
+}
