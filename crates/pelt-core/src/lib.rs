@@ -14,3 +14,4 @@ pub mod texture;
 
 pub use fur::{FurParams, FurStructure, GrowthDirection, SeparatedStructure};
 pub use mesh::{ImportOptions, Mesh, MeshError, MeshReport, builtin::Builtin};
+pub use sim::{Scene, SimError, SimParams, Simulation};

@@ -53,6 +53,35 @@ impl Camera {
         Self::orbit(centre, azimuth_deg, elevation_deg, distance)
     }
 
+    /// Frames `points` (e.g. mesh vertices) tightly from the given angles, looking at `target`,
+    /// with `padding` world units around every point (e.g. the fur length) and a small margin.
+    #[must_use]
+    pub fn framing_points(
+        target: Vec3,
+        points: impl IntoIterator<Item = Vec3>,
+        padding: f32,
+        azimuth_deg: f32,
+        elevation_deg: f32,
+        aspect_ratio: f32,
+    ) -> Self {
+        let unit = Self::orbit(target, azimuth_deg, elevation_deg, 1.0);
+        let backward = (unit.eye - target).normalize();
+        let right = unit.up.cross(backward).normalize();
+        let up = backward.cross(right);
+        let tan_y = (Self::DEFAULT_FOV_Y_RAD * 0.5).tan();
+        let tan_x = tan_y * aspect_ratio.max(1e-3);
+        let margin = 1.06;
+        let mut distance = 1e-6_f32;
+        for point in points {
+            let offset = point - target;
+            let depth = offset.dot(backward);
+            let needed_x = (offset.dot(right).abs() + padding) * margin / tan_x;
+            let needed_y = (offset.dot(up).abs() + padding) * margin / tan_y;
+            distance = distance.max(depth + padding + needed_x.max(needed_y));
+        }
+        Self::orbit(target, azimuth_deg, elevation_deg, distance)
+    }
+
     /// View matrix.
     #[must_use]
     pub fn view_from_world(&self) -> Mat4 {
@@ -90,6 +119,22 @@ mod tests {
             }
             assert!(widest > 0.8, "the sphere fills the view: {widest}");
         }
+    }
+
+    #[test]
+    fn framed_points_fit_the_view_tightly() {
+        let points = [Vec3::new(-3.0, -0.5, 0.2), Vec3::new(3.0, 0.5, -0.2), Vec3::new(0.0, 1.0, 1.0)];
+        let aspect = 16.0 / 9.0;
+        let camera = Camera::framing_points(Vec3::ZERO, points, 0.1, 20.0, 10.0, aspect);
+        let clip_from_world = camera.clip_from_world(aspect);
+        let mut widest = 0.0_f32;
+        for point in points {
+            let clip = clip_from_world * point.extend(1.0);
+            let ndc = clip.truncate() / clip.w;
+            assert!(ndc.x.abs() < 1.0 && ndc.y.abs() < 1.0 && (0.0..1.0).contains(&ndc.z), "{ndc}");
+            widest = widest.max(ndc.x.abs()).max(ndc.y.abs());
+        }
+        assert!(widest > 0.8, "tight: {widest}");
     }
 
     #[test]

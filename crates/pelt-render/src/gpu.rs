@@ -57,6 +57,27 @@ impl fmt::Display for Backend {
     }
 }
 
+/// The best adapter of `backends`: a real GPU if there is one, else a software one.
+fn request_adapter(backends: wgpu::Backends) -> Result<(wgpu::Instance, wgpu::Adapter), wgpu::RequestAdapterError> {
+    let mut descriptor = wgpu::InstanceDescriptor::new_without_display_handle();
+    descriptor.backends = backends;
+    let instance = wgpu::Instance::new(descriptor);
+    let options = wgpu::RequestAdapterOptions {
+        power_preference: wgpu::PowerPreference::HighPerformance,
+        force_fallback_adapter: false,
+        ..wgpu::RequestAdapterOptions::default()
+    };
+    let adapter = match pollster::block_on(instance.request_adapter(&options)) {
+        Ok(adapter) => adapter,
+        // Some drivers only list a CPU adapter as the fallback one.
+        Err(first) => pollster::block_on(
+            instance.request_adapter(&wgpu::RequestAdapterOptions { force_fallback_adapter: true, ..options }),
+        )
+        .map_err(|_| first)?,
+    };
+    Ok((instance, adapter))
+}
+
 /// An adapter with its device and queue.
 #[derive(Debug)]
 pub struct Gpu {
@@ -75,23 +96,23 @@ impl Gpu {
     /// [`RenderError::NoAdapter`] (with install advice), [`RenderError::NoDevice`] or
     /// [`RenderError::NoVertexStorage`].
     pub fn new(backend: Backend) -> Result<Self, RenderError> {
-        let mut descriptor = wgpu::InstanceDescriptor::new_without_display_handle();
-        descriptor.backends = backend.backends();
-        let instance = wgpu::Instance::new(descriptor);
-        let options = wgpu::RequestAdapterOptions {
-            power_preference: wgpu::PowerPreference::HighPerformance,
-            force_fallback_adapter: false,
-            ..wgpu::RequestAdapterOptions::default()
+        // Auto tries the modern APIs first and GL only without them: probing GL (EGL) prints
+        // warnings on machines without a display, which a working Vulkan makes pointless.
+        let attempts = match backend {
+            Backend::Auto if wgpu::Backends::from_env().is_none() => {
+                vec![wgpu::Backends::PRIMARY, wgpu::Backends::GL]
+            }
+            _ => vec![backend.backends()],
         };
-        let adapter = match pollster::block_on(instance.request_adapter(&options)) {
-            Ok(adapter) => adapter,
-            // Some drivers only list a CPU adapter as the fallback one.
-            Err(first) => pollster::block_on(
-                instance.request_adapter(&wgpu::RequestAdapterOptions { force_fallback_adapter: true, ..options }),
-            )
-            .map_err(|_| RenderError::NoAdapter { backend: backend.to_string(), source: first })?,
-        };
-        Self::from_adapter(instance, adapter)
+        let mut last_error = None;
+        for backends in attempts {
+            match request_adapter(backends) {
+                Ok((instance, adapter)) => return Self::from_adapter(instance, adapter),
+                Err(error) => last_error = Some(error),
+            }
+        }
+        let source = last_error.expect("at least one attempt");
+        Err(RenderError::NoAdapter { backend: backend.to_string(), source })
     }
 
     /// Opens a device on `adapter` (e.g. one compatible with a window surface) with the limits

@@ -85,7 +85,7 @@ impl Headless {
         Renderer::new(&self.gpu.device, &self.gpu.queue, self.format(), fur, textures)
     }
 
-    /// Renders one frame and reads it back.
+    /// Renders one frame with `renderer` and reads it back.
     ///
     /// # Errors
     /// [`RenderError::Readback`], or a GPU error raised while drawing.
@@ -95,10 +95,24 @@ impl Headless {
         camera: &Camera,
         settings: &RenderSettings,
     ) -> Result<image::RgbaImage, RenderError> {
+        self.render_with(|queue, encoder, targets, output| {
+            renderer.render(queue, encoder, targets, output, camera, settings);
+        })
+    }
+
+    /// Renders one frame recorded by `record(queue, encoder, targets, output)` (e.g. a
+    /// [`crate::SeparatedRenderer`]) and reads it back.
+    ///
+    /// # Errors
+    /// [`RenderError::Readback`], or a GPU error raised while drawing.
+    pub fn render_with(
+        &self,
+        record: impl FnOnce(&wgpu::Queue, &mut wgpu::CommandEncoder, &RenderTargets, &wgpu::TextureView),
+    ) -> Result<image::RgbaImage, RenderError> {
         let device = &self.gpu.device;
         let scope = ErrorScope::push(device);
         let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("pelt frame") });
-        renderer.render(&self.gpu.queue, &mut encoder, &self.targets, &self.output_view, camera, settings);
+        record(&self.gpu.queue, &mut encoder, &self.targets, &self.output_view);
         let (width, height) = self.size();
         encoder.copy_texture_to_buffer(
             self.output.as_image_copy(),

@@ -6,7 +6,7 @@
 //! 2. shells, instanced per layer from the innermost out, over the same `3F` triangle corners,
 //!    alpha-blended with depth test on and depth writes off (or alpha-to-coverage), faded where
 //!    the surface turns edge-on;
-//! 3. fins, instanced per edge, `6L` vertices each, faded in near the silhouette.
+//! 3. fins, instanced per edge over one shared strip of `6L` indices, faded in near the silhouette.
 
 use glam::{Mat4, Vec2, Vec3, Vec4};
 use pelt_core::mesh::Mesh;
@@ -53,8 +53,9 @@ pub struct RenderSettings {
     pub fin_fade_cos: f32,
     /// Shells fade where the surface turns below this |cos| to the view.
     pub shell_fade_cos: f32,
-    /// Shell texture tiles across the mesh's bounding radius: strand density independent of the
-    /// mesh's size.
+    /// Shell texture tiles across the mesh's bounding radius, so strands have the same density
+    /// relative to the mesh whatever its size. (A larger tile holds more, finer strands: the
+    /// texture's resolution sets how fine the fur is, as in the paper's "resizing".)
     pub tiles_per_radius: f32,
     /// Linear RGB clear colour.
     pub background: Vec3,
@@ -75,7 +76,7 @@ impl Default for RenderSettings {
             root_occlusion: 0.3,
             fin_fade_cos: 0.2,
             shell_fade_cos: 0.25,
-            tiles_per_radius: 3.0,
+            tiles_per_radius: 0.4,
             background: Vec3::new(0.045, 0.05, 0.06),
         }
     }
@@ -119,7 +120,11 @@ const _: () = assert!(size_of::<ObjectUniform>() == 48, "matches `Object` in uni
 #[derive(Debug)]
 struct GpuObject {
     uniform: wgpu::Buffer,
+    /// The fin strip of one edge (`6L` indices into `2(L + 1)` strip vertices), shared by all
+    /// edges: indexed, each strip vertex is shaded once however many triangles use it.
+    fin_indices: wgpu::Buffer,
     positions: wgpu::Buffer,
+    topology: wgpu::Buffer,
     bind_group: wgpu::BindGroup,
     vertex_count: u32,
     layers: u32,
@@ -166,7 +171,19 @@ impl GpuObject {
         let positions = storage("pelt shared vertices", bytemuck::cast_slice(positions), wgpu::BufferUsages::COPY_DST);
         let normals = storage("pelt rest normals", bytemuck::cast_slice(&mesh.normals), wgpu::BufferUsages::empty());
         let uvs = storage("pelt corner uvs", bytemuck::cast_slice(&corner_uvs), wgpu::BufferUsages::empty());
-        let topology = storage("pelt topology", bytemuck::cast_slice(&topology), wgpu::BufferUsages::empty());
+        // Also the index buffer of the base triangles for meshes without uvs.
+        let topology = storage("pelt topology", bytemuck::cast_slice(&topology), wgpu::BufferUsages::INDEX);
+        let strip: Vec<u32> = (0..layers.max(1))
+            .flat_map(|i| {
+                let (a, b, a_up, b_up) = (2 * i, 2 * i + 1, 2 * i + 2, 2 * i + 3);
+                [a, b, b_up, a, b_up, a_up]
+            })
+            .collect();
+        let fin_indices = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: Some("pelt fin strip"),
+            contents: bytemuck::cast_slice(&strip),
+            usage: wgpu::BufferUsages::INDEX,
+        });
         let uniform = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("pelt object"),
             size: size_of::<ObjectUniform>() as u64,
@@ -186,7 +203,9 @@ impl GpuObject {
         });
         Ok(Self {
             uniform,
+            fin_indices,
             positions,
+            topology,
             bind_group,
             vertex_count: mesh.vertex_count() as u32,
             layers,
@@ -197,6 +216,20 @@ impl GpuObject {
             radius: mesh.bounding_sphere().1.max(1e-6),
             colour,
         })
+    }
+
+    /// Draws the base triangles (`instances` = layers): by corner with uvs, else indexed.
+    fn draw_surface(&self, pass: &mut wgpu::RenderPass<'_>, instances: std::ops::Range<u32>) {
+        if self.has_uvs {
+            pass.draw(0..3 * self.triangle_count, instances);
+        } else {
+            // The topology buffer starts with the base triangles.
+            pass.set_index_buffer(
+                self.topology.slice(..u64::from(self.triangle_count) * 12),
+                wgpu::IndexFormat::Uint32,
+            );
+            pass.draw_indexed(0..3 * self.triangle_count, 0, instances);
+        }
     }
 
     fn write_uniform(&self, queue: &wgpu::Queue, tiles_per_radius: f32, shell_slices: u32) {
@@ -216,6 +249,12 @@ impl GpuObject {
     }
 }
 
+impl Pipelines {
+    fn surface(&self, object: &GpuObject) -> &SurfacePipelines {
+        if object.has_uvs { &self.corners } else { &self.indexed }
+    }
+}
+
 /// sqrt(surface area / uv area), or 1 without uvs.
 pub(crate) fn world_per_uv(mesh: &Mesh) -> f32 {
     let Some(uvs) = &mesh.corner_uvs else { return 1.0 };
@@ -223,13 +262,22 @@ pub(crate) fn world_per_uv(mesh: &Mesh) -> f32 {
     if uv_area > 1e-12 { (mesh.surface_area() / uv_area).sqrt() } else { 1.0 }
 }
 
+/// Pipelines for one way of walking the base triangles (see `unified.wgsl`).
 #[derive(Debug)]
-struct Pipelines {
+struct SurfacePipelines {
     plain: wgpu::RenderPipeline,
     skin: wgpu::RenderPipeline,
     shells_blended: wgpu::RenderPipeline,
-    fins_blended: wgpu::RenderPipeline,
     shells_coverage: wgpu::RenderPipeline,
+}
+
+#[derive(Debug)]
+struct Pipelines {
+    /// Meshes with uvs: non-indexed over the triangle corners.
+    corners: SurfacePipelines,
+    /// Meshes without uvs: indexed by the base triangles.
+    indexed: SurfacePipelines,
+    fins_blended: wgpu::RenderPipeline,
     fins_coverage: wgpu::RenderPipeline,
 }
 
@@ -452,9 +500,10 @@ impl Renderer {
             shininess: settings.shininess,
         };
         queue.write_buffer(&self.globals, 0, bytemuck::bytes_of(&globals));
-        self.fur.write_uniform(queue, settings.tiles_per_radius, self.textures.shell_slices);
+        let tiles_per_radius = settings.tiles_per_radius;
+        self.fur.write_uniform(queue, tiles_per_radius, self.textures.shell_slices);
         for plain in &self.plain {
-            plain.write_uniform(queue, settings.tiles_per_radius, self.textures.shell_slices);
+            plain.write_uniform(queue, tiles_per_radius, self.textures.shell_slices);
         }
     }
 
@@ -462,31 +511,34 @@ impl Renderer {
     /// viewer's pass that also draws a UI afterwards).
     pub fn draw(&self, pass: &mut wgpu::RenderPass<'_>, settings: &RenderSettings) {
         pass.set_bind_group(0, &self.globals_bind_group, &[]);
-        pass.set_pipeline(&self.pipelines.plain);
         for plain in &self.plain {
             pass.set_bind_group(1, &plain.bind_group, &[]);
-            pass.draw(0..3 * plain.triangle_count, 0..1);
+            pass.set_pipeline(&self.pipelines.surface(plain).plain);
+            plain.draw_surface(pass, 0..1);
         }
         let fur = &self.fur;
+        let surface = self.pipelines.surface(fur);
         pass.set_bind_group(1, &fur.bind_group, &[]);
         if settings.skin {
-            pass.set_pipeline(&self.pipelines.skin);
-            pass.draw(0..3 * fur.triangle_count, 0..1);
+            pass.set_pipeline(&surface.skin);
+            fur.draw_surface(pass, 0..1);
         }
-        let (fins, shells) = if settings.alpha_to_coverage {
-            (&self.pipelines.fins_coverage, &self.pipelines.shells_coverage)
-        } else {
-            (&self.pipelines.fins_blended, &self.pipelines.shells_blended)
-        };
         if settings.shells && fur.layers > 0 {
-            pass.set_pipeline(shells);
-            pass.draw(0..3 * fur.triangle_count, 0..fur.layers);
+            pass.set_pipeline(if settings.alpha_to_coverage {
+                &surface.shells_coverage
+            } else {
+                &surface.shells_blended
+            });
+            fur.draw_surface(pass, 0..fur.layers);
         }
         // Fins after the shells: at the silhouette, where fins matter, they stand outside the
         // shells and must not be covered by the faded outer layers.
         if settings.fins && fur.layers > 0 {
+            let fins =
+                if settings.alpha_to_coverage { &self.pipelines.fins_coverage } else { &self.pipelines.fins_blended };
             pass.set_pipeline(fins);
-            pass.draw(0..6 * fur.layers, 0..fur.edge_count);
+            pass.set_index_buffer(fur.fin_indices.slice(..), wgpu::IndexFormat::Uint32);
+            pass.draw_indexed(0..6 * fur.layers, 0, 0..fur.edge_count);
         }
     }
 
@@ -532,15 +584,23 @@ impl Pipelines {
             bind_group_layouts: &[Some(globals_layout), Some(object_layout)],
             immediate_size: 0,
         });
-        let build = |label, vertex, fragment, kind| {
+        let build = |label: &str, vertex: &str, fragment: &str, kind| {
             create_pipeline(device, &layout, &module, format, label, (vertex, fragment), kind, &[])
         };
+        let surface = |walk: &str| {
+            let skin = format!("vs_skin_{walk}");
+            let shell = format!("vs_shell_{walk}");
+            SurfacePipelines {
+                plain: build("pelt plain", &skin, "fs_plain", PassKind::Opaque),
+                skin: build("pelt skin", &skin, "fs_skin", PassKind::Opaque),
+                shells_blended: build("pelt shells", &shell, "fs_shell", PassKind::Shells(Transparency::Blend)),
+                shells_coverage: build("pelt shells a2c", &shell, "fs_shell", PassKind::Shells(Transparency::Coverage)),
+            }
+        };
         Self {
-            plain: build("pelt plain", "vs_skin", "fs_plain", PassKind::Opaque),
-            skin: build("pelt skin", "vs_skin", "fs_skin", PassKind::Opaque),
-            shells_blended: build("pelt shells", "vs_shell", "fs_shell", PassKind::Shells(Transparency::Blend)),
+            corners: surface("corners"),
+            indexed: surface("indexed"),
             fins_blended: build("pelt fins", "vs_fin", "fs_fin", PassKind::Fins(Transparency::Blend)),
-            shells_coverage: build("pelt shells a2c", "vs_shell", "fs_shell", PassKind::Shells(Transparency::Coverage)),
             fins_coverage: build("pelt fins a2c", "vs_fin", "fs_fin", PassKind::Fins(Transparency::Coverage)),
         }
     }

@@ -3,8 +3,10 @@
 //! 32 bytes each) reused by one index buffer with a base-vertex offset per layer, and fins as
 //! geometry of their own, `N` faces per fin, built once on the CPU (they do not bend).
 //!
-//! Each fin is a strip of `N / 2` quads up the rest strands with its own vertices (they carry the
-//! fin's plane normal for Lengyel's fade and uvs along the fin), `N + 2` vertices a fin.
+//! Each fin is a strip of `N / 2` quads up the rest strands with vertices of its own (they carry
+//! the fin's plane normal for Lengyel's fade and uvs along the fin), stored as a plain triangle
+//! list: 6 vertices a quad. (The paper counts `N` vertices a fin, sharing strip vertices; the
+//! drawn cost is the same.)
 
 use glam::{Vec2, Vec3};
 use pelt_core::FurStructure;

@@ -63,8 +63,8 @@ fn face_normal(face: u32) -> vec3<f32> {
     return safe_normalize(cross(b - a, c - a), vec3<f32>(0.0));
 }
 
-fn surface_varyings(corner: u32, layer: u32) -> Varyings {
-    let vertex = triangle_vertex(corner);
+// `corner` indexes the per-corner uvs; it is only read when the mesh has uvs.
+fn surface_varyings(vertex: u32, corner: u32, layer: u32) -> Varyings {
     let position = shared_vertex(layer, vertex);
     var out: Varyings;
     out.clip_position = globals.clip_from_world * vec4<f32>(position, 1.0);
@@ -85,16 +85,32 @@ fn surface_varyings(corner: u32, layer: u32) -> Varyings {
     return out;
 }
 
-// The opaque skin: layer 0, one vertex per triangle corner (non-indexed, 3F vertices).
+// Two ways to walk the base triangles. Meshes with uvs: non-indexed over the 3F corners
+// (`vertex_index` = corner, so seams keep their own uvs). Meshes without: indexed by the base
+// triangles themselves (`vertex_index` = base vertex), so each vertex is shaded once a layer.
+
+// The opaque skin: layer 0.
 @vertex
-fn vs_skin(@builtin(vertex_index) corner: u32) -> Varyings {
-    return surface_varyings(corner, 0u);
+fn vs_skin_corners(@builtin(vertex_index) corner: u32) -> Varyings {
+    return surface_varyings(triangle_vertex(corner), corner, 0u);
 }
 
-// Shells: instance i draws layer i + 1 over the same 3F corners.
 @vertex
-fn vs_shell(@builtin(vertex_index) corner: u32, @builtin(instance_index) instance: u32) -> Varyings {
-    var out = surface_varyings(corner, instance + 1u);
+fn vs_skin_indexed(@builtin(vertex_index) vertex: u32) -> Varyings {
+    return surface_varyings(vertex, 0u, 0u);
+}
+
+// Shells: instance i draws layer i + 1.
+@vertex
+fn vs_shell_corners(@builtin(vertex_index) corner: u32, @builtin(instance_index) instance: u32) -> Varyings {
+    var out = surface_varyings(triangle_vertex(corner), corner, instance + 1u);
+    out.fade = shell_fade(out.normal, out.world_position);
+    return out;
+}
+
+@vertex
+fn vs_shell_indexed(@builtin(vertex_index) vertex: u32, @builtin(instance_index) instance: u32) -> Varyings {
+    var out = surface_varyings(vertex, 0u, instance + 1u);
     out.fade = shell_fade(out.normal, out.world_position);
     return out;
 }
@@ -106,17 +122,13 @@ fn hash(x: u32) -> u32 {
     return h ^ (h >> 16u);
 }
 
-// Fins: instance = edge, 6 vertices (two triangles) per layer step, L steps up the strands.
+// Fins: instance = edge; vertex 2i + s is strand node i on side s (0 = a, 1 = b) of the edge, and
+// a shared index buffer joins them into two triangles per layer step, L steps up the strands.
 // Each corner is a shared vertex, so fins bend with the simulated fur.
 @vertex
 fn vs_fin(@builtin(vertex_index) index: u32, @builtin(instance_index) edge: u32) -> Varyings {
-    let step = index / 6u;
-    // (side along the edge, step up) of the quad (i,a) (i,b) (i+1,b) / (i,a) (i+1,b) (i+1,a).
-    let sides = array<u32, 6>(0u, 1u, 1u, 0u, 1u, 0u);
-    let ups = array<u32, 6>(0u, 0u, 1u, 0u, 1u, 1u);
-    let corner = index % 6u;
-    let side = sides[corner];
-    let layer = step + ups[corner];
+    let side = index % 2u;
+    let layer = index / 2u;
 
     let edges_start = 3u * object.triangle_count;
     let a = topology[edges_start + 2u * edge];

@@ -1,9 +1,242 @@
-//! `pelt stats`.
+//! `pelt stats`: the paper's Table 2 for any mesh, measured rather than quoted.
+//!
+//! Grows the unified structure on the mesh and prints its counts and GPU bytes next to the
+//! separated structure of Lengyel et al. with 2-face fins and with `N`-face fins.
+
+use std::fmt::Write as _;
+use std::io::Write as _;
+
+use anyhow::Context as _;
+use pelt_core::fur::{Footprint, FurLength, MAX_LAYERS};
+use pelt_core::{Builtin, FurParams, FurStructure, GrowthDirection, MeshReport, SeparatedStructure};
+
+use crate::mesh_args::MeshArgs;
 
 /// Arguments of `pelt stats`.
 #[derive(Debug, clap::Args)]
-pub struct Args {}
+pub struct Args {
+    #[command(flatten)]
+    pub mesh: MeshArgs,
+    /// Shells above the base, `L` (the paper's tables use 16).
+    #[arg(long, default_value_t = 16)]
+    pub layers: u32,
+    /// Faces per fin of the separated structure it is compared against, `N` (the paper: 30).
+    #[arg(long, default_value_t = 30, value_parser = clap::value_parser!(u32).range(1..=1024))]
+    pub fin_faces: u32,
+    /// Print JSON instead of a table.
+    #[arg(long)]
+    pub json: bool,
+}
 
-pub fn run(_args: &Args) -> anyhow::Result<()> {
-    anyhow::bail!("`pelt stats` is not built yet")
+/// The numbers `pelt stats` reports.
+#[derive(Debug, serde::Serialize)]
+pub struct Stats {
+    pub mesh: MeshReport,
+    pub layers: u32,
+    /// `N`, faces per fin of the second separated structure.
+    pub fin_faces: u32,
+    pub unified: Footprint,
+    pub separated_two_face_fins: Footprint,
+    pub separated_n_face_fins: Footprint,
+    /// How much the unified structure saves, in percent of each separated one.
+    pub savings: Savings,
+}
+
+/// Savings of the unified structure, in percent of a separated one.
+#[derive(Debug, serde::Serialize)]
+pub struct Savings {
+    pub vertices_vs_two_face_fins_percent: f64,
+    pub vertices_vs_n_face_fins_percent: f64,
+    pub gpu_bytes_vs_two_face_fins_percent: f64,
+    pub gpu_bytes_vs_n_face_fins_percent: f64,
+}
+
+/// The paper's printed Table 2 row for its Box: (shared vertices, separated with 2-face fins,
+/// separated with 30-face fins), at 16 layers.
+const PAPER_BOX: (u64, u64, u64) = (5_032, 6_796, 31_492);
+
+pub fn run(args: &Args) -> anyhow::Result<()> {
+    let (mesh, report) = args.mesh.load(Builtin::Box)?;
+    let stats = measure(mesh, report, args.layers, args.fin_faces)?;
+    let text = if args.json { serde_json::to_string_pretty(&stats)? + "\n" } else { table(&stats) };
+    write_stdout(&text)
+}
+
+/// Writes to stdout; a closed pipe (`pelt stats | head`) is not an error.
+fn write_stdout(text: &str) -> anyhow::Result<()> {
+    let mut stdout = std::io::stdout().lock();
+    match stdout.write_all(text.as_bytes()).and_then(|()| stdout.flush()) {
+        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => Ok(()),
+        result => result.context("cannot write the report to stdout"),
+    }
+}
+
+/// Grows the unified structure on `mesh` and measures both structures.
+///
+/// # Errors
+/// When `layers` is outside `1..=MAX_LAYERS`.
+pub fn measure(mesh: pelt_core::Mesh, report: MeshReport, layers: u32, fin_faces: u32) -> anyhow::Result<Stats> {
+    let params = FurParams { layers, length: FurLength::Constant(1.0), direction: GrowthDirection::default() };
+    let fur = FurStructure::new(mesh, &params)
+        .with_context(|| format!("--layers {layers}: choose between 1 and {MAX_LAYERS}"))?;
+    let unified = fur.footprint();
+    // The footprint counts what was actually built.
+    anyhow::ensure!(
+        unified.vertices == fur.positions.len() as u64,
+        "unified vertex count disagrees with the structure"
+    );
+    let separated_two_face_fins = SeparatedStructure { layers, fin_faces: 2 }.footprint(&fur.mesh);
+    let separated_n_face_fins = SeparatedStructure { layers, fin_faces }.footprint(&fur.mesh);
+    let vertices = |f: &Footprint| f.vertices;
+    let bytes = |f: &Footprint| f.total_bytes();
+    let savings = Savings {
+        vertices_vs_two_face_fins_percent: unified.savings_percent(&separated_two_face_fins, vertices),
+        vertices_vs_n_face_fins_percent: unified.savings_percent(&separated_n_face_fins, vertices),
+        gpu_bytes_vs_two_face_fins_percent: unified.savings_percent(&separated_two_face_fins, bytes),
+        gpu_bytes_vs_n_face_fins_percent: unified.savings_percent(&separated_n_face_fins, bytes),
+    };
+    Ok(Stats { mesh: report, layers, fin_faces, unified, separated_two_face_fins, separated_n_face_fins, savings })
+}
+
+/// The human-readable report; on the built-in Box it adds the paper's printed numbers.
+#[must_use]
+pub fn table(stats: &Stats) -> String {
+    let mut out = String::new();
+    let r = &stats.mesh;
+    let _ = writeln!(out, "{r}");
+    let _ = writeln!(out);
+    let _ = writeln!(
+        out,
+        "Table 2 on {} (V = {}, F = {}, E = {}; L = {} shells above the base)",
+        r.source,
+        grouped(r.vertices as u64),
+        grouped(r.triangles as u64),
+        grouped(r.edges as u64),
+        stats.layers
+    );
+    let _ = writeln!(
+        out,
+        "{:<26} {:>10} {:>11} {:>11} {:>13} {:>13} {:>13}",
+        "structure", "vertices", "shell faces", "fin faces", "vertex bytes", "index bytes", "GPU bytes"
+    );
+    let mut rows = vec![("unified (shared vertices)".to_owned(), &stats.unified)];
+    rows.push(("separated, 2-face fins".to_owned(), &stats.separated_two_face_fins));
+    if stats.fin_faces != 2 {
+        rows.push((format!("separated, {}-face fins", stats.fin_faces), &stats.separated_n_face_fins));
+    }
+    for (name, f) in rows {
+        let _ = writeln!(
+            out,
+            "{name:<26} {:>10} {:>11} {:>11} {:>13} {:>13} {:>13}",
+            grouped(f.vertices),
+            grouped(f.shell_faces),
+            grouped(f.fin_faces),
+            grouped(f.position_bytes + f.attribute_bytes),
+            grouped(f.index_bytes),
+            grouped(f.total_bytes())
+        );
+    }
+    let s = &stats.savings;
+    let _ = writeln!(
+        out,
+        "unified saves {:.2}% of the vertices and {:.2}% of the GPU bytes against 2-face fins",
+        s.vertices_vs_two_face_fins_percent, s.gpu_bytes_vs_two_face_fins_percent
+    );
+    if stats.fin_faces != 2 {
+        let _ = writeln!(
+            out,
+            "unified saves {:.2}% of the vertices and {:.2}% of the GPU bytes against {}-face fins",
+            s.vertices_vs_n_face_fins_percent, s.gpu_bytes_vs_n_face_fins_percent, stats.fin_faces
+        );
+    }
+    if r.source == format!("builtin:{}", Builtin::Box) && stats.layers == 16 {
+        let (unified, two, thirty) = PAPER_BOX;
+        let measured = (stats.unified.vertices, stats.separated_two_face_fins.vertices);
+        let thirty_measured = (stats.fin_faces == 30).then_some(stats.separated_n_face_fins.vertices);
+        let agrees = measured == (unified, two) && thirty_measured.is_none_or(|v| v == thirty);
+        let _ = writeln!(
+            out,
+            "paper's Table 2, Box: {} / {} / {} vertices (unified / 2-face / 30-face): {}",
+            grouped(unified),
+            grouped(two),
+            grouped(thirty),
+            if agrees { "matches" } else { "DIFFERS" }
+        );
+    }
+    out
+}
+
+/// `1234567` as `1,234,567`.
+fn grouped(n: u64) -> String {
+    let digits = n.to_string();
+    let mut out = String::with_capacity(digits.len() + digits.len() / 3);
+    for (k, c) in digits.chars().enumerate() {
+        if k > 0 && (digits.len() - k).is_multiple_of(3) {
+            out.push(',');
+        }
+        out.push(c);
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn stats_of(builtin: Builtin, layers: u32, fin_faces: u32) -> Stats {
+        let (mesh, report) = builtin.mesh();
+        measure(mesh, report, layers, fin_faces).unwrap()
+    }
+
+    #[test]
+    fn thousands_are_grouped() {
+        assert_eq!(grouped(0), "0");
+        assert_eq!(grouped(999), "999");
+        assert_eq!(grouped(1_000), "1,000");
+        assert_eq!(grouped(31_492), "31,492");
+        assert_eq!(grouped(1_234_567), "1,234,567");
+    }
+
+    #[test]
+    fn the_paper_box_reproduces_table_2() {
+        let stats = stats_of(Builtin::Box, 16, 30);
+        assert_eq!(stats.unified.vertices, 5_032);
+        assert_eq!(stats.separated_two_face_fins.vertices, 6_796);
+        assert_eq!(stats.separated_n_face_fins.vertices, 31_492);
+        let text = table(&stats);
+        assert!(text.contains("5,032") && text.contains("6,796") && text.contains("31,492"), "{text}");
+        assert!(text.contains("25.96%") && text.contains("84.02%"), "{text}");
+        assert!(text.contains("matches"), "{text}");
+        // The unified structure wins on GPU bytes too, not only on vertex counts.
+        assert!(stats.savings.gpu_bytes_vs_two_face_fins_percent > 0.0);
+        assert!(stats.savings.gpu_bytes_vs_n_face_fins_percent > stats.savings.gpu_bytes_vs_two_face_fins_percent);
+    }
+
+    #[test]
+    fn two_face_fins_are_listed_once() {
+        let text = table(&stats_of(Builtin::Torus, 8, 2));
+        assert_eq!(text.matches("separated").count(), 1, "{text}");
+        assert!(!text.contains("paper's"), "{text}");
+    }
+
+    #[test]
+    fn json_carries_every_number() {
+        let stats = stats_of(Builtin::Plane, 4, 30);
+        let json: serde_json::Value = serde_json::to_value(&stats).unwrap();
+        let v = stats.mesh.vertices as u64;
+        let e = stats.mesh.edges as u64;
+        assert_eq!(json["unified"]["vertices"], v * 5);
+        assert_eq!(json["separated_n_face_fins"]["vertices"], v * 5 + 30 * e);
+        assert_eq!(json["mesh"]["boundary_loops"], 1);
+        assert!(json["savings"]["vertices_vs_n_face_fins_percent"].as_f64().unwrap() > 0.0);
+    }
+
+    #[test]
+    fn bad_layer_counts_name_the_flag() {
+        for layers in [0, MAX_LAYERS + 1] {
+            let (mesh, report) = Builtin::Box.mesh();
+            let message = format!("{:#}", measure(mesh, report, layers, 30).unwrap_err());
+            assert!(message.contains("--layers"), "{message}");
+        }
+    }
 }

@@ -189,6 +189,7 @@ mod tests {
             let (mesh, report) = builtin.mesh();
             assert_eq!(report.inconsistent_winding_edges, 0, "{builtin}");
             assert_eq!(report.non_manifold_edges, 0, "{builtin}");
+            assert_eq!(report.boundary_loops, usize::from(builtin == Builtin::Plane), "{builtin}");
             if builtin != Builtin::Plane {
                 assert_eq!(report.boundary_edges, 0, "{builtin}: {report}");
                 assert_eq!(mesh.edges.len() * 2, mesh.triangles.len() * 3, "E = 3F/2 on {builtin}");

@@ -20,8 +20,9 @@ pub const NO_FACE: u32 = u32::MAX;
 /// Errors from reading or validating a mesh. Each names the file (or built-in) it came from.
 #[derive(Debug, thiserror::Error)]
 pub enum MeshError {
-    #[error("{}: cannot read the file: {source}", file.display())]
-    Io { file: PathBuf, source: std::io::Error },
+    // The cause is part of the message (not a `source`) so it is printed exactly once.
+    #[error("{}: cannot read the file: {error}", file.display())]
+    Io { file: PathBuf, error: std::io::Error },
     #[error("{}: unknown mesh format {extension:?} (Pelt reads .obj, .gltf and .glb)", file.display())]
     UnknownFormat { file: PathBuf, extension: String },
     #[error("{}{}: {message}", file.display(), line.map(|l| format!(":{l}")).unwrap_or_default())]
@@ -52,11 +53,14 @@ pub struct ImportOptions {
     pub weld: bool,
     /// Welding distance relative to the bounding-box diagonal.
     pub weld_tolerance: f32,
+    /// Flip triangles so neighbours agree on winding and closed parts face outward (fur grows
+    /// along normals computed from the winding, and fins need consistent neighbours).
+    pub orient: bool,
 }
 
 impl Default for ImportOptions {
     fn default() -> Self {
-        Self { weld: true, weld_tolerance: 1e-6 }
+        Self { weld: true, weld_tolerance: 1e-6, orient: true }
     }
 }
 
@@ -81,11 +85,18 @@ pub struct MeshReport {
     pub welded_vertices: usize,
     pub dropped_zero_area_triangles: usize,
     pub dropped_repeated_index_triangles: usize,
+    /// Triangles over the same three vertices as an earlier one, either winding (double-sided
+    /// or doubled geometry would make every edge non-manifold and draw its fins twice).
+    pub dropped_duplicate_triangles: usize,
     pub dropped_unreferenced_vertices: usize,
+    /// Triangles flipped to agree with their neighbours (or to turn a closed part outward).
+    pub reoriented_triangles: usize,
     pub normals: NormalSource,
     /// Whether the mesh has texture coordinates (none are generated when the file has none).
     pub has_uvs: bool,
     pub boundary_edges: usize,
+    /// Connected chains of boundary edges: the holes and open rims (0 on a closed mesh).
+    pub boundary_loops: usize,
     pub non_manifold_edges: usize,
     /// Edges whose two faces traverse them in the same direction (flipped winding).
     pub inconsistent_winding_edges: usize,
@@ -113,9 +124,13 @@ impl fmt::Display for MeshReport {
         writeln!(f, "  welded {} duplicate vertices", self.welded_vertices)?;
         writeln!(
             f,
-            "  dropped {} zero-area and {} repeated-index triangles, {} unreferenced vertices",
-            self.dropped_zero_area_triangles, self.dropped_repeated_index_triangles, self.dropped_unreferenced_vertices
+            "  dropped {} zero-area, {} repeated-index and {} duplicate triangles, {} unreferenced vertices",
+            self.dropped_zero_area_triangles,
+            self.dropped_repeated_index_triangles,
+            self.dropped_duplicate_triangles,
+            self.dropped_unreferenced_vertices
         )?;
+        writeln!(f, "  flipped {} triangles to a consistent, outward winding", self.reoriented_triangles)?;
         let normals = match self.normals {
             NormalSource::File => "from the file",
             NormalSource::Computed => "computed (smooth)",
@@ -124,8 +139,8 @@ impl fmt::Display for MeshReport {
         writeln!(f, "  normals {normals}; uvs {uvs}")?;
         write!(
             f,
-            "  {} boundary edges, {} non-manifold edges, {} edges with inconsistent winding",
-            self.boundary_edges, self.non_manifold_edges, self.inconsistent_winding_edges
+            "  {} boundary edges in {} loops, {} non-manifold edges, {} edges with inconsistent winding",
+            self.boundary_edges, self.boundary_loops, self.non_manifold_edges, self.inconsistent_winding_edges
         )
     }
 }
@@ -158,7 +173,7 @@ impl Mesh {
         if !path.exists() {
             return Err(MeshError::Io {
                 file: path.to_path_buf(),
-                source: std::io::Error::new(std::io::ErrorKind::NotFound, "no such file"),
+                error: std::io::Error::new(std::io::ErrorKind::NotFound, "no such file"),
             });
         }
         let raw = match extension.as_str() {
@@ -175,6 +190,20 @@ impl Mesh {
     /// As [`Mesh::load`]; `name` stands in for the file name in messages.
     pub fn from_obj_str(text: &str, name: &Path, options: &ImportOptions) -> Result<(Self, MeshReport), MeshError> {
         let raw = obj::parse(text, name)?;
+        Self::from_raw(raw, name, options)
+    }
+
+    /// Parses glTF 2.0 held in memory (`.gltf` JSON with embedded `data:` buffers, or `.glb`).
+    ///
+    /// # Errors
+    /// As [`Mesh::load`]; `name` stands in for the file name in messages. Buffers in external
+    /// files cannot be read this way.
+    pub fn from_gltf_slice(
+        bytes: &[u8],
+        name: &Path,
+        options: &ImportOptions,
+    ) -> Result<(Self, MeshReport), MeshError> {
+        let raw = gltf::parse(bytes, name, None)?;
         Self::from_raw(raw, name, options)
     }
 
@@ -221,6 +250,8 @@ impl Mesh {
         let area_epsilon = (diagonal * 1e-7).powi(2);
         let mut dropped_repeated = 0;
         let mut dropped_zero_area = 0;
+        let mut dropped_duplicate = 0;
+        let mut seen = std::collections::HashSet::with_capacity(raw.triangles.len());
         let mut kept: Vec<([u32; 3], usize)> = Vec::with_capacity(raw.triangles.len());
         for (t, tri) in raw.triangles.iter().enumerate() {
             let w = tri.map(|i| canonical[i as usize]);
@@ -231,6 +262,12 @@ impl Mesh {
             let [a, b, c] = w.map(|i| raw.positions[i as usize]);
             if (b - a).cross(c - a).length_squared() * 0.25 <= area_epsilon {
                 dropped_zero_area += 1;
+                continue;
+            }
+            let mut corners = w;
+            corners.sort_unstable();
+            if !seen.insert(corners) {
+                dropped_duplicate += 1;
                 continue;
             }
             kept.push((w, t));
@@ -259,10 +296,18 @@ impl Mesh {
         }
         let canonical_count = canonical.iter().enumerate().filter(|&(i, &c)| c as usize == i).count();
         let dropped_unreferenced = canonical_count - positions.len();
-        let triangles: Vec<[u32; 3]> = kept.iter().map(|(tri, _)| tri.map(|i| new_index[i as usize])).collect();
-        let corner_uvs = raw_uvs
+        let mut triangles: Vec<[u32; 3]> = kept.iter().map(|(tri, _)| tri.map(|i| new_index[i as usize])).collect();
+        let mut corner_uvs = raw_uvs
             .as_ref()
             .map(|uvs| kept.iter().map(|&(_, t)| raw.triangles[t].map(|i| uvs[i as usize])).collect::<Vec<_>>());
+        let flips = if options.orient { orientation_flips(&positions, &triangles) } else { Vec::new() };
+        for (t, _) in flips.iter().enumerate().filter(|&(_, &flip)| flip) {
+            triangles[t].swap(1, 2);
+            if let Some(uvs) = &mut corner_uvs {
+                uvs[t].swap(1, 2);
+            }
+        }
+        let reoriented_triangles = flips.iter().filter(|&&flip| flip).count();
 
         let computed = smooth_normals(&positions, &triangles);
         let (normals, normal_source) = match &raw_normals {
@@ -281,6 +326,7 @@ impl Mesh {
         };
 
         let topology = Topology::build(&triangles);
+        let boundary_loops = topology.boundary_loops();
         let mesh =
             Mesh { positions, normals, corner_uvs, triangles, edges: topology.edges, edge_faces: topology.edge_faces };
         let report = MeshReport {
@@ -290,10 +336,13 @@ impl Mesh {
             welded_vertices,
             dropped_zero_area_triangles: dropped_zero_area,
             dropped_repeated_index_triangles: dropped_repeated,
+            dropped_duplicate_triangles: dropped_duplicate,
             dropped_unreferenced_vertices: dropped_unreferenced,
+            reoriented_triangles,
             normals: normal_source,
             has_uvs: mesh.corner_uvs.is_some(),
             boundary_edges: topology.boundary_edges,
+            boundary_loops,
             non_manifold_edges: topology.non_manifold_edges,
             inconsistent_winding_edges: topology.inconsistent_winding_edges,
             vertices: mesh.positions.len(),
@@ -413,6 +462,109 @@ impl Topology {
         }
         topology
     }
+}
+
+impl Topology {
+    /// Connected components of the boundary edges (a hole or an open rim is one loop).
+    #[must_use]
+    pub fn boundary_loops(&self) -> usize {
+        fn root(parent: &mut HashMap<u32, u32>, mut v: u32) -> u32 {
+            while let Some(&p) = parent.get(&v).filter(|&&p| p != v) {
+                // Path halving keeps the chains short.
+                let grandparent = parent.get(&p).copied().unwrap_or(p);
+                parent.insert(v, grandparent);
+                v = grandparent;
+            }
+            v
+        }
+        let mut parent: HashMap<u32, u32> = HashMap::new();
+        let boundary = self.edges.iter().zip(&self.edge_faces).filter(|(_, faces)| faces[1] == NO_FACE);
+        for ([a, b], _) in boundary {
+            parent.entry(*a).or_insert(*a);
+            parent.entry(*b).or_insert(*b);
+            let (ra, rb) = (root(&mut parent, *a), root(&mut parent, *b));
+            if ra != rb {
+                parent.insert(ra.max(rb), ra.min(rb));
+            }
+        }
+        let vertices: Vec<u32> = parent.keys().copied().collect();
+        vertices.into_iter().filter(|&v| root(&mut parent, v) == v).count()
+    }
+}
+
+/// Which triangles to flip so that every manifold edge is traversed in opposite directions by
+/// its two faces. Each connected part (through manifold edges) is oriented from its first
+/// triangle, then as a whole: a closed part to enclose positive volume (outward), an open part
+/// to flip as few triangles as possible. A non-orientable part (a Moebius strip) keeps the
+/// conflicts it cannot avoid; they stay counted as inconsistent winding.
+fn orientation_flips(positions: &[Vec3], triangles: &[[u32; 3]]) -> Vec<bool> {
+    // (low, high, face, forward) per half-edge, sorted so each edge's uses are adjacent.
+    let mut half_edges: Vec<(u32, u32, u32, bool)> = Vec::with_capacity(triangles.len() * 3);
+    for (face, tri) in triangles.iter().enumerate() {
+        for k in 0..3 {
+            let (a, b) = (tri[k], tri[(k + 1) % 3]);
+            half_edges.push((a.min(b), a.max(b), face as u32, a < b));
+        }
+    }
+    half_edges.sort_unstable();
+    // (neighbour, whether the two traverse the edge the same way, i.e. one must flip).
+    let mut neighbours: Vec<Vec<(u32, bool)>> = vec![Vec::new(); triangles.len()];
+    let mut is_open = vec![false; triangles.len()];
+    for group in half_edges.chunk_by(|x, y| (x.0, x.1) == (y.0, y.1)) {
+        if let [first, second] = group {
+            let same_way = first.3 == second.3;
+            neighbours[first.2 as usize].push((second.2, same_way));
+            neighbours[second.2 as usize].push((first.2, same_way));
+        } else {
+            for use_ in group {
+                is_open[use_.2 as usize] = true;
+            }
+        }
+    }
+
+    let mut flip = vec![false; triangles.len()];
+    let mut visited = vec![false; triangles.len()];
+    let mut part = Vec::new();
+    for seed in 0..triangles.len() {
+        if visited[seed] {
+            continue;
+        }
+        visited[seed] = true;
+        part.clear();
+        part.push(seed as u32);
+        let mut next = 0;
+        while next < part.len() {
+            let face = part[next] as usize;
+            next += 1;
+            for &(other, same_way) in &neighbours[face] {
+                if !visited[other as usize] {
+                    visited[other as usize] = true;
+                    flip[other as usize] = flip[face] ^ same_way;
+                    part.push(other);
+                }
+            }
+        }
+        let is_closed = part.iter().all(|&f| !is_open[f as usize]);
+        let turn_around = if is_closed {
+            let volume: f64 = part
+                .iter()
+                .map(|&f| {
+                    let [a, b, c] = triangles[f as usize].map(|i| positions[i as usize].as_dvec3());
+                    let v = a.dot(b.cross(c));
+                    if flip[f as usize] { -v } else { v }
+                })
+                .sum();
+            volume < 0.0
+        } else {
+            2 * part.iter().filter(|&&f| flip[f as usize]).count() > part.len()
+        };
+        if turn_around {
+            for &f in &part {
+                flip[f as usize] = !flip[f as usize];
+            }
+        }
+    }
+    flip
 }
 
 fn bounds(positions: &[Vec3]) -> (Vec3, Vec3) {
@@ -573,8 +725,10 @@ mod tests {
     fn flipped_and_non_manifold_edges_are_reported() {
         let mut m = tetrahedron();
         m.triangles[3] = [1, 3, 2]; // flip one face
-        let (_, report) = Mesh::from_raw(m, Path::new("t"), &ImportOptions::default()).unwrap();
+        let as_read = ImportOptions { orient: false, ..ImportOptions::default() };
+        let (_, report) = Mesh::from_raw(m, Path::new("t"), &as_read).unwrap();
         assert_eq!(report.inconsistent_winding_edges, 3);
+        assert_eq!(report.reoriented_triangles, 0);
 
         // Three triangles sharing edge 0-1.
         let fan = raw(
@@ -584,6 +738,108 @@ mod tests {
         let (mesh, report) = Mesh::from_raw(fan, Path::new("fan"), &ImportOptions::default()).unwrap();
         assert_eq!(report.non_manifold_edges, 1);
         assert_eq!(report.boundary_edges, 6);
+        assert_eq!(report.boundary_loops, 1, "the fan's rim is one chain through vertices 0 and 1");
         assert_eq!(mesh.edges.len(), 7, "fins are still built for every edge");
+    }
+
+    fn volume(mesh: &Mesh) -> f32 {
+        mesh.triangles
+            .iter()
+            .map(|t| {
+                let [a, b, c] = t.map(|i| mesh.positions[i as usize]);
+                a.dot(b.cross(c)) / 6.0
+            })
+            .sum()
+    }
+
+    #[test]
+    fn flipped_faces_are_turned_back_and_uvs_follow_their_corners() {
+        let mut m = tetrahedron();
+        m.triangles[3] = [1, 3, 2];
+        m.uvs = Some(m.positions.iter().map(|p| p.truncate()).collect());
+        let (mesh, report) = Mesh::from_raw(m, Path::new("t"), &ImportOptions::default()).unwrap();
+        assert_eq!(report.reoriented_triangles, 1);
+        assert!(report.is_closed_manifold(), "{report}");
+        assert!((volume(&mesh) - 1.0 / 6.0).abs() < 1e-6);
+        let uvs = mesh.corner_uvs.as_ref().unwrap();
+        for (tri, corners) in mesh.triangles.iter().zip(uvs) {
+            for k in 0..3 {
+                assert_eq!(corners[k], mesh.positions[tri[k] as usize].truncate(), "uv stays with its vertex");
+            }
+        }
+    }
+
+    #[test]
+    fn a_closed_mesh_inside_out_is_turned_outward() {
+        let mut m = tetrahedron();
+        for t in &mut m.triangles {
+            t.swap(0, 1);
+        }
+        let (mesh, report) = Mesh::from_raw(m, Path::new("t"), &ImportOptions::default()).unwrap();
+        assert_eq!(report.reoriented_triangles, 4);
+        assert!(volume(&mesh) > 0.0);
+        let centre = Vec3::splat(0.25);
+        assert!(mesh.positions.iter().zip(&mesh.normals).all(|(p, n)| n.dot(*p - centre) > 0.0));
+    }
+
+    #[test]
+    fn an_open_mesh_keeps_its_majority_winding() {
+        // A 4 x 4 grid of quads facing -Z as read; three triangles flipped.
+        let mut grid = RawMesh::default();
+        for row in 0..5 {
+            for col in 0..5 {
+                grid.positions.push(Vec3::new(col as f32, row as f32, 0.0));
+            }
+        }
+        for row in 0..4 {
+            for col in 0..4 {
+                let i = row * 5 + col;
+                grid.triangles.push([i, i + 6, i + 1]);
+                grid.triangles.push([i, i + 5, i + 6]);
+            }
+        }
+        for t in [3, 10, 17] {
+            grid.triangles[t].swap(0, 1);
+        }
+        let (mesh, report) = Mesh::from_raw(grid, Path::new("grid"), &ImportOptions::default()).unwrap();
+        assert_eq!(report.reoriented_triangles, 3);
+        assert_eq!(report.inconsistent_winding_edges, 0);
+        assert!((0..mesh.triangles.len()).all(|t| mesh.face_normal(t).z < -0.99), "the majority (-Z) wins");
+    }
+
+    #[test]
+    fn a_moebius_strip_keeps_the_conflict_it_cannot_avoid() {
+        let segments = 12;
+        let mut strip = RawMesh::default();
+        for k in 0..segments {
+            let angle = std::f32::consts::TAU * k as f32 / segments as f32;
+            let twist = angle / 2.0;
+            let centre = Vec3::new(angle.cos(), angle.sin(), 0.0) * 2.0;
+            let across = Vec3::new(angle.cos() * twist.cos(), angle.sin() * twist.cos(), twist.sin()) * 0.5;
+            strip.positions.push(centre - across);
+            strip.positions.push(centre + across);
+        }
+        for k in 0..segments {
+            let (a, b) = (2 * k, 2 * k + 1);
+            // The last segment joins the first one upside down.
+            let (c, d) = if k + 1 == segments { (1, 0) } else { (2 * k + 2, 2 * k + 3) };
+            strip.triangles.push([a, c, d]);
+            strip.triangles.push([a, d, b]);
+        }
+        let (mesh, report) = Mesh::from_raw(strip, Path::new("moebius"), &ImportOptions::default()).unwrap();
+        assert_eq!(mesh.triangles.len(), 2 * segments as usize);
+        assert_eq!(report.inconsistent_winding_edges, 1, "{report}");
+        assert_eq!(report.boundary_loops, 1, "a Moebius strip has a single rim");
+    }
+
+    #[test]
+    fn duplicate_and_double_sided_triangles_are_dropped() {
+        let mut m = tetrahedron();
+        m.triangles.push([2, 1, 0]); // the back side of triangle 0
+        m.triangles.push([1, 3, 0]); // triangle 1 again, rotated
+        let (mesh, report) = Mesh::from_raw(m, Path::new("t"), &ImportOptions::default()).unwrap();
+        assert_eq!(report.dropped_duplicate_triangles, 2);
+        assert_eq!(mesh.triangles.len(), 4);
+        assert!(report.is_closed_manifold(), "{report}");
     }
 }

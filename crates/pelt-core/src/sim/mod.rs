@@ -1,29 +1,85 @@
-//! Fur simulation (PAPER-NOTES section 4).
+//! Fur simulation (PAPER-NOTES section 4): gravity, wind and touch bend every strand of the
+//! shared vertex array by rotating its nodes about the node before them, root first.
 //!
-//! INTERFACE (fixed so presets and the renderer can build against it; the simulation issue
-//! fills the rest).
+//! - [`bend`]: the rotation scheme of the paper's Equation 1, in O(L) per strand
+//!   ([`bend_strand`]) and as the literal O(L^2) loop kept as the oracle ([`bend_strand_literal`]).
+//! - [`wind`]: wind with gusts that travel with it and a small seeded jitter.
+//! - [`field`]: the per-vertex [`ForceField`] and the touch (patting) overlay.
+//! - [`pick`]: ray picking of the base mesh, so a pointer or a script can touch the fur.
+//! - [`simulation`]: [`Simulation`], fixed steps with linear interpolation between the last two.
+//! - [`scene`]: scripted wind and touch strokes ([`Scene`]), reproducible frame by frame.
+//!
+//! The model is quasi-static, as in the paper: a strand's pose is a function of the force on it,
+//! with no velocity. So a state at time `t` never depends on earlier states, which makes every
+//! step deterministic, parallel over strands, and cheap to jump to any time.
+
+mod batch;
+pub mod bend;
+pub mod field;
+pub mod pick;
+pub mod scene;
+pub mod simulation;
+pub mod wind;
 
 use glam::Vec3;
+
+pub use bend::{BEND_GAIN, bend_strand, bend_strand_literal, bend_weight};
+pub use field::{ForceField, Touch};
+pub use pick::{Hit, pick};
+pub use scene::{Scene, SceneError, Stroke, WindKey};
+pub use simulation::{SimError, Simulation};
+pub use wind::{WindParams, value_noise3};
 
 /// Simulation parameters; part of a fur preset (`[simulation]` table).
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct SimParams {
-    /// Stiffness: larger is stiffer (the paper's `stability`).
+    /// Stiffness: larger is stiffer (the paper's `stability`). Default 8.
     pub stability: f32,
-    /// Unit gravity direction.
+    /// Unit gravity direction. Default `-Y`.
     pub gravity_direction: Vec3,
-    /// Gravity strength (0 turns gravity off).
+    /// Gravity strength (0 turns gravity off). Default 1: with the default stability and 16
+    /// layers a horizontal strand's tip turns about a third of the way down.
     pub gravity_strength: f32,
-    /// Simulation steps per second.
+    /// Simulation steps per second. Default 30.
     pub rate_hz: f32,
     /// Draw `lerp(previous, current)` between steps; when false the simulation runs every frame.
     pub interpolate: bool,
+    /// Wind (`[simulation.wind]`); off by default (strength 0).
+    pub wind: WindParams,
+    /// Touch (`[simulation.touch]`).
+    pub touch: TouchParams,
 }
 
 impl Default for SimParams {
     fn default() -> Self {
-        Self { stability: 8.0, gravity_direction: Vec3::NEG_Y, gravity_strength: 1.0, rate_hz: 30.0, interpolate: true }
+        Self {
+            stability: 8.0,
+            gravity_direction: Vec3::NEG_Y,
+            gravity_strength: 1.0,
+            rate_hz: 30.0,
+            interpolate: true,
+            wind: WindParams::default(),
+            touch: TouchParams::default(),
+        }
+    }
+}
+
+/// How a touch (patting) acts on the force field (`[simulation.touch]`).
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct TouchParams {
+    /// Force per radius of drag: dragging the pointer one touch radius away from the hit point
+    /// pushes with this force at the centre. Default 4 (well above gravity's 1).
+    pub strength: f32,
+    /// After release the touch fades out linearly over this many seconds; 0 (the default)
+    /// restores the field's original values at once. Either way the originals come back exactly.
+    pub release_secs: f32,
+}
+
+impl Default for TouchParams {
+    fn default() -> Self {
+        Self { strength: 4.0, release_secs: 0.0 }
     }
 }
 
@@ -36,6 +92,9 @@ pub struct ParamError {
     /// What is wrong and the allowed range.
     pub problem: String,
 }
+
+/// The largest force magnitude (gravity, wind or touch) the simulation accepts as a parameter.
+pub const MAX_FORCE: f32 = 1e9;
 
 impl SimParams {
     /// Checks every field against its documented range.
@@ -53,12 +112,46 @@ impl SimParams {
                 format!("must be a finite non-zero vector, got {}", self.gravity_direction),
             );
         }
-        if !(self.gravity_strength.is_finite() && self.gravity_strength >= 0.0) {
-            return error("gravity_strength", format!("must be finite and at least 0, got {}", self.gravity_strength));
+        if !(self.gravity_strength.is_finite() && (0.0..=MAX_FORCE).contains(&self.gravity_strength)) {
+            return error("gravity_strength", format!("must be between 0 and 1e9, got {}", self.gravity_strength));
         }
         if !(self.rate_hz.is_finite() && (1.0..=1000.0).contains(&self.rate_hz)) {
             return error("rate_hz", format!("must be between 1 and 1000, got {}", self.rate_hz));
         }
+        self.wind.validate().map_err(|e| ParamError { key: format!("simulation.{}", e.key), problem: e.problem })?;
+        if !(self.touch.strength.is_finite() && (0.0..=MAX_FORCE).contains(&self.touch.strength)) {
+            return error("touch.strength", format!("must be between 0 and 1e9, got {}", self.touch.strength));
+        }
+        if !(self.touch.release_secs.is_finite() && (0.0..=60.0).contains(&self.touch.release_secs)) {
+            return error("touch.release_secs", format!("must be between 0 and 60, got {}", self.touch.release_secs));
+        }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn defaults_are_valid_and_round_trip_through_toml() {
+        let params = SimParams::default();
+        params.validate().unwrap();
+        let text = toml::to_string(&params).unwrap();
+        let back: SimParams = toml::from_str(&text).unwrap();
+        assert_eq!(back, params);
+    }
+
+    #[test]
+    fn bad_values_name_their_key() {
+        let mut params = SimParams::default();
+        params.wind.gust_scale = 0.0;
+        assert_eq!(params.validate().unwrap_err().key, "simulation.wind.gust_scale");
+        let mut params = SimParams::default();
+        params.touch.release_secs = f32::NAN;
+        assert_eq!(params.validate().unwrap_err().key, "simulation.touch.release_secs");
+        let params = SimParams { stability: 0.0, ..SimParams::default() };
+        assert_eq!(params.validate().unwrap_err().key, "simulation.stability");
+        assert!(toml::from_str::<SimParams>("[wind]\nspeeed = 1.0").is_err());
     }
 }

@@ -144,3 +144,49 @@ pub fn pixel_difference(a: &image::Rgba<u8>, b: &image::Rgba<u8>) -> u8 {
 pub fn light_direction() -> Vec3 {
     RenderSettings::default().light_from_view
 }
+
+/// Golden images live beside the tests and were rendered on lavapipe (Vulkan, CPU).
+///
+/// The comparison allows small differences: llvmpipe (GL) and hardware GPUs place MSAA samples
+/// and filter textures slightly differently, which moves strand edges by a fraction of a pixel.
+/// Lavapipe reproduces its own references exactly.
+const GOLDEN_MEAN_LIMIT: f64 = 3.0;
+const GOLDEN_P99_LIMIT: u8 = 64;
+
+/// Compares `image` with `tests/golden/{name}.png`; `PELT_UPDATE_GOLDEN=1` rewrites it. On a
+/// mismatch writes `{name}-actual.png` and `{name}-diff.png` next to it and panics.
+pub fn check_golden(name: &str, image: &image::RgbaImage) {
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/golden");
+    let path = dir.join(format!("{name}.png"));
+    if std::env::var("PELT_UPDATE_GOLDEN").is_ok_and(|v| v == "1") {
+        std::fs::create_dir_all(&dir).expect("golden dir");
+        image.save(&path).expect("write golden");
+        return;
+    }
+    let golden = image::open(&path)
+        .unwrap_or_else(|error| panic!("{}: {error} (PELT_UPDATE_GOLDEN=1 writes it)", path.display()))
+        .to_rgba8();
+    assert_eq!(golden.dimensions(), image.dimensions(), "{name}: size");
+    let mut differences: Vec<u8> = golden.pixels().zip(image.pixels()).map(|(a, b)| pixel_difference(a, b)).collect();
+    let mean = differences.iter().map(|&d| f64::from(d)).sum::<f64>() / differences.len() as f64;
+    let diff = image::RgbaImage::from_fn(image.width(), image.height(), |x, y| {
+        let d = differences[(y * image.width() + x) as usize].saturating_mul(4);
+        image::Rgba([d, d, d, 255])
+    });
+    differences.sort_unstable();
+    let p99 = differences[differences.len() * 99 / 100];
+    if mean > GOLDEN_MEAN_LIMIT || p99 > GOLDEN_P99_LIMIT {
+        image.save(dir.join(format!("{name}-actual.png"))).expect("write actual");
+        diff.save(dir.join(format!("{name}-diff.png"))).expect("write diff");
+        panic!(
+            "{name}: differs from the golden image (mean {mean:.2} > {GOLDEN_MEAN_LIMIT} or 99th percentile {p99} > \
+             {GOLDEN_P99_LIMIT}); see {name}-actual.png and {name}-diff.png in {}",
+            dir.display()
+        );
+    }
+}
+
+/// Loads one of the repository's meshes.
+pub fn load_asset(name: &str) -> Mesh {
+    Mesh::load(&asset(name), &pelt_core::ImportOptions::default()).expect("asset mesh").0
+}

@@ -1,0 +1,258 @@
+//! Scene scripts: wind that changes over time and touch strokes, in TOML, so a render can
+//! reproduce an interaction frame by frame.
+//!
+//! ```toml
+//! duration_secs = 6.0              # optional; default: the last key or stroke end
+//!
+//! [[wind]]                         # keyframes, sorted by time, linearly interpolated
+//! time_secs = 0.0
+//! direction = [1.0, 0.0, 0.0]      # any non-zero vector; directions are blended, then normalised
+//! strength = 0.0
+//! gust_strength = 0.5              # optional (default 0.5), 0..=1
+//! jitter = 0.1                     # optional (default 0.1), 0..=1
+//!
+//! [[stroke]]                       # a touch: pressed at path[0], dragged along the path
+//! start_secs = 1.0
+//! end_secs = 2.0
+//! radius = 0.8                     # world units
+//! path = [[0.0, 5.0, 2.6], [0.0, 3.5, 2.6]]
+//! ```
+//!
+//! Stroke points are world positions, on or near the base surface, which keeps a script
+//! independent of any camera. The touch begins at `path[0]` (it affects the roots within
+//! `radius`); the pointer then moves along the polyline at one path segment per equal share of
+//! the stroke's time. Wind settings not in a key (gust size and speed, seed, jitter rate) come
+//! from the simulation's parameters.
+//!
+//! Drive it as `scene.apply(t, &mut sim)?; sim.advance_to(t);` every frame.
+
+use std::path::{Path, PathBuf};
+
+use glam::Vec3;
+
+use super::MAX_FORCE;
+use super::simulation::{SimError, Simulation};
+
+/// Errors from reading a scene; each names the file and, where it can, the key.
+#[derive(Debug, thiserror::Error)]
+pub enum SceneError {
+    #[error("{}: cannot read the file: {source}", file.display())]
+    Io { file: PathBuf, source: std::io::Error },
+    #[error("{}: {message}", file.display())]
+    Parse { file: PathBuf, message: String },
+    #[error("{}: {key}: {problem}", file.display())]
+    Invalid { file: PathBuf, key: String, problem: String },
+}
+
+/// One wind keyframe.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct WindKey {
+    pub time_secs: f64,
+    pub direction: Vec3,
+    pub strength: f32,
+    #[serde(default = "default_gust_strength")]
+    pub gust_strength: f32,
+    #[serde(default = "default_jitter")]
+    pub jitter: f32,
+}
+
+fn default_gust_strength() -> f32 {
+    0.5
+}
+
+fn default_jitter() -> f32 {
+    0.1
+}
+
+/// One touch stroke: pressed at `path[0]` at `start_secs`, dragged along `path`, released at
+/// `end_secs`.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Stroke {
+    pub start_secs: f64,
+    pub end_secs: f64,
+    /// Radius of the touch (world units).
+    pub radius: f32,
+    /// World points; the first is the hit point.
+    pub path: Vec<Vec3>,
+}
+
+impl Stroke {
+    /// The pointer position at `time_secs` (clamped to the stroke's span).
+    #[must_use]
+    pub fn point_at(&self, time_secs: f64) -> Vec3 {
+        let segments = self.path.len() - 1;
+        if segments == 0 {
+            return self.path[0];
+        }
+        let fraction = ((time_secs - self.start_secs) / (self.end_secs - self.start_secs)).clamp(0.0, 1.0);
+        let along = fraction * segments as f64;
+        let k = (along.floor() as usize).min(segments - 1);
+        let t = (along - k as f64) as f32;
+        self.path[k] * (1.0 - t) + self.path[k + 1] * t
+    }
+}
+
+/// A parsed, validated scene script.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Scene {
+    /// Length of the scene; default the last keyframe or stroke end.
+    #[serde(default)]
+    pub duration_secs: Option<f64>,
+    /// Wind keyframes, sorted by time.
+    #[serde(default)]
+    pub wind: Vec<WindKey>,
+    /// Touch strokes.
+    #[serde(default, rename = "stroke")]
+    pub strokes: Vec<Stroke>,
+}
+
+impl Scene {
+    /// Reads and validates a scene file.
+    ///
+    /// # Errors
+    /// [`SceneError`] naming the file, and the key for bad values.
+    pub fn load(path: &Path) -> Result<Self, SceneError> {
+        let text =
+            std::fs::read_to_string(path).map_err(|source| SceneError::Io { file: path.to_path_buf(), source })?;
+        Self::from_toml_str(&text, path)
+    }
+
+    /// Parses and validates scene text; `name` stands in for the file name in errors.
+    ///
+    /// # Errors
+    /// [`SceneError::Parse`] for TOML or type errors (the message shows the key and line),
+    /// [`SceneError::Invalid`] for values out of range.
+    pub fn from_toml_str(text: &str, name: &Path) -> Result<Self, SceneError> {
+        let scene: Self = toml::from_str(text).map_err(|e| SceneError::Parse {
+            file: name.to_path_buf(),
+            message: e.to_string().trim_end().to_owned(),
+        })?;
+        scene.validate().map_err(|(key, problem)| SceneError::Invalid { file: name.to_path_buf(), key, problem })?;
+        Ok(scene)
+    }
+
+    fn validate(&self) -> Result<(), (String, String)> {
+        let finite_time = |key: String, value: f64| {
+            if value.is_finite() && value >= 0.0 {
+                Ok(())
+            } else {
+                Err((key, format!("must be finite and at least 0, got {value}")))
+            }
+        };
+        let range = |key: String, value: f32, low: f32, high: f32| {
+            if value.is_finite() && (low..=high).contains(&value) {
+                Ok(())
+            } else {
+                Err((key, format!("must be between {low} and {high}, got {value}")))
+            }
+        };
+        if let Some(duration) = self.duration_secs {
+            finite_time("duration_secs".into(), duration)?;
+        }
+        for (i, key) in self.wind.iter().enumerate() {
+            finite_time(format!("wind[{i}].time_secs"), key.time_secs)?;
+            if i > 0 && key.time_secs < self.wind[i - 1].time_secs {
+                return Err((format!("wind[{i}].time_secs"), "keyframes must be sorted by time".into()));
+            }
+            if !key.direction.is_finite() || key.direction.length_squared() == 0.0 {
+                return Err((
+                    format!("wind[{i}].direction"),
+                    format!("must be a finite non-zero vector, got {}", key.direction),
+                ));
+            }
+            range(format!("wind[{i}].strength"), key.strength, 0.0, MAX_FORCE)?;
+            range(format!("wind[{i}].gust_strength"), key.gust_strength, 0.0, 1.0)?;
+            range(format!("wind[{i}].jitter"), key.jitter, 0.0, 1.0)?;
+        }
+        for (i, stroke) in self.strokes.iter().enumerate() {
+            finite_time(format!("stroke[{i}].start_secs"), stroke.start_secs)?;
+            finite_time(format!("stroke[{i}].end_secs"), stroke.end_secs)?;
+            if stroke.end_secs <= stroke.start_secs {
+                return Err((format!("stroke[{i}].end_secs"), "must be later than start_secs".into()));
+            }
+            range(format!("stroke[{i}].radius"), stroke.radius, f32::MIN_POSITIVE, f32::MAX)?;
+            if stroke.path.is_empty() {
+                return Err((format!("stroke[{i}].path"), "needs at least one point".into()));
+            }
+            if let Some(k) = stroke.path.iter().position(|p| !p.is_finite()) {
+                return Err((format!("stroke[{i}].path[{k}]"), "must be finite".into()));
+            }
+        }
+        Ok(())
+    }
+
+    /// The scene's length: `duration_secs`, else the last keyframe or stroke end.
+    #[must_use]
+    pub fn duration_secs(&self) -> f64 {
+        self.duration_secs.unwrap_or_else(|| {
+            let wind = self.wind.last().map_or(0.0, |k| k.time_secs);
+            self.strokes.iter().map(|s| s.end_secs).fold(wind, f64::max)
+        })
+    }
+
+    /// The wind keyframe blended for `time_secs` (held before the first and after the last).
+    #[must_use]
+    pub fn wind_at(&self, time_secs: f64) -> Option<WindKey> {
+        let after = self.wind.iter().position(|k| k.time_secs > time_secs);
+        match after {
+            None => self.wind.last().cloned(),
+            Some(0) => self.wind.first().cloned(),
+            Some(i) => {
+                let (a, b) = (&self.wind[i - 1], &self.wind[i]);
+                let t = ((time_secs - a.time_secs) / (b.time_secs - a.time_secs)) as f32;
+                let lerp = |x: f32, y: f32| x * (1.0 - t) + y * t;
+                let blended = a.direction.normalize() * (1.0 - t) + b.direction.normalize() * t;
+                Some(WindKey {
+                    time_secs,
+                    // Opposite directions meet at zero halfway; keep the earlier one there.
+                    direction: blended.try_normalize().unwrap_or(a.direction),
+                    strength: lerp(a.strength, b.strength),
+                    gust_strength: lerp(a.gust_strength, b.gust_strength),
+                    jitter: lerp(a.jitter, b.jitter),
+                })
+            }
+        }
+    }
+
+    /// The stroke active at `time_secs` (the last one listed, where several overlap).
+    #[must_use]
+    pub fn stroke_at(&self, time_secs: f64) -> Option<&Stroke> {
+        self.strokes.iter().rev().find(|s| (s.start_secs..s.end_secs).contains(&time_secs))
+    }
+
+    /// Sets the simulation's wind and touch for `time_secs`: begins, drags and ends touches as
+    /// the strokes say. Call it before `sim.advance_to(time_secs)` on every frame.
+    ///
+    /// # Errors
+    /// [`SimError`] if the blended wind fails validation (it cannot for a validated scene and
+    /// valid simulation parameters).
+    pub fn apply(&self, time_secs: f64, sim: &mut Simulation) -> Result<(), SimError> {
+        if let Some(key) = self.wind_at(time_secs) {
+            let mut wind = sim.params().wind.clone();
+            wind.direction = key.direction;
+            wind.strength = key.strength;
+            wind.gust_strength = key.gust_strength;
+            wind.jitter = key.jitter;
+            sim.set_wind(&wind)?;
+        }
+        let held = sim.touch().filter(|t| t.released_at_secs.is_none()).map(|t| (t.point, t.radius));
+        match self.stroke_at(time_secs) {
+            Some(stroke) => {
+                if held != Some((stroke.path[0], stroke.radius)) {
+                    sim.touch_begin(stroke.path[0], stroke.radius)?;
+                }
+                sim.touch_drag(stroke.point_at(time_secs))?;
+            }
+            None => {
+                let ours = held.is_some_and(|(p, r)| self.strokes.iter().any(|s| s.path[0] == p && s.radius == r));
+                if ours {
+                    sim.touch_end();
+                }
+            }
+        }
+        Ok(())
+    }
+}

@@ -1,0 +1,531 @@
+//! [`Simulation`]: the strands of a [`FurStructure`] under gravity, wind and touch, stepped at a
+//! fixed rate and drawn as `lerp(previous, current, alpha)` in between.
+
+use std::time::Instant;
+
+use glam::{Quat, Vec3};
+use rayon::prelude::*;
+
+use super::batch::{LANES, RestSegment, StrandInputs, VecLanes, bend_batch};
+use super::field::{ForceField, Touch};
+use super::pick::{Hit, pick};
+use super::{ParamError, SimParams, WindParams};
+use crate::fur::FurStructure;
+
+/// Errors from building or driving a [`Simulation`].
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum SimError {
+    #[error(transparent)]
+    Params(#[from] ParamError),
+    #[error("{what} has {got} entries but the fur has {expected}")]
+    Size { what: &'static str, expected: usize, got: usize },
+    #[error("{what} must be finite, got {value}")]
+    NonFinite { what: &'static str, value: String },
+    #[error("touch radius must be finite and positive, got {0}")]
+    TouchRadius(f32),
+    #[error("stability map entry {vertex} is {value}: must be between 1e-6 and 1e9")]
+    Stability { vertex: usize, value: f32 },
+}
+
+/// Batches of [`LANES`] strands per parallel task: enough work to pay for the task, small
+/// enough to balance.
+const BATCHES_PER_TASK: usize = 8;
+
+/// Strands per parallel task of the interpolation (a multiple of [`LANES`]).
+const LERP_STRANDS_PER_TASK: usize = 32 * LANES;
+
+/// The fur simulation over the shared vertex array of one [`FurStructure`].
+///
+/// Internally strands go in batches of 8, structure of arrays (node `i` of batch `b` is one
+/// `[x, y, z]` of 8 lanes at `b * (L + 1) + i`) so the bend runs as SIMD over 8 strands and each
+/// batch is one contiguous run; [`Simulation::positions`] is layer-major like
+/// [`FurStructure::positions`] (`NV[i * V + j]`), ready to upload.
+///
+/// Time: state `n` is the pose at `n / rate_hz` seconds. With interpolation, at render time `t`
+/// the simulation holds states `n - 1` and `n` for `n = floor(t * rate_hz)` and draws
+/// `lerp(state(n - 1), state(n), t * rate_hz - n)`: one step of latency buys a smooth picture at
+/// any frame rate for the cost of a lerp per frame. As the model is quasi-static, a jump in time
+/// costs at most two steps.
+#[derive(Debug)]
+pub struct Simulation {
+    params: SimParams,
+    layers: u32,
+    vertex_count: usize,
+    /// Rest segments of batch `b` (lanes = strands `8b..8b + 8`, zero past `V`) at `b * L + k`.
+    rest_segments: Vec<RestSegment>,
+    rest_normals: Vec<Vec3>,
+    roots: Vec<Vec3>,
+    /// Rotation of each strand's rest frame into the current base frame (from `set_base`).
+    frames: Vec<Quat>,
+    stability_map: Option<Vec<f32>>,
+    /// Bounding radius of the base at rest: the unit of wind gust sizes and speeds.
+    radius: f32,
+    field: ForceField,
+    touch: Option<Touch>,
+    /// The external field (wind + field + touch) of the newest state.
+    external: Vec<Vec3>,
+    /// States, batch-major like `rest_segments` with `L + 1` nodes per batch.
+    previous: Vec<VecLanes>,
+    current: Vec<VecLanes>,
+    /// Layer-major `lerp(previous, current, alpha)` for the last render time.
+    output: Vec<Vec3>,
+    step_index: i64,
+    time_secs: f64,
+    alpha: f32,
+    last_step_secs: f64,
+    steps_taken: u64,
+}
+
+impl Simulation {
+    /// Sets up the simulation of `fur` and computes the state at time 0.
+    ///
+    /// # Errors
+    /// [`SimError::Params`] if `params` fail [`SimParams::validate`]; [`SimError::Size`] if the
+    /// structure's arrays disagree with its mesh.
+    pub fn new(fur: &FurStructure, params: &SimParams) -> Result<Self, SimError> {
+        params.validate()?;
+        let v = fur.vertex_count();
+        let layers = fur.layers as usize;
+        if fur.positions.len() != v * (layers + 1) {
+            return Err(SimError::Size {
+                what: "the shared vertex array",
+                expected: v * (layers + 1),
+                got: fur.positions.len(),
+            });
+        }
+        if fur.mesh.normals.len() != v {
+            return Err(SimError::Size { what: "the base normals", expected: v, got: fur.mesh.normals.len() });
+        }
+        let batches = v.div_ceil(LANES);
+        let mut rest_segments = vec![RestSegment::default(); batches * layers];
+        for j in 0..v {
+            for k in 0..layers {
+                let segment = fur.positions[(k + 1) * v + j] - fur.positions[k * v + j];
+                rest_segments[j / LANES * layers + k].set(j % LANES, segment);
+            }
+        }
+        let roots = fur.positions[..v].to_vec();
+        let (centre, radius) = bounding_sphere(&roots);
+        debug_assert!(centre.is_finite());
+        let nodes = v * (layers + 1);
+        let batch_nodes = batches * (layers + 1);
+        let mut simulation = Self {
+            params: params.clone(),
+            layers: fur.layers,
+            vertex_count: v,
+            rest_segments,
+            rest_normals: fur.mesh.normals.clone(),
+            roots,
+            frames: vec![Quat::IDENTITY; v],
+            stability_map: None,
+            radius,
+            field: ForceField::new(v),
+            touch: None,
+            external: vec![Vec3::ZERO; v],
+            previous: vec![[[0.0; LANES]; 3]; batch_nodes],
+            current: vec![[[0.0; LANES]; 3]; batch_nodes],
+            output: vec![Vec3::ZERO; nodes],
+            step_index: 0,
+            time_secs: 0.0,
+            alpha: 0.0,
+            last_step_secs: 0.0,
+            steps_taken: 0,
+        };
+        simulation.jump_to_step(0);
+        simulation.update_output();
+        Ok(simulation)
+    }
+
+    /// The parameters in use.
+    #[must_use]
+    pub fn params(&self) -> &SimParams {
+        &self.params
+    }
+
+    /// Replaces the parameters (gravity, stability, wind, rate, ...). Takes effect from the next
+    /// step; a new rate re-times the states at the next [`Simulation::advance_to`].
+    ///
+    /// # Errors
+    /// [`SimError::Params`]; the old parameters stay.
+    pub fn set_params(&mut self, params: &SimParams) -> Result<(), SimError> {
+        params.validate()?;
+        if params.rate_hz != self.params.rate_hz {
+            // Force a full recompute at the next advance: old step indices mean other times.
+            self.step_index = i64::MIN;
+        }
+        self.params = params.clone();
+        Ok(())
+    }
+
+    /// Sets the wind from the next step on.
+    ///
+    /// # Errors
+    /// [`SimError::Params`] naming the bad `simulation.wind` key.
+    pub fn set_wind(&mut self, wind: &WindParams) -> Result<(), SimError> {
+        let params = SimParams { wind: wind.clone(), ..self.params.clone() };
+        params.validate()?;
+        self.params = params;
+        Ok(())
+    }
+
+    /// One stability per base vertex (`None` goes back to `SimParams::stability` everywhere).
+    ///
+    /// # Errors
+    /// [`SimError::Size`] for a map of the wrong length; [`SimError::Stability`] for a value
+    /// outside `1e-6..=1e9`.
+    pub fn set_stability_map(&mut self, map: Option<Vec<f32>>) -> Result<(), SimError> {
+        if let Some(map) = &map {
+            if map.len() != self.vertex_count {
+                return Err(SimError::Size { what: "the stability map", expected: self.vertex_count, got: map.len() });
+            }
+            if let Some((vertex, &value)) =
+                map.iter().enumerate().find(|(_, s)| !(s.is_finite() && (1e-6..=1e9).contains(*s)))
+            {
+                return Err(SimError::Stability { vertex, value });
+            }
+        }
+        self.stability_map = map;
+        Ok(())
+    }
+
+    /// Moves the roots with a deforming base mesh: new base positions and normals (one per base
+    /// vertex). Each strand's rest shape turns with the shortest rotation from its rest normal
+    /// to the new normal, so fur stays attached at the same angle to the surface. A normal alone
+    /// cannot say how the surface twisted about it: fur that leans (random or combed growth)
+    /// keeps its lean's world heading; use [`Simulation::set_base_rotations`] when the full
+    /// rotation is known (skinning). Takes effect from the next step.
+    ///
+    /// # Errors
+    /// [`SimError::Size`] for arrays of the wrong length, [`SimError::NonFinite`] for NaN or
+    /// infinite entries; nothing changes then.
+    pub fn set_base(&mut self, positions: &[Vec3], normals: &[Vec3]) -> Result<(), SimError> {
+        self.check_base(positions, normals, "the base normals")?;
+        self.roots.copy_from_slice(positions);
+        for ((frame, rest), normal) in self.frames.iter_mut().zip(&self.rest_normals).zip(normals) {
+            *frame = match (rest.try_normalize(), normal.try_normalize()) {
+                (Some(rest), Some(normal)) => Quat::from_rotation_arc(rest, normal),
+                _ => Quat::IDENTITY,
+            };
+        }
+        Ok(())
+    }
+
+    /// Like [`Simulation::set_base`], with each strand's full rotation from its rest frame (for
+    /// a skinned base: the rotation part of each vertex's skinning transform).
+    ///
+    /// # Errors
+    /// As [`Simulation::set_base`]; zero-length rotations are errors too.
+    pub fn set_base_rotations(&mut self, positions: &[Vec3], rotations: &[Quat]) -> Result<(), SimError> {
+        let as_vectors: Vec<Vec3> = rotations.iter().map(|q| Vec3::new(q.x, q.y, q.z) + Vec3::splat(q.w)).collect();
+        self.check_base(positions, &as_vectors, "the base rotations")?;
+        if let Some(bad) = rotations.iter().find(|q| q.length_squared() == 0.0) {
+            return Err(SimError::NonFinite { what: "the base rotations", value: bad.to_string() });
+        }
+        self.roots.copy_from_slice(positions);
+        for (frame, rotation) in self.frames.iter_mut().zip(rotations) {
+            *frame = rotation.normalize();
+        }
+        Ok(())
+    }
+
+    fn check_base(&self, positions: &[Vec3], frames: &[Vec3], what_frames: &'static str) -> Result<(), SimError> {
+        let v = self.vertex_count;
+        for (what, values) in [("the base positions", positions), (what_frames, frames)] {
+            if values.len() != v {
+                return Err(SimError::Size { what, expected: v, got: values.len() });
+            }
+            if let Some(bad) = values.iter().find(|p| !p.is_finite()) {
+                return Err(SimError::NonFinite { what, value: bad.to_string() });
+            }
+        }
+        Ok(())
+    }
+
+    /// The user force field (added to wind; the touch overrides it near the hit).
+    #[must_use]
+    pub fn field(&self) -> &ForceField {
+        &self.field
+    }
+
+    /// The user force field, to edit; takes effect from the next step.
+    pub fn field_mut(&mut self) -> &mut ForceField {
+        &mut self.field
+    }
+
+    /// The external field (wind + field + touch, gravity not included) the newest state used.
+    #[must_use]
+    pub fn external_field(&self) -> &[Vec3] {
+        &self.external
+    }
+
+    /// Computes the external field (wind + field + touch, without gravity) at `time_secs` into
+    /// `out`, without stepping.
+    ///
+    /// # Panics
+    /// If `out.len()` is not the base vertex count.
+    pub fn evaluate_field(&self, time_secs: f64, out: &mut [Vec3]) {
+        assert_eq!(out.len(), self.vertex_count, "one force per base vertex");
+        let wind = &self.params.wind;
+        let (field, roots, radius) = (self.field.values(), &self.roots, self.radius);
+        out.par_iter_mut().enumerate().with_min_len(256).for_each(|(j, force)| {
+            *force = wind.sample(j, roots[j], time_secs, radius) + field[j];
+        });
+        if let Some(touch) = &self.touch {
+            touch.apply(self.params.touch.strength, touch.presence(time_secs, self.params.touch.release_secs), out);
+        }
+    }
+
+    /// Begins a touch at `point` (on or near the base surface; see [`Simulation::pick`]) with
+    /// radius `radius` (world units). Replaces any touch in progress.
+    ///
+    /// # Errors
+    /// [`SimError::NonFinite`] for a non-finite point, [`SimError::TouchRadius`] for a radius
+    /// that is not finite and positive.
+    pub fn touch_begin(&mut self, point: Vec3, radius: f32) -> Result<(), SimError> {
+        if !point.is_finite() {
+            return Err(SimError::NonFinite { what: "the touch point", value: point.to_string() });
+        }
+        if !(radius.is_finite() && radius > 0.0) {
+            return Err(SimError::TouchRadius(radius));
+        }
+        self.touch = Some(Touch::new(point, radius, &self.roots));
+        Ok(())
+    }
+
+    /// Picks the base mesh (current roots, `triangles` from [`FurStructure::mesh`]) with a ray
+    /// and begins a touch of `radius` at the hit; `None` (and no touch) on a miss.
+    ///
+    /// # Errors
+    /// [`SimError::TouchRadius`] for a radius that is not finite and positive.
+    pub fn touch_ray(
+        &mut self,
+        triangles: &[[u32; 3]],
+        ray_origin: Vec3,
+        ray_direction: Vec3,
+        radius: f32,
+    ) -> Result<Option<Hit>, SimError> {
+        let Some(hit) = self.pick(triangles, ray_origin, ray_direction) else { return Ok(None) };
+        self.touch_begin(hit.point, radius)?;
+        Ok(Some(hit))
+    }
+
+    /// Drags the touch in progress to `point`: the interaction vector becomes `point - hit`.
+    /// Does nothing without a touch in progress.
+    ///
+    /// # Errors
+    /// [`SimError::NonFinite`] for a non-finite point.
+    pub fn touch_drag(&mut self, point: Vec3) -> Result<(), SimError> {
+        if !point.is_finite() {
+            return Err(SimError::NonFinite { what: "the drag point", value: point.to_string() });
+        }
+        if let Some(touch) = self.touch.as_mut().filter(|t| t.released_at_secs.is_none()) {
+            touch.drag = point;
+        }
+        Ok(())
+    }
+
+    /// Ends the touch at the current time. The field's original values come back at once, or
+    /// fade back over `SimParams::touch.release_secs`; either way exactly.
+    pub fn touch_end(&mut self) {
+        if self.params.touch.release_secs <= 0.0 {
+            self.touch = None;
+        } else if let Some(touch) = self.touch.as_mut().filter(|t| t.released_at_secs.is_none()) {
+            touch.released_at_secs = Some(self.time_secs);
+        }
+    }
+
+    /// The touch in progress (or fading out), if any.
+    #[must_use]
+    pub fn touch(&self) -> Option<&Touch> {
+        self.touch.as_ref()
+    }
+
+    /// The nearest hit of a ray with the base mesh at its current root positions.
+    #[must_use]
+    pub fn pick(&self, triangles: &[[u32; 3]], ray_origin: Vec3, ray_direction: Vec3) -> Option<Hit> {
+        pick(&self.roots, triangles, ray_origin, ray_direction)
+    }
+
+    /// Advances to render time `time_secs`: runs the fixed steps needed (at most two, whatever
+    /// the jump) and updates [`Simulation::positions`]. Without interpolation it simulates at
+    /// `time_secs` itself, every call. A non-finite time does nothing.
+    pub fn advance_to(&mut self, time_secs: f64) {
+        if !time_secs.is_finite() {
+            return;
+        }
+        self.time_secs = time_secs;
+        if self.params.interpolate {
+            let steps = time_secs * f64::from(self.params.rate_hz);
+            let index = steps.floor() as i64;
+            if index != self.step_index {
+                if index.checked_sub(1) == Some(self.step_index) {
+                    std::mem::swap(&mut self.previous, &mut self.current);
+                    self.step_into_current(index as f64 / f64::from(self.params.rate_hz));
+                    self.step_index = index;
+                } else {
+                    self.jump_to_step(index);
+                }
+            }
+            self.alpha = (steps - index as f64).clamp(0.0, 1.0) as f32;
+        } else {
+            std::mem::swap(&mut self.previous, &mut self.current);
+            self.step_into_current(time_secs);
+            self.alpha = 1.0;
+        }
+        self.drop_faded_touch();
+        self.update_output();
+    }
+
+    /// The positions to draw, layer-major like [`FurStructure::positions`]:
+    /// `lerp(previous, current, alpha)` for the last [`Simulation::advance_to`] time.
+    #[must_use]
+    pub fn positions(&self) -> &[Vec3] {
+        &self.output
+    }
+
+    /// Writes `previous * (1 - alpha) + current * alpha`, layer-major, to `out`: exactly the
+    /// previous state at `alpha = 0` and exactly the current one at `alpha = 1`.
+    ///
+    /// # Panics
+    /// If `out` is not `(L + 1) * V` long.
+    pub fn write_lerp(&self, alpha: f32, out: &mut [Vec3]) {
+        let v = self.vertex_count;
+        let nodes = self.layers as usize + 1;
+        assert_eq!(out.len(), v * nodes, "the shared vertex array has (L + 1) * V entries");
+        if v == 0 {
+            return;
+        }
+        let (previous, current) = (&self.previous, &self.current);
+        // Each task owns a run of whole batches and writes their slice of every layer row, so it
+        // reads its batches' memory once, front to back, instead of once per row.
+        let mut pieces: Vec<Vec<&mut [Vec3]>> =
+            (0..v.div_ceil(LERP_STRANDS_PER_TASK)).map(|_| Vec::with_capacity(nodes)).collect();
+        for row in out.chunks_mut(v) {
+            for (piece, task) in row.chunks_mut(LERP_STRANDS_PER_TASK).zip(&mut pieces) {
+                task.push(piece);
+            }
+        }
+        pieces.into_par_iter().enumerate().for_each(|(t, rows)| {
+            let first_batch = t * LERP_STRANDS_PER_TASK / LANES;
+            for (i, row) in rows.into_iter().enumerate() {
+                for (bb, positions) in row.chunks_mut(LANES).enumerate() {
+                    let k = (first_batch + bb) * nodes + i;
+                    let (a, c) = (&previous[k], &current[k]);
+                    for (lane, position) in positions.iter_mut().enumerate() {
+                        let lerp = |axis: usize| a[axis][lane] * (1.0 - alpha) + c[axis][lane] * alpha;
+                        *position = Vec3::new(lerp(0), lerp(1), lerp(2));
+                    }
+                }
+            }
+        });
+    }
+
+    /// The interpolation weight of the current state at the last render time.
+    #[must_use]
+    pub fn alpha(&self) -> f32 {
+        self.alpha
+    }
+
+    /// The last render time given to [`Simulation::advance_to`].
+    #[must_use]
+    pub fn time_secs(&self) -> f64 {
+        self.time_secs
+    }
+
+    /// Wall-clock seconds the last step took (the viewer shows it).
+    #[must_use]
+    pub fn last_step_secs(&self) -> f64 {
+        self.last_step_secs
+    }
+
+    /// Steps run since construction.
+    #[must_use]
+    pub fn steps_taken(&self) -> u64 {
+        self.steps_taken
+    }
+
+    /// `L`, the number of layers above the base.
+    #[must_use]
+    pub fn layers(&self) -> u32 {
+        self.layers
+    }
+
+    /// `V`, the number of strands (base vertices).
+    #[must_use]
+    pub fn vertex_count(&self) -> usize {
+        self.vertex_count
+    }
+
+    /// The current root positions.
+    #[must_use]
+    pub fn roots(&self) -> &[Vec3] {
+        &self.roots
+    }
+
+    fn jump_to_step(&mut self, index: i64) {
+        let rate = f64::from(self.params.rate_hz);
+        self.step_into_current((index as f64 - 1.0) / rate);
+        std::mem::swap(&mut self.previous, &mut self.current);
+        self.step_into_current(index as f64 / rate);
+        self.step_index = index;
+    }
+
+    /// Computes the state at `time_secs` into `current`.
+    fn step_into_current(&mut self, time_secs: f64) {
+        let started = Instant::now();
+        let mut external = std::mem::take(&mut self.external);
+        self.evaluate_field(time_secs, &mut external);
+        self.external = external;
+        let gravity = self.params.gravity_direction.normalize_or_zero() * self.params.gravity_strength;
+        let layers = self.layers as usize;
+        let v = self.vertex_count;
+        let stability = self.params.stability;
+        let (roots, frames, rest, external, map) =
+            (&self.roots, &self.frames, &self.rest_segments, &self.external, self.stability_map.as_deref());
+        self.current.par_chunks_mut(layers + 1).enumerate().with_min_len(BATCHES_PER_TASK).for_each(|(b, nodes)| {
+            let inputs: [StrandInputs; LANES] = std::array::from_fn(|lane| {
+                let j = b * LANES + lane;
+                if j < v {
+                    StrandInputs {
+                        root: roots[j],
+                        frame: frames[j],
+                        force: gravity + external[j],
+                        stability: map.map_or(stability, |m| m[j]),
+                    }
+                } else {
+                    StrandInputs::default()
+                }
+            });
+            bend_batch(&inputs, &rest[b * layers..(b + 1) * layers], nodes);
+        });
+        self.last_step_secs = started.elapsed().as_secs_f64();
+        self.steps_taken += 1;
+    }
+
+    fn drop_faded_touch(&mut self) {
+        let release_secs = self.params.touch.release_secs;
+        if self
+            .touch
+            .as_ref()
+            .is_some_and(|t| t.released_at_secs.is_some() && t.presence(self.time_secs, release_secs) == 0.0)
+        {
+            self.touch = None;
+        }
+    }
+
+    fn update_output(&mut self) {
+        let mut output = std::mem::take(&mut self.output);
+        self.write_lerp(self.alpha, &mut output);
+        self.output = output;
+    }
+}
+
+/// Centre and radius of a bounding sphere (box centre, farthest point); radius at least a tiny
+/// positive value so relative sizes stay finite on a degenerate base.
+fn bounding_sphere(points: &[Vec3]) -> (Vec3, f32) {
+    let (min, max) =
+        points.iter().fold((Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
+    let centre = if points.is_empty() { Vec3::ZERO } else { (min + max) * 0.5 };
+    let radius = points.iter().map(|p| p.distance(centre)).fold(0.0, f32::max);
+    (centre, radius.max(1e-6))
+}

@@ -1,0 +1,211 @@
+//! Renderer tests on a real adapter (lavapipe in CI). They fail, never skip, without one.
+
+mod common;
+
+use common::*;
+use glam::Vec3;
+use pelt_core::Builtin;
+use pelt_render::{Camera, Headless, RenderSettings, Renderer, SeparatedRenderer};
+
+const SIZE: u32 = 256;
+
+/// The background as stored in the image (sRGB of the default clear colour).
+fn background(headless: &Headless, renderer: &Renderer, camera: &Camera) -> [u8; 3] {
+    let away = Camera { target: camera.eye * 2.0 - camera.target, ..*camera };
+    let empty = headless.render(renderer, &away, &settings()).expect("frame");
+    let p = empty.get_pixel(0, 0).0;
+    [p[0], p[1], p[2]]
+}
+
+fn render(headless: &Headless, renderer: &Renderer, camera: &Camera, settings: &RenderSettings) -> image::RgbaImage {
+    headless.render(renderer, camera, settings).expect("frame")
+}
+
+#[test]
+fn golden_bunny_still() {
+    let fur = builtin_fur(Builtin::Bunny, 16);
+    let headless = headless(SIZE, SIZE);
+    let renderer = headless.renderer(&fur, &strand_textures(256, 16, BROWN_ROOT, BROWN_TIP)).expect("renderer");
+    check_golden("bunny-still", &render(&headless, &renderer, &framed(&fur, 1.0), &settings()));
+}
+
+#[test]
+fn golden_box() {
+    let fur = builtin_fur(Builtin::Box, 16);
+    let headless = headless(SIZE, SIZE);
+    let textures = strand_textures(256, 16, [40, 40, 44], [235, 235, 240]);
+    let renderer = headless.renderer(&fur, &textures).expect("renderer");
+    check_golden("box", &render(&headless, &renderer, &framed(&fur, 1.0), &settings()));
+}
+
+#[test]
+fn golden_tryon() {
+    let body = load_asset("female_generic.obj");
+    let garment = grow(load_asset("skirthelper.obj"), 16, 0.12);
+    let headless = headless(SIZE, SIZE);
+    let textures = strand_textures(256, 16, [30, 20, 45], [150, 110, 190]);
+    let mut renderer = headless.renderer(&garment, &textures).expect("renderer");
+    renderer.add_plain_mesh(&headless.gpu.device, &body, Vec3::new(0.6, 0.45, 0.38)).expect("body");
+    let (centre, radius) = garment.mesh.bounding_sphere();
+    let camera = Camera::framing(centre, radius * 1.6, 25.0, 10.0, 1.0);
+    check_golden("tryon", &render(&headless, &renderer, &camera, &settings()));
+}
+
+/// Fins only add pixels at the silhouette: on a sphere (no inner silhouettes) every pixel they
+/// change lies within the fur's reach of the bare sphere's outline.
+#[test]
+fn fins_change_silhouette_pixels_only() {
+    let fur = builtin_fur(Builtin::Sphere, 16);
+    let headless = headless(SIZE, SIZE);
+    let renderer = headless.renderer(&fur, &strand_textures(256, 16, BROWN_ROOT, BROWN_TIP)).expect("renderer");
+    let camera = framed(&fur, 1.0);
+    let with_fins = render(&headless, &renderer, &camera, &settings());
+    let without = render(&headless, &renderer, &camera, &RenderSettings { fins: false, ..settings() });
+    let bare = render(&headless, &renderer, &camera, &RenderSettings { fins: false, shells: false, ..settings() });
+    let background = background(&headless, &renderer, &camera);
+    let inside = |x: u32, y: u32| covered(bare.get_pixel(x, y), background);
+    // The outline of the bare sphere, and the fur length in pixels (the sphere has radius 1).
+    let outline: Vec<(i64, i64)> = (1..SIZE - 1)
+        .flat_map(|y| (1..SIZE - 1).map(move |x| (x, y)))
+        .filter(|&(x, y)| {
+            inside(x, y) && !(inside(x - 1, y) && inside(x + 1, y) && inside(x, y - 1) && inside(x, y + 1))
+        })
+        .map(|(x, y)| (i64::from(x), i64::from(y)))
+        .collect();
+    assert!(outline.len() > 100, "the sphere has an outline");
+    let sphere_pixels =
+        (outline.iter().map(|p| p.0).max().unwrap() - outline.iter().map(|p| p.0).min().unwrap()) as f32;
+    let reach = (fur.lengths[0] * sphere_pixels / 2.0).ceil() as i64 + 3;
+    let mut changed = 0;
+    for (x, y, pixel) in with_fins.enumerate_pixels() {
+        if pixel_difference(pixel, without.get_pixel(x, y)) <= 8 {
+            continue;
+        }
+        changed += 1;
+        let (x, y) = (i64::from(x), i64::from(y));
+        let near = outline.iter().any(|&(ox, oy)| (ox - x).pow(2) + (oy - y).pow(2) <= reach * reach);
+        assert!(near, "fins changed pixel ({x}, {y}) more than {reach} px from the silhouette");
+    }
+    assert!(changed > 50, "fins change the silhouette ({changed} pixels)");
+}
+
+/// Coverage: the mean difference from the background, 0 (nothing drawn) to 1.
+fn fur_coverage(image: &image::RgbaImage, background: [u8; 3]) -> f64 {
+    let total: f64 = image
+        .pixels()
+        .map(|p| f64::from(p.0.iter().zip(background).map(|(a, b)| a.abs_diff(b)).max().unwrap_or(0)) / 255.0)
+        .sum();
+    total / f64::from(image.width() * image.height())
+}
+
+#[test]
+fn more_layers_raise_fur_coverage() {
+    let headless = headless(SIZE, SIZE);
+    let textures = strand_textures(256, 16, BROWN_ROOT, BROWN_TIP);
+    let fur_only = RenderSettings { skin: false, fins: false, ..settings() };
+    let mut coverage = Vec::new();
+    let mut camera = None;
+    for layers in [2, 6, 16] {
+        let fur = builtin_fur(Builtin::Torus, layers);
+        let camera = *camera.get_or_insert_with(|| framed(&fur, 1.0));
+        let renderer = headless.renderer(&fur, &textures).expect("renderer");
+        let background = background(&headless, &renderer, &camera);
+        coverage.push(fur_coverage(&render(&headless, &renderer, &camera, &fur_only), background));
+    }
+    assert!(coverage[0] < coverage[1] && coverage[1] < coverage[2], "coverage by layers 2, 6, 16: {coverage:?}");
+}
+
+/// Horizontal centre of the drawn pixels.
+fn centroid_x(image: &image::RgbaImage, background: [u8; 3]) -> f64 {
+    let (mut sum, mut count) = (0.0, 0.0);
+    for (x, _, pixel) in image.enumerate_pixels() {
+        if covered(pixel, background) {
+            sum += f64::from(x);
+            count += 1.0;
+        }
+    }
+    sum / count
+}
+
+/// Bending the shared vertices (as the simulation does) moves shells and fins together: fur
+/// blown toward the camera's right lands right of the rest pose.
+#[test]
+fn bent_shared_vertices_move_fur_pixels_that_way() {
+    let fur = builtin_fur(Builtin::Sphere, 16);
+    let headless = headless(SIZE, SIZE);
+    let renderer = headless.renderer(&fur, &strand_textures(256, 16, BROWN_ROOT, BROWN_TIP)).expect("renderer");
+    let camera = Camera::orbit(Vec3::ZERO, 0.0, 0.0, 5.0);
+    let fur_only = RenderSettings { skin: false, ..settings() };
+    let background = background(&headless, &renderer, &camera);
+    let rest = centroid_x(&render(&headless, &renderer, &camera, &fur_only), background);
+    // The camera looks down -Z from +Z, so +X is to the right in the image.
+    let v = fur.vertex_count();
+    let bent: Vec<Vec3> = fur
+        .positions
+        .iter()
+        .enumerate()
+        .map(|(k, p)| *p + Vec3::X * (0.08 * (k / v) as f32 / fur.layers as f32))
+        .collect();
+    renderer.update_positions(&headless.gpu.queue, &bent).expect("positions");
+    let blown = centroid_x(&render(&headless, &renderer, &camera, &fur_only), background);
+    assert!(blown > rest + 1.0, "fur moved right: centroid {rest:.2} -> {blown:.2}");
+    let error = renderer.update_positions(&headless.gpu.queue, &bent[1..]).expect_err("wrong count");
+    assert!(error.to_string().contains("(L + 1) * V"), "{error}");
+}
+
+#[test]
+fn alpha_to_coverage_draws_the_same_fur() {
+    let fur = builtin_fur(Builtin::Torus, 16);
+    let headless = headless(SIZE, SIZE);
+    let renderer = headless.renderer(&fur, &strand_textures(256, 16, BROWN_ROOT, BROWN_TIP)).expect("renderer");
+    let camera = framed(&fur, 1.0);
+    let background = background(&headless, &renderer, &camera);
+    let blended = render(&headless, &renderer, &camera, &settings());
+    let coverage = render(&headless, &renderer, &camera, &RenderSettings { alpha_to_coverage: true, ..settings() });
+    // The same outline; inside, coverage quantised to 4 samples drops the faint strand edges.
+    let drawn = |image: &image::RgbaImage| image.pixels().filter(|p| covered(p, background)).count() as f64;
+    let (a, b) = (drawn(&blended), drawn(&coverage));
+    assert!((a - b).abs() < 0.05 * a, "pixels drawn blended {a}, alpha-to-coverage {b}");
+    let mean = blended.pixels().zip(coverage.pixels()).map(|(p, q)| f64::from(pixel_difference(p, q))).sum::<f64>()
+        / f64::from(SIZE * SIZE);
+    assert!(mean > 0.0 && mean < 60.0, "similar but not identical: mean difference {mean:.2}");
+}
+
+#[test]
+fn separated_structure_renders_the_same_scene() {
+    let fur = builtin_fur(Builtin::Box, 16);
+    let headless = headless(SIZE, SIZE);
+    let textures = strand_textures(256, 16, BROWN_ROOT, BROWN_TIP);
+    let unified = headless.renderer(&fur, &textures).expect("renderer");
+    let camera = framed(&fur, 1.0);
+    let background = background(&headless, &unified, &camera);
+    let unified_image = render(&headless, &unified, &camera, &settings());
+    let device = &headless.gpu.device;
+    for fin_faces in [2, 30] {
+        let separated =
+            SeparatedRenderer::new(device, &headless.gpu.queue, headless.format(), &fur, &textures, fin_faces)
+                .expect("separated");
+        let image = headless.render_with(|queue, encoder, targets, output| {
+            separated.render(queue, encoder, targets, output, &camera, &settings());
+        });
+        let image = image.expect("frame");
+        let (a, b) = (fur_coverage(&unified_image, background), fur_coverage(&image, background));
+        assert!((a - b).abs() < 0.1 * a, "{fin_faces}-face fins: coverage unified {a:.3}, separated {b:.3}");
+        let expected_vertices =
+            (fur.positions.len() + fur.mesh.edges.len() * 6 * fin_faces.div_ceil(2) as usize) as u64;
+        assert_eq!(separated.gpu_bytes(), expected_vertices * 32 + fur.mesh.triangles.len() as u64 * 12);
+    }
+}
+
+/// `PELT_TEST_BACKEND` (CI runs the suite on lavapipe and on llvmpipe) really picks that backend.
+#[test]
+fn adapter_uses_the_requested_backend() {
+    let headless = headless(8, 8);
+    let backend = headless.gpu.adapter.get_info().backend;
+    match std::env::var("PELT_TEST_BACKEND").as_deref() {
+        Ok("gl") => assert_eq!(backend, wgpu::Backend::Gl),
+        Ok("vulkan") => assert_eq!(backend, wgpu::Backend::Vulkan),
+        _ => assert_ne!(backend, wgpu::Backend::Noop),
+    }
+    eprintln!("adapter: {}", headless.gpu.summary());
+}

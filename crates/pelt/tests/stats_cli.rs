@@ -1,0 +1,58 @@
+//! `pelt stats` run as a program: exit codes, stdout and error messages.
+
+use std::path::Path;
+use std::process::{Command, Output};
+
+fn pelt(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_pelt"))
+        .args(args)
+        .current_dir(Path::new(env!("CARGO_MANIFEST_DIR")).join("../.."))
+        .env("RUST_BACKTRACE", "0")
+        .output()
+        .expect("the pelt binary runs")
+}
+
+fn stdout(output: &Output) -> String {
+    String::from_utf8_lossy(&output.stdout).into_owned()
+}
+
+fn stderr(output: &Output) -> String {
+    String::from_utf8_lossy(&output.stderr).into_owned()
+}
+
+#[test]
+fn the_default_mesh_is_the_papers_box() {
+    let output = pelt(&["stats"]);
+    assert!(output.status.success(), "{}", stderr(&output));
+    let text = stdout(&output);
+    assert!(text.contains("builtin:box") && text.contains("5,032") && text.contains("31,492"), "{text}");
+    assert!(text.contains("matches"), "{text}");
+}
+
+#[test]
+fn a_mesh_file_gives_json_on_request() {
+    let output = pelt(&["stats", "assets/meshes/skirthelper.obj", "--layers", "8", "--json"]);
+    assert!(output.status.success(), "{}", stderr(&output));
+    let json: serde_json::Value = serde_json::from_slice(&output.stdout).expect("valid JSON");
+    assert_eq!(json["mesh"]["vertices"], 720);
+    assert_eq!(json["mesh"]["boundary_loops"], 2);
+    assert_eq!(json["unified"]["vertices"], 720 * 9);
+    assert_eq!(json["layers"], 8);
+}
+
+#[test]
+fn bad_input_fails_with_a_message_not_a_panic() {
+    for (args, expected) in [
+        (&["stats", "no/such/mesh.obj"][..], "no/such/mesh.obj"),
+        (&["stats", "crates/pelt-core/tests/fixtures/bad_number.obj"][..], "bad_number.obj:3"),
+        (&["stats", "--builtin", "cube"][..], "unknown built-in mesh \"cube\""),
+        (&["stats", "--layers", "0"][..], "--layers 0"),
+        (&["stats", "--fin-faces", "0"][..], "--fin-faces"),
+    ] {
+        let output = pelt(args);
+        let message = stderr(&output);
+        assert!(!output.status.success(), "{args:?} should fail");
+        assert!(message.contains(expected), "{args:?}: {message}");
+        assert!(!message.contains("panicked"), "{args:?}: {message}");
+    }
+}
