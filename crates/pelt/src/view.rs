@@ -28,6 +28,13 @@ pub struct Args {
     /// Where `--screenshot-after` writes its PNG.
     #[arg(long, value_name = "FILE.png", requires = "screenshot_after")]
     pub out: Option<PathBuf>,
+    /// Play a scene script (the simulation's TOML: wind keys and touch strokes in world
+    /// coordinates) on the simulation clock.
+    #[arg(long, value_name = "SCENE.toml")]
+    pub script: Option<PathBuf>,
+    /// Start with the overlay (timings, sizes, brush and hints) hidden; O shows it.
+    #[arg(long)]
+    pub no_overlay: bool,
     /// Window size in logical pixels, `WIDTHxHEIGHT`.
     #[arg(long, value_name = "WxH", default_value = "1280x800", value_parser = parse_size)]
     pub size: [u32; 2],

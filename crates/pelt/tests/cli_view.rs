@@ -70,3 +70,49 @@ fn the_window_shows_the_panel_with_text_beside_the_3d_view() {
         .collect();
     assert!(distinct.len() > 20, "anti-aliased text gives many shades: {}", distinct.len());
 }
+
+/// Mean absolute difference per channel of two frames inside `x0..x1, y0..y1`.
+fn mean_difference(a: &image::RgbaImage, b: &image::RgbaImage, (x0, y0, x1, y1): (u32, u32, u32, u32)) -> f64 {
+    let mut sum = 0.0;
+    for y in y0..y1 {
+        for x in x0..x1 {
+            let (p, q) = (a.get_pixel(x, y).0, b.get_pixel(x, y).0);
+            sum += (0..3).map(|c| f64::from(p[c].abs_diff(q[c]))).sum::<f64>() / 3.0;
+        }
+    }
+    sum / f64::from((x1 - x0) * (y1 - y0))
+}
+
+#[test]
+fn a_scripted_touch_flattens_the_fur_where_it_presses_and_nowhere_else() {
+    // The plane (2 x 2, facing +Y, centred on the origin) is framed in the middle of the 3D view,
+    // so the origin lands at the view's centre. The stroke presses there and drags along +X
+    // within the first second and holds until after the screenshot.
+    let script = Path::new(env!("CARGO_TARGET_TMPDIR")).join("cli_view_touch.toml");
+    std::fs::write(
+        &script,
+        "[[stroke]]\nstart_secs = 0.0\nend_secs = 3.0\nradius = 0.5\n\
+         path = [[0.0, 0.0, 0.0], [0.7, 0.0, 0.0], [0.7, 0.0, 0.0], [0.7, 0.0, 0.0]]\n",
+    )
+    .unwrap();
+    let frames = 60;
+    // Without the overlay, so only the fur can differ (not the timings or the brush).
+    let untouched = screenshot("untouched", frames, &["--builtin", "plane", "--no-overlay"]);
+    let script = script.to_str().unwrap();
+    let touched = screenshot("touched", frames, &["--builtin", "plane", "--no-overlay", "--script", script]);
+    let view_centre = ((WIDTH_PX - PANEL_PX) / 2, HEIGHT_PX / 2);
+    let around = |half: u32, dy: i32| {
+        let y = (view_centre.1 as i32 + dy) as u32;
+        (view_centre.0 - half, y - half / 2, view_centre.0 + half, y + half / 2)
+    };
+    let pressed = mean_difference(&untouched, &touched, around(50, 0));
+    // Fur at the plane's left and far corners, well outside the touch radius.
+    let left_corner = mean_difference(&untouched, &touched, (75, 315, 135, 335));
+    let background = mean_difference(&untouched, &touched, (200, 470, 600, 560));
+    println!("pressed {pressed:.2}, left corner {left_corner:.2}, background {background:.2}");
+    assert!(pressed > 8.0, "the fur under the touch changed: {pressed:.2}");
+    assert!(left_corner < pressed / 8.0, "fur far from the touch stays put: {left_corner:.2} vs {pressed:.2}");
+    assert!(background < 0.5, "the background is untouched: {background:.2}");
+    let panel = mean_difference(&untouched, &touched, (WIDTH_PX - PANEL_PX + 4, 0, WIDTH_PX, HEIGHT_PX));
+    assert!(panel < 0.5, "the panel looks the same: {panel:.2}");
+}

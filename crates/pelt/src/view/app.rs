@@ -5,8 +5,9 @@ use std::sync::Arc;
 use std::time::Instant;
 
 use anyhow::Context as _;
-use glam::Vec2;
+use glam::{Vec2, Vec3};
 use pelt_core::fur::FurLength;
+use pelt_core::sim::{Scene, Simulation};
 use pelt_core::{Builtin, FurParams, FurStructure, GrowthDirection, Mesh, SeparatedStructure};
 use winit::application::ApplicationHandler;
 use winit::event::WindowEvent;
@@ -69,7 +70,16 @@ struct Model {
     viewport_px: [u32; 2],
     clock: Clock,
     frame_time_secs: f64,
+    sim: Simulation,
+    /// Scripted wind and touch strokes (`--script`), played on the simulation clock.
+    scene: Option<Scene>,
+    /// Simulation time: advances only while the simulation runs.
+    sim_clock_secs: f64,
+    /// Smoothed cost of one `advance_to`.
     sim_time_secs: f64,
+    touch: Option<TouchDrag>,
+    /// Wind strength W restores after turning the wind off.
+    wind_strength_on: f32,
     frames_drawn: u32,
     skipped_frames: u32,
     screenshots_saved: u32,
@@ -80,31 +90,27 @@ struct Model {
 }
 
 /// Wall-clock time, or exactly `FIXED_FRAME_SECS` per frame for repeatable runs.
-#[allow(dead_code, reason = "touch and the simulation use it as they land in this branch")]
 struct Clock {
     fixed: bool,
-    start: Instant,
     last: Instant,
-    frame_index: u64,
 }
 
-#[allow(dead_code, reason = "touch and the simulation use it as they land in this branch")]
 impl Clock {
-    /// Seconds since the previous tick.
-    fn tick(&mut self) -> f64 {
-        self.frame_index += 1;
-        if self.fixed {
-            return FIXED_FRAME_SECS;
-        }
+    /// `(wall seconds since the previous tick, seconds the scene advances)`.
+    fn tick(&mut self) -> (f64, f64) {
         let now = Instant::now();
-        let delta = now - self.last;
+        let wall_secs = (now - self.last).as_secs_f64();
         self.last = now;
-        delta.as_secs_f64()
+        // A long stall (a dragged window, a breakpoint) should not fast-forward the scene.
+        (wall_secs, if self.fixed { FIXED_FRAME_SECS } else { wall_secs.min(0.25) })
     }
+}
 
-    fn now_secs(&self) -> f64 {
-        if self.fixed { self.frame_index as f64 * FIXED_FRAME_SECS } else { self.start.elapsed().as_secs_f64() }
-    }
+/// A touch in progress: the pointer drags the hit point across the plane facing the camera.
+#[derive(Clone, Copy, Debug)]
+struct TouchDrag {
+    hit: Vec3,
+    plane_normal: Vec3,
 }
 
 impl App {
@@ -119,9 +125,14 @@ impl App {
             (None, Some(name)) => (MeshChoice::Builtin(Builtin::from_name(name).unwrap_or(Builtin::Bunny)), None),
             (None, None) => (MeshChoice::Builtin(Builtin::Bunny), None),
         };
-        let settings = Settings::new(choice);
+        let mut settings = Settings::new(choice);
+        settings.overlay = !args.no_overlay;
         let structure = grow(mesh, &settings)?;
-        let now = Instant::now();
+        let sim = Simulation::new(&structure, &settings.sim)?;
+        let scene = match &args.script {
+            Some(path) => Some(Scene::load(path)?),
+            None => None,
+        };
         let model = Model {
             settings,
             mesh_choices,
@@ -130,9 +141,14 @@ impl App {
             camera: OrbitCamera::default(),
             frame_pending: true,
             viewport_px: [1, 1],
-            clock: Clock { fixed: args.screenshot_after.is_some(), start: now, last: now, frame_index: 0 },
+            clock: Clock { fixed: args.screenshot_after.is_some(), last: Instant::now() },
             frame_time_secs: 0.0,
+            sim,
+            scene,
+            sim_clock_secs: 0.0,
             sim_time_secs: 0.0,
+            touch: None,
+            wind_strength_on: 1.0,
             frames_drawn: 0,
             skipped_frames: 0,
             screenshots_saved: 0,
@@ -188,12 +204,12 @@ impl App {
     fn redraw(&mut self) -> anyhow::Result<()> {
         let Some(running) = self.running.as_mut() else { return Ok(()) };
         let model = &mut self.model;
-        let frame_secs = model.clock.tick();
-        model.frame_time_secs = smooth(model.frame_time_secs, frame_secs);
+        let (wall_secs, frame_secs) = model.clock.tick();
+        model.frame_time_secs = smooth(model.frame_time_secs, wall_secs);
 
         let raw_input = running.egui_state.take_egui_input(&running.window);
         let texture_id = running.viewport.texture_id;
-        let mut outcome = (Changes::default(), Requests::default());
+        let mut outcome = (Changes::default(), Requests::default(), Ok(()));
         let mut full_output = running.egui_ctx.run_ui(raw_input, |ui| outcome = model.ui(ui, texture_id));
         // egui's texture changes apply whether or not this frame gets drawn.
         let mut textures_delta = std::mem::take(&mut full_output.textures_delta);
@@ -207,9 +223,12 @@ impl App {
         }
         textures_delta.clear();
         running.egui_state.handle_platform_output(&running.window, full_output.platform_output);
+        outcome.2?;
         if model.apply(outcome.0)? {
             running.fur.set_structure(&running.gpu, &model.structure)?;
         }
+        model.simulate(frame_secs)?;
+        running.fur.set_positions(&running.gpu, model.sim.positions())?;
         if outcome.1.screenshot {
             model.screenshot_pending = true;
         }
@@ -355,7 +374,7 @@ impl ApplicationHandler for App {
 
 impl Model {
     /// The panel, the 3D view with its overlay, and the shortcuts.
-    fn ui(&mut self, ui: &mut egui::Ui, texture_id: egui::TextureId) -> (Changes, Requests) {
+    fn ui(&mut self, ui: &mut egui::Ui, texture_id: egui::TextureId) -> (Changes, Requests, anyhow::Result<()>) {
         let mut outcome = (Changes::default(), Requests::default());
         let shortcuts = self.shortcuts(ui.ctx());
         outcome.1.frame |= shortcuts.frame;
@@ -366,8 +385,8 @@ impl Model {
             });
         }
         outcome.0.simulation |= shortcuts.simulation;
-        egui::CentralPanel::no_frame().show(ui, |ui| self.view_3d(ui, texture_id));
-        outcome
+        let view = egui::CentralPanel::no_frame().show(ui, |ui| self.view_3d(ui, texture_id));
+        (outcome.0, outcome.1, view.inner)
     }
 
     /// Keys that act anywhere except while typing into a text field.
@@ -399,6 +418,22 @@ impl Model {
                     *toggle = !*toggle;
                 }
             }
+            if input.consume_key(none, egui::Key::W) {
+                let wind = &mut settings.sim.wind;
+                if wind.strength > 0.0 {
+                    self.wind_strength_on = wind.strength;
+                    wind.strength = 0.0;
+                } else {
+                    wind.strength = self.wind_strength_on;
+                }
+                outcome.simulation = true;
+            }
+            if input.consume_key(none, egui::Key::OpenBracket) {
+                settings.brush_per_radius = (settings.brush_per_radius / 1.25).max(0.02);
+            }
+            if input.consume_key(none, egui::Key::CloseBracket) {
+                settings.brush_per_radius = (settings.brush_per_radius * 1.25).min(1.0);
+            }
             if input.consume_key(none, egui::Key::H) {
                 self.panel_hidden = !self.panel_hidden;
             }
@@ -418,7 +453,7 @@ struct ShortcutOutcome {
 
 impl Model {
     /// The fur image, camera controls and the overlay.
-    fn view_3d(&mut self, ui: &mut egui::Ui, texture_id: egui::TextureId) {
+    fn view_3d(&mut self, ui: &mut egui::Ui, texture_id: egui::TextureId) -> anyhow::Result<()> {
         let rect = ui.max_rect();
         let pixels_per_point = ui.ctx().pixels_per_point();
         self.viewport_px =
@@ -437,7 +472,32 @@ impl Model {
         let delta = response.drag_delta();
         let drag = Vec2::new(delta.x, delta.y);
         let primary = response.dragged_by(egui::PointerButton::Primary);
-        if response.dragged_by(egui::PointerButton::Middle) || (primary && modifiers.shift) {
+        let pointer = response.hover_pos().or_else(|| response.interact_pointer_pos());
+        let ray = pointer.map(|p| self.camera.ray(Vec2::new(p.x - rect.left(), p.y - rect.top()), size));
+        let brush_radius = self.settings.brush_per_radius * self.structure.mesh.bounding_sphere().1;
+        let hover_hit = ray
+            .filter(|_| self.touch.is_none() && !modifiers.alt && !modifiers.shift)
+            .and_then(|ray| self.sim.pick(&self.structure.mesh.triangles, ray.origin, ray.direction));
+
+        if response.drag_started_by(egui::PointerButton::Primary)
+            && let Some(hit) = hover_hit
+        {
+            self.sim.touch_begin(hit.point, brush_radius)?;
+            let plane_normal = (self.camera.target - self.camera.eye()).normalize_or(Vec3::NEG_Z);
+            self.touch = Some(TouchDrag { hit: hit.point, plane_normal });
+        }
+        if let Some(touch) = self.touch {
+            if primary && let Some(ray) = ray {
+                let along = ray.direction.dot(touch.plane_normal);
+                if along.abs() > 1e-6 {
+                    let distance = (touch.hit - ray.origin).dot(touch.plane_normal) / along;
+                    self.sim.touch_drag(ray.origin + ray.direction * distance.max(0.0))?;
+                }
+            } else {
+                self.sim.touch_end();
+                self.touch = None;
+            }
+        } else if response.dragged_by(egui::PointerButton::Middle) || (primary && modifiers.shift) {
             self.camera.pan(drag, size.y);
         } else if response.dragged_by(egui::PointerButton::Secondary) || primary {
             self.camera.orbit(drag);
@@ -450,7 +510,40 @@ impl Model {
             }
         }
         if self.settings.overlay {
+            self.brush(&painter, rect, pointer, hover_hit.map(|hit| hit.point), brush_radius);
             self.overlay(&painter, rect);
+        }
+        Ok(())
+    }
+
+    /// The brush under the pointer, sized to the touch radius at the fur it would touch; while
+    /// patting, the drag from the hit point.
+    fn brush(
+        &self,
+        painter: &egui::Painter,
+        rect: egui::Rect,
+        pointer: Option<egui::Pos2>,
+        hover: Option<Vec3>,
+        radius: f32,
+    ) {
+        let size = Vec2::new(rect.width(), rect.height()).max(Vec2::ONE);
+        let to_screen = |point: Vec3| {
+            let ndc = self.camera.clip_from_world(size.x / size.y).project_point3(point);
+            egui::pos2(rect.left() + (ndc.x + 1.0) * 0.5 * size.x, rect.top() + (1.0 - ndc.y) * 0.5 * size.y)
+        };
+        let accent = egui::Color32::from_rgb(255, 190, 90);
+        // The simulation's touch, so scripted strokes show as well as the pointer's.
+        if let Some(touch) = self.sim.touch().filter(|t| t.released_at_secs.is_none()) {
+            let centre = to_screen(touch.point);
+            let radius_px = touch.radius * self.camera.px_per_world_at(touch.point, size.y);
+            painter.circle_stroke(centre, radius_px, egui::Stroke::new(2.0, accent));
+            let end = to_screen(touch.drag);
+            painter.line_segment([centre, end], egui::Stroke::new(2.0, accent));
+            painter.circle_filled(end, 3.0, accent);
+        } else if let (Some(pointer), Some(point)) = (pointer, hover) {
+            let radius_px = radius * self.camera.px_per_world_at(point, size.y);
+            painter.circle_stroke(pointer, radius_px, egui::Stroke::new(1.5, egui::Color32::from_white_alpha(200)));
+            painter.circle_filled(pointer, 2.0, egui::Color32::from_white_alpha(200));
         }
     }
 
@@ -505,6 +598,21 @@ impl Model {
         self.camera.frame(center, radius + longest, aspect);
     }
 
+    /// Plays the script and steps the simulation to this frame's time.
+    fn simulate(&mut self, frame_secs: f64) -> anyhow::Result<()> {
+        if !self.settings.simulate {
+            return Ok(());
+        }
+        self.sim_clock_secs += frame_secs;
+        if let Some(scene) = &self.scene {
+            scene.apply(self.sim_clock_secs, &mut self.sim)?;
+        }
+        let start = Instant::now();
+        self.sim.advance_to(self.sim_clock_secs);
+        self.sim_time_secs = smooth(self.sim_time_secs, start.elapsed().as_secs_f64());
+        Ok(())
+    }
+
     /// Rebuilds what the panel's changes touch; true when the structure is new.
     fn apply(&mut self, changes: Changes) -> anyhow::Result<bool> {
         if changes.mesh {
@@ -517,7 +625,14 @@ impl Model {
         } else if changes.structure {
             self.structure = grow(self.structure.mesh.clone(), &self.settings)?;
         }
-        Ok(changes.mesh || changes.structure)
+        let rebuilt = changes.mesh || changes.structure;
+        if rebuilt {
+            self.sim = Simulation::new(&self.structure, &self.settings.sim)?;
+            self.touch = None;
+        } else if changes.simulation {
+            self.sim.set_params(&self.settings.sim)?;
+        }
+        Ok(rebuilt)
     }
 }
 

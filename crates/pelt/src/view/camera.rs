@@ -31,7 +31,6 @@ impl Default for OrbitCamera {
 }
 
 /// A ray in world space.
-#[allow(dead_code, reason = "touch and the simulation use it as they land in this branch")]
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Ray {
     pub origin: Vec3,
@@ -39,7 +38,6 @@ pub struct Ray {
     pub direction: Vec3,
 }
 
-#[allow(dead_code, reason = "touch and the simulation use it as they land in this branch")]
 impl OrbitCamera {
     /// Unit vector from the target to the eye.
     fn backward(&self) -> Vec3 {

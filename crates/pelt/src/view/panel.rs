@@ -10,6 +10,8 @@ pub const SHORTCUTS: &[(&str, &str)] = &[
     ("R", "reset the view"),
     ("Space", "pause or resume the simulation"),
     ("1 / 2 / 3", "skin / shells / fins on or off"),
+    ("W", "wind on or off"),
+    ("[ / ]", "smaller / larger brush"),
     ("H", "hide or show the panel"),
     ("O", "overlay on or off"),
     ("Ctrl+P", "save a screenshot"),
@@ -71,6 +73,8 @@ pub struct Settings {
     pub comb_blend: f32,
     pub sim: SimParams,
     pub simulate: bool,
+    /// Touch brush radius as a fraction of the mesh's bounding radius.
+    pub brush_per_radius: f32,
     pub draw: DrawToggles,
     pub overlay: bool,
 }
@@ -87,6 +91,7 @@ impl Settings {
             comb_blend: 0.0,
             sim: SimParams::default(),
             simulate: true,
+            brush_per_radius: 0.25,
             draw: DrawToggles::default(),
             overlay: true,
         }
@@ -161,6 +166,35 @@ pub fn show(
             changes.simulation |=
                 ui.add(egui::Slider::new(&mut sim.rate_hz, 1.0..=240.0).logarithmic(true).text("rate (Hz)")).changed();
             changes.simulation |= ui.checkbox(&mut sim.interpolate, "interpolate between steps").changed();
+            ui.label(egui::RichText::new("Wind").strong());
+            let wind = &mut sim.wind;
+            changes.simulation |=
+                ui.add(egui::Slider::new(&mut wind.strength, 0.0..=5.0).text("strength (W)")).changed();
+            ui.horizontal(|ui| {
+                ui.label("direction");
+                for (axis, value) in
+                    [("x ", &mut wind.direction.x), ("y ", &mut wind.direction.y), ("z ", &mut wind.direction.z)]
+                {
+                    changes.simulation |=
+                        ui.add(egui::DragValue::new(value).speed(0.02).range(-1.0..=1.0).prefix(axis)).changed();
+                }
+            });
+            if wind.direction.length_squared() == 0.0 {
+                wind.direction = glam::Vec3::X;
+            }
+            changes.simulation |= ui.add(egui::Slider::new(&mut wind.gust_strength, 0.0..=1.0).text("gusts")).changed();
+            changes.simulation |= ui
+                .add(egui::Slider::new(&mut wind.gust_scale, 0.05..=4.0).logarithmic(true).text("gust size"))
+                .changed();
+            changes.simulation |=
+                ui.add(egui::Slider::new(&mut wind.gust_speed, 0.0..=8.0).text("gust speed")).changed();
+            changes.simulation |= ui.add(egui::Slider::new(&mut wind.jitter, 0.0..=1.0).text("shake")).changed();
+            ui.label(egui::RichText::new("Touch").strong());
+            changes.simulation |=
+                ui.add(egui::Slider::new(&mut sim.touch.strength, 0.0..=20.0).text("strength")).changed();
+            changes.simulation |=
+                ui.add(egui::Slider::new(&mut sim.touch.release_secs, 0.0..=3.0).text("release (s)")).changed();
+            ui.add(egui::Slider::new(&mut settings.brush_per_radius, 0.02..=1.0).logarithmic(true).text("brush ([ ])"));
         });
         section(ui, "Drawing", true, |ui| {
             let draw = &mut settings.draw;
