@@ -21,6 +21,9 @@ use crate::mesh_args::MeshArgs;
 pub struct Args {
     #[command(flatten)]
     pub mesh: MeshArgs,
+    /// Start with the try-on scene: a furry skirt on a body (the paper's virtual try-on).
+    #[arg(long, conflicts_with_all = ["mesh", "builtin"])]
+    pub try_on: bool,
     /// Draw N frames, save the window's own frame as a PNG to `--out` and exit. Time then advances
     /// by exactly 1/60 s per frame, so runs repeat (used by the tests under Xvfb).
     #[arg(long, value_name = "N", requires = "out")]

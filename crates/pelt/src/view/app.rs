@@ -63,6 +63,10 @@ struct Model {
     /// The mesh from the command line, kept to switch back to.
     file_mesh: Option<Mesh>,
     structure: FurStructure,
+    /// The try-on scene's body, drawn without fur under the furry garment.
+    body: Option<Mesh>,
+    /// GPU bytes of the separated structure while it is shown.
+    separated_bytes: Option<u64>,
     camera: OrbitCamera,
     /// Frame the fur once the 3D view's size is known.
     frame_pending: bool,
@@ -116,6 +120,7 @@ struct TouchDrag {
 impl App {
     pub fn new(args: &Args, mesh: Mesh, mesh_source: String) -> anyhow::Result<Self> {
         let mut mesh_choices: Vec<MeshChoice> = Builtin::ALL.into_iter().map(MeshChoice::Builtin).collect();
+        mesh_choices.push(MeshChoice::TryOn);
         let (choice, file_mesh) = match (&args.mesh.mesh, &args.mesh.builtin) {
             (Some(path), _) => {
                 let name = path.file_name().map_or(mesh_source, |n| n.to_string_lossy().into_owned());
@@ -138,6 +143,8 @@ impl App {
             mesh_choices,
             file_mesh,
             structure,
+            body: None,
+            separated_bytes: None,
             camera: OrbitCamera::default(),
             frame_pending: true,
             viewport_px: [1, 1],
@@ -157,6 +164,11 @@ impl App {
             panel_hidden: false,
             status: String::new(),
         };
+        let mut model = model;
+        if args.try_on {
+            model.settings.mesh = MeshChoice::TryOn;
+            model.apply(Changes { mesh: true, ..Changes::default() })?;
+        }
         let screenshot_after = args.screenshot_after.zip(args.out.clone());
         Ok(Self { window_size: args.size, screenshot_after, model, running: None, error: None })
     }
@@ -196,7 +208,8 @@ impl App {
         let mut egui_renderer =
             egui_wgpu::Renderer::new(&gpu.device, surface.config.format, egui_wgpu::RendererOptions::default());
         let viewport = Viewport::new(&gpu.device, &mut egui_renderer, [1, 1])?;
-        let fur = FurView::new(&gpu, &self.model.structure, &interim_textures(16))?;
+        let mut fur = FurView::new(&gpu, &self.model.structure, &interim_textures(16))?;
+        fur.set_body(&gpu, self.model.body.as_ref())?;
         Ok(Running { window, gpu, surface, egui_ctx, egui_state, egui_renderer, viewport, fur, visible: true })
     }
 
@@ -226,6 +239,7 @@ impl App {
         outcome.2?;
         if model.apply(outcome.0)? {
             running.fur.set_structure(&running.gpu, &model.structure)?;
+            running.fur.set_body(&running.gpu, model.body.as_ref())?;
         }
         model.simulate(frame_secs)?;
         running.fur.set_positions(&running.gpu, model.sim.positions())?;
@@ -251,7 +265,15 @@ impl App {
         running.viewport.resize(&gpu.device, &mut running.egui_renderer, model.viewport_px)?;
 
         let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
-        running.fur.draw(gpu, &mut encoder, &running.viewport, &model.camera);
+        running.fur.settings.skin = model.settings.draw.skin;
+        running.fur.settings.shells = model.settings.draw.shells;
+        running.fur.settings.fins = model.settings.draw.fins;
+        let separated = !model.settings.draw.unified;
+        if separated {
+            running.fur.prepare_separated(gpu, &model.structure)?;
+        }
+        model.separated_bytes = running.fur.separated_bytes();
+        running.fur.draw(gpu, &mut encoder, &running.viewport, &model.camera, separated);
 
         let screen = egui_wgpu::ScreenDescriptor {
             size_in_pixels: [frame.texture.width(), frame.texture.height()],
@@ -561,14 +583,19 @@ impl Model {
         let faces = mesh.triangles.len() as u64 * u64::from(draw.skin)
             + footprint.shell_faces * u64::from(draw.shells)
             + footprint.fin_faces * u64::from(draw.fins);
+        // The separated renderer's own count once built (it also holds uvs and normals per vertex).
+        let structure_bytes = match self.separated_bytes {
+            Some(separated) if !draw.unified => separated,
+            _ => footprint.total_bytes(),
+        };
         let frame_ms = self.frame_time_secs * 1e3;
         let fps = if self.frame_time_secs > 0.0 { 1.0 / self.frame_time_secs } else { 0.0 };
         let text = format!(
-            "frame    {frame_ms:6.2} ms  ({fps:.0} fps)\nsim      {:6.2} ms\nvertices {:>9}\nfaces    {:>9}\nGPU      {:>9}  {}\nmesh     {}  L = {}",
+            "frame    {frame_ms:6.2} ms  ({fps:.0} fps)\nsim      {:6.2} ms\nvertices {:>9}\nfaces    {:>9}\nGPU      {:>9}  {} structure\nmesh     {}  L = {}",
             self.sim_time_secs * 1e3,
             thousands(vertices),
             thousands(faces),
-            bytes(footprint.total_bytes()),
+            bytes(structure_bytes),
             if draw.unified { "unified" } else { "separated" },
             self.settings.mesh.label(),
             self.structure.layers,
@@ -595,7 +622,9 @@ impl Model {
     fn frame(&mut self, aspect: f32) {
         let (center, radius) = self.structure.mesh.bounding_sphere();
         let longest = self.structure.lengths.iter().copied().fold(0.0, f32::max);
-        self.camera.frame(center, radius + longest, aspect);
+        // A garment on a body: show some of the body around it too.
+        let context = if self.body.is_some() { 1.6 } else { 1.0 };
+        self.camera.frame(center, (radius + longest) * context, aspect);
     }
 
     /// Plays the script and steps the simulation to this frame's time.
@@ -616,8 +645,14 @@ impl Model {
     /// Rebuilds what the panel's changes touch; true when the structure is new.
     fn apply(&mut self, changes: Changes) -> anyhow::Result<bool> {
         if changes.mesh {
+            self.body = None;
             let mesh = match &self.settings.mesh {
                 MeshChoice::Builtin(builtin) => builtin.mesh().0,
+                MeshChoice::TryOn => {
+                    let (garment, body) = try_on_scene()?;
+                    self.body = Some(body);
+                    garment
+                }
                 MeshChoice::File(_) => self.file_mesh.clone().context("the command-line mesh is gone")?,
             };
             self.structure = grow(mesh, &self.settings)?;
@@ -634,6 +669,18 @@ impl Model {
         }
         Ok(rebuilt)
     }
+}
+
+/// The paper's virtual try-on: a furry skirt (an open tube around the hips) on a body, both
+/// MakeHuman assets in the same space.
+fn try_on_scene() -> anyhow::Result<(Mesh, Mesh)> {
+    let options = pelt_core::ImportOptions::default();
+    let load = |text: &str, name: &str| -> anyhow::Result<Mesh> {
+        Ok(Mesh::from_obj_str(text, std::path::Path::new(name), &options)?.0)
+    };
+    let garment = load(include_str!("../../../../assets/meshes/skirthelper.obj"), "skirthelper.obj")?;
+    let body = load(include_str!("../../../../assets/meshes/female_generic.obj"), "female_generic.obj")?;
+    Ok((garment, body))
 }
 
 /// Grows the rest pose of the fur on `mesh`.

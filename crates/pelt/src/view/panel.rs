@@ -31,6 +31,8 @@ pub const MOUSE: &[(&str, &str)] = &[
 #[derive(Clone, Debug, PartialEq)]
 pub enum MeshChoice {
     Builtin(Builtin),
+    /// The paper's virtual try-on: a furry skirt on a body.
+    TryOn,
     /// The mesh given on the command line.
     File(String),
 }
@@ -39,6 +41,7 @@ impl MeshChoice {
     pub fn label(&self) -> String {
         match self {
             Self::Builtin(builtin) => builtin.name().to_owned(),
+            Self::TryOn => "try-on (skirt on a body)".to_owned(),
             Self::File(name) => name.clone(),
         }
     }
