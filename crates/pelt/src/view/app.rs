@@ -351,7 +351,11 @@ impl ApplicationHandler for App {
         let Some(running) = self.running.as_mut() else { return };
         let response = running.egui_state.on_window_event(&running.window, &event);
         match event {
-            WindowEvent::CloseRequested | WindowEvent::Destroyed => event_loop.exit(),
+            WindowEvent::CloseRequested | WindowEvent::Destroyed => {
+                // Let go of the surface now: no frame may touch a window that is going away.
+                self.running = None;
+                event_loop.exit();
+            }
             WindowEvent::Resized(size) => {
                 running.surface.resize(&running.gpu, size.width, size.height);
                 running.visible = size.width > 0 && size.height > 0;

@@ -10,7 +10,7 @@ const ZOOM_PER_STEP: f32 = 0.88;
 /// Keeps the camera off the poles, where `look_at` has no up vector.
 const MAX_PITCH_RAD: f32 = 1.55;
 /// Room left around a framed object, as a factor of its bounding radius.
-const FRAME_MARGIN: f32 = 1.08;
+const FRAME_MARGIN: f32 = 1.2;
 
 /// A perspective camera orbiting `target`, Y up.
 #[derive(Clone, Copy, Debug, PartialEq)]
