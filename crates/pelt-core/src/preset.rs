@@ -1,3 +1,290 @@
 //! Fur presets: everything about one fur in one TOML file.
 //!
-//! INTERFACE placeholder; the textures-and-presets issue fills it.
+//! Every table denies unknown keys and every field has a default, so an empty file is a valid
+//! preset (the [`Preset::default`] fur). Image paths are relative to the preset file's folder.
+//!
+//! ```toml
+//! layers = 16          # shells above the base, 1..=MAX_LAYERS
+//! length = 0.08        # fraction of the mesh's bounding-sphere radius, 0 < length <= 2
+//! [direction]          # fur direction on the mesh (see `DirectionParams`)
+//! [texture]            # the strand field (see `texture::TextureParams`)
+//! [colour]             # colours are "#rrggbb" strings (see `texture::ColourParams`)
+//! [simulation]         # `sim::SimParams`
+//! ```
+
+use std::path::{Path, PathBuf};
+
+use glam::Vec3;
+
+use crate::fur::{FurLength, FurParams, GrowthDirection, MAX_LAYERS};
+use crate::mesh::Mesh;
+use crate::sim::{ParamError, SimParams};
+use crate::texture::{self, ColourMode, ColourParams, FurTextures, ImageRgba8, TextureInputs, TextureParams};
+
+/// Why a preset could not be read, checked or used. Every message starts with the file.
+#[derive(Debug, thiserror::Error)]
+pub enum PresetError {
+    #[error("{file}: cannot read or write the preset: {source}")]
+    Io { file: PathBuf, source: std::io::Error },
+    /// TOML syntax, wrong types and unknown keys: toml's own message, with the line and key.
+    #[error("{file}: {message}")]
+    Parse { file: PathBuf, message: String },
+    #[error("{file}: {key}: {problem}")]
+    Invalid { file: PathBuf, key: String, problem: String },
+    #[error("{file}: {key}: cannot load image {image}: {problem}")]
+    Image { file: PathBuf, key: String, image: PathBuf, problem: String },
+    #[error("cannot write the preset as TOML: {0}")]
+    Write(String),
+}
+
+/// The `[direction]` table: how fur grows out of the mesh (becomes [`GrowthDirection`]).
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct DirectionParams {
+    /// Each vertex's growing vector tilts from its normal by up to this, degrees. `0..=80`, default 12.
+    pub random_angle_deg: f32,
+    /// A world-space combing direction `[x, y, z]`; only its part along the surface counts.
+    /// Default `[0, -1, 0]` (fur lies down with gravity).
+    pub comb: Vec3,
+    /// How far fur leans into the comb: 0 = along the normal, 1 = flat. `0..=1`, default 0.3.
+    pub comb_blend: f32,
+    /// Seed of the random tilt. Default 1.
+    pub seed: u64,
+}
+
+impl Default for DirectionParams {
+    fn default() -> Self {
+        Self { random_angle_deg: 12.0, comb: Vec3::NEG_Y, comb_blend: 0.3, seed: 1 }
+    }
+}
+
+/// One fur: layer count, length, direction, textures, colour and simulation.
+#[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct Preset {
+    /// Shells above the base, `1..=MAX_LAYERS`. Default 16.
+    pub layers: u32,
+    /// Fur length as a fraction of the mesh's bounding-sphere radius, so a preset fits every
+    /// mesh. `0 < length <= 2`, default 0.08.
+    pub length: f32,
+    pub direction: DirectionParams,
+    pub texture: TextureParams,
+    pub colour: ColourParams,
+    pub simulation: SimParams,
+    /// The preset file (for messages) and its folder (for relative image paths); not in TOML.
+    #[serde(skip)]
+    file: PathBuf,
+}
+
+impl Default for Preset {
+    fn default() -> Self {
+        Self {
+            layers: 16,
+            length: 0.08,
+            direction: DirectionParams::default(),
+            texture: TextureParams::default(),
+            colour: ColourParams::default(),
+            simulation: SimParams::default(),
+            file: PathBuf::from("<default preset>"),
+        }
+    }
+}
+
+/// Two presets are equal when they describe the same fur, wherever they were read from.
+impl PartialEq for Preset {
+    fn eq(&self, other: &Self) -> bool {
+        self.layers == other.layers
+            && self.length == other.length
+            && self.direction == other.direction
+            && self.texture == other.texture
+            && self.colour == other.colour
+            && self.simulation == other.simulation
+    }
+}
+
+impl Preset {
+    /// Reads and checks a preset file; image paths in it are relative to its folder.
+    ///
+    /// # Errors
+    /// [`PresetError`] naming the file (and the key) for a missing file, bad TOML, unknown keys,
+    /// wrong types, values out of range and referenced images that do not exist.
+    pub fn load(path: impl AsRef<Path>) -> Result<Self, PresetError> {
+        let path = path.as_ref();
+        let text =
+            std::fs::read_to_string(path).map_err(|source| PresetError::Io { file: path.to_path_buf(), source })?;
+        let preset = Self::from_toml_str(&text, path)?;
+        for (key, image) in preset.image_paths() {
+            let resolved = preset.resolve(image);
+            if !resolved.is_file() {
+                return Err(PresetError::Image {
+                    file: preset.file.clone(),
+                    key: key.to_owned(),
+                    image: resolved,
+                    problem: "no such file".to_owned(),
+                });
+            }
+        }
+        Ok(preset)
+    }
+
+    /// Parses and checks preset text. `file` names it in messages, and its folder is where
+    /// relative image paths resolve (use a path in the current folder for none).
+    ///
+    /// # Errors
+    /// [`PresetError::Parse`] or [`PresetError::Invalid`], naming `file`.
+    pub fn from_toml_str(text: &str, file: impl AsRef<Path>) -> Result<Self, PresetError> {
+        let file = file.as_ref().to_path_buf();
+        let mut preset: Self =
+            toml::from_str(text).map_err(|e| PresetError::Parse { file: file.clone(), message: e.to_string() })?;
+        preset.file = file;
+        preset.validate()?;
+        Ok(preset)
+    }
+
+    /// The preset as TOML (every field written out, so it doubles as documentation).
+    ///
+    /// # Errors
+    /// [`PresetError::Write`] if a value cannot be written (e.g. a non-finite number).
+    pub fn to_toml_string(&self) -> Result<String, PresetError> {
+        toml::to_string(self).map_err(|e| PresetError::Write(e.to_string()))
+    }
+
+    /// Writes the preset as TOML to `path` (e.g. from an authoring tool). Image paths are written
+    /// as they are, so keep them relative to the new file's folder.
+    ///
+    /// # Errors
+    /// [`PresetError::Write`] or [`PresetError::Io`] naming the file.
+    pub fn save(&self, path: impl AsRef<Path>) -> Result<(), PresetError> {
+        let path = path.as_ref();
+        let text = self.to_toml_string()?;
+        std::fs::write(path, text).map_err(|source| PresetError::Io { file: path.to_path_buf(), source })
+    }
+
+    /// The file this preset was read from (or a placeholder name).
+    #[must_use]
+    pub fn file(&self) -> &Path {
+        &self.file
+    }
+
+    /// Checks every value against its documented range.
+    ///
+    /// # Errors
+    /// The first problem as [`PresetError::Invalid`], naming the file and the key.
+    pub fn validate(&self) -> Result<(), PresetError> {
+        let invalid = |ParamError { key, problem }| PresetError::Invalid { file: self.file.clone(), key, problem };
+        let check = |ok: bool, key: &str, problem: String| {
+            if ok { Ok(()) } else { Err(invalid(ParamError { key: key.to_owned(), problem })) }
+        };
+        check(
+            (1..=MAX_LAYERS).contains(&self.layers),
+            "layers",
+            format!("must be between 1 and {MAX_LAYERS}, got {}", self.layers),
+        )?;
+        check(
+            self.length.is_finite() && self.length > 0.0 && self.length <= 2.0,
+            "length",
+            format!("must be above 0 and at most 2 (a fraction of the mesh's radius), got {}", self.length),
+        )?;
+        let direction = &self.direction;
+        check(
+            direction.random_angle_deg.is_finite() && (0.0..=80.0).contains(&direction.random_angle_deg),
+            "direction.random_angle_deg",
+            format!("must be between 0 and 80, got {}", direction.random_angle_deg),
+        )?;
+        check(
+            direction.comb.is_finite(),
+            "direction.comb",
+            format!("must be a finite vector, got {}", direction.comb),
+        )?;
+        check(
+            direction.comb_blend.is_finite() && (0.0..=1.0).contains(&direction.comb_blend),
+            "direction.comb_blend",
+            format!("must be between 0 and 1, got {}", direction.comb_blend),
+        )?;
+        self.texture.validate().map_err(invalid)?;
+        self.colour.validate().map_err(invalid)?;
+        self.simulation.validate().map_err(invalid)
+    }
+
+    /// The fur structure's parameters on `mesh`: the length scaled by its bounding-sphere radius.
+    #[must_use]
+    pub fn fur_params(&self, mesh: &Mesh) -> FurParams {
+        let radius = mesh.bounding_sphere().1;
+        FurParams {
+            layers: self.layers,
+            length: FurLength::Constant(self.length * radius),
+            direction: GrowthDirection {
+                random_angle_rad: self.direction.random_angle_deg.to_radians(),
+                seed: self.direction.seed,
+                comb: self.direction.comb,
+                comb_blend: self.direction.comb_blend,
+            },
+        }
+    }
+
+    /// Loads the images the preset refers to and generates its shell and fin textures.
+    ///
+    /// # Errors
+    /// [`PresetError`] for out-of-range values or an image that cannot be read, naming the key.
+    pub fn generate_textures(&self) -> Result<FurTextures, PresetError> {
+        self.validate()?;
+        let load = |key: &str, path: &Option<PathBuf>| -> Result<Option<ImageRgba8>, PresetError> {
+            let Some(path) = path else { return Ok(None) };
+            let image = self.resolve(path);
+            ImageRgba8::load(&image).map(Some).map_err(|problem| PresetError::Image {
+                file: self.file.clone(),
+                key: key.to_owned(),
+                image,
+                problem,
+            })
+        };
+        let inputs = TextureInputs {
+            pattern: load("texture.pattern", &self.texture.pattern)?,
+            gradient: match self.colour.mode {
+                ColourMode::Height => load("colour.gradient", &self.colour.gradient)?,
+                _ => None,
+            },
+            surface: match self.colour.mode {
+                ColourMode::Surface => load("colour.surface", &self.colour.surface)?,
+                _ => None,
+            },
+        };
+        texture::generate(self.layers, &self.texture, &self.colour, &inputs).map_err(|e| {
+            let (key, problem) = match e {
+                texture::TextureError::Param(ParamError { key, problem }) => (key, problem),
+                texture::TextureError::Layers { got } => {
+                    ("layers".to_owned(), format!("must be between 1 and {MAX_LAYERS}, got {got}"))
+                }
+                texture::TextureError::MissingImage { key, mode } => {
+                    (key.to_owned(), format!("{mode} mode needs this image, but none was given"))
+                }
+            };
+            PresetError::Invalid { file: self.file.clone(), key, problem }
+        })
+    }
+
+    /// `path` resolved against the preset file's folder.
+    #[must_use]
+    pub fn resolve(&self, path: &Path) -> PathBuf {
+        match self.file.parent() {
+            Some(folder) if path.is_relative() => folder.join(path),
+            _ => path.to_path_buf(),
+        }
+    }
+
+    /// The image paths the preset uses, with their keys (unused ones, e.g. a gradient outside
+    /// height mode, are left out).
+    fn image_paths(&self) -> Vec<(&'static str, &Path)> {
+        let mut paths = Vec::new();
+        if let Some(pattern) = &self.texture.pattern {
+            paths.push(("texture.pattern", pattern.as_path()));
+        }
+        if let (ColourMode::Height, Some(gradient)) = (self.colour.mode, &self.colour.gradient) {
+            paths.push(("colour.gradient", gradient.as_path()));
+        }
+        if let (ColourMode::Surface, Some(surface)) = (self.colour.mode, &self.colour.surface) {
+            paths.push(("colour.surface", surface.as_path()));
+        }
+        paths
+    }
+}

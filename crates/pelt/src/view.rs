@@ -31,6 +31,9 @@ pub struct Args {
     /// Where `--screenshot-after` writes its PNG.
     #[arg(long, value_name = "FILE.png", requires = "screenshot_after")]
     pub out: Option<PathBuf>,
+    /// A fur preset (TOML) to start from; the panel edits it, Save writes it back.
+    #[arg(long, value_name = "P")]
+    pub preset: Option<PathBuf>,
     /// Play a scene script (the simulation's TOML: wind keys and touch strokes in world
     /// coordinates) on the simulation clock.
     #[arg(long, value_name = "SCENE.toml")]

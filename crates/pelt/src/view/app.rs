@@ -6,9 +6,8 @@ use std::time::Instant;
 
 use anyhow::Context as _;
 use glam::{Vec2, Vec3};
-use pelt_core::fur::FurLength;
 use pelt_core::sim::{Scene, Simulation};
-use pelt_core::{Builtin, FurParams, FurStructure, GrowthDirection, Mesh, SeparatedStructure};
+use pelt_core::{Builtin, FurStructure, FurTextures, Mesh, Preset, PresetError, SeparatedStructure};
 use winit::application::ApplicationHandler;
 use winit::event::WindowEvent;
 use winit::event_loop::ActiveEventLoop;
@@ -17,7 +16,7 @@ use winit::window::{Window, WindowId};
 use super::Args;
 use super::camera::OrbitCamera;
 use super::capture::FrameCopy;
-use super::fur::{FurView, interim_textures};
+use super::fur::FurView;
 use super::gpu::{self, Acquired, WindowSurface};
 use super::panel::{self, Changes, MeshChoice, Requests, Settings};
 use super::viewport::Viewport;
@@ -84,6 +83,12 @@ struct Model {
     touch: Option<TouchDrag>,
     /// Wind strength W restores after turning the wind off.
     wind_strength_on: f32,
+    /// Textures made and not yet uploaded.
+    textures: Option<FurTextures>,
+    /// Texture generation runs off the UI thread, so sliders stay smooth.
+    texture_job: Option<std::thread::JoinHandle<Result<FurTextures, PresetError>>>,
+    /// The preset changed while a job ran: start another when it ends.
+    textures_stale: bool,
     frames_drawn: u32,
     skipped_frames: u32,
     screenshots_saved: u32,
@@ -130,10 +135,16 @@ impl App {
             (None, Some(name)) => (MeshChoice::Builtin(Builtin::from_name(name).unwrap_or(Builtin::Bunny)), None),
             (None, None) => (MeshChoice::Builtin(Builtin::Bunny), None),
         };
-        let mut settings = Settings::new(choice);
+        let (preset, preset_path) = match &args.preset {
+            Some(path) => (Preset::load(path)?, path.display().to_string()),
+            None => (Preset::default(), "fur.toml".to_owned()),
+        };
+        let mut settings = Settings::new(choice, preset, preset_path);
         settings.overlay = !args.no_overlay;
-        let structure = grow(mesh, &settings)?;
-        let sim = Simulation::new(&structure, &settings.sim)?;
+        let structure = grow(mesh, &settings.preset)?;
+        let sim = Simulation::new(&structure, &settings.preset.simulation)?;
+        // The first textures are made before the window opens, so the first frame has them.
+        let textures = settings.preset.generate_textures()?;
         let scene = match &args.script {
             Some(path) => Some(Scene::load(path)?),
             None => None,
@@ -156,6 +167,9 @@ impl App {
             sim_time_secs: 0.0,
             touch: None,
             wind_strength_on: 1.0,
+            textures: Some(textures),
+            texture_job: None,
+            textures_stale: false,
             frames_drawn: 0,
             skipped_frames: 0,
             screenshots_saved: 0,
@@ -208,7 +222,8 @@ impl App {
         let mut egui_renderer =
             egui_wgpu::Renderer::new(&gpu.device, surface.config.format, egui_wgpu::RendererOptions::default());
         let viewport = Viewport::new(&gpu.device, &mut egui_renderer, [1, 1])?;
-        let mut fur = FurView::new(&gpu, &self.model.structure, &interim_textures(16))?;
+        let textures = self.model.textures.take().context("the first textures were made before the window")?;
+        let mut fur = FurView::new(&gpu, &self.model.structure, &textures)?;
         fur.set_body(&gpu, self.model.body.as_ref())?;
         Ok(Running { window, gpu, surface, egui_ctx, egui_state, egui_renderer, viewport, fur, visible: true })
     }
@@ -237,16 +252,31 @@ impl App {
         textures_delta.clear();
         running.egui_state.handle_platform_output(&running.window, full_output.platform_output);
         outcome.2?;
-        if model.apply(outcome.0)? {
-            running.fur.set_structure(&running.gpu, &model.structure)?;
-            running.fur.set_body(&running.gpu, model.body.as_ref())?;
+        let (mut changes, requests) = (outcome.0, outcome.1);
+        if requests.load_preset {
+            changes.merge(model.load_preset());
+        }
+        if requests.save_preset {
+            model.save_preset();
+        }
+        // A bad value from the panel is reported, not fatal: the previous fur stays.
+        match model.apply(changes) {
+            Ok(true) => {
+                running.fur.set_structure(&running.gpu, &model.structure)?;
+                running.fur.set_body(&running.gpu, model.body.as_ref())?;
+            }
+            Ok(false) => {}
+            Err(error) => model.status = format!("{error:#}"),
+        }
+        if let Some(textures) = model.poll_textures() {
+            running.fur.set_textures(&running.gpu, &textures)?;
         }
         model.simulate(frame_secs)?;
         running.fur.set_positions(&running.gpu, model.sim.positions())?;
-        if outcome.1.screenshot {
+        if requests.screenshot {
             model.screenshot_pending = true;
         }
-        if outcome.1.frame {
+        if requests.frame {
             model.frame_pending = true;
         }
 
@@ -405,6 +435,7 @@ impl Model {
         let shortcuts = self.shortcuts(ui.ctx());
         outcome.1.frame |= shortcuts.frame;
         outcome.1.screenshot |= shortcuts.screenshot;
+        outcome.1.save_preset |= shortcuts.save_preset;
         if !self.panel_hidden {
             egui::Panel::right("settings").resizable(true).default_size(320.0).min_size(260.0).show(ui, |ui| {
                 outcome = panel::show(ui, &mut self.settings, &self.mesh_choices, &self.status);
@@ -445,7 +476,7 @@ impl Model {
                 }
             }
             if input.consume_key(none, egui::Key::W) {
-                let wind = &mut settings.sim.wind;
+                let wind = &mut settings.preset.simulation.wind;
                 if wind.strength > 0.0 {
                     self.wind_strength_on = wind.strength;
                     wind.strength = 0.0;
@@ -460,10 +491,14 @@ impl Model {
             if input.consume_key(none, egui::Key::CloseBracket) {
                 settings.brush_per_radius = (settings.brush_per_radius * 1.25).min(1.0);
             }
+            if input.consume_key(none, egui::Key::U) {
+                settings.draw.unified = !settings.draw.unified;
+            }
             if input.consume_key(none, egui::Key::H) {
                 self.panel_hidden = !self.panel_hidden;
             }
             outcome.screenshot = input.consume_key(command, egui::Key::P);
+            outcome.save_preset = input.consume_key(command, egui::Key::S);
             self.quit |= input.consume_key(command, egui::Key::Q);
         });
         outcome
@@ -474,6 +509,7 @@ impl Model {
 struct ShortcutOutcome {
     frame: bool,
     screenshot: bool,
+    save_preset: bool,
     simulation: bool,
 }
 
@@ -631,6 +667,53 @@ impl Model {
         self.camera.frame(center, (radius + longest) * context, aspect);
     }
 
+    /// Starts texture generation when the preset changed and none runs; hands over finished
+    /// textures.
+    fn poll_textures(&mut self) -> Option<FurTextures> {
+        let mut done = None;
+        if self.texture_job.as_ref().is_some_and(std::thread::JoinHandle::is_finished)
+            && let Some(job) = self.texture_job.take()
+        {
+            match job.join() {
+                Ok(Ok(textures)) => {
+                    self.status.clear();
+                    done = Some(textures);
+                }
+                Ok(Err(error)) => self.status = error.to_string(),
+                Err(_) => self.status = "texture generation failed unexpectedly".to_owned(),
+            }
+        }
+        if self.texture_job.is_none() && self.textures_stale {
+            self.textures_stale = false;
+            let preset = self.settings.preset.clone();
+            self.texture_job = Some(std::thread::spawn(move || preset.generate_textures()));
+            self.status = "making textures…".to_owned();
+        }
+        done
+    }
+
+    /// Reads the preset file named in the panel; everything it sets changes.
+    fn load_preset(&mut self) -> Changes {
+        match Preset::load(&self.settings.preset_path) {
+            Ok(preset) => {
+                self.settings.preset = preset;
+                self.status = format!("loaded {}", self.settings.preset_path);
+                Changes { structure: true, textures: true, simulation: true, ..Changes::default() }
+            }
+            Err(error) => {
+                self.status = error.to_string();
+                Changes::default()
+            }
+        }
+    }
+
+    fn save_preset(&mut self) {
+        self.status = match self.settings.preset.save(&self.settings.preset_path) {
+            Ok(()) => format!("saved {}", self.settings.preset_path),
+            Err(error) => error.to_string(),
+        };
+    }
+
     /// Plays the script and steps the simulation to this frame's time.
     fn simulate(&mut self, frame_secs: f64) -> anyhow::Result<()> {
         if !self.settings.simulate {
@@ -659,17 +742,20 @@ impl Model {
                 }
                 MeshChoice::File(_) => self.file_mesh.clone().context("the command-line mesh is gone")?,
             };
-            self.structure = grow(mesh, &self.settings)?;
+            self.structure = grow(mesh, &self.settings.preset)?;
             self.frame_pending = true;
         } else if changes.structure {
-            self.structure = grow(self.structure.mesh.clone(), &self.settings)?;
+            self.structure = grow(self.structure.mesh.clone(), &self.settings.preset)?;
         }
         let rebuilt = changes.mesh || changes.structure;
         if rebuilt {
-            self.sim = Simulation::new(&self.structure, &self.settings.sim)?;
+            self.sim = Simulation::new(&self.structure, &self.settings.preset.simulation)?;
             self.touch = None;
         } else if changes.simulation {
-            self.sim.set_params(&self.settings.sim)?;
+            self.sim.set_params(&self.settings.preset.simulation)?;
+        }
+        if changes.textures {
+            self.textures_stale = true;
         }
         Ok(rebuilt)
     }
@@ -688,18 +774,8 @@ fn try_on_scene() -> anyhow::Result<(Mesh, Mesh)> {
 }
 
 /// Grows the rest pose of the fur on `mesh`.
-fn grow(mesh: Mesh, settings: &Settings) -> anyhow::Result<FurStructure> {
-    let radius = mesh.bounding_sphere().1;
-    let params = FurParams {
-        layers: settings.layers,
-        length: FurLength::Constant(settings.length_per_radius * radius),
-        direction: GrowthDirection {
-            random_angle_rad: settings.random_angle_deg.to_radians(),
-            seed: settings.direction_seed,
-            comb: settings.comb,
-            comb_blend: settings.comb_blend,
-        },
-    };
+fn grow(mesh: Mesh, preset: &Preset) -> anyhow::Result<FurStructure> {
+    let params = preset.fur_params(&mesh);
     Ok(FurStructure::new(mesh, &params)?)
 }
 
@@ -772,10 +848,10 @@ mod tests {
     fn growing_scales_the_length_with_the_mesh() {
         let (mesh, _) = Builtin::Sphere.mesh();
         let radius = mesh.bounding_sphere().1;
-        let mut settings = Settings::new(MeshChoice::Builtin(Builtin::Sphere));
-        settings.length_per_radius = 0.25;
-        let fur = grow(mesh, &settings).unwrap();
+        let mut preset = Preset::default();
+        preset.length = 0.25;
+        let fur = grow(mesh, &preset).unwrap();
         assert!(fur.lengths.iter().all(|l| (l - 0.25 * radius).abs() < 1e-5));
-        assert_eq!(fur.layers, settings.layers);
+        assert_eq!(fur.layers, preset.layers);
     }
 }

@@ -36,7 +36,6 @@ impl FurView {
         Ok(self.renderer.set_structure(&gpu.device, structure)?)
     }
 
-    #[allow(dead_code, reason = "the panel regenerates textures once the preset's generator lands here")]
     pub fn set_textures(&mut self, gpu: &pelt_render::Gpu, textures: &FurTextures) -> anyhow::Result<()> {
         self.separated = None;
         self.textures = textures.clone();
@@ -95,38 +94,4 @@ impl FurView {
             None => self.renderer.render(&gpu.queue, encoder, targets, output, &camera, &self.settings),
         }
     }
-}
-
-/// A plain seeded strand field (round tapering strands, brown roots to light tips), drawn until
-/// the preset's own textures are wired in.
-pub fn interim_textures(layers: u32) -> FurTextures {
-    const SIZE: u32 = 64;
-    let mut shell = vec![0_u8; (SIZE * SIZE * layers * 4) as usize];
-    let mut fin = vec![0_u8; (SIZE * layers * 4) as usize];
-    for y in 0..SIZE {
-        for x in 0..SIZE {
-            let bits = pelt_core::rng::hash(7, u64::from(x), u64::from(y), 0);
-            if pelt_core::rng::unit_f32(bits) > 0.3 {
-                continue;
-            }
-            let length = 0.6 + 0.4 * pelt_core::rng::unit_f32(pelt_core::rng::mix64(bits));
-            for k in 0..layers {
-                let height = (k + 1) as f32 / layers as f32;
-                if height > length {
-                    break;
-                }
-                let shade = (90.0 + 140.0 * height) as u8;
-                let texel = [shade, (f32::from(shade) * 0.75) as u8, (f32::from(shade) * 0.5) as u8, 255];
-                let at = (((k * SIZE + y) * SIZE + x) * 4) as usize;
-                shell[at..at + 4].copy_from_slice(&texel);
-                if y == 0 {
-                    // Fin rows run from the tips (row 0) down to the roots.
-                    let row = layers - 1 - k;
-                    let at = ((row * SIZE + x) * 4) as usize;
-                    fin[at..at + 4].copy_from_slice(&texel);
-                }
-            }
-        }
-    }
-    FurTextures { size: SIZE, layers, shell, fin_width: SIZE, fin_height: layers, fin }
 }
