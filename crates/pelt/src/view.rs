@@ -57,9 +57,10 @@ fn parse_size(text: &str) -> Result<[u32; 2], String> {
 
 pub fn run(args: &Args) -> anyhow::Result<()> {
     let (mesh, report) = args.mesh.load(pelt_core::Builtin::Bunny)?;
+    // Files and presets are checked before the display is opened, so their errors come first.
+    let mut app = app::App::new(args, mesh, report.source)?;
     let event_loop = winit::event_loop::EventLoop::new()
         .context("opening the display (is DISPLAY or WAYLAND_DISPLAY set? under CI use xvfb-run)")?;
-    let mut app = app::App::new(args, mesh, report.source)?;
     event_loop.run_app(&mut app).context("running the window's event loop")?;
     app.finish()
 }

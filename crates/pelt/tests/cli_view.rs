@@ -95,11 +95,16 @@ fn a_scripted_touch_flattens_the_fur_where_it_presses_and_nowhere_else() {
          path = [[0.0, 0.0, 0.0], [0.7, 0.0, 0.0], [0.7, 0.0, 0.0], [0.7, 0.0, 0.0]]\n",
     )
     .unwrap();
+    // Long upright fur, so a pat shows plainly.
+    let preset = Path::new(env!("CARGO_TARGET_TMPDIR")).join("cli_view_touch_preset.toml");
+    std::fs::write(&preset, "length = 0.2\n[direction]\nrandom_angle_deg = 0.0\ncomb_blend = 0.0\n").unwrap();
+    let preset = preset.to_str().unwrap();
     let frames = 60;
     // Without the overlay, so only the fur can differ (not the timings or the brush).
-    let untouched = screenshot("untouched", frames, &["--builtin", "plane", "--no-overlay"]);
+    let base = ["--builtin", "plane", "--no-overlay", "--preset", preset];
+    let untouched = screenshot("untouched", frames, &base);
     let script = script.to_str().unwrap();
-    let touched = screenshot("touched", frames, &["--builtin", "plane", "--no-overlay", "--script", script]);
+    let touched = screenshot("touched", frames, &[&base[..], &["--script", script]].concat());
     let view_centre = ((WIDTH_PX - PANEL_PX) / 2, HEIGHT_PX / 2);
     let around = |half: u32, dy: i32| {
         let y = (view_centre.1 as i32 + dy) as u32;
@@ -115,4 +120,19 @@ fn a_scripted_touch_flattens_the_fur_where_it_presses_and_nowhere_else() {
     assert!(background < 0.5, "the background is untouched: {background:.2}");
     let panel = mean_difference(&untouched, &touched, (WIDTH_PX - PANEL_PX + 4, 0, WIDTH_PX, HEIGHT_PX));
     assert!(panel < 0.5, "the panel looks the same: {panel:.2}");
+}
+
+#[test]
+fn a_missing_preset_or_script_is_named_before_any_window_opens() {
+    for (flag, file) in [("--preset", "no-such-preset.toml"), ("--script", "no-such-scene.toml")] {
+        let output = Command::new(env!("CARGO_BIN_EXE_pelt"))
+            .args(["view", "--builtin", "box", flag, file])
+            .env_remove("DISPLAY")
+            .env_remove("WAYLAND_DISPLAY")
+            .output()
+            .unwrap();
+        assert!(!output.status.success());
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert!(stderr.contains(file), "{flag}: the error names the file: {stderr}");
+    }
 }
