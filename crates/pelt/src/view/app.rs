@@ -438,7 +438,9 @@ impl Model {
         outcome.1.save_preset |= shortcuts.save_preset;
         if !self.panel_hidden {
             egui::Panel::right("settings").resizable(true).default_size(320.0).min_size(260.0).show(ui, |ui| {
-                outcome = panel::show(ui, &mut self.settings, &self.mesh_choices, &self.status);
+                let (changes, requests) = panel::show(ui, &mut self.settings, &self.mesh_choices, &self.status);
+                outcome.0.merge(changes);
+                outcome.1.merge(requests);
             });
         }
         outcome.0.simulation |= shortcuts.simulation;

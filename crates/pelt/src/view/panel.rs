@@ -121,6 +121,15 @@ pub struct Requests {
     pub load_preset: bool,
 }
 
+impl Requests {
+    pub fn merge(&mut self, other: Self) {
+        self.frame |= other.frame;
+        self.screenshot |= other.screenshot;
+        self.save_preset |= other.save_preset;
+        self.load_preset |= other.load_preset;
+    }
+}
+
 /// Draws the panel's contents; returns what changed and what was asked for.
 pub fn show(
     ui: &mut egui::Ui,
@@ -343,13 +352,13 @@ fn gradient_editor(ui: &mut egui::Ui, stops: &mut Vec<Rgb>) {
         ui.horizontal(|ui| {
             ui.color_edit_button_srgb(&mut stop.0);
             ui.monospace(stop.to_string());
-            if ui.add_enabled(i > 0, egui::Button::new("↑").small()).clicked() {
+            if ui.add_enabled(i > 0, egui::Button::new("^").small()).on_hover_text("toward the root").clicked() {
                 swap = Some(i - 1);
             }
-            if ui.add_enabled(i + 1 < count, egui::Button::new("↓").small()).clicked() {
+            if ui.add_enabled(i + 1 < count, egui::Button::new("v").small()).on_hover_text("toward the tip").clicked() {
                 swap = Some(i);
             }
-            if ui.add_enabled(count > 2, egui::Button::new("✖").small()).clicked() {
+            if ui.add_enabled(count > 2, egui::Button::new("x").small()).on_hover_text("remove").clicked() {
                 remove = Some(i);
             }
         });
