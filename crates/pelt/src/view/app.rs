@@ -837,6 +837,77 @@ fn draw_egui(
 mod tests {
     use super::*;
 
+    fn model(args: &[&str]) -> Model {
+        #[derive(clap::Parser)]
+        struct Wrapper {
+            #[command(flatten)]
+            args: Args,
+        }
+        let wrapper = <Wrapper as clap::Parser>::parse_from([&["view"], args].concat());
+        let (mesh, report) = wrapper.args.mesh.load(Builtin::Bunny).unwrap();
+        App::new(&wrapper.args, mesh, report.source).unwrap().model
+    }
+
+    /// One panel pass with `key` pressed.
+    fn press(model: &mut Model, key: egui::Key, modifiers: egui::Modifiers) -> (Changes, Requests) {
+        let ctx = egui::Context::default();
+        let screen = egui::Rect::from_min_size(egui::Pos2::ZERO, egui::vec2(1000.0, 700.0));
+        let events = vec![
+            egui::Event::ModifiersChanged(modifiers),
+            egui::Event::Key { key, physical_key: None, pressed: true, repeat: false, modifiers },
+        ];
+        let input = egui::RawInput { screen_rect: Some(screen), events, ..egui::RawInput::default() };
+        let mut outcome = None;
+        let mut output = ctx.run_ui(input, |ui| outcome = Some(model.ui(ui, egui::TextureId::default())));
+        // No GPU here: the font atlas is not uploaded anywhere.
+        output.textures_delta.clear();
+        let (changes, requests, result) = outcome.unwrap();
+        result.unwrap();
+        (changes, requests)
+    }
+
+    #[test]
+    fn shortcuts_reach_the_app_with_the_panel_shown() {
+        let mut model = model(&["--builtin", "box"]);
+        let none = egui::Modifiers::NONE;
+        assert!(press(&mut model, egui::Key::S, egui::Modifiers::COMMAND).1.save_preset);
+        assert!(press(&mut model, egui::Key::P, egui::Modifiers::COMMAND).1.screenshot);
+        assert!(press(&mut model, egui::Key::F, none).1.frame);
+        let (changes, _) = press(&mut model, egui::Key::Space, none);
+        assert!(changes.simulation && !model.settings.simulate);
+        press(&mut model, egui::Key::U, none);
+        assert!(!model.settings.draw.unified);
+        let (changes, _) = press(&mut model, egui::Key::W, none);
+        assert!(changes.simulation && model.settings.preset.simulation.wind.strength > 0.0);
+        press(&mut model, egui::Key::W, none);
+        assert_eq!(model.settings.preset.simulation.wind.strength, 0.0);
+        let brush = model.settings.brush_per_radius;
+        press(&mut model, egui::Key::CloseBracket, none);
+        assert!(model.settings.brush_per_radius > brush);
+        press(&mut model, egui::Key::H, none);
+        assert!(model.panel_hidden);
+        // Plain keys do nothing while they type into a text field; here none is focused.
+        press(&mut model, egui::Key::Q, egui::Modifiers::COMMAND);
+        assert!(model.quit);
+    }
+
+    #[test]
+    fn panel_changes_rebuild_only_what_they_touch() {
+        let mut model = model(&["--builtin", "sphere"]);
+        let before = model.structure.positions.clone();
+        assert!(!model.apply(Changes { simulation: true, ..Changes::default() }).unwrap());
+        assert!(!model.textures_stale, "a simulation change makes no textures");
+        model.settings.preset.length *= 2.0;
+        assert!(model.apply(Changes { structure: true, ..Changes::default() }).unwrap());
+        assert_ne!(model.structure.positions, before);
+        assert_eq!(model.sim.positions().len(), model.structure.positions.len());
+        assert!(!model.apply(Changes { textures: true, ..Changes::default() }).unwrap());
+        assert!(model.textures_stale);
+        model.settings.mesh = MeshChoice::TryOn;
+        assert!(model.apply(Changes { mesh: true, ..Changes::default() }).unwrap());
+        assert!(model.body.is_some() && model.frame_pending);
+    }
+
     #[test]
     fn overlay_numbers_read_well() {
         assert_eq!(thousands(0), "0");
