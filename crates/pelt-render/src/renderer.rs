@@ -74,7 +74,7 @@ impl Default for RenderSettings {
             specular: 0.2,
             shininess: 40.0,
             root_occlusion: 0.3,
-            fin_fade_cos: 0.2,
+            fin_fade_cos: 0.1,
             shell_fade_cos: 0.25,
             tiles_per_radius: 0.4,
             background: Vec3::new(0.045, 0.05, 0.06),
@@ -97,8 +97,10 @@ struct GlobalsUniform {
     shell_fade_cos: f32,
     root_occlusion: f32,
     shininess: f32,
+    has_surface: u32,
+    _padding: [u32; 3],
 }
-const _: () = assert!(size_of::<GlobalsUniform>() == 144, "matches `Globals` in shading.wgsl");
+const _: () = assert!(size_of::<GlobalsUniform>() == 160, "matches `Globals` in shading.wgsl");
 
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
@@ -328,6 +330,7 @@ impl Renderer {
                 layout_entry(2, texture_binding(wgpu::TextureViewDimension::D2)),
                 layout_entry(3, wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering)),
                 layout_entry(4, wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering)),
+                layout_entry(5, texture_binding(wgpu::TextureViewDimension::D2)),
             ],
         });
         let storage = wgpu::BindingType::Buffer {
@@ -498,6 +501,8 @@ impl Renderer {
             shell_fade_cos: settings.shell_fade_cos.max(1e-3),
             root_occlusion: settings.root_occlusion,
             shininess: settings.shininess,
+            has_surface: u32::from(self.textures.has_surface),
+            _padding: [0; 3],
         };
         queue.write_buffer(&self.globals, 0, bytemuck::bytes_of(&globals));
         let tiles_per_radius = settings.tiles_per_radius;
@@ -720,6 +725,7 @@ fn globals_bind_group(
             wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::TextureView(&textures.fin) },
             wgpu::BindGroupEntry { binding: 3, resource: wgpu::BindingResource::Sampler(shell_sampler) },
             wgpu::BindGroupEntry { binding: 4, resource: wgpu::BindingResource::Sampler(fin_sampler) },
+            wgpu::BindGroupEntry { binding: 5, resource: wgpu::BindingResource::TextureView(&textures.surface) },
         ],
     })
 }

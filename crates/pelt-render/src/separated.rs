@@ -46,8 +46,10 @@ struct SeparatedUniform {
     layers: u32,
     shell_slices: u32,
     has_uvs: u32,
+    world_per_uv: f32,
+    _padding: [u32; 3],
 }
-const _: () = assert!(size_of::<SeparatedUniform>() == 16, "matches `Separated` in separated.wgsl");
+const _: () = assert!(size_of::<SeparatedUniform>() == 32, "matches `Separated` in separated.wgsl");
 
 /// Draws the separated structure with the unified renderer's textures, globals and skin.
 #[derive(Debug)]
@@ -66,6 +68,7 @@ pub struct SeparatedRenderer {
     index_count: u32,
     layers: u32,
     has_uvs: bool,
+    world_per_uv: f32,
     radius: f32,
     shell_slices: u32,
     gpu_bytes: u64,
@@ -207,6 +210,7 @@ impl SeparatedRenderer {
             index_count: indices.len() as u32,
             layers: fur.layers,
             has_uvs: mesh.corner_uvs.is_some(),
+            world_per_uv,
             radius: mesh.bounding_sphere().1.max(1e-6),
             shell_slices: textures.layers,
             gpu_bytes,
@@ -235,6 +239,8 @@ impl SeparatedRenderer {
             layers: self.layers,
             shell_slices: self.shell_slices,
             has_uvs: u32::from(self.has_uvs),
+            world_per_uv: self.world_per_uv,
+            _padding: [0; 3],
         };
         queue.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&uniform));
         // The unified renderer draws the skin (and plain meshes) and sets the globals.

@@ -8,6 +8,11 @@ struct Separated {
     layers: u32,
     shell_slices: u32,
     has_uvs: u32,
+    // World units per uv unit: recovers the mesh uv for surface colour.
+    world_per_uv: f32,
+    padding_0: u32,
+    padding_1: u32,
+    padding_2: u32,
 }
 
 @group(1) @binding(0) var<uniform> separated: Separated;
@@ -34,6 +39,7 @@ fn vs_separated_shell(in: VertexIn, @builtin(instance_index) layer: u32) -> Vary
     out.tangent = in.normal;
     out.tile_position = in.position * separated.tiles_per_world;
     out.uv = in.uv * separated.tiles_per_world;
+    out.surface_uv = in.uv / separated.world_per_uv;
     out.layer = layer;
     out.slice = i32(((max(layer, 1u) - 1u) * separated.shell_slices) / max(separated.layers, 1u));
     out.height = f32(layer) / f32(max(separated.layers, 1u));
@@ -52,6 +58,8 @@ fn vs_separated_fin(in: VertexIn) -> Varyings {
     out.uv = vec2<f32>(in.uv.x * separated.tiles_per_world, in.uv.y);
     out.layer = 0u;
     out.slice = 0;
+    // Separated fins keep no mesh uv: surface colour mode tints them with the texture's corner.
+    out.surface_uv = vec2<f32>(0.0);
     out.height = in.uv.y;
     // Lengyel's fade: a fin shows where it faces the viewer, i.e. stands on a silhouette edge.
     let to_camera = safe_normalize(globals.camera_position - in.position, in.normal);
@@ -72,6 +80,6 @@ fn fs_separated_fin(in: Varyings) -> @location(0) vec4<f32> {
     let texel = textureSample(fin_texture, fin_sampler, vec2<f32>(in.uv.x, 1.0 - in.uv.y));
     let normal = normalize(in.normal);
     let tangent = safe_normalize(up, normal);
-    let colour = hair_lighting(texel.rgb, tangent, tangent, in.world_position, in.height);
+    let colour = hair_lighting(texel.rgb * surface_tint(in.surface_uv), tangent, tangent, in.world_position, in.height);
     return fur_output(colour, texel.a * in.fade);
 }

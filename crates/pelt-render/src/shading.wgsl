@@ -20,6 +20,11 @@ struct Globals {
     // Light left at the roots by self-shadowing (1 = none).
     root_occlusion: f32,
     shininess: f32,
+    // 1 when strand colours are grey brightness to be multiplied by the surface texture.
+    has_surface: u32,
+    padding_0: u32,
+    padding_1: u32,
+    padding_2: u32,
 }
 
 @group(0) @binding(0) var<uniform> globals: Globals;
@@ -27,6 +32,8 @@ struct Globals {
 @group(0) @binding(2) var fin_texture: texture_2d<f32>;
 @group(0) @binding(3) var shell_sampler: sampler;
 @group(0) @binding(4) var fin_sampler: sampler;
+// The mesh's colour texture (surface colour mode), else 1x1 white.
+@group(0) @binding(5) var surface_texture: texture_2d<f32>;
 
 struct Varyings {
     @builtin(position) clip_position: vec4<f32>,
@@ -47,6 +54,8 @@ struct Varyings {
     @location(7) fade: f32,
     // Shell texture slice.
     @location(8) @interpolate(flat) slice: i32,
+    // The mesh uv at the strand's root (surface colour mode).
+    @location(9) surface_uv: vec2<f32>,
 }
 
 fn safe_normalize(v: vec3<f32>, fallback: vec3<f32>) -> vec3<f32> {
@@ -112,6 +121,12 @@ fn shell_texel(in: Varyings) -> vec4<f32> {
     return x * weights.x + y * weights.y + z * weights.z;
 }
 
+// Surface colour mode: the mesh's texture at the strand's root tints the strand's brightness.
+fn surface_tint(uv: vec2<f32>) -> vec3<f32> {
+    let colour = textureSample(surface_texture, shell_sampler, uv).rgb;
+    return select(vec3<f32>(1.0), colour, globals.has_surface != 0u);
+}
+
 fn fur_output(colour: vec3<f32>, alpha: f32) -> vec4<f32> {
     if globals.alpha_to_coverage != 0u {
         return vec4<f32>(colour, alpha);
@@ -123,7 +138,8 @@ fn fur_output(colour: vec3<f32>, alpha: f32) -> vec4<f32> {
 @fragment
 fn fs_skin(in: Varyings) -> @location(0) vec4<f32> {
     let normal = normalize(in.normal);
-    let colour = surface_lighting(globals.root_colour.rgb, normal) * globals.root_occlusion;
+    let albedo = globals.root_colour.rgb * surface_tint(in.surface_uv);
+    let colour = surface_lighting(albedo, normal) * globals.root_occlusion;
     return vec4<f32>(colour, 1.0);
 }
 
@@ -132,7 +148,8 @@ fn fs_shell(in: Varyings) -> @location(0) vec4<f32> {
     let texel = shell_texel(in);
     let alpha = texel.a * in.fade;
     let normal = normalize(in.normal);
-    let colour = hair_lighting(texel.rgb, normalize(in.tangent), normal, in.world_position, in.height);
+    let albedo = texel.rgb * surface_tint(in.surface_uv);
+    let colour = hair_lighting(albedo, normalize(in.tangent), normal, in.world_position, in.height);
     return fur_output(colour, alpha);
 }
 
@@ -142,10 +159,11 @@ fn fs_fin(in: Varyings) -> @location(0) vec4<f32> {
     let texel = textureSample(fin_texture, fin_sampler, vec2<f32>(in.uv.x, 1.0 - in.uv.y));
     // Several fins overlap along a silhouette; thinning them keeps the fringe from reading as a
     // solid band, most of all at the roots where the shells already cover.
-    let alpha = texel.a * in.fade * mix(0.35, 0.8, in.height);
+    let alpha = texel.a * in.fade * mix(0.15, 0.6, in.height);
     let normal = normalize(in.normal);
     // Seen from the side the roots are less hidden than from above: lift the occlusion.
     let height = sqrt(in.height);
-    let colour = hair_lighting(texel.rgb, normalize(in.tangent), normal, in.world_position, height);
+    let albedo = texel.rgb * surface_tint(in.surface_uv);
+    let colour = hair_lighting(albedo, normalize(in.tangent), normal, in.world_position, height);
     return fur_output(colour, alpha);
 }

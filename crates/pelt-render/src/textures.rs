@@ -1,7 +1,8 @@
 //! Uploading [`FurTextures`]: the shell slices as one 2D array texture and the fin texture, both
-//! with mipmaps so distant fur averages out instead of sparkling.
+//! with mipmaps (pelt-core's alpha-weighted filter) so distant fur averages out instead of
+//! sparkling.
 
-use pelt_core::texture::FurTextures;
+use pelt_core::texture::{FurTextures, downsample_rgba8};
 
 use crate::RenderError;
 
@@ -11,6 +12,9 @@ pub(crate) struct GpuTextures {
     pub shell: wgpu::TextureView,
     pub fin: wgpu::TextureView,
     pub shell_slices: u32,
+    /// The mesh's colour texture (surface colour mode), else 1x1 white.
+    pub surface: wgpu::TextureView,
+    pub has_surface: bool,
     /// Alpha-weighted mean strand colour of the root slice, linear RGB.
     pub root_colour: glam::Vec3,
 }
@@ -32,7 +36,21 @@ impl GpuTextures {
             ..wgpu::TextureViewDescriptor::default()
         });
         let fin = fin.create_view(&wgpu::TextureViewDescriptor::default());
-        Ok(Self { shell, fin, shell_slices: textures.layers, root_colour: root_colour(textures, slice_bytes) })
+        let white = [255_u8; 4];
+        let (surface_size, surface_pixels): ((u32, u32), &[u8]) = match &textures.surface {
+            Some(image) => ((image.width, image.height), &image.pixels),
+            None => ((1, 1), &white),
+        };
+        let surface = upload(device, queue, "pelt surface colour", surface_size, vec![surface_pixels])
+            .create_view(&wgpu::TextureViewDescriptor::default());
+        Ok(Self {
+            shell,
+            fin,
+            shell_slices: textures.layers,
+            surface,
+            has_surface: textures.surface.is_some(),
+            root_colour: root_colour(textures, slice_bytes),
+        })
     }
 }
 
@@ -51,6 +69,17 @@ fn validate(textures: &FurTextures) -> Result<(), RenderError> {
     let fin_bytes = textures.fin_width as usize * textures.fin_height as usize * 4;
     if textures.fin.len() != fin_bytes {
         return bad(format!("fin has {} bytes, expected {fin_bytes}", textures.fin.len()));
+    }
+    if let Some(surface) = &textures.surface {
+        let bytes = surface.width as usize * surface.height as usize * 4;
+        if surface.width == 0 || surface.height == 0 || surface.pixels.len() != bytes {
+            return bad(format!(
+                "surface image {}x{} has {} bytes",
+                surface.width,
+                surface.height,
+                surface.pixels.len()
+            ));
+        }
     }
     Ok(())
 }
@@ -89,36 +118,11 @@ fn upload(
                 wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(4 * w), rows_per_image: Some(h) },
                 wgpu::Extent3d { width: w, height: h, depth_or_array_layers: 1 },
             );
-            (level, w, h) = downsample(&level, w, h);
+            level = downsample_rgba8(&level, w, h, 1);
+            (w, h) = ((w / 2).max(1), (h / 2).max(1));
         }
     }
     texture
-}
-
-/// Halves an RGBA8 image (wrapping, as the tiles do). Colour is averaged weighted by alpha so
-/// the empty space between strands does not darken them.
-fn downsample(texels: &[u8], width: u32, height: u32) -> (Vec<u8>, u32, u32) {
-    let (w, h) = ((width / 2).max(1), (height / 2).max(1));
-    let mut out = Vec::with_capacity((w * h * 4) as usize);
-    for y in 0..h {
-        for x in 0..w {
-            let mut sum = [0.0_f32; 4];
-            for (dx, dy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
-                let (sx, sy) = ((2 * x + dx) % width, (2 * y + dy) % height);
-                let k = ((sy * width + sx) * 4) as usize;
-                let alpha = f32::from(texels[k + 3]);
-                for c in 0..3 {
-                    sum[c] += f32::from(texels[k + c]) * alpha;
-                }
-                sum[3] += alpha;
-            }
-            for c in 0..3 {
-                out.push(if sum[3] > 0.0 { (sum[c] / sum[3]).round() as u8 } else { 0 });
-            }
-            out.push((sum[3] / 4.0).round() as u8);
-        }
-    }
-    (out, w, h)
 }
 
 fn srgb_to_linear(value: f32) -> f32 {
@@ -147,15 +151,6 @@ mod tests {
     use super::*;
 
     #[test]
-    fn downsampling_keeps_strand_colour_and_mean_coverage() {
-        // One opaque red texel among three transparent black ones.
-        let texels = [255, 0, 0, 255, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0];
-        let (out, w, h) = downsample(&texels, 2, 2);
-        assert_eq!((w, h), (1, 1));
-        assert_eq!(out, vec![255, 0, 0, 64]);
-    }
-
-    #[test]
     fn wrong_sizes_are_errors() {
         let textures = FurTextures {
             size: 4,
@@ -164,9 +159,12 @@ mod tests {
             fin_width: 2,
             fin_height: 2,
             fin: vec![0; 16],
+            surface: None,
         };
         assert!(matches!(validate(&textures), Err(RenderError::Textures(_))));
         let textures = FurTextures { shell: vec![0; 4 * 4 * 4 * 2], ..textures };
         assert!(validate(&textures).is_ok());
+        let surface = pelt_core::texture::ImageRgba8 { width: 2, height: 2, pixels: vec![0; 12] };
+        assert!(validate(&FurTextures { surface: Some(surface), ..textures }).is_err());
     }
 }

@@ -73,8 +73,10 @@ fn surface_varyings(vertex: u32, corner: u32, layer: u32) -> Varyings {
     out.tangent = strand_tangent(layer, vertex);
     out.tile_position = shared_vertex(0u, vertex) * object.tiles_per_world;
     if object.has_uvs != 0u {
-        out.uv = corner_uvs[corner] * object.tiles_per_uv;
+        out.surface_uv = corner_uvs[corner];
+        out.uv = out.surface_uv * object.tiles_per_uv;
     } else {
+        out.surface_uv = vec2<f32>(0.0);
         out.uv = vec2<f32>(0.0);
     }
     out.layer = layer;
@@ -134,7 +136,6 @@ fn vs_fin(@builtin(vertex_index) index: u32, @builtin(instance_index) edge: u32)
     let a = topology[edges_start + 2u * edge];
     let b = topology[edges_start + 2u * edge + 1u];
     let vertex = select(a, b, side == 1u);
-    let position = shared_vertex(layer, vertex);
 
     // Fade in near the silhouette: where the faces beside the edge turn edge-on, or one faces
     // the camera and the other away.
@@ -154,8 +155,16 @@ fn vs_fin(@builtin(vertex_index) index: u32, @builtin(instance_index) edge: u32)
             edge_on = 0.0;
         }
     }
-
+    let fade = 1.0 - smoothstep(0.0, globals.fin_fade_cos, edge_on);
     var out: Varyings;
+    if fade <= 0.0 {
+        // Invisible fin (most of them): every vertex of the edge lands outside the clip volume,
+        // so it costs no rasterisation, and returning now skips the rest of the shading.
+        out.clip_position = vec4<f32>(2.0, 2.0, 2.0, 1.0);
+        return out;
+    }
+
+    let position = shared_vertex(layer, vertex);
     out.clip_position = globals.clip_from_world * vec4<f32>(position, 1.0);
     out.world_position = position;
     out.normal = safe_normalize(rest_normal(a) + rest_normal(b), rest_normal(a));
@@ -165,13 +174,17 @@ fn vs_fin(@builtin(vertex_index) index: u32, @builtin(instance_index) edge: u32)
     out.uv = vec2<f32>(offset + f32(side) * distance(root_a, root_b) * object.tiles_per_world, f32(layer) / f32(max(object.layers, 1u)));
     out.layer = 0u;
     out.slice = 0;
-    out.height = out.uv.y;
-    out.fade = 1.0 - smoothstep(0.0, globals.fin_fade_cos, edge_on);
-    if out.fade <= 0.0 {
-        // Invisible fin: every vertex of the edge lands outside the clip volume, so it costs
-        // no rasterisation at all.
-        out.clip_position = vec4<f32>(2.0, 2.0, 2.0, 1.0);
+    // The surface uv of this end of the edge, from its corner in the first face.
+    out.surface_uv = vec2<f32>(0.0);
+    if object.has_uvs != 0u && globals.has_surface != 0u {
+        for (var k = 0u; k < 3u; k++) {
+            if topology[3u * face_a + k] == vertex {
+                out.surface_uv = corner_uvs[3u * face_a + k];
+            }
+        }
     }
+    out.height = out.uv.y;
+    out.fade = fade;
     return out;
 }
 

@@ -5,6 +5,7 @@ mod common;
 use common::*;
 use glam::Vec3;
 use pelt_core::Builtin;
+use pelt_core::sim::{SimParams, Simulation, WindParams};
 use pelt_render::{Camera, Headless, RenderSettings, Renderer, SeparatedRenderer};
 
 const SIZE: u32 = 256;
@@ -49,6 +50,45 @@ fn golden_tryon() {
     let (centre, radius) = garment.mesh.bounding_sphere();
     let camera = Camera::framing(centre, radius * 1.6, 25.0, 10.0, 1.0);
     check_golden("tryon", &render(&headless, &renderer, &camera, &settings()));
+}
+
+/// The simulation with a steady wind along `direction` (no gusts or shake, so the pose is exact).
+fn windy_simulation(fur: &pelt_core::FurStructure, direction: Vec3, strength: f32, frames: u32) -> Simulation {
+    let wind = WindParams { direction, strength, gust_strength: 0.0, jitter: 0.0, ..WindParams::default() };
+    let mut simulation = Simulation::new(fur, &SimParams { wind, ..SimParams::default() }).expect("simulation");
+    for frame in 0..=frames {
+        simulation.advance_to(f64::from(frame) / 30.0);
+    }
+    simulation
+}
+
+#[test]
+fn golden_bunny_in_wind() {
+    let fur = builtin_fur(Builtin::Bunny, 16);
+    let headless = headless(SIZE, SIZE);
+    let renderer = headless.renderer(&fur, &strand_textures(256, 16, BROWN_ROOT, BROWN_TIP)).expect("renderer");
+    let simulation = windy_simulation(&fur, Vec3::new(1.0, 0.0, 0.3), 1.5, 12);
+    renderer.update_positions(&headless.gpu.queue, simulation.positions()).expect("positions");
+    check_golden("bunny-wind", &render(&headless, &renderer, &framed(&fur, 1.0), &settings()));
+}
+
+/// Simulated wind toward the camera's right moves the fur's pixels right, shells and fins alike.
+#[test]
+fn wind_moves_fur_pixels_in_the_wind_direction() {
+    let fur = grow(Builtin::Sphere.mesh().0, 16, 0.25);
+    let headless = headless(SIZE, SIZE);
+    let renderer = headless.renderer(&fur, &strand_textures(256, 16, BROWN_ROOT, BROWN_TIP)).expect("renderer");
+    // Looking down -Z, so +X is right in the image.
+    let camera = Camera::orbit(Vec3::ZERO, 0.0, 0.0, 6.0);
+    let fur_only = RenderSettings { skin: false, ..settings() };
+    let background = background(&headless, &renderer, &camera);
+    let mut centroids = Vec::new();
+    for direction in [Vec3::NEG_X, Vec3::X] {
+        let simulation = windy_simulation(&fur, direction, 3.0, 6);
+        renderer.update_positions(&headless.gpu.queue, simulation.positions()).expect("positions");
+        centroids.push(centroid_x(&render(&headless, &renderer, &camera, &fur_only), background));
+    }
+    assert!(centroids[1] > centroids[0] + 2.0, "fur follows the wind: centroid x {centroids:?}");
 }
 
 /// Fins only add pixels at the silhouette: on a sphere (no inner silhouettes) every pixel they
@@ -208,4 +248,22 @@ fn adapter_uses_the_requested_backend() {
         _ => assert_ne!(backend, wgpu::Backend::Noop),
     }
     eprintln!("adapter: {}", headless.gpu.summary());
+}
+
+/// Surface colour mode: grey strands take the mesh texture's colour at their roots.
+#[test]
+fn surface_colour_tints_strands_by_the_mesh_uvs() {
+    let fur = builtin_fur(Builtin::Sphere, 16);
+    assert!(fur.mesh.corner_uvs.is_some(), "the sphere has uvs");
+    let mut textures = strand_textures(256, 16, [180, 180, 180], [255, 255, 255]);
+    // Red and blue stripes across u (around the sphere), each 1/8 of the way round.
+    let pixels = (0..8).flat_map(|x| if x % 2 == 0 { [230, 20, 20, 255] } else { [20, 20, 230, 255] }).collect();
+    textures.surface = Some(pelt_core::texture::ImageRgba8 { width: 8, height: 1, pixels });
+    let headless = headless(SIZE, SIZE);
+    let renderer = headless.renderer(&fur, &textures).expect("renderer");
+    let camera = Camera::orbit(Vec3::ZERO, 0.0, 0.0, 5.0);
+    let image = render(&headless, &renderer, &camera, &settings());
+    let reddish = image.pixels().filter(|p| i32::from(p.0[0]) > i32::from(p.0[2]) + 40).count();
+    let bluish = image.pixels().filter(|p| i32::from(p.0[2]) > i32::from(p.0[0]) + 40).count();
+    assert!(reddish > 500 && bluish > 500, "red {reddish} and blue {bluish} pixels");
 }

@@ -1,9 +1,290 @@
-//! `pelt render`.
+//! `pelt render`: fur on a mesh to a PNG, a numbered PNG sequence or an animated GIF, headless.
+
+use std::fs::File;
+use std::io::BufWriter;
+use std::path::{Path, PathBuf};
+use std::time::{Duration, Instant};
+
+use anyhow::{Context as _, bail};
+use glam::Vec3;
+use pelt_core::sim::{Scene, Simulation, WindParams};
+use pelt_core::{Builtin, FurStructure, ImportOptions, Mesh, Preset};
+use pelt_render::{Backend, Camera, Headless, RenderSettings};
+
+use crate::mesh_args::MeshArgs;
+
+/// The try-on scene's body and garment (MakeHuman, CC0; see `assets/CREDITS.md`), embedded so the
+/// scene works from any folder.
+const TRYON_BODY_OBJ: &str = include_str!("../../../assets/meshes/female_generic.obj");
+const TRYON_GARMENT_OBJ: &str = include_str!("../../../assets/meshes/skirthelper.obj");
+
+/// Skin tone of plain meshes (linear RGB).
+const PLAIN_COLOUR: Vec3 = Vec3::new(0.62, 0.46, 0.38);
+
+/// Wind of the default render (no `--wind`, and the preset has none): a light breeze from the
+/// camera's left.
+const LIGHT_WIND: Vec3 = Vec3::new(0.35, 0.0, 0.1);
 
 /// Arguments of `pelt render`.
 #[derive(Debug, clap::Args)]
-pub struct Args {}
+#[command(after_help = "\
+With no arguments: the built-in bunny, the default fur and a light breeze, to pelt.png.
+`--builtin tryon` renders a body (plain) wearing a furry garment; with your own meshes:
+`pelt render GARMENT.obj --plain-mesh BODY.obj`.")]
+pub struct Args {
+    #[command(flatten)]
+    mesh: MeshArgs,
+    /// Meshes drawn without fur beside the furry one (e.g. the body under a furry garment).
+    #[arg(long, value_name = "MESH")]
+    plain_mesh: Vec<PathBuf>,
+    /// The fur preset (TOML); the built-in default fur without one.
+    #[arg(long, value_name = "P")]
+    preset: Option<PathBuf>,
+    /// A scene script (TOML): wind keys and touch strokes over time.
+    #[arg(long, value_name = "SCENE.toml")]
+    script: Option<PathBuf>,
+    /// Frames to render (default: 1 for a .png; the script's length, or 2 seconds, otherwise).
+    #[arg(long, value_name = "N")]
+    frames: Option<u32>,
+    /// Frames per second of simulated time.
+    #[arg(long, default_value_t = 30.0)]
+    fps: f64,
+    /// Image size, WIDTHxHEIGHT.
+    #[arg(long, default_value = "1280x720", value_parser = parse_size)]
+    size: (u32, u32),
+    /// Camera as azimuth,elevation (degrees) and distance (world units) around the meshes'
+    /// centre; without it the camera frames the meshes automatically.
+    #[arg(long, value_name = "AZIMUTH,ELEVATION,DISTANCE", value_parser = parse_vec3, allow_hyphen_values = true)]
+    camera: Option<Vec3>,
+    /// Wind x,y,z (direction and strength; 0,0,0 for none). Default: the preset's, or a light breeze.
+    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
+    wind: Option<Vec3>,
+    /// Graphics backend: vulkan, gl (or metal, dx12); default `WGPU_BACKEND`, else the best there is.
+    #[arg(long, default_value = "auto")]
+    backend: Backend,
+    /// Shells and fins with alpha-to-coverage instead of blending.
+    #[arg(long)]
+    alpha_to_coverage: bool,
+    /// Leave out the fins (shells only).
+    #[arg(long)]
+    no_fins: bool,
+    /// Output: a .png (one frame), a .gif (animated) or a folder (numbered PNGs).
+    #[arg(short, long, default_value = "pelt.png")]
+    output: PathBuf,
+}
 
-pub fn run(_args: &Args) -> anyhow::Result<()> {
-    anyhow::bail!("`pelt render` is not built yet")
+/// Where frames go.
+enum Output {
+    Png(PathBuf),
+    Folder(PathBuf),
+    Gif(PathBuf),
+}
+
+impl Output {
+    fn new(path: &Path) -> Self {
+        match path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref() {
+            Some("png") => Self::Png(path.to_path_buf()),
+            Some("gif") => Self::Gif(path.to_path_buf()),
+            _ => Self::Folder(path.to_path_buf()),
+        }
+    }
+}
+
+pub fn run(args: &Args) -> anyhow::Result<()> {
+    let started = Instant::now();
+    let output = Output::new(&args.output);
+    let frames = match (&output, args.frames) {
+        (Output::Png(_), Some(n)) if n > 1 => {
+            bail!("{} frames need a folder or a .gif as output, not {}", n, args.output.display())
+        }
+        (_, Some(0)) => bail!("--frames must be at least 1"),
+        (_, Some(n)) => n,
+        (Output::Png(_), None) => 1,
+        (_, None) => 0, // decided below from the script
+    };
+    if !(args.fps.is_finite() && args.fps > 0.0) {
+        bail!("--fps must be a positive number, got {}", args.fps);
+    }
+    let preset = match &args.preset {
+        Some(path) => Preset::load(path)?,
+        None => Preset::default(),
+    };
+    let scene = args.script.as_deref().map(Scene::load).transpose()?;
+    let frames = if frames > 0 {
+        frames
+    } else {
+        let secs = scene.as_ref().map_or(2.0, Scene::duration_secs);
+        ((secs * args.fps).round() as u32).max(1)
+    };
+
+    let (mesh, plain) = load_meshes(args)?;
+    let params = preset.fur_params(&mesh);
+    let fur = FurStructure::new(mesh, &params)?;
+    let textures = preset.generate_textures()?;
+    let mut simulation = Simulation::new(&fur, &preset.simulation)?;
+    let wind = match args.wind {
+        Some(wind) => Some(wind),
+        None if preset.simulation.wind.strength > 0.0 => None,
+        None => Some(LIGHT_WIND),
+    };
+    if let Some(wind) = wind {
+        let direction = wind.try_normalize().unwrap_or(Vec3::X);
+        simulation.set_wind(&WindParams { direction, strength: wind.length(), ..preset.simulation.wind.clone() })?;
+    }
+
+    let (width, height) = args.size;
+    let headless = Headless::new(args.backend, width, height)?;
+    let mut renderer = headless.renderer(&fur, &textures)?;
+    for mesh in &plain {
+        renderer.add_plain_mesh(&headless.gpu.device, mesh, PLAIN_COLOUR)?;
+    }
+    let camera = camera(args, &fur, &plain, headless.aspect_ratio());
+    let settings =
+        RenderSettings { alpha_to_coverage: args.alpha_to_coverage, fins: !args.no_fins, ..RenderSettings::default() };
+
+    let progress = (frames > 1).then(|| {
+        let bar = indicatif::ProgressBar::new(u64::from(frames));
+        bar.set_style(
+            indicatif::ProgressStyle::with_template("{bar:40} {pos}/{len} frames, {elapsed} elapsed, eta {eta}")
+                .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+        );
+        bar
+    });
+    if let Output::Folder(folder) = &output {
+        std::fs::create_dir_all(folder).with_context(|| format!("cannot create {}", folder.display()))?;
+    }
+    let mut gif = match &output {
+        Output::Gif(path) => {
+            let file = File::create(path).with_context(|| format!("cannot create {}", path.display()))?;
+            let mut encoder = image::codecs::gif::GifEncoder::new_with_speed(BufWriter::new(file), 10);
+            encoder.set_repeat(image::codecs::gif::Repeat::Infinite)?;
+            Some(encoder)
+        }
+        _ => None,
+    };
+    let (mut render_time, mut simulation_time) = (Duration::ZERO, Duration::ZERO);
+    for frame in 0..frames {
+        let time_secs = f64::from(frame) / args.fps;
+        let sim_started = Instant::now();
+        if let Some(scene) = &scene {
+            scene.apply(time_secs, &mut simulation)?;
+        }
+        simulation.advance_to(time_secs);
+        simulation_time += sim_started.elapsed();
+        let render_started = Instant::now();
+        renderer.update_positions(&headless.gpu.queue, simulation.positions())?;
+        let image = headless.render(&renderer, &camera, &settings)?;
+        render_time += render_started.elapsed();
+        match (&output, &mut gif) {
+            (Output::Png(path), _) => save_png(&image, path)?,
+            (Output::Folder(folder), _) => save_png(&image, &folder.join(format!("frame_{:04}.png", frame + 1)))?,
+            (Output::Gif(_), Some(encoder)) => {
+                let delay = image::Delay::from_saturating_duration(Duration::from_secs_f64(1.0 / args.fps));
+                encoder.encode_frame(image::Frame::from_parts(image, 0, 0, delay))?;
+            }
+            (Output::Gif(_), None) => unreachable!("the GIF encoder exists for GIF output"),
+        }
+        if let Some(bar) = &progress {
+            bar.inc(1);
+        }
+    }
+    drop(gif);
+    if let Some(bar) = progress {
+        bar.finish_and_clear();
+    }
+    let per_frame = |total: Duration| total.as_secs_f64() * 1000.0 / f64::from(frames);
+    println!(
+        "{}: {frames} frame{} of {width}x{height}, {} shell layers on {} triangles; mean frame {:.1} ms \
+         (render and read back), simulation {:.1} ms a frame; {:.1} s in all on {}",
+        args.output.display(),
+        if frames == 1 { "" } else { "s" },
+        fur.layers,
+        fur.mesh.triangles.len(),
+        per_frame(render_time),
+        per_frame(simulation_time),
+        started.elapsed().as_secs_f64(),
+        headless.gpu.summary(),
+    );
+    Ok(())
+}
+
+/// The furry mesh and the plain ones: `--builtin tryon` is the garment on the body.
+fn load_meshes(args: &Args) -> anyhow::Result<(Mesh, Vec<Mesh>)> {
+    let mut plain = Vec::new();
+    let mesh = if args.mesh.mesh.is_none() && args.mesh.builtin.as_deref() == Some("tryon") {
+        let options = ImportOptions { weld: !args.mesh.no_weld, ..ImportOptions::default() };
+        plain.push(Mesh::from_obj_str(TRYON_BODY_OBJ, Path::new("builtin:tryon/female_generic.obj"), &options)?.0);
+        Mesh::from_obj_str(TRYON_GARMENT_OBJ, Path::new("builtin:tryon/skirthelper.obj"), &options)?.0
+    } else {
+        args.mesh.load(Builtin::Bunny)?.0
+    };
+    for path in &args.plain_mesh {
+        plain.push(Mesh::load(path, &ImportOptions::default())?.0);
+    }
+    Ok((mesh, plain))
+}
+
+/// `--camera`, or a view from the front left that frames the fur (and any plain meshes) tightly.
+fn camera(args: &Args, fur: &FurStructure, plain: &[Mesh], aspect_ratio: f32) -> Camera {
+    let meshes = || std::iter::once(&fur.mesh).chain(plain);
+    let (mut low, mut high) = fur.mesh.bounds();
+    for mesh in plain {
+        let (l, h) = mesh.bounds();
+        (low, high) = (low.min(l), high.max(h));
+    }
+    let centre = (low + high) * 0.5;
+    match args.camera {
+        Some(v) => Camera::orbit(centre, v.x, v.y, v.z),
+        None => {
+            let points = meshes().flat_map(|mesh| mesh.positions.iter().copied());
+            let fur_length = fur.lengths.iter().copied().fold(0.0, f32::max);
+            Camera::framing_points(centre, points, fur_length, 30.0, 15.0, aspect_ratio)
+        }
+    }
+}
+
+fn save_png(image: &image::RgbaImage, path: &Path) -> anyhow::Result<()> {
+    image.save(path).with_context(|| format!("cannot write {}", path.display()))
+}
+
+fn parse_size(text: &str) -> Result<(u32, u32), String> {
+    let parsed = text.split_once(['x', 'X']).and_then(|(w, h)| Some((w.trim().parse().ok()?, h.trim().parse().ok()?)));
+    match parsed {
+        Some((w, h)) if w > 0 && h > 0 => Ok((w, h)),
+        _ => Err(format!("expected WIDTHxHEIGHT with both above 0, e.g. 1280x720, got {text:?}")),
+    }
+}
+
+fn parse_vec3(text: &str) -> Result<Vec3, String> {
+    let values: Vec<f32> = text
+        .split(',')
+        .map(|v| v.trim().parse::<f32>())
+        .collect::<Result<_, _>>()
+        .map_err(|e| format!("{text:?}: {e}"))?;
+    match values[..] {
+        [x, y, z] if values.iter().all(|v| v.is_finite()) => Ok(Vec3::new(x, y, z)),
+        _ => Err(format!("expected three numbers x,y,z, got {text:?}")),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn sizes_and_vectors_parse() {
+        assert_eq!(parse_size("1280x720"), Ok((1280, 720)));
+        assert!(parse_size("0x5").is_err());
+        assert!(parse_size("big").is_err());
+        assert_eq!(parse_vec3("1,-2, 3.5"), Ok(Vec3::new(1.0, -2.0, 3.5)));
+        assert!(parse_vec3("1,2").is_err());
+        assert!(parse_vec3("1,nan,2").is_err());
+    }
+
+    #[test]
+    fn outputs_follow_the_extension() {
+        assert!(matches!(Output::new(Path::new("a/b.PNG")), Output::Png(_)));
+        assert!(matches!(Output::new(Path::new("a.gif")), Output::Gif(_)));
+        assert!(matches!(Output::new(Path::new("frames")), Output::Folder(_)));
+    }
 }

@@ -81,7 +81,7 @@ pub fn strand_textures(size: u32, layers: u32, root: [u8; 3], tip: [u8; 3]) -> F
             }
         }
     }
-    FurTextures { size, layers, shell, fin_width, fin_height, fin }
+    FurTextures { size, layers, shell, fin_width, fin_height, fin, surface: None }
 }
 
 pub const BROWN_ROOT: [u8; 3] = [70, 45, 28];

@@ -1,0 +1,80 @@
+//! `pelt render` end to end: the binary on lavapipe (CI) writes PNGs, sequences and GIFs.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn pelt(args: &[&str], dir: &Path) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_pelt")).args(args).current_dir(dir).output().expect("run pelt")
+}
+
+fn temp_dir(name: &str) -> PathBuf {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("cli_render").join(name);
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    dir
+}
+
+fn text(output: &Output) -> String {
+    format!("{}{}", String::from_utf8_lossy(&output.stdout), String::from_utf8_lossy(&output.stderr))
+}
+
+/// The fraction of pixels that differ from the corner pixel (the background).
+fn drawn_fraction(image: &image::RgbaImage) -> f64 {
+    let background = *image.get_pixel(0, 0);
+    let drawn = image.pixels().filter(|p| p.0.iter().zip(background.0).any(|(a, b)| a.abs_diff(b) > 6)).count();
+    drawn as f64 / f64::from(image.width() * image.height())
+}
+
+#[test]
+fn no_arguments_but_a_size_render_the_bunny_to_pelt_png() {
+    let dir = temp_dir("default");
+    let output = pelt(&["render", "--size", "160x120"], &dir);
+    assert!(output.status.success(), "{}", text(&output));
+    let image = image::open(dir.join("pelt.png")).expect("pelt.png").to_rgba8();
+    assert_eq!(image.dimensions(), (160, 120));
+    let drawn = drawn_fraction(&image);
+    assert!((0.1..0.9).contains(&drawn), "the bunny fills a good part of the frame: {drawn}");
+    assert!(text(&output).contains("1 frame of 160x120"), "{}", text(&output));
+}
+
+#[test]
+fn folders_get_numbered_frames_and_gifs_animate() {
+    let dir = temp_dir("sequence");
+    let output = pelt(&["render", "--builtin", "box", "--size", "64x48", "--frames", "3", "-o", "frames"], &dir);
+    assert!(output.status.success(), "{}", text(&output));
+    for k in 1..=3 {
+        assert!(dir.join(format!("frames/frame_{k:04}.png")).is_file(), "frame {k}");
+    }
+    assert!(text(&output).contains("3 frames"), "the summary line: {}", text(&output));
+    let output = pelt(&["render", "--builtin", "torus", "--size", "64x48", "--frames", "2", "-o", "fur.gif"], &dir);
+    assert!(output.status.success(), "{}", text(&output));
+    let file = std::fs::File::open(dir.join("fur.gif")).expect("gif");
+    let decoder = image::codecs::gif::GifDecoder::new(std::io::BufReader::new(file)).expect("gif decoder");
+    let frames = image::AnimationDecoder::into_frames(decoder).collect_frames().expect("frames");
+    assert_eq!(frames.len(), 2);
+}
+
+#[test]
+fn tryon_draws_the_body_and_the_furry_garment() {
+    let dir = temp_dir("tryon");
+    let output = pelt(&["render", "--builtin", "tryon", "--size", "96x128", "-o", "tryon.png"], &dir);
+    assert!(output.status.success(), "{}", text(&output));
+    let image = image::open(dir.join("tryon.png")).expect("tryon.png").to_rgba8();
+    assert!(drawn_fraction(&image) > 0.1);
+}
+
+#[test]
+fn bad_arguments_are_clear_errors() {
+    let dir = temp_dir("errors");
+    let cases: [(&[&str], &str); 4] = [
+        (&["render", "--size", "0x10"], "WIDTHxHEIGHT"),
+        (&["render", "--backend", "glide"], "unknown backend"),
+        (&["render", "--frames", "4", "-o", "one.png"], "folder or a .gif"),
+        (&["render", "missing.obj"], "missing.obj"),
+    ];
+    for (args, message) in cases {
+        let output = pelt(args, &dir);
+        assert!(!output.status.success(), "{args:?} should fail");
+        assert!(text(&output).contains(message), "{args:?}: {}", text(&output));
+    }
+}
