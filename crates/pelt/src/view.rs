@@ -21,9 +21,6 @@ use crate::mesh_args::MeshArgs;
 pub struct Args {
     #[command(flatten)]
     pub mesh: MeshArgs,
-    /// Start with the try-on scene: a furry skirt on a body (the paper's virtual try-on).
-    #[arg(long, conflicts_with_all = ["mesh", "builtin"])]
-    pub try_on: bool,
     /// Draw N frames, save the window's own frame as a PNG to `--out` and exit. Time then advances
     /// by exactly 1/60 s per frame, so runs repeat (used by the tests under Xvfb).
     #[arg(long, value_name = "N", requires = "out")]
@@ -56,7 +53,12 @@ fn parse_size(text: &str) -> Result<[u32; 2], String> {
 }
 
 pub fn run(args: &Args) -> anyhow::Result<()> {
-    let (mesh, report) = args.mesh.load(pelt_core::Builtin::Bunny)?;
+    // `--builtin tryon` (as in `pelt render`) is the furry skirt on a body; the app loads it.
+    let (mesh, report) = if args.mesh.mesh.is_none() && args.mesh.builtin.as_deref() == Some(app::TRY_ON_NAME) {
+        pelt_core::Builtin::Plane.mesh()
+    } else {
+        args.mesh.load(pelt_core::Builtin::Bunny)?
+    };
     // Files and presets are checked before the display is opened, so their errors come first.
     let mut app = app::App::new(args, mesh, report.source)?;
     let event_loop = winit::event_loop::EventLoop::new()

@@ -15,8 +15,12 @@ fn out_path(name: &str) -> PathBuf {
     Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("cli_view_{name}.png"))
 }
 
+/// `xvfb-run -a` can hand two servers started at once the same display number: one at a time.
+static XVFB: std::sync::Mutex<()> = std::sync::Mutex::new(());
+
 /// Runs `pelt view ARGS --screenshot-after FRAMES --out OUT` under Xvfb and loads the PNG.
 fn screenshot(name: &str, frames: u32, args: &[&str]) -> image::RgbaImage {
+    let _one_at_a_time = XVFB.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
     let out = out_path(name);
     let _stale = std::fs::remove_file(&out);
     let output = Command::new("xvfb-run")

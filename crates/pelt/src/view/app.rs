@@ -179,7 +179,7 @@ impl App {
             status: String::new(),
         };
         let mut model = model;
-        if args.try_on {
+        if args.mesh.mesh.is_none() && args.mesh.builtin.as_deref() == Some(TRY_ON_NAME) {
             model.settings.mesh = MeshChoice::TryOn;
             model.apply(Changes { mesh: true, ..Changes::default() })?;
         }
@@ -664,9 +664,12 @@ impl Model {
     fn frame(&mut self, aspect: f32) {
         let (center, radius) = self.structure.mesh.bounding_sphere();
         let longest = self.structure.lengths.iter().copied().fold(0.0, f32::max);
-        // A garment on a body: show some of the body around it too.
-        let context = if self.body.is_some() { 1.6 } else { 1.0 };
-        self.camera.frame(center, (radius + longest) * context, aspect);
+        // A garment is seen on the whole body wearing it.
+        let (center, radius) = match &self.body {
+            Some(body) => body.bounding_sphere(),
+            None => (center, radius + longest),
+        };
+        self.camera.frame(center, radius, aspect);
     }
 
     /// Starts texture generation when the preset changed and none runs; hands over finished
@@ -762,6 +765,9 @@ impl Model {
         Ok(rebuilt)
     }
 }
+
+/// The `--builtin` name of the try-on scene (as in `pelt render`).
+pub const TRY_ON_NAME: &str = "tryon";
 
 /// The paper's virtual try-on: a furry skirt (an open tube around the hips) on a body, both
 /// MakeHuman assets in the same space.

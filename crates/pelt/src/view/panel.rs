@@ -42,7 +42,7 @@ impl MeshChoice {
     pub fn label(&self) -> String {
         match self {
             Self::Builtin(builtin) => builtin.name().to_owned(),
-            Self::TryOn => "try-on (skirt on a body)".to_owned(),
+            Self::TryOn => "tryon (skirt on a body)".to_owned(),
             Self::File(name) => name.clone(),
         }
     }
