@@ -230,6 +230,16 @@ pub fn show(
             let before = sim.clone();
             ui.add(egui::Slider::new(&mut sim.stability, 0.5..=200.0).logarithmic(true).text("stability"));
             ui.add(egui::Slider::new(&mut sim.gravity_strength, 0.0..=5.0).text("gravity"));
+            ui.horizontal(|ui| {
+                ui.label("gravity toward");
+                let down = &mut sim.gravity_direction;
+                for (axis, value) in [("x ", &mut down.x), ("y ", &mut down.y), ("z ", &mut down.z)] {
+                    ui.add(egui::DragValue::new(value).speed(0.02).range(-1.0..=1.0).prefix(axis));
+                }
+            });
+            if sim.gravity_direction.length_squared() == 0.0 {
+                sim.gravity_direction = before.gravity_direction;
+            }
             ui.add(egui::Slider::new(&mut sim.rate_hz, 1.0..=240.0).logarithmic(true).text("rate (Hz)"));
             ui.checkbox(&mut sim.interpolate, "interpolate between steps");
             ui.label(egui::RichText::new("Wind").strong());
