@@ -15,5 +15,5 @@ pub mod texture;
 pub use fur::{FurParams, FurStructure, GrowthDirection, SeparatedStructure};
 pub use mesh::{ImportOptions, Mesh, MeshError, MeshReport, builtin::Builtin};
 pub use preset::{Preset, PresetError};
-pub use texture::{FurTextures, TextureParams};
 pub use sim::{Scene, SimError, SimParams, Simulation};
+pub use texture::{FurTextures, TextureParams};
