@@ -1,9 +1,81 @@
-//! `pelt view`.
+//! `pelt view`: the interactive viewer and authoring tool. A winit window drawn with wgpu: the
+//! fur in the central area, an egui panel that edits everything live, an overlay with timings
+//! and sizes.
+
+mod app;
+mod camera;
+mod capture;
+mod fur;
+mod gpu;
+mod panel;
+mod viewport;
+
+use std::path::PathBuf;
+
+use anyhow::Context as _;
+
+use crate::mesh_args::MeshArgs;
 
 /// Arguments of `pelt view`.
 #[derive(Debug, clap::Args)]
-pub struct Args {}
+pub struct Args {
+    #[command(flatten)]
+    pub mesh: MeshArgs,
+    /// Draw N frames, save the window's own frame as a PNG to `--out` and exit. Time then advances
+    /// by exactly 1/60 s per frame, so runs repeat (used by the tests under Xvfb).
+    #[arg(long, value_name = "N", requires = "out")]
+    pub screenshot_after: Option<u32>,
+    /// Where `--screenshot-after` writes its PNG.
+    #[arg(long, value_name = "FILE.png", requires = "screenshot_after")]
+    pub out: Option<PathBuf>,
+    /// A fur preset (TOML) to start from; the panel edits it, Save writes it back.
+    #[arg(long, value_name = "P")]
+    pub preset: Option<PathBuf>,
+    /// Play a scene script (the simulation's TOML: wind keys and touch strokes in world
+    /// coordinates) on the simulation clock.
+    #[arg(long, value_name = "SCENE.toml")]
+    pub script: Option<PathBuf>,
+    /// Start with the overlay (timings, sizes, brush and hints) hidden; O shows it.
+    #[arg(long)]
+    pub no_overlay: bool,
+    /// Window size in logical pixels, `WIDTHxHEIGHT`.
+    #[arg(long, value_name = "WxH", default_value = "1280x800", value_parser = parse_size)]
+    pub size: [u32; 2],
+}
 
-pub fn run(_args: &Args) -> anyhow::Result<()> {
-    anyhow::bail!("`pelt view` is not built yet")
+fn parse_size(text: &str) -> Result<[u32; 2], String> {
+    let (width, height) = text.split_once('x').ok_or_else(|| format!("expected WIDTHxHEIGHT, got {text:?}"))?;
+    let parse = |s: &str| s.trim().parse::<u32>().ok().filter(|v| (64..=16_384).contains(v));
+    match (parse(width), parse(height)) {
+        (Some(w), Some(h)) => Ok([w, h]),
+        _ => Err(format!("each side must be a whole number from 64 to 16384, got {text:?}")),
+    }
+}
+
+pub fn run(args: &Args) -> anyhow::Result<()> {
+    // `--builtin tryon` (as in `pelt render`) is the furry skirt on a body; the app loads it.
+    let (mesh, report) = if args.mesh.mesh.is_none() && args.mesh.builtin.as_deref() == Some(app::TRY_ON_NAME) {
+        pelt_core::Builtin::Plane.mesh()
+    } else {
+        args.mesh.load(pelt_core::Builtin::Bunny)?
+    };
+    // Files and presets are checked before the display is opened, so their errors come first.
+    let mut app = app::App::new(args, mesh, report.source)?;
+    let event_loop = winit::event_loop::EventLoop::new()
+        .context("opening the display (is DISPLAY or WAYLAND_DISPLAY set? under CI use xvfb-run)")?;
+    event_loop.run_app(&mut app).context("running the window's event loop")?;
+    app.finish()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn window_sizes_parse_and_bad_ones_say_why() {
+        assert_eq!(parse_size("640x480"), Ok([640, 480]));
+        assert!(parse_size("640").unwrap_err().contains("WIDTHxHEIGHT"));
+        assert!(parse_size("0x480").unwrap_err().contains("64 to 16384"));
+        assert!(parse_size("axb").is_err());
+    }
 }

@@ -1,0 +1,142 @@
+//! `pelt view` in a real window under Xvfb: the window's own frame comes back as a PNG.
+//!
+//! Needs `xvfb-run` (Debian's xvfb and xauth) and a Vulkan or GL driver (lavapipe, llvmpipe);
+//! `.ci/run` installs them.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+const WIDTH_PX: u32 = 960;
+const HEIGHT_PX: u32 = 640;
+/// The panel's default width in points (and pixels: Xvfb has a scale factor of 1).
+const PANEL_PX: u32 = 320;
+
+fn out_path(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("cli_view_{name}.png"))
+}
+
+/// `xvfb-run -a` can hand two servers started at once the same display number: one at a time.
+static XVFB: std::sync::Mutex<()> = std::sync::Mutex::new(());
+
+/// Runs `pelt view ARGS --screenshot-after FRAMES --out OUT` under Xvfb and loads the PNG.
+fn screenshot(name: &str, frames: u32, args: &[&str]) -> image::RgbaImage {
+    let _one_at_a_time = XVFB.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
+    let out = out_path(name);
+    let _stale = std::fs::remove_file(&out);
+    let output = Command::new("xvfb-run")
+        .args(["-a", "-s", "-screen 0 1280x800x24"])
+        .arg(env!("CARGO_BIN_EXE_pelt"))
+        .arg("view")
+        .args(args)
+        .args(["--size", &format!("{WIDTH_PX}x{HEIGHT_PX}"), "--screenshot-after", &frames.to_string(), "--out"])
+        .arg(&out)
+        .output()
+        .expect("xvfb-run runs (install xvfb and xauth)");
+    assert!(
+        output.status.success(),
+        "pelt view failed ({}):\n{}\n{}",
+        output.status,
+        String::from_utf8_lossy(&output.stdout),
+        String::from_utf8_lossy(&output.stderr)
+    );
+    image::open(&out).unwrap_or_else(|e| panic!("reading {}: {e}", out.display())).to_rgba8()
+}
+
+fn luminance(pixel: &image::Rgba<u8>) -> f64 {
+    let [r, g, b, _] = pixel.0;
+    0.2126 * f64::from(r) + 0.7152 * f64::from(g) + 0.0722 * f64::from(b)
+}
+
+/// Horizontal luminance jumps of more than 40 levels inside `x0..x1`: text and widget edges make
+/// many, a flat fill none.
+fn edges(image: &image::RgbaImage, x0: u32, x1: u32) -> usize {
+    let mut count = 0;
+    for y in 0..image.height() {
+        for x in x0 + 1..x1 {
+            if (luminance(image.get_pixel(x, y)) - luminance(image.get_pixel(x - 1, y))).abs() > 40.0 {
+                count += 1;
+            }
+        }
+    }
+    count
+}
+
+#[test]
+fn the_window_shows_the_panel_with_text_beside_the_3d_view() {
+    let image = screenshot("panel", 4, &["--builtin", "sphere"]);
+    assert_eq!(image.dimensions(), (WIDTH_PX, HEIGHT_PX), "the screenshot is the window's frame");
+    let panel_x0 = WIDTH_PX - PANEL_PX;
+    let panel_edges = edges(&image, panel_x0, WIDTH_PX);
+    assert!(panel_edges > 2_000, "the panel has text and widgets: {panel_edges} edges");
+    let distinct: std::collections::HashSet<_> = (panel_x0..WIDTH_PX)
+        .flat_map(|x| (0..HEIGHT_PX).map(move |y| (x, y)))
+        .map(|(x, y)| image.get_pixel(x, y).0)
+        .collect();
+    assert!(distinct.len() > 20, "anti-aliased text gives many shades: {}", distinct.len());
+}
+
+/// Mean absolute difference per channel of two frames inside `x0..x1, y0..y1`.
+fn mean_difference(a: &image::RgbaImage, b: &image::RgbaImage, (x0, y0, x1, y1): (u32, u32, u32, u32)) -> f64 {
+    let mut sum = 0.0;
+    for y in y0..y1 {
+        for x in x0..x1 {
+            let (p, q) = (a.get_pixel(x, y).0, b.get_pixel(x, y).0);
+            sum += (0..3).map(|c| f64::from(p[c].abs_diff(q[c]))).sum::<f64>() / 3.0;
+        }
+    }
+    sum / f64::from((x1 - x0) * (y1 - y0))
+}
+
+#[test]
+fn a_scripted_touch_flattens_the_fur_where_it_presses_and_nowhere_else() {
+    // The plane (2 x 2, facing +Y, centred on the origin) is framed in the middle of the 3D view,
+    // so the origin lands at the view's centre. The stroke presses there and drags along +X
+    // within the first second and holds until after the screenshot.
+    let script = Path::new(env!("CARGO_TARGET_TMPDIR")).join("cli_view_touch.toml");
+    std::fs::write(
+        &script,
+        "[[stroke]]\nstart_secs = 0.0\nend_secs = 3.0\nradius = 0.5\n\
+         path = [[0.0, 0.0, 0.0], [0.7, 0.0, 0.0], [0.7, 0.0, 0.0], [0.7, 0.0, 0.0]]\n",
+    )
+    .unwrap();
+    // Long upright fur, so a pat shows plainly.
+    let preset = Path::new(env!("CARGO_TARGET_TMPDIR")).join("cli_view_touch_preset.toml");
+    std::fs::write(&preset, "length = 0.2\n[direction]\nrandom_angle_deg = 0.0\ncomb_blend = 0.0\n").unwrap();
+    let preset = preset.to_str().unwrap();
+    let frames = 60;
+    // Without the overlay, so only the fur can differ (not the timings or the brush).
+    let base = ["--builtin", "plane", "--no-overlay", "--preset", preset];
+    let untouched = screenshot("untouched", frames, &base);
+    let script = script.to_str().unwrap();
+    let touched = screenshot("touched", frames, &[&base[..], &["--script", script]].concat());
+    let view_centre = ((WIDTH_PX - PANEL_PX) / 2, HEIGHT_PX / 2);
+    let around = |half: u32, dy: i32| {
+        let y = (view_centre.1 as i32 + dy) as u32;
+        (view_centre.0 - half, y - half / 2, view_centre.0 + half, y + half / 2)
+    };
+    let pressed = mean_difference(&untouched, &touched, around(50, 0));
+    // Fur at the plane's left and far corners, well outside the touch radius.
+    let left_corner = mean_difference(&untouched, &touched, (75, 315, 135, 335));
+    let background = mean_difference(&untouched, &touched, (200, 470, 600, 560));
+    println!("pressed {pressed:.2}, left corner {left_corner:.2}, background {background:.2}");
+    assert!(pressed > 8.0, "the fur under the touch changed: {pressed:.2}");
+    assert!(left_corner < pressed / 8.0, "fur far from the touch stays put: {left_corner:.2} vs {pressed:.2}");
+    assert!(background < 0.5, "the background is untouched: {background:.2}");
+    let panel = mean_difference(&untouched, &touched, (WIDTH_PX - PANEL_PX + 4, 0, WIDTH_PX, HEIGHT_PX));
+    assert!(panel < 0.5, "the panel looks the same: {panel:.2}");
+}
+
+#[test]
+fn a_missing_preset_or_script_is_named_before_any_window_opens() {
+    for (flag, file) in [("--preset", "no-such-preset.toml"), ("--script", "no-such-scene.toml")] {
+        let output = Command::new(env!("CARGO_BIN_EXE_pelt"))
+            .args(["view", "--builtin", "box", flag, file])
+            .env_remove("DISPLAY")
+            .env_remove("WAYLAND_DISPLAY")
+            .output()
+            .unwrap();
+        assert!(!output.status.success());
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert!(stderr.contains(file), "{flag}: the error names the file: {stderr}");
+    }
+}
