@@ -217,6 +217,20 @@ impl SeparatedRenderer {
         })
     }
 
+    /// Adds a mesh drawn without fur (e.g. the body under a furred garment), as
+    /// [`Renderer::add_plain_mesh`], so both structures can draw the same scene.
+    ///
+    /// # Errors
+    /// As [`Renderer::add_plain_mesh`].
+    pub fn add_plain_mesh(
+        &mut self,
+        device: &wgpu::Device,
+        mesh: &pelt_core::Mesh,
+        colour: Vec3,
+    ) -> Result<(), RenderError> {
+        self.unified.add_plain_mesh(device, mesh, colour)
+    }
+
     /// Bytes of the separated geometry on the GPU (shell and fin vertices, shell indices).
     #[must_use]
     pub fn gpu_bytes(&self) -> u64 {

@@ -162,9 +162,6 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
 
 const QUICK_SKIPS: &str = "--quick times the Box only";
 const QUICK_DRAWS: &str = "--quick draws the Box at 16 layers only";
-/// Why the try-on scene has no frame times: the same scene in all three structures needs the body.
-const NO_SEPARATED_BODY: &str = "the separated renderer draws one furred mesh and no plain body, so the \
-     three structures cannot draw the same try-on scene; the garment alone is the skirt row";
 
 /// Every figure for one model at one layer count.
 fn measure(model: &Model, layers: u32, plan: Plan, gpu: Result<&render::Bench, &String>) -> anyhow::Result<ResultRow> {
@@ -214,12 +211,9 @@ fn measure(model: &Model, layers: u32, plan: Plan, gpu: Result<&render::Bench, &
         _ if !plan.renders(key, layers) => {
             RenderFigures { render_unavailable_reason: Some(QUICK_DRAWS.to_owned()), ..RenderFigures::default() }
         }
-        _ if model.body.is_some() => {
-            RenderFigures { render_unavailable_reason: Some(NO_SEPARATED_BODY.to_owned()), ..RenderFigures::default() }
-        }
         Ok(gpu) => {
             eprintln!("pelt bench:   {key} L={layers}: frame time");
-            gpu.measure(&fur, &textures, plan.render_budget())?
+            gpu.measure(&fur, model.body.as_ref(), &textures, plan.render_budget())?
         }
         Err(reason) => RenderFigures { render_unavailable_reason: Some(reason.clone()), ..RenderFigures::default() },
     };

@@ -19,7 +19,7 @@ const TRYON_BODY_OBJ: &str = include_str!("../../../assets/meshes/female_generic
 const TRYON_GARMENT_OBJ: &str = include_str!("../../../assets/meshes/skirthelper.obj");
 
 /// Skin tone of plain meshes (linear RGB).
-const PLAIN_COLOUR: Vec3 = Vec3::new(0.62, 0.46, 0.38);
+pub const PLAIN_COLOUR: Vec3 = Vec3::new(0.62, 0.46, 0.38);
 
 /// Wind of the default render (no `--wind`, and the preset has none): a light breeze from the
 /// camera's left.

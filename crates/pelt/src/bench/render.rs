@@ -4,14 +4,15 @@
 use std::time::{Duration, Instant};
 
 use anyhow::Context as _;
-use pelt_core::FurStructure;
 use pelt_core::texture::FurTextures;
+use pelt_core::{FurStructure, Mesh};
 use pelt_render::{
     Backend, Camera, Gpu, HEADLESS_FORMAT, RenderSettings, RenderTargets, Renderer, SeparatedRenderer, TargetFormat,
 };
 
 use super::report::{Adapter, RenderFigures};
 use super::table2::MANY_FIN_FACES;
+use crate::render::PLAIN_COLOUR;
 
 /// The two frame sizes: a typical window and a small one where vertex work dominates.
 pub const SIZES: [(u32, u32); 2] = [(1280, 720), (256, 256)];
@@ -49,22 +50,31 @@ impl Bench {
         }
     }
 
-    /// Median frame times of the three structures at both sizes.
+    /// Median frame times of the three structures at both sizes, each drawing the same scene:
+    /// the fur and, for the try-on model, the plain `body` under it.
     pub fn measure(
         &self,
         fur: &FurStructure,
+        body: Option<&Mesh>,
         textures: &FurTextures,
         budget: RenderBudget,
     ) -> anyhow::Result<RenderFigures> {
         let (device, queue) = (&self.gpu.device, &self.gpu.queue);
         let format = TargetFormat::msaa(HEADLESS_FORMAT);
-        let unified = Renderer::new(device, queue, format, fur, textures).context("building the unified renderer")?;
-        let separated2 = SeparatedRenderer::new(device, queue, format, fur, textures, 2)
+        let mut unified =
+            Renderer::new(device, queue, format, fur, textures).context("building the unified renderer")?;
+        let mut separated2 = SeparatedRenderer::new(device, queue, format, fur, textures, 2)
             .context("building the separated renderer (2-face fins)")?;
-        let separated30 = SeparatedRenderer::new(device, queue, format, fur, textures, MANY_FIN_FACES)
+        let mut separated30 = SeparatedRenderer::new(device, queue, format, fur, textures, MANY_FIN_FACES)
             .context("building the separated renderer (30-face fins)")?;
+        if let Some(body) = body {
+            unified.add_plain_mesh(device, body, PLAIN_COLOUR)?;
+            separated2.add_plain_mesh(device, body, PLAIN_COLOUR)?;
+            separated30.add_plain_mesh(device, body, PLAIN_COLOUR)?;
+        }
         let settings = RenderSettings::default();
-        let (centre, radius) = fur.mesh.bounding_sphere();
+        // Frame the whole scene: the body where there is one (the garment sits on it).
+        let (centre, radius) = body.map_or_else(|| fur.mesh.bounding_sphere(), Mesh::bounding_sphere);
         let radius = radius + fur.lengths.iter().copied().fold(0.0, f32::max);
 
         let mut medians = [[0.0; 3]; SIZES.len()];
