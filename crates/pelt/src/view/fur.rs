@@ -21,6 +21,8 @@ pub struct FurView {
     /// The separated structure of Lengyel et al., built when first shown; it holds the rest pose
     /// (its fins are geometry of their own and do not follow the simulation).
     separated: Option<SeparatedRenderer>,
+    /// The furless body both structures draw (the try-on scene's), kept for rebuilding.
+    body: Option<Mesh>,
     textures: FurTextures,
     pub settings: RenderSettings,
 }
@@ -28,7 +30,13 @@ pub struct FurView {
 impl FurView {
     pub fn new(gpu: &pelt_render::Gpu, structure: &FurStructure, textures: &FurTextures) -> anyhow::Result<Self> {
         let renderer = Renderer::new(&gpu.device, &gpu.queue, target_format(), structure, textures)?;
-        Ok(Self { renderer, separated: None, textures: textures.clone(), settings: RenderSettings::default() })
+        Ok(Self {
+            renderer,
+            separated: None,
+            body: None,
+            textures: textures.clone(),
+            settings: RenderSettings::default(),
+        })
     }
 
     pub fn set_structure(&mut self, gpu: &pelt_render::Gpu, structure: &FurStructure) -> anyhow::Result<()> {
@@ -44,6 +52,8 @@ impl FurView {
 
     /// Replaces the furless body drawn with the fur (the try-on scene's), if any.
     pub fn set_body(&mut self, gpu: &pelt_render::Gpu, body: Option<&Mesh>) -> anyhow::Result<()> {
+        self.separated = None;
+        self.body = body.cloned();
         self.renderer.clear_plain_meshes();
         if let Some(body) = body {
             self.renderer.add_plain_mesh(&gpu.device, body, BODY_COLOUR)?;
@@ -54,14 +64,18 @@ impl FurView {
     /// Builds the separated structure if it is to be drawn and is not there yet.
     pub fn prepare_separated(&mut self, gpu: &pelt_render::Gpu, structure: &FurStructure) -> anyhow::Result<()> {
         if self.separated.is_none() {
-            self.separated = Some(SeparatedRenderer::new(
+            let mut separated = SeparatedRenderer::new(
                 &gpu.device,
                 &gpu.queue,
                 target_format(),
                 structure,
                 &self.textures,
                 SEPARATED_FIN_FACES,
-            )?);
+            )?;
+            if let Some(body) = &self.body {
+                separated.add_plain_mesh(&gpu.device, body, BODY_COLOUR)?;
+            }
+            self.separated = Some(separated);
         }
         Ok(())
     }
