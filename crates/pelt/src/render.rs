@@ -7,16 +7,12 @@ use std::time::{Duration, Instant};
 
 use anyhow::{Context as _, bail};
 use glam::Vec3;
+use pelt_core::mesh::builtin::{TRY_ON_NAME, try_on_scene};
 use pelt_core::sim::{Scene, Simulation, WindParams};
 use pelt_core::{Builtin, FurStructure, ImportOptions, Mesh, Preset};
 use pelt_render::{Backend, Camera, Headless, RenderSettings};
 
 use crate::mesh_args::MeshArgs;
-
-/// The try-on scene's body and garment (MakeHuman, CC0; see `assets/CREDITS.md`), embedded so the
-/// scene works from any folder.
-const TRYON_BODY_OBJ: &str = include_str!("../../../assets/meshes/female_generic.obj");
-const TRYON_GARMENT_OBJ: &str = include_str!("../../../assets/meshes/skirthelper.obj");
 
 /// Skin tone of plain meshes (linear RGB).
 pub const PLAIN_COLOUR: Vec3 = Vec3::new(0.62, 0.46, 0.38);
@@ -211,10 +207,11 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
 /// The furry mesh and the plain ones: `--builtin tryon` is the garment on the body.
 fn load_meshes(args: &Args) -> anyhow::Result<(Mesh, Vec<Mesh>)> {
     let mut plain = Vec::new();
-    let mesh = if args.mesh.mesh.is_none() && args.mesh.builtin.as_deref() == Some("tryon") {
+    let mesh = if args.mesh.mesh.is_none() && args.mesh.builtin.as_deref() == Some(TRY_ON_NAME) {
         let options = ImportOptions { weld: !args.mesh.no_weld, ..ImportOptions::default() };
-        plain.push(Mesh::from_obj_str(TRYON_BODY_OBJ, Path::new("builtin:tryon/female_generic.obj"), &options)?.0);
-        Mesh::from_obj_str(TRYON_GARMENT_OBJ, Path::new("builtin:tryon/skirthelper.obj"), &options)?.0
+        let scene = try_on_scene(&options)?;
+        plain.push(scene.body);
+        scene.garment
     } else {
         args.mesh.load(Builtin::Bunny)?.0
     };

@@ -54,11 +54,12 @@ fn parse_size(text: &str) -> Result<[u32; 2], String> {
 
 pub fn run(args: &Args) -> anyhow::Result<()> {
     // `--builtin tryon` (as in `pelt render`) is the furry skirt on a body; the app loads it.
-    let (mesh, report) = if args.mesh.mesh.is_none() && args.mesh.builtin.as_deref() == Some(app::TRY_ON_NAME) {
-        pelt_core::Builtin::Plane.mesh()
-    } else {
-        args.mesh.load(pelt_core::Builtin::Bunny)?
-    };
+    let (mesh, report) =
+        if args.mesh.mesh.is_none() && args.mesh.builtin.as_deref() == Some(pelt_core::mesh::builtin::TRY_ON_NAME) {
+            pelt_core::Builtin::Plane.mesh()
+        } else {
+            args.mesh.load(pelt_core::Builtin::Bunny)?
+        };
     // Files and presets are checked before the display is opened, so their errors come first.
     let mut app = app::App::new(args, mesh, report.source)?;
     let event_loop = winit::event_loop::EventLoop::new()

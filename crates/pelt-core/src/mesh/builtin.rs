@@ -11,6 +11,30 @@ use super::{ImportOptions, Mesh, MeshReport, RawMesh};
 /// The Stanford bunny (low resolution), embedded. Credits in `assets/CREDITS.md`.
 const BUNNY_OBJ: &str = include_str!("../../../../assets/meshes/bunny.obj");
 
+/// The `--builtin` name of the paper's virtual try-on scene ([`try_on_scene`]).
+pub const TRY_ON_NAME: &str = "tryon";
+const TRY_ON_GARMENT_OBJ: &str = include_str!("../../../../assets/meshes/skirthelper.obj");
+const TRY_ON_BODY_OBJ: &str = include_str!("../../../../assets/meshes/female_generic.obj");
+
+/// The paper's virtual try-on: a garment to grow fur on, worn by a body drawn plain.
+#[derive(Clone, Debug)]
+pub struct TryOnScene {
+    /// `skirthelper.obj`: an open cloth tube around the hips (MakeHuman, CC0).
+    pub garment: Mesh,
+    /// `female_generic.obj`: the body, in the same space (MakeHuman, CC0).
+    pub body: Mesh,
+}
+
+/// Loads the embedded try-on scene (one copy of its meshes in any binary that uses it).
+///
+/// # Errors
+/// Only if `options` make the shipped meshes unusable (e.g. a weld tolerance that collapses them).
+pub fn try_on_scene(options: &ImportOptions) -> Result<TryOnScene, super::MeshError> {
+    let garment = Mesh::from_obj_str(TRY_ON_GARMENT_OBJ, Path::new("builtin:tryon/skirthelper.obj"), options)?.0;
+    let body = Mesh::from_obj_str(TRY_ON_BODY_OBJ, Path::new("builtin:tryon/female_generic.obj"), options)?.0;
+    Ok(TryOnScene { garment, body })
+}
+
 /// A mesh Pelt can build without a file.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Builtin {
@@ -181,6 +205,15 @@ mod tests {
         let (mesh, report) = Builtin::Bunny.mesh();
         assert_eq!((mesh.vertex_count(), mesh.triangles.len()), (1839, 3674));
         assert!(report.is_closed_manifold(), "{report}");
+    }
+
+    #[test]
+    fn try_on_garment_sits_on_the_body() {
+        let scene = try_on_scene(&ImportOptions::default()).unwrap();
+        assert_eq!((scene.garment.vertex_count(), scene.body.vertex_count()), (720, 13_868));
+        let (garment_min, garment_max) = scene.garment.bounds();
+        let (body_min, body_max) = scene.body.bounds();
+        assert!(garment_min.y > body_min.y && garment_max.y < body_max.y, "the skirt is within the body's height");
     }
 
     #[test]

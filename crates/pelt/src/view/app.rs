@@ -6,6 +6,7 @@ use std::time::Instant;
 
 use anyhow::Context as _;
 use glam::{Vec2, Vec3};
+use pelt_core::mesh::builtin::{TRY_ON_NAME, TryOnScene, try_on_scene};
 use pelt_core::sim::{Scene, Simulation};
 use pelt_core::{Builtin, FurStructure, FurTextures, Mesh, Preset, PresetError, SeparatedStructure};
 use winit::application::ApplicationHandler;
@@ -741,7 +742,7 @@ impl Model {
             let mesh = match &self.settings.mesh {
                 MeshChoice::Builtin(builtin) => builtin.mesh().0,
                 MeshChoice::TryOn => {
-                    let (garment, body) = try_on_scene()?;
+                    let TryOnScene { garment, body } = try_on_scene(&pelt_core::ImportOptions::default())?;
                     self.body = Some(body);
                     garment
                 }
@@ -764,21 +765,6 @@ impl Model {
         }
         Ok(rebuilt)
     }
-}
-
-/// The `--builtin` name of the try-on scene (as in `pelt render`).
-pub const TRY_ON_NAME: &str = "tryon";
-
-/// The paper's virtual try-on: a furry skirt (an open tube around the hips) on a body, both
-/// MakeHuman assets in the same space.
-fn try_on_scene() -> anyhow::Result<(Mesh, Mesh)> {
-    let options = pelt_core::ImportOptions::default();
-    let load = |text: &str, name: &str| -> anyhow::Result<Mesh> {
-        Ok(Mesh::from_obj_str(text, std::path::Path::new(name), &options)?.0)
-    };
-    let garment = load(include_str!("../../../../assets/meshes/skirthelper.obj"), "skirthelper.obj")?;
-    let body = load(include_str!("../../../../assets/meshes/female_generic.obj"), "female_generic.obj")?;
-    Ok((garment, body))
 }
 
 /// Grows the rest pose of the fur on `mesh`.
