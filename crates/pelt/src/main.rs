@@ -1,6 +1,7 @@
 //! `pelt`: render, view, measure and author real-time fur.
 
 mod bench;
+mod format;
 mod mesh_args;
 mod render;
 mod stats;

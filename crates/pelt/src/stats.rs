@@ -10,6 +10,7 @@ use anyhow::Context as _;
 use pelt_core::fur::{Footprint, FurLength, MAX_LAYERS};
 use pelt_core::{Builtin, FurParams, FurStructure, GrowthDirection, MeshReport, SeparatedStructure};
 
+use crate::format::thousands;
 use crate::mesh_args::MeshArgs;
 
 /// Arguments of `pelt stats`.
@@ -109,9 +110,9 @@ pub fn table(stats: &Stats) -> String {
         out,
         "Table 2 on {} (V = {}, F = {}, E = {}; L = {} shells above the base)",
         r.source,
-        grouped(r.vertices as u64),
-        grouped(r.triangles as u64),
-        grouped(r.edges as u64),
+        thousands(r.vertices as u64),
+        thousands(r.triangles as u64),
+        thousands(r.edges as u64),
         stats.layers
     );
     let _ = writeln!(
@@ -128,12 +129,12 @@ pub fn table(stats: &Stats) -> String {
         let _ = writeln!(
             out,
             "{name:<26} {:>10} {:>11} {:>11} {:>13} {:>13} {:>13}",
-            grouped(f.vertices),
-            grouped(f.shell_faces),
-            grouped(f.fin_faces),
-            grouped(f.position_bytes + f.attribute_bytes),
-            grouped(f.index_bytes),
-            grouped(f.total_bytes())
+            thousands(f.vertices),
+            thousands(f.shell_faces),
+            thousands(f.fin_faces),
+            thousands(f.position_bytes + f.attribute_bytes),
+            thousands(f.index_bytes),
+            thousands(f.total_bytes())
         );
     }
     let s = &stats.savings;
@@ -157,24 +158,11 @@ pub fn table(stats: &Stats) -> String {
         let _ = writeln!(
             out,
             "paper's Table 2, Box: {} / {} / {} vertices (unified / 2-face / 30-face): {}",
-            grouped(unified),
-            grouped(two),
-            grouped(thirty),
+            thousands(unified),
+            thousands(two),
+            thousands(thirty),
             if agrees { "matches" } else { "DIFFERS" }
         );
-    }
-    out
-}
-
-/// `1234567` as `1,234,567`.
-fn grouped(n: u64) -> String {
-    let digits = n.to_string();
-    let mut out = String::with_capacity(digits.len() + digits.len() / 3);
-    for (k, c) in digits.chars().enumerate() {
-        if k > 0 && (digits.len() - k).is_multiple_of(3) {
-            out.push(',');
-        }
-        out.push(c);
     }
     out
 }
@@ -186,15 +174,6 @@ mod tests {
     fn stats_of(builtin: Builtin, layers: u32, fin_faces: u32) -> Stats {
         let (mesh, report) = builtin.mesh();
         measure(mesh, report, layers, fin_faces).unwrap()
-    }
-
-    #[test]
-    fn thousands_are_grouped() {
-        assert_eq!(grouped(0), "0");
-        assert_eq!(grouped(999), "999");
-        assert_eq!(grouped(1_000), "1,000");
-        assert_eq!(grouped(31_492), "31,492");
-        assert_eq!(grouped(1_234_567), "1,234,567");
     }
 
     #[test]

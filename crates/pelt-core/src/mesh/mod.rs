@@ -429,15 +429,7 @@ impl Topology {
     /// Builds the sorted undirected edge list of `triangles`.
     #[must_use]
     pub fn build(triangles: &[[u32; 3]]) -> Self {
-        // (low, high, face, forward) for every half-edge, sorted so each edge's uses are adjacent.
-        let mut half_edges: Vec<(u32, u32, u32, bool)> = Vec::with_capacity(triangles.len() * 3);
-        for (face, tri) in triangles.iter().enumerate() {
-            for k in 0..3 {
-                let (a, b) = (tri[k], tri[(k + 1) % 3]);
-                half_edges.push((a.min(b), a.max(b), face as u32, a < b));
-            }
-        }
-        half_edges.sort_unstable();
+        let half_edges = sorted_half_edges(triangles);
         let mut topology = Self::default();
         let mut start = 0;
         while start < half_edges.len() {
@@ -498,15 +490,7 @@ impl Topology {
 /// to flip as few triangles as possible. A non-orientable part (a Moebius strip) keeps the
 /// conflicts it cannot avoid; they stay counted as inconsistent winding.
 fn orientation_flips(positions: &[Vec3], triangles: &[[u32; 3]]) -> Vec<bool> {
-    // (low, high, face, forward) per half-edge, sorted so each edge's uses are adjacent.
-    let mut half_edges: Vec<(u32, u32, u32, bool)> = Vec::with_capacity(triangles.len() * 3);
-    for (face, tri) in triangles.iter().enumerate() {
-        for k in 0..3 {
-            let (a, b) = (tri[k], tri[(k + 1) % 3]);
-            half_edges.push((a.min(b), a.max(b), face as u32, a < b));
-        }
-    }
-    half_edges.sort_unstable();
+    let half_edges = sorted_half_edges(triangles);
     // (neighbour, whether the two traverse the edge the same way, i.e. one must flip).
     let mut neighbours: Vec<Vec<(u32, bool)>> = vec![Vec::new(); triangles.len()];
     let mut is_open = vec![false; triangles.len()];
@@ -565,6 +549,19 @@ fn orientation_flips(positions: &[Vec3], triangles: &[[u32; 3]]) -> Vec<bool> {
         }
     }
     flip
+}
+
+/// `(low, high, face, forward)` for every half-edge, sorted so each edge's uses are adjacent.
+fn sorted_half_edges(triangles: &[[u32; 3]]) -> Vec<(u32, u32, u32, bool)> {
+    let mut half_edges = Vec::with_capacity(triangles.len() * 3);
+    for (face, tri) in triangles.iter().enumerate() {
+        for k in 0..3 {
+            let (a, b) = (tri[k], tri[(k + 1) % 3]);
+            half_edges.push((a.min(b), a.max(b), face as u32, a < b));
+        }
+    }
+    half_edges.sort_unstable();
+    half_edges
 }
 
 fn bounds(positions: &[Vec3]) -> (Vec3, Vec3) {

@@ -3,6 +3,7 @@
 use std::fmt::Write as _;
 
 use super::table2::{PAPER_SAVINGS_VS_2_PERCENT, PAPER_SAVINGS_VS_30_PERCENT, Table2Row, savings_percent};
+use crate::format::thousands;
 
 /// Everything one `pelt bench` run measured.
 #[derive(Debug, serde::Serialize)]
@@ -335,31 +336,4 @@ fn mib(bytes: u64) -> String {
 
 fn gib(bytes: u64) -> String {
     format!("{:.1} GiB", bytes as f64 / (1024.0 * 1024.0 * 1024.0))
-}
-
-/// `31492` -> `31,492`, as the paper prints counts.
-fn thousands(n: u64) -> String {
-    let digits = n.to_string();
-    let mut out = String::with_capacity(digits.len() + digits.len() / 3);
-    for (i, c) in digits.chars().enumerate() {
-        if i > 0 && (digits.len() - i).is_multiple_of(3) {
-            out.push(',');
-        }
-        out.push(c);
-    }
-    out
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn thousands_groups_digits() {
-        assert_eq!(thousands(0), "0");
-        assert_eq!(thousands(296), "296");
-        assert_eq!(thousands(5_032), "5,032");
-        assert_eq!(thousands(275_460), "275,460");
-        assert_eq!(thousands(1_234_567), "1,234,567");
-    }
 }

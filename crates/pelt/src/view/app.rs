@@ -21,6 +21,7 @@ use super::fur::FurView;
 use super::gpu::{self, Acquired, WindowSurface};
 use super::panel::{self, Changes, MeshChoice, Requests, Settings};
 use super::viewport::Viewport;
+use crate::format::thousands;
 
 /// Time step of `--screenshot-after` runs, so they repeat exactly.
 const FIXED_FRAME_SECS: f64 = 1.0 / 60.0;
@@ -776,18 +777,6 @@ fn grow(mesh: Mesh, preset: &Preset) -> anyhow::Result<FurStructure> {
 /// Exponential moving average, so the overlay's numbers are readable.
 fn smooth(previous: f64, sample: f64) -> f64 {
     if previous == 0.0 { sample } else { previous * 0.9 + sample * 0.1 }
-}
-
-fn thousands(value: u64) -> String {
-    let digits = value.to_string();
-    let mut out = String::new();
-    for (i, digit) in digits.chars().enumerate() {
-        if i > 0 && (digits.len() - i).is_multiple_of(3) {
-            out.push(',');
-        }
-        out.push(digit);
-    }
-    out
 }
 
 fn bytes(value: u64) -> String {
