@@ -9,12 +9,12 @@ use glam::{Vec2, Vec3};
 use super::{ImportOptions, Mesh, MeshReport, RawMesh};
 
 /// The Stanford bunny (low resolution), embedded. Credits in `assets/CREDITS.md`.
-const BUNNY_OBJ: &str = include_str!("../../../../assets/meshes/bunny.obj");
+const BUNNY_OBJ: &str = include_str!("../../assets/meshes/bunny.obj");
 
 /// The `--builtin` name of the paper's virtual try-on scene ([`try_on_scene`]).
 pub const TRY_ON_NAME: &str = "tryon";
-const TRY_ON_GARMENT_OBJ: &str = include_str!("../../../../assets/meshes/skirthelper.obj");
-const TRY_ON_BODY_OBJ: &str = include_str!("../../../../assets/meshes/female_generic.obj");
+const TRY_ON_GARMENT_OBJ: &str = include_str!("../../assets/meshes/skirthelper.obj");
+const TRY_ON_BODY_OBJ: &str = include_str!("../../assets/meshes/female_generic.obj");
 
 /// The paper's virtual try-on: a garment to grow fur on, worn by a body drawn plain.
 #[derive(Clone, Debug)]
