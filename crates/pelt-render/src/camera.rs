@@ -1,16 +1,25 @@
-//! A perspective camera and automatic framing from a bounding sphere.
+//! A perspective camera and automatic framing from a bounding sphere: a convenience that makes
+//! [`ViewData`] for Pelt's own commands and examples. Hosts with a camera of their own build
+//! [`ViewData`] from it instead.
 
 use glam::{Mat4, Vec3};
 
-/// A right-handed, Y-up perspective camera.
+use crate::view::{Light, ViewData};
+
+/// A right-handed, Y-up perspective camera with conventional depth (0 at `near`, 1 at `far`).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Camera {
+    /// Where the camera is.
     pub eye: Vec3,
+    /// The point it looks at.
     pub target: Vec3,
+    /// The world direction that is up in the picture.
     pub up: Vec3,
     /// Vertical field of view.
     pub fov_y_rad: f32,
+    /// Near plane distance.
     pub near: f32,
+    /// Far plane distance.
     pub far: f32,
 }
 
@@ -94,6 +103,17 @@ impl Camera {
         let clip_from_view =
             glam::camera::rh::proj::directx::perspective(self.fov_y_rad, aspect_ratio.max(1e-3), self.near, self.far);
         clip_from_view * self.view_from_world()
+    }
+
+    /// The view for a target of `aspect_ratio`, lit by `light`.
+    #[must_use]
+    pub fn view_data(&self, aspect_ratio: f32, light: &Light) -> ViewData {
+        let world_from_view = self.view_from_world().inverse();
+        ViewData {
+            // The eye itself rather than the inverse's translation, which rounds.
+            camera_position_world: self.eye,
+            ..ViewData::new(self.clip_from_world(aspect_ratio), world_from_view, light)
+        }
     }
 }
 

@@ -1,4 +1,5 @@
-//! The GPU: instance, adapter, device and queue, chosen by backend.
+//! The GPU for Pelt's own commands and tests: instance, adapter, device and queue, chosen by
+//! backend, created blocking (the `headless` feature). Hosts bring their own device instead.
 
 use std::fmt;
 use std::str::FromStr;
@@ -11,9 +12,13 @@ pub enum Backend {
     /// `WGPU_BACKEND` when set, else every backend wgpu supports here (a real GPU wins).
     #[default]
     Auto,
+    /// Vulkan (lavapipe without a GPU).
     Vulkan,
+    /// OpenGL / GLES (llvmpipe without a GPU).
     Gl,
+    /// Metal.
     Metal,
+    /// Direct3D 12.
     Dx12,
 }
 
@@ -81,9 +86,13 @@ fn request_adapter(backends: wgpu::Backends) -> Result<(wgpu::Instance, wgpu::Ad
 /// An adapter with its device and queue.
 #[derive(Debug)]
 pub struct Gpu {
+    /// The instance the adapter came from (window surfaces are made with it).
     pub instance: wgpu::Instance,
+    /// The adapter.
     pub adapter: wgpu::Adapter,
+    /// The device, with [`crate::required_limits`] of the adapter's own limits.
     pub device: wgpu::Device,
+    /// The device's queue.
     pub queue: wgpu::Queue,
 }
 
@@ -94,7 +103,7 @@ impl Gpu {
     ///
     /// # Errors
     /// [`RenderError::NoAdapter`] (with install advice), [`RenderError::NoDevice`] or
-    /// [`RenderError::NoVertexStorage`].
+    /// what [`crate::check_adapter`] finds.
     pub fn new(backend: Backend) -> Result<Self, RenderError> {
         // Auto tries the modern APIs first and GL only without them: probing GL (EGL) prints
         // warnings on machines without a display, which a working Vulkan makes pointless.
@@ -119,16 +128,14 @@ impl Gpu {
     /// the renderer needs: the adapter's own, so large meshes fit where the hardware allows.
     ///
     /// # Errors
-    /// [`RenderError::NoDevice`] or [`RenderError::NoVertexStorage`].
+    /// [`RenderError::NoDevice`] or what [`crate::check_adapter`] finds.
     pub fn from_adapter(instance: wgpu::Instance, adapter: wgpu::Adapter) -> Result<Self, RenderError> {
+        crate::check_adapter(&adapter)?;
         let name = adapter.get_info().name;
-        if !adapter.get_downlevel_capabilities().flags.contains(wgpu::DownlevelFlags::VERTEX_STORAGE) {
-            return Err(RenderError::NoVertexStorage { adapter: name });
-        }
         let descriptor = wgpu::DeviceDescriptor {
             label: Some("pelt"),
-            required_features: wgpu::Features::empty(),
-            required_limits: adapter.limits(),
+            required_features: crate::required_features(),
+            required_limits: crate::required_limits(&adapter.limits()),
             ..wgpu::DeviceDescriptor::default()
         };
         let (device, queue) = pollster::block_on(adapter.request_device(&descriptor))

@@ -1,20 +1,22 @@
-//! Rendering without a window: a GPU, an offscreen target and a readback into an image.
+//! Rendering without a window (the `headless` feature): a GPU, an offscreen target and a
+//! readback into an image.
 
-use pelt_core::FurStructure;
-use pelt_core::texture::FurTextures;
+use glam::Vec3;
 
 use crate::RenderError;
-use crate::camera::Camera;
 use crate::gpu::{Backend, Gpu};
-use crate::renderer::{ErrorScope, RenderSettings, Renderer};
-use crate::targets::{RenderTargets, TargetFormat};
+use crate::renderer::FurRenderer;
+use crate::requirements::ErrorScope;
+use crate::targets::{FurTarget, RenderTargets};
 
 /// Colour format of headless frames (sRGB: what PNGs hold).
 pub const HEADLESS_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrgb;
 
-/// A GPU with an offscreen `width x height` target that reads frames back as RGBA8 images.
+/// A GPU with an offscreen `width x height` target ([`FurTarget::new`] of [`HEADLESS_FORMAT`]:
+/// 4x MSAA, conventional depth) that reads frames back as RGBA8 images.
 #[derive(Debug)]
 pub struct Headless {
+    /// The GPU frames are drawn on.
     pub gpu: Gpu,
     targets: RenderTargets,
     output: wgpu::Texture,
@@ -37,14 +39,29 @@ impl Headless {
     /// # Errors
     /// [`RenderError::TargetSize`].
     pub fn with_gpu(gpu: Gpu, width: u32, height: u32) -> Result<Self, RenderError> {
-        let targets = RenderTargets::new(&gpu.device, TargetFormat::msaa(HEADLESS_FORMAT), width, height)?;
+        Self::with_target(gpu, FurTarget::new(HEADLESS_FORMAT), width, height)
+    }
+
+    /// Uses an existing GPU and another target description (e.g. reverse-Z depth or no MSAA);
+    /// its colour format must be RGBA8 (`Rgba8UnormSrgb` or `Rgba8Unorm`).
+    ///
+    /// # Errors
+    /// [`RenderError::TargetSize`], or [`RenderError::Target`] for another colour format.
+    pub fn with_target(gpu: Gpu, target: FurTarget, width: u32, height: u32) -> Result<Self, RenderError> {
+        if !matches!(target.colour_format, wgpu::TextureFormat::Rgba8UnormSrgb | wgpu::TextureFormat::Rgba8Unorm) {
+            return Err(RenderError::Target(format!(
+                "headless frames are read back as RGBA8, not {:?}",
+                target.colour_format
+            )));
+        }
+        let targets = RenderTargets::new(&gpu.device, target, width, height)?;
         let output = gpu.device.create_texture(&wgpu::TextureDescriptor {
             label: Some("pelt headless output"),
             size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
             mip_level_count: 1,
             sample_count: 1,
             dimension: wgpu::TextureDimension::D2,
-            format: HEADLESS_FORMAT,
+            format: target.colour_format,
             usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
             view_formats: &[],
         });
@@ -59,16 +76,16 @@ impl Headless {
         Ok(Self { gpu, targets, output, output_view, readback, padded_row_bytes })
     }
 
-    /// The target format renderers for this target must be built with.
+    /// The target description renderers for this target must be built with.
     #[must_use]
-    pub fn format(&self) -> TargetFormat {
-        self.targets.format
+    pub fn target(&self) -> FurTarget {
+        self.targets.target()
     }
 
     /// `(width, height)`.
     #[must_use]
     pub fn size(&self) -> (u32, u32) {
-        (self.targets.width, self.targets.height)
+        self.targets.size()
     }
 
     /// Aspect ratio of the target.
@@ -80,39 +97,28 @@ impl Headless {
     /// A renderer for this target.
     ///
     /// # Errors
-    /// As [`Renderer::new`].
-    pub fn renderer(&self, fur: &FurStructure, textures: &FurTextures) -> Result<Renderer, RenderError> {
-        Renderer::new(&self.gpu.device, &self.gpu.queue, self.format(), fur, textures)
+    /// As [`FurRenderer::new`].
+    pub fn renderer(&self) -> Result<FurRenderer, RenderError> {
+        FurRenderer::new(&self.gpu.device, self.target())
     }
 
-    /// Renders one frame with `renderer` and reads it back.
+    /// Renders one frame and reads it back: a pass cleared to `background` (linear RGB) and the
+    /// far depth, in which `draw` records (after the `prepare` calls it relies on).
     ///
     /// # Errors
     /// [`RenderError::Readback`], or a GPU error raised while drawing.
     pub fn render(
         &self,
-        renderer: &Renderer,
-        camera: &Camera,
-        settings: &RenderSettings,
-    ) -> Result<image::RgbaImage, RenderError> {
-        self.render_with(|queue, encoder, targets, output| {
-            renderer.render(queue, encoder, targets, output, camera, settings);
-        })
-    }
-
-    /// Renders one frame recorded by `record(queue, encoder, targets, output)` (e.g. a
-    /// [`crate::SeparatedRenderer`]) and reads it back.
-    ///
-    /// # Errors
-    /// [`RenderError::Readback`], or a GPU error raised while drawing.
-    pub fn render_with(
-        &self,
-        record: impl FnOnce(&wgpu::Queue, &mut wgpu::CommandEncoder, &RenderTargets, &wgpu::TextureView),
+        background: Vec3,
+        draw: impl FnOnce(&mut wgpu::RenderPass<'_>),
     ) -> Result<image::RgbaImage, RenderError> {
         let device = &self.gpu.device;
         let scope = ErrorScope::push(device);
         let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("pelt frame") });
-        record(&self.gpu.queue, &mut encoder, &self.targets, &self.output_view);
+        {
+            let mut pass = self.targets.begin_pass(&mut encoder, &self.output_view, background);
+            draw(&mut pass);
+        }
         let (width, height) = self.size();
         encoder.copy_texture_to_buffer(
             self.output.as_image_copy(),

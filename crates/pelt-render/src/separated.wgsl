@@ -1,69 +1,74 @@
 // The separated structure of Lengyel et al. 2001: shells and fins as their own static vertex
-// buffers (position, normal, uv: 32 bytes a vertex). Appended to `shading.wgsl`.
-
-struct Separated {
-    // World units -> tiles.
-    tiles_per_world: f32,
-    // L.
-    layers: u32,
-    shell_slices: u32,
-    has_uvs: u32,
-    // World units per uv unit: recovers the mesh uv for surface colour.
-    world_per_uv: f32,
-    padding_0: u32,
-    padding_1: u32,
-    padding_2: u32,
-}
-
-@group(1) @binding(0) var<uniform> separated: Separated;
-
-fn uses_mesh_uvs() -> bool {
-    return separated.has_uvs != 0u;
-}
+// buffers (position, normal, uv: 32 bytes a vertex, model space). Appended to `shading.wgsl`;
+// group 1 holds only the object uniform.
 
 struct VertexIn {
     @location(0) position: vec3<f32>,
-    // Shells: the growing vector. Fins: the fin's plane normal.
+    // Layer 0 (the skin): the base normal. Shells: the growing vector. Fins: the fin's plane normal.
     @location(1) normal: vec3<f32>,
-    // Shells: mesh uv scaled to world units on the CPU. Fins: (world units along the edge, height).
+    // Shells: mesh uv scaled to model units on the CPU. Fins: (model units along the edge, height).
     @location(2) uv: vec2<f32>,
+}
+
+// Layer 0 of the shell vertices, opaque, as the unified skin.
+@vertex
+fn vs_separated_skin(in: VertexIn) -> Varyings {
+    var out: Varyings;
+    let position = world_from_model_point(in.position);
+    out.clip_position = view.clip_from_world * vec4<f32>(position, 1.0);
+    out.world_position = position;
+    out.normal = world_from_model_normal(in.normal);
+    out.tangent = out.normal;
+    out.tile_position = vec3<f32>(0.0);
+    out.tile_normal = vec3<f32>(0.0);
+    out.uv = vec2<f32>(0.0);
+    out.surface_uv = in.uv / object.world_per_uv;
+    out.layer = 0u;
+    out.slice = 0;
+    out.height = 0.0;
+    out.fade = 1.0;
+    return out;
 }
 
 // Shells: one draw per layer with a base-vertex offset; the instance index carries the layer.
 @vertex
 fn vs_separated_shell(in: VertexIn, @builtin(instance_index) layer: u32) -> Varyings {
     var out: Varyings;
-    out.clip_position = globals.clip_from_world * vec4<f32>(in.position, 1.0);
-    out.world_position = in.position;
-    out.normal = in.normal;
-    out.tangent = in.normal;
-    out.tile_position = in.position * separated.tiles_per_world;
-    out.uv = in.uv * separated.tiles_per_world;
-    out.surface_uv = in.uv / separated.world_per_uv;
+    let position = world_from_model_point(in.position);
+    out.clip_position = view.clip_from_world * vec4<f32>(position, 1.0);
+    out.world_position = position;
+    out.normal = world_from_model_normal(in.normal);
+    out.tangent = out.normal;
+    out.tile_position = in.position * object.tiles_per_world;
+    out.tile_normal = in.normal;
+    out.uv = in.uv * object.tiles_per_world;
+    out.surface_uv = in.uv / object.world_per_uv;
     out.layer = layer;
-    out.slice = i32(((max(layer, 1u) - 1u) * separated.shell_slices) / max(separated.layers, 1u));
-    out.height = f32(layer) / f32(max(separated.layers, 1u));
-    out.fade = shell_fade(in.normal, in.position);
+    out.slice = shell_slice(layer);
+    out.height = layer_height(layer);
+    out.fade = shell_fade(out.normal, position);
     return out;
 }
 
 @vertex
 fn vs_separated_fin(in: VertexIn) -> Varyings {
     var out: Varyings;
-    out.clip_position = globals.clip_from_world * vec4<f32>(in.position, 1.0);
-    out.world_position = in.position;
-    out.normal = in.normal;
-    out.tangent = in.normal;
+    let position = world_from_model_point(in.position);
+    out.clip_position = view.clip_from_world * vec4<f32>(position, 1.0);
+    out.world_position = position;
+    out.normal = world_from_model_normal(in.normal);
+    out.tangent = out.normal;
     out.tile_position = vec3<f32>(0.0);
-    out.uv = vec2<f32>(in.uv.x * separated.tiles_per_world, in.uv.y);
+    out.tile_normal = vec3<f32>(0.0);
+    out.uv = vec2<f32>(in.uv.x * object.tiles_per_world, in.uv.y);
     out.layer = 0u;
     out.slice = 0;
     // Separated fins keep no mesh uv: surface colour mode tints them with the texture's corner.
     out.surface_uv = vec2<f32>(0.0);
     out.height = in.uv.y;
     // Lengyel's fade: a fin shows where it faces the viewer, i.e. stands on a silhouette edge.
-    let to_camera = safe_normalize(globals.camera_position - in.position, in.normal);
-    out.fade = smoothstep(1.0 - globals.fin_fade_cos, 1.0, abs(dot(in.normal, to_camera)));
+    let to_camera = safe_normalize(view.camera_position - position, out.normal);
+    out.fade = smoothstep(1.0 - object.fin_fade_cos, 1.0, abs(dot(out.normal, to_camera)));
     return out;
 }
 

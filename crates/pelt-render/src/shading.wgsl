@@ -1,48 +1,84 @@
-// Shared by every fur pipeline: the frame's globals, the fur textures and the lighting.
-// `unified.wgsl` and `separated.wgsl` are appended to this file to make one module each.
+// Shared by every Pelt pipeline: the view, the per-object uniforms, the fur textures and the
+// lighting. `unified.wgsl` and `separated.wgsl` are appended to this file to make one module each.
+//
+// Bind groups: 0 = one view (`FurView`), 1 = one object (a fur or a plain mesh), 2 = the fur's
+// textures (fur pipelines only).
 
-struct Globals {
+// One view, written by the host every frame (`ViewData`).
+struct View {
     clip_from_world: mat4x4<f32>,
     camera_position: vec3<f32>,
-    // 1 when shells and fins use alpha-to-coverage (straight colour out), 0 when blended.
-    alpha_to_coverage: u32,
-    // Unit vector toward the key light.
-    light_direction: vec3<f32>,
     ambient: f32,
+    // Unit vector toward the key light, world space.
+    light_direction: vec3<f32>,
+    padding_0: f32,
+    // Linear RGB.
     light_colour: vec3<f32>,
-    specular: f32,
-    // Fur colour at the roots (linear RGB); the opaque skin uses it.
-    root_colour: vec4<f32>,
+    padding_1: f32,
+}
+
+// One fur or plain mesh (`object.rs`).
+struct Object {
+    world_from_model: mat4x4<f32>,
+    // Inverse transpose of `world_from_model`'s upper 3x3: model normals to world normals.
+    world_normal_from_model: mat3x3<f32>,
+    // Furs: the colour of the roots, for the opaque skin. Plain meshes: their colour. Linear RGB.
+    colour: vec4<f32>,
+    // V: base vertices, the stride between layers.
+    vertex_count: u32,
+    // L: shells above the base (0 for a plain mesh).
+    layers: u32,
+    triangle_count: u32,
+    edge_count: u32,
+    has_uvs: u32,
+    // 1 when strand colours are grey brightness to be multiplied by the surface texture.
+    has_surface: u32,
+    // Slices in the shell texture (may differ from `layers` while a viewer edits them).
+    shell_slices: u32,
+    padding_0: u32,
+    // Mesh uv -> tiles.
+    tiles_per_uv: f32,
+    // Model units -> tiles (triplanar projection and fins).
+    tiles_per_world: f32,
+    // Model units per uv unit (the separated structure recovers mesh uvs with it).
+    world_per_uv: f32,
+    // Weight of the current state against the previous one (unified structure).
+    interpolation: f32,
     // |cos| between the view and a fin's faces below which the fin is fully shown.
     fin_fade_cos: f32,
     // |cos| between the view and the surface below which shells fade out.
     shell_fade_cos: f32,
     // Light left at the roots by self-shadowing (1 = none).
     root_occlusion: f32,
+    specular: f32,
+    // Kajiya-Kay specular exponent.
     shininess: f32,
-    // 1 when strand colours are grey brightness to be multiplied by the surface texture.
-    has_surface: u32,
-    padding_0: u32,
-    padding_1: u32,
-    padding_2: u32,
+    padding_1: f32,
+    padding_2: f32,
+    padding_3: f32,
 }
 
-@group(0) @binding(0) var<uniform> globals: Globals;
-@group(0) @binding(1) var shell_texture: texture_2d_array<f32>;
-@group(0) @binding(2) var fin_texture: texture_2d<f32>;
-@group(0) @binding(3) var shell_sampler: sampler;
-@group(0) @binding(4) var fin_sampler: sampler;
+// Set per pipeline: shells and fins with alpha-to-coverage output straight colour, blended ones
+// premultiplied.
+override ALPHA_TO_COVERAGE: bool = false;
+
+@group(0) @binding(0) var<uniform> view: View;
+@group(1) @binding(0) var<uniform> object: Object;
+@group(2) @binding(0) var shell_texture: texture_2d_array<f32>;
+@group(2) @binding(1) var fin_texture: texture_2d<f32>;
+@group(2) @binding(2) var shell_sampler: sampler;
+@group(2) @binding(3) var fin_sampler: sampler;
 // The mesh's colour texture (surface colour mode), else 1x1 white.
-@group(0) @binding(5) var surface_texture: texture_2d<f32>;
+@group(2) @binding(4) var surface_texture: texture_2d<f32>;
 
 struct Varyings {
     @builtin(position) clip_position: vec4<f32>,
     @location(0) world_position: vec3<f32>,
-    // Rest normal of the base surface (stable while the fur moves).
+    // Base surface normal in world space (stable while the fur moves).
     @location(1) normal: vec3<f32>,
-    // Strand direction from the simulated shared vertices.
+    // Strand direction from the simulated shared vertices, world space.
     @location(2) tangent: vec3<f32>,
-    // Shells: rest root position in tiles (triplanar lookup). Fins: unused.
+    // Shells: root position in tiles, model space (triplanar lookup). Fins: unused.
     @location(3) tile_position: vec3<f32>,
     // Shells: mesh uv in tiles. Fins: (along the edge in tiles, height).
     @location(4) uv: vec2<f32>,
@@ -56,6 +92,13 @@ struct Varyings {
     @location(8) @interpolate(flat) slice: i32,
     // The mesh uv at the strand's root (surface colour mode).
     @location(9) surface_uv: vec2<f32>,
+    // Shells: the base normal in model space, weighting the triplanar projections (which are
+    // fixed to the model, so they move with it).
+    @location(10) tile_normal: vec3<f32>,
+}
+
+fn uses_mesh_uvs() -> bool {
+    return object.has_uvs != 0u;
 }
 
 fn safe_normalize(v: vec3<f32>, fallback: vec3<f32>) -> vec3<f32> {
@@ -66,53 +109,74 @@ fn safe_normalize(v: vec3<f32>, fallback: vec3<f32>) -> vec3<f32> {
     return fallback;
 }
 
+fn world_from_model_point(p: vec3<f32>) -> vec3<f32> {
+    return (object.world_from_model * vec4<f32>(p, 1.0)).xyz;
+}
+
+fn world_from_model_direction(d: vec3<f32>) -> vec3<f32> {
+    return (object.world_from_model * vec4<f32>(d, 0.0)).xyz;
+}
+
+// A model-space normal in world space, unit length (zero stays zero).
+fn world_from_model_normal(n: vec3<f32>) -> vec3<f32> {
+    return safe_normalize(object.world_normal_from_model * n, vec3<f32>(0.0));
+}
+
+// Shell layer i (1..=L) shows slice i - 1, scaled when the texture has another count.
+fn shell_slice(layer: u32) -> i32 {
+    return i32(((max(layer, 1u) - 1u) * object.shell_slices) / max(object.layers, 1u));
+}
+
+fn layer_height(layer: u32) -> f32 {
+    return f32(layer) / f32(max(object.layers, 1u));
+}
+
 // Shells fade where the surface is seen edge-on (where the sheets would show).
 fn shell_fade(normal: vec3<f32>, world_position: vec3<f32>) -> f32 {
-    let to_camera = safe_normalize(globals.camera_position - world_position, normal);
+    let to_camera = safe_normalize(view.camera_position - world_position, normal);
     let facing = abs(dot(normal, to_camera));
-    return mix(0.5, 1.0, smoothstep(0.0, globals.shell_fade_cos, facing));
+    return mix(0.5, 1.0, smoothstep(0.0, object.shell_fade_cos, facing));
 }
 
 // Darkening toward the roots: strands shadow each other deeper in the coat.
 fn occlusion(height: f32) -> f32 {
-    return mix(globals.root_occlusion, 1.0, pow(clamp(height, 0.0, 1.0), 0.7));
+    return mix(object.root_occlusion, 1.0, pow(clamp(height, 0.0, 1.0), 0.7));
 }
 
 // Kajiya-Kay hair lighting around the strand tangent, gated by the surface normal so the side
 // of the body facing away from the light stays dark.
 fn hair_lighting(albedo: vec3<f32>, tangent: vec3<f32>, normal: vec3<f32>, world_position: vec3<f32>, height: f32) -> vec3<f32> {
-    let to_light = globals.light_direction;
-    let to_camera = safe_normalize(globals.camera_position - world_position, normal);
+    let to_light = view.light_direction;
+    let to_camera = safe_normalize(view.camera_position - world_position, normal);
     let t_dot_l = dot(tangent, to_light);
     let diffuse = sqrt(max(1.0 - t_dot_l * t_dot_l, 0.0));
     let half_vector = safe_normalize(to_light + to_camera, to_light);
     let t_dot_h = dot(tangent, half_vector);
-    let specular = pow(sqrt(max(1.0 - t_dot_h * t_dot_h, 0.0)), globals.shininess);
+    let specular = pow(sqrt(max(1.0 - t_dot_h * t_dot_h, 0.0)), object.shininess);
     let lit_side = smoothstep(-0.25, 0.6, dot(normal, to_light));
     let ao = occlusion(height);
-    let light = globals.light_colour * lit_side;
-    let colour = albedo * (globals.ambient + light * diffuse * 0.85) * ao;
+    let light = view.light_colour * lit_side;
+    let colour = albedo * (view.ambient + light * diffuse * 0.85) * ao;
     // The highlight takes some of the strand's colour, as light scattered in hair does.
     let highlight = mix(vec3<f32>(1.0), albedo / max(max(albedo.r, albedo.g), max(albedo.b, 1e-3)), 0.5);
-    return colour + light * highlight * (specular * globals.specular * ao * height);
+    return colour + light * highlight * (specular * object.specular * ao * height);
 }
 
 // Lambert with a soft terminator for surfaces without fur (the skin, plain meshes).
 fn surface_lighting(albedo: vec3<f32>, normal: vec3<f32>) -> vec3<f32> {
-    let wrapped = max(dot(normal, globals.light_direction) * 0.7 + 0.3, 0.0);
-    return albedo * (globals.ambient + globals.light_colour * wrapped);
+    let wrapped = max(dot(normal, view.light_direction) * 0.7 + 0.3, 0.0);
+    return albedo * (view.ambient + view.light_colour * wrapped);
 }
 
 fn shell_texel(in: Varyings) -> vec4<f32> {
     let slice = in.slice;
-    // `uses_mesh_uvs` reads a uniform (defined by the appended module), so sampling stays in
-    // uniform control flow.
+    // `uses_mesh_uvs` reads a uniform, so sampling stays in uniform control flow.
     if uses_mesh_uvs() {
         return textureSample(shell_texture, shell_sampler, in.uv, slice);
     }
     // Triplanar: three axis-aligned projections of the tile, blended with sharp weights so the
     // strands stay crisp and only narrow bands mix two projections.
-    let weights_raw = pow(abs(in.normal), vec3<f32>(6.0));
+    let weights_raw = pow(abs(in.tile_normal), vec3<f32>(6.0));
     let weights = weights_raw / max(weights_raw.x + weights_raw.y + weights_raw.z, 1e-6);
     let p = in.tile_position;
     let x = textureSample(shell_texture, shell_sampler, p.yz, slice);
@@ -124,22 +188,29 @@ fn shell_texel(in: Varyings) -> vec4<f32> {
 // Surface colour mode: the mesh's texture at the strand's root tints the strand's brightness.
 fn surface_tint(uv: vec2<f32>) -> vec3<f32> {
     let colour = textureSample(surface_texture, shell_sampler, uv).rgb;
-    return select(vec3<f32>(1.0), colour, globals.has_surface != 0u);
+    return select(vec3<f32>(1.0), colour, object.has_surface != 0u);
 }
 
 fn fur_output(colour: vec3<f32>, alpha: f32) -> vec4<f32> {
-    if globals.alpha_to_coverage != 0u {
+    if ALPHA_TO_COVERAGE {
         return vec4<f32>(colour, alpha);
     }
     // Premultiplied for the (One, OneMinusSrcAlpha) blend.
     return vec4<f32>(colour * alpha, alpha);
 }
 
+// Plain meshes (no fur, e.g. the body under a furry garment): lit in the object's colour.
+@fragment
+fn fs_plain(in: Varyings) -> @location(0) vec4<f32> {
+    return vec4<f32>(surface_lighting(object.colour.rgb, normalize(in.normal)), 1.0);
+}
+
+// The opaque skin under the fur, in the colour of the roots.
 @fragment
 fn fs_skin(in: Varyings) -> @location(0) vec4<f32> {
     let normal = normalize(in.normal);
-    let albedo = globals.root_colour.rgb * surface_tint(in.surface_uv);
-    let colour = surface_lighting(albedo, normal) * globals.root_occlusion;
+    let albedo = object.colour.rgb * surface_tint(in.surface_uv);
+    let colour = surface_lighting(albedo, normal) * object.root_occlusion;
     return vec4<f32>(colour, 1.0);
 }
 

@@ -5,23 +5,45 @@
 use pelt_core::texture::{FurTextures, downsample_rgba8};
 
 use crate::RenderError;
+use crate::pipeline::Layouts;
 
-/// The fur textures on the GPU.
+/// One fur's textures on the GPU with their bind group (group 2 of the fur pipelines).
 #[derive(Debug)]
 pub(crate) struct GpuTextures {
-    pub shell: wgpu::TextureView,
-    pub fin: wgpu::TextureView,
+    pub bind_group: wgpu::BindGroup,
     pub shell_slices: u32,
-    /// The mesh's colour texture (surface colour mode), else 1x1 white.
-    pub surface: wgpu::TextureView,
     pub has_surface: bool,
     /// Alpha-weighted mean strand colour of the root slice, linear RGB.
     pub root_colour: glam::Vec3,
+    /// Bytes of all three textures with their mipmaps.
+    pub bytes: u64,
 }
 
 impl GpuTextures {
-    pub fn new(device: &wgpu::Device, queue: &wgpu::Queue, textures: &FurTextures) -> Result<Self, RenderError> {
+    pub fn new(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        layouts: &Layouts,
+        textures: &FurTextures,
+    ) -> Result<Self, RenderError> {
         validate(textures)?;
+        let limits = device.limits();
+        let side = textures.size.max(textures.fin_width).max(textures.fin_height);
+        let surface_side = textures.surface.as_ref().map_or(1, |s| s.width.max(s.height));
+        if side.max(surface_side) > limits.max_texture_dimension_2d || textures.layers > limits.max_texture_array_layers
+        {
+            return Err(RenderError::Textures(format!(
+                "{0}x{0}x{1} shell, {2}x{3} fin and a {4}-texel surface image exceed this GPU's texture limits \
+                 ({5} texels a side, {6} layers)",
+                textures.size,
+                textures.layers,
+                textures.fin_width,
+                textures.fin_height,
+                surface_side,
+                limits.max_texture_dimension_2d,
+                limits.max_texture_array_layers
+            )));
+        }
         let slice_bytes = textures.size as usize * textures.size as usize * 4;
         let shell = upload(
             device,
@@ -43,15 +65,38 @@ impl GpuTextures {
         };
         let surface = upload(device, queue, "pelt surface colour", surface_size, vec![surface_pixels])
             .create_view(&wgpu::TextureViewDescriptor::default());
+        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("pelt fur textures"),
+            layout: &layouts.textures,
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&shell) },
+                wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&fin) },
+                wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::Sampler(&layouts.shell_sampler) },
+                wgpu::BindGroupEntry { binding: 3, resource: wgpu::BindingResource::Sampler(&layouts.fin_sampler) },
+                wgpu::BindGroupEntry { binding: 4, resource: wgpu::BindingResource::TextureView(&surface) },
+            ],
+        });
+        let bytes = mipmapped_bytes(textures.size, textures.size) * u64::from(textures.layers)
+            + mipmapped_bytes(textures.fin_width, textures.fin_height)
+            + mipmapped_bytes(surface_size.0, surface_size.1);
         Ok(Self {
-            shell,
-            fin,
+            bind_group,
             shell_slices: textures.layers,
-            surface,
             has_surface: textures.surface.is_some(),
             root_colour: root_colour(textures, slice_bytes),
+            bytes,
         })
     }
+}
+
+/// Bytes of an RGBA8 texture with the full mip chain `upload` makes.
+fn mipmapped_bytes(width: u32, height: u32) -> u64 {
+    let (mut w, mut h, mut bytes) = (u64::from(width), u64::from(height), 0);
+    for _ in 0..32 - width.max(height).leading_zeros() {
+        bytes += 4 * w * h;
+        (w, h) = ((w / 2).max(1), (h / 2).max(1));
+    }
+    bytes
 }
 
 fn validate(textures: &FurTextures) -> Result<(), RenderError> {
@@ -166,5 +211,12 @@ mod tests {
         assert!(validate(&textures).is_ok());
         let surface = pelt_core::texture::ImageRgba8 { width: 2, height: 2, pixels: vec![0; 12] };
         assert!(validate(&FurTextures { surface: Some(surface), ..textures }).is_err());
+    }
+
+    #[test]
+    fn mip_chains_are_counted() {
+        assert_eq!(mipmapped_bytes(1, 1), 4);
+        assert_eq!(mipmapped_bytes(4, 4), 4 * (16 + 4 + 1));
+        assert_eq!(mipmapped_bytes(4, 1), 4 * (4 + 2 + 1));
     }
 }

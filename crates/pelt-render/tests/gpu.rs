@@ -6,50 +6,38 @@ use common::*;
 use glam::Vec3;
 use pelt_core::Builtin;
 use pelt_core::sim::{SimParams, Simulation, WindParams};
-use pelt_render::{Camera, Headless, RenderSettings, Renderer, SeparatedRenderer};
+use pelt_render::{
+    Camera, DEFAULT_BACKGROUND, FurDrawSettings, FurFrame, FurRenderer, SeparatedFur, SeparatedRenderer,
+};
 
 const SIZE: u32 = 256;
-
-/// The background as stored in the image (sRGB of the default clear colour).
-fn background(headless: &Headless, renderer: &Renderer, camera: &Camera) -> [u8; 3] {
-    let away = Camera { target: camera.eye * 2.0 - camera.target, ..*camera };
-    let empty = headless.render(renderer, &away, &settings()).expect("frame");
-    let p = empty.get_pixel(0, 0).0;
-    [p[0], p[1], p[2]]
-}
-
-fn render(headless: &Headless, renderer: &Renderer, camera: &Camera, settings: &RenderSettings) -> image::RgbaImage {
-    headless.render(renderer, camera, settings).expect("frame")
-}
 
 #[test]
 fn golden_bunny_still() {
     let fur = builtin_fur(Builtin::Bunny, 16);
-    let headless = headless(SIZE, SIZE);
-    let renderer = headless.renderer(&fur, &strand_textures(256, 16, BROWN_ROOT, BROWN_TIP)).expect("renderer");
-    check_golden("bunny-still", &render(&headless, &renderer, &framed(&fur, 1.0), &settings()));
+    let rig = Rig::new(SIZE, SIZE);
+    let gpu_fur = rig.fur(&fur, &strand_textures(256, 16, BROWN_ROOT, BROWN_TIP));
+    check_golden("bunny-still", &rig.render(&gpu_fur, &framed(&fur, 1.0), &settings()));
 }
 
 #[test]
 fn golden_box() {
     let fur = builtin_fur(Builtin::Box, 16);
-    let headless = headless(SIZE, SIZE);
-    let textures = strand_textures(256, 16, [40, 40, 44], [235, 235, 240]);
-    let renderer = headless.renderer(&fur, &textures).expect("renderer");
-    check_golden("box", &render(&headless, &renderer, &framed(&fur, 1.0), &settings()));
+    let rig = Rig::new(SIZE, SIZE);
+    let gpu_fur = rig.fur(&fur, &strand_textures(256, 16, [40, 40, 44], [235, 235, 240]));
+    check_golden("box", &rig.render(&gpu_fur, &framed(&fur, 1.0), &settings()));
 }
 
 #[test]
 fn golden_tryon() {
     let body = load_asset("female_generic.obj");
     let garment = grow(load_asset("skirthelper.obj"), 16, 0.12);
-    let headless = headless(SIZE, SIZE);
-    let textures = strand_textures(256, 16, [30, 20, 45], [150, 110, 190]);
-    let mut renderer = headless.renderer(&garment, &textures).expect("renderer");
-    renderer.add_plain_mesh(&headless.gpu.device, &body, Vec3::new(0.6, 0.45, 0.38)).expect("body");
+    let rig = Rig::new(SIZE, SIZE);
+    let fur = rig.fur(&garment, &strand_textures(256, 16, [30, 20, 45], [150, 110, 190]));
+    let body = rig.plain(&body, Vec3::new(0.6, 0.45, 0.38));
     let (centre, radius) = garment.mesh.bounding_sphere();
     let camera = Camera::framing(centre, radius * 1.6, 25.0, 10.0, 1.0);
-    check_golden("tryon", &render(&headless, &renderer, &camera, &settings()));
+    check_golden("tryon", &rig.render_scene(&[&body], Some(&fur), &camera, &settings()));
 }
 
 /// The simulation with a steady wind along `direction` (no gusts or shake, so the pose is exact).
@@ -65,28 +53,28 @@ fn windy_simulation(fur: &pelt_core::FurStructure, direction: Vec3, strength: f3
 #[test]
 fn golden_bunny_in_wind() {
     let fur = builtin_fur(Builtin::Bunny, 16);
-    let headless = headless(SIZE, SIZE);
-    let renderer = headless.renderer(&fur, &strand_textures(256, 16, BROWN_ROOT, BROWN_TIP)).expect("renderer");
+    let rig = Rig::new(SIZE, SIZE);
+    let gpu_fur = rig.fur(&fur, &strand_textures(256, 16, BROWN_ROOT, BROWN_TIP));
     let simulation = windy_simulation(&fur, Vec3::new(1.0, 0.0, 0.3), 1.5, 12);
-    renderer.update_positions(&headless.gpu.queue, simulation.positions()).expect("positions");
-    check_golden("bunny-wind", &render(&headless, &renderer, &framed(&fur, 1.0), &settings()));
+    gpu_fur.set_positions(rig.queue(), simulation.positions()).expect("positions");
+    check_golden("bunny-wind", &rig.render(&gpu_fur, &framed(&fur, 1.0), &settings()));
 }
 
 /// Simulated wind toward the camera's right moves the fur's pixels right, shells and fins alike.
 #[test]
 fn wind_moves_fur_pixels_in_the_wind_direction() {
     let fur = grow(Builtin::Sphere.mesh().0, 16, 0.25);
-    let headless = headless(SIZE, SIZE);
-    let renderer = headless.renderer(&fur, &strand_textures(256, 16, BROWN_ROOT, BROWN_TIP)).expect("renderer");
+    let rig = Rig::new(SIZE, SIZE);
+    let gpu_fur = rig.fur(&fur, &strand_textures(256, 16, BROWN_ROOT, BROWN_TIP));
     // Looking down -Z, so +X is right in the image.
     let camera = Camera::orbit(Vec3::ZERO, 0.0, 0.0, 6.0);
-    let fur_only = RenderSettings { skin: false, ..settings() };
-    let background = background(&headless, &renderer, &camera);
+    let fur_only = FurDrawSettings { skin: false, ..settings() };
+    let background = rig.background();
     let mut centroids = Vec::new();
     for direction in [Vec3::NEG_X, Vec3::X] {
         let simulation = windy_simulation(&fur, direction, 3.0, 6);
-        renderer.update_positions(&headless.gpu.queue, simulation.positions()).expect("positions");
-        centroids.push(centroid_x(&render(&headless, &renderer, &camera, &fur_only), background));
+        gpu_fur.set_positions(rig.queue(), simulation.positions()).expect("positions");
+        centroids.push(centroid_x(&rig.render(&gpu_fur, &camera, &fur_only), background));
     }
     assert!(centroids[1] > centroids[0] + 2.0, "fur follows the wind: centroid x {centroids:?}");
 }
@@ -96,13 +84,13 @@ fn wind_moves_fur_pixels_in_the_wind_direction() {
 #[test]
 fn fins_change_silhouette_pixels_only() {
     let fur = builtin_fur(Builtin::Sphere, 16);
-    let headless = headless(SIZE, SIZE);
-    let renderer = headless.renderer(&fur, &strand_textures(256, 16, BROWN_ROOT, BROWN_TIP)).expect("renderer");
+    let rig = Rig::new(SIZE, SIZE);
+    let gpu_fur = rig.fur(&fur, &strand_textures(256, 16, BROWN_ROOT, BROWN_TIP));
     let camera = framed(&fur, 1.0);
-    let with_fins = render(&headless, &renderer, &camera, &settings());
-    let without = render(&headless, &renderer, &camera, &RenderSettings { fins: false, ..settings() });
-    let bare = render(&headless, &renderer, &camera, &RenderSettings { fins: false, shells: false, ..settings() });
-    let background = background(&headless, &renderer, &camera);
+    let with_fins = rig.render(&gpu_fur, &camera, &settings());
+    let without = rig.render(&gpu_fur, &camera, &FurDrawSettings { fins: false, ..settings() });
+    let bare = rig.render(&gpu_fur, &camera, &FurDrawSettings::SKIN);
+    let background = rig.background();
     let inside = |x: u32, y: u32| covered(bare.get_pixel(x, y), background);
     // The outline of the bare sphere, and the fur length in pixels (the sphere has radius 1).
     let outline: Vec<(i64, i64)> = (1..SIZE - 1)
@@ -140,19 +128,25 @@ fn fur_coverage(image: &image::RgbaImage, background: [u8; 3]) -> f64 {
 
 #[test]
 fn more_layers_raise_fur_coverage() {
-    let headless = headless(SIZE, SIZE);
+    let rig = Rig::new(SIZE, SIZE);
     let textures = strand_textures(256, 16, BROWN_ROOT, BROWN_TIP);
-    let fur_only = RenderSettings { skin: false, fins: false, ..settings() };
+    let fur_only = FurDrawSettings { skin: false, fins: false, ..settings() };
+    let background = rig.background();
     let mut coverage = Vec::new();
     let mut camera = None;
     for layers in [2, 6, 16] {
         let fur = builtin_fur(Builtin::Torus, layers);
         let camera = *camera.get_or_insert_with(|| framed(&fur, 1.0));
-        let renderer = headless.renderer(&fur, &textures).expect("renderer");
-        let background = background(&headless, &renderer, &camera);
-        coverage.push(fur_coverage(&render(&headless, &renderer, &camera, &fur_only), background));
+        let gpu_fur = rig.fur(&fur, &textures);
+        coverage.push(fur_coverage(&rig.render(&gpu_fur, &camera, &fur_only), background));
     }
     assert!(coverage[0] < coverage[1] && coverage[1] < coverage[2], "coverage by layers 2, 6, 16: {coverage:?}");
+}
+
+/// Mean of the largest channel difference per pixel.
+fn mean_difference(a: &image::RgbaImage, b: &image::RgbaImage) -> f64 {
+    a.pixels().zip(b.pixels()).map(|(p, q)| f64::from(pixel_difference(p, q))).sum::<f64>()
+        / f64::from(a.width() * a.height())
 }
 
 /// Horizontal centre of the drawn pixels.
@@ -172,12 +166,12 @@ fn centroid_x(image: &image::RgbaImage, background: [u8; 3]) -> f64 {
 #[test]
 fn bent_shared_vertices_move_fur_pixels_that_way() {
     let fur = builtin_fur(Builtin::Sphere, 16);
-    let headless = headless(SIZE, SIZE);
-    let renderer = headless.renderer(&fur, &strand_textures(256, 16, BROWN_ROOT, BROWN_TIP)).expect("renderer");
+    let rig = Rig::new(SIZE, SIZE);
+    let gpu_fur = rig.fur(&fur, &strand_textures(256, 16, BROWN_ROOT, BROWN_TIP));
     let camera = Camera::orbit(Vec3::ZERO, 0.0, 0.0, 5.0);
-    let fur_only = RenderSettings { skin: false, ..settings() };
-    let background = background(&headless, &renderer, &camera);
-    let rest = centroid_x(&render(&headless, &renderer, &camera, &fur_only), background);
+    let fur_only = FurDrawSettings { skin: false, ..settings() };
+    let background = rig.background();
+    let rest = centroid_x(&rig.render(&gpu_fur, &camera, &fur_only), background);
     // The camera looks down -Z from +Z, so +X is to the right in the image.
     let v = fur.vertex_count();
     let bent: Vec<Vec3> = fur
@@ -186,22 +180,22 @@ fn bent_shared_vertices_move_fur_pixels_that_way() {
         .enumerate()
         .map(|(k, p)| *p + Vec3::X * (0.08 * (k / v) as f32 / fur.layers as f32))
         .collect();
-    renderer.update_positions(&headless.gpu.queue, &bent).expect("positions");
-    let blown = centroid_x(&render(&headless, &renderer, &camera, &fur_only), background);
+    gpu_fur.set_positions(rig.queue(), &bent).expect("positions");
+    let blown = centroid_x(&rig.render(&gpu_fur, &camera, &fur_only), background);
     assert!(blown > rest + 1.0, "fur moved right: centroid {rest:.2} -> {blown:.2}");
-    let error = renderer.update_positions(&headless.gpu.queue, &bent[1..]).expect_err("wrong count");
+    let error = gpu_fur.set_positions(rig.queue(), &bent[1..]).expect_err("wrong count");
     assert!(error.to_string().contains("(L + 1) * V"), "{error}");
 }
 
 #[test]
 fn alpha_to_coverage_draws_the_same_fur() {
     let fur = builtin_fur(Builtin::Torus, 16);
-    let headless = headless(SIZE, SIZE);
-    let renderer = headless.renderer(&fur, &strand_textures(256, 16, BROWN_ROOT, BROWN_TIP)).expect("renderer");
+    let rig = Rig::new(SIZE, SIZE);
+    let gpu_fur = rig.fur(&fur, &strand_textures(256, 16, BROWN_ROOT, BROWN_TIP));
     let camera = framed(&fur, 1.0);
-    let background = background(&headless, &renderer, &camera);
-    let blended = render(&headless, &renderer, &camera, &settings());
-    let coverage = render(&headless, &renderer, &camera, &RenderSettings { alpha_to_coverage: true, ..settings() });
+    let background = rig.background();
+    let blended = rig.render(&gpu_fur, &camera, &settings());
+    let coverage = rig.render(&gpu_fur, &camera, &FurDrawSettings { alpha_to_coverage: true, ..settings() });
     // The same outline; inside, coverage quantised to 4 samples drops the faint strand edges.
     let drawn = |image: &image::RgbaImage| image.pixels().filter(|p| covered(p, background)).count() as f64;
     let (a, b) = (drawn(&blended), drawn(&coverage));
@@ -214,40 +208,54 @@ fn alpha_to_coverage_draws_the_same_fur() {
 #[test]
 fn separated_structure_renders_the_same_scene() {
     let fur = builtin_fur(Builtin::Box, 16);
-    let headless = headless(SIZE, SIZE);
+    let rig = Rig::new(SIZE, SIZE);
     let textures = strand_textures(256, 16, BROWN_ROOT, BROWN_TIP);
-    let unified = headless.renderer(&fur, &textures).expect("renderer");
+    let unified = rig.fur(&fur, &textures);
     let camera = framed(&fur, 1.0);
-    let background = background(&headless, &unified, &camera);
-    let unified_image = render(&headless, &unified, &camera, &settings());
-    let device = &headless.gpu.device;
+    let background = rig.background();
+    let unified_image = rig.render(&unified, &camera, &settings());
+    let separated_renderer = SeparatedRenderer::new(rig.device(), &rig.renderer).expect("separated pipelines");
     for fin_faces in [2, 30] {
-        let separated =
-            SeparatedRenderer::new(device, &headless.gpu.queue, headless.format(), &fur, &textures, fin_faces)
-                .expect("separated");
-        let image = headless.render_with(|queue, encoder, targets, output| {
-            separated.render(queue, encoder, targets, output, &camera, &settings());
-        });
-        let image = image.expect("frame");
+        let separated = SeparatedFur::new(rig.device(), rig.queue(), &rig.renderer, &fur, &textures, fin_faces)
+            .expect("separated");
+        separated.prepare(rig.queue(), &FurFrame::default());
+        let image = rig
+            .headless
+            .render(DEFAULT_BACKGROUND, |pass| separated_renderer.draw(pass, &rig.view, &separated, &settings()))
+            .expect("frame");
         let (a, b) = (fur_coverage(&unified_image, background), fur_coverage(&image, background));
         assert!((a - b).abs() < 0.1 * a, "{fin_faces}-face fins: coverage unified {a:.3}, separated {b:.3}");
+        // The same skin: where neither draws fur, the pictures agree.
+        let skin_unified = rig.render(&unified, &camera, &FurDrawSettings::SKIN);
+        let skin_separated = rig
+            .headless
+            .render(DEFAULT_BACKGROUND, |pass| {
+                separated_renderer.draw(pass, &rig.view, &separated, &FurDrawSettings::SKIN);
+            })
+            .expect("frame");
+        let skin_difference = mean_difference(&skin_unified, &skin_separated);
+        assert!(skin_difference < 0.5, "{fin_faces}: skins differ by {skin_difference:.3} on average");
         let expected_vertices =
             (fur.positions.len() + fur.mesh.edges.len() * 6 * fin_faces.div_ceil(2) as usize) as u64;
-        assert_eq!(separated.gpu_bytes(), expected_vertices * 32 + fur.mesh.triangles.len() as u64 * 12);
+        assert_eq!(
+            separated.gpu_bytes().structure(),
+            expected_vertices * 32 + fur.mesh.triangles.len() as u64 * 12
+        );
+        assert_eq!(separated.gpu_bytes().textures, unified.gpu_bytes().textures);
     }
 }
 
 /// `PELT_TEST_BACKEND` (CI runs the suite on lavapipe and on llvmpipe) really picks that backend.
 #[test]
 fn adapter_uses_the_requested_backend() {
-    let headless = headless(8, 8);
-    let backend = headless.gpu.adapter.get_info().backend;
+    let gpu = gpu();
+    let backend = gpu.adapter.get_info().backend;
     match std::env::var("PELT_TEST_BACKEND").as_deref() {
         Ok("gl") => assert_eq!(backend, wgpu::Backend::Gl),
         Ok("vulkan") => assert_eq!(backend, wgpu::Backend::Vulkan),
         _ => assert_ne!(backend, wgpu::Backend::Noop),
     }
-    eprintln!("adapter: {}", headless.gpu.summary());
+    eprintln!("adapter: {}", gpu.summary());
 }
 
 /// Surface colour mode: grey strands take the mesh texture's colour at their roots.
@@ -259,10 +267,10 @@ fn surface_colour_tints_strands_by_the_mesh_uvs() {
     // Red and blue stripes across u (around the sphere), each 1/8 of the way round.
     let pixels = (0..8).flat_map(|x| if x % 2 == 0 { [230, 20, 20, 255] } else { [20, 20, 230, 255] }).collect();
     textures.surface = Some(pelt_core::texture::ImageRgba8 { width: 8, height: 1, pixels });
-    let headless = headless(SIZE, SIZE);
-    let renderer = headless.renderer(&fur, &textures).expect("renderer");
+    let rig = Rig::new(SIZE, SIZE);
+    let gpu_fur = rig.fur(&fur, &textures);
     let camera = Camera::orbit(Vec3::ZERO, 0.0, 0.0, 5.0);
-    let image = render(&headless, &renderer, &camera, &settings());
+    let image = rig.render(&gpu_fur, &camera, &settings());
     let reddish = image.pixels().filter(|p| i32::from(p.0[0]) > i32::from(p.0[2]) + 40).count();
     let bluish = image.pixels().filter(|p| i32::from(p.0[2]) > i32::from(p.0[0]) + 40).count();
     assert!(reddish > 500 && bluish > 500, "red {reddish} and blue {bluish} pixels");

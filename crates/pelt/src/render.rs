@@ -6,11 +6,14 @@ use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use anyhow::{Context as _, bail};
-use glam::Vec3;
+use glam::{Mat4, Vec3};
 use pelt_core::mesh::builtin::{TRY_ON_NAME, try_on_scene};
 use pelt_core::sim::{Scene, Simulation, WindParams};
 use pelt_core::{Builtin, FurStructure, ImportOptions, Mesh, Preset};
-use pelt_render::{Backend, Camera, Headless, RenderSettings};
+use pelt_render::{
+    Backend, Camera, DEFAULT_BACKGROUND, FurDrawSettings, FurFrame, FurStates, FurView, GpuFur, Headless, Light,
+    PlainMesh,
+};
 
 use crate::mesh_args::MeshArgs;
 
@@ -130,13 +133,21 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
 
     let (width, height) = args.size;
     let headless = Headless::new(args.backend, width, height)?;
-    let mut renderer = headless.renderer(&fur, &textures)?;
-    for mesh in &plain {
-        renderer.add_plain_mesh(&headless.gpu.device, mesh, PLAIN_COLOUR)?;
+    let (device, queue) = (&headless.gpu.device, &headless.gpu.queue);
+    let renderer = headless.renderer()?;
+    // The CPU simulation interpolates, so one state uploaded per frame is all the GPU needs.
+    let gpu_fur = GpuFur::new(device, queue, &renderer, &fur, &textures, FurStates::One)?;
+    gpu_fur.prepare(queue, &FurFrame::default());
+    let plain_meshes =
+        plain.iter().map(|mesh| PlainMesh::new(device, &renderer, mesh, PLAIN_COLOUR)).collect::<Result<Vec<_>, _>>()?;
+    for mesh in &plain_meshes {
+        mesh.prepare(queue, Mat4::IDENTITY);
     }
     let camera = camera(args, &fur, &plain, headless.aspect_ratio());
+    let view = FurView::new(device, &renderer);
+    view.prepare(queue, &camera.view_data(headless.aspect_ratio(), &Light::default()));
     let settings =
-        RenderSettings { alpha_to_coverage: args.alpha_to_coverage, fins: !args.no_fins, ..RenderSettings::default() };
+        FurDrawSettings { alpha_to_coverage: args.alpha_to_coverage, fins: !args.no_fins, ..FurDrawSettings::ALL };
 
     let progress = (frames > 1).then(|| {
         let bar = indicatif::ProgressBar::new(u64::from(frames));
@@ -168,8 +179,13 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         simulation.advance_to(time_secs);
         simulation_time += sim_started.elapsed();
         let render_started = Instant::now();
-        renderer.update_positions(&headless.gpu.queue, simulation.positions())?;
-        let image = headless.render(&renderer, &camera, &settings)?;
+        gpu_fur.set_positions(queue, simulation.positions())?;
+        let image = headless.render(DEFAULT_BACKGROUND, |pass| {
+            for mesh in &plain_meshes {
+                renderer.draw_plain(pass, &view, mesh);
+            }
+            renderer.draw(pass, &view, &gpu_fur, &settings);
+        })?;
         render_time += render_started.elapsed();
         match (&output, &mut gif) {
             (Output::Png(path), _) => save_png(&image, path)?,

@@ -7,7 +7,9 @@ mod camera;
 mod capture;
 mod fur;
 mod gpu;
+mod model;
 mod panel;
+mod ui;
 mod viewport;
 
 use std::path::PathBuf;

@@ -9,7 +9,10 @@ use glam::Vec3;
 use pelt_core::fur::FurLength;
 use pelt_core::texture::FurTextures;
 use pelt_core::{Builtin, FurParams, FurStructure, GrowthDirection, Mesh};
-use pelt_render::{Backend, Camera, Headless, RenderSettings};
+use pelt_render::{
+    Backend, Camera, DEFAULT_BACKGROUND, FurDrawSettings, FurFrame, FurRenderer, FurStates, FurView, GpuFur, Gpu,
+    Headless, Light, PlainMesh,
+};
 
 fn hash(x: u32, y: u32, salt: u32) -> u32 {
     let mut h = x.wrapping_mul(0x8da6_b343) ^ y.wrapping_mul(0xd816_3841) ^ salt.wrapping_mul(0xcb1a_b31f);
@@ -102,12 +105,92 @@ pub fn builtin_fur(builtin: Builtin, layers: u32) -> FurStructure {
     grow(builtin.mesh().0, layers, 0.08)
 }
 
+/// The GPU every GPU test uses (`PELT_TEST_BACKEND` picks the API): fails (never skips)
+/// without an adapter.
+pub fn gpu() -> Gpu {
+    let backend = std::env::var("PELT_TEST_BACKEND").map_or(Backend::Auto, |name| name.parse().expect("backend"));
+    match Gpu::new(backend) {
+        Ok(gpu) => gpu,
+        Err(error) => panic!("GPU tests need an adapter (CI uses lavapipe): {error}"),
+    }
+}
+
 /// The headless target every GPU test uses: fails (never skips) without an adapter.
 pub fn headless(width: u32, height: u32) -> Headless {
-    let backend = std::env::var("PELT_TEST_BACKEND").map_or(Backend::Auto, |name| name.parse().expect("backend"));
-    match Headless::new(backend, width, height) {
-        Ok(headless) => headless,
-        Err(error) => panic!("GPU tests need an adapter (CI uses lavapipe): {error}"),
+    Headless::with_gpu(gpu(), width, height).expect("headless target")
+}
+
+/// A headless target with a renderer for it and one view: what most GPU tests draw with.
+pub struct Rig {
+    pub headless: Headless,
+    pub renderer: FurRenderer,
+    pub view: FurView,
+}
+
+impl Rig {
+    pub fn new(width: u32, height: u32) -> Self {
+        let headless = headless(width, height);
+        let renderer = headless.renderer().expect("renderer");
+        let view = FurView::new(&headless.gpu.device, &renderer);
+        Self { headless, renderer, view }
+    }
+
+    pub fn device(&self) -> &wgpu::Device {
+        &self.headless.gpu.device
+    }
+
+    pub fn queue(&self) -> &wgpu::Queue {
+        &self.headless.gpu.queue
+    }
+
+    /// The rest pose of `structure`, one state, with its look at the defaults.
+    pub fn fur(&self, structure: &FurStructure, textures: &FurTextures) -> GpuFur {
+        self.fur_with_states(structure, textures, FurStates::One)
+    }
+
+    pub fn fur_with_states(&self, structure: &FurStructure, textures: &FurTextures, states: FurStates) -> GpuFur {
+        let fur = GpuFur::new(self.device(), self.queue(), &self.renderer, structure, textures, states).expect("fur");
+        fur.prepare(self.queue(), &FurFrame::default());
+        fur
+    }
+
+    pub fn plain(&self, mesh: &Mesh, colour: Vec3) -> PlainMesh {
+        let plain = PlainMesh::new(self.device(), &self.renderer, mesh, colour).expect("plain mesh");
+        plain.prepare(self.queue(), glam::Mat4::IDENTITY);
+        plain
+    }
+
+    /// One frame: the plain meshes, then the fur, from `camera` with the default light.
+    pub fn render_scene(
+        &self,
+        plain: &[&PlainMesh],
+        fur: Option<&GpuFur>,
+        camera: &Camera,
+        settings: &FurDrawSettings,
+    ) -> image::RgbaImage {
+        self.view.prepare(self.queue(), &camera.view_data(self.headless.aspect_ratio(), &Light::default()));
+        self.headless
+            .render(DEFAULT_BACKGROUND, |pass| {
+                for mesh in plain {
+                    self.renderer.draw_plain(pass, &self.view, mesh);
+                }
+                if let Some(fur) = fur {
+                    self.renderer.draw(pass, &self.view, fur, settings);
+                }
+            })
+            .expect("frame")
+    }
+
+    pub fn render(&self, fur: &GpuFur, camera: &Camera, settings: &FurDrawSettings) -> image::RgbaImage {
+        self.render_scene(&[], Some(fur), camera, settings)
+    }
+
+    /// The background as stored in the image (sRGB of the default clear colour).
+    pub fn background(&self) -> [u8; 3] {
+        let camera = Camera::orbit(Vec3::ZERO, 0.0, 0.0, 1.0);
+        let empty = self.render_scene(&[], None, &camera, &FurDrawSettings::ALL);
+        let p = empty.get_pixel(0, 0).0;
+        [p[0], p[1], p[2]]
     }
 }
 
@@ -117,8 +200,8 @@ pub fn framed(fur: &FurStructure, aspect_ratio: f32) -> Camera {
     Camera::framing(centre, radius + length, 30.0, 15.0, aspect_ratio)
 }
 
-pub fn settings() -> RenderSettings {
-    RenderSettings::default()
+pub fn settings() -> FurDrawSettings {
+    FurDrawSettings::ALL
 }
 
 pub fn asset(name: &str) -> PathBuf {
@@ -141,10 +224,6 @@ pub fn pixel_difference(a: &image::Rgba<u8>, b: &image::Rgba<u8>) -> u8 {
     a.0.iter().zip(b.0).map(|(x, y)| x.abs_diff(y)).max().unwrap_or(0)
 }
 
-pub fn light_direction() -> Vec3 {
-    RenderSettings::default().light_from_view
-}
-
 /// Golden images live beside the tests and were rendered on lavapipe (Vulkan, CPU).
 ///
 /// The comparison allows small differences: llvmpipe (GL) and hardware GPUs place MSAA samples
@@ -153,16 +232,14 @@ pub fn light_direction() -> Vec3 {
 const GOLDEN_MEAN_LIMIT: f64 = 3.0;
 const GOLDEN_P99_LIMIT: u8 = 64;
 
-/// Compares `image` with `tests/golden/{name}.png`; `PELT_UPDATE_GOLDEN=1` rewrites it. On a
-/// mismatch writes `{name}-actual.png` and `{name}-diff.png` next to it and panics.
-pub fn check_golden(name: &str, image: &image::RgbaImage) {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/golden");
-    let path = dir.join(format!("{name}.png"));
-    if std::env::var("PELT_UPDATE_GOLDEN").is_ok_and(|v| v == "1") {
-        std::fs::create_dir_all(&dir).expect("golden dir");
-        image.save(&path).expect("write golden");
-        return;
-    }
+fn golden_dir() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/golden")
+}
+
+/// The mean and 99th percentile of the per-pixel difference from `tests/golden/{name}.png`, and
+/// the difference image.
+pub fn golden_difference(name: &str, image: &image::RgbaImage) -> (f64, u8, image::RgbaImage) {
+    let path = golden_dir().join(format!("{name}.png"));
     let golden = image::open(&path)
         .unwrap_or_else(|error| panic!("{}: {error} (PELT_UPDATE_GOLDEN=1 writes it)", path.display()))
         .to_rgba8();
@@ -174,7 +251,26 @@ pub fn check_golden(name: &str, image: &image::RgbaImage) {
         image::Rgba([d, d, d, 255])
     });
     differences.sort_unstable();
-    let p99 = differences[differences.len() * 99 / 100];
+    (mean, differences[differences.len() * 99 / 100], diff)
+}
+
+/// Whether `image` is within the golden limits of `tests/golden/{name}.png`.
+pub fn matches_golden(name: &str, image: &image::RgbaImage) -> bool {
+    let (mean, p99, _) = golden_difference(name, image);
+    mean <= GOLDEN_MEAN_LIMIT && p99 <= GOLDEN_P99_LIMIT
+}
+
+/// Compares `image` with `tests/golden/{name}.png`; `PELT_UPDATE_GOLDEN=1` rewrites it. On a
+/// mismatch writes `{name}-actual.png` and `{name}-diff.png` next to it and panics.
+pub fn check_golden(name: &str, image: &image::RgbaImage) {
+    let dir = golden_dir();
+    let path = dir.join(format!("{name}.png"));
+    if std::env::var("PELT_UPDATE_GOLDEN").is_ok_and(|v| v == "1") {
+        std::fs::create_dir_all(&dir).expect("golden dir");
+        image.save(&path).expect("write golden");
+        return;
+    }
+    let (mean, p99, diff) = golden_difference(name, image);
     if mean > GOLDEN_MEAN_LIMIT || p99 > GOLDEN_P99_LIMIT {
         image.save(dir.join(format!("{name}-actual.png"))).expect("write actual");
         diff.save(dir.join(format!("{name}-diff.png"))).expect("write diff");

@@ -7,7 +7,8 @@ use anyhow::Context as _;
 use pelt_core::texture::FurTextures;
 use pelt_core::{FurStructure, Mesh};
 use pelt_render::{
-    Backend, Camera, Gpu, HEADLESS_FORMAT, RenderSettings, RenderTargets, Renderer, SeparatedRenderer, TargetFormat,
+    Backend, Camera, DEFAULT_BACKGROUND, FurDrawSettings, FurFrame, FurRenderer, FurStates, FurTarget, FurView, Gpu,
+    GpuFur, HEADLESS_FORMAT, Light, PlainMesh, RenderTargets, SeparatedFur, SeparatedRenderer,
 };
 
 use super::report::{Adapter, RenderFigures};
@@ -55,39 +56,57 @@ impl Bench {
     pub fn measure(
         &self,
         fur: &FurStructure,
-        body: Option<&Mesh>,
+        body_mesh: Option<&Mesh>,
         textures: &FurTextures,
         budget: RenderBudget,
     ) -> anyhow::Result<RenderFigures> {
         let (device, queue) = (&self.gpu.device, &self.gpu.queue);
-        let format = TargetFormat::msaa(HEADLESS_FORMAT);
-        let mut unified =
-            Renderer::new(device, queue, format, fur, textures).context("building the unified renderer")?;
-        let mut separated2 = SeparatedRenderer::new(device, queue, format, fur, textures, 2)
-            .context("building the separated renderer (2-face fins)")?;
-        let mut separated30 = SeparatedRenderer::new(device, queue, format, fur, textures, MANY_FIN_FACES)
-            .context("building the separated renderer (30-face fins)")?;
-        if let Some(body) = body {
-            unified.add_plain_mesh(device, body, PLAIN_COLOUR)?;
-            separated2.add_plain_mesh(device, body, PLAIN_COLOUR)?;
-            separated30.add_plain_mesh(device, body, PLAIN_COLOUR)?;
+        let target = FurTarget::new(HEADLESS_FORMAT);
+        let renderer = FurRenderer::new(device, target).context("building the unified renderer")?;
+        let separated_renderer =
+            SeparatedRenderer::new(device, &renderer).context("building the separated renderer")?;
+        // One state, uploaded per frame, as `pelt render` and the viewer draw it.
+        let unified = GpuFur::new(device, queue, &renderer, fur, textures, FurStates::One)
+            .context("uploading the unified structure")?;
+        let separated2 = SeparatedFur::new(device, queue, &renderer, fur, textures, 2)
+            .context("building the separated structure (2-face fins)")?;
+        let separated30 = SeparatedFur::new(device, queue, &renderer, fur, textures, MANY_FIN_FACES)
+            .context("building the separated structure (30-face fins)")?;
+        unified.prepare(queue, &FurFrame::default());
+        separated2.prepare(queue, &FurFrame::default());
+        separated30.prepare(queue, &FurFrame::default());
+        let body = body_mesh.map(|body| PlainMesh::new(device, &renderer, body, PLAIN_COLOUR)).transpose()?;
+        if let Some(body) = &body {
+            body.prepare(queue, glam::Mat4::IDENTITY);
         }
-        let settings = RenderSettings::default();
+        let view = FurView::new(device, &renderer);
+        let settings = FurDrawSettings::ALL;
         // Frame the whole scene: the body where there is one (the garment sits on it).
-        let (centre, radius) = body.map_or_else(|| fur.mesh.bounding_sphere(), Mesh::bounding_sphere);
+        let (centre, radius) = body_mesh.map_or_else(|| fur.mesh.bounding_sphere(), Mesh::bounding_sphere);
         let radius = radius + fur.lengths.iter().copied().fold(0.0, f32::max);
 
         let mut medians = [[0.0; 3]; SIZES.len()];
         let mut frames_measured = u32::MAX;
         for ((width, height), row) in SIZES.into_iter().zip(&mut medians) {
-            let targets = RenderTargets::new(device, format, width, height)?;
+            let targets = RenderTargets::new(device, target, width, height)?;
             let output = device.create_texture(&wgpu_output_descriptor(width, height));
-            let view = output.create_view(&Default::default());
+            let output_view = output.create_view(&Default::default());
             let camera = Camera::framing(centre, radius, 35.0, 20.0, targets.aspect_ratio());
+            let view_data = camera.view_data(targets.aspect_ratio(), &Light::default());
+            // Every structure draws the same scene the same way: the view written, the body
+            // (if any), then the fur, in one pass.
+            let frame = |encoder: &mut wgpu::CommandEncoder, draw_fur: &dyn Fn(&mut wgpu::RenderPass<'_>)| {
+                view.prepare(queue, &view_data);
+                let mut pass = targets.begin_pass(encoder, &output_view, DEFAULT_BACKGROUND);
+                if let Some(body) = &body {
+                    renderer.draw_plain(&mut pass, &view, body);
+                }
+                draw_fur(&mut pass);
+            };
             let cases: [&dyn Fn(&mut wgpu::CommandEncoder); 3] = [
-                &|encoder| unified.render(queue, encoder, &targets, &view, &camera, &settings),
-                &|encoder| separated2.render(queue, encoder, &targets, &view, &camera, &settings),
-                &|encoder| separated30.render(queue, encoder, &targets, &view, &camera, &settings),
+                &|encoder| frame(encoder, &|pass| renderer.draw(pass, &view, &unified, &settings)),
+                &|encoder| frame(encoder, &|pass| separated_renderer.draw(pass, &view, &separated2, &settings)),
+                &|encoder| frame(encoder, &|pass| separated_renderer.draw(pass, &view, &separated30, &settings)),
             ];
             for (case, median) in cases.iter().zip(row.iter_mut()) {
                 let times = self.time_frames(case, budget)?;
@@ -96,9 +115,9 @@ impl Bench {
             }
         }
         // The per-frame upload an animated unified fur adds: the whole shared vertex array.
-        unified.update_positions(queue, &fur.positions)?;
+        unified.set_positions(queue, &fur.positions)?;
         let upload_times = self
-            .time_frames(&|_| unified.update_positions(queue, &fur.positions).expect("checked just above"), budget)?;
+            .time_frames(&|_| unified.set_positions(queue, &fur.positions).expect("checked just above"), budget)?;
         let [[u_large, s2_large, s30_large], [u_small, s2_small, s30_small]] = medians;
         Ok(RenderFigures {
             frame_ms_unified_1280x720: Some(u_large),

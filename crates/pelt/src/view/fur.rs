@@ -1,13 +1,16 @@
-//! The fur on the GPU: the structure, its textures and the renderer, kept in step with the
-//! panel (a new mesh or layer count rebuilds the structure, a texture setting the textures).
+//! The fur on the GPU: the renderers, the fur, the body and the view, kept in step with the panel
+//! (a new mesh or layer count rebuilds the structure, a texture setting the textures).
 
-use glam::Vec3;
+use glam::{Mat4, Vec3};
 use pelt_core::texture::FurTextures;
 use pelt_core::{FurStructure, Mesh};
-use pelt_render::{Camera, RenderSettings, Renderer, SeparatedRenderer};
+use pelt_render::{
+    Camera, DEFAULT_BACKGROUND, FurDrawSettings, FurFrame, FurRenderer, FurStates, FurView, GpuFur, Light, PlainMesh,
+    SeparatedFur, SeparatedRenderer,
+};
 
 use super::camera::OrbitCamera;
-use super::viewport::{Viewport, target_format};
+use super::viewport::{Viewport, target};
 
 /// Colour of a plain (furless) body, linear RGB.
 const BODY_COLOUR: Vec3 = Vec3::new(0.6, 0.45, 0.38);
@@ -16,81 +19,101 @@ const SEPARATED_FIN_FACES: u32 = 2;
 
 /// The renderers with what they draw.
 #[derive(Debug)]
-pub struct FurView {
-    renderer: Renderer,
-    /// The separated structure of Lengyel et al., built when first shown; it holds the rest pose
-    /// (its fins are geometry of their own and do not follow the simulation).
-    separated: Option<SeparatedRenderer>,
-    /// The furless body both structures draw (the try-on scene's), kept for rebuilding.
-    body: Option<Mesh>,
+pub struct FurScene {
+    renderer: FurRenderer,
+    /// The unified structure; the CPU simulation interpolates, so one state uploaded per frame.
+    fur: GpuFur,
+    /// The separated structure of Lengyel et al. and its pipelines, built when first shown; it
+    /// holds the rest pose (its fins are geometry of their own and do not follow the simulation).
+    separated: Option<(SeparatedRenderer, SeparatedFur)>,
+    /// The furless body both structures are drawn with (the try-on scene's).
+    body: Option<PlainMesh>,
+    view: FurView,
     textures: FurTextures,
-    pub settings: RenderSettings,
+    pub settings: FurDrawSettings,
 }
 
-impl FurView {
+impl FurScene {
     pub fn new(gpu: &pelt_render::Gpu, structure: &FurStructure, textures: &FurTextures) -> anyhow::Result<Self> {
-        let renderer = Renderer::new(&gpu.device, &gpu.queue, target_format(), structure, textures)?;
+        let renderer = FurRenderer::new(&gpu.device, target())?;
+        let fur = GpuFur::new(&gpu.device, &gpu.queue, &renderer, structure, textures, FurStates::One)?;
+        fur.prepare(&gpu.queue, &FurFrame::default());
+        let view = FurView::new(&gpu.device, &renderer);
         Ok(Self {
             renderer,
+            fur,
             separated: None,
             body: None,
+            view,
             textures: textures.clone(),
-            settings: RenderSettings::default(),
+            settings: FurDrawSettings::ALL,
         })
     }
 
     pub fn set_structure(&mut self, gpu: &pelt_render::Gpu, structure: &FurStructure) -> anyhow::Result<()> {
         self.separated = None;
-        Ok(self.renderer.set_structure(&gpu.device, structure)?)
+        self.fur.set_structure(&gpu.device, &self.renderer, structure)?;
+        self.fur.prepare(&gpu.queue, &FurFrame::default());
+        Ok(())
     }
 
     pub fn set_textures(&mut self, gpu: &pelt_render::Gpu, textures: &FurTextures) -> anyhow::Result<()> {
         self.separated = None;
         self.textures = textures.clone();
-        Ok(self.renderer.set_textures(&gpu.device, &gpu.queue, textures)?)
+        self.fur.set_textures(&gpu.device, &gpu.queue, &self.renderer, textures)?;
+        // The root colour (the skin's) and the slice count live in the fur's uniform.
+        self.fur.prepare(&gpu.queue, &FurFrame::default());
+        Ok(())
     }
 
     /// Replaces the furless body drawn with the fur (the try-on scene's), if any.
     pub fn set_body(&mut self, gpu: &pelt_render::Gpu, body: Option<&Mesh>) -> anyhow::Result<()> {
-        self.separated = None;
-        self.body = body.cloned();
-        self.renderer.clear_plain_meshes();
-        if let Some(body) = body {
-            self.renderer.add_plain_mesh(&gpu.device, body, BODY_COLOUR)?;
-        }
+        self.body = match body {
+            Some(mesh) => {
+                let body = PlainMesh::new(&gpu.device, &self.renderer, mesh, BODY_COLOUR)?;
+                body.prepare(&gpu.queue, Mat4::IDENTITY);
+                Some(body)
+            }
+            None => None,
+        };
         Ok(())
     }
 
     /// Builds the separated structure if it is to be drawn and is not there yet.
     pub fn prepare_separated(&mut self, gpu: &pelt_render::Gpu, structure: &FurStructure) -> anyhow::Result<()> {
         if self.separated.is_none() {
-            let mut separated = SeparatedRenderer::new(
+            let renderer = SeparatedRenderer::new(&gpu.device, &self.renderer)?;
+            let fur = SeparatedFur::new(
                 &gpu.device,
                 &gpu.queue,
-                target_format(),
+                &self.renderer,
                 structure,
                 &self.textures,
                 SEPARATED_FIN_FACES,
             )?;
-            if let Some(body) = &self.body {
-                separated.add_plain_mesh(&gpu.device, body, BODY_COLOUR)?;
-            }
-            self.separated = Some(separated);
+            fur.prepare(&gpu.queue, &FurFrame::default());
+            self.separated = Some((renderer, fur));
         }
         Ok(())
     }
 
+    /// GPU bytes of the unified structure as the renderer holds it.
+    pub fn unified_bytes(&self) -> u64 {
+        self.fur.gpu_bytes().structure()
+    }
+
     /// GPU bytes of the separated geometry, once built.
     pub fn separated_bytes(&self) -> Option<u64> {
-        self.separated.as_ref().map(SeparatedRenderer::gpu_bytes)
+        self.separated.as_ref().map(|(_, fur)| fur.gpu_bytes().structure())
     }
 
     /// Uploads this frame's shared vertex array (the simulation's output).
     pub fn set_positions(&self, gpu: &pelt_render::Gpu, positions: &[Vec3]) -> anyhow::Result<()> {
-        Ok(self.renderer.update_positions(&gpu.queue, positions)?)
+        Ok(self.fur.set_positions(&gpu.queue, positions)?)
     }
 
-    /// Draws the unified structure, or the separated one when `separated` and it is built.
+    /// Draws the body and the unified structure, or the separated one when `separated` and it is
+    /// built, into the viewport.
     pub fn draw(
         &self,
         gpu: &pelt_render::Gpu,
@@ -102,10 +125,14 @@ impl FurView {
         let (near, far) = camera.near_far();
         let camera =
             Camera { eye: camera.eye(), target: camera.target, up: Vec3::Y, fov_y_rad: camera.fov_y_rad, near, far };
-        let (targets, output) = (&viewport.targets, &viewport.colour_view);
+        self.view.prepare(&gpu.queue, &camera.view_data(viewport.targets.aspect_ratio(), &Light::default()));
+        let mut pass = viewport.targets.begin_pass(encoder, &viewport.colour_view, DEFAULT_BACKGROUND);
+        if let Some(body) = &self.body {
+            self.renderer.draw_plain(&mut pass, &self.view, body);
+        }
         match self.separated.as_ref().filter(|_| separated) {
-            Some(renderer) => renderer.render(&gpu.queue, encoder, targets, output, &camera, &self.settings),
-            None => self.renderer.render(&gpu.queue, encoder, targets, output, &camera, &self.settings),
+            Some((renderer, fur)) => renderer.draw(&mut pass, &self.view, fur, &self.settings),
+            None => self.renderer.draw(&mut pass, &self.view, &self.fur, &self.settings),
         }
     }
 }

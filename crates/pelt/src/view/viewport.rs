@@ -2,16 +2,16 @@
 //! the central panel. Drawing it offscreen gives the camera the true aspect of the area beside
 //! the panel and lets egui lay the overlay and the brush on top.
 
-use pelt_render::{RenderTargets, TargetFormat};
+use pelt_render::{FurTarget, RenderTargets};
 
 /// Format the 3D view is drawn in: sRGB, so shading stays linear.
 pub const COLOUR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSrgb;
 /// egui samples gamma-encoded textures, so it reads the same texels through a non-sRGB view.
 const EGUI_VIEW_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
 
-/// The format the fur renderer draws the view in (4x MSAA resolved into the target).
-pub fn target_format() -> TargetFormat {
-    TargetFormat::msaa(COLOUR_FORMAT)
+/// What the fur renderer draws the view into (4x MSAA resolved into the texture, conventional depth).
+pub fn target() -> FurTarget {
+    FurTarget::new(COLOUR_FORMAT)
 }
 
 /// The offscreen target, its MSAA and depth attachments, and its egui texture.
@@ -32,7 +32,7 @@ impl Viewport {
     ) -> anyhow::Result<Self> {
         let size_px = clamp_size(device, size_px);
         let (texture, colour_view, egui_view) = create_target(device, size_px);
-        let targets = RenderTargets::new(device, target_format(), size_px[0], size_px[1])?;
+        let targets = RenderTargets::new(device, target(), size_px[0], size_px[1])?;
         let texture_id = egui_renderer.register_native_texture(device, &egui_view, wgpu::FilterMode::Linear);
         Ok(Self { texture, colour_view, targets, texture_id })
     }
@@ -53,7 +53,7 @@ impl Viewport {
             return Ok(());
         }
         let (texture, colour_view, egui_view) = create_target(device, size_px);
-        self.targets = RenderTargets::new(device, target_format(), size_px[0], size_px[1])?;
+        self.targets = RenderTargets::new(device, target(), size_px[0], size_px[1])?;
         egui_renderer.update_egui_texture_from_wgpu_texture(
             device,
             &egui_view,

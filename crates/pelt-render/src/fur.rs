@@ -1,0 +1,220 @@
+//! One fur on the GPU in the unified structure: its shared vertex array (one or two simulation
+//! states), rest topology, uvs, base normals, textures and per-fur uniform.
+
+use glam::Vec3;
+use pelt_core::FurStructure;
+use pelt_core::texture::FurTextures;
+
+use crate::RenderError;
+use crate::geometry::UnifiedGeometry;
+use crate::object::{FurFrame, GpuBytes};
+use crate::renderer::FurRenderer;
+use crate::requirements::ErrorScope;
+use crate::textures::GpuTextures;
+
+/// How many simulation states a [`GpuFur`] keeps on the GPU.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum FurStates {
+    /// One shared array: the host uploads the positions to draw each frame (e.g. the CPU
+    /// simulation's interpolated output). Half the memory.
+    One,
+    /// The previous and the current state; the vertex shader draws
+    /// `previous * (1 - t) + current * t` with `t` = [`FurFrame::interpolation`], so a
+    /// simulation uploads (or computes) once per step, not once per frame.
+    #[default]
+    Two,
+}
+
+/// One fur's GPU data: draw it with [`FurRenderer::draw`] into any pass of the renderer's target,
+/// as many furs per pass as you like.
+///
+/// # The shared arrays, for hosts that write them on the GPU
+/// Each state is one buffer of `(L + 1) * V` positions `NV[i * V + j]` (layer `i`, base vertex
+/// `j`), each three little-endian `f32` (x, y, z) packed with no padding (12 bytes, so WGSL reads
+/// it as `array<f32>`), in model space; usage [`POSITIONS_USAGE`](crate::POSITIONS_USAGE)
+/// (`STORAGE | VERTEX | COPY_DST | COPY_SRC`). A compute pass (e.g. a GPU simulation) steps by
+/// calling [`GpuFur::swap_states`] and then writing the new state into
+/// [`GpuFur::current_positions`], reading the last one from [`GpuFur::previous_positions`].
+/// The base normals ([`GpuFur::base_normals`]) are `V` packed xyz `f32` triples likewise
+/// (`STORAGE | COPY_DST`).
+#[derive(Debug)]
+pub struct GpuFur {
+    geometry: UnifiedGeometry,
+    textures: GpuTextures,
+}
+
+impl GpuFur {
+    /// Uploads `structure` (its rest pose into every state) and `textures` for drawing with
+    /// `renderer`.
+    ///
+    /// # Errors
+    /// [`RenderError::TooLarge`] when the structure exceeds the device's buffer limits,
+    /// [`RenderError::Textures`] for malformed textures, [`RenderError::OutOfMemory`] or
+    /// [`RenderError::Gpu`] where the device reports one.
+    pub fn new(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        renderer: &FurRenderer,
+        structure: &FurStructure,
+        textures: &FurTextures,
+        states: FurStates,
+    ) -> Result<Self, RenderError> {
+        let scope = ErrorScope::push(device);
+        let geometry = geometry(device, renderer, structure, states);
+        let textures = GpuTextures::new(device, queue, renderer.layouts(), textures);
+        scope.pop("uploading the fur")?;
+        Ok(Self { geometry: geometry?, textures: textures? })
+    }
+
+    /// Replaces the structure (new mesh, layer count or rest pose), keeping the textures and the
+    /// number of states.
+    ///
+    /// # Errors
+    /// As [`GpuFur::new`].
+    pub fn set_structure(
+        &mut self,
+        device: &wgpu::Device,
+        renderer: &FurRenderer,
+        structure: &FurStructure,
+    ) -> Result<(), RenderError> {
+        let states = if self.geometry.state_count() == 1 { FurStates::One } else { FurStates::Two };
+        let scope = ErrorScope::push(device);
+        let geometry = geometry(device, renderer, structure, states);
+        scope.pop("uploading the fur")?;
+        self.geometry = geometry?;
+        Ok(())
+    }
+
+    /// Replaces the shell and fin textures (any slice count: slices are spread over the layers).
+    ///
+    /// # Errors
+    /// [`RenderError::Textures`] for malformed textures, [`RenderError::OutOfMemory`].
+    pub fn set_textures(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        renderer: &FurRenderer,
+        textures: &FurTextures,
+    ) -> Result<(), RenderError> {
+        let scope = ErrorScope::push(device);
+        let textures = GpuTextures::new(device, queue, renderer.layouts(), textures);
+        scope.pop("uploading the fur textures")?;
+        self.textures = textures?;
+        Ok(())
+    }
+
+    /// Writes this frame's model transform, interpolation and look (takes effect at the next
+    /// submission; one transform per fur and submission).
+    pub fn prepare(&self, queue: &wgpu::Queue, frame: &FurFrame) {
+        let textures = (self.textures.shell_slices, self.textures.has_surface);
+        self.geometry.write_uniform(queue, &self.geometry.shape.uniform(frame, self.textures.root_colour, textures));
+    }
+
+    /// Writes `positions` (`(L + 1) * V`, layer-major, model space) into both states: the
+    /// one-state way to animate (upload what to draw, every frame).
+    ///
+    /// # Errors
+    /// [`RenderError::Count`] unless there are exactly `(L + 1) * V` positions.
+    pub fn set_positions(&self, queue: &wgpu::Queue, positions: &[Vec3]) -> Result<(), RenderError> {
+        self.geometry.set_positions(queue, positions)
+    }
+
+    /// Writes both states at once (with [`FurStates::One`] only `current` is kept).
+    ///
+    /// # Errors
+    /// [`RenderError::Count`] unless both have `(L + 1) * V` positions.
+    pub fn set_states(&self, queue: &wgpu::Queue, previous: &[Vec3], current: &[Vec3]) -> Result<(), RenderError> {
+        self.geometry.set_states(queue, previous, current)
+    }
+
+    /// A new simulation step: the current state becomes the previous one and `positions` the
+    /// current one. One upload per step; frames between steps only change
+    /// [`FurFrame::interpolation`].
+    ///
+    /// # Errors
+    /// [`RenderError::Count`] unless there are exactly `(L + 1) * V` positions.
+    pub fn push_state(&mut self, queue: &wgpu::Queue, positions: &[Vec3]) -> Result<(), RenderError> {
+        self.geometry.push_state(queue, positions)
+    }
+
+    /// Makes the current state the previous one; the buffer that held the previous state becomes
+    /// [`GpuFur::current_positions`], to be overwritten with the new state (e.g. by a compute
+    /// pass). With [`FurStates::One`] nothing changes.
+    pub fn swap_states(&mut self) {
+        self.geometry.swap_states();
+    }
+
+    /// The buffer of the current (newer) state; see the layout in [`GpuFur`].
+    #[must_use]
+    pub fn current_positions(&self) -> &wgpu::Buffer {
+        self.geometry.current()
+    }
+
+    /// The buffer of the previous (older) state; the same buffer as the current one with
+    /// [`FurStates::One`].
+    #[must_use]
+    pub fn previous_positions(&self) -> &wgpu::Buffer {
+        self.geometry.previous()
+    }
+
+    /// Replaces the base normals (`V` of them, model space, unit length): an animated mesh's
+    /// posed normals. They start as the rest normals.
+    ///
+    /// # Errors
+    /// [`RenderError::Count`] unless there are exactly `V` normals.
+    pub fn set_base_normals(&self, queue: &wgpu::Queue, normals: &[Vec3]) -> Result<(), RenderError> {
+        self.geometry.set_normals(queue, normals)
+    }
+
+    /// The base normals' buffer; see the layout in [`GpuFur`].
+    #[must_use]
+    pub fn base_normals(&self) -> &wgpu::Buffer {
+        self.geometry.normals()
+    }
+
+    /// Bytes this fur holds on the GPU (both states of the shared array when it keeps two).
+    #[must_use]
+    pub fn gpu_bytes(&self) -> GpuBytes {
+        GpuBytes { textures: self.textures.bytes, ..self.geometry.bytes() }
+    }
+
+    /// `L`, the shell layers above the base.
+    #[must_use]
+    pub fn layers(&self) -> u32 {
+        self.geometry.shape.layers
+    }
+
+    /// `V`, the base vertices (strands).
+    #[must_use]
+    pub fn vertex_count(&self) -> u32 {
+        self.geometry.shape.vertex_count
+    }
+
+    pub(crate) fn geometry(&self) -> &UnifiedGeometry {
+        &self.geometry
+    }
+
+    pub(crate) fn textures_bind_group(&self) -> &wgpu::BindGroup {
+        &self.textures.bind_group
+    }
+}
+
+fn geometry(
+    device: &wgpu::Device,
+    renderer: &FurRenderer,
+    structure: &FurStructure,
+    states: FurStates,
+) -> Result<UnifiedGeometry, RenderError> {
+    let state_count = match states {
+        FurStates::One => 1,
+        FurStates::Two => 2,
+    };
+    UnifiedGeometry::new(
+        device,
+        renderer.layouts(),
+        &structure.mesh,
+        structure.layers,
+        &structure.positions,
+        state_count,
+    )
+}

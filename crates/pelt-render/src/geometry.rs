@@ -1,0 +1,228 @@
+//! A mesh in the unified layout on the GPU, shared by [`crate::GpuFur`] (`L` layers) and
+//! [`crate::PlainMesh`] (layer 0 only): the shared vertex array (one or two states), base
+//! normals, corner uvs and topology as storage buffers, and the object uniform.
+
+use glam::{Vec2, Vec3};
+use pelt_core::Mesh;
+use pelt_core::fur::POSITION_BYTES;
+use wgpu::util::DeviceExt as _;
+
+use crate::RenderError;
+use crate::object::{GpuBytes, OBJECT_UNIFORM_BYTES, ObjectShape, ObjectUniform, check_size, uniform_buffer};
+use crate::pipeline::Layouts;
+
+/// Usage of the shared-array buffers: read by the vertex shaders, written by the queue or by a
+/// host's compute pass, and bindable as vertex buffers or copied by hosts that want to.
+pub const POSITIONS_USAGE: wgpu::BufferUsages = wgpu::BufferUsages::STORAGE
+    .union(wgpu::BufferUsages::VERTEX)
+    .union(wgpu::BufferUsages::COPY_DST)
+    .union(wgpu::BufferUsages::COPY_SRC);
+
+#[derive(Debug)]
+pub(crate) struct UnifiedGeometry {
+    pub shape: ObjectShape,
+    uniform: wgpu::Buffer,
+    /// One buffer, or two used in turn: `states[current]` is the newer state.
+    states: Vec<wgpu::Buffer>,
+    current: usize,
+    normals: wgpu::Buffer,
+    /// Triangles (3F), edges (2E), edge faces (2E); also the index buffer of the base triangles.
+    topology: wgpu::Buffer,
+    /// The fin strip of one edge (`6L` indices into `2(L + 1)` strip vertices), shared by all
+    /// edges: indexed, each strip vertex is shaded once however many triangles use it.
+    fin_indices: Option<wgpu::Buffer>,
+    /// `bind_groups[c]` reads `states[c]` as current and the other state as previous.
+    bind_groups: Vec<wgpu::BindGroup>,
+    bytes: GpuBytes,
+}
+
+impl UnifiedGeometry {
+    /// Uploads `mesh` with `positions` (`(L + 1) * V`, layer-major) into every state.
+    pub fn new(
+        device: &wgpu::Device,
+        layouts: &Layouts,
+        mesh: &Mesh,
+        layers: u32,
+        positions: &[Vec3],
+        state_count: usize,
+    ) -> Result<Self, RenderError> {
+        let shape = ObjectShape::new(mesh, layers);
+        let expected = (layers as usize + 1) * mesh.vertex_count();
+        if positions.len() != expected {
+            return Err(RenderError::Count {
+                what: "shared vertex positions",
+                expected,
+                got: positions.len(),
+                rule: "(L + 1) * V",
+            });
+        }
+        let position_bytes = positions.len() as u64 * POSITION_BYTES;
+        check_size(device, "shared vertex array", position_bytes)?;
+        let mut topology: Vec<u32> = mesh.triangles.iter().flatten().copied().collect();
+        topology.extend(mesh.edges.iter().flatten());
+        topology.extend(mesh.edge_faces.iter().flatten());
+        check_size(device, "mesh topology", topology.len() as u64 * 4)?;
+        let corner_uvs: Vec<Vec2> = match &mesh.corner_uvs {
+            Some(uvs) => uvs.iter().flatten().copied().collect(),
+            None => vec![Vec2::ZERO],
+        };
+        check_size(device, "mesh uvs", corner_uvs.len() as u64 * 8)?;
+
+        let buffer = |label, contents: &[u8], usage| {
+            device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents, usage })
+        };
+        let states: Vec<wgpu::Buffer> = (0..state_count.clamp(1, 2))
+            .map(|_| buffer("pelt shared vertices", bytemuck::cast_slice(positions), POSITIONS_USAGE))
+            .collect();
+        let normals = buffer(
+            "pelt base normals",
+            bytemuck::cast_slice(&mesh.normals),
+            wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+        );
+        let uvs = buffer("pelt corner uvs", bytemuck::cast_slice(&corner_uvs), wgpu::BufferUsages::STORAGE);
+        let topology_buffer = buffer(
+            "pelt topology",
+            bytemuck::cast_slice(&topology),
+            wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::INDEX,
+        );
+        let strip: Vec<u32> = (0..layers)
+            .flat_map(|i| {
+                let (a, b, a_up, b_up) = (2 * i, 2 * i + 1, 2 * i + 2, 2 * i + 3);
+                [a, b, b_up, a, b_up, a_up]
+            })
+            .collect();
+        let fin_indices = (layers > 0)
+            .then(|| buffer("pelt fin strip", bytemuck::cast_slice(&strip), wgpu::BufferUsages::INDEX));
+        let uniform = uniform_buffer(device);
+        let bind_groups = (0..states.len())
+            .map(|current| {
+                let previous = (current + 1) % states.len();
+                device.create_bind_group(&wgpu::BindGroupDescriptor {
+                    label: Some("pelt unified object"),
+                    layout: &layouts.unified_object,
+                    entries: &[
+                        wgpu::BindGroupEntry { binding: 0, resource: uniform.as_entire_binding() },
+                        wgpu::BindGroupEntry { binding: 1, resource: states[previous].as_entire_binding() },
+                        wgpu::BindGroupEntry { binding: 2, resource: states[current].as_entire_binding() },
+                        wgpu::BindGroupEntry { binding: 3, resource: normals.as_entire_binding() },
+                        wgpu::BindGroupEntry { binding: 4, resource: uvs.as_entire_binding() },
+                        wgpu::BindGroupEntry { binding: 5, resource: topology_buffer.as_entire_binding() },
+                    ],
+                })
+            })
+            .collect();
+        let bytes = GpuBytes {
+            positions: position_bytes * states.len() as u64,
+            attributes: normals.size() + uvs.size(),
+            indices: topology_buffer.size() + fin_indices.as_ref().map_or(0, wgpu::Buffer::size),
+            textures: 0,
+        };
+        debug_assert_eq!(uniform.size(), OBJECT_UNIFORM_BYTES);
+        Ok(Self {
+            shape,
+            uniform,
+            states,
+            current: 0,
+            normals,
+            topology: topology_buffer,
+            fin_indices,
+            bind_groups,
+            bytes,
+        })
+    }
+
+    pub fn bytes(&self) -> GpuBytes {
+        self.bytes
+    }
+
+    pub fn state_count(&self) -> usize {
+        self.states.len()
+    }
+
+    pub fn write_uniform(&self, queue: &wgpu::Queue, uniform: &ObjectUniform) {
+        queue.write_buffer(&self.uniform, 0, bytemuck::bytes_of(uniform));
+    }
+
+    fn check_positions(&self, positions: &[Vec3]) -> Result<(), RenderError> {
+        let expected = (self.shape.layers as usize + 1) * self.shape.vertex_count as usize;
+        if positions.len() == expected {
+            Ok(())
+        } else {
+            Err(RenderError::Count { what: "shared vertex positions", expected, got: positions.len(), rule: "(L + 1) * V" })
+        }
+    }
+
+    /// Writes `positions` into every state.
+    pub fn set_positions(&self, queue: &wgpu::Queue, positions: &[Vec3]) -> Result<(), RenderError> {
+        self.check_positions(positions)?;
+        for state in &self.states {
+            queue.write_buffer(state, 0, bytemuck::cast_slice(positions));
+        }
+        Ok(())
+    }
+
+    pub fn set_states(&self, queue: &wgpu::Queue, previous: &[Vec3], current: &[Vec3]) -> Result<(), RenderError> {
+        self.check_positions(previous)?;
+        self.check_positions(current)?;
+        queue.write_buffer(self.previous(), 0, bytemuck::cast_slice(previous));
+        queue.write_buffer(self.current(), 0, bytemuck::cast_slice(current));
+        Ok(())
+    }
+
+    /// The newer state becomes the older one; the buffer that held the older is now current.
+    pub fn swap_states(&mut self) {
+        self.current = (self.current + 1) % self.states.len();
+    }
+
+    pub fn push_state(&mut self, queue: &wgpu::Queue, positions: &[Vec3]) -> Result<(), RenderError> {
+        self.check_positions(positions)?;
+        self.swap_states();
+        queue.write_buffer(self.current(), 0, bytemuck::cast_slice(positions));
+        Ok(())
+    }
+
+    pub fn current(&self) -> &wgpu::Buffer {
+        &self.states[self.current]
+    }
+
+    pub fn previous(&self) -> &wgpu::Buffer {
+        &self.states[(self.current + 1) % self.states.len()]
+    }
+
+    pub fn normals(&self) -> &wgpu::Buffer {
+        &self.normals
+    }
+
+    pub fn set_normals(&self, queue: &wgpu::Queue, normals: &[Vec3]) -> Result<(), RenderError> {
+        let expected = self.shape.vertex_count as usize;
+        if normals.len() != expected {
+            return Err(RenderError::Count { what: "base normals", expected, got: normals.len(), rule: "V" });
+        }
+        queue.write_buffer(&self.normals, 0, bytemuck::cast_slice(normals));
+        Ok(())
+    }
+
+    pub fn bind_group(&self) -> &wgpu::BindGroup {
+        &self.bind_groups[self.current]
+    }
+
+    /// Draws the base triangles (`instances` = layers): by corner with uvs, else indexed.
+    pub fn draw_surface(&self, pass: &mut wgpu::RenderPass<'_>, instances: std::ops::Range<u32>) {
+        let triangles = self.shape.triangle_count;
+        if self.shape.has_uvs {
+            pass.draw(0..3 * triangles, instances);
+        } else {
+            // The topology buffer starts with the base triangles.
+            pass.set_index_buffer(self.topology.slice(..u64::from(triangles) * 12), wgpu::IndexFormat::Uint32);
+            pass.draw_indexed(0..3 * triangles, 0, instances);
+        }
+    }
+
+    /// Draws every fin (instance = edge).
+    pub fn draw_fins(&self, pass: &mut wgpu::RenderPass<'_>) {
+        if let Some(strip) = &self.fin_indices {
+            pass.set_index_buffer(strip.slice(..), wgpu::IndexFormat::Uint32);
+            pass.draw_indexed(0..6 * self.shape.layers, 0, 0..self.shape.edge_count);
+        }
+    }
+}

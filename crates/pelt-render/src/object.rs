@@ -1,0 +1,234 @@
+//! What every drawn object shares: the per-object uniform (group 1, binding 0 of every pipeline:
+//! model transform, interpolation, fur look), the per-frame data a host gives for it, and the
+//! byte counts objects report.
+
+use glam::{Mat3, Mat4, Vec3, Vec4};
+use pelt_core::Mesh;
+
+/// How one fur looks, beyond its textures: lighting response, fading and strand density.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FurLook {
+    /// Strength of the Kajiya-Kay highlight.
+    pub specular: f32,
+    /// Kajiya-Kay specular exponent.
+    pub shininess: f32,
+    /// Brightness left at the roots (1 = no darkening toward the roots).
+    pub root_occlusion: f32,
+    /// Fins are fully shown where the faces beside the edge turn below this |cos| to the view.
+    pub fin_fade_cos: f32,
+    /// Shells fade where the surface turns below this |cos| to the view.
+    pub shell_fade_cos: f32,
+    /// Shell texture tiles across the mesh's bounding radius, so strands have the same density
+    /// relative to the mesh whatever its size. (A larger tile holds more, finer strands: the
+    /// texture's resolution sets how fine the fur is, as in the paper's "resizing".)
+    pub tiles_per_radius: f32,
+}
+
+impl Default for FurLook {
+    fn default() -> Self {
+        Self {
+            specular: 0.2,
+            shininess: 40.0,
+            root_occlusion: 0.3,
+            fin_fade_cos: 0.1,
+            shell_fade_cos: 0.25,
+            tiles_per_radius: 0.4,
+        }
+    }
+}
+
+/// One fur's data for the coming frame, written by [`crate::GpuFur::prepare`].
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FurFrame {
+    /// The model transform (any affine transform; the shared array is in model space).
+    pub world_from_model: Mat4,
+    /// Where the frame falls between the previous and the current simulation state: 0 draws the
+    /// previous state, 1 the current one (see [`crate::GpuFur::push_state`]).
+    pub interpolation: f32,
+    /// Lighting, fading and density.
+    pub look: FurLook,
+}
+
+impl Default for FurFrame {
+    fn default() -> Self {
+        Self { world_from_model: Mat4::IDENTITY, interpolation: 1.0, look: FurLook::default() }
+    }
+}
+
+/// Where an object keeps its bytes on the GPU.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct GpuBytes {
+    /// Vertex positions: the shared array (once per kept state) or the separated vertices'
+    /// positions.
+    pub positions: u64,
+    /// Other per-vertex or per-corner data: normals, uvs (the separated structure's 20 bytes a
+    /// vertex).
+    pub attributes: u64,
+    /// Topology and index buffers.
+    pub indices: u64,
+    /// Shell, fin and surface textures with their mipmaps.
+    pub textures: u64,
+}
+
+impl GpuBytes {
+    /// Positions, attributes and indices: the structure's bytes (what
+    /// `pelt_core::fur::Footprint::total_bytes` predicts for one state).
+    #[must_use]
+    pub fn structure(&self) -> u64 {
+        self.positions + self.attributes + self.indices
+    }
+
+    /// Everything.
+    #[must_use]
+    pub fn total(&self) -> u64 {
+        self.structure() + self.textures
+    }
+}
+
+/// The per-object uniform; matches `Object` in `shading.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+pub(crate) struct ObjectUniform {
+    world_from_model: Mat4,
+    /// A `mat3x3<f32>` in a uniform: three 16-byte columns.
+    world_normal_from_model: [Vec4; 3],
+    colour: Vec4,
+    vertex_count: u32,
+    layers: u32,
+    triangle_count: u32,
+    edge_count: u32,
+    has_uvs: u32,
+    has_surface: u32,
+    shell_slices: u32,
+    _padding_0: u32,
+    tiles_per_uv: f32,
+    tiles_per_world: f32,
+    world_per_uv: f32,
+    interpolation: f32,
+    fin_fade_cos: f32,
+    shell_fade_cos: f32,
+    root_occlusion: f32,
+    specular: f32,
+    shininess: f32,
+    _padding_1: [f32; 3],
+}
+const _: () = assert!(size_of::<ObjectUniform>() == 208, "matches `Object` in shading.wgsl");
+
+pub(crate) const OBJECT_UNIFORM_BYTES: u64 = size_of::<ObjectUniform>() as u64;
+
+/// The constant part of an object's uniform: what its mesh and textures fix.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct ObjectShape {
+    pub vertex_count: u32,
+    pub layers: u32,
+    pub triangle_count: u32,
+    pub edge_count: u32,
+    pub has_uvs: bool,
+    /// Model units per uv unit (sqrt of surface area over uv area): uv tiles match model tiles.
+    pub world_per_uv: f32,
+    /// Bounding radius of the base mesh, model units.
+    pub radius: f32,
+}
+
+impl ObjectShape {
+    pub fn new(mesh: &Mesh, layers: u32) -> Self {
+        Self {
+            vertex_count: mesh.vertex_count() as u32,
+            layers,
+            triangle_count: mesh.triangles.len() as u32,
+            edge_count: mesh.edges.len() as u32,
+            has_uvs: mesh.corner_uvs.is_some(),
+            world_per_uv: world_per_uv(mesh),
+            radius: mesh.bounding_sphere().1.max(1e-6),
+        }
+    }
+
+    /// The uniform for one frame. `colour`: the skin's (furs) or the mesh's (plain) colour;
+    /// `textures`: `(shell slices, has a surface texture)`.
+    pub fn uniform(&self, frame: &FurFrame, colour: Vec3, (shell_slices, has_surface): (u32, bool)) -> ObjectUniform {
+        let look = &frame.look;
+        let tiles_per_world = look.tiles_per_radius / self.radius;
+        // The inverse transpose keeps normals perpendicular under non-uniform scale; a singular
+        // transform (a flattened model) keeps the plain 3x3 rather than producing infinities.
+        let linear = Mat3::from_mat4(frame.world_from_model);
+        let normal_matrix =
+            if linear.determinant().abs() > 1e-30 { linear.inverse().transpose() } else { linear };
+        ObjectUniform {
+            world_from_model: frame.world_from_model,
+            world_normal_from_model: [
+                normal_matrix.x_axis.extend(0.0),
+                normal_matrix.y_axis.extend(0.0),
+                normal_matrix.z_axis.extend(0.0),
+            ],
+            colour: colour.extend(1.0),
+            vertex_count: self.vertex_count,
+            layers: self.layers,
+            triangle_count: self.triangle_count,
+            edge_count: self.edge_count,
+            has_uvs: u32::from(self.has_uvs),
+            has_surface: u32::from(has_surface),
+            shell_slices,
+            _padding_0: 0,
+            tiles_per_uv: tiles_per_world * self.world_per_uv,
+            tiles_per_world,
+            world_per_uv: self.world_per_uv,
+            interpolation: frame.interpolation.clamp(0.0, 1.0),
+            fin_fade_cos: look.fin_fade_cos.max(1e-3),
+            shell_fade_cos: look.shell_fade_cos.max(1e-3),
+            root_occlusion: look.root_occlusion,
+            specular: look.specular,
+            shininess: look.shininess,
+            _padding_1: [0.0; 3],
+        }
+    }
+}
+
+/// sqrt(surface area / uv area), or 1 without uvs.
+pub(crate) fn world_per_uv(mesh: &Mesh) -> f32 {
+    let Some(uvs) = &mesh.corner_uvs else { return 1.0 };
+    let uv_area: f32 = uvs.iter().map(|[a, b, c]| (*b - *a).perp_dot(*c - *a).abs() * 0.5).sum();
+    if uv_area > 1e-12 { (mesh.surface_area() / uv_area).sqrt() } else { 1.0 }
+}
+
+/// Creates the uniform buffer of one object.
+pub(crate) fn uniform_buffer(device: &wgpu::Device) -> wgpu::Buffer {
+    device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("pelt object"),
+        size: OBJECT_UNIFORM_BYTES,
+        usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+        mapped_at_creation: false,
+    })
+}
+
+/// Fails with [`crate::RenderError::TooLarge`] when `bytes` exceed what one storage binding or
+/// buffer may hold on `device`.
+pub(crate) fn check_size(device: &wgpu::Device, what: &'static str, bytes: u64) -> Result<(), crate::RenderError> {
+    let limits = device.limits();
+    let limit = limits.max_storage_buffer_binding_size.min(limits.max_buffer_size);
+    if bytes > limit { Err(crate::RenderError::TooLarge { what, bytes, limit }) } else { Ok(()) }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn normals_follow_non_uniform_scale() {
+        let (mesh, _) = pelt_core::Builtin::Box.mesh();
+        let shape = ObjectShape::new(&mesh, 4);
+        let frame = FurFrame { world_from_model: Mat4::from_scale(Vec3::new(2.0, 1.0, 1.0)), ..FurFrame::default() };
+        let uniform = shape.uniform(&frame, Vec3::ONE, (4, false));
+        let normal_matrix = Mat3::from_cols(
+            uniform.world_normal_from_model[0].truncate(),
+            uniform.world_normal_from_model[1].truncate(),
+            uniform.world_normal_from_model[2].truncate(),
+        );
+        // A plane x = y in model space is stretched along x; its normal turns toward y.
+        let normal = (normal_matrix * Vec3::new(1.0, -1.0, 0.0)).normalize();
+        let in_plane = frame.world_from_model.transform_vector3(Vec3::new(1.0, 1.0, 0.0));
+        assert!(normal.dot(in_plane).abs() < 1e-6, "normal {normal} stays perpendicular to {in_plane}");
+        let flat = FurFrame { world_from_model: Mat4::from_scale(Vec3::new(1.0, 0.0, 1.0)), ..frame };
+        let uniform = shape.uniform(&flat, Vec3::ONE, (4, false));
+        assert!(uniform.world_normal_from_model.iter().all(|c| c.is_finite()));
+    }
+}

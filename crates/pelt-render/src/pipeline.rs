@@ -1,0 +1,210 @@
+//! Pipeline plumbing shared by the unified and the separated renderer: bind group layouts,
+//! samplers and one function that builds every fur pipeline for a [`FurTarget`].
+
+use crate::targets::FurTarget;
+
+/// The bind group layouts and samplers of one renderer, shared by everything it draws.
+#[derive(Debug, Clone)]
+pub(crate) struct Layouts {
+    /// Group 0: the view uniform.
+    pub view: wgpu::BindGroupLayout,
+    /// Group 1 of the unified structure and plain meshes: the object uniform and the storage
+    /// buffers (positions twice, base normals, corner uvs, topology).
+    pub unified_object: wgpu::BindGroupLayout,
+    /// Group 1 of the separated structure: the object uniform alone.
+    pub separated_object: wgpu::BindGroupLayout,
+    /// Group 2: a fur's textures and the samplers.
+    pub textures: wgpu::BindGroupLayout,
+    pub shell_sampler: wgpu::Sampler,
+    pub fin_sampler: wgpu::Sampler,
+}
+
+impl Layouts {
+    pub fn new(device: &wgpu::Device) -> Self {
+        let uniform = wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Uniform,
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        };
+        let storage = wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Storage { read_only: true },
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        };
+        let both = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT;
+        let entry = |binding, visibility, ty| wgpu::BindGroupLayoutEntry { binding, visibility, ty, count: None };
+        let view = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("pelt view"),
+            entries: &[entry(0, both, uniform)],
+        });
+        // Storage buffers are read by vertex shaders only, so fragment stages need no storage.
+        let vertex = wgpu::ShaderStages::VERTEX;
+        let unified_object = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("pelt unified object"),
+            entries: &[
+                entry(0, both, uniform),
+                entry(1, vertex, storage),
+                entry(2, vertex, storage),
+                entry(3, vertex, storage),
+                entry(4, vertex, storage),
+                entry(5, vertex, storage),
+            ],
+        });
+        let separated_object = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("pelt separated object"),
+            entries: &[entry(0, both, uniform)],
+        });
+        let texture = |view_dimension| wgpu::BindingType::Texture {
+            sample_type: wgpu::TextureSampleType::Float { filterable: true },
+            view_dimension,
+            multisampled: false,
+        };
+        let filtering = wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering);
+        let fragment = wgpu::ShaderStages::FRAGMENT;
+        let textures = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("pelt fur textures"),
+            entries: &[
+                entry(0, fragment, texture(wgpu::TextureViewDimension::D2Array)),
+                entry(1, fragment, texture(wgpu::TextureViewDimension::D2)),
+                entry(2, fragment, filtering),
+                entry(3, fragment, filtering),
+                entry(4, fragment, texture(wgpu::TextureViewDimension::D2)),
+            ],
+        });
+        let sampler = |label, v_mode| {
+            device.create_sampler(&wgpu::SamplerDescriptor {
+                label: Some(label),
+                address_mode_u: wgpu::AddressMode::Repeat,
+                address_mode_v: v_mode,
+                mag_filter: wgpu::FilterMode::Linear,
+                min_filter: wgpu::FilterMode::Linear,
+                mipmap_filter: wgpu::MipmapFilterMode::Linear,
+                ..wgpu::SamplerDescriptor::default()
+            })
+        };
+        Self {
+            view,
+            unified_object,
+            separated_object,
+            textures,
+            shell_sampler: sampler("pelt shell sampler", wgpu::AddressMode::Repeat),
+            // Fin rows run root to tip: clamp so the tips do not bleed into the roots.
+            fin_sampler: sampler("pelt fin sampler", wgpu::AddressMode::ClampToEdge),
+        }
+    }
+
+    /// The layout of pipelines that draw with `object` in group 1, with or without textures.
+    pub fn pipeline_layout(
+        &self,
+        device: &wgpu::Device,
+        label: &str,
+        object: &wgpu::BindGroupLayout,
+        with_textures: bool,
+    ) -> wgpu::PipelineLayout {
+        let with = [Some(&self.view), Some(object), Some(&self.textures)];
+        device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some(label),
+            bind_group_layouts: if with_textures { &with } else { &with[..2] },
+            immediate_size: 0,
+        })
+    }
+}
+
+/// How the fur's transparency is resolved.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Transparency {
+    /// Premultiplied alpha blending, depth writes off (drawn in order, inner to outer).
+    Blend,
+    /// Alpha-to-coverage with depth writes on (order independent).
+    Coverage,
+}
+
+impl Transparency {
+    /// The blended variant and the alpha-to-coverage one, in the order pipelines are kept.
+    pub const BOTH: [Self; 2] = [Self::Blend, Self::Coverage];
+
+    pub fn index(alpha_to_coverage: bool) -> usize {
+        usize::from(alpha_to_coverage)
+    }
+}
+
+/// What a pipeline draws, which sets its blending, depth writes and culling.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum PassKind {
+    Opaque,
+    Shells(Transparency),
+    Fins(Transparency),
+}
+
+/// One pipeline's shader and vertex input.
+pub(crate) struct PipelineSource<'a> {
+    pub layout: &'a wgpu::PipelineLayout,
+    pub module: &'a wgpu::ShaderModule,
+    pub vertex_entry: &'a str,
+    pub fragment_entry: &'a str,
+    pub buffers: &'a [Option<wgpu::VertexBufferLayout<'a>>],
+}
+
+/// Builds one Pelt pipeline for `target`.
+pub(crate) fn create_pipeline(
+    device: &wgpu::Device,
+    target: &FurTarget,
+    label: &str,
+    source: &PipelineSource<'_>,
+    kind: PassKind,
+) -> wgpu::RenderPipeline {
+    let transparency = match kind {
+        PassKind::Opaque => None,
+        PassKind::Shells(t) | PassKind::Fins(t) => Some(t),
+    };
+    let coverage = transparency == Some(Transparency::Coverage);
+    let blend = (transparency == Some(Transparency::Blend)).then_some(wgpu::BlendState::PREMULTIPLIED_ALPHA_BLENDING);
+    let depth_write = transparency != Some(Transparency::Blend);
+    // Shells facing away lie behind the skin; fins are seen from both sides.
+    let cull_mode = match kind {
+        PassKind::Fins(_) => None,
+        PassKind::Opaque | PassKind::Shells(_) => Some(wgpu::Face::Back),
+    };
+    let constants = [("ALPHA_TO_COVERAGE", if coverage { 1.0 } else { 0.0 })];
+    let compilation_options = wgpu::PipelineCompilationOptions { constants: &constants, ..Default::default() };
+    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some(label),
+        layout: Some(source.layout),
+        vertex: wgpu::VertexState {
+            module: source.module,
+            entry_point: Some(source.vertex_entry),
+            compilation_options: compilation_options.clone(),
+            buffers: source.buffers,
+        },
+        primitive: wgpu::PrimitiveState {
+            topology: wgpu::PrimitiveTopology::TriangleList,
+            front_face: wgpu::FrontFace::Ccw,
+            cull_mode,
+            ..wgpu::PrimitiveState::default()
+        },
+        depth_stencil: Some(wgpu::DepthStencilState {
+            format: target.depth_format,
+            depth_write_enabled: Some(depth_write),
+            depth_compare: Some(target.depth_compare),
+            stencil: wgpu::StencilState::default(),
+            bias: wgpu::DepthBiasState::default(),
+        }),
+        multisample: wgpu::MultisampleState {
+            count: target.sample_count,
+            mask: !0,
+            alpha_to_coverage_enabled: coverage && target.sample_count > 1,
+        },
+        fragment: Some(wgpu::FragmentState {
+            module: source.module,
+            entry_point: Some(source.fragment_entry),
+            compilation_options,
+            targets: &[Some(wgpu::ColorTargetState {
+                format: target.colour_format,
+                blend,
+                write_mask: wgpu::ColorWrites::ALL,
+            })],
+        }),
+        multiview_mask: None,
+        cache: None,
+    })
+}

@@ -1,0 +1,47 @@
+//! Meshes drawn without fur (e.g. the body under a furry garment), lit like the fur's skin.
+
+use glam::{Mat4, Vec3};
+use pelt_core::Mesh;
+
+use crate::RenderError;
+use crate::geometry::UnifiedGeometry;
+use crate::object::{FurFrame, GpuBytes};
+use crate::renderer::FurRenderer;
+use crate::requirements::ErrorScope;
+
+/// A furless mesh on the GPU, drawn with [`FurRenderer::draw_plain`] before the furs.
+#[derive(Debug)]
+pub struct PlainMesh {
+    geometry: UnifiedGeometry,
+    colour: Vec3,
+}
+
+impl PlainMesh {
+    /// Uploads `mesh`, drawn in linear RGB `colour`.
+    ///
+    /// # Errors
+    /// [`RenderError::TooLarge`] when the mesh exceeds the device's buffer limits,
+    /// [`RenderError::OutOfMemory`] or [`RenderError::Gpu`].
+    pub fn new(device: &wgpu::Device, renderer: &FurRenderer, mesh: &Mesh, colour: Vec3) -> Result<Self, RenderError> {
+        let scope = ErrorScope::push(device);
+        let geometry = UnifiedGeometry::new(device, renderer.layouts(), mesh, 0, &mesh.positions, 1);
+        scope.pop("uploading a plain mesh")?;
+        Ok(Self { geometry: geometry?, colour })
+    }
+
+    /// Writes this frame's model transform (takes effect at the next submission).
+    pub fn prepare(&self, queue: &wgpu::Queue, world_from_model: Mat4) {
+        let frame = FurFrame { world_from_model, ..FurFrame::default() };
+        self.geometry.write_uniform(queue, &self.geometry.shape.uniform(&frame, self.colour, (0, false)));
+    }
+
+    /// Bytes the mesh holds on the GPU.
+    #[must_use]
+    pub fn gpu_bytes(&self) -> GpuBytes {
+        self.geometry.bytes()
+    }
+
+    pub(crate) fn geometry(&self) -> &UnifiedGeometry {
+        &self.geometry
+    }
+}

@@ -1,0 +1,156 @@
+//! Per-view data supplied by the host: the camera's transform and position and the light.
+//! Each view has its own uniform buffer ([`FurView`]), so several views drawn in one submission
+//! do not overwrite each other.
+
+use glam::{Mat4, Vec3};
+
+use crate::renderer::FurRenderer;
+
+/// Where the key light comes from.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum LightDirection {
+    /// Unit vector toward the light in world space (a sun).
+    World(Vec3),
+    /// Unit vector toward the light in view space (x right, y up, z toward the viewer), so the
+    /// light follows the camera.
+    View(Vec3),
+}
+
+/// The key light and the ambient term.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Light {
+    /// Toward the light.
+    pub direction: LightDirection,
+    /// Linear RGB.
+    pub colour: Vec3,
+    /// Light everywhere, as a fraction of the surface colour.
+    pub ambient: f32,
+}
+
+impl Light {
+    /// Pelt's default: from the upper left, following the camera.
+    pub const DEFAULT_FROM_VIEW: Vec3 = Vec3::new(-0.45, 0.65, 0.6);
+}
+
+impl Default for Light {
+    fn default() -> Self {
+        Self {
+            direction: LightDirection::View(Self::DEFAULT_FROM_VIEW.normalize()),
+            colour: Vec3::ONE,
+            ambient: 0.25,
+        }
+    }
+}
+
+/// One view as the shaders see it; build it from the host's camera with [`ViewData::new`] or
+/// fill the fields directly.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ViewData {
+    /// Projection times view, with the host's depth convention (reverse-Z or not).
+    pub clip_from_world: Mat4,
+    /// The camera's position in world space (shell and fin fading, highlights).
+    pub camera_position_world: Vec3,
+    /// Unit vector toward the key light, world space.
+    pub light_direction_world: Vec3,
+    /// Linear RGB.
+    pub light_colour: Vec3,
+    /// Light everywhere, as a fraction of the surface colour.
+    pub ambient: f32,
+}
+
+impl ViewData {
+    /// A view from the host's camera: `clip_from_world` and the camera's transform
+    /// `world_from_view` (its position is the translation), with `light` resolved to world space.
+    #[must_use]
+    pub fn new(clip_from_world: Mat4, world_from_view: Mat4, light: &Light) -> Self {
+        let light_direction_world = match light.direction {
+            LightDirection::World(direction) => direction,
+            LightDirection::View(direction) => world_from_view.transform_vector3(direction),
+        };
+        Self {
+            clip_from_world,
+            camera_position_world: world_from_view.w_axis.truncate(),
+            light_direction_world: light_direction_world.normalize_or(Vec3::Y),
+            light_colour: light.colour,
+            ambient: light.ambient,
+        }
+    }
+}
+
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+struct ViewUniform {
+    clip_from_world: Mat4,
+    camera_position: Vec3,
+    ambient: f32,
+    light_direction: Vec3,
+    _padding_0: f32,
+    light_colour: Vec3,
+    _padding_1: f32,
+}
+const _: () = assert!(size_of::<ViewUniform>() == 112, "matches `View` in shading.wgsl");
+
+/// One view's uniform buffer and bind group (group 0 of every Pelt pipeline). Make one per
+/// camera (or per eye, per shadow view...) and [`FurView::prepare`] it each frame before
+/// submitting the passes that draw with it.
+#[derive(Debug)]
+pub struct FurView {
+    buffer: wgpu::Buffer,
+    bind_group: wgpu::BindGroup,
+}
+
+impl FurView {
+    /// A view for passes drawn with `renderer` (or a [`crate::SeparatedRenderer`] made from it).
+    #[must_use]
+    pub fn new(device: &wgpu::Device, renderer: &FurRenderer) -> Self {
+        let buffer = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("pelt view"),
+            size: size_of::<ViewUniform>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("pelt view"),
+            layout: &renderer.layouts().view,
+            entries: &[wgpu::BindGroupEntry { binding: 0, resource: buffer.as_entire_binding() }],
+        });
+        Self { buffer, bind_group }
+    }
+
+    /// Writes this frame's view (takes effect at the next submission).
+    pub fn prepare(&self, queue: &wgpu::Queue, data: &ViewData) {
+        let uniform = ViewUniform {
+            clip_from_world: data.clip_from_world,
+            camera_position: data.camera_position_world,
+            ambient: data.ambient,
+            light_direction: data.light_direction_world,
+            _padding_0: 0.0,
+            light_colour: data.light_colour,
+            _padding_1: 0.0,
+        };
+        queue.write_buffer(&self.buffer, 0, bytemuck::bytes_of(&uniform));
+    }
+
+    pub(crate) fn bind_group(&self) -> &wgpu::BindGroup {
+        &self.bind_group
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn view_space_light_turns_with_the_camera() {
+        let world_from_view = Mat4::from_rotation_translation(
+            glam::Quat::from_rotation_y(std::f32::consts::FRAC_PI_2),
+            Vec3::new(1.0, 2.0, 3.0),
+        );
+        let light = Light { direction: LightDirection::View(Vec3::Z), ..Light::default() };
+        let view = ViewData::new(Mat4::IDENTITY, world_from_view, &light);
+        assert!(view.camera_position_world.distance(Vec3::new(1.0, 2.0, 3.0)) < 1e-6);
+        assert!(view.light_direction_world.distance(Vec3::X) < 1e-6, "{}", view.light_direction_world);
+        let sun = Light { direction: LightDirection::World(Vec3::new(0.0, 2.0, 0.0)), ..light };
+        assert!(ViewData::new(Mat4::IDENTITY, world_from_view, &sun).light_direction_world.distance(Vec3::Y) < 1e-6);
+    }
+}

@@ -1,0 +1,314 @@
+//! The viewer's state apart from the window: settings, the fur structure and its simulation, the
+//! camera, timings and textures in the making, and how the panel's changes rebuild them.
+
+use std::time::Instant;
+
+use anyhow::Context as _;
+use glam::Vec3;
+use pelt_core::mesh::builtin::{TRY_ON_NAME, TryOnScene, try_on_scene};
+use pelt_core::sim::{Scene, Simulation};
+use pelt_core::{Builtin, FurStructure, FurTextures, Mesh, Preset, PresetError};
+
+use super::Args;
+use super::camera::OrbitCamera;
+use super::panel::{Changes, MeshChoice, Settings};
+
+/// Time step of `--screenshot-after` runs, so they repeat exactly.
+const FIXED_FRAME_SECS: f64 = 1.0 / 60.0;
+
+/// Everything that is not the window: settings, fur, camera, timings.
+pub(super) struct Model {
+    pub(super) settings: Settings,
+    pub(super) mesh_choices: Vec<MeshChoice>,
+    /// The mesh from the command line, kept to switch back to.
+    pub(super) file_mesh: Option<Mesh>,
+    pub(super) structure: FurStructure,
+    /// The try-on scene's body, drawn without fur under the furry garment.
+    pub(super) body: Option<Mesh>,
+    /// GPU bytes of the unified structure as the renderer holds it.
+    pub(super) unified_bytes: Option<u64>,
+    /// GPU bytes of the separated structure while it is shown.
+    pub(super) separated_bytes: Option<u64>,
+    pub(super) camera: OrbitCamera,
+    /// Frame the fur once the 3D view's size is known.
+    pub(super) frame_pending: bool,
+    /// Size of the 3D view in physical pixels, from the last panel pass.
+    pub(super) viewport_px: [u32; 2],
+    pub(super) clock: Clock,
+    pub(super) frame_time_secs: f64,
+    pub(super) sim: Simulation,
+    /// Scripted wind and touch strokes (`--script`), played on the simulation clock.
+    pub(super) scene: Option<Scene>,
+    /// Simulation time: advances only while the simulation runs.
+    pub(super) sim_clock_secs: f64,
+    /// Smoothed cost of one `advance_to`.
+    pub(super) sim_time_secs: f64,
+    pub(super) touch: Option<TouchDrag>,
+    /// Wind strength W restores after turning the wind off.
+    pub(super) wind_strength_on: f32,
+    /// Textures made and not yet uploaded.
+    pub(super) textures: Option<FurTextures>,
+    /// Texture generation runs off the UI thread, so sliders stay smooth.
+    pub(super) texture_job: Option<std::thread::JoinHandle<Result<FurTextures, PresetError>>>,
+    /// The preset changed while a job ran: start another when it ends.
+    pub(super) textures_stale: bool,
+    pub(super) frames_drawn: u32,
+    pub(super) skipped_frames: u32,
+    pub(super) screenshots_saved: u32,
+    pub(super) screenshot_pending: bool,
+    pub(super) quit: bool,
+    pub(super) panel_hidden: bool,
+    pub(super) status: String,
+}
+
+/// Wall-clock time, or exactly `FIXED_FRAME_SECS` per frame for repeatable runs.
+pub(super) struct Clock {
+    pub(super) fixed: bool,
+    pub(super) last: Instant,
+}
+
+impl Clock {
+    /// `(wall seconds since the previous tick, seconds the scene advances)`.
+    pub(super) fn tick(&mut self) -> (f64, f64) {
+        let now = Instant::now();
+        let wall_secs = (now - self.last).as_secs_f64();
+        self.last = now;
+        // A long stall (a dragged window, a breakpoint) should not fast-forward the scene.
+        (wall_secs, if self.fixed { FIXED_FRAME_SECS } else { wall_secs.min(0.25) })
+    }
+}
+
+/// A touch in progress: the pointer drags the hit point across the plane facing the camera.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct TouchDrag {
+    pub(super) hit: Vec3,
+    pub(super) plane_normal: Vec3,
+}
+
+impl Model {
+    /// The model for `args`, with `mesh` (named `mesh_source`) as the command line's mesh.
+    pub(super) fn new(args: &Args, mesh: Mesh, mesh_source: String) -> anyhow::Result<Self> {
+        let mut mesh_choices: Vec<MeshChoice> = Builtin::ALL.into_iter().map(MeshChoice::Builtin).collect();
+        mesh_choices.push(MeshChoice::TryOn);
+        let (choice, file_mesh) = match (&args.mesh.mesh, &args.mesh.builtin) {
+            (Some(path), _) => {
+                let name = path.file_name().map_or(mesh_source, |n| n.to_string_lossy().into_owned());
+                mesh_choices.push(MeshChoice::File(name.clone()));
+                (MeshChoice::File(name), Some(mesh.clone()))
+            }
+            (None, Some(name)) => (MeshChoice::Builtin(Builtin::from_name(name).unwrap_or(Builtin::Bunny)), None),
+            (None, None) => (MeshChoice::Builtin(Builtin::Bunny), None),
+        };
+        let (preset, preset_path) = match &args.preset {
+            Some(path) => (Preset::load(path)?, path.display().to_string()),
+            None => (Preset::default(), "fur.toml".to_owned()),
+        };
+        let mut settings = Settings::new(choice, preset, preset_path);
+        settings.overlay = !args.no_overlay;
+        let structure = grow(mesh, &settings.preset)?;
+        let sim = Simulation::new(&structure, &settings.preset.simulation)?;
+        // The first textures are made before the window opens, so the first frame has them.
+        let textures = settings.preset.generate_textures()?;
+        let scene = match &args.script {
+            Some(path) => Some(Scene::load(path)?),
+            None => None,
+        };
+        let mut model = Self {
+            settings,
+            mesh_choices,
+            file_mesh,
+            structure,
+            body: None,
+            unified_bytes: None,
+            separated_bytes: None,
+            camera: OrbitCamera::default(),
+            frame_pending: true,
+            viewport_px: [1, 1],
+            clock: Clock { fixed: args.screenshot_after.is_some(), last: Instant::now() },
+            frame_time_secs: 0.0,
+            sim,
+            scene,
+            sim_clock_secs: 0.0,
+            sim_time_secs: 0.0,
+            touch: None,
+            wind_strength_on: 1.0,
+            textures: Some(textures),
+            texture_job: None,
+            textures_stale: false,
+            frames_drawn: 0,
+            skipped_frames: 0,
+            screenshots_saved: 0,
+            screenshot_pending: false,
+            quit: false,
+            panel_hidden: false,
+            status: String::new(),
+        };
+        if args.mesh.mesh.is_none() && args.mesh.builtin.as_deref() == Some(TRY_ON_NAME) {
+            model.settings.mesh = MeshChoice::TryOn;
+            model.apply(Changes { mesh: true, ..Changes::default() })?;
+        }
+        Ok(model)
+    }
+
+    /// Looks at the whole fur (mesh plus its longest strand).
+    pub(super) fn frame(&mut self, aspect: f32) {
+        let (center, radius) = self.structure.mesh.bounding_sphere();
+        let longest = self.structure.lengths.iter().copied().fold(0.0, f32::max);
+        // A garment is seen on the whole body wearing it.
+        let (center, radius) = match &self.body {
+            Some(body) => body.bounding_sphere(),
+            None => (center, radius + longest),
+        };
+        self.camera.frame(center, radius, aspect);
+    }
+
+    /// Starts texture generation when the preset changed and none runs; hands over finished
+    /// textures.
+    pub(super) fn poll_textures(&mut self) -> Option<FurTextures> {
+        let mut done = None;
+        if self.texture_job.as_ref().is_some_and(std::thread::JoinHandle::is_finished)
+            && let Some(job) = self.texture_job.take()
+        {
+            match job.join() {
+                Ok(Ok(textures)) => {
+                    self.status.clear();
+                    done = Some(textures);
+                }
+                Ok(Err(error)) => self.status = error.to_string(),
+                Err(_) => self.status = "texture generation failed unexpectedly".to_owned(),
+            }
+        }
+        if self.texture_job.is_none() && self.textures_stale {
+            self.textures_stale = false;
+            let preset = self.settings.preset.clone();
+            self.texture_job = Some(std::thread::spawn(move || preset.generate_textures()));
+            self.status = "making textures…".to_owned();
+        }
+        done
+    }
+
+    /// Reads the preset file named in the panel; everything it sets changes.
+    pub(super) fn load_preset(&mut self) -> Changes {
+        match Preset::load(&self.settings.preset_path) {
+            Ok(preset) => {
+                self.settings.preset = preset;
+                self.status = format!("loaded {}", self.settings.preset_path);
+                Changes { structure: true, textures: true, simulation: true, ..Changes::default() }
+            }
+            Err(error) => {
+                self.status = error.to_string();
+                Changes::default()
+            }
+        }
+    }
+
+    pub(super) fn save_preset(&mut self) {
+        self.status = match self.settings.preset.save(&self.settings.preset_path) {
+            Ok(()) => format!("saved {}", self.settings.preset_path),
+            Err(error) => error.to_string(),
+        };
+    }
+
+    /// Plays the script and steps the simulation to this frame's time.
+    pub(super) fn simulate(&mut self, frame_secs: f64) -> anyhow::Result<()> {
+        if !self.settings.simulate {
+            return Ok(());
+        }
+        self.sim_clock_secs += frame_secs;
+        if let Some(scene) = &self.scene {
+            scene.apply(self.sim_clock_secs, &mut self.sim)?;
+        }
+        let start = Instant::now();
+        self.sim.advance_to(self.sim_clock_secs);
+        self.sim_time_secs = smooth(self.sim_time_secs, start.elapsed().as_secs_f64());
+        Ok(())
+    }
+
+    /// Rebuilds what the panel's changes touch; true when the structure is new.
+    pub(super) fn apply(&mut self, changes: Changes) -> anyhow::Result<bool> {
+        if changes.mesh {
+            self.body = None;
+            let mesh = match &self.settings.mesh {
+                MeshChoice::Builtin(builtin) => builtin.mesh().0,
+                MeshChoice::TryOn => {
+                    let TryOnScene { garment, body } = try_on_scene(&pelt_core::ImportOptions::default())?;
+                    self.body = Some(body);
+                    garment
+                }
+                MeshChoice::File(_) => self.file_mesh.clone().context("the command-line mesh is gone")?,
+            };
+            self.structure = grow(mesh, &self.settings.preset)?;
+            self.frame_pending = true;
+        } else if changes.structure {
+            self.structure = grow(self.structure.mesh.clone(), &self.settings.preset)?;
+        }
+        let rebuilt = changes.mesh || changes.structure;
+        if rebuilt {
+            self.sim = Simulation::new(&self.structure, &self.settings.preset.simulation)?;
+            self.touch = None;
+        } else if changes.simulation {
+            self.sim.set_params(&self.settings.preset.simulation)?;
+        }
+        if changes.textures {
+            self.textures_stale = true;
+        }
+        Ok(rebuilt)
+    }
+}
+
+/// Grows the rest pose of the fur on `mesh`.
+fn grow(mesh: Mesh, preset: &Preset) -> anyhow::Result<FurStructure> {
+    let params = preset.fur_params(&mesh);
+    Ok(FurStructure::new(mesh, &params)?)
+}
+
+/// Exponential moving average, so the overlay's numbers are readable.
+pub(super) fn smooth(previous: f64, sample: f64) -> f64 {
+    if previous == 0.0 { sample } else { previous * 0.9 + sample * 0.1 }
+}
+
+/// A model from `pelt view` arguments, as the tests of the viewer's modules need one.
+#[cfg(test)]
+pub(super) fn test_model(args: &[&str]) -> Model {
+    #[derive(clap::Parser)]
+    struct Wrapper {
+        #[command(flatten)]
+        args: Args,
+    }
+    let wrapper = <Wrapper as clap::Parser>::parse_from([&["view"], args].concat());
+    let (mesh, report) = wrapper.args.mesh.load(Builtin::Bunny).unwrap();
+    Model::new(&wrapper.args, mesh, report.source).unwrap()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn panel_changes_rebuild_only_what_they_touch() {
+        let mut model = test_model(&["--builtin", "sphere"]);
+        let before = model.structure.positions.clone();
+        assert!(!model.apply(Changes { simulation: true, ..Changes::default() }).unwrap());
+        assert!(!model.textures_stale, "a simulation change makes no textures");
+        model.settings.preset.length *= 2.0;
+        assert!(model.apply(Changes { structure: true, ..Changes::default() }).unwrap());
+        assert_ne!(model.structure.positions, before);
+        assert_eq!(model.sim.positions().len(), model.structure.positions.len());
+        assert!(!model.apply(Changes { textures: true, ..Changes::default() }).unwrap());
+        assert!(model.textures_stale);
+        model.settings.mesh = MeshChoice::TryOn;
+        assert!(model.apply(Changes { mesh: true, ..Changes::default() }).unwrap());
+        assert!(model.body.is_some() && model.frame_pending);
+    }
+
+    #[test]
+    fn growing_scales_the_length_with_the_mesh() {
+        let (mesh, _) = Builtin::Sphere.mesh();
+        let radius = mesh.bounding_sphere().1;
+        let mut preset = Preset::default();
+        preset.length = 0.25;
+        let fur = grow(mesh, &preset).unwrap();
+        assert!(fur.lengths.iter().all(|l| (l - 0.25 * radius).abs() < 1e-5));
+        assert_eq!(fur.layers, preset.layers);
+    }
+}
