@@ -91,8 +91,8 @@ impl UnifiedGeometry {
                 [a, b, b_up, a, b_up, a_up]
             })
             .collect();
-        let fin_indices = (layers > 0)
-            .then(|| buffer("pelt fin strip", bytemuck::cast_slice(&strip), wgpu::BufferUsages::INDEX));
+        let fin_indices =
+            (layers > 0).then(|| buffer("pelt fin strip", bytemuck::cast_slice(&strip), wgpu::BufferUsages::INDEX));
         let uniform = uniform_buffer(device);
         let bind_groups = (0..states.len())
             .map(|current| {
@@ -148,7 +148,12 @@ impl UnifiedGeometry {
         if positions.len() == expected {
             Ok(())
         } else {
-            Err(RenderError::Count { what: "shared vertex positions", expected, got: positions.len(), rule: "(L + 1) * V" })
+            Err(RenderError::Count {
+                what: "shared vertex positions",
+                expected,
+                got: positions.len(),
+                rule: "(L + 1) * V",
+            })
         }
     }
 

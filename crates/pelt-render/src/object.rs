@@ -151,8 +151,7 @@ impl ObjectShape {
         // The inverse transpose keeps normals perpendicular under non-uniform scale; a singular
         // transform (a flattened model) keeps the plain 3x3 rather than producing infinities.
         let linear = Mat3::from_mat4(frame.world_from_model);
-        let normal_matrix =
-            if linear.determinant().abs() > 1e-30 { linear.inverse().transpose() } else { linear };
+        let normal_matrix = if linear.determinant().abs() > 1e-30 { linear.inverse().transpose() } else { linear };
         ObjectUniform {
             world_from_model: frame.world_from_model,
             world_normal_from_model: [

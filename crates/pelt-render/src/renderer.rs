@@ -114,9 +114,8 @@ impl FurRenderer {
             SurfacePipelines {
                 plain: build("pelt plain", &plain_layout, (&skin, "fs_plain"), PassKind::Opaque),
                 skin: build("pelt skin", &fur_layout, (&skin, "fs_skin"), PassKind::Opaque),
-                shells: Transparency::BOTH.map(|t| {
-                    build("pelt shells", &fur_layout, (&shell, "fs_shell"), PassKind::Shells(t))
-                }),
+                shells: Transparency::BOTH
+                    .map(|t| build("pelt shells", &fur_layout, (&shell, "fs_shell"), PassKind::Shells(t))),
             }
         };
         let corners = surface("corners");

@@ -75,8 +75,13 @@ impl SeparatedRenderer {
             attributes: &wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x2],
         })];
         let build = |label: &str, (vertex_entry, fragment_entry), kind| {
-            let source =
-                PipelineSource { layout: &layout, module: &module, vertex_entry, fragment_entry, buffers: &vertex_layout };
+            let source = PipelineSource {
+                layout: &layout,
+                module: &module,
+                vertex_entry,
+                fragment_entry,
+                buffers: &vertex_layout,
+            };
             create_pipeline(device, &target, label, &source, kind)
         };
         let skin = build("pelt separated skin", ("vs_separated_skin", "fs_skin"), PassKind::Opaque);
@@ -201,8 +206,11 @@ impl SeparatedFur {
     /// Writes this frame's model transform and look; the interpolation is unused (the separated
     /// structure is static).
     pub fn prepare(&self, queue: &wgpu::Queue, frame: &FurFrame) {
-        let uniform =
-            self.shape.uniform(frame, self.textures.root_colour, (self.textures.shell_slices, self.textures.has_surface));
+        let uniform = self.shape.uniform(
+            frame,
+            self.textures.root_colour,
+            (self.textures.shell_slices, self.textures.has_surface),
+        );
         queue.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&uniform));
     }
 

@@ -34,11 +34,7 @@ impl Light {
 
 impl Default for Light {
     fn default() -> Self {
-        Self {
-            direction: LightDirection::View(Self::DEFAULT_FROM_VIEW.normalize()),
-            colour: Vec3::ONE,
-            ambient: 0.25,
-        }
+        Self { direction: LightDirection::View(Self::DEFAULT_FROM_VIEW.normalize()), colour: Vec3::ONE, ambient: 0.25 }
     }
 }
 

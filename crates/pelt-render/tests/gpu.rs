@@ -6,9 +6,7 @@ use common::*;
 use glam::Vec3;
 use pelt_core::Builtin;
 use pelt_core::sim::{SimParams, Simulation, WindParams};
-use pelt_render::{
-    Camera, DEFAULT_BACKGROUND, FurDrawSettings, FurFrame, FurRenderer, SeparatedFur, SeparatedRenderer,
-};
+use pelt_render::{Camera, DEFAULT_BACKGROUND, FurDrawSettings, FurFrame, SeparatedFur, SeparatedRenderer};
 
 const SIZE: u32 = 256;
 
@@ -216,8 +214,8 @@ fn separated_structure_renders_the_same_scene() {
     let unified_image = rig.render(&unified, &camera, &settings());
     let separated_renderer = SeparatedRenderer::new(rig.device(), &rig.renderer).expect("separated pipelines");
     for fin_faces in [2, 30] {
-        let separated = SeparatedFur::new(rig.device(), rig.queue(), &rig.renderer, &fur, &textures, fin_faces)
-            .expect("separated");
+        let separated =
+            SeparatedFur::new(rig.device(), rig.queue(), &rig.renderer, &fur, &textures, fin_faces).expect("separated");
         separated.prepare(rig.queue(), &FurFrame::default());
         let image = rig
             .headless
@@ -237,10 +235,7 @@ fn separated_structure_renders_the_same_scene() {
         assert!(skin_difference < 0.5, "{fin_faces}: skins differ by {skin_difference:.3} on average");
         let expected_vertices =
             (fur.positions.len() + fur.mesh.edges.len() * 6 * fin_faces.div_ceil(2) as usize) as u64;
-        assert_eq!(
-            separated.gpu_bytes().structure(),
-            expected_vertices * 32 + fur.mesh.triangles.len() as u64 * 12
-        );
+        assert_eq!(separated.gpu_bytes().structure(), expected_vertices * 32 + fur.mesh.triangles.len() as u64 * 12);
         assert_eq!(separated.gpu_bytes().textures, unified.gpu_bytes().textures);
     }
 }

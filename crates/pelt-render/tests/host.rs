@@ -25,7 +25,8 @@ fn difference(a: &image::RgbaImage, b: &image::RgbaImage) -> (f64, u8) {
 }
 
 fn windy(fur: &pelt_core::FurStructure) -> Simulation {
-    let wind = WindParams { direction: Vec3::X, strength: 3.0, gust_strength: 0.0, jitter: 0.0, ..WindParams::default() };
+    let wind =
+        WindParams { direction: Vec3::X, strength: 3.0, gust_strength: 0.0, jitter: 0.0, ..WindParams::default() };
     Simulation::new(fur, &SimParams { wind, ..SimParams::default() }).expect("simulation")
 }
 
@@ -111,7 +112,8 @@ fn several_views_in_one_submission_keep_their_own_uniforms() {
     let half = Rig::new(SIZE / 2, SIZE);
     let half_fur = half.fur(&structure, &strand_textures(128, 8, BROWN_ROOT, BROWN_TIP));
     let aspect = 0.5;
-    let cameras = [framed(&structure, aspect), Camera { eye: framed(&structure, aspect).eye * Vec3::new(-1.0, 1.0, -1.0), ..framed(&structure, aspect) }];
+    let (centre, radius) = structure.mesh.bounding_sphere();
+    let cameras = [framed(&structure, aspect), Camera::framing(centre, radius * 1.2, 75.0, 70.0, aspect)];
     let views = cameras.map(|camera| {
         let view = FurView::new(rig.device(), &rig.renderer);
         view.prepare(rig.queue(), &camera.view_data(aspect, &Light::default()));
@@ -158,7 +160,8 @@ fn reverse_z_draws_what_conventional_depth_draws() {
     let camera = framed(&structure, 1.0);
     let view_from_world = camera.view_from_world();
     let clip_from_world =
-        Mat4::perspective_infinite_reverse_rh(camera.fov_y_rad, 1.0, camera.near) * view_from_world;
+        glam::camera::rh::proj::directx::perspective_infinite_reverse(camera.fov_y_rad, 1.0, camera.near)
+            * view_from_world;
     let view = FurView::new(device, &renderer);
     let data = ViewData {
         camera_position_world: camera.eye,
@@ -187,7 +190,8 @@ fn posed_base_normals_change_the_lighting() {
     // Normals turned to face away from the light darken the lit side.
     let flipped: Vec<Vec3> = structure.mesh.normals.iter().map(|n| -*n).collect();
     fur.set_base_normals(rig.queue(), &flipped).expect("normals");
-    let brightness = |image: &image::RgbaImage| image.pixels().map(|p| u64::from(p.0[0]) + u64::from(p.0[1])).sum::<u64>();
+    let brightness =
+        |image: &image::RgbaImage| image.pixels().map(|p| u64::from(p.0[0]) + u64::from(p.0[1])).sum::<u64>();
     let posed = rig.render(&fur, &camera, &FurDrawSettings::SKIN);
     assert!(brightness(&posed) * 10 < brightness(&rest) * 9, "posed normals relight the skin");
     let error = fur.set_base_normals(rig.queue(), &flipped[1..]).expect_err("wrong count");

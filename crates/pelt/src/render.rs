@@ -138,8 +138,10 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     // The CPU simulation interpolates, so one state uploaded per frame is all the GPU needs.
     let gpu_fur = GpuFur::new(device, queue, &renderer, &fur, &textures, FurStates::One)?;
     gpu_fur.prepare(queue, &FurFrame::default());
-    let plain_meshes =
-        plain.iter().map(|mesh| PlainMesh::new(device, &renderer, mesh, PLAIN_COLOUR)).collect::<Result<Vec<_>, _>>()?;
+    let plain_meshes = plain
+        .iter()
+        .map(|mesh| PlainMesh::new(device, &renderer, mesh, PLAIN_COLOUR))
+        .collect::<Result<Vec<_>, _>>()?;
     for mesh in &plain_meshes {
         mesh.prepare(queue, Mat4::IDENTITY);
     }

@@ -172,17 +172,22 @@ impl Scene {
         let aspect = size.0 as f32 / size.1.max(1) as f32;
         let target = Vec3::new(0.0, 0.4, 0.0);
         let (azimuth, elevation) = (azimuth_deg.to_radians(), 18_f32.to_radians());
-        let eye = target
-            + 3.0 * Vec3::new(azimuth.sin() * elevation.cos(), elevation.sin(), azimuth.cos() * elevation.cos());
-        let view_from_world = Mat4::look_at_rh(eye, target, Vec3::Y);
-        let clip_from_world = Mat4::perspective_infinite_reverse_rh(38_f32.to_radians(), aspect, 0.05) * view_from_world;
+        let eye =
+            target + 3.0 * Vec3::new(azimuth.sin() * elevation.cos(), elevation.sin(), azimuth.cos() * elevation.cos());
+        let view_from_world = glam::camera::rh::view::look_at_mat4(eye, target, Vec3::Y);
+        let clip_from_world =
+            glam::camera::rh::proj::directx::perspective_infinite_reverse(38_f32.to_radians(), aspect, 0.05)
+                * view_from_world;
         let light = Light { direction: LightDirection::World(SUN.normalize()), colour: Vec3::ONE, ambient: 0.3 };
         let camera = HostCamera { clip_from_world, light_direction: SUN.normalize(), padding: 0.0 };
         queue.write_buffer(&self.host_camera, 0, bytemuck::bytes_of(&camera));
         // Pelt's per-frame data: the view from the host's camera, the fur's transform.
         self.view.prepare(queue, &ViewData::new(clip_from_world, view_from_world.inverse(), &light));
         let interpolation = self.simulation.alpha();
-        self.fur.prepare(queue, &FurFrame { world_from_model: self.world_from_model, interpolation, ..FurFrame::default() });
+        self.fur.prepare(
+            queue,
+            &FurFrame { world_from_model: self.world_from_model, interpolation, ..FurFrame::default() },
+        );
 
         let Some(attachments) = &self.attachments else { return };
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
@@ -249,11 +254,7 @@ impl Scene {
             texture.as_image_copy(),
             wgpu::TexelCopyBufferInfo {
                 buffer: &readback,
-                layout: wgpu::TexelCopyBufferLayout {
-                    offset: 0,
-                    bytes_per_row: Some(row_bytes),
-                    rows_per_image: None,
-                },
+                layout: wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(row_bytes), rows_per_image: None },
             },
             texture.size(),
         );

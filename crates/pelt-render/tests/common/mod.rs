@@ -10,7 +10,7 @@ use pelt_core::fur::FurLength;
 use pelt_core::texture::FurTextures;
 use pelt_core::{Builtin, FurParams, FurStructure, GrowthDirection, Mesh};
 use pelt_render::{
-    Backend, Camera, DEFAULT_BACKGROUND, FurDrawSettings, FurFrame, FurRenderer, FurStates, FurView, GpuFur, Gpu,
+    Backend, Camera, DEFAULT_BACKGROUND, FurDrawSettings, FurFrame, FurRenderer, FurStates, FurView, Gpu, GpuFur,
     Headless, Light, PlainMesh,
 };
 

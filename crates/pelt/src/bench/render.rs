@@ -116,8 +116,8 @@ impl Bench {
         }
         // The per-frame upload an animated unified fur adds: the whole shared vertex array.
         unified.set_positions(queue, &fur.positions)?;
-        let upload_times = self
-            .time_frames(&|_| unified.set_positions(queue, &fur.positions).expect("checked just above"), budget)?;
+        let upload_times =
+            self.time_frames(&|_| unified.set_positions(queue, &fur.positions).expect("checked just above"), budget)?;
         let [[u_large, s2_large, s30_large], [u_small, s2_small, s30_small]] = medians;
         Ok(RenderFigures {
             frame_ms_unified_1280x720: Some(u_large),

@@ -11,7 +11,11 @@ use crate::format::thousands;
 
 impl Model {
     /// The panel, the 3D view with its overlay, and the shortcuts.
-    pub(super) fn ui(&mut self, ui: &mut egui::Ui, texture_id: egui::TextureId) -> (Changes, Requests, anyhow::Result<()>) {
+    pub(super) fn ui(
+        &mut self,
+        ui: &mut egui::Ui,
+        texture_id: egui::TextureId,
+    ) -> (Changes, Requests, anyhow::Result<()>) {
         let mut outcome = (Changes::default(), Requests::default());
         let shortcuts = self.shortcuts(ui.ctx());
         outcome.1.frame |= shortcuts.frame;
