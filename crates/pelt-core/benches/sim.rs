@@ -17,7 +17,8 @@ use rayon::prelude::*;
 
 fn meshes() -> Vec<(&'static str, Mesh)> {
     let female = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/meshes/female_generic.obj");
-    let (female, _) = Mesh::load(&female, &ImportOptions::default()).expect("crates/pelt-core/assets/meshes/female_generic.obj loads");
+    let (female, _) = Mesh::load(&female, &ImportOptions::default())
+        .expect("crates/pelt-core/assets/meshes/female_generic.obj loads");
     vec![("bunny", Builtin::Bunny.mesh().0), ("female_generic", female)]
 }
 
