@@ -25,12 +25,20 @@ pub const INDEX_BYTES: u64 = 4;
 /// Errors from building a fur structure.
 #[derive(Debug, thiserror::Error, PartialEq)]
 pub enum FurError {
+    /// A layer count outside `1..=MAX_LAYERS`.
     #[error("layers must be between 1 and {MAX_LAYERS}, got {0}")]
     Layers(u32),
+    /// A negative or non-finite fur length.
     #[error("fur length must be finite and not negative, got {0}")]
     Length(f32),
+    /// A per-vertex length map of the wrong size.
     #[error("the length map has {got} entries but the mesh has {expected} vertices")]
-    LengthMapSize { expected: usize, got: usize },
+    LengthMapSize {
+        /// Vertices of the mesh.
+        expected: usize,
+        /// Entries in the map.
+        got: usize,
+    },
 }
 
 /// How long the fur is.
@@ -99,7 +107,9 @@ const MIN_HEIGHT: f32 = 0.1;
 pub struct FurParams {
     /// Number of shells `L` above the base (layer 0 is the base surface, layer `L` the tips).
     pub layers: u32,
+    /// How long the strands are.
     pub length: FurLength,
+    /// Which way the strands grow out of the surface.
     pub direction: GrowthDirection,
 }
 
@@ -191,6 +201,7 @@ impl FurStructure {
 /// The separated structure of Lengyel et al.: shells plus fins as geometry of their own.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct SeparatedStructure {
+    /// Number of shells `L` above the base.
     pub layers: u32,
     /// Faces per fin: 2 (one quad, Lengyel) or `N` (the paper compares `N = 30`).
     pub fin_faces: u32,
@@ -216,13 +227,19 @@ impl SeparatedStructure {
 ///   with a base-vertex offset, and `3N` per fin.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
 pub struct Footprint {
+    /// Vertices stored (the paper's counting).
     pub vertices: u64,
     /// Shell faces (`F * L`, the base is drawn once more as the opaque skin) plus fin faces.
     pub faces: u64,
+    /// Shell faces, `F * L`.
     pub shell_faces: u64,
+    /// Fin faces: `2LE` unified, `NE` separated.
     pub fin_faces: u64,
+    /// GPU bytes of vertex positions.
     pub position_bytes: u64,
+    /// GPU bytes of other vertex data (normals, uvs).
     pub attribute_bytes: u64,
+    /// GPU bytes of indices and topology.
     pub index_bytes: u64,
 }
 

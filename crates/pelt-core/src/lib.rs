@@ -5,6 +5,8 @@
 //! [`texture`] (seeded shell and fin textures) -> [`sim`] (gravity, wind, touch) -> the renderer
 //! in `pelt-render`. [`preset`] holds everything about one fur in one TOML file.
 
+#![warn(missing_docs)]
+
 pub mod fur;
 pub mod mesh;
 pub mod preset;

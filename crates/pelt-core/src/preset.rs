@@ -24,15 +24,45 @@ use crate::texture::{self, ColourMode, ColourParams, FurTextures, ImageRgba8, Te
 /// Why a preset could not be read, checked or used. Every message starts with the file.
 #[derive(Debug, thiserror::Error)]
 pub enum PresetError {
+    /// The file could not be read or written.
     #[error("{file}: cannot read or write the preset: {source}")]
-    Io { file: PathBuf, source: std::io::Error },
+    Io {
+        /// The preset file.
+        file: PathBuf,
+        /// Why.
+        source: std::io::Error,
+    },
     /// TOML syntax, wrong types and unknown keys: toml's own message, with the line and key.
     #[error("{file}: {message}")]
-    Parse { file: PathBuf, message: String },
+    Parse {
+        /// The preset file.
+        file: PathBuf,
+        /// toml's message.
+        message: String,
+    },
+    /// A value out of range.
     #[error("{file}: {key}: {problem}")]
-    Invalid { file: PathBuf, key: String, problem: String },
+    Invalid {
+        /// The preset file.
+        file: PathBuf,
+        /// The key.
+        key: String,
+        /// What is wrong with it.
+        problem: String,
+    },
+    /// An image the preset names could not be loaded.
     #[error("{file}: {key}: cannot load image {image}: {problem}")]
-    Image { file: PathBuf, key: String, image: PathBuf, problem: String },
+    Image {
+        /// The preset file.
+        file: PathBuf,
+        /// The key naming the image.
+        key: String,
+        /// The image file.
+        image: PathBuf,
+        /// Why it could not be loaded.
+        problem: String,
+    },
+    /// The preset could not be written as TOML.
     #[error("cannot write the preset as TOML: {0}")]
     Write(String),
 }
@@ -67,9 +97,13 @@ pub struct Preset {
     /// Fur length as a fraction of the mesh's bounding-sphere radius, so a preset fits every
     /// mesh. `0 < length <= 2`, default 0.08.
     pub length: f32,
+    /// How fur grows out of the mesh.
     pub direction: DirectionParams,
+    /// The strand texture.
     pub texture: TextureParams,
+    /// How strands are coloured.
     pub colour: ColourParams,
+    /// Gravity, wind, touch and stepping.
     pub simulation: SimParams,
     /// The preset file (for messages) and its folder (for relative image paths); not in TOML.
     #[serde(skip)]

@@ -34,6 +34,7 @@ pub struct Rng {
 }
 
 impl Rng {
+    /// A generator whose stream depends only on `seed`.
     #[must_use]
     pub fn new(seed: u64) -> Self {
         Self { state: mix64(seed) }

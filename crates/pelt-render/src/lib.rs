@@ -48,7 +48,7 @@
 //! #     clip_from_world: glam::Mat4,
 //! #     world_from_view: glam::Mat4,
 //! # ) -> Result<(), Box<dyn std::error::Error>> {
-//! use pelt_core::{Builtin, FurParams, FurStructure, Preset, Simulation};
+//! use pelt_core::{Builtin, FurStructure, Preset, Simulation};
 //! use pelt_render::{FurDrawSettings, FurFrame, FurRenderer, FurStates, FurTarget, FurView, GpuFur, Light, ViewData};
 //!
 //! // Once: the pipelines for the host's attachments (here reverse-Z depth), a fur and a view.
@@ -56,9 +56,10 @@
 //! let renderer = FurRenderer::new(device, target)?;
 //! let (mesh, _report) = Builtin::Bunny.mesh();
 //! let preset = Preset::default();
-//! let structure = FurStructure::new(mesh, &preset.fur_params(&Builtin::Bunny.mesh().0))?;
+//! let params = preset.fur_params(&mesh);
+//! let structure = FurStructure::new(mesh, &params)?;
 //! let mut simulation = Simulation::new(&structure, &preset.simulation)?;
-//! let mut fur = GpuFur::new(device, queue, &renderer, &structure, &preset.generate_textures()?, FurStates::One)?;
+//! let fur = GpuFur::new(device, queue, &renderer, &structure, &preset.generate_textures()?, FurStates::One)?;
 //! let view = FurView::new(device, &renderer);
 //!
 //! // Each frame: simulate, upload, prepare, then draw into the host's pass.

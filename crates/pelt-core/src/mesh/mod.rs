@@ -21,18 +21,62 @@ pub const NO_FACE: u32 = u32::MAX;
 #[derive(Debug, thiserror::Error)]
 pub enum MeshError {
     // The cause is part of the message (not a `source`) so it is printed exactly once.
+    /// The file could not be read.
     #[error("{}: cannot read the file: {error}", file.display())]
-    Io { file: PathBuf, error: std::io::Error },
+    Io {
+        /// The file.
+        file: PathBuf,
+        /// Why it could not be read.
+        error: std::io::Error,
+    },
+    /// The file's extension is no mesh format Pelt reads.
     #[error("{}: unknown mesh format {extension:?} (Pelt reads .obj, .gltf and .glb)", file.display())]
-    UnknownFormat { file: PathBuf, extension: String },
+    UnknownFormat {
+        /// The file.
+        file: PathBuf,
+        /// Its extension.
+        extension: String,
+    },
+    /// The file is malformed.
     #[error("{}{}: {message}", file.display(), line.map(|l| format!(":{l}")).unwrap_or_default())]
-    Parse { file: PathBuf, line: Option<usize>, message: String },
+    Parse {
+        /// The file.
+        file: PathBuf,
+        /// The line, where the format has lines.
+        line: Option<usize>,
+        /// What is wrong.
+        message: String,
+    },
+    /// No usable triangle is left.
     #[error("{}: the mesh has no triangles{detail}", file.display())]
-    NoTriangles { file: PathBuf, detail: String },
+    NoTriangles {
+        /// The file.
+        file: PathBuf,
+        /// What was dropped, if anything.
+        detail: String,
+    },
+    /// A triangle refers to a vertex that does not exist.
     #[error("{}: triangle {triangle} uses vertex index {index}, but the mesh has only {vertex_count} vertices", file.display())]
-    IndexOutOfRange { file: PathBuf, triangle: usize, index: u32, vertex_count: usize },
+    IndexOutOfRange {
+        /// The file.
+        file: PathBuf,
+        /// The triangle.
+        triangle: usize,
+        /// The vertex index it uses.
+        index: u32,
+        /// Vertices in the mesh.
+        vertex_count: usize,
+    },
+    /// A vertex has a NaN or infinite coordinate.
     #[error("{}: vertex {vertex} has a non-finite coordinate {position:?} (NaN or infinity)", file.display())]
-    NonFinite { file: PathBuf, vertex: usize, position: [f32; 3] },
+    NonFinite {
+        /// The file.
+        file: PathBuf,
+        /// The vertex.
+        vertex: usize,
+        /// Its coordinates.
+        position: [f32; 3],
+    },
 }
 
 /// An indexed triangle list as read from a file, before any repair.
@@ -40,9 +84,13 @@ pub enum MeshError {
 /// `normals` and `uvs`, when present, have one entry per position.
 #[derive(Clone, Debug, Default)]
 pub struct RawMesh {
+    /// Vertex positions.
     pub positions: Vec<Vec3>,
+    /// Vertex normals, when the file has them.
     pub normals: Option<Vec<Vec3>>,
+    /// Texture coordinates, when the file has them.
     pub uvs: Option<Vec<Vec2>>,
+    /// Triangles as indices into `positions`.
     pub triangles: Vec<[u32; 3]>,
 }
 
@@ -79,29 +127,40 @@ pub enum NormalSource {
 pub struct MeshReport {
     /// The file or built-in this mesh came from.
     pub source: String,
+    /// Vertices in the file.
     pub input_vertices: usize,
+    /// Triangles in the file.
     pub input_triangles: usize,
     /// Vertices merged into another one by welding.
     pub welded_vertices: usize,
+    /// Triangles dropped for having no area.
     pub dropped_zero_area_triangles: usize,
+    /// Triangles dropped for using one vertex twice.
     pub dropped_repeated_index_triangles: usize,
     /// Triangles over the same three vertices as an earlier one, either winding (double-sided
     /// or doubled geometry would make every edge non-manifold and draw its fins twice).
     pub dropped_duplicate_triangles: usize,
+    /// Vertices dropped because no triangle uses them.
     pub dropped_unreferenced_vertices: usize,
     /// Triangles flipped to agree with their neighbours (or to turn a closed part outward).
     pub reoriented_triangles: usize,
+    /// Where the normals came from.
     pub normals: NormalSource,
     /// Whether the mesh has texture coordinates (none are generated when the file has none).
     pub has_uvs: bool,
+    /// Edges with one face.
     pub boundary_edges: usize,
     /// Connected chains of boundary edges: the holes and open rims (0 on a closed mesh).
     pub boundary_loops: usize,
+    /// Edges with more than two faces.
     pub non_manifold_edges: usize,
     /// Edges whose two faces traverse them in the same direction (flipped winding).
     pub inconsistent_winding_edges: usize,
+    /// Vertices after repair.
     pub vertices: usize,
+    /// Triangles after repair.
     pub triangles: usize,
+    /// Undirected edges after repair.
     pub edges: usize,
 }
 
@@ -418,10 +477,15 @@ impl Mesh {
 /// Undirected edges of a triangle list and what is wrong with them.
 #[derive(Clone, Debug, Default, PartialEq, Eq)]
 pub struct Topology {
+    /// Undirected edges, each `[low, high]`, sorted.
     pub edges: Vec<[u32; 2]>,
+    /// The faces beside each edge (`NO_FACE` for a missing second one).
     pub edge_faces: Vec<[u32; 2]>,
+    /// Edges with one face.
     pub boundary_edges: usize,
+    /// Edges with more than two faces.
     pub non_manifold_edges: usize,
+    /// Edges whose two faces traverse them in the same direction.
     pub inconsistent_winding_edges: usize,
 }
 

@@ -5,7 +5,7 @@
 //!   ([`bend_strand`]) and as the literal O(L^2) loop kept as the oracle ([`bend_strand_literal`]).
 //! - [`wind`]: wind with gusts that travel with it and a small seeded jitter.
 //! - [`field`]: the per-vertex [`ForceField`] and the touch (patting) overlay.
-//! - [`pick`]: ray picking of the base mesh, so a pointer or a script can touch the fur.
+//! - [`mod@pick`]: ray picking of the base mesh, so a pointer or a script can touch the fur.
 //! - [`simulation`]: [`Simulation`], fixed steps with linear interpolation between the last two.
 //! - [`scene`]: scripted wind and touch strokes ([`Scene`]), reproducible frame by frame.
 //!

@@ -36,23 +36,48 @@ use super::simulation::{SimError, Simulation};
 /// Errors from reading a scene; each names the file and, where it can, the key.
 #[derive(Debug, thiserror::Error)]
 pub enum SceneError {
+    /// The file could not be read.
     #[error("{}: cannot read the file: {source}", file.display())]
-    Io { file: PathBuf, source: std::io::Error },
+    Io {
+        /// The scene file.
+        file: PathBuf,
+        /// Why.
+        source: std::io::Error,
+    },
+    /// The file is not valid TOML or has unknown keys.
     #[error("{}: {message}", file.display())]
-    Parse { file: PathBuf, message: String },
+    Parse {
+        /// The scene file.
+        file: PathBuf,
+        /// toml's message.
+        message: String,
+    },
+    /// A value out of range.
     #[error("{}: {key}: {problem}", file.display())]
-    Invalid { file: PathBuf, key: String, problem: String },
+    Invalid {
+        /// The scene file.
+        file: PathBuf,
+        /// The key.
+        key: String,
+        /// What is wrong with it.
+        problem: String,
+    },
 }
 
 /// One wind keyframe.
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct WindKey {
+    /// When this key applies (seconds of scene time).
     pub time_secs: f64,
+    /// Direction the wind blows toward.
     pub direction: Vec3,
+    /// Wind strength.
     pub strength: f32,
+    /// Strength of travelling gusts, relative to `strength` (default 0.5).
     #[serde(default = "default_gust_strength")]
     pub gust_strength: f32,
+    /// Fast random shake, relative to `strength` (default 0.1).
     #[serde(default = "default_jitter")]
     pub jitter: f32,
 }
@@ -70,7 +95,9 @@ fn default_jitter() -> f32 {
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Stroke {
+    /// When the touch presses (seconds of scene time).
     pub start_secs: f64,
+    /// When it releases.
     pub end_secs: f64,
     /// Radius of the touch (world units).
     pub radius: f32,

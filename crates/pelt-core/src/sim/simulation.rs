@@ -15,16 +15,38 @@ use crate::fur::FurStructure;
 /// Errors from building or driving a [`Simulation`].
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum SimError {
+    /// Invalid simulation parameters.
     #[error(transparent)]
     Params(#[from] ParamError),
+    /// An array of the wrong length.
     #[error("{what} has {got} entries but the fur has {expected}")]
-    Size { what: &'static str, expected: usize, got: usize },
+    Size {
+        /// Which array.
+        what: &'static str,
+        /// The length the fur needs.
+        expected: usize,
+        /// The length given.
+        got: usize,
+    },
+    /// A NaN or infinite input.
     #[error("{what} must be finite, got {value}")]
-    NonFinite { what: &'static str, value: String },
+    NonFinite {
+        /// Which input.
+        what: &'static str,
+        /// The value given.
+        value: String,
+    },
+    /// A touch radius that is not finite and positive.
     #[error("touch radius must be finite and positive, got {0}")]
     TouchRadius(f32),
+    /// A stability map entry out of range.
     #[error("stability map entry {vertex} is {value}: must be between 1e-6 and 1e9")]
-    Stability { vertex: usize, value: f32 },
+    Stability {
+        /// The vertex.
+        vertex: usize,
+        /// Its value.
+        value: f32,
+    },
 }
 
 /// Batches of [`LANES`] strands per parallel task: enough work to pay for the task, small

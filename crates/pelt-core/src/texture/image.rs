@@ -7,7 +7,9 @@ use glam::Vec4;
 /// An RGBA8 image, rows top to bottom, straight (not premultiplied) alpha.
 #[derive(Clone, PartialEq, Eq)]
 pub struct ImageRgba8 {
+    /// Width in pixels.
     pub width: u32,
+    /// Height in pixels.
     pub height: u32,
     /// `width * height * 4` bytes.
     pub pixels: Vec<u8>,

@@ -26,8 +26,9 @@ pub use self::image::{ImageRgba8, downsample_rgba8, mip_level_count};
 pub use self::pattern::leopard_pattern;
 use crate::sim::ParamError;
 
-/// Smallest and largest tile edge (texels).
+/// Smallest tile edge (texels).
 pub const MIN_TILE_SIZE: u32 = 32;
+/// Largest tile edge (texels).
 pub const MAX_TILE_SIZE: u32 = 2048;
 
 /// The generated textures of one fur, in the layout the renderer uploads directly.
@@ -46,6 +47,7 @@ pub struct FurTextures {
     /// The fin texture: the side view of the same strands, u along the edge, v up the strand
     /// (row 0 = tips, last row = roots).
     pub fin_width: u32,
+    /// Height of the fin texture (texels, root to tip).
     pub fin_height: u32,
     /// RGBA8, `fin_width * fin_height * 4` bytes.
     pub fin: Vec<u8>,
@@ -303,12 +305,23 @@ pub struct TextureInputs {
 /// Why a texture set could not be generated.
 #[derive(Debug, thiserror::Error, PartialEq, Eq)]
 pub enum TextureError {
+    /// Invalid texture parameters.
     #[error("{0}")]
     Param(#[from] ParamError),
+    /// A layer count out of range.
     #[error("layers: must be between 1 and {max}, got {got}", max = crate::fur::MAX_LAYERS)]
-    Layers { got: u32 },
+    Layers {
+        /// The count given.
+        got: u32,
+    },
+    /// A colour mode without the image it needs.
     #[error("{key}: {mode} mode needs this image, but none was given")]
-    MissingImage { key: &'static str, mode: &'static str },
+    MissingImage {
+        /// The key that names the image.
+        key: &'static str,
+        /// The colour mode.
+        mode: &'static str,
+    },
 }
 
 /// Generates the shell slices and the fin texture of `layers` shells.
