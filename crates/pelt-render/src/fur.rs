@@ -107,7 +107,9 @@ impl GpuFur {
     /// submission; one transform per fur and submission).
     pub fn prepare(&self, queue: &wgpu::Queue, frame: &FurFrame) {
         let textures = (self.textures.shell_slices, self.textures.has_surface);
-        self.geometry.write_uniform(queue, &self.geometry.shape.uniform(frame, self.textures.root_colour, textures));
+        // One state has nothing to interpolate; 1 lets the shader fetch it once.
+        let frame = if self.geometry.state_count() == 1 { FurFrame { interpolation: 1.0, ..*frame } } else { *frame };
+        self.geometry.write_uniform(queue, &self.geometry.shape.uniform(&frame, self.textures.root_colour, textures));
     }
 
     /// Writes `positions` (`(L + 1) * V`, layer-major, model space) into both states: the

@@ -23,10 +23,14 @@ const NO_FACE: u32 = 0xffffffffu;
 // NV[layer * V + vertex] in model space, between the two states.
 fn model_vertex(layer: u32, vertex: u32) -> vec3<f32> {
     let k = 3u * (layer * object.vertex_count + vertex);
-    let previous = vec3<f32>(previous_positions[k], previous_positions[k + 1u], previous_positions[k + 2u]);
     let current = vec3<f32>(current_positions[k], current_positions[k + 1u], current_positions[k + 2u]);
-    // The form of `Simulation::write_lerp`: exactly one state at 0 and the other at 1.
+    // One state (or a frame on a step): one fetch. The branch is uniform.
     let t = object.interpolation;
+    if t >= 1.0 {
+        return current;
+    }
+    let previous = vec3<f32>(previous_positions[k], previous_positions[k + 1u], previous_positions[k + 2u]);
+    // The form of `Simulation::write_lerp`: exactly one state at 0 and the other at 1.
     return previous * (1.0 - t) + current * t;
 }
 
