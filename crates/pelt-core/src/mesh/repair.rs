@@ -16,6 +16,16 @@ impl Mesh {
     /// [`MeshError::IndexOutOfRange`], [`MeshError::NonFinite`] or [`MeshError::NoTriangles`]
     /// (also when every triangle was degenerate).
     pub fn from_raw(raw: RawMesh, file: &Path, options: &ImportOptions) -> Result<(Self, MeshReport), MeshError> {
+        Self::repair(raw, file, options).map(|(mesh, report, _)| (mesh, report))
+    }
+
+    /// [`Mesh::from_raw`], also returning for each kept vertex the raw vertex it was taken from
+    /// (so per-vertex data read beside the mesh, like skin weights, follows welding and repair).
+    pub(super) fn repair(
+        raw: RawMesh,
+        file: &Path,
+        options: &ImportOptions,
+    ) -> Result<(Self, MeshReport, Vec<u32>), MeshError> {
         let file_buf = || file.to_path_buf();
         let input_vertices = raw.positions.len();
         let input_triangles = raw.triangles.len();
@@ -91,10 +101,12 @@ impl Mesh {
             }
         }
         let mut positions = Vec::new();
+        let mut source = Vec::new();
         for (i, &is_used) in referenced.iter().enumerate() {
             if is_used {
                 new_index[i] = positions.len() as u32;
                 positions.push(raw.positions[i]);
+                source.push(i as u32);
             }
         }
         let canonical_count = canonical.iter().enumerate().filter(|&(i, &c)| c as usize == i).count();
@@ -152,7 +164,7 @@ impl Mesh {
             triangles: mesh.triangles.len(),
             edges: mesh.edges.len(),
         };
-        Ok((mesh, report))
+        Ok((mesh, report, source))
     }
 }
 

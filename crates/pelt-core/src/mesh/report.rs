@@ -12,7 +12,7 @@ pub enum NormalSource {
     Computed,
 }
 
-/// What [`Mesh::from_raw`] found and repaired.
+/// What [`Mesh::from_raw`](super::Mesh::from_raw) found and repaired.
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct MeshReport {
     /// The file or built-in this mesh came from.
