@@ -9,7 +9,7 @@
 //! [direction]          # fur direction on the mesh (see `DirectionParams`)
 //! [texture]            # the strand field (see `texture::TextureParams`)
 //! [colour]             # colours are "#rrggbb" strings (see `texture::ColourParams`)
-//! [simulation]         # `sim::SimParams`
+//! [simulation]         # `sim::SimParams`; equation = "pelt" | "paper" (`sim::Equation`)
 //! ```
 
 use std::path::{Path, PathBuf};

@@ -6,7 +6,10 @@ use std::path::Path;
 use glam::{Quat, Vec3};
 use pelt_core::fur::{FurLength, FurParams, FurStructure, GrowthDirection};
 use pelt_core::mesh::builtin::Builtin;
-use pelt_core::sim::{Scene, SceneError, SimParams, Simulation, WindParams, bend_strand, bend_strand_literal, pick};
+use pelt_core::sim::{
+    CpuKernel, Scene, SceneError, SimParams, Simulation, SoakStep, SoakSubject, WindParams, bend_strand,
+    bend_strand_literal, pick, soak,
+};
 use proptest::prelude::*;
 
 fn grow(builtin: Builtin, layers: u32, length: f32) -> FurStructure {
@@ -196,12 +199,23 @@ fn gravity_pulls_fur_down_and_keeps_roots_and_lengths() {
     assert!(drop / v as f32 > 0.01, "mean tip drop {}", drop / v as f32);
 }
 
-fn simulate_with_threads(threads: usize) -> Vec<u8> {
+fn simulate_with_threads(threads: usize, kernel: CpuKernel, curved: bool) -> Vec<u8> {
     let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
     pool.install(|| {
-        let fur = grow(Builtin::Bunny, 16, 0.5);
+        let mut fur = grow(Builtin::Bunny, 16, 0.5);
+        if curved {
+            // Every strand bends away from its growth line: the general form of the kernel.
+            let v = fur.vertex_count();
+            for k in 1..=16 {
+                for j in 0..v {
+                    fur.positions[k * v + j] += Vec3::new(0.0, 0.002, 0.001) * (k * k) as f32;
+                }
+            }
+        }
         let params = SimParams { wind: windy(), ..SimParams::default() };
         let mut sim = Simulation::new(&fur, &params).unwrap();
+        sim.set_cpu_kernel(kernel);
+        assert_eq!(sim.straight_share() == 1.0, !curved);
         sim.touch_begin(fur.mesh.positions[100], 1.5).unwrap();
         sim.touch_drag(fur.mesh.positions[100] + Vec3::new(0.5, -1.0, 0.0)).unwrap();
         let mut bytes = Vec::new();
@@ -214,8 +228,14 @@ fn simulate_with_threads(threads: usize) -> Vec<u8> {
 }
 
 #[test]
-fn results_do_not_depend_on_the_thread_count() {
-    assert_eq!(simulate_with_threads(1), simulate_with_threads(4));
+fn results_do_not_depend_on_the_thread_count_or_the_instructions() {
+    for curved in [false, true] {
+        let reference = simulate_with_threads(1, CpuKernel::Portable, curved);
+        assert!(reference == simulate_with_threads(4, CpuKernel::Portable, curved), "curved {curved}: threads");
+        // On a CPU without AVX2 + FMA this runs the portable kernel again (the oracle tests say
+        // which ran).
+        assert!(reference == simulate_with_threads(3, CpuKernel::Avx2Fma, curved), "curved {curved}: AVX2");
+    }
 }
 
 #[test]
@@ -341,7 +361,16 @@ fn without_interpolation_every_frame_is_simulated() {
         assert_eq!(sim.positions(), current.as_slice());
     }
     assert_eq!(sim.steps_taken() - before, 10);
-    assert!(sim.last_step_secs() >= 0.0);
+    // With interpolation, frames between steps run no step: the last step's time stays.
+    let mut sim = Simulation::new(&fur, &SimParams { interpolate: true, ..params }).unwrap();
+    sim.advance_to(1.0);
+    let (steps, secs) = (sim.steps_taken(), sim.last_step_secs());
+    assert!(secs > 0.0 && secs < 10.0, "{secs}");
+    sim.advance_to(1.0 + 0.5 / 30.0);
+    assert_eq!((sim.steps_taken(), sim.last_step_secs()), (steps, secs));
+    sim.advance_to(1.0 + 1.5 / 30.0);
+    assert_eq!(sim.steps_taken(), steps + 1);
+    assert_ne!(sim.last_step_secs(), secs, "a new step is timed anew");
 }
 
 #[test]
@@ -375,32 +404,45 @@ fn a_rotated_base_carries_the_rest_pose_along() {
     }
 }
 
+/// The soak CI runs: 10,000 bunny steps under extreme, changing inputs (`pelt bench --soak`
+/// runs a million).
 #[test]
-fn soak_under_changing_wind_stays_finite_and_keeps_lengths() {
-    let fur = grow(Builtin::Sphere, 8, 0.3);
-    let mut params = SimParams { wind: windy(), ..SimParams::default() };
-    let mut sim = Simulation::new(&fur, &params).unwrap();
-    for step in 0..1500u32 {
-        if step % 50 == 0 {
-            let angle = step as f32 * 0.01;
-            params.wind.direction = Vec3::new(angle.cos(), (angle * 3.0).sin(), angle.sin());
-            params.wind.strength = 1e3f32.powf((angle * 2.0).sin());
-            params.gravity_strength = (step % 7) as f32;
-            sim.set_params(&params).unwrap();
+fn soak_keeps_every_node_finite_and_every_length() {
+    let fur = grow(Builtin::Bunny, 16, 0.5);
+    let mut sim = Simulation::new(&fur, &SimParams::default()).unwrap();
+    let report = soak(&fur, &mut sim, 10_000, |_| {}).unwrap();
+    assert_eq!(report.steps, 10_000);
+    assert!(report.passed(1e-5), "{report:?}");
+    // The schedule reaches its extremes within those steps.
+    let steps: Vec<SoakStep> = (0..10_000).map(|i| SoakStep::at(i, fur.vertex_count(), 3.0)).collect();
+    assert!(steps.iter().any(|s| s.params.gravity_strength == 1000.0));
+    assert!(steps.iter().any(|s| s.params.stability < 1e-4));
+    assert!(steps.iter().any(|s| s.params.wind.strength > 1e3));
+    assert!(steps.iter().any(|s| s.field.is_some_and(|f| f.x.abs() >= 1e29)));
+    assert!(
+        steps.iter().any(|s| s.base.is_some()) && steps.iter().any(|s| s.stability_map.is_some_and(|m| m.is_some()))
+    );
+}
+
+#[test]
+fn soak_catches_a_kernel_that_stretches_strands() {
+    /// Wraps a simulation and stretches one segment of its state by 1e-3 of its length.
+    struct Stretching(Simulation);
+    impl SoakSubject for Stretching {
+        fn step(&mut self, step: &SoakStep) -> Result<(), pelt_core::SimError> {
+            self.0.step(step)
         }
-        if step % 200 == 0 {
-            sim.touch_begin(fur.mesh.positions[step as usize % fur.vertex_count()], 0.4).unwrap();
+        fn read_state(&mut self, out: &mut [Vec3]) {
+            self.0.read_state(out);
+            let v = self.0.vertex_count();
+            out[2 * v + 5] += (out[2 * v + 5] - out[v + 5]) * 1e-3;
         }
-        sim.touch_drag(Vec3::splat((step as f32 * 0.1).sin())).unwrap();
-        if step % 200 == 100 {
-            sim.touch_end();
-        }
-        sim.advance_to(f64::from(step) / 30.0);
     }
-    let mut current = vec![Vec3::ZERO; fur.positions.len()];
-    sim.write_lerp(1.0, &mut current);
-    assert!(current.iter().all(|p| p.is_finite()));
-    assert!(worst_length_error(&fur, &current) < 1e-5);
+    let fur = grow(Builtin::Sphere, 8, 0.3);
+    let mut subject = Stretching(Simulation::new(&fur, &SimParams::default()).unwrap());
+    let report = soak(&fur, &mut subject, 20, |_| {}).unwrap();
+    assert!(!report.passed(1e-5), "{report:?}");
+    assert!(report.worst_length_error > 1e-5);
 }
 
 #[test]

@@ -5,7 +5,7 @@ use std::process::Command;
 
 use serde_json::Value;
 
-const TOP_LEVEL_KEYS: [&str; 14] = [
+const TOP_LEVEL_KEYS: [&str; 16] = [
     "pelt_version",
     "date_utc",
     "command",
@@ -16,6 +16,8 @@ const TOP_LEVEL_KEYS: [&str; 14] = [
     "adapter_unavailable_reason",
     "paper_savings_vs_2_percent",
     "paper_savings_vs_30_percent",
+    "sim_cpu_kernel",
+    "sim_large_mesh",
     "results",
     "skipped_models",
     "peak_rss_bytes",
@@ -61,6 +63,7 @@ const MEASURED_KEYS: [(&str, &[&str]); 3] = [
         "sim_unavailable_reason",
         &[
             "sim_node_updates_per_sec",
+            "sim_node_updates_per_sec_all_threads",
             "sim_literal_node_updates_per_sec",
             "sim_cpu_ms_per_frame_interpolated",
             "sim_cpu_ms_per_frame_every_frame",
@@ -102,6 +105,15 @@ fn quick_bench_writes_every_key_with_sane_values() {
     }
     if cfg!(target_os = "linux") {
         assert!(report["peak_rss_bytes"].as_u64().is_some_and(|b| b > 1 << 20));
+    }
+
+    let kernel = report["sim_cpu_kernel"].as_str().unwrap();
+    assert!(kernel == "avx2+fma" || kernel == "portable", "{kernel}");
+    let large = &report["sim_large_mesh"];
+    assert_eq!(large["vertices"], 35_000);
+    assert_eq!(large["layers"], 32);
+    for key in ["sim_node_updates_per_sec", "sim_node_updates_per_sec_all_threads"] {
+        assert!(large[key].as_f64().is_some_and(|v| v.is_finite() && v > 0.0), "{key} in {large}");
     }
 
     let results = report["results"].as_array().unwrap();

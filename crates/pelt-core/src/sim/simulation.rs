@@ -6,9 +6,10 @@ use std::time::Instant;
 use glam::{Quat, Vec3};
 use rayon::prelude::*;
 
-use super::batch::{LANES, RestSegment, StrandInputs, VecLanes, bend_batch};
+use super::dispatch::{self, CpuKernel};
 use super::field::{ForceField, Touch};
 use super::inertia::Inertia;
+use super::kernel::{LANES, RestBatches, Step, VecLanes};
 use super::pick::{Hit, pick};
 use super::{ParamError, SimParams, WindParams};
 use crate::fur::FurStructure;
@@ -50,10 +51,6 @@ pub enum SimError {
     },
 }
 
-/// Batches of [`LANES`] strands per parallel task: enough work to pay for the task, small
-/// enough to balance.
-const BATCHES_PER_TASK: usize = 8;
-
 /// Strands per parallel task of the interpolation (a multiple of [`LANES`]).
 const LERP_STRANDS_PER_TASK: usize = 32 * LANES;
 
@@ -74,9 +71,11 @@ pub struct Simulation {
     params: SimParams,
     layers: u32,
     vertex_count: usize,
-    /// Rest segments of batch `b` (lanes = strands `8b..8b + 8`, zero past `V`) at `b * L + k`.
-    rest_segments: Vec<RestSegment>,
+    /// The rest shape, batch-major, in the kernel's layout.
+    rest: RestBatches,
+    cpu_kernel: CpuKernel,
     rest_normals: Vec<Vec3>,
+    rest_roots: Vec<Vec3>,
     roots: Vec<Vec3>,
     /// Rotation of each strand's rest frame into the current base frame (from `set_base`).
     frames: Vec<Quat>,
@@ -87,6 +86,8 @@ pub struct Simulation {
     touch: Option<Touch>,
     /// The external field (wind + field + touch) of the newest state.
     external: Vec<Vec3>,
+    /// Scratch: the external plus the inertial force per strand, what the kernel bends by.
+    forces: Vec<Vec3>,
     /// The force from the roots' acceleration (the one state carried from step to step).
     inertia: Inertia,
     /// States, batch-major like `rest_segments` with `L + 1` nodes per batch.
@@ -122,13 +123,6 @@ impl Simulation {
             return Err(SimError::Size { what: "the base normals", expected: v, got: fur.mesh.normals.len() });
         }
         let batches = v.div_ceil(LANES);
-        let mut rest_segments = vec![RestSegment::default(); batches * layers];
-        for j in 0..v {
-            for k in 0..layers {
-                let segment = fur.positions[(k + 1) * v + j] - fur.positions[k * v + j];
-                rest_segments[j / LANES * layers + k].set(j % LANES, segment);
-            }
-        }
         let roots = fur.positions[..v].to_vec();
         let (centre, radius) = bounding_sphere(&roots);
         debug_assert!(centre.is_finite());
@@ -138,8 +132,10 @@ impl Simulation {
             params: params.clone(),
             layers: fur.layers,
             vertex_count: v,
-            rest_segments,
+            rest: RestBatches::new(&fur.positions, v, layers),
+            cpu_kernel: CpuKernel::Auto,
             rest_normals: fur.mesh.normals.clone(),
+            rest_roots: roots.clone(),
             roots,
             frames: vec![Quat::IDENTITY; v],
             stability_map: None,
@@ -147,6 +143,7 @@ impl Simulation {
             field: ForceField::new(v),
             touch: None,
             external: vec![Vec3::ZERO; v],
+            forces: Vec::with_capacity(v),
             inertia: Inertia::new(v),
             previous: vec![[[0.0; LANES]; 3]; batch_nodes],
             current: vec![[[0.0; LANES]; 3]; batch_nodes],
@@ -446,6 +443,42 @@ impl Simulation {
         });
     }
 
+    /// Chooses the CPU kernel's instructions (AVX2 + FMA or portable; both give the same bytes).
+    /// [`CpuKernel::Auto`], the default, takes the best the CPU has; asking for AVX2 on a CPU
+    /// without it runs the portable kernel ([`Simulation::cpu_kernel`] says which runs).
+    pub fn set_cpu_kernel(&mut self, kernel: CpuKernel) {
+        self.cpu_kernel = kernel;
+    }
+
+    /// The CPU kernel that runs the steps ([`CpuKernel::Avx2Fma`] or [`CpuKernel::Portable`]).
+    #[must_use]
+    pub fn cpu_kernel(&self) -> CpuKernel {
+        self.cpu_kernel.resolve()
+    }
+
+    /// The share of strands the straight (cheaper, exact) form of the kernel bends, in `[0, 1]`:
+    /// batches of 8 strands that are all straight. Fur grown by [`FurStructure::new`] is
+    /// straight; a structure whose positions were edited to curve takes the general form.
+    #[must_use]
+    pub fn straight_share(&self) -> f32 {
+        self.rest.straight_share()
+    }
+
+    /// Runs one step at `time_secs` into the newest state (the newest becomes the previous)
+    /// without updating [`Simulation::positions`]: the simulation's whole per-step work (field,
+    /// then the bend of every strand) and nothing else, for benchmarks and soak tests. Read the
+    /// state with [`Simulation::write_lerp`] at alpha 1. The next [`Simulation::advance_to`]
+    /// recomputes its states from scratch. A non-finite time does nothing.
+    pub fn step_at(&mut self, time_secs: f64) {
+        if !time_secs.is_finite() {
+            return;
+        }
+        std::mem::swap(&mut self.previous, &mut self.current);
+        self.step_into_current(time_secs);
+        self.time_secs = time_secs;
+        self.step_index = i64::MIN;
+    }
+
     /// The interpolation weight of the current state at the last render time.
     #[must_use]
     pub fn alpha(&self) -> f32 {
@@ -480,6 +513,12 @@ impl Simulation {
     #[must_use]
     pub fn vertex_count(&self) -> usize {
         self.vertex_count
+    }
+
+    /// The root positions at rest (the base mesh's vertices).
+    #[must_use]
+    pub fn rest_roots(&self) -> &[Vec3] {
+        &self.rest_roots
     }
 
     /// The current root positions.
@@ -534,29 +573,24 @@ impl Simulation {
         self.external = external;
         let (inertia, damping) = (self.params.inertia, self.params.damping);
         self.inertia.update(&self.roots, time_secs, inertia, damping, self.radius);
-        let gravity = self.params.gravity_direction.normalize_or_zero() * self.params.gravity_strength;
-        let layers = self.layers as usize;
-        let v = self.vertex_count;
-        let stability = self.params.stability;
-        let (roots, frames, rest, external, map) =
-            (&self.roots, &self.frames, &self.rest_segments, &self.external, self.stability_map.as_deref());
-        let inertial = self.inertia.forces();
-        self.current.par_chunks_mut(layers + 1).enumerate().with_min_len(BATCHES_PER_TASK).for_each(|(b, nodes)| {
-            let inputs: [StrandInputs; LANES] = std::array::from_fn(|lane| {
-                let j = b * LANES + lane;
-                if j < v {
-                    StrandInputs {
-                        root: roots[j],
-                        frame: frames[j],
-                        force: gravity + external[j] + inertial[j],
-                        stability: map.map_or(stability, |m| m[j]),
-                    }
-                } else {
-                    StrandInputs::default()
-                }
-            });
-            bend_batch(&inputs, &rest[b * layers..(b + 1) * layers], nodes);
-        });
+        // The kernel takes one external force per strand: the field plus the inertial force.
+        let mut forces = std::mem::take(&mut self.forces);
+        forces.clear();
+        forces.extend(self.external.iter().zip(self.inertia.forces()).map(|(e, i)| *e + *i));
+        let step = Step {
+            layers: self.layers as usize,
+            vertex_count: self.vertex_count,
+            gain: self.params.equation.gain(self.layers),
+            gravity: self.params.gravity_direction.normalize_or_zero() * self.params.gravity_strength,
+            stability: self.params.stability,
+            stability_map: self.stability_map.as_deref(),
+            roots: &self.roots,
+            frames: &self.frames,
+            external: &forces,
+            rest: &self.rest,
+        };
+        dispatch::bend_all(self.cpu_kernel, &step, &mut self.current);
+        self.forces = forces;
         self.last_step_secs = started.elapsed().as_secs_f64();
         self.steps_taken += 1;
     }
