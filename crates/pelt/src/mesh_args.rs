@@ -21,16 +21,8 @@ pub struct MeshArgs {
 }
 
 impl MeshArgs {
-    /// Loads the chosen mesh; with neither a file nor `--builtin`, `default`.
-    pub fn load(&self, default: Builtin) -> anyhow::Result<(Mesh, MeshReport)> {
-        let options = ImportOptions { weld: !self.no_weld, ..ImportOptions::default() };
-        match (&self.mesh, &self.builtin) {
-            (Some(path), _) => Ok(Mesh::load(path, &options)?),
-            (None, _) => self.load_builtin(default),
-        }
-    }
-
-    /// Like [`MeshArgs::load`], with the file's rig (skins, animations) when it has one.
+    /// Loads the chosen mesh, with the file's rig (skins, animations) when it has one; with
+    /// neither a file nor `--builtin`, `default`.
     pub fn load_animated(&self, default: Builtin) -> anyhow::Result<(Mesh, MeshReport, Option<Rig>)> {
         let options = ImportOptions { weld: !self.no_weld, ..ImportOptions::default() };
         match &self.mesh {

@@ -140,3 +140,14 @@ fn a_missing_preset_or_script_is_named_before_any_window_opens() {
         assert!(stderr.contains(file), "{flag}: the error names the file: {stderr}");
     }
 }
+
+#[test]
+fn an_animated_file_moves_in_the_window() {
+    let fox = concat!(env!("CARGO_MANIFEST_DIR"), "/../../assets/meshes/Fox.glb");
+    // The first clip (Survey) plays at 60 fixed frames a second: a second apart, the fox has moved.
+    let early = screenshot("fox_early", 3, &[fox]);
+    let later = screenshot("fox_later", 63, &[fox]);
+    let view = (0, 0, WIDTH_PX - PANEL_PX, HEIGHT_PX);
+    let moved = mean_difference(&early, &later, view);
+    assert!(moved > 0.5, "the animation moves the fox: mean difference {moved}");
+}

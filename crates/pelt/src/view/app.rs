@@ -6,6 +6,7 @@ use std::sync::Arc;
 
 use anyhow::Context as _;
 use pelt_core::Mesh;
+use pelt_core::anim::Rig;
 use winit::application::ApplicationHandler;
 use winit::event::WindowEvent;
 use winit::event_loop::ActiveEventLoop;
@@ -52,8 +53,8 @@ struct Running {
 }
 
 impl App {
-    pub fn new(args: &Args, mesh: Mesh, mesh_source: String) -> anyhow::Result<Self> {
-        let model = Model::new(args, mesh, mesh_source)?;
+    pub fn new(args: &Args, mesh: Mesh, rig: Option<Rig>, mesh_source: String) -> anyhow::Result<Self> {
+        let model = Model::new(args, mesh, rig, mesh_source)?;
         let screenshot_after = args.screenshot_after.zip(args.out.clone());
         Ok(Self { window_size: args.size, screenshot_after, model, running: None, error: None })
     }
@@ -144,6 +145,9 @@ impl App {
         }
         model.simulate(frame_secs)?;
         running.fur.set_positions(&running.gpu, model.sim.positions())?;
+        if model.posed {
+            running.fur.set_base_normals(&running.gpu, &model.pose.normals)?;
+        }
         if requests.screenshot {
             model.screenshot_pending = true;
         }

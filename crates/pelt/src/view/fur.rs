@@ -112,6 +112,11 @@ impl FurScene {
         Ok(self.fur.set_positions(&gpu.queue, positions)?)
     }
 
+    /// Uploads the posed base normals (skin shading of an animated mesh).
+    pub fn set_base_normals(&self, gpu: &pelt_render::Gpu, normals: &[Vec3]) -> anyhow::Result<()> {
+        Ok(self.fur.set_base_normals(&gpu.queue, normals)?)
+    }
+
     /// Draws the body and the unified structure, or the separated one when `separated` and it is
     /// built, into the viewport.
     pub fn draw(
