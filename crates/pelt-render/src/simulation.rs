@@ -110,7 +110,7 @@ fn step_uniform(simulation: &Simulation, time_secs: f64, counts: [u32; 2], grid_
 
 /// A fur's simulation on the GPU: bends every strand exactly as `pelt_core::sim` defines it
 /// (Equation 1 as Pelt implements it, gravity, the wind with the same noise and seeds, the user
-/// field and the touch over it, posed roots and frames) in a compute pass, one invocation per
+/// field and the touch over it, the inertial force, posed roots and frames) in a compute pass, one invocation per
 /// strand, writing the new state into [`GpuFur::current_positions`] after
 /// [`GpuFur::swap_states`]; the fur's vertex shader interpolates between its two states.
 ///
@@ -134,7 +134,7 @@ pub struct GpuSimulation {
     grid: [u32; 2],
     /// What `strands` and `forces` hold, so unchanged inputs are not uploaded again.
     strand_data: Vec<[f32; 8]>,
-    force_data: Vec<[f32; 4]>,
+    force_data: Vec<[f32; 8]>,
     /// `Simulation::steps_taken` at the last prepare (`None`: replay the last two steps).
     seen_steps: Option<u64>,
     /// Steps prepared and not yet dispatched (at most [`STEP_SLOTS`], in slot order).
@@ -211,7 +211,7 @@ impl GpuSimulation {
             }
         }
         check_size(device, "simulation rest segments", rest.len() as u64 * 16)?;
-        check_size(device, "simulation strands", v.max(1) as u64 * 32)?;
+        check_size(device, "simulation strands and forces", v.max(1) as u64 * 32)?;
 
         let scope = ErrorScope::push(device);
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
@@ -278,7 +278,7 @@ impl GpuSimulation {
             },
         );
         let strands = buffer("pelt simulation strands", v.max(1) as u64 * 32, storage_usage);
-        let forces = buffer("pelt simulation forces", v.max(1) as u64 * 16, storage_usage);
+        let forces = buffer("pelt simulation forces", v.max(1) as u64 * 32, storage_usage);
         scope.pop("creating the GPU simulation")?;
         Ok(Self {
             pipeline,
@@ -300,9 +300,11 @@ impl GpuSimulation {
 
     /// Takes the steps `simulation` ran since the last call (all of its last two the first
     /// time): writes their uniforms and, when they changed, the per-strand inputs (roots,
-    /// frames, stability, field, touch weights). Queue writes only; call
+    /// frames, stability, field, touch weights, inertial forces). Queue writes only; call
     /// [`GpuSimulation::dispatch`] before the next submission. Steps not dispatched yet are kept
-    /// (the last two).
+    /// (the last two). The per-strand inputs are the simulation's now: when it took two steps
+    /// at once (a catch-up), the older one is bent with the newer one's inertial force (the CPU
+    /// keeps no older one); everything else of a step is its own.
     ///
     /// # Errors
     /// [`RenderError::Count`] when `simulation` or `fur` is not the shape this was made for;
@@ -452,7 +454,13 @@ impl GpuSimulation {
             queue.write_buffer(&self.strands, 0, bytemuck::cast_slice(&strands));
             self.strand_data = strands;
         }
-        let mut forces: Vec<[f32; 4]> = simulation.field().values().iter().map(|f| f.extend(0.0).to_array()).collect();
+        let mut forces: Vec<[f32; 8]> = simulation
+            .field()
+            .values()
+            .iter()
+            .zip(simulation.inertial_forces())
+            .map(|(f, i)| [f.x, f.y, f.z, 0.0, i.x, i.y, i.z, 0.0])
+            .collect();
         if let Some(touch) = simulation.touch() {
             for &(j, weight) in touch.weights() {
                 forces[j as usize][3] = weight;

@@ -1,5 +1,5 @@
 // One step of pelt-core's `Simulation` on the GPU: per strand (one invocation each) the force
-// (gravity + wind + the user field, the touch blended over it), then the bend of Equation 1 as
+// (gravity + wind + the user field with the touch blended over it + inertia), then the bend of Equation 1 as
 // `pelt_core::sim::bend` defines it (a running quaternion, O(L)), written layer-major into the
 // shared vertex array the renderer draws from. Appended to `simulation_wind.wgsl`.
 
@@ -38,8 +38,14 @@ struct Strand {
 // Rest segment k of strand j at k * V + j (xyz; w unused).
 @group(0) @binding(1) var<storage, read> rest_segments: array<vec4<f32>>;
 @group(0) @binding(2) var<storage, read> strands: array<Strand>;
-// Per strand: the user field (xyz) and the touch's falloff weight (w, 0 outside it).
-@group(0) @binding(3) var<storage, read> forces: array<vec4<f32>>;
+// Per strand: the user field (xyz) and the touch's falloff weight (w, 0 outside it); the
+// inertial force of this step (from the roots' motion, computed on the CPU).
+struct StrandForces {
+    field_touch: vec4<f32>,
+    inertial: vec4<f32>,
+}
+
+@group(0) @binding(3) var<storage, read> forces: array<StrandForces>;
 // The shared vertex array: NV[i * V + j] as packed xyz.
 @group(0) @binding(4) var<storage, read_write> positions: array<f32>;
 
@@ -155,13 +161,14 @@ fn step_strands(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocati
     let stability = strand.root_stability.w;
 
     // The external field (wind + user field) with the touch over it (`evaluate_field`), then gravity.
-    let field = forces[j];
+    let strand_forces = forces[j];
+    let field = strand_forces.field_touch;
     var field_force = wind(j, root) + field.xyz;
     let touch_weight = field.w * inputs.touch.w;
     if touch_weight > 0.0 {
         field_force = field_force * (1.0 - touch_weight) + inputs.touch.xyz * touch_weight;
     }
-    let force = inputs.gravity.xyz + field_force;
+    let force = inputs.gravity.xyz + field_force + strand_forces.inertial.xyz;
 
     // `bend::split_force`: unit direction and magnitude without overflow; a non-finite force
     // has neither.

@@ -85,7 +85,8 @@ fn worst_relative_difference(structure: &FurStructure, gpu: &[Vec3], cpu: &[Vec3
 
 /// The same script on both simulations: wind with gusts and jitter throughout; a touch that is
 /// dragged, released with a fade, and a second one released at once; a user field; a stability
-/// map; a posed (rotated and moved) base; and a jump in time (two steps at once).
+/// map; a posed (rotated and moved) base that then sways (inertia); and a jump in time (two
+/// steps at once).
 fn script(step: u32, simulation: &mut Simulation, structure: &FurStructure) {
     let v = structure.vertex_count();
     let root = structure.positions[v / 3];
@@ -119,6 +120,13 @@ fn script(step: u32, simulation: &mut Simulation, structure: &FurStructure) {
         220 => {
             let rotation = Quat::from_axis_angle(Vec3::new(0.3, 1.0, 0.2).normalize(), 0.7);
             let roots: Vec<Vec3> = structure.positions[..v].iter().map(|p| rotation * *p + Vec3::X * 0.1).collect();
+            simulation.set_base_rotations(&roots, &vec![rotation; v]).expect("posed base");
+        }
+        231..=270 => {
+            // A swaying body, so the roots accelerate and the inertial force bends the fur.
+            let rotation = Quat::from_axis_angle(Vec3::new(0.3, 1.0, 0.2).normalize(), 0.7);
+            let sway = Vec3::new(0.1 + 0.05 * radius * (step as f32 * 0.4).sin(), 0.0, 0.0);
+            let roots: Vec<Vec3> = structure.positions[..v].iter().map(|p| rotation * *p + sway).collect();
             simulation.set_base_rotations(&roots, &vec![rotation; v]).expect("posed base");
         }
         _ => {}
@@ -162,6 +170,9 @@ fn agreement(backend: Backend) {
         if step == 150 {
             let difference = worst_relative_difference(&structure, &previous, &cpu_state(&cpu, 0.0));
             assert!(difference <= 1e-4, "{backend}: after the jump the previous state is {difference} off");
+        }
+        if step == 270 {
+            assert!(control.inertial_forces().iter().any(|f| f.length() > 0.01), "the sway gives an inertial force");
         }
         worst = worst.max(difference);
         moved = moved.max(worst_relative_difference(&structure, &current, &structure.positions));
