@@ -562,6 +562,18 @@ impl Simulation {
         self.inertia.reset();
     }
 
+    /// Recomputes both kept states for the current base and time, forgetting the motion so far:
+    /// for a base that jumped (the first pose of an animation, a new animation, a scrubbed
+    /// timeline), so the fur starts from it at rest instead of flying to it.
+    pub fn restart(&mut self) {
+        self.inertia.reset();
+        let index = if self.step_index == i64::MIN { 0 } else { self.step_index };
+        self.jump_to_step(index);
+        if self.cpu_bending {
+            self.update_output();
+        }
+    }
+
     fn jump_to_step(&mut self, index: i64) {
         // The inertia sees the two steps' times: a short skip forward keeps the swing going (the
         // acceleration is taken over the uneven steps), a jump back or far ahead starts it over.
