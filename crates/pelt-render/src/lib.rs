@@ -23,7 +23,9 @@
 //! 2. Once per target description: [`FurRenderer::new`]. Once per fur: [`GpuFur::new`]. Once per
 //!    camera: [`FurView::new`].
 //! 3. Each simulation step: [`GpuFur::push_state`] (or [`GpuFur::set_positions`] each frame, or a
-//!    compute pass writing [`GpuFur::current_positions`]).
+//!    compute pass writing [`GpuFur::current_positions`]: [`GpuSimulation`] is Pelt's, which
+//!    bends the strands on the GPU from a `pelt_core::Simulation`'s inputs, so nothing is
+//!    uploaded per step but those inputs).
 //! 4. Each frame, before submitting: [`FurView::prepare`] for each view, [`GpuFur::prepare`]
 //!    (model transform, interpolation, look) for each fur.
 //! 5. In the host's render pass, after its opaque geometry: [`FurRenderer::draw_plain`] for
@@ -102,6 +104,7 @@ mod plain;
 mod renderer;
 mod requirements;
 mod separated;
+mod simulation;
 mod targets;
 mod textures;
 mod view;
@@ -119,5 +122,6 @@ pub use plain::PlainMesh;
 pub use renderer::{FurDrawSettings, FurRenderer, unified_shader_source};
 pub use requirements::{check_adapter, required_downlevel_flags, required_features, required_limits};
 pub use separated::{SeparatedFur, SeparatedRenderer, separated_shader_source};
+pub use simulation::{GpuSimulation, simulation_shader_source};
 pub use targets::{DEFAULT_BACKGROUND, DEPTH_FORMAT, FurTarget, RenderTargets, SAMPLE_COUNT};
 pub use view::{FurView, Light, LightDirection, ViewData};

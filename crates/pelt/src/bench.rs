@@ -19,7 +19,8 @@ use pelt_core::{FurStructure, Preset};
 
 use self::models::{MODELS, Model};
 use self::report::{
-    LargeMeshFigures, Machine, RenderFigures, Report, ResultRow, SimFigures, SkippedModel, TextureFigures,
+    GpuSimFigures, LargeMeshFigures, Machine, RenderFigures, Report, ResultRow, SimFigures, SkippedModel,
+    TextureFigures,
 };
 use self::table2::Table2Row;
 
@@ -79,6 +80,11 @@ impl Plan {
             // Enough frames for a stable median on a GPU; at least 5 where a frame takes a second.
             render::RenderBudget { warmup_frames: 2, min_frames: 5, max_frames: 101, max_secs_per_case: 2.0 }
         }
+    }
+
+    /// GPU simulation: (steps per timed run, runs); the figure is the median run.
+    fn gpu_sim_runs(self) -> (u32, usize) {
+        if self.quick { (4, 3) } else { (30, 7) }
     }
 
     fn texture_runs(self) -> u32 {
@@ -183,7 +189,7 @@ const QUICK_DRAWS: &str = "--quick draws the Box at 16 layers only";
 
 /// Every figure for one model at one layer count.
 fn measure(model: &Model, layers: u32, plan: Plan, gpu: Result<&render::Bench, &String>) -> anyhow::Result<ResultRow> {
-    let row = |render, sim, texture| -> anyhow::Result<ResultRow> {
+    let row = |render, sim, texture, gpu_sim| -> anyhow::Result<ResultRow> {
         Ok(ResultRow {
             model: model.spec.key,
             paper_model: model.spec.paper_model,
@@ -193,6 +199,7 @@ fn measure(model: &Model, layers: u32, plan: Plan, gpu: Result<&render::Bench, &
             render,
             sim,
             texture,
+            gpu_sim,
         })
     };
     if !plan.times(model.spec.key) {
@@ -201,6 +208,7 @@ fn measure(model: &Model, layers: u32, plan: Plan, gpu: Result<&render::Bench, &
             RenderFigures { render_unavailable_reason: reason(), ..RenderFigures::default() },
             SimFigures { sim_unavailable_reason: reason(), ..SimFigures::default() },
             TextureFigures { texture_unavailable_reason: reason(), ..TextureFigures::default() },
+            GpuSimFigures { gpu_sim_unavailable_reason: reason(), ..GpuSimFigures::default() },
         );
     }
 
@@ -237,7 +245,15 @@ fn measure(model: &Model, layers: u32, plan: Plan, gpu: Result<&render::Bench, &
     };
     eprintln!("pelt bench:   {key} L={layers}: simulation");
     let sim = sim::measure(&fur, &preset.simulation, plan.sim_budget())?;
-    row(render, sim, texture)
+    let gpu_sim = match gpu {
+        Ok(gpu) => {
+            eprintln!("pelt bench:   {key} L={layers}: GPU simulation");
+            let (steps, runs) = plan.gpu_sim_runs();
+            gpu.measure_simulation(&fur, &preset.simulation, steps, runs, plan.sim_budget().drawn_frames)?
+        }
+        Err(reason) => GpuSimFigures { gpu_sim_unavailable_reason: Some(reason.clone()), ..GpuSimFigures::default() },
+    };
+    row(render, sim, texture, gpu_sim)
 }
 
 /// The simulation's throughput on the 35,000-vertex mesh at 32 layers, default preset.

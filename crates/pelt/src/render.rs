@@ -12,11 +12,12 @@ use pelt_core::mesh::builtin::{TRY_ON_NAME, try_on_scene};
 use pelt_core::sim::{Scene, Simulation, WindParams};
 use pelt_core::{Builtin, FurStructure, ImportOptions, Mesh, Preset};
 use pelt_render::{
-    Backend, Camera, DEFAULT_BACKGROUND, FurDrawSettings, FurFrame, FurStates, FurView, GpuFur, Headless, Light,
-    PlainMesh,
+    Backend, Camera, DEFAULT_BACKGROUND, FurDrawSettings, FurFrame, FurStates, FurView, GpuFur, GpuSimulation,
+    Headless, Light, PlainMesh,
 };
 
 use crate::mesh_args::MeshArgs;
+use crate::sim_kernel::{self, SimChoice, SimKernel};
 
 /// Skin tone of plain meshes (linear RGB).
 pub const PLAIN_COLOUR: Vec3 = Vec3::new(0.62, 0.46, 0.38);
@@ -69,6 +70,10 @@ pub struct Args {
     /// Graphics backend: vulkan, gl (or metal, dx12); default `WGPU_BACKEND`, else the best there is.
     #[arg(long, default_value = "auto")]
     backend: Backend,
+    /// Where the fur is simulated: the CPU, the GPU (a compute pass), or auto (both timed on
+    /// this fur first, the faster runs).
+    #[arg(long, value_enum, default_value_t = SimChoice::Auto)]
+    sim: SimChoice,
     /// Shells and fins with alpha-to-coverage instead of blending.
     #[arg(long)]
     alpha_to_coverage: bool,
@@ -146,9 +151,19 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let headless = Headless::new(args.backend, width, height)?;
     let (device, queue) = (&headless.gpu.device, &headless.gpu.queue);
     let renderer = headless.renderer()?;
-    // The CPU simulation interpolates, so one state uploaded per frame is all the GPU needs.
-    let gpu_fur = GpuFur::new(device, queue, &renderer, &fur, &textures, FurStates::One)?;
+    let (kernel, kernel_reason) = sim_kernel::choose(args.sim, device, queue, &fur, simulation.params())?;
+    // The CPU simulation interpolates, so one state uploaded per frame is all the GPU needs; the
+    // GPU one writes two states and the vertex shader interpolates.
+    let states = if kernel == SimKernel::Gpu { FurStates::Two } else { FurStates::One };
+    let mut gpu_fur = GpuFur::new(device, queue, &renderer, &fur, &textures, states)?;
     gpu_fur.prepare(queue, &FurFrame::default());
+    let mut gpu_simulation = match kernel {
+        SimKernel::Gpu => {
+            simulation.set_cpu_bending(false);
+            Some(GpuSimulation::new(device, &gpu_fur, &fur)?)
+        }
+        SimKernel::Cpu => None,
+    };
     let plain_meshes = plain
         .iter()
         .map(|mesh| PlainMesh::new(device, &renderer, mesh, PLAIN_COLOUR))
@@ -202,7 +217,16 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         simulation.advance_to(time_secs);
         simulation_time += sim_started.elapsed();
         let render_started = Instant::now();
-        gpu_fur.set_positions(queue, simulation.positions())?;
+        match &mut gpu_simulation {
+            Some(gpu_simulation) => {
+                gpu_simulation.prepare(device, queue, &simulation, &gpu_fur)?;
+                let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor::default());
+                gpu_simulation.dispatch(&mut encoder, &mut gpu_fur)?;
+                queue.submit([encoder.finish()]);
+                gpu_fur.prepare(queue, &FurFrame { interpolation: simulation.alpha(), ..FurFrame::default() });
+            }
+            None => gpu_fur.set_positions(queue, simulation.positions())?,
+        }
         if moves {
             gpu_fur.set_base_normals(queue, &pose.normals)?;
             for mesh in &plain_meshes {
@@ -236,7 +260,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let per_frame = |total: Duration| total.as_secs_f64() * 1000.0 / f64::from(frames);
     println!(
         "{}: {frames} frame{} of {width}x{height}, {} shell layers on {} triangles; mean frame {:.1} ms \
-         (render and read back), simulation {:.1} ms a frame; {:.1} s in all on {}",
+         (render and read back), simulation {:.1} ms a frame on the {kernel} ({kernel_reason}); {:.1} s in all on {}",
         args.output.display(),
         if frames == 1 { "" } else { "s" },
         fur.layers,

@@ -40,6 +40,10 @@ pub struct Args {
     /// Start with the overlay (timings, sizes, brush and hints) hidden; O shows it.
     #[arg(long)]
     pub no_overlay: bool,
+    /// Where the fur is simulated: the CPU, the GPU (a compute pass), or auto (both timed on
+    /// this fur when the window opens, the faster runs). The panel switches it live.
+    #[arg(long, value_enum, default_value_t = crate::sim_kernel::SimChoice::Auto)]
+    pub sim: crate::sim_kernel::SimChoice,
     /// Window size in logical pixels, `WIDTHxHEIGHT`.
     #[arg(long, value_name = "WxH", default_value = "1280x800", value_parser = parse_size)]
     pub size: [u32; 2],

@@ -45,7 +45,7 @@ const PERCENT_KEYS: [&str; 4] =
     ["savings_vs_2_percent", "savings_vs_30_percent", "bytes_savings_vs_2_percent", "bytes_savings_vs_30_percent"];
 
 /// Measured figures, grouped by the key that says why they are null when they are.
-const MEASURED_KEYS: [(&str, &[&str]); 3] = [
+const MEASURED_KEYS: [(&str, &[&str]); 4] = [
     (
         "render_unavailable_reason",
         &[
@@ -70,6 +70,10 @@ const MEASURED_KEYS: [(&str, &[&str]); 3] = [
         ],
     ),
     ("texture_unavailable_reason", &["texture_generation_ms", "texture_size_texels"]),
+    (
+        "gpu_sim_unavailable_reason",
+        &["gpu_sim_node_updates_per_sec", "gpu_sim_steps_per_run", "gpu_sim_cpu_ms_per_frame"],
+    ),
 ];
 
 fn count(row: &Value, key: &str) -> u64 {

@@ -79,6 +79,28 @@ fn bad_arguments_are_clear_errors() {
     }
 }
 
+/// `--sim gpu` draws what `--sim cpu` draws (a windy sequence, so the fur moves), and the summary
+/// says which kernel ran; `auto` says what it measured.
+#[test]
+fn the_gpu_simulation_renders_what_the_cpu_one_does() {
+    let dir = temp_dir("sim");
+    let common = ["render", "--builtin", "bunny", "--size", "128x96", "--frames", "4", "--wind", "2,0,1"];
+    let mut frames = Vec::new();
+    for kernel in ["cpu", "gpu"] {
+        let output = pelt(&[&common[..], &["--sim", kernel, "-o", kernel]].concat(), &dir);
+        assert!(output.status.success(), "{}", text(&output));
+        let upper = kernel.to_ascii_uppercase();
+        assert!(text(&output).contains(&format!("on the {upper} (--sim {kernel})")), "{}", text(&output));
+        frames.push(image::open(dir.join(kernel).join("frame_0004.png")).expect("frame").to_rgba8());
+    }
+    let differing = frames[0].pixels().zip(frames[1].pixels()).filter(|(a, b)| a != b).count();
+    let fraction = differing as f64 / f64::from(frames[0].width() * frames[0].height());
+    assert!(fraction < 0.01, "{:.2}% of the pixels differ between the kernels", fraction * 100.0);
+    let output = pelt(&["render", "--builtin", "box", "--size", "32x32", "--sim", "auto"], &dir);
+    assert!(output.status.success(), "{}", text(&output));
+    assert!(text(&output).contains("(auto: GPU "), "{}", text(&output));
+}
+
 fn png(dir: &Path, name: &str) -> image::RgbaImage {
     image::open(dir.join(name)).unwrap_or_else(|e| panic!("{name}: {e}")).to_rgba8()
 }

@@ -100,6 +100,10 @@ pub struct Simulation {
     alpha: f32,
     last_step_secs: f64,
     steps_taken: u64,
+    /// Whether steps bend the strands here; off when another kernel (a GPU pass) does.
+    cpu_bending: bool,
+    /// Times of the last (up to) two steps, oldest first.
+    recent_step_times: Vec<f64>,
 }
 
 impl Simulation {
@@ -153,6 +157,8 @@ impl Simulation {
             alpha: 0.0,
             last_step_secs: 0.0,
             steps_taken: 0,
+            cpu_bending: true,
+            recent_step_times: Vec::with_capacity(3),
         };
         simulation.jump_to_step(0);
         simulation.update_output();
@@ -396,7 +402,9 @@ impl Simulation {
             self.alpha = 1.0;
         }
         self.drop_faded_touch();
-        self.update_output();
+        if self.cpu_bending {
+            self.update_output();
+        }
     }
 
     /// The positions to draw, layer-major like [`FurStructure::positions`]:
@@ -527,6 +535,54 @@ impl Simulation {
         &self.roots
     }
 
+    /// Turns the bending of strands on this CPU on or off. Off, [`Simulation::advance_to`] still
+    /// keeps the time, the steps ([`Simulation::recent_step_times`]), the touch and every input,
+    /// but bends nothing and leaves [`Simulation::positions`] and
+    /// [`Simulation::external_field`] as they were: for a host whose strands are bent by another
+    /// kernel (`pelt_render::GpuSimulation`) from this simulation's inputs. Either way the next
+    /// `advance_to` recomputes both states, so switching never mixes kernels in one pair.
+    pub fn set_cpu_bending(&mut self, on: bool) {
+        if on != self.cpu_bending {
+            self.cpu_bending = on;
+            self.step_index = i64::MIN;
+        }
+    }
+
+    /// Whether steps bend the strands on this CPU (see [`Simulation::set_cpu_bending`]).
+    #[must_use]
+    pub fn cpu_bending(&self) -> bool {
+        self.cpu_bending
+    }
+
+    /// The simulation times of the last two steps (fewer before two were taken), oldest first.
+    /// Every step makes the current state the previous one and computes the new current state
+    /// at its time; with [`Simulation::steps_taken`] another kernel can replay the steps it has
+    /// not seen (only the last two matter: a step depends on its inputs, not on earlier states).
+    #[must_use]
+    pub fn recent_step_times(&self) -> &[f64] {
+        &self.recent_step_times
+    }
+
+    /// Each strand's rotation from its rest frame into the current base frame (identity until
+    /// [`Simulation::set_base`] or [`Simulation::set_base_rotations`]).
+    #[must_use]
+    pub fn frames(&self) -> &[Quat] {
+        &self.frames
+    }
+
+    /// The per-vertex stability map, if one is set.
+    #[must_use]
+    pub fn stability_map(&self) -> Option<&[f32]> {
+        self.stability_map.as_deref()
+    }
+
+    /// The bounding radius of the base at rest (from the box centre): the unit of the wind's
+    /// gust sizes and speeds ([`WindParams::sample`]'s `radius`).
+    #[must_use]
+    pub fn bounding_radius(&self) -> f32 {
+        self.radius
+    }
+
     /// The inertial force per strand at the newest step (see [`Inertia`]).
     #[must_use]
     pub fn inertial_forces(&self) -> &[Vec3] {
@@ -552,7 +608,9 @@ impl Simulation {
         self.inertia.reset();
         let index = if self.step_index == i64::MIN { 0 } else { self.step_index };
         self.jump_to_step(index);
-        self.update_output();
+        if self.cpu_bending {
+            self.update_output();
+        }
     }
 
     fn jump_to_step(&mut self, index: i64) {
@@ -567,12 +625,21 @@ impl Simulation {
 
     /// Computes the state at `time_secs` into `current`.
     fn step_into_current(&mut self, time_secs: f64) {
+        self.steps_taken += 1;
+        self.recent_step_times.push(time_secs);
+        if self.recent_step_times.len() > 2 {
+            self.recent_step_times.remove(0);
+        }
+        // The inertia is state carried from step to step: it advances whichever kernel bends.
+        let (inertia, damping) = (self.params.inertia, self.params.damping);
+        self.inertia.update(&self.roots, time_secs, inertia, damping, self.radius);
+        if !self.cpu_bending {
+            return;
+        }
         let started = Instant::now();
         let mut external = std::mem::take(&mut self.external);
         self.evaluate_field(time_secs, &mut external);
         self.external = external;
-        let (inertia, damping) = (self.params.inertia, self.params.damping);
-        self.inertia.update(&self.roots, time_secs, inertia, damping, self.radius);
         // The kernel takes one external force per strand: the field plus the inertial force.
         let mut forces = std::mem::take(&mut self.forces);
         forces.clear();
@@ -592,7 +659,6 @@ impl Simulation {
         dispatch::bend_all(self.cpu_kernel, &step, &mut self.current);
         self.forces = forces;
         self.last_step_secs = started.elapsed().as_secs_f64();
-        self.steps_taken += 1;
     }
 
     fn drop_faded_touch(&mut self) {

@@ -11,7 +11,7 @@ use pelt_render::{
     GpuFur, HEADLESS_FORMAT, Light, PlainMesh, RenderTargets, SeparatedFur, SeparatedRenderer,
 };
 
-use super::report::{Adapter, RenderFigures};
+use super::report::{Adapter, GpuSimFigures, RenderFigures};
 use super::table2::MANY_FIN_FACES;
 use crate::render::PLAIN_COLOUR;
 
@@ -49,6 +49,42 @@ impl Bench {
             device_type: format!("{:?}", info.device_type),
             driver: format!("{} {}", info.driver, info.driver_info).trim().to_owned(),
         }
+    }
+
+    /// The GPU simulation's node updates per second on `fur` under `params` with wind (so the
+    /// noise is evaluated, as in a windy scene): the median of `runs` runs of `steps` steps
+    /// (`crate::sim_kernel::gpu_secs_per_step`, the code `--sim gpu` runs); and the CPU cost
+    /// per drawn frame over `drawn_frames` frames at 120 Hz with the simulation at 30 Hz.
+    pub fn measure_simulation(
+        &self,
+        fur: &FurStructure,
+        params: &pelt_core::sim::SimParams,
+        steps: u32,
+        runs: usize,
+        drawn_frames: u32,
+    ) -> anyhow::Result<GpuSimFigures> {
+        let mut windy = params.clone();
+        if windy.wind.strength == 0.0 {
+            windy.wind.strength = 0.5;
+        }
+        let (device, queue) = (&self.gpu.device, &self.gpu.queue);
+        let secs = crate::sim_kernel::gpu_secs_per_step(device, queue, fur, &windy, steps, runs)?;
+        let nodes = fur.vertex_count() as f64 * f64::from(fur.layers);
+        windy.rate_hz = super::sim::SIM_RATE_HZ;
+        let cpu_ms = crate::sim_kernel::gpu_cpu_ms_per_drawn_frame(
+            device,
+            queue,
+            fur,
+            &windy,
+            super::sim::DRAW_RATE_HZ,
+            drawn_frames,
+        )?;
+        Ok(GpuSimFigures {
+            gpu_sim_node_updates_per_sec: Some(nodes / secs),
+            gpu_sim_steps_per_run: Some(steps),
+            gpu_sim_cpu_ms_per_frame: Some(cpu_ms),
+            gpu_sim_unavailable_reason: None,
+        })
     }
 
     /// Median frame times of the three structures at both sizes, each drawing the same scene:

@@ -72,6 +72,8 @@ pub struct ResultRow {
     pub sim: SimFigures,
     #[serde(flatten)]
     pub texture: TextureFigures,
+    #[serde(flatten)]
+    pub gpu_sim: GpuSimFigures,
 }
 
 /// The Table 2 part: counts and bytes, all computed.
@@ -170,6 +172,21 @@ pub struct SimFigures {
     /// ... against simulating every drawn frame.
     pub sim_cpu_ms_per_frame_every_frame: Option<f64>,
     pub sim_unavailable_reason: Option<String>,
+}
+
+/// The GPU simulation (`pelt_render::GpuSimulation`) on the report's adapter.
+#[derive(Debug, Default, serde::Serialize)]
+pub struct GpuSimFigures {
+    /// Non-root nodes moved per second (`V * L` per step) by the compute pass: the median of
+    /// repeated runs, each a batch of steps in one submission waited for with a fence.
+    pub gpu_sim_node_updates_per_sec: Option<f64>,
+    /// Steps per timed run.
+    pub gpu_sim_steps_per_run: Option<u32>,
+    /// CPU ms per drawn frame at 120 Hz drawing with the GPU simulating at 30 Hz (time, steps,
+    /// prepare, recording and submission; no interpolation or upload), to set beside
+    /// `sim_cpu_ms_per_frame_interpolated`.
+    pub gpu_sim_cpu_ms_per_frame: Option<f64>,
+    pub gpu_sim_unavailable_reason: Option<String>,
 }
 
 /// Shell and fin texture generation.
@@ -323,7 +340,27 @@ impl Report {
                 [(r, r.sim.sim_unavailable_reason.as_deref()), (r, r.texture.texture_unavailable_reason.as_deref())]
             }),
         );
+        self.gpu_sim_markdown(&mut md);
         md
+    }
+
+    /// The GPU simulation's table: which kernel ran where, and how fast.
+    fn gpu_sim_markdown(&self, md: &mut String) {
+        let adapter =
+            self.adapter.as_ref().map_or_else(|| "no adapter".to_owned(), |a| format!("{} ({})", a.name, a.backend));
+        let _ = writeln!(md, "\n### Simulation on the GPU (compute pass on {adapter})\n");
+        let _ = writeln!(
+            md,
+            "| model | L | node updates/s | steps per timed run | CPU ms per drawn frame, GPU sim at 30 Hz |"
+        );
+        let _ = writeln!(md, "|---|---:|---:|---:|---:|");
+        for r in &self.results {
+            let g = &r.gpu_sim;
+            let steps = g.gpu_sim_steps_per_run.map_or_else(|| "-".to_owned(), |n| n.to_string());
+            let (updates, cpu) = (rate(g.gpu_sim_node_updates_per_sec), ms(g.gpu_sim_cpu_ms_per_frame));
+            let _ = writeln!(md, "| {} | {} | {updates} | {steps} | {cpu} |", r.model, r.layers);
+        }
+        notes(md, self.results.iter().map(|r| (r, r.gpu_sim.gpu_sim_unavailable_reason.as_deref())));
     }
 }
 

@@ -19,6 +19,7 @@ use super::gpu::{self, Acquired, WindowSurface};
 use super::model::{Model, smooth};
 use super::panel::{Changes, Requests};
 use super::viewport::Viewport;
+use crate::sim_kernel::SimKernel;
 
 /// Consecutive frames without a swap-chain texture before a scripted run gives up.
 const MAX_SKIPPED_FRAMES: u32 = 600;
@@ -97,6 +98,13 @@ impl App {
         let textures = self.model.textures.take().context("the first textures were made before the window")?;
         let mut fur = FurScene::new(&gpu, &self.model.structure, &textures)?;
         fur.set_body(&gpu, self.model.body.as_ref())?;
+        let model = &mut self.model;
+        let (kernel, reason) =
+            crate::sim_kernel::choose(model.sim_choice, &gpu.device, &gpu.queue, &model.structure, model.sim.params())?;
+        model.settings.gpu_sim = kernel == SimKernel::Gpu;
+        model.kernel_reason = reason;
+        model.sim.set_cpu_bending(kernel == SimKernel::Cpu);
+        fur.set_gpu_simulation(&gpu, &model.structure, model.settings.gpu_sim)?;
         Ok(Running { window, gpu, surface, egui_ctx, egui_state, egui_renderer, viewport, fur, visible: true })
     }
 
@@ -140,11 +148,12 @@ impl App {
             Ok(false) => {}
             Err(error) => model.status = format!("{error:#}"),
         }
+        running.fur.set_gpu_simulation(&running.gpu, &model.structure, model.settings.gpu_sim)?;
         if let Some(textures) = model.poll_textures() {
             running.fur.set_textures(&running.gpu, &textures)?;
         }
         model.simulate(frame_secs)?;
-        running.fur.set_positions(&running.gpu, model.sim.positions())?;
+        running.fur.update(&running.gpu, &model.sim)?;
         if model.posed {
             running.fur.set_base_normals(&running.gpu, &model.pose.normals)?;
         }

@@ -13,6 +13,7 @@ use pelt_core::{Builtin, FurStructure, FurTextures, Mesh, Preset, PresetError};
 use super::Args;
 use super::camera::OrbitCamera;
 use super::panel::{AnimationSettings, Changes, MeshChoice, Settings};
+use crate::sim_kernel::{SimChoice, SimKernel};
 
 /// Time step of `--screenshot-after` runs, so they repeat exactly.
 const FIXED_FRAME_SECS: f64 = 1.0 / 60.0;
@@ -44,6 +45,10 @@ pub(super) struct Model {
     pub(super) sim_clock_secs: f64,
     /// Smoothed cost of one `advance_to`.
     pub(super) sim_time_secs: f64,
+    /// `--sim`, resolved once the GPU is open.
+    pub(super) sim_choice: SimChoice,
+    /// Why the kernel in use was chosen (the overlay shows it).
+    pub(super) kernel_reason: String,
     pub(super) touch: Option<TouchDrag>,
     /// Wind strength W restores after turning the wind off.
     pub(super) wind_strength_on: f32,
@@ -149,6 +154,8 @@ impl Model {
             scene,
             sim_clock_secs: 0.0,
             sim_time_secs: 0.0,
+            sim_choice: args.sim,
+            kernel_reason: String::new(),
             touch: None,
             wind_strength_on: 1.0,
             textures: Some(textures),
@@ -301,10 +308,22 @@ impl Model {
         } else if changes.simulation {
             self.sim.set_params(&self.settings.preset.simulation)?;
         }
+        if changes.kernel {
+            self.kernel_reason = "panel".to_owned();
+        }
+        // The GPU bends the strands from the CPU simulation's inputs; the CPU then only keeps time.
+        self.sim.set_cpu_bending(self.kernel() == SimKernel::Cpu);
         if changes.textures {
             self.textures_stale = true;
         }
         Ok(rebuilt)
+    }
+}
+
+impl Model {
+    /// The kernel the panel's toggle selects.
+    pub(super) fn kernel(&self) -> SimKernel {
+        if self.settings.gpu_sim { SimKernel::Gpu } else { SimKernel::Cpu }
     }
 }
 

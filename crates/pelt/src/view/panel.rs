@@ -73,6 +73,8 @@ pub struct Settings {
     /// Touch brush radius as a fraction of the mesh's bounding radius.
     pub brush_per_radius: f32,
     pub draw: DrawToggles,
+    /// Bend the strands on the GPU (a compute pass) rather than the CPU.
+    pub gpu_sim: bool,
     pub overlay: bool,
     /// Where Load and Save read and write the preset.
     pub preset_path: String,
@@ -101,6 +103,7 @@ impl Settings {
             simulate: true,
             brush_per_radius: 0.25,
             draw: DrawToggles::default(),
+            gpu_sim: false,
             overlay: true,
             preset_path,
             animation: AnimationSettings::default(),
@@ -119,6 +122,8 @@ pub struct Changes {
     pub simulation: bool,
     /// Another clip: the fur starts over from its first pose.
     pub animation: bool,
+    /// The CPU/GPU simulation toggle.
+    pub kernel: bool,
 }
 
 impl Changes {
@@ -128,6 +133,7 @@ impl Changes {
         self.structure |= other.structure;
         self.textures |= other.textures;
         self.simulation |= other.simulation;
+        self.kernel |= other.kernel;
     }
 }
 
@@ -270,6 +276,7 @@ pub fn show(
         });
         section(ui, "Simulation", true, |ui| {
             changes.simulation |= ui.checkbox(&mut settings.simulate, "running (Space)").changed();
+            changes.kernel |= ui.checkbox(&mut settings.gpu_sim, "on the GPU (compute pass)").changed();
             let sim = &mut preset.simulation;
             let before = sim.clone();
             ui.add(egui::Slider::new(&mut sim.stability, 0.5..=200.0).logarithmic(true).text("stability"));
