@@ -8,6 +8,7 @@ use rayon::prelude::*;
 
 use super::dispatch::{self, CpuKernel};
 use super::field::{ForceField, Touch};
+use super::inertia::Inertia;
 use super::kernel::{LANES, RestBatches, Step, VecLanes};
 use super::pick::{Hit, pick};
 use super::{ParamError, SimParams, WindParams};
@@ -85,6 +86,8 @@ pub struct Simulation {
     touch: Option<Touch>,
     /// The external field (wind + field + touch) of the newest state.
     external: Vec<Vec3>,
+    /// The force from the roots' acceleration (the one state carried from step to step).
+    inertia: Inertia,
     /// States, batch-major like `rest_segments` with `L + 1` nodes per batch.
     previous: Vec<VecLanes>,
     current: Vec<VecLanes>,
@@ -138,6 +141,7 @@ impl Simulation {
             field: ForceField::new(v),
             touch: None,
             external: vec![Vec3::ZERO; v],
+            inertia: Inertia::new(v),
             previous: vec![[[0.0; LANES]; 3]; batch_nodes],
             current: vec![[[0.0; LANES]; 3]; batch_nodes],
             output: vec![Vec3::ZERO; nodes],
@@ -520,7 +524,27 @@ impl Simulation {
         &self.roots
     }
 
+    /// The inertial force per strand at the newest step (see [`Inertia`]).
+    #[must_use]
+    pub fn inertial_forces(&self) -> &[Vec3] {
+        self.inertia.forces()
+    }
+
+    /// The inertial state, e.g. to count teleports.
+    #[must_use]
+    pub fn inertia(&self) -> &Inertia {
+        &self.inertia
+    }
+
+    /// Forgets the base's motion so far (call it when a new animation starts or the body is
+    /// moved somewhere else): the fur is not flung by the jump.
+    pub fn reset_motion(&mut self) {
+        self.inertia.reset();
+    }
+
     fn jump_to_step(&mut self, index: i64) {
+        // The inertia sees the two steps' times: a short skip forward keeps the swing going (the
+        // acceleration is taken over the uneven steps), a jump back or far ahead starts it over.
         let rate = f64::from(self.params.rate_hz);
         self.step_into_current((index as f64 - 1.0) / rate);
         std::mem::swap(&mut self.previous, &mut self.current);
@@ -534,6 +558,8 @@ impl Simulation {
         let mut external = std::mem::take(&mut self.external);
         self.evaluate_field(time_secs, &mut external);
         self.external = external;
+        let (inertia, damping) = (self.params.inertia, self.params.damping);
+        self.inertia.update(&self.roots, time_secs, inertia, damping, self.radius);
         let step = Step {
             layers: self.layers as usize,
             vertex_count: self.vertex_count,
@@ -544,6 +570,7 @@ impl Simulation {
             roots: &self.roots,
             frames: &self.frames,
             external: &self.external,
+            inertial: self.inertia.forces(),
             rest: &self.rest,
         };
         dispatch::bend_all(self.cpu_kernel, &step, &mut self.current);
