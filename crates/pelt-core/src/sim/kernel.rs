@@ -369,6 +369,8 @@ pub(crate) struct Step<'a> {
     pub frames: &'a [Quat],
     /// The external field (wind, field, touch), one per strand.
     pub external: &'a [Vec3],
+    /// The inertial force from the roots' acceleration, one per strand.
+    pub inertial: &'a [Vec3],
     pub rest: &'a RestBatches,
 }
 
@@ -381,7 +383,7 @@ impl Step<'_> {
                 StrandInputs {
                     root: self.roots[j],
                     frame: self.frames[j],
-                    force: self.gravity + self.external[j],
+                    force: self.gravity + self.external[j] + self.inertial[j],
                     stability: self.stability_map.map_or(self.stability, |m| m[j]),
                 }
             } else {

@@ -10,7 +10,7 @@
 //! - [`scene`]: scripted wind and touch strokes ([`Scene`]), reproducible frame by frame.
 //! - [`motion`]: scripted rigid motion of the meshes (`[[motion]]` keys of a [`Scene`]).
 //! - [`inertia`]: the force from the roots' acceleration on a moving body ([`Inertia`]).
-//! - [`soak`]: many steps under extreme, changing inputs for any kernel ([`SoakSubject`]).
+//! - [`mod@soak`]: many steps under extreme, changing inputs for any kernel ([`SoakSubject`]).
 //!
 //! `Simulation` bends with a batched kernel (8 strands per AVX2 register, an exact closed form
 //! for straight strands, the running quaternion for curved ones; AVX2 + FMA where the CPU has
@@ -25,9 +25,9 @@ pub mod bend;
 mod dispatch;
 pub mod field;
 pub mod inertia;
-pub mod motion;
 mod kernel;
 mod lanes;
+pub mod motion;
 pub mod pick;
 pub mod scene;
 pub mod simulation;

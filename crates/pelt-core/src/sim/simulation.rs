@@ -86,8 +86,6 @@ pub struct Simulation {
     touch: Option<Touch>,
     /// The external field (wind + field + touch) of the newest state.
     external: Vec<Vec3>,
-    /// Scratch: the external plus the inertial force per strand, what the kernel bends by.
-    forces: Vec<Vec3>,
     /// The force from the roots' acceleration (the one state carried from step to step).
     inertia: Inertia,
     /// States, batch-major like `rest_segments` with `L + 1` nodes per batch.
@@ -147,7 +145,6 @@ impl Simulation {
             field: ForceField::new(v),
             touch: None,
             external: vec![Vec3::ZERO; v],
-            forces: Vec::with_capacity(v),
             inertia: Inertia::new(v),
             previous: vec![[[0.0; LANES]; 3]; batch_nodes],
             current: vec![[[0.0; LANES]; 3]; batch_nodes],
@@ -640,10 +637,6 @@ impl Simulation {
         let mut external = std::mem::take(&mut self.external);
         self.evaluate_field(time_secs, &mut external);
         self.external = external;
-        // The kernel takes one external force per strand: the field plus the inertial force.
-        let mut forces = std::mem::take(&mut self.forces);
-        forces.clear();
-        forces.extend(self.external.iter().zip(self.inertia.forces()).map(|(e, i)| *e + *i));
         let step = Step {
             layers: self.layers as usize,
             vertex_count: self.vertex_count,
@@ -653,11 +646,11 @@ impl Simulation {
             stability_map: self.stability_map.as_deref(),
             roots: &self.roots,
             frames: &self.frames,
-            external: &forces,
+            external: &self.external,
+            inertial: self.inertia.forces(),
             rest: &self.rest,
         };
         dispatch::bend_all(self.cpu_kernel, &step, &mut self.current);
-        self.forces = forces;
         self.last_step_secs = started.elapsed().as_secs_f64();
     }
 

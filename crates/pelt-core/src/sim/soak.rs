@@ -3,7 +3,8 @@
 //!
 //! The inputs are a pure function of the step index ([`SoakStep::at`]): gravity up to 1,000
 //! times its default turning in every direction, both forms of Equation 1, stability from 1e-6
-//! (the least allowed) to 1e3, gusty wind up to 1e4, a force field switched between zero,
+//! (the least allowed) to 1e3, gusty wind up to 1e4, inertia up to 100 (its maximum) with the
+//! base teleported and turned every 307 steps, a force field switched between zero,
 //! moderate and huge finite values (1e30, whose squared length overflows `f32`), a stability map,
 //! the base turned and moved, and touches begun, dragged a million radii away and released. A
 //! kernel is driven through [`SoakSubject`]; [`Simulation`] implements it, and a GPU kernel can
@@ -105,6 +106,8 @@ impl SoakStep {
             gravity_strength,
             interpolate: false,
             wind,
+            inertia: [0.0, 0.05, 100.0][(epoch % 3) as usize],
+            damping: 2.0 * r(13),
             ..SimParams::default()
         };
         let touch = match index % 90 {
