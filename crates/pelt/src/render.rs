@@ -6,7 +6,8 @@ use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use anyhow::{Context as _, bail};
-use glam::{Mat4, Vec3};
+use glam::{Mat4, Quat, Vec3};
+use pelt_core::anim::{Pose, Rig};
 use pelt_core::mesh::builtin::{TRY_ON_NAME, try_on_scene};
 use pelt_core::sim::{Scene, Simulation, WindParams};
 use pelt_core::{Builtin, FurStructure, ImportOptions, Mesh, Preset};
@@ -29,7 +30,10 @@ const LIGHT_WIND: Vec3 = Vec3::new(0.35, 0.0, 0.1);
 #[command(after_help = "\
 With no arguments: the built-in bunny, the default fur and a light breeze, to pelt.png.
 `--builtin tryon` renders a body (plain) wearing a furry garment; with your own meshes:
-`pelt render GARMENT.obj --plain-mesh BODY.obj`.")]
+`pelt render GARMENT.obj --plain-mesh BODY.obj`. An animated glTF plays its first animation
+(`--animation` picks another, `none` keeps the rest pose): `pelt render assets/meshes/Fox.glb
+--animation Walk --frames 90 -o fox.gif`. A script's [[motion]] keys move the meshes:
+`pelt render --builtin tryon --script assets/scenes/catwalk.toml -o catwalk.gif`.")]
 pub struct Args {
     #[command(flatten)]
     mesh: MeshArgs,
@@ -39,9 +43,13 @@ pub struct Args {
     /// The fur preset (TOML); the built-in default fur without one.
     #[arg(long, value_name = "P")]
     preset: Option<PathBuf>,
-    /// A scene script (TOML): wind keys and touch strokes over time.
+    /// A scene script (TOML): wind keys, touch strokes and rigid motion over time.
     #[arg(long, value_name = "SCENE.toml")]
     script: Option<PathBuf>,
+    /// The animation of an animated glTF to play: its name or index, or `none` for the rest
+    /// pose. Default: the first animation.
+    #[arg(long, value_name = "NAME|INDEX|none")]
+    animation: Option<String>,
     /// Frames to render (default: 1 for a .png; the script's length, or 2 seconds, otherwise).
     #[arg(long, value_name = "N")]
     frames: Option<u32>,
@@ -112,14 +120,17 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         None => Preset::default(),
     };
     let scene = args.script.as_deref().map(Scene::load).transpose()?;
+    let (mesh, plain, rig) = load_meshes(args)?;
+    let clip = choose_animation(args, rig.as_ref())?;
     let frames = if frames > 0 {
         frames
     } else {
-        let secs = scene.as_ref().map_or(2.0, Scene::duration_secs);
+        // One loop of the animation, or the script, or 2 seconds.
+        let clip_secs = clip.and_then(|k| rig.as_ref().map(|r| f64::from(r.animations()[k].duration_secs())));
+        let secs = scene.as_ref().map(Scene::duration_secs).or(clip_secs).unwrap_or(2.0);
         ((secs * args.fps).round() as u32).max(1)
     };
-
-    let (mesh, plain) = load_meshes(args)?;
+    let moves = clip.is_some() || scene.as_ref().is_some_and(|s| !s.motion.is_empty());
     let params = preset.fur_params(&mesh);
     let fur = FurStructure::new(mesh, &params)?;
     let textures = preset.generate_textures()?;
@@ -158,7 +169,9 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     for mesh in &plain_meshes {
         mesh.prepare(queue, Mat4::IDENTITY);
     }
-    let camera = camera(args, &preset, &fur, &plain, headless.aspect_ratio());
+    let motion_keys = scene.as_ref().map_or(&[][..], |s| &s.motion[..]);
+    let camera = camera(args, &preset, &fur, &plain, motion_keys, frames, headless.aspect_ratio());
+    let mut pose = Pose::default();
     let view = FurView::new(device, &renderer);
     view.prepare(queue, &camera.view_data(headless.aspect_ratio(), &Light::default()));
     let settings = FurDrawSettings {
@@ -191,6 +204,14 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     for frame in 0..frames {
         let time_secs = f64::from(frame) / args.fps;
         let sim_started = Instant::now();
+        let world_from_model = scene.as_ref().and_then(|s| s.motion_at(time_secs)).unwrap_or(Mat4::IDENTITY);
+        if moves {
+            pose_base(&fur, rig.as_ref(), clip, time_secs, world_from_model, &mut pose);
+            simulation.set_base_rotations(&pose.positions, &pose.rotations)?;
+            if frame == 0 {
+                simulation.restart();
+            }
+        }
         if let Some(scene) = &scene {
             scene.apply(time_secs, &mut simulation)?;
         }
@@ -198,6 +219,12 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         simulation_time += sim_started.elapsed();
         let render_started = Instant::now();
         gpu_fur.set_positions(queue, simulation.positions())?;
+        if moves {
+            gpu_fur.set_base_normals(queue, &pose.normals)?;
+            for mesh in &plain_meshes {
+                mesh.prepare(queue, world_from_model);
+            }
+        }
         let image = headless.render_with(
             DEFAULT_BACKGROUND,
             |encoder| renderer.prepare_fins(encoder, &view, &gpu_fur),
@@ -243,37 +270,103 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// The furry mesh and the plain ones: `--builtin tryon` is the garment on the body.
-fn load_meshes(args: &Args) -> anyhow::Result<(Mesh, Vec<Mesh>)> {
+/// The furry mesh (with its rig, for an animated file) and the plain ones: `--builtin tryon`
+/// is the garment on the body.
+fn load_meshes(args: &Args) -> anyhow::Result<(Mesh, Vec<Mesh>, Option<Rig>)> {
     let mut plain = Vec::new();
-    let mesh = if args.mesh.mesh.is_none() && args.mesh.builtin.as_deref() == Some(TRY_ON_NAME) {
+    let (mesh, rig) = if args.mesh.mesh.is_none() && args.mesh.builtin.as_deref() == Some(TRY_ON_NAME) {
         let options = ImportOptions { weld: !args.mesh.no_weld, ..ImportOptions::default() };
         let scene = try_on_scene(&options)?;
         plain.push(scene.body);
-        scene.garment
+        (scene.garment, None)
     } else {
-        args.mesh.load(Builtin::Bunny)?.0
+        let (mesh, _, rig) = args.mesh.load_animated(Builtin::Bunny)?;
+        (mesh, rig)
     };
     for path in &args.plain_mesh {
         plain.push(Mesh::load(path, &ImportOptions::default())?.0);
     }
-    Ok((mesh, plain))
+    Ok((mesh, plain, rig))
 }
 
-/// `--camera`, or a view that frames the fur (and any plain meshes) tightly: from the preset's
-/// `[render]` angles, else from the front left.
-fn camera(args: &Args, preset: &Preset, fur: &FurStructure, plain: &[Mesh], aspect_ratio: f32) -> Camera {
-    let meshes = || std::iter::once(&fur.mesh).chain(plain);
-    let (mut low, mut high) = fur.mesh.bounds();
-    for mesh in plain {
-        let (l, h) = mesh.bounds();
-        (low, high) = (low.min(l), high.max(h));
+/// The animation `--animation` names: by default the first one an animated file has.
+fn choose_animation(args: &Args, rig: Option<&Rig>) -> anyhow::Result<Option<usize>> {
+    let clips = rig.map_or(0, |r| r.animations().len());
+    match (args.animation.as_deref(), rig) {
+        (Some("none"), _) => Ok(None),
+        (Some(name), Some(rig)) if clips > 0 => {
+            rig.find_animation(name).map(Some).map_err(|e| anyhow::anyhow!("--animation: {e}"))
+        }
+        (Some(name), _) => bail!("--animation {name:?}: the mesh has no animations"),
+        (None, _) => Ok((clips > 0).then_some(0)),
     }
+}
+
+/// The base this frame: the rig's pose (or the rest mesh), moved by the script's transform.
+fn pose_base(
+    fur: &FurStructure,
+    rig: Option<&Rig>,
+    clip: Option<usize>,
+    time_secs: f64,
+    world_from_model: Mat4,
+    pose: &mut Pose,
+) {
+    match rig {
+        Some(rig) => rig.pose(&fur.mesh, clip, time_secs, pose),
+        None => {
+            pose.positions.clone_from(&fur.mesh.positions);
+            pose.normals.clone_from(&fur.mesh.normals);
+            pose.rotations.clear();
+            pose.rotations.resize(fur.mesh.vertex_count(), Quat::IDENTITY);
+        }
+    }
+    if world_from_model != Mat4::IDENTITY {
+        let (_, turn, _) = world_from_model.to_scale_rotation_translation();
+        for p in &mut pose.positions {
+            *p = world_from_model.transform_point3(*p);
+        }
+        for n in &mut pose.normals {
+            *n = turn * *n;
+        }
+        for q in &mut pose.rotations {
+            *q = (turn * *q).normalize();
+        }
+    }
+}
+
+/// `--camera`, or a view that frames the fur (and any plain meshes) tightly, wherever the
+/// script's motion takes them: from the preset's `[render]` angles, else from the front left.
+fn camera(
+    args: &Args,
+    preset: &Preset,
+    fur: &FurStructure,
+    plain: &[Mesh],
+    motion: &[pelt_core::sim::MotionKey],
+    frames: u32,
+    aspect_ratio: f32,
+) -> Camera {
+    let meshes = || std::iter::once(&fur.mesh).chain(plain);
+    // The transforms the meshes take: every tenth of a second of the motion (or none).
+    let transforms: Vec<Mat4> = if motion.is_empty() {
+        vec![Mat4::IDENTITY]
+    } else {
+        let secs = f64::from(frames) / args.fps;
+        (0..=(secs * 10.0).ceil() as u32)
+            .filter_map(|k| pelt_core::sim::motion::motion_at(motion, f64::from(k) / 10.0))
+            .collect()
+    };
+    let all_points = || {
+        transforms.iter().flat_map(move |m| {
+            meshes().flat_map(move |mesh| mesh.positions.iter().map(move |p| m.transform_point3(*p)))
+        })
+    };
+    let (low, high) = all_points()
+        .fold((Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)), |(lo, hi), p| (lo.min(p), hi.max(p)));
     let centre = (low + high) * 0.5;
     match args.camera {
         Some(v) => Camera::orbit(centre, v.x, v.y, v.z),
         None => {
-            let points = meshes().flat_map(|mesh| mesh.positions.iter().copied());
+            let points = all_points();
             let fur_length = fur.lengths.iter().copied().fold(0.0, f32::max);
             let azimuth = preset.render.camera_azimuth_deg.unwrap_or(30.0);
             let elevation = preset.render.camera_elevation_deg.unwrap_or(15.0);

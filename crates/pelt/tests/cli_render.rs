@@ -78,3 +78,51 @@ fn bad_arguments_are_clear_errors() {
         assert!(text(&output).contains(message), "{args:?}: {}", text(&output));
     }
 }
+
+fn png(dir: &Path, name: &str) -> image::RgbaImage {
+    image::open(dir.join(name)).unwrap_or_else(|e| panic!("{name}: {e}")).to_rgba8()
+}
+
+/// Pixels whose colour differs by more than a small amount.
+fn differing_fraction(a: &image::RgbaImage, b: &image::RgbaImage) -> f64 {
+    let differ =
+        a.pixels().zip(b.pixels()).filter(|(p, q)| p.0.iter().zip(q.0).any(|(x, y)| x.abs_diff(y) > 24)).count();
+    differ as f64 / f64::from(a.width() * a.height())
+}
+
+#[test]
+fn the_fox_walks_and_unknown_animations_list_the_real_ones() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let fox = root.join("assets/meshes/Fox.glb");
+    let fox = fox.to_str().unwrap();
+    let dir = temp_dir("fox");
+    // Walk frames 1 and 6 (a sixth of a second apart) differ; `none` renders the rest pose.
+    let walk = ["render", fox, "--animation", "Walk", "--size", "160x120", "--frames", "6", "-o", "walk"];
+    let output = pelt(&walk, &dir);
+    assert!(output.status.success(), "{}", text(&output));
+    let output = pelt(&["render", fox, "--animation", "none", "--size", "160x120", "-o", "rest.png"], &dir);
+    assert!(output.status.success(), "{}", text(&output));
+    let (first, later) = (png(&dir, "walk/frame_0001.png"), png(&dir, "walk/frame_0006.png"));
+    let moved = differing_fraction(&first, &later);
+    assert!(moved > 0.01, "the walk moves the fox: {moved}");
+    let output = pelt(&["render", fox, "--animation", "Dance", "-o", "x.png"], &dir);
+    assert!(!output.status.success());
+    assert!(text(&output).contains("Survey") && text(&output).contains("Walk"), "{}", text(&output));
+    let output = pelt(&["render", "--builtin", "torus", "--animation", "Walk", "-o", "x.png"], &dir);
+    assert!(!output.status.success() && text(&output).contains("no animations"), "{}", text(&output));
+}
+
+#[test]
+fn the_catwalk_script_moves_the_body_and_the_skirt_together() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let script = root.join("assets/scenes/catwalk.toml");
+    let dir = temp_dir("catwalk");
+    // Frames at 0, 2, 4 and 6 seconds: walking, turned, walking back.
+    let args = ["render", "--builtin", "tryon", "--script", script.to_str().unwrap(), "--fps", "0.5", "--frames", "4"];
+    let output = pelt(&[&args[..], &["--size", "96x128", "-o", "cat"]].concat(), &dir);
+    assert!(output.status.success(), "{}", text(&output));
+    let frames: Vec<_> = (1..=4).map(|k| png(&dir, &format!("cat/frame_{k:04}.png"))).collect();
+    for pair in frames.windows(2) {
+        assert!(differing_fraction(&pair[0], &pair[1]) > 0.01, "every frame shows her elsewhere");
+    }
+}
