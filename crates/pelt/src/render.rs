@@ -12,8 +12,8 @@ use pelt_core::mesh::builtin::{TRY_ON_NAME, try_on_scene};
 use pelt_core::sim::{Scene, Simulation, WindParams};
 use pelt_core::{Builtin, FurStructure, ImportOptions, Mesh, Preset};
 use pelt_render::{
-    Backend, Camera, DEFAULT_BACKGROUND, FurDrawSettings, FurFrame, FurStates, FurView, GpuFur, GpuSimulation,
-    Headless, Light, PlainMesh,
+    Backend, Camera, DEFAULT_BACKGROUND, FurDrawSettings, FurFrame, FurStates, FurTarget, FurView, Gpu, GpuFur,
+    GpuSimulation, HEADLESS_FORMAT, Headless, Light, PlainMesh, SAMPLE_COUNT, default_sample_count,
 };
 
 use crate::mesh_args::MeshArgs;
@@ -74,9 +74,12 @@ pub struct Args {
     /// this fur first, the faster runs).
     #[arg(long, value_enum, default_value_t = SimChoice::Auto)]
     sim: SimChoice,
-    /// Shells and fins with alpha-to-coverage instead of blending.
+    /// Shells and fins with alpha-to-coverage instead of blending (needs MSAA: 4 unless --msaa says more).
     #[arg(long)]
     alpha_to_coverage: bool,
+    /// MSAA samples: 1, 2, 4 or 8. Default: 1 on a CPU rasteriser (lavapipe), 4 on a GPU.
+    #[arg(long, value_name = "N", value_parser = parse_msaa)]
+    msaa: Option<u32>,
     /// Leave out the fins (shells only).
     #[arg(long)]
     no_fins: bool,
@@ -148,7 +151,17 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     }
 
     let (width, height) = args.size;
-    let headless = Headless::new(args.backend, width, height)?;
+    let gpu = Gpu::new(args.backend)?;
+    let samples = match args.msaa {
+        Some(samples) => samples,
+        None if args.alpha_to_coverage => SAMPLE_COUNT,
+        None => default_sample_count(&gpu.adapter.get_info()),
+    };
+    if args.alpha_to_coverage && samples < 2 {
+        bail!("--alpha-to-coverage needs MSAA: --msaa 2 or more, got {samples}");
+    }
+    let headless =
+        Headless::with_target(gpu, FurTarget::new(HEADLESS_FORMAT).with_sample_count(samples), width, height)?;
     let (device, queue) = (&headless.gpu.device, &headless.gpu.queue);
     let renderer = headless.renderer()?;
     let (kernel, kernel_reason) = sim_kernel::choose(args.sim, device, queue, &fur, simulation.params())?;
@@ -172,12 +185,15 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         mesh.prepare(queue, Mat4::IDENTITY);
     }
     let motion_keys = scene.as_ref().map_or(&[][..], |s| &s.motion[..]);
-    let camera = camera(args, &fur, &plain, motion_keys, frames, headless.aspect_ratio());
+    let camera = camera(args, &preset, &fur, &plain, motion_keys, frames, headless.aspect_ratio());
     let mut pose = Pose::default();
     let view = FurView::new(device, &renderer);
     view.prepare(queue, &camera.view_data(headless.aspect_ratio(), &Light::default()));
-    let settings =
-        FurDrawSettings { alpha_to_coverage: args.alpha_to_coverage, fins: !args.no_fins, ..FurDrawSettings::ALL };
+    let settings = FurDrawSettings {
+        alpha_to_coverage: args.alpha_to_coverage,
+        fins: !args.no_fins,
+        ..FurDrawSettings::SILHOUETTE
+    };
 
     let progress = (frames > 1).then(|| {
         let bar = indicatif::ProgressBar::new(u64::from(frames));
@@ -233,12 +249,16 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                 mesh.prepare(queue, world_from_model);
             }
         }
-        let image = headless.render(DEFAULT_BACKGROUND, |pass| {
-            for mesh in &plain_meshes {
-                renderer.draw_plain(pass, &view, mesh);
-            }
-            renderer.draw(pass, &view, &gpu_fur, &settings);
-        })?;
+        let image = headless.render_with(
+            DEFAULT_BACKGROUND,
+            |encoder| renderer.prepare_fins(encoder, &view, &gpu_fur),
+            |pass| {
+                for mesh in &plain_meshes {
+                    renderer.draw_plain(pass, &view, mesh);
+                }
+                renderer.draw(pass, &view, &gpu_fur, &settings);
+            },
+        )?;
         render_time += render_started.elapsed();
         match (&output, &mut gif) {
             (Output::Png(path), _) => save_png(&image, path)?,
@@ -260,7 +280,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let per_frame = |total: Duration| total.as_secs_f64() * 1000.0 / f64::from(frames);
     println!(
         "{}: {frames} frame{} of {width}x{height}, {} shell layers on {} triangles; mean frame {:.1} ms \
-         (render and read back), simulation {:.1} ms a frame on the {kernel} ({kernel_reason}); {:.1} s in all on {}",
+         (render and read back), simulation {:.1} ms a frame on the {kernel} ({kernel_reason}); {:.1} s in all on {}, {}x MSAA",
         args.output.display(),
         if frames == 1 { "" } else { "s" },
         fur.layers,
@@ -269,6 +289,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         per_frame(simulation_time),
         started.elapsed().as_secs_f64(),
         headless.gpu.summary(),
+        headless.target().sample_count,
     );
     Ok(())
 }
@@ -337,10 +358,11 @@ fn pose_base(
     }
 }
 
-/// `--camera`, or a view from the front left that frames the fur (and any plain meshes) tightly,
-/// wherever the script's motion takes them.
+/// `--camera`, or a view that frames the fur (and any plain meshes) tightly, wherever the
+/// script's motion takes them: from the preset's `[render]` angles, else from the front left.
 fn camera(
     args: &Args,
+    preset: &Preset,
     fur: &FurStructure,
     plain: &[Mesh],
     motion: &[pelt_core::sim::MotionKey],
@@ -370,7 +392,9 @@ fn camera(
         None => {
             let points = all_points();
             let fur_length = fur.lengths.iter().copied().fold(0.0, f32::max);
-            Camera::framing_points(centre, points, fur_length, 30.0, 15.0, aspect_ratio)
+            let azimuth = preset.render.camera_azimuth_deg.unwrap_or(30.0);
+            let elevation = preset.render.camera_elevation_deg.unwrap_or(15.0);
+            Camera::framing_points(centre, points, fur_length, azimuth, elevation, aspect_ratio)
         }
     }
 }
@@ -384,6 +408,13 @@ fn parse_size(text: &str) -> Result<(u32, u32), String> {
     match parsed {
         Some((w, h)) if w > 0 && h > 0 => Ok((w, h)),
         _ => Err(format!("expected WIDTHxHEIGHT with both above 0, e.g. 1280x720, got {text:?}")),
+    }
+}
+
+fn parse_msaa(text: &str) -> Result<u32, String> {
+    match text.trim().parse() {
+        Ok(samples @ (1 | 2 | 4 | 8)) => Ok(samples),
+        _ => Err(format!("expected 1, 2, 4 or 8 samples, got {text:?}")),
     }
 }
 
@@ -408,6 +439,8 @@ mod tests {
         assert_eq!(parse_size("1280x720"), Ok((1280, 720)));
         assert!(parse_size("0x5").is_err());
         assert!(parse_size("big").is_err());
+        assert_eq!(parse_msaa("4"), Ok(4));
+        assert!(parse_msaa("3").is_err());
         assert_eq!(parse_vec3("1,-2, 3.5"), Ok(Vec3::new(1.0, -2.0, 3.5)));
         assert!(parse_vec3("1,2").is_err());
         assert!(parse_vec3("1,nan,2").is_err());

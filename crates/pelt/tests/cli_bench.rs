@@ -29,7 +29,7 @@ const COUNT_KEYS: [&str; 14] = [
     "faces",
     "fur_vertices",
     "fur_edges",
-    "shared_vertices",
+    "unified_vertices",
     "separated2_vertices",
     "separated30_vertices",
     "unified_faces",
@@ -57,6 +57,7 @@ const MEASURED_KEYS: [(&str, &[&str]); 4] = [
             "frame_ms_separated30_256x256",
             "render_frames",
             "upload_ms_per_frame",
+            "fin_edges_drawn",
         ],
     ),
     (
@@ -133,7 +134,7 @@ fn quick_bench_writes_every_key_with_sane_values() {
         let layers = count(row, "layers");
         let body = count(row, "vertices") - count(row, "fur_vertices");
         let shared = count(row, "fur_vertices") * (layers + 1) + body;
-        assert_eq!(count(row, "shared_vertices"), shared, "{row}");
+        assert_eq!(count(row, "unified_vertices"), shared, "{row}");
         assert_eq!(count(row, "separated2_vertices"), shared + 2 * count(row, "fur_edges"), "{row}");
         assert_eq!(count(row, "separated30_vertices"), shared + 30 * count(row, "fur_edges"), "{row}");
         assert!(count(row, "unified_bytes") < count(row, "separated2_bytes"), "{row}");
@@ -163,7 +164,7 @@ fn quick_bench_writes_every_key_with_sane_values() {
     let box16 = results.iter().find(|r| r["model"] == "box" && r["layers"] == 16).unwrap();
     assert_eq!(count(box16, "vertices"), 296);
     assert_eq!(count(box16, "faces"), 588);
-    assert_eq!(count(box16, "shared_vertices"), 5_032);
+    assert_eq!(count(box16, "unified_vertices"), 5_032);
     assert_eq!(count(box16, "separated2_vertices"), 6_796);
     assert_eq!(count(box16, "separated30_vertices"), 31_492);
 

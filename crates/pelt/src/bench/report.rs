@@ -49,6 +49,8 @@ pub struct Adapter {
     pub backend: String,
     pub device_type: String,
     pub driver: String,
+    /// MSAA samples every frame is drawn with (`pelt_render::default_sample_count`).
+    pub msaa_samples: u32,
 }
 
 #[derive(Debug, serde::Serialize)]
@@ -87,7 +89,7 @@ pub struct Table2Figures {
     pub fur_vertices: u64,
     pub fur_edges: u64,
     /// The unified structure's vertices: `V(L+1)` (plus the body's).
-    pub shared_vertices: u64,
+    pub unified_vertices: u64,
     /// The separated structure's: `V(L+1) + 2E` and `V(L+1) + 30E` (plus the body's).
     pub separated2_vertices: u64,
     pub separated30_vertices: u64,
@@ -114,7 +116,7 @@ impl From<&Table2Row> for Table2Figures {
             faces: row.faces,
             fur_vertices: row.fur_vertices,
             fur_edges: row.fur_edges,
-            shared_vertices: row.shared_vertices(),
+            unified_vertices: row.unified_vertices(),
             separated2_vertices: row.separated2_vertices(),
             separated30_vertices: row.separated30_vertices(),
             unified_faces: row.unified.faces + body_faces,
@@ -123,8 +125,8 @@ impl From<&Table2Row> for Table2Figures {
             unified_bytes: row.unified_bytes(),
             separated2_bytes: row.separated2_bytes(),
             separated30_bytes: row.separated30_bytes(),
-            savings_vs_2_percent: savings_percent(row.shared_vertices(), row.separated2_vertices()),
-            savings_vs_30_percent: savings_percent(row.shared_vertices(), row.separated30_vertices()),
+            savings_vs_2_percent: savings_percent(row.unified_vertices(), row.separated2_vertices()),
+            savings_vs_30_percent: savings_percent(row.unified_vertices(), row.separated30_vertices()),
             bytes_savings_vs_2_percent: savings_percent(row.unified_bytes(), row.separated2_bytes()),
             bytes_savings_vs_30_percent: savings_percent(row.unified_bytes(), row.separated30_bytes()),
         }
@@ -142,6 +144,9 @@ pub struct RenderFigures {
     pub frame_ms_separated30_256x256: Option<f64>,
     /// Frames each median was taken over.
     pub render_frames: Option<u32>,
+    /// Fins the unified structure drew at 1280x720: the edges the silhouette pass kept, of
+    /// `fur_edges`.
+    pub fin_edges_drawn: Option<u64>,
     /// Uploading the unified shared vertex array (what a simulated fur sends every frame),
     /// submitted and waited for.
     pub upload_ms_per_frame: Option<f64>,
@@ -225,7 +230,11 @@ impl Report {
         );
         match (&self.adapter, &self.adapter_unavailable_reason) {
             (Some(a), _) => {
-                let _ = writeln!(md, "- adapter: {} ({}, {}, driver {})", a.name, a.backend, a.device_type, a.driver);
+                let _ = writeln!(
+                    md,
+                    "- adapter: {} ({}, {}, driver {}), {}x MSAA",
+                    a.name, a.backend, a.device_type, a.driver, a.msaa_samples
+                );
             }
             (None, reason) => {
                 let _ = writeln!(md, "- adapter: none ({})", reason.as_deref().unwrap_or("not searched"));
@@ -254,7 +263,7 @@ impl Report {
                 thousands(t.vertices),
                 thousands(t.faces),
                 thousands(t.fur_edges),
-                thousands(t.shared_vertices),
+                thousands(t.unified_vertices),
                 thousands(t.separated2_vertices),
                 thousands(t.separated30_vertices),
                 t.savings_vs_2_percent,
@@ -279,14 +288,14 @@ impl Report {
         let _ = writeln!(md, "\n### Frame time (median ms, GPU work waited for)\n");
         let _ = writeln!(
             md,
-            "| model | L | unified 1280x720 | sep-2 1280x720 | sep-30 1280x720 | unified 256x256 | sep-2 256x256 | sep-30 256x256 | upload of the shared array | frames |"
+            "| model | L | unified 1280x720 | sep-2 1280x720 | sep-30 1280x720 | unified 256x256 | sep-2 256x256 | sep-30 256x256 | upload of the shared array | fin edges drawn (unified) | frames |"
         );
-        let _ = writeln!(md, "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
+        let _ = writeln!(md, "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
         for r in &self.results {
             let f = &r.render;
             let _ = writeln!(
                 md,
-                "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
+                "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
                 r.model,
                 r.layers,
                 ms(f.frame_ms_unified_1280x720),
@@ -296,6 +305,10 @@ impl Report {
                 ms(f.frame_ms_separated2_256x256),
                 ms(f.frame_ms_separated30_256x256),
                 ms(f.upload_ms_per_frame),
+                f.fin_edges_drawn.map_or_else(
+                    || "-".to_owned(),
+                    |n| format!("{} of {}", thousands(n), thousands(r.table2.fur_edges))
+                ),
                 f.render_frames.map_or_else(|| "-".to_owned(), |n| n.to_string()),
             );
         }

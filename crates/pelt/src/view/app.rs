@@ -94,7 +94,8 @@ impl App {
         );
         let mut egui_renderer =
             egui_wgpu::Renderer::new(&gpu.device, surface.config.format, egui_wgpu::RendererOptions::default());
-        let viewport = Viewport::new(&gpu.device, &mut egui_renderer, [1, 1])?;
+        let target = super::viewport::target(&gpu.adapter.get_info());
+        let viewport = Viewport::new(&gpu.device, &mut egui_renderer, [1, 1], target)?;
         let textures = self.model.textures.take().context("the first textures were made before the window")?;
         let mut fur = FurScene::new(&gpu, &self.model.structure, &textures)?;
         fur.set_body(&gpu, self.model.body.as_ref())?;

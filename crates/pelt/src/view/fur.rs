@@ -39,7 +39,7 @@ pub struct FurScene {
 
 impl FurScene {
     pub fn new(gpu: &pelt_render::Gpu, structure: &FurStructure, textures: &FurTextures) -> anyhow::Result<Self> {
-        let renderer = FurRenderer::new(&gpu.device, target())?;
+        let renderer = FurRenderer::new(&gpu.device, target(&gpu.adapter.get_info()))?;
         let fur = GpuFur::new(&gpu.device, &gpu.queue, &renderer, structure, textures, FurStates::One)?;
         fur.prepare(&gpu.queue, &FurFrame::default());
         let view = FurView::new(&gpu.device, &renderer);
@@ -51,7 +51,7 @@ impl FurScene {
             body: None,
             view,
             textures: textures.clone(),
-            settings: FurDrawSettings::ALL,
+            settings: FurDrawSettings::SILHOUETTE,
         })
     }
 
@@ -171,11 +171,15 @@ impl FurScene {
         let camera =
             Camera { eye: camera.eye(), target: camera.target, up: Vec3::Y, fov_y_rad: camera.fov_y_rad, near, far };
         self.view.prepare(&gpu.queue, &camera.view_data(viewport.targets.aspect_ratio(), &Light::default()));
+        let separated = self.separated.as_ref().filter(|_| separated);
+        if separated.is_none() {
+            self.renderer.prepare_fins(encoder, &self.view, &self.fur);
+        }
         let mut pass = viewport.targets.begin_pass(encoder, &viewport.colour_view, DEFAULT_BACKGROUND);
         if let Some(body) = &self.body {
             self.renderer.draw_plain(&mut pass, &self.view, body);
         }
-        match self.separated.as_ref().filter(|_| separated) {
+        match separated {
             Some((renderer, fur)) => renderer.draw(&mut pass, &self.view, fur, &self.settings),
             None => self.renderer.draw(&mut pass, &self.view, &self.fur, &self.settings),
         }

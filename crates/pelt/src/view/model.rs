@@ -117,6 +117,12 @@ impl Model {
             Some(path) => (Preset::load(path)?, path.display().to_string()),
             None => (Preset::default(), "fur.toml".to_owned()),
         };
+        let default_camera = OrbitCamera::default();
+        let camera = OrbitCamera {
+            yaw_rad: preset.render.camera_azimuth_deg.map_or(default_camera.yaw_rad, f32::to_radians),
+            pitch_rad: preset.render.camera_elevation_deg.map_or(default_camera.pitch_rad, f32::to_radians),
+            ..default_camera
+        };
         let mut settings = Settings::new(choice, preset, preset_path);
         settings.overlay = !args.no_overlay;
         if let Some(rig) = &rig {
@@ -145,7 +151,7 @@ impl Model {
             body: None,
             unified_bytes: None,
             separated_bytes: None,
-            camera: OrbitCamera::default(),
+            camera,
             frame_pending: true,
             viewport_px: [1, 1],
             clock: Clock { fixed: args.screenshot_after.is_some(), last: Instant::now() },
