@@ -525,3 +525,112 @@ fn batched_simulation_matches_the_per_strand_bend() {
         }
     }
 }
+
+/// Mean over strands of the tip's offset from its root, minus the same at rest.
+fn mean_tip_lean(fur: &FurStructure, positions: &[Vec3]) -> Vec3 {
+    let v = fur.vertex_count();
+    let tips = fur.layers as usize * v;
+    let lean: Vec3 =
+        (0..v).map(|j| (positions[tips + j] - positions[j]) - (fur.positions[tips + j] - fur.positions[j])).sum();
+    lean / v as f32
+}
+
+/// Steps to the inertia tests' base: translated by `offset`, not turned.
+fn move_base(sim: &mut Simulation, fur: &FurStructure, offset: Vec3) {
+    let positions: Vec<Vec3> = fur.mesh.positions.iter().map(|p| *p + offset).collect();
+    sim.set_base_rotations(&positions, &vec![Quat::IDENTITY; positions.len()]).unwrap();
+}
+
+#[test]
+fn a_sudden_start_tilts_the_fur_back_then_it_swings_past_and_settles() {
+    let fur = grow(Builtin::Plane, 8, 0.3);
+    let (_, radius) = fur.mesh.bounding_sphere();
+    let params = SimParams { inertia: 0.2, damping: 0.3, ..still() };
+    let rate = f64::from(params.rate_hz);
+    let mut sim = Simulation::new(&fur, &params).unwrap();
+    // At rest for 10 steps, then from step 10 on a constant velocity of 1 radius/s along +X:
+    // one step of acceleration, then none.
+    let speed = Vec3::X * radius;
+    let mut leans = Vec::new();
+    let mut forces = Vec::new();
+    for n in 1..=120_i32 {
+        let moving_secs = (n - 10).max(0) as f32 / params.rate_hz;
+        move_base(&mut sim, &fur, speed * moving_secs);
+        sim.advance_to(f64::from(n) / rate);
+        let step_positions = {
+            let mut out = vec![Vec3::ZERO; sim.positions().len()];
+            sim.write_lerp(1.0, &mut out);
+            out
+        };
+        leans.push(mean_tip_lean(&fur, &step_positions).x);
+        forces.push(sim.inertial_forces()[0].x);
+    }
+    assert!(leans[..10].iter().all(|l| l.abs() < 1e-6), "still at rest before the start: {:?}", &leans[..10]);
+    let back = leans.iter().copied().fold(0.0, f32::min);
+    let past = leans.iter().copied().fold(0.0, f32::max);
+    assert!(back < -0.01 * 0.3, "the tips lag against the acceleration (+X): {back}");
+    assert!(past > 0.0, "and swing past afterwards: {past}");
+    let first_back = leans.iter().position(|l| *l < back * 0.5).unwrap();
+    assert!((10..16).contains(&first_back), "the lag shows within a few steps of the start: {first_back}");
+    // Damping ratio 0.3 at 2 Hz: the envelope falls by e^(-0.3 * 2 pi * 2 * t), to 1% in 1.2 s.
+    // Stated: within 45 steps (1.5 s) of the start the force is below 1% of its peak.
+    let peak = forces.iter().map(|f| f.abs()).fold(0.0, f32::max);
+    assert!(forces[10 + 45..].iter().all(|f| f.abs() < 0.01 * peak), "settled: {:?}", &forces[10 + 45..]);
+    // The pose follows: within 45 steps the lean is below 2% of the largest lag, within 90
+    // below 0.1% (a small force bends relatively more than a large one, so it trails the force).
+    assert!(leans[10 + 45..].iter().all(|l| l.abs() < 0.02 * back.abs()), "{back}: {:?}", &leans[10 + 45..]);
+    assert!(leans[10 + 90..].iter().all(|l| l.abs() < 0.001 * back.abs()), "{back}: {:?}", &leans[10 + 90..]);
+}
+
+#[test]
+fn a_teleport_does_not_fling_the_fur() {
+    let fur = grow(Builtin::Torus, 8, 0.3);
+    let (_, radius) = fur.mesh.bounding_sphere();
+    let params = SimParams { inertia: 1.0, ..still() };
+    let mut sim = Simulation::new(&fur, &params).unwrap();
+    for n in 1..=5 {
+        sim.advance_to(f64::from(n) / 30.0);
+    }
+    let far = Vec3::new(10.0 * radius, 0.0, 0.0);
+    move_base(&mut sim, &fur, far);
+    sim.advance_to(6.0 / 30.0);
+    assert!(sim.inertial_forces().iter().all(|f| *f == Vec3::ZERO));
+    assert_eq!(sim.inertia().teleports(), 1);
+    let mut arrived = vec![Vec3::ZERO; fur.positions.len()];
+    sim.write_lerp(1.0, &mut arrived);
+    for (now, rest) in arrived.iter().zip(&fur.positions) {
+        assert!(now.distance(*rest + far) < 1e-4, "the fur arrives in its rest pose: {now}");
+    }
+    // A new animation: the host resets, and the next steps see no jump either.
+    sim.reset_motion();
+    move_base(&mut sim, &fur, Vec3::ZERO);
+    sim.advance_to(7.0 / 30.0);
+    sim.advance_to(8.0 / 30.0);
+    assert!(sim.inertial_forces().iter().all(|f| *f == Vec3::ZERO));
+}
+
+#[test]
+fn ten_thousand_animated_steps_stay_finite_and_keep_lengths() {
+    let fur = grow(Builtin::Sphere, 8, 0.3);
+    let params = SimParams { inertia: 2.0, damping: 0.1, wind: windy(), gravity_strength: 1.0, ..SimParams::default() };
+    let mut sim = Simulation::new(&fur, &params).unwrap();
+    let mut positions = vec![Vec3::ZERO; fur.positions.len()];
+    let mut worst = 0.0f32;
+    for n in 1..=10_000_u32 {
+        let t = n as f32 / 30.0;
+        // A body that bobs, sways and turns, with a jerk every 97 steps.
+        let turn = Quat::from_rotation_y((t * 1.3).sin() * 2.0) * Quat::from_rotation_x((t * 0.7).cos() * 0.4);
+        let jerk = if n % 97 == 0 { 0.2 } else { 0.0 };
+        let offset = Vec3::new((t * 2.1).sin() * 0.8 + jerk, (t * 5.0).sin().abs() * 0.3, (t * 0.9).cos());
+        let roots: Vec<Vec3> = fur.mesh.positions.iter().map(|p| turn * *p + offset).collect();
+        sim.set_base_rotations(&roots, &vec![turn; roots.len()]).unwrap();
+        sim.advance_to(f64::from(n) / 30.0);
+        if n % 500 == 0 || n == 10_000 {
+            sim.write_lerp(1.0, &mut positions);
+            assert!(positions.iter().all(|p| p.is_finite()), "step {n}");
+            worst = worst.max(worst_length_error(&fur, &positions));
+        }
+    }
+    assert!(sim.inertial_forces().iter().any(|f| f.length() > 0.1), "the motion did make inertial forces");
+    assert!(worst < 1e-4, "segment lengths drift by {worst}");
+}

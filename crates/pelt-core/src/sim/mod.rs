@@ -8,14 +8,19 @@
 //! - [`mod@pick`]: ray picking of the base mesh, so a pointer or a script can touch the fur.
 //! - [`simulation`]: [`Simulation`], fixed steps with linear interpolation between the last two.
 //! - [`scene`]: scripted wind and touch strokes ([`Scene`]), reproducible frame by frame.
+//! - [`motion`]: scripted rigid motion of the meshes (`[[motion]]` keys of a [`Scene`]).
+//! - [`inertia`]: the force from the roots' acceleration on a moving body ([`Inertia`]).
 //!
 //! The model is quasi-static, as in the paper: a strand's pose is a function of the force on it,
-//! with no velocity. So a state at time `t` never depends on earlier states, which makes every
-//! step deterministic, parallel over strands, and cheap to jump to any time.
+//! with no velocity. So a state at time `t` depends on earlier states only through the inertial
+//! force (a damped spring per strand, reset by a jump in time), which keeps every step
+//! deterministic, parallel over strands, and cheap to jump to any time.
 
 mod batch;
 pub mod bend;
 pub mod field;
+pub mod inertia;
+pub mod motion;
 pub mod pick;
 pub mod scene;
 pub mod simulation;
@@ -25,6 +30,8 @@ use glam::Vec3;
 
 pub use bend::{BEND_GAIN, bend_strand, bend_strand_literal, bend_weight};
 pub use field::{ForceField, Touch};
+pub use inertia::Inertia;
+pub use motion::{Ease, MotionKey};
 pub use pick::{Hit, pick};
 pub use scene::{Scene, SceneError, Stroke, WindKey};
 pub use simulation::{SimError, Simulation};
@@ -49,6 +56,13 @@ pub struct SimParams {
     pub wind: WindParams,
     /// Touch (`[simulation.touch]`).
     pub touch: TouchParams,
+    /// How strongly the fur lags behind the body's acceleration: the inertial force is
+    /// `-inertia * acceleration / radius` (acceleration in bounding radii per second squared,
+    /// force in gravity's units). 0 turns it off. Default 0.05.
+    pub inertia: f32,
+    /// Damping ratio of the fur's swing after the body's motion changes: below 1 it swings past
+    /// and settles, 1 or more it settles without swinging. Default 0.3.
+    pub damping: f32,
 }
 
 impl Default for SimParams {
@@ -61,6 +75,8 @@ impl Default for SimParams {
             interpolate: true,
             wind: WindParams::default(),
             touch: TouchParams::default(),
+            inertia: 0.05,
+            damping: 0.3,
         }
     }
 }
@@ -125,6 +141,12 @@ impl SimParams {
         if !(self.touch.release_secs.is_finite() && (0.0..=60.0).contains(&self.touch.release_secs)) {
             return error("touch.release_secs", format!("must be between 0 and 60, got {}", self.touch.release_secs));
         }
+        if !(self.inertia.is_finite() && (0.0..=100.0).contains(&self.inertia)) {
+            return error("inertia", format!("must be between 0 and 100, got {}", self.inertia));
+        }
+        if !(self.damping.is_finite() && (0.0..=100.0).contains(&self.damping)) {
+            return error("damping", format!("must be between 0 and 100, got {}", self.damping));
+        }
         Ok(())
     }
 }
@@ -152,6 +174,10 @@ mod tests {
         assert_eq!(params.validate().unwrap_err().key, "simulation.touch.release_secs");
         let params = SimParams { stability: 0.0, ..SimParams::default() };
         assert_eq!(params.validate().unwrap_err().key, "simulation.stability");
+        let params = SimParams { inertia: -1.0, ..SimParams::default() };
+        assert_eq!(params.validate().unwrap_err().key, "simulation.inertia");
+        let params = SimParams { damping: f32::INFINITY, ..SimParams::default() };
+        assert_eq!(params.validate().unwrap_err().key, "simulation.damping");
         assert!(toml::from_str::<SimParams>("[wind]\nspeeed = 1.0").is_err());
     }
 }

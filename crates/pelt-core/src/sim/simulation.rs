@@ -14,6 +14,7 @@ use rayon::prelude::*;
 
 use super::batch::{LANES, RestSegment, StrandInputs, VecLanes, bend_batch};
 use super::field::{ForceField, Touch};
+use super::inertia::Inertia;
 use super::pick::{Hit, pick};
 use super::{ParamError, SimParams, WindParams};
 use crate::fur::FurStructure;
@@ -92,6 +93,8 @@ pub struct Simulation {
     touch: Option<Touch>,
     /// The external field (wind + field + touch) of the newest state.
     external: Vec<Vec3>,
+    /// The force from the roots' acceleration (the one state carried from step to step).
+    inertia: Inertia,
     /// States, batch-major like `rest_segments` with `L + 1` nodes per batch.
     previous: Vec<VecLanes>,
     current: Vec<VecLanes>,
@@ -150,6 +153,7 @@ impl Simulation {
             field: ForceField::new(v),
             touch: None,
             external: vec![Vec3::ZERO; v],
+            inertia: Inertia::new(v),
             previous: vec![[[0.0; LANES]; 3]; batch_nodes],
             current: vec![[[0.0; LANES]; 3]; batch_nodes],
             output: vec![Vec3::ZERO; nodes],
@@ -490,7 +494,27 @@ impl Simulation {
         &self.roots
     }
 
+    /// The inertial force per strand at the newest step (see [`Inertia`]).
+    #[must_use]
+    pub fn inertial_forces(&self) -> &[Vec3] {
+        self.inertia.forces()
+    }
+
+    /// The inertial state, e.g. to count teleports.
+    #[must_use]
+    pub fn inertia(&self) -> &Inertia {
+        &self.inertia
+    }
+
+    /// Forgets the base's motion so far (call it when a new animation starts or the body is
+    /// moved somewhere else): the fur is not flung by the jump.
+    pub fn reset_motion(&mut self) {
+        self.inertia.reset();
+    }
+
     fn jump_to_step(&mut self, index: i64) {
+        // The inertia sees the two steps' times: a short skip forward keeps the swing going (the
+        // acceleration is taken over the uneven steps), a jump back or far ahead starts it over.
         let rate = f64::from(self.params.rate_hz);
         self.step_into_current((index as f64 - 1.0) / rate);
         std::mem::swap(&mut self.previous, &mut self.current);
@@ -504,12 +528,15 @@ impl Simulation {
         let mut external = std::mem::take(&mut self.external);
         self.evaluate_field(time_secs, &mut external);
         self.external = external;
+        let (inertia, damping) = (self.params.inertia, self.params.damping);
+        self.inertia.update(&self.roots, time_secs, inertia, damping, self.radius);
         let gravity = self.params.gravity_direction.normalize_or_zero() * self.params.gravity_strength;
         let layers = self.layers as usize;
         let v = self.vertex_count;
         let stability = self.params.stability;
         let (roots, frames, rest, external, map) =
             (&self.roots, &self.frames, &self.rest_segments, &self.external, self.stability_map.as_deref());
+        let inertial = self.inertia.forces();
         self.current.par_chunks_mut(layers + 1).enumerate().with_min_len(BATCHES_PER_TASK).for_each(|(b, nodes)| {
             let inputs: [StrandInputs; LANES] = std::array::from_fn(|lane| {
                 let j = b * LANES + lane;
@@ -517,7 +544,7 @@ impl Simulation {
                     StrandInputs {
                         root: roots[j],
                         frame: frames[j],
-                        force: gravity + external[j],
+                        force: gravity + external[j] + inertial[j],
                         stability: map.map_or(stability, |m| m[j]),
                     }
                 } else {
