@@ -12,7 +12,10 @@ pub mod presets;
 
 #[cfg(target_arch = "wasm32")]
 mod gpu;
+// wasm-bindgen's generated glue (the exports and their ABI conversions) is unsafe code; the
+// module's own code has none.
 #[cfg(target_arch = "wasm32")]
+#[allow(unsafe_code)]
 mod web;
 
 #[cfg(target_arch = "wasm32")]
