@@ -1,7 +1,13 @@
 //! [`Simulation`]: the strands of a [`FurStructure`] under gravity, wind and touch, stepped at a
 //! fixed rate and drawn as `lerp(previous, current, alpha)` in between.
 
+#[cfg(not(target_arch = "wasm32"))]
 use std::time::Instant;
+
+// wasm32-unknown-unknown has no clock in std (`Instant::now` panics there); web-time reads the
+// browser's `performance.now()`.
+#[cfg(target_arch = "wasm32")]
+use web_time::Instant;
 
 use glam::{Quat, Vec3};
 use rayon::prelude::*;
