@@ -175,7 +175,7 @@ fn fur_covers_more_than_the_bare_cube_and_respects_depth() {
     let wall_kept = bare.pixels().zip(furred.pixels()).filter(|(b, f)| near(b, WALL) && near(f, WALL)).count();
     assert_eq!(wall_kept, wall_pixels, "fur was drawn over the wall in front of it");
     // The fur is the preset's colour (warm: red above blue), not Bevy's grey cube.
-    let warm = furred.pixels().filter(|p| p.0[0] > p.0[2] + 40 && !near(p, WALL)).count();
+    let warm = furred.pixels().filter(|p| u16::from(p.0[0]) > u16::from(p.0[2]) + 40 && !near(p, WALL)).count();
     assert!(warm > cube_pixels / 4, "{warm} fur-coloured pixels");
 
     golden(&furred, "cube-furred");
@@ -210,8 +210,8 @@ fn several_furs_and_cameras() {
     });
     save(&images[0], "two-front");
     save(&images[1], "two-back");
-    let warm = |p: &image::Rgba<u8>| p.0[0] > p.0[2] + 40;
-    let cool = |p: &image::Rgba<u8>| p.0[2] > p.0[0] + 40;
+    let warm = |p: &image::Rgba<u8>| u16::from(p.0[0]) > u16::from(p.0[2]) + 40;
+    let cool = |p: &image::Rgba<u8>| u16::from(p.0[2]) > u16::from(p.0[0]) + 40;
     let count = |image: &image::RgbaImage, left: bool, wanted: &dyn Fn(&image::Rgba<u8>) -> bool| {
         image.enumerate_pixels().filter(|(x, _, p)| (*x < SIZE / 2) == left && wanted(p)).count()
     };
