@@ -1,5 +1,6 @@
-//! Simulation figures: strand-node updates per second (O(L) against the literal loop, bunny and
-//! `female_generic.obj`, 16 and 32 layers) and the CPU cost per drawn frame with interpolation
+//! Simulation figures: strand-node updates per second of `Simulation`'s kernel (straight and
+//! curved strands, all threads and one) against the paper's literal loop (bunny and
+//! `female_generic.obj`, 16 and 32 layers), and the CPU cost per drawn frame with interpolation
 //! (30 Hz simulation, 120 Hz drawing) against simulating every frame.
 //!
 //! `cargo bench -p pelt-core --bench sim -- --warm-up-time 1 --measurement-time 3`
@@ -12,8 +13,7 @@ use glam::{Quat, Vec3};
 use pelt_core::fur::{FurLength, FurParams, FurStructure, GrowthDirection};
 use pelt_core::mesh::builtin::Builtin;
 use pelt_core::mesh::{ImportOptions, Mesh};
-use pelt_core::sim::{SimParams, Simulation, WindParams, bend_strand, bend_strand_literal};
-use rayon::prelude::*;
+use pelt_core::sim::{SimParams, Simulation, WindParams, bend_strand_literal};
 
 fn meshes() -> Vec<(&'static str, Mesh)> {
     let female = Path::new(env!("CARGO_MANIFEST_DIR")).join("assets/meshes/female_generic.obj");
@@ -32,50 +32,68 @@ fn params() -> SimParams {
     SimParams { wind: WindParams { strength: 1.0, ..WindParams::default() }, ..SimParams::default() }
 }
 
-/// One bend of every strand (gravity + a per-strand force), parallel, strand-major output.
-fn bend_all(
-    bend: fn(Vec3, Quat, &[Vec3], Vec3, f32, &mut [Vec3]),
-    roots: &[Vec3],
-    segments: &[Vec3],
-    forces: &[Vec3],
-    layers: usize,
-    nodes: &mut [Vec3],
-) {
-    nodes.par_chunks_mut(layers + 1).enumerate().with_min_len(64).for_each(|(j, strand)| {
-        let rest = &segments[j * layers..(j + 1) * layers];
-        bend(roots[j], Quat::IDENTITY, rest, Vec3::NEG_Y + forces[j], 8.0, strand);
-    });
+/// Curls every strand of `fur` a little (each segment turned about a fixed axis by 2 degrees
+/// more than the last, about an axis across the strand), so the general form of the kernel bends them.
+fn curl(fur: &mut FurStructure) {
+    let v = fur.vertex_count();
+    let layers = fur.layers as usize;
+    for j in 0..v {
+        let segments: Vec<Vec3> =
+            (0..layers).map(|k| fur.positions[(k + 1) * v + j] - fur.positions[k * v + j]).collect();
+        let axis = segments[0].any_orthonormal_vector();
+        let mut node = fur.positions[j];
+        for (k, segment) in segments.into_iter().enumerate() {
+            node += Quat::from_axis_angle(axis, (2.0 * k as f32).to_radians()) * segment;
+            fur.positions[(k + 1) * v + j] = node;
+        }
+    }
 }
 
+/// Node updates of the kernel `Simulation` runs (`step_at`: field, then the bend), on all
+/// threads and on one, for straight (grown) and curved strands; and the paper's literal loop on
+/// one thread, timed the same way.
 fn node_updates(c: &mut Criterion) {
     let mut group = c.benchmark_group("sim_nodes");
+    let one_thread = rayon::ThreadPoolBuilder::new().num_threads(1).build().expect("a pool");
     for (name, mesh) in meshes() {
         for layers in [16u32, 32] {
             let fur = grow(&mesh, layers);
             let (v, l) = (fur.vertex_count(), layers as usize);
             group.throughput(Throughput::Elements((v * l) as u64));
+            let id = format!("{name}/L{layers}");
+            let mut curled = fur.clone();
+            curl(&mut curled);
+            for (shape, fur) in [("straight", &fur), ("curved", &curled)] {
+                let mut sim = Simulation::new(fur, &SimParams { interpolate: false, ..params() }).expect("valid");
+                sim.field_mut().fill(Vec3::new(0.5, 0.0, 0.2));
+                let mut time = 0.0;
+                group.bench_function(BenchmarkId::new(format!("step_{shape}_all_threads"), &id), |b| {
+                    b.iter(|| {
+                        time += 1.0 / 30.0;
+                        sim.step_at(time);
+                    });
+                });
+                group.bench_function(BenchmarkId::new(format!("step_{shape}_1_thread"), &id), |b| {
+                    one_thread.install(|| {
+                        b.iter(|| {
+                            time += 1.0 / 30.0;
+                            sim.step_at(time);
+                        });
+                    });
+                });
+            }
             let segments: Vec<Vec3> = (0..v)
                 .flat_map(|j| (0..l).map(move |k| (j, k)))
                 .map(|(j, k)| fur.positions[(k + 1) * v + j] - fur.positions[k * v + j])
                 .collect();
-            let forces: Vec<Vec3> = (0..v).map(|j| Vec3::new((j % 7) as f32 * 0.3, 0.0, 0.5)).collect();
-            let mut nodes = vec![Vec3::ZERO; v * (l + 1)];
-            let roots = &fur.positions[..v];
-            let id = format!("{name}/L{layers}");
-            group.bench_function(BenchmarkId::new("o_l", &id), |b| {
-                b.iter(|| bend_all(bend_strand, roots, &segments, &forces, l, black_box(&mut nodes)));
-            });
-            group.bench_function(BenchmarkId::new("literal", &id), |b| {
-                b.iter(|| bend_all(bend_strand_literal, roots, &segments, &forces, l, black_box(&mut nodes)));
-            });
-            // A whole step: wind field (gusts, jitter) plus the bend, plus the layer-major lerp.
-            let mut sim = Simulation::new(&fur, &SimParams { interpolate: false, ..params() }).expect("valid");
-            let mut time = 0.0;
-            group.bench_function(BenchmarkId::new("step", &id), |b| {
+            let mut nodes = vec![Vec3::ZERO; l + 1];
+            let force = Vec3::new(0.5, -1.0, 0.2);
+            group.bench_function(BenchmarkId::new("literal_1_thread", &id), |b| {
                 b.iter(|| {
-                    time += 1.0 / 30.0;
-                    sim.advance_to(time);
-                    black_box(sim.positions());
+                    for (root, strand) in fur.positions[..v].iter().zip(segments.chunks_exact(l)) {
+                        bend_strand_literal(*root, Quat::IDENTITY, black_box(strand), force, 8.0, &mut nodes);
+                        black_box(&nodes);
+                    }
                 });
             });
         }

@@ -1,12 +1,13 @@
 //! Pelt's core: everything about fur that needs no GPU.
 //!
 //! Data flows one way through the modules:
-//! [`mesh`] (import and repair) -> [`fur`] (the unified shell-and-fin structure) ->
+//! [`mesh`] (import and repair; [`anim`] poses a moving one) -> [`fur`] (the unified shell-and-fin structure) ->
 //! [`texture`] (seeded shell and fin textures) -> [`sim`] (gravity, wind, touch) -> the renderer
 //! in `pelt-render`. [`preset`] holds everything about one fur in one TOML file.
 
 #![warn(missing_docs)]
 
+pub mod anim;
 pub mod fur;
 pub mod mesh;
 pub mod preset;
@@ -16,6 +17,6 @@ pub mod texture;
 
 pub use fur::{FurParams, FurStructure, GrowthDirection, SeparatedStructure};
 pub use mesh::{ImportOptions, Mesh, MeshError, MeshReport, builtin::Builtin};
-pub use preset::{Preset, PresetError};
+pub use preset::{Preset, PresetError, RenderParams};
 pub use sim::{Scene, SimError, SimParams, Simulation};
 pub use texture::{FurTextures, TextureParams};

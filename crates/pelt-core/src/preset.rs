@@ -9,7 +9,8 @@
 //! [direction]          # fur direction on the mesh (see `DirectionParams`)
 //! [texture]            # the strand field (see `texture::TextureParams`)
 //! [colour]             # colours are "#rrggbb" strings (see `texture::ColourParams`)
-//! [simulation]         # `sim::SimParams`
+//! [simulation]         # `sim::SimParams`; equation = "pelt" | "paper" (`sim::Equation`)
+//! [render]             # how Pelt's commands show it (see `RenderParams`)
 //! ```
 
 use std::path::{Path, PathBuf};
@@ -88,6 +89,20 @@ impl Default for DirectionParams {
     }
 }
 
+/// The `[render]` table: how Pelt's own commands (`pelt render`, `pelt view`) show the fur.
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct RenderParams {
+    /// The default camera's turn about +Y, degrees: 0 looks from +Z, 90 from +X. Meshes face
+    /// different ways (Spot faces -Z, so its preset says 210). Unset: each command's own view.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub camera_azimuth_deg: Option<f32>,
+    /// The default camera's height above the horizon, degrees, `-89..=89`. Unset: each
+    /// command's own view.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub camera_elevation_deg: Option<f32>,
+}
+
 /// One fur: layer count, length, direction, textures, colour and simulation.
 #[derive(Clone, Debug, serde::Serialize, serde::Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -105,6 +120,8 @@ pub struct Preset {
     pub colour: ColourParams,
     /// Gravity, wind, touch and stepping.
     pub simulation: SimParams,
+    /// How Pelt's commands show it.
+    pub render: RenderParams,
     /// The preset file (for messages) and its folder (for relative image paths); not in TOML.
     #[serde(skip)]
     file: PathBuf,
@@ -119,6 +136,7 @@ impl Default for Preset {
             texture: TextureParams::default(),
             colour: ColourParams::default(),
             simulation: SimParams::default(),
+            render: RenderParams::default(),
             file: PathBuf::from("<default preset>"),
         }
     }
@@ -133,6 +151,7 @@ impl PartialEq for Preset {
             && self.texture == other.texture
             && self.colour == other.colour
             && self.simulation == other.simulation
+            && self.render == other.render
     }
 }
 
@@ -235,6 +254,17 @@ impl Preset {
             "direction.comb_blend",
             format!("must be between 0 and 1, got {}", direction.comb_blend),
         )?;
+        let render = &self.render;
+        if let Some(azimuth) = render.camera_azimuth_deg {
+            check(azimuth.is_finite(), "render.camera_azimuth_deg", format!("must be a finite angle, got {azimuth}"))?;
+        }
+        if let Some(elevation) = render.camera_elevation_deg {
+            check(
+                elevation.is_finite() && (-89.0..=89.0).contains(&elevation),
+                "render.camera_elevation_deg",
+                format!("must be between -89 and 89, got {elevation}"),
+            )?;
+        }
         self.texture.validate().map_err(invalid)?;
         self.colour.validate().map_err(invalid)?;
         self.simulation.validate().map_err(invalid)

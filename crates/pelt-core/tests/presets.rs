@@ -24,7 +24,7 @@ fn an_empty_file_is_the_default_preset() {
     assert_eq!(preset.layers, 16);
     assert!(preset.length > 0.0);
     // Empty tables too.
-    let tables = "[direction]\n[texture]\n[colour]\n[simulation]\n";
+    let tables = "[direction]\n[texture]\n[colour]\n[simulation]\n[render]\n";
     assert_eq!(Preset::from_toml_str(tables, "tables.toml").unwrap(), Preset::default());
 }
 
@@ -178,6 +178,7 @@ fn out_of_range_values_name_the_key_and_the_range() {
         ("[colour]\nmode = \"height\"", "colour.height_colours", "at least one colour"),
         ("[colour]\nmode = \"surface\"", "colour.surface", "surface mode needs"),
         ("[simulation]\nstability = -1", "simulation.stability", "between"),
+        ("[render]\ncamera_elevation_deg = 95", "render.camera_elevation_deg", "between -89 and 89"),
     ];
     for (text, key, range) in cases {
         let message = bad(text, key);

@@ -38,7 +38,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     view.prepare(queue, &camera.view_data(headless.aspect_ratio(), &Light::default()));
 
     // Draw into a pass and read the frame back.
-    let image = headless.render(DEFAULT_BACKGROUND, |pass| renderer.draw(pass, &view, &fur, &FurDrawSettings::ALL))?;
+    let image = headless.render_with(
+        DEFAULT_BACKGROUND,
+        |encoder| renderer.prepare_fins(encoder, &view, &fur),
+        |pass| renderer.draw(pass, &view, &fur, &FurDrawSettings::SILHOUETTE),
+    )?;
     image.save(&output)?;
     println!("wrote {output} on {}", headless.gpu.summary());
     Ok(())

@@ -10,6 +10,7 @@ use crate::geometry::UnifiedGeometry;
 use crate::object::{FurFrame, GpuBytes};
 use crate::renderer::FurRenderer;
 use crate::requirements::ErrorScope;
+use crate::silhouette::FinList;
 use crate::textures::GpuTextures;
 
 /// How many simulation states a [`GpuFur`] keeps on the GPU.
@@ -41,6 +42,8 @@ pub enum FurStates {
 pub struct GpuFur {
     geometry: UnifiedGeometry,
     textures: GpuTextures,
+    /// The silhouette pass's output (none without fins).
+    fins: Option<FinList>,
 }
 
 impl GpuFur {
@@ -62,8 +65,9 @@ impl GpuFur {
         let scope = ErrorScope::push(device);
         let geometry = geometry(device, renderer, structure, states);
         let textures = GpuTextures::new(device, queue, renderer.layouts(), textures);
+        let fins = fin_list(device, renderer, structure);
         scope.pop("uploading the fur")?;
-        Ok(Self { geometry: geometry?, textures: textures? })
+        Ok(Self { geometry: geometry?, textures: textures?, fins: fins? })
     }
 
     /// Replaces the structure (new mesh, layer count or rest pose), keeping the textures and the
@@ -80,8 +84,9 @@ impl GpuFur {
         let states = if self.geometry.state_count() == 1 { FurStates::One } else { FurStates::Two };
         let scope = ErrorScope::push(device);
         let geometry = geometry(device, renderer, structure, states);
+        let fins = fin_list(device, renderer, structure);
         scope.pop("uploading the fur")?;
-        self.geometry = geometry?;
+        (self.geometry, self.fins) = (geometry?, fins?);
         Ok(())
     }
 
@@ -174,10 +179,26 @@ impl GpuFur {
         self.geometry.normals()
     }
 
-    /// Bytes this fur holds on the GPU (both states of the shared array when it keeps two).
+    /// Bytes this fur holds on the GPU (both states of the shared array when it keeps two). The
+    /// silhouette pass's per-frame list (8 bytes per edge, [`GpuFur::silhouette_list_bytes`]) is
+    /// working memory, not structure, and is not counted here.
     #[must_use]
     pub fn gpu_bytes(&self) -> GpuBytes {
         GpuBytes { textures: self.textures.bytes, ..self.geometry.bytes() }
+    }
+
+    /// Bytes of the silhouette pass's fin list (the edges it keeps and their indirect draw).
+    #[must_use]
+    pub fn silhouette_list_bytes(&self) -> u64 {
+        self.fins.as_ref().map_or(0, FinList::bytes)
+    }
+
+    /// The silhouette pass's indirect draw (`wgpu::util::DrawIndexedIndirectArgs`, 20 bytes,
+    /// `COPY_SRC`): its second `u32` is the number of fins the last pass kept. For hosts and
+    /// benchmarks that read it back; `None` for a fur without fins.
+    #[must_use]
+    pub fn silhouette_draw(&self) -> Option<&wgpu::Buffer> {
+        self.fins.as_ref().map(|list| &list.draw)
     }
 
     /// `L`, the shell layers above the base.
@@ -199,6 +220,18 @@ impl GpuFur {
     pub(crate) fn textures_bind_group(&self) -> &wgpu::BindGroup {
         &self.textures.bind_group
     }
+
+    pub(crate) fn fin_list(&self) -> Option<&FinList> {
+        self.fins.as_ref()
+    }
+}
+
+fn fin_list(
+    device: &wgpu::Device,
+    renderer: &FurRenderer,
+    structure: &FurStructure,
+) -> Result<Option<FinList>, RenderError> {
+    FinList::new(device, renderer.layouts(), structure.mesh.edges.len() as u32, structure.layers)
 }
 
 fn geometry(

@@ -223,6 +223,15 @@ impl UnifiedGeometry {
         }
     }
 
+    /// Draws the fins of `list` (the silhouette pass's edges), through its indirect draw.
+    pub fn draw_fin_list(&self, pass: &mut wgpu::RenderPass<'_>, list: &crate::silhouette::FinList) {
+        if let Some(strip) = &self.fin_indices {
+            pass.set_index_buffer(strip.slice(..), wgpu::IndexFormat::Uint32);
+            pass.set_vertex_buffer(0, list.instances.slice(..));
+            pass.draw_indexed_indirect(&list.draw, 0);
+        }
+    }
+
     /// Draws every fin (instance = edge).
     pub fn draw_fins(&self, pass: &mut wgpu::RenderPass<'_>) {
         if let Some(strip) = &self.fin_indices {

@@ -112,9 +112,24 @@ impl Headless {
         background: Vec3,
         draw: impl FnOnce(&mut wgpu::RenderPass<'_>),
     ) -> Result<image::RgbaImage, RenderError> {
+        self.render_with(background, |_| {}, draw)
+    }
+
+    /// [`Headless::render`] with work recorded into the frame's encoder before its pass: e.g.
+    /// [`FurRenderer::prepare_fins`](crate::FurRenderer::prepare_fins).
+    ///
+    /// # Errors
+    /// As [`Headless::render`].
+    pub fn render_with(
+        &self,
+        background: Vec3,
+        before: impl FnOnce(&mut wgpu::CommandEncoder),
+        draw: impl FnOnce(&mut wgpu::RenderPass<'_>),
+    ) -> Result<image::RgbaImage, RenderError> {
         let device = &self.gpu.device;
         let scope = ErrorScope::push(device);
         let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("pelt frame") });
+        before(&mut encoder);
         {
             let mut pass = self.targets.begin_pass(&mut encoder, &self.output_view, background);
             draw(&mut pass);

@@ -23,10 +23,15 @@
 //! 2. Once per target description: [`FurRenderer::new`]. Once per fur: [`GpuFur::new`]. Once per
 //!    camera: [`FurView::new`].
 //! 3. Each simulation step: [`GpuFur::push_state`] (or [`GpuFur::set_positions`] each frame, or a
-//!    compute pass writing [`GpuFur::current_positions`]).
+//!    compute pass writing [`GpuFur::current_positions`]: [`GpuSimulation`] is Pelt's, which
+//!    bends the strands on the GPU from a `pelt_core::Simulation`'s inputs, so nothing is
+//!    uploaded per step but those inputs).
 //! 4. Each frame, before submitting: [`FurView::prepare`] for each view, [`GpuFur::prepare`]
 //!    (model transform, interpolation, look) for each fur.
-//! 5. In the host's render pass, after its opaque geometry: [`FurRenderer::draw_plain`] for
+//! 5. In the host's encoder, before the render pass: [`FurRenderer::prepare_fins`] for each fur
+//!    and view (the silhouette pass, a compute pass) when drawing with
+//!    [`FurDrawSettings::silhouette_fins`].
+//! 6. In the host's render pass, after its opaque geometry: [`FurRenderer::draw_plain`] for
 //!    plain meshes, then [`FurRenderer::draw`] for each fur (farthest first when blending).
 //!
 //! Nothing in the library path blocks, spawns threads or needs `image`/`pollster`: those are in
@@ -67,6 +72,8 @@
 //! fur.set_positions(queue, simulation.positions())?;
 //! fur.prepare(queue, &FurFrame::default());
 //! view.prepare(queue, &ViewData::new(clip_from_world, world_from_view, &Light::default()));
+//! // The silhouette pass (compute) into the host's encoder, before the render pass.
+//! renderer.prepare_fins(encoder, &view, &fur);
 //! let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
 //!     color_attachments: &[Some(wgpu::RenderPassColorAttachment {
 //!         view: colour,
@@ -81,7 +88,7 @@
 //!     }),
 //!     ..Default::default()
 //! });
-//! renderer.draw(&mut pass, &view, &fur, &FurDrawSettings::ALL);
+//! renderer.draw(&mut pass, &view, &fur, &FurDrawSettings::SILHOUETTE);
 //! # Ok(())
 //! # }
 //! ```
@@ -102,6 +109,8 @@ mod plain;
 mod renderer;
 mod requirements;
 mod separated;
+mod silhouette;
+mod simulation;
 mod targets;
 mod textures;
 mod view;
@@ -119,5 +128,7 @@ pub use plain::PlainMesh;
 pub use renderer::{FurDrawSettings, FurRenderer, unified_shader_source};
 pub use requirements::{check_adapter, required_downlevel_flags, required_features, required_limits};
 pub use separated::{SeparatedFur, SeparatedRenderer, separated_shader_source};
-pub use targets::{DEFAULT_BACKGROUND, DEPTH_FORMAT, FurTarget, RenderTargets, SAMPLE_COUNT};
+pub use silhouette::silhouette_shader_source;
+pub use simulation::{GpuSimulation, simulation_shader_source};
+pub use targets::{DEFAULT_BACKGROUND, DEPTH_FORMAT, FurTarget, RenderTargets, SAMPLE_COUNT, default_sample_count};
 pub use view::{FurView, Light, LightDirection, ViewData};

@@ -15,6 +15,8 @@ pub(crate) struct Layouts {
     pub separated_object: wgpu::BindGroupLayout,
     /// Group 2: a fur's textures and the samplers.
     pub textures: wgpu::BindGroupLayout,
+    /// Group 3 of the silhouette pass: a fur's fin list.
+    pub fin_list: wgpu::BindGroupLayout,
     pub shell_sampler: wgpu::Sampler,
     pub fin_sampler: wgpu::Sampler,
 }
@@ -31,14 +33,16 @@ impl Layouts {
             has_dynamic_offset: false,
             min_binding_size: None,
         };
-        let both = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT;
+        // The silhouette pass (compute) reads the view, the object and its positions too.
+        let both = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE;
         let entry = |binding, visibility, ty| wgpu::BindGroupLayoutEntry { binding, visibility, ty, count: None };
         let view = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("pelt view"),
             entries: &[entry(0, both, uniform)],
         });
-        // Storage buffers are read by vertex shaders only, so fragment stages need no storage.
-        let vertex = wgpu::ShaderStages::VERTEX;
+        // Storage buffers are read by vertex shaders and the silhouette pass only, so fragment
+        // stages need no storage.
+        let vertex = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::COMPUTE;
         let unified_object = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("pelt unified object"),
             entries: &[
@@ -87,6 +91,7 @@ impl Layouts {
             unified_object,
             separated_object,
             textures,
+            fin_list: crate::silhouette::fin_list_layout(device),
             shell_sampler: sampler("pelt shell sampler", wgpu::AddressMode::Repeat),
             // Fin rows run root to tip: clamp so the tips do not bleed into the roots.
             fin_sampler: sampler("pelt fin sampler", wgpu::AddressMode::ClampToEdge),
@@ -201,7 +206,11 @@ pub(crate) fn create_pipeline(
             targets: &[Some(wgpu::ColorTargetState {
                 format: target.colour_format,
                 blend,
-                write_mask: wgpu::ColorWrites::ALL,
+                // Coverage already says how much of a pixel a strand covers; writing its alpha
+                // too would leave the target (and a PNG read from it) translucent.
+                // Coverage already says how much of a pixel a strand covers; writing its alpha
+                // too would leave the target (and a PNG read from it) translucent.
+                write_mask: if coverage { wgpu::ColorWrites::COLOR } else { wgpu::ColorWrites::ALL },
             })],
         }),
         multiview_mask: None,

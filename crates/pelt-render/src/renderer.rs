@@ -6,13 +6,16 @@
 //! 2. shells, instanced per layer from the innermost out, over the same `3F` triangle corners,
 //!    alpha-blended with depth test on and depth writes off (or alpha-to-coverage), faded where
 //!    the surface turns edge-on;
-//! 3. fins, instanced per edge over one shared strip of `6L` indices, faded in near the silhouette.
+//! 3. fins, instanced per edge over one shared strip of `6L` indices, faded in near the silhouette:
+//!    with [`FurDrawSettings::silhouette_fins`] only the edges the silhouette pass
+//!    ([`FurRenderer::prepare_fins`]) kept, through an indirect draw; else every edge.
 
 use crate::RenderError;
 use crate::fur::GpuFur;
 use crate::pipeline::{Layouts, PassKind, PipelineSource, Transparency, create_pipeline};
 use crate::plain::PlainMesh;
 use crate::requirements::{ErrorScope, check_features_and_limits};
+use crate::silhouette::{FIN_INSTANCE_LAYOUT, silhouette_pipeline};
 use crate::targets::FurTarget;
 use crate::view::FurView;
 
@@ -41,15 +44,26 @@ pub struct FurDrawSettings {
     /// Shells and fins with alpha-to-coverage (order independent, writes depth) instead of
     /// blending. Needs a target with MSAA.
     pub alpha_to_coverage: bool,
+    /// Draw only the fins the silhouette pass kept: the host records
+    /// [`FurRenderer::prepare_fins`] for this fur and view before the render pass, every frame.
+    /// Without it every edge's fin is drawn and each vertex tests its own edge (no compute pass,
+    /// several times the vertex work).
+    pub silhouette_fins: bool,
 }
 
 impl FurDrawSettings {
-    /// Skin, shells and fins, blended.
-    pub const ALL: Self = Self { skin: true, shells: true, fins: true, alpha_to_coverage: false };
+    /// Skin, shells and fins, blended; fins on every edge (no silhouette pass needed).
+    pub const ALL: Self =
+        Self { skin: true, shells: true, fins: true, alpha_to_coverage: false, silhouette_fins: false };
     /// The opaque skin only.
-    pub const SKIN: Self = Self { skin: true, shells: false, fins: false, alpha_to_coverage: false };
-    /// Shells and fins only (blended).
-    pub const FUR: Self = Self { skin: false, shells: true, fins: true, alpha_to_coverage: false };
+    pub const SKIN: Self =
+        Self { skin: true, shells: false, fins: false, alpha_to_coverage: false, silhouette_fins: false };
+    /// Shells and fins only (blended; fins on every edge).
+    pub const FUR: Self =
+        Self { skin: false, shells: true, fins: true, alpha_to_coverage: false, silhouette_fins: false };
+    /// [`FurDrawSettings::ALL`] with silhouette fins: what Pelt's own commands draw (record
+    /// [`FurRenderer::prepare_fins`] first).
+    pub const SILHOUETTE: Self = Self { silhouette_fins: true, ..Self::ALL };
 }
 
 impl Default for FurDrawSettings {
@@ -80,8 +94,11 @@ pub struct FurRenderer {
     corners: SurfacePipelines,
     /// Meshes without uvs: indexed by the base triangles.
     indexed: SurfacePipelines,
-    /// Blended, alpha-to-coverage.
+    /// Blended, alpha-to-coverage: every edge.
     fins: [wgpu::RenderPipeline; 2],
+    /// Blended, alpha-to-coverage: the silhouette pass's edges.
+    silhouette_fins: [wgpu::RenderPipeline; 2],
+    silhouette: wgpu::ComputePipeline,
 }
 
 impl FurRenderer {
@@ -104,9 +121,16 @@ impl FurRenderer {
         });
         let fur_layout = layouts.pipeline_layout(device, "pelt unified", &layouts.unified_object, true);
         let plain_layout = layouts.pipeline_layout(device, "pelt plain", &layouts.unified_object, false);
-        let build = |label: &str, layout, (vertex_entry, fragment_entry): (&str, &str), kind| {
-            let source = PipelineSource { layout, module: &module, vertex_entry, fragment_entry, buffers: &[] };
+        let build_with = |label: &str,
+                          layout: &wgpu::PipelineLayout,
+                          (vertex_entry, fragment_entry): (&str, &str),
+                          kind: PassKind,
+                          buffers: &[Option<wgpu::VertexBufferLayout<'_>>]| {
+            let source = PipelineSource { layout, module: &module, vertex_entry, fragment_entry, buffers };
             create_pipeline(device, &target, label, &source, kind)
+        };
+        let build = |label: &str, layout: &wgpu::PipelineLayout, entries: (&str, &str), kind: PassKind| {
+            build_with(label, layout, entries, kind, &[])
         };
         let surface = |walk: &str| {
             let skin = format!("vs_skin_{walk}");
@@ -121,8 +145,14 @@ impl FurRenderer {
         let corners = surface("corners");
         let indexed = surface("indexed");
         let fins = Transparency::BOTH.map(|t| build("pelt fins", &fur_layout, ("vs_fin", "fs_fin"), PassKind::Fins(t)));
+        let instances = [Some(FIN_INSTANCE_LAYOUT)];
+        let silhouette_fins = Transparency::BOTH.map(|t| {
+            let entries = ("vs_fin_silhouette", "fs_fin");
+            build_with("pelt silhouette fins", &fur_layout, entries, PassKind::Fins(t), &instances)
+        });
+        let silhouette = silhouette_pipeline(device, &layouts);
         scope.pop("building the fur pipelines")?;
-        Ok(Self { target, layouts, corners, indexed, fins })
+        Ok(Self { target, layouts, corners, indexed, fins, silhouette_fins, silhouette })
     }
 
     /// The target description the pipelines were built for.
@@ -154,8 +184,27 @@ impl FurRenderer {
         // Fins after the shells: at the silhouette, where fins matter, they stand outside the
         // shells and must not be covered by the faded outer layers.
         if settings.fins && layers > 0 {
-            pass.set_pipeline(&self.fins[which]);
-            geometry.draw_fins(pass);
+            match fur.fin_list() {
+                Some(list) if settings.silhouette_fins => {
+                    pass.set_pipeline(&self.silhouette_fins[which]);
+                    geometry.draw_fin_list(pass, list);
+                }
+                _ => {
+                    pass.set_pipeline(&self.fins[which]);
+                    geometry.draw_fins(pass);
+                }
+            }
+        }
+    }
+
+    /// Records the silhouette pass of `fur` seen from `view` into `encoder` (a compute pass): it
+    /// decides once per edge which fins show, for a [`FurRenderer::draw`] with
+    /// [`FurDrawSettings::silhouette_fins`] in a render pass recorded after it. Call it every
+    /// frame, after [`FurView::prepare`] and [`GpuFur::prepare`] (it reads both uniforms), once per
+    /// view that draws the fur, each before that view's pass. Nothing blocks or is read back.
+    pub fn prepare_fins(&self, encoder: &mut wgpu::CommandEncoder, view: &FurView, fur: &GpuFur) {
+        if let Some(list) = fur.fin_list() {
+            list.record(encoder, &self.silhouette, view.bind_group(), fur.geometry().bind_group());
         }
     }
 

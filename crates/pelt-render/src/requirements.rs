@@ -6,8 +6,8 @@ use crate::RenderError;
 /// Storage buffers the unified vertex shaders read: two position states, base normals, corner
 /// uvs and topology.
 const STORAGE_BUFFERS_PER_STAGE: u32 = 5;
-/// View, object and textures.
-const BIND_GROUPS: u32 = 3;
+/// View, object and textures; the silhouette pass's fin list is group 3.
+const BIND_GROUPS: u32 = 4;
 /// The varyings of `shading.wgsl`.
 const INTER_STAGE_VARIABLES: u32 = 11;
 
@@ -18,10 +18,13 @@ pub fn required_features() -> wgpu::Features {
 }
 
 /// Downlevel capabilities Pelt needs: storage buffers in vertex shaders (the shared vertex array
-/// is fetched there). Every WebGPU, Vulkan, Metal and DX12 adapter has it; WebGL2 does not.
+/// is fetched there), compute shaders and indirect draws (the silhouette pass). Every WebGPU,
+/// Vulkan, Metal and DX12 adapter has them; WebGL2 does not.
 #[must_use]
 pub fn required_downlevel_flags() -> wgpu::DownlevelFlags {
     wgpu::DownlevelFlags::VERTEX_STORAGE
+        | wgpu::DownlevelFlags::COMPUTE_SHADERS
+        | wgpu::DownlevelFlags::INDIRECT_EXECUTION
 }
 
 /// `base` (e.g. `adapter.limits()` for the largest meshes the hardware allows, or

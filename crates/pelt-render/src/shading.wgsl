@@ -187,8 +187,11 @@ fn shell_texel(in: Varyings) -> vec4<f32> {
 
 // Surface colour mode: the mesh's texture at the strand's root tints the strand's brightness.
 fn surface_tint(uv: vec2<f32>) -> vec3<f32> {
-    let colour = textureSample(surface_texture, shell_sampler, uv).rgb;
-    return select(vec3<f32>(1.0), colour, object.has_surface != 0u);
+    // A uniform branch: furs without a surface texture skip the fetch.
+    if object.has_surface == 0u {
+        return vec3<f32>(1.0);
+    }
+    return textureSample(surface_texture, shell_sampler, uv).rgb;
 }
 
 fn fur_output(colour: vec3<f32>, alpha: f32) -> vec4<f32> {

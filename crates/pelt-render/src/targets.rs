@@ -10,6 +10,14 @@ pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
 /// MSAA sample count of [`FurTarget::new`].
 pub const SAMPLE_COUNT: u32 = 4;
 
+/// MSAA samples worth their cost on `adapter`: 1 on CPU rasterisers (lavapipe, llvmpipe, WARP),
+/// where every sample is shaded and blended in software and fur strands are filtered textures
+/// anyway; [`SAMPLE_COUNT`] on GPUs, whose silhouettes and fins alias without it.
+#[must_use]
+pub fn default_sample_count(adapter: &wgpu::AdapterInfo) -> u32 {
+    if adapter.device_type == wgpu::DeviceType::Cpu { 1 } else { SAMPLE_COUNT }
+}
+
 /// The clear colour of Pelt's own pictures (linear RGB): a dark blue-grey.
 pub const DEFAULT_BACKGROUND: glam::Vec3 = glam::Vec3::new(0.045, 0.05, 0.06);
 

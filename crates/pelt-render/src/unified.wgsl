@@ -39,11 +39,16 @@ fn model_normal(vertex: u32) -> vec3<f32> {
     return vec3<f32>(base_normals[k], base_normals[k + 1u], base_normals[k + 2u]);
 }
 
-// The strand direction at NV[layer*V + vertex] in world space: NV[(i+1)V+j] - NV[iV+j] (the
-// last segment at the tips).
-fn strand_tangent(layer: u32, vertex: u32, fallback: vec3<f32>) -> vec3<f32> {
-    let lower = min(layer, max(object.layers, 1u) - 1u);
-    let segment = model_vertex(lower + 1u, vertex) - model_vertex(lower, vertex);
+// The strand direction at NV[layer*V + vertex] = `here` in world space: NV[(i+1)V+j] - NV[iV+j]
+// (the last segment at the tips). `here` is passed in so the vertex fetches one more position,
+// not two. Furs only (L >= 1).
+fn strand_tangent(layer: u32, vertex: u32, here: vec3<f32>, fallback: vec3<f32>) -> vec3<f32> {
+    var segment: vec3<f32>;
+    if layer < object.layers {
+        segment = model_vertex(layer + 1u, vertex) - here;
+    } else {
+        segment = here - model_vertex(layer - 1u, vertex);
+    }
     return safe_normalize(world_from_model_direction(segment), fallback);
 }
 
@@ -59,21 +64,34 @@ fn face_normal(face: u32) -> vec3<f32> {
     return world_from_model_normal(cross(b - a, c - a));
 }
 
-// `corner` indexes the per-corner uvs; it is only read when the mesh has uvs.
+// `corner` indexes the per-corner uvs; it is only read when the mesh has uvs. Every branch here
+// is on the object uniform, so whole draws take one side: a vertex fetches only what its draw
+// uses (the tangent for shells, the root for the triplanar projection without uvs).
 fn surface_varyings(vertex: u32, corner: u32, layer: u32) -> Varyings {
-    let position = world_from_model_point(model_vertex(layer, vertex));
+    let here = model_vertex(layer, vertex);
+    let position = world_from_model_point(here);
     let rest_normal = model_normal(vertex);
     var out: Varyings;
     out.clip_position = view.clip_from_world * vec4<f32>(position, 1.0);
     out.world_position = position;
     out.normal = world_from_model_normal(rest_normal);
-    out.tangent = strand_tangent(layer, vertex, out.normal);
-    out.tile_position = model_vertex(0u, vertex) * object.tiles_per_world;
+    // The skin and plain meshes are lit by the normal alone.
+    out.tangent = out.normal;
+    if layer > 0u {
+        out.tangent = strand_tangent(layer, vertex, here, out.normal);
+    }
     out.tile_normal = rest_normal;
     if object.has_uvs != 0u {
+        out.tile_position = vec3<f32>(0.0);
         out.surface_uv = corner_uvs[corner];
         out.uv = out.surface_uv * object.tiles_per_uv;
     } else {
+        // Shells are textured from their strand's root, the skin from itself.
+        var root = here;
+        if layer > 0u {
+            root = model_vertex(0u, vertex);
+        }
+        out.tile_position = root * object.tiles_per_world;
         out.surface_uv = vec2<f32>(0.0);
         out.uv = vec2<f32>(0.0);
     }
@@ -121,27 +139,20 @@ fn hash(x: u32) -> u32 {
     return h ^ (h >> 16u);
 }
 
-// Fins: instance = edge; vertex 2i + s is strand node i on side s (0 = a, 1 = b) of the edge, and
-// a shared index buffer joins them into two triangles per layer step, L steps up the strands.
+// Fins: one per edge; vertex 2i + s is strand node i on side s (0 = a, 1 = b) of the edge, and a
+// shared index buffer joins them into two triangles per layer step, L steps up the strands.
 // Each corner is a shared vertex, so fins bend with the simulated fur.
-@vertex
-fn vs_fin(@builtin(vertex_index) index: u32, @builtin(instance_index) edge: u32) -> Varyings {
-    let side = index % 2u;
-    let layer = index / 2u;
 
+// How much of an edge's fin shows: 1 on the silhouette, fading to 0 where the faces beside the
+// edge turn toward the camera (both in front, or both behind).
+fn fin_fade(edge: u32) -> f32 {
     let edges_start = 3u * object.triangle_count;
     let a = topology[edges_start + 2u * edge];
     let b = topology[edges_start + 2u * edge + 1u];
-    let vertex = select(a, b, side == 1u);
-
-    // Fade in near the silhouette: where the faces beside the edge turn edge-on, or one faces
-    // the camera and the other away.
     let faces_start = edges_start + 2u * object.edge_count;
     let face_a = topology[faces_start + 2u * edge];
     let face_b = topology[faces_start + 2u * edge + 1u];
-    let root_a = model_vertex(0u, a);
-    let root_b = model_vertex(0u, b);
-    let middle = world_from_model_point(0.5 * (root_a + root_b));
+    let middle = world_from_model_point(0.5 * (model_vertex(0u, a) + model_vertex(0u, b)));
     let to_camera = safe_normalize(view.camera_position - middle, vec3<f32>(0.0, 0.0, 1.0));
     let facing_a = dot(face_normal(face_a), to_camera);
     var edge_on = abs(facing_a);
@@ -153,30 +164,37 @@ fn vs_fin(@builtin(vertex_index) index: u32, @builtin(instance_index) edge: u32)
             edge_on = 0.0;
         }
     }
-    let fade = 1.0 - smoothstep(0.0, object.fin_fade_cos, edge_on);
-    var out: Varyings;
-    if fade <= 0.0 {
-        // Invisible fin (most of them): every vertex of the edge lands outside the clip volume,
-        // so it costs no rasterisation, and returning now skips the rest of the shading.
-        out.clip_position = vec4<f32>(2.0, 2.0, 2.0, 1.0);
-        return out;
-    }
+    return 1.0 - smoothstep(0.0, object.fin_fade_cos, edge_on);
+}
 
-    let position = world_from_model_point(model_vertex(layer, vertex));
+// The fin vertex `index` of a shown `edge` (fade > 0).
+fn fin_varyings(index: u32, edge: u32, fade: f32) -> Varyings {
+    let side = index % 2u;
+    let layer = index / 2u;
+    let edges_start = 3u * object.triangle_count;
+    let a = topology[edges_start + 2u * edge];
+    let b = topology[edges_start + 2u * edge + 1u];
+    let vertex = select(a, b, side == 1u);
+
+    var out: Varyings;
+    let here = model_vertex(layer, vertex);
+    let position = world_from_model_point(here);
     out.clip_position = view.clip_from_world * vec4<f32>(position, 1.0);
     out.world_position = position;
     let normal_a = world_from_model_normal(model_normal(a));
     out.normal = safe_normalize(normal_a + world_from_model_normal(model_normal(b)), normal_a);
-    out.tangent = strand_tangent(layer, vertex, out.normal);
+    out.tangent = strand_tangent(layer, vertex, here, out.normal);
     out.tile_position = vec3<f32>(0.0);
     out.tile_normal = vec3<f32>(0.0);
     let offset = f32(hash(edge) & 0xffffu) / 65536.0;
-    out.uv = vec2<f32>(offset + f32(side) * distance(root_a, root_b) * object.tiles_per_world, layer_height(layer));
+    let along = f32(side) * distance(model_vertex(0u, a), model_vertex(0u, b)) * object.tiles_per_world;
+    out.uv = vec2<f32>(offset + along, layer_height(layer));
     out.layer = 0u;
     out.slice = 0;
     // The surface uv of this end of the edge, from its corner in the first face.
     out.surface_uv = vec2<f32>(0.0);
     if object.has_uvs != 0u && object.has_surface != 0u {
+        let face_a = topology[edges_start + 2u * object.edge_count + 2u * edge];
         for (var k = 0u; k < 3u; k++) {
             if topology[3u * face_a + k] == vertex {
                 out.surface_uv = corner_uvs[3u * face_a + k];
@@ -186,4 +204,26 @@ fn vs_fin(@builtin(vertex_index) index: u32, @builtin(instance_index) edge: u32)
     out.height = out.uv.y;
     out.fade = fade;
     return out;
+}
+
+// Every edge (instance = edge), each vertex deciding whether its edge shows: for hosts that
+// record no silhouette pass.
+@vertex
+fn vs_fin(@builtin(vertex_index) index: u32, @builtin(instance_index) edge: u32) -> Varyings {
+    let fade = fin_fade(edge);
+    if fade <= 0.0 {
+        // Invisible fin (most of them): every vertex of the edge lands outside the clip volume,
+        // so it costs no rasterisation, and returning now skips the rest of the shading.
+        var out: Varyings;
+        out.clip_position = vec4<f32>(2.0, 2.0, 2.0, 1.0);
+        return out;
+    }
+    return fin_varyings(index, edge, fade);
+}
+
+// Silhouette edges only: `fin` = (edge, fade bits), one instance per edge the silhouette pass
+// (`silhouette.wgsl`) kept this frame.
+@vertex
+fn vs_fin_silhouette(@builtin(vertex_index) index: u32, @location(0) fin: vec2<u32>) -> Varyings {
+    return fin_varyings(index, fin.x, bitcast<f32>(fin.y));
 }

@@ -18,6 +18,28 @@ fn golden_bunny_still() {
     check_golden("bunny-still", &rig.render(&gpu_fur, &framed(&fur, 1.0), &settings()));
 }
 
+/// The golden tests guard the fins: the bunny and the box without them fail, in the silhouette
+/// band (over the whole image a missing fringe is within the limits).
+#[test]
+fn golden_tests_fail_without_fins() {
+    let rig = Rig::new(SIZE, SIZE);
+    let no_fins = FurDrawSettings { fins: false, ..settings() };
+    for (name, builtin, root, tip) in
+        [("bunny-still", Builtin::Bunny, BROWN_ROOT, BROWN_TIP), ("box", Builtin::Box, [40, 40, 44], [235, 235, 240])]
+    {
+        let fur = builtin_fur(builtin, 16);
+        let gpu_fur = rig.fur(&fur, &strand_textures(256, 16, root, tip));
+        let difference = golden_difference(name, &rig.render(&gpu_fur, &framed(&fur, 1.0), &no_fins));
+        eprintln!("{name} without fins: mean {:.2}, band {:.2}", difference.mean, difference.silhouette_mean);
+        assert!(
+            !difference.within_limits(),
+            "{name} without fins passed the golden test (mean {:.2}, silhouette band {:.2})",
+            difference.mean,
+            difference.silhouette_mean
+        );
+    }
+}
+
 #[test]
 fn golden_box() {
     let fur = builtin_fur(Builtin::Box, 16);
@@ -115,6 +137,48 @@ fn fins_change_silhouette_pixels_only() {
     assert!(changed > 50, "fins change the silhouette ({changed} pixels)");
 }
 
+/// The silhouette pass keeps only the edges whose fins show, and drawing those gives the picture
+/// of every edge's fin testing itself.
+#[test]
+fn silhouette_fins_draw_what_every_edge_draws() {
+    let fur = builtin_fur(Builtin::Bunny, 16);
+    let rig = Rig::new(SIZE, SIZE);
+    let gpu_fur = rig.fur(&fur, &strand_textures(256, 16, BROWN_ROOT, BROWN_TIP));
+    let camera = framed(&fur, 1.0);
+    let every_edge = rig.render(&gpu_fur, &camera, &settings());
+    let silhouette = rig.render_silhouette(&gpu_fur, &camera, &settings());
+    let draw = rig.read_u32s(gpu_fur.silhouette_draw().expect("fins"));
+    let (indices, kept, edges) = (draw[0], draw[1] as usize, fur.mesh.edges.len());
+    assert_eq!(indices, 6 * fur.layers, "one strip of 6L indices per fin");
+    // The oracle: the same test on the CPU, from the rest pose (which the GPU has).
+    let eye = camera.eye;
+    let shown = fur
+        .mesh
+        .edges
+        .iter()
+        .zip(&fur.mesh.edge_faces)
+        .filter(|([a, b], faces)| {
+            let middle = 0.5 * (fur.mesh.positions[*a as usize] + fur.mesh.positions[*b as usize]);
+            let to_camera = (eye - middle).normalize();
+            let facing: Vec<f32> = faces
+                .iter()
+                .filter(|&&f| f != pelt_core::mesh::NO_FACE)
+                .map(|&f| fur.mesh.face_normal(f as usize).dot(to_camera))
+                .collect();
+            let silhouette = facing.len() == 2 && facing[0] * facing[1] <= 0.0;
+            silhouette || facing.iter().any(|f| f.abs() < pelt_render::FurLook::default().fin_fade_cos)
+        })
+        .count();
+    assert!(kept < edges / 3, "the pass keeps a fraction of the {edges} edges: {kept}");
+    assert!(kept.abs_diff(shown) <= shown / 50 + 2, "kept {kept}, the CPU finds {shown}");
+    let changed = every_edge.pixels().zip(silhouette.pixels()).filter(|(p, q)| pixel_difference(p, q) > 8).count();
+    assert!(changed < 40, "{changed} pixels differ between every edge and silhouette edges");
+    // And the fins are really there: without them the picture changes.
+    let without = rig.render(&gpu_fur, &camera, &FurDrawSettings { fins: false, ..settings() });
+    let fin_pixels = silhouette.pixels().zip(without.pixels()).filter(|(p, q)| pixel_difference(p, q) > 8).count();
+    assert!(fin_pixels > 200, "silhouette fins change {fin_pixels} pixels");
+}
+
 /// Coverage: the mean difference from the background, 0 (nothing drawn) to 1.
 fn fur_coverage(image: &image::RgbaImage, background: [u8; 3]) -> f64 {
     let total: f64 = image
@@ -198,9 +262,18 @@ fn alpha_to_coverage_draws_the_same_fur() {
     let drawn = |image: &image::RgbaImage| image.pixels().filter(|p| covered(p, background)).count() as f64;
     let (a, b) = (drawn(&blended), drawn(&coverage));
     assert!((a - b).abs() < 0.05 * a, "pixels drawn blended {a}, alpha-to-coverage {b}");
-    let mean = blended.pixels().zip(coverage.pixels()).map(|(p, q)| f64::from(pixel_difference(p, q))).sum::<f64>()
+    // A PNG is opaque: coverage decides which samples a strand covers, never the stored alpha.
+    for (name, image) in [("blended", &blended), ("alpha-to-coverage", &coverage)] {
+        let translucent = image.pixels().filter(|p| p.0[3] != 255).count();
+        assert_eq!(translucent, 0, "{name}: {translucent} pixels with alpha below 255");
+    }
+    // Colour only: the alpha channel is checked above and must not dilute the mean.
+    let rgb_difference = |p: &image::Rgba<u8>, q: &image::Rgba<u8>| {
+        p.0[..3].iter().zip(&q.0[..3]).map(|(a, b)| a.abs_diff(*b)).max().unwrap_or(0)
+    };
+    let mean = blended.pixels().zip(coverage.pixels()).map(|(p, q)| f64::from(rgb_difference(p, q))).sum::<f64>()
         / f64::from(SIZE * SIZE);
-    assert!(mean > 0.0 && mean < 60.0, "similar but not identical: mean difference {mean:.2}");
+    assert!(mean > 0.0 && mean < 60.0, "similar but not identical: mean colour difference {mean:.2}");
 }
 
 #[test]

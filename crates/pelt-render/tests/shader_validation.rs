@@ -19,8 +19,23 @@ fn separated_module_validates() {
 }
 
 #[test]
+fn simulation_module_validates() {
+    validate("simulation_wind.wgsl + simulation.wgsl", &pelt_render::simulation_shader_source());
+}
+
+#[test]
+fn silhouette_module_validates() {
+    validate("shading.wgsl + unified.wgsl + silhouette.wgsl", &pelt_render::silhouette_shader_source());
+}
+
+#[test]
 fn every_wgsl_file_is_part_of_a_validated_module() {
-    let sources = [pelt_render::unified_shader_source(), pelt_render::separated_shader_source()];
+    let sources = [
+        pelt_render::unified_shader_source(),
+        pelt_render::separated_shader_source(),
+        pelt_render::simulation_shader_source(),
+        pelt_render::silhouette_shader_source(),
+    ];
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
     let mut checked = 0;
     for entry in std::fs::read_dir(&dir).expect("src dir") {
@@ -31,5 +46,5 @@ fn every_wgsl_file_is_part_of_a_validated_module() {
             checked += 1;
         }
     }
-    assert_eq!(checked, 3, "shading, unified and separated");
+    assert_eq!(checked, 6, "shading, unified, separated, silhouette, simulation_wind and simulation");
 }

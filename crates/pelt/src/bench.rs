@@ -18,7 +18,10 @@ use anyhow::Context as _;
 use pelt_core::{FurStructure, Preset};
 
 use self::models::{MODELS, Model};
-use self::report::{Machine, RenderFigures, Report, ResultRow, SimFigures, SkippedModel, TextureFigures};
+use self::report::{
+    GpuSimFigures, LargeMeshFigures, Machine, RenderFigures, Report, ResultRow, SimFigures, SkippedModel,
+    TextureFigures,
+};
 use self::table2::Table2Row;
 
 /// Arguments of `pelt bench`.
@@ -39,6 +42,14 @@ pub struct Args {
     /// The folder with the mesh files (default: `assets/meshes`).
     #[arg(long, value_name = "DIR")]
     pub meshes: Option<PathBuf>,
+    /// Instead of the report: soak the CPU simulation (the bunny at 16 layers) under extreme,
+    /// changing forces and report the worst segment length error; fails if any node is not
+    /// finite or a length moved by more than 1e-5 of its strand's length.
+    #[arg(long)]
+    pub soak: bool,
+    /// Steps of `--soak`.
+    #[arg(long, value_name = "N", default_value_t = 1_000_000, requires = "soak")]
+    pub steps: u64,
 }
 
 /// The layer counts the paper's comparison is made at.
@@ -71,21 +82,29 @@ impl Plan {
         }
     }
 
+    /// GPU simulation: (steps per timed run, runs); the figure is the median run.
+    fn gpu_sim_runs(self) -> (u32, usize) {
+        if self.quick { (4, 3) } else { (30, 7) }
+    }
+
     fn texture_runs(self) -> u32 {
         if self.quick { 1 } else { 3 }
     }
 
     fn sim_budget(self) -> sim::SimBudget {
         if self.quick {
-            sim::SimBudget { min_bend_secs: 0.05, drawn_frames: 24 }
+            sim::SimBudget { runs: 3, min_run_secs: 0.02, drawn_frames: 24 }
         } else {
             // 4 s of simulated time: 120 steps at 30 Hz under 480 drawn frames.
-            sim::SimBudget { min_bend_secs: 0.5, drawn_frames: 480 }
+            sim::SimBudget { runs: 7, min_run_secs: 0.15, drawn_frames: 480 }
         }
     }
 }
 
 pub fn run(args: &Args) -> anyhow::Result<()> {
+    if args.soak {
+        return soak(args.steps);
+    }
     let started = Instant::now();
     for name in &args.models {
         anyhow::ensure!(
@@ -126,6 +145,9 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         }
     }
 
+    eprintln!("pelt bench: simulation on a {}-vertex mesh", models::LARGE_MESH_VERTICES);
+    let sim_large_mesh = Some(measure_large_mesh(plan)?);
+
     let report = Report {
         pelt_version: env!("CARGO_PKG_VERSION"),
         date_utc: system::utc_now(),
@@ -142,6 +164,8 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         adapter_unavailable_reason: gpu.as_ref().err().cloned(),
         paper_savings_vs_2_percent: table2::PAPER_SAVINGS_VS_2_PERCENT,
         paper_savings_vs_30_percent: table2::PAPER_SAVINGS_VS_30_PERCENT,
+        sim_cpu_kernel: pelt_core::sim::CpuKernel::Auto.name(),
+        sim_large_mesh,
         results,
         skipped_models,
         peak_rss_bytes: system::peak_rss_bytes(),
@@ -165,7 +189,7 @@ const QUICK_DRAWS: &str = "--quick draws the Box at 16 layers only";
 
 /// Every figure for one model at one layer count.
 fn measure(model: &Model, layers: u32, plan: Plan, gpu: Result<&render::Bench, &String>) -> anyhow::Result<ResultRow> {
-    let row = |render, sim, texture| -> anyhow::Result<ResultRow> {
+    let row = |render, sim, texture, gpu_sim| -> anyhow::Result<ResultRow> {
         Ok(ResultRow {
             model: model.spec.key,
             paper_model: model.spec.paper_model,
@@ -175,6 +199,7 @@ fn measure(model: &Model, layers: u32, plan: Plan, gpu: Result<&render::Bench, &
             render,
             sim,
             texture,
+            gpu_sim,
         })
     };
     if !plan.times(model.spec.key) {
@@ -183,6 +208,7 @@ fn measure(model: &Model, layers: u32, plan: Plan, gpu: Result<&render::Bench, &
             RenderFigures { render_unavailable_reason: reason(), ..RenderFigures::default() },
             SimFigures { sim_unavailable_reason: reason(), ..SimFigures::default() },
             TextureFigures { texture_unavailable_reason: reason(), ..TextureFigures::default() },
+            GpuSimFigures { gpu_sim_unavailable_reason: reason(), ..GpuSimFigures::default() },
         );
     }
 
@@ -219,5 +245,63 @@ fn measure(model: &Model, layers: u32, plan: Plan, gpu: Result<&render::Bench, &
     };
     eprintln!("pelt bench:   {key} L={layers}: simulation");
     let sim = sim::measure(&fur, &preset.simulation, plan.sim_budget())?;
-    row(render, sim, texture)
+    let gpu_sim = match gpu {
+        Ok(gpu) => {
+            eprintln!("pelt bench:   {key} L={layers}: GPU simulation");
+            let (steps, runs) = plan.gpu_sim_runs();
+            gpu.measure_simulation(&fur, &preset.simulation, steps, runs, plan.sim_budget().drawn_frames)?
+        }
+        Err(reason) => GpuSimFigures { gpu_sim_unavailable_reason: Some(reason.clone()), ..GpuSimFigures::default() },
+    };
+    row(render, sim, texture, gpu_sim)
+}
+
+/// The simulation's throughput on the 35,000-vertex mesh at 32 layers, default preset.
+fn measure_large_mesh(plan: Plan) -> anyhow::Result<LargeMeshFigures> {
+    let mesh = models::large_mesh()?;
+    let mut preset = Preset::default();
+    preset.layers = 32;
+    let params = preset.fur_params(&mesh);
+    let fur = FurStructure::new(mesh, &params)?;
+    let throughput = sim::throughput(&fur, &preset.simulation, plan.sim_budget())?;
+    Ok(LargeMeshFigures {
+        mesh: models::LARGE_MESH.to_owned(),
+        vertices: fur.vertex_count() as u64,
+        layers: preset.layers,
+        sim_node_updates_per_sec: throughput.one_thread,
+        sim_node_updates_per_sec_all_threads: throughput.all_threads,
+    })
+}
+
+/// The most a segment's length may move in the soak, as a fraction of its strand's length.
+const SOAK_TOLERANCE: f64 = 1e-5;
+
+/// `pelt bench --soak`: the bunny at 16 layers through `steps` soak steps.
+fn soak(steps: u64) -> anyhow::Result<()> {
+    let started = Instant::now();
+    let (mesh, _) = pelt_core::Builtin::Bunny.mesh();
+    let preset = Preset::default();
+    let fur = FurStructure::new(mesh.clone(), &preset.fur_params(&mesh))?;
+    let mut simulation = pelt_core::Simulation::new(&fur, &preset.simulation)?;
+    eprintln!(
+        "pelt bench --soak: bunny, {} strands x {} layers, {steps} steps, {} kernel",
+        fur.vertex_count(),
+        fur.layers,
+        simulation.cpu_kernel().name()
+    );
+    let report = pelt_core::sim::soak(&fur, &mut simulation, steps, |done| {
+        if done % 100_000 == 0 {
+            eprintln!("pelt bench --soak: {done} steps, {:.0} s", started.elapsed().as_secs_f64());
+        }
+    })?;
+    println!(
+        "soak: {} steps in {:.1} s; worst segment length error {:.3e} of the strand length (step {}); steps with a non-finite node: {}",
+        report.steps,
+        started.elapsed().as_secs_f64(),
+        report.worst_length_error,
+        report.worst_step,
+        report.non_finite_steps
+    );
+    anyhow::ensure!(report.passed(SOAK_TOLERANCE), "soak failed (tolerance {SOAK_TOLERANCE:e}): {report:?}");
+    Ok(())
 }

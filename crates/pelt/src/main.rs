@@ -4,6 +4,7 @@ mod bench;
 mod format;
 mod mesh_args;
 mod render;
+mod sim_kernel;
 mod stats;
 mod textures;
 mod view;

@@ -3,6 +3,7 @@
 use std::path::PathBuf;
 
 use anyhow::Context as _;
+use pelt_core::anim::Rig;
 use pelt_core::{Builtin, ImportOptions, Mesh, MeshReport};
 
 /// Which mesh to grow fur on.
@@ -20,19 +21,26 @@ pub struct MeshArgs {
 }
 
 impl MeshArgs {
-    /// Loads the chosen mesh; with neither a file nor `--builtin`, `default`.
-    pub fn load(&self, default: Builtin) -> anyhow::Result<(Mesh, MeshReport)> {
+    /// Loads the chosen mesh, with the file's rig (skins, animations) when it has one; with
+    /// neither a file nor `--builtin`, `default`.
+    pub fn load_animated(&self, default: Builtin) -> anyhow::Result<(Mesh, MeshReport, Option<Rig>)> {
         let options = ImportOptions { weld: !self.no_weld, ..ImportOptions::default() };
-        match (&self.mesh, &self.builtin) {
-            (Some(path), _) => Ok(Mesh::load(path, &options)?),
-            (None, Some(name)) => {
+        match &self.mesh {
+            Some(path) => Ok(Mesh::load_animated(path, &options)?),
+            None => self.load_builtin(default).map(|(mesh, report)| (mesh, report, None)),
+        }
+    }
+
+    fn load_builtin(&self, default: Builtin) -> anyhow::Result<(Mesh, MeshReport)> {
+        match &self.builtin {
+            Some(name) => {
                 let builtin = Builtin::from_name(name).with_context(|| {
                     let names: Vec<_> = Builtin::ALL.iter().map(|b| b.name()).collect();
                     format!("unknown built-in mesh {name:?}; choose one of {}", names.join(", "))
                 })?;
                 Ok(builtin.mesh())
             }
-            (None, None) => Ok(default.mesh()),
+            None => Ok(default.mesh()),
         }
     }
 }

@@ -6,16 +6,18 @@ use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use anyhow::{Context as _, bail};
-use glam::{Mat4, Vec3};
+use glam::{Mat4, Quat, Vec3};
+use pelt_core::anim::{Pose, Rig};
 use pelt_core::mesh::builtin::{TRY_ON_NAME, try_on_scene};
 use pelt_core::sim::{Scene, Simulation, WindParams};
 use pelt_core::{Builtin, FurStructure, ImportOptions, Mesh, Preset};
 use pelt_render::{
-    Backend, Camera, DEFAULT_BACKGROUND, FurDrawSettings, FurFrame, FurStates, FurView, GpuFur, Headless, Light,
-    PlainMesh,
+    Backend, Camera, DEFAULT_BACKGROUND, FurDrawSettings, FurFrame, FurStates, FurTarget, FurView, Gpu, GpuFur,
+    GpuSimulation, HEADLESS_FORMAT, Headless, Light, PlainMesh, SAMPLE_COUNT, default_sample_count,
 };
 
 use crate::mesh_args::MeshArgs;
+use crate::sim_kernel::{self, SimChoice, SimKernel};
 
 /// Skin tone of plain meshes (linear RGB).
 pub const PLAIN_COLOUR: Vec3 = Vec3::new(0.62, 0.46, 0.38);
@@ -29,7 +31,10 @@ const LIGHT_WIND: Vec3 = Vec3::new(0.35, 0.0, 0.1);
 #[command(after_help = "\
 With no arguments: the built-in bunny, the default fur and a light breeze, to pelt.png.
 `--builtin tryon` renders a body (plain) wearing a furry garment; with your own meshes:
-`pelt render GARMENT.obj --plain-mesh BODY.obj`.")]
+`pelt render GARMENT.obj --plain-mesh BODY.obj`. An animated glTF plays its first animation
+(`--animation` picks another, `none` keeps the rest pose): `pelt render assets/meshes/Fox.glb
+--animation Walk --frames 90 -o fox.gif`. A script's [[motion]] keys move the meshes:
+`pelt render --builtin tryon --script assets/scenes/catwalk.toml -o catwalk.gif`.")]
 pub struct Args {
     #[command(flatten)]
     mesh: MeshArgs,
@@ -39,9 +44,13 @@ pub struct Args {
     /// The fur preset (TOML); the built-in default fur without one.
     #[arg(long, value_name = "P")]
     preset: Option<PathBuf>,
-    /// A scene script (TOML): wind keys and touch strokes over time.
+    /// A scene script (TOML): wind keys, touch strokes and rigid motion over time.
     #[arg(long, value_name = "SCENE.toml")]
     script: Option<PathBuf>,
+    /// The animation of an animated glTF to play: its name or index, or `none` for the rest
+    /// pose. Default: the first animation.
+    #[arg(long, value_name = "NAME|INDEX|none")]
+    animation: Option<String>,
     /// Frames to render (default: 1 for a .png; the script's length, or 2 seconds, otherwise).
     #[arg(long, value_name = "N")]
     frames: Option<u32>,
@@ -61,9 +70,16 @@ pub struct Args {
     /// Graphics backend: vulkan, gl (or metal, dx12); default `WGPU_BACKEND`, else the best there is.
     #[arg(long, default_value = "auto")]
     backend: Backend,
-    /// Shells and fins with alpha-to-coverage instead of blending.
+    /// Where the fur is simulated: the CPU, the GPU (a compute pass), or auto (both timed on
+    /// this fur first, the faster runs).
+    #[arg(long, value_enum, default_value_t = SimChoice::Auto)]
+    sim: SimChoice,
+    /// Shells and fins with alpha-to-coverage instead of blending (needs MSAA: 4 unless --msaa says more).
     #[arg(long)]
     alpha_to_coverage: bool,
+    /// MSAA samples: 1, 2, 4 or 8. Default: 1 on a CPU rasteriser (lavapipe), 4 on a GPU.
+    #[arg(long, value_name = "N", value_parser = parse_msaa)]
+    msaa: Option<u32>,
     /// Leave out the fins (shells only).
     #[arg(long)]
     no_fins: bool,
@@ -109,14 +125,17 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         None => Preset::default(),
     };
     let scene = args.script.as_deref().map(Scene::load).transpose()?;
+    let (mesh, plain, rig) = load_meshes(args)?;
+    let clip = choose_animation(args, rig.as_ref())?;
     let frames = if frames > 0 {
         frames
     } else {
-        let secs = scene.as_ref().map_or(2.0, Scene::duration_secs);
+        // One loop of the animation, or the script, or 2 seconds.
+        let clip_secs = clip.and_then(|k| rig.as_ref().map(|r| f64::from(r.animations()[k].duration_secs())));
+        let secs = scene.as_ref().map(Scene::duration_secs).or(clip_secs).unwrap_or(2.0);
         ((secs * args.fps).round() as u32).max(1)
     };
-
-    let (mesh, plain) = load_meshes(args)?;
+    let moves = clip.is_some() || scene.as_ref().is_some_and(|s| !s.motion.is_empty());
     let params = preset.fur_params(&mesh);
     let fur = FurStructure::new(mesh, &params)?;
     let textures = preset.generate_textures()?;
@@ -132,12 +151,32 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     }
 
     let (width, height) = args.size;
-    let headless = Headless::new(args.backend, width, height)?;
+    let gpu = Gpu::new(args.backend)?;
+    let samples = match args.msaa {
+        Some(samples) => samples,
+        None if args.alpha_to_coverage => SAMPLE_COUNT,
+        None => default_sample_count(&gpu.adapter.get_info()),
+    };
+    if args.alpha_to_coverage && samples < 2 {
+        bail!("--alpha-to-coverage needs MSAA: --msaa 2 or more, got {samples}");
+    }
+    let headless =
+        Headless::with_target(gpu, FurTarget::new(HEADLESS_FORMAT).with_sample_count(samples), width, height)?;
     let (device, queue) = (&headless.gpu.device, &headless.gpu.queue);
     let renderer = headless.renderer()?;
-    // The CPU simulation interpolates, so one state uploaded per frame is all the GPU needs.
-    let gpu_fur = GpuFur::new(device, queue, &renderer, &fur, &textures, FurStates::One)?;
+    let (kernel, kernel_reason) = sim_kernel::choose(args.sim, device, queue, &fur, simulation.params())?;
+    // The CPU simulation interpolates, so one state uploaded per frame is all the GPU needs; the
+    // GPU one writes two states and the vertex shader interpolates.
+    let states = if kernel == SimKernel::Gpu { FurStates::Two } else { FurStates::One };
+    let mut gpu_fur = GpuFur::new(device, queue, &renderer, &fur, &textures, states)?;
     gpu_fur.prepare(queue, &FurFrame::default());
+    let mut gpu_simulation = match kernel {
+        SimKernel::Gpu => {
+            simulation.set_cpu_bending(false);
+            Some(GpuSimulation::new(device, &gpu_fur, &fur)?)
+        }
+        SimKernel::Cpu => None,
+    };
     let plain_meshes = plain
         .iter()
         .map(|mesh| PlainMesh::new(device, &renderer, mesh, PLAIN_COLOUR))
@@ -145,11 +184,16 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     for mesh in &plain_meshes {
         mesh.prepare(queue, Mat4::IDENTITY);
     }
-    let camera = camera(args, &fur, &plain, headless.aspect_ratio());
+    let motion_keys = scene.as_ref().map_or(&[][..], |s| &s.motion[..]);
+    let camera = camera(args, &preset, &fur, &plain, motion_keys, frames, headless.aspect_ratio());
+    let mut pose = Pose::default();
     let view = FurView::new(device, &renderer);
     view.prepare(queue, &camera.view_data(headless.aspect_ratio(), &Light::default()));
-    let settings =
-        FurDrawSettings { alpha_to_coverage: args.alpha_to_coverage, fins: !args.no_fins, ..FurDrawSettings::ALL };
+    let settings = FurDrawSettings {
+        alpha_to_coverage: args.alpha_to_coverage,
+        fins: !args.no_fins,
+        ..FurDrawSettings::SILHOUETTE
+    };
 
     let progress = (frames > 1).then(|| {
         let bar = indicatif::ProgressBar::new(u64::from(frames));
@@ -175,19 +219,46 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     for frame in 0..frames {
         let time_secs = f64::from(frame) / args.fps;
         let sim_started = Instant::now();
+        let world_from_model = scene.as_ref().and_then(|s| s.motion_at(time_secs)).unwrap_or(Mat4::IDENTITY);
+        if moves {
+            pose_base(&fur, rig.as_ref(), clip, time_secs, world_from_model, &mut pose);
+            simulation.set_base_rotations(&pose.positions, &pose.rotations)?;
+            if frame == 0 {
+                simulation.restart();
+            }
+        }
         if let Some(scene) = &scene {
             scene.apply(time_secs, &mut simulation)?;
         }
         simulation.advance_to(time_secs);
         simulation_time += sim_started.elapsed();
         let render_started = Instant::now();
-        gpu_fur.set_positions(queue, simulation.positions())?;
-        let image = headless.render(DEFAULT_BACKGROUND, |pass| {
-            for mesh in &plain_meshes {
-                renderer.draw_plain(pass, &view, mesh);
+        match &mut gpu_simulation {
+            Some(gpu_simulation) => {
+                gpu_simulation.prepare(device, queue, &simulation, &gpu_fur)?;
+                let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor::default());
+                gpu_simulation.dispatch(&mut encoder, &mut gpu_fur)?;
+                queue.submit([encoder.finish()]);
+                gpu_fur.prepare(queue, &FurFrame { interpolation: simulation.alpha(), ..FurFrame::default() });
             }
-            renderer.draw(pass, &view, &gpu_fur, &settings);
-        })?;
+            None => gpu_fur.set_positions(queue, simulation.positions())?,
+        }
+        if moves {
+            gpu_fur.set_base_normals(queue, &pose.normals)?;
+            for mesh in &plain_meshes {
+                mesh.prepare(queue, world_from_model);
+            }
+        }
+        let image = headless.render_with(
+            DEFAULT_BACKGROUND,
+            |encoder| renderer.prepare_fins(encoder, &view, &gpu_fur),
+            |pass| {
+                for mesh in &plain_meshes {
+                    renderer.draw_plain(pass, &view, mesh);
+                }
+                renderer.draw(pass, &view, &gpu_fur, &settings);
+            },
+        )?;
         render_time += render_started.elapsed();
         match (&output, &mut gif) {
             (Output::Png(path), _) => save_png(&image, path)?,
@@ -209,7 +280,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let per_frame = |total: Duration| total.as_secs_f64() * 1000.0 / f64::from(frames);
     println!(
         "{}: {frames} frame{} of {width}x{height}, {} shell layers on {} triangles; mean frame {:.1} ms \
-         (render and read back), simulation {:.1} ms a frame; {:.1} s in all on {}",
+         (render and read back), simulation {:.1} ms a frame on the {kernel} ({kernel_reason}); {:.1} s in all on {}, {}x MSAA",
         args.output.display(),
         if frames == 1 { "" } else { "s" },
         fur.layers,
@@ -218,42 +289,112 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         per_frame(simulation_time),
         started.elapsed().as_secs_f64(),
         headless.gpu.summary(),
+        headless.target().sample_count,
     );
     Ok(())
 }
 
-/// The furry mesh and the plain ones: `--builtin tryon` is the garment on the body.
-fn load_meshes(args: &Args) -> anyhow::Result<(Mesh, Vec<Mesh>)> {
+/// The furry mesh (with its rig, for an animated file) and the plain ones: `--builtin tryon`
+/// is the garment on the body.
+fn load_meshes(args: &Args) -> anyhow::Result<(Mesh, Vec<Mesh>, Option<Rig>)> {
     let mut plain = Vec::new();
-    let mesh = if args.mesh.mesh.is_none() && args.mesh.builtin.as_deref() == Some(TRY_ON_NAME) {
+    let (mesh, rig) = if args.mesh.mesh.is_none() && args.mesh.builtin.as_deref() == Some(TRY_ON_NAME) {
         let options = ImportOptions { weld: !args.mesh.no_weld, ..ImportOptions::default() };
         let scene = try_on_scene(&options)?;
         plain.push(scene.body);
-        scene.garment
+        (scene.garment, None)
     } else {
-        args.mesh.load(Builtin::Bunny)?.0
+        let (mesh, _, rig) = args.mesh.load_animated(Builtin::Bunny)?;
+        (mesh, rig)
     };
     for path in &args.plain_mesh {
         plain.push(Mesh::load(path, &ImportOptions::default())?.0);
     }
-    Ok((mesh, plain))
+    Ok((mesh, plain, rig))
 }
 
-/// `--camera`, or a view from the front left that frames the fur (and any plain meshes) tightly.
-fn camera(args: &Args, fur: &FurStructure, plain: &[Mesh], aspect_ratio: f32) -> Camera {
-    let meshes = || std::iter::once(&fur.mesh).chain(plain);
-    let (mut low, mut high) = fur.mesh.bounds();
-    for mesh in plain {
-        let (l, h) = mesh.bounds();
-        (low, high) = (low.min(l), high.max(h));
+/// The animation `--animation` names: by default the first one an animated file has.
+fn choose_animation(args: &Args, rig: Option<&Rig>) -> anyhow::Result<Option<usize>> {
+    let clips = rig.map_or(0, |r| r.animations().len());
+    match (args.animation.as_deref(), rig) {
+        (Some("none"), _) => Ok(None),
+        (Some(name), Some(rig)) if clips > 0 => {
+            rig.find_animation(name).map(Some).map_err(|e| anyhow::anyhow!("--animation: {e}"))
+        }
+        (Some(name), _) => bail!("--animation {name:?}: the mesh has no animations"),
+        (None, _) => Ok((clips > 0).then_some(0)),
     }
+}
+
+/// The base this frame: the rig's pose (or the rest mesh), moved by the script's transform.
+fn pose_base(
+    fur: &FurStructure,
+    rig: Option<&Rig>,
+    clip: Option<usize>,
+    time_secs: f64,
+    world_from_model: Mat4,
+    pose: &mut Pose,
+) {
+    match rig {
+        Some(rig) => rig.pose(&fur.mesh, clip, time_secs, pose),
+        None => {
+            pose.positions.clone_from(&fur.mesh.positions);
+            pose.normals.clone_from(&fur.mesh.normals);
+            pose.rotations.clear();
+            pose.rotations.resize(fur.mesh.vertex_count(), Quat::IDENTITY);
+        }
+    }
+    if world_from_model != Mat4::IDENTITY {
+        let (_, turn, _) = world_from_model.to_scale_rotation_translation();
+        for p in &mut pose.positions {
+            *p = world_from_model.transform_point3(*p);
+        }
+        for n in &mut pose.normals {
+            *n = turn * *n;
+        }
+        for q in &mut pose.rotations {
+            *q = (turn * *q).normalize();
+        }
+    }
+}
+
+/// `--camera`, or a view that frames the fur (and any plain meshes) tightly, wherever the
+/// script's motion takes them: from the preset's `[render]` angles, else from the front left.
+fn camera(
+    args: &Args,
+    preset: &Preset,
+    fur: &FurStructure,
+    plain: &[Mesh],
+    motion: &[pelt_core::sim::MotionKey],
+    frames: u32,
+    aspect_ratio: f32,
+) -> Camera {
+    let meshes = || std::iter::once(&fur.mesh).chain(plain);
+    // The transforms the meshes take: every tenth of a second of the motion (or none).
+    let transforms: Vec<Mat4> = if motion.is_empty() {
+        vec![Mat4::IDENTITY]
+    } else {
+        let secs = f64::from(frames) / args.fps;
+        (0..=(secs * 10.0).ceil() as u32)
+            .filter_map(|k| pelt_core::sim::motion::motion_at(motion, f64::from(k) / 10.0))
+            .collect()
+    };
+    let all_points = || {
+        transforms.iter().flat_map(move |m| {
+            meshes().flat_map(move |mesh| mesh.positions.iter().map(move |p| m.transform_point3(*p)))
+        })
+    };
+    let (low, high) = all_points()
+        .fold((Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)), |(lo, hi), p| (lo.min(p), hi.max(p)));
     let centre = (low + high) * 0.5;
     match args.camera {
         Some(v) => Camera::orbit(centre, v.x, v.y, v.z),
         None => {
-            let points = meshes().flat_map(|mesh| mesh.positions.iter().copied());
+            let points = all_points();
             let fur_length = fur.lengths.iter().copied().fold(0.0, f32::max);
-            Camera::framing_points(centre, points, fur_length, 30.0, 15.0, aspect_ratio)
+            let azimuth = preset.render.camera_azimuth_deg.unwrap_or(30.0);
+            let elevation = preset.render.camera_elevation_deg.unwrap_or(15.0);
+            Camera::framing_points(centre, points, fur_length, azimuth, elevation, aspect_ratio)
         }
     }
 }
@@ -267,6 +408,13 @@ fn parse_size(text: &str) -> Result<(u32, u32), String> {
     match parsed {
         Some((w, h)) if w > 0 && h > 0 => Ok((w, h)),
         _ => Err(format!("expected WIDTHxHEIGHT with both above 0, e.g. 1280x720, got {text:?}")),
+    }
+}
+
+fn parse_msaa(text: &str) -> Result<u32, String> {
+    match text.trim().parse() {
+        Ok(samples @ (1 | 2 | 4 | 8)) => Ok(samples),
+        _ => Err(format!("expected 1, 2, 4 or 8 samples, got {text:?}")),
     }
 }
 
@@ -291,6 +439,8 @@ mod tests {
         assert_eq!(parse_size("1280x720"), Ok((1280, 720)));
         assert!(parse_size("0x5").is_err());
         assert!(parse_size("big").is_err());
+        assert_eq!(parse_msaa("4"), Ok(4));
+        assert!(parse_msaa("3").is_err());
         assert_eq!(parse_vec3("1,-2, 3.5"), Ok(Vec3::new(1.0, -2.0, 3.5)));
         assert!(parse_vec3("1,2").is_err());
         assert!(parse_vec3("1,nan,2").is_err());

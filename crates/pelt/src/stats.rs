@@ -7,6 +7,7 @@ use std::fmt::Write as _;
 use std::io::Write as _;
 
 use anyhow::Context as _;
+use pelt_core::anim::Rig;
 use pelt_core::fur::{Footprint, FurLength, MAX_LAYERS};
 use pelt_core::{Builtin, FurParams, FurStructure, GrowthDirection, MeshReport, SeparatedStructure};
 
@@ -36,19 +37,77 @@ pub struct Stats {
     pub layers: u32,
     /// `N`, faces per fin of the second separated structure.
     pub fin_faces: u32,
+    /// The JSON names structures as `pelt bench --json` does (`unified`, `separated2`;
+    /// `separated_n` has `fin_faces` faces per fin): see "JSON keys" in BENCHMARKS.md.
     pub unified: Footprint,
+    #[serde(rename = "separated2")]
     pub separated_two_face_fins: Footprint,
+    #[serde(rename = "separated_n")]
     pub separated_n_face_fins: Footprint,
     /// How much the unified structure saves, in percent of each separated one.
+    #[serde(flatten)]
     pub savings: Savings,
+    /// Skins, joints and animations, for a file that moves.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub motion: Option<Motion>,
+}
+
+/// What moves in a glTF file.
+#[derive(Debug, serde::Serialize)]
+pub struct Motion {
+    pub skins: Vec<SkinRow>,
+    pub nodes: usize,
+    pub morph_targets: usize,
+    pub animations: Vec<AnimationRow>,
+    /// What was wrong with the skins and animations and how it was handled.
+    pub notes: Vec<String>,
+}
+
+#[derive(Debug, serde::Serialize)]
+pub struct SkinRow {
+    pub name: Option<String>,
+    pub joints: usize,
+}
+
+#[derive(Debug, serde::Serialize)]
+pub struct AnimationRow {
+    pub name: Option<String>,
+    pub duration_secs: f32,
+    pub channels: usize,
+}
+
+impl Motion {
+    /// The report rows of `rig`.
+    #[must_use]
+    pub fn of(rig: &Rig) -> Self {
+        Self {
+            skins: rig.skins().iter().map(|s| SkinRow { name: s.name.clone(), joints: s.joints }).collect(),
+            nodes: rig.nodes().len(),
+            morph_targets: rig.morph_target_count(),
+            animations: rig
+                .animations()
+                .iter()
+                .map(|a| AnimationRow {
+                    name: a.name.clone(),
+                    duration_secs: a.duration_secs(),
+                    channels: a.channels.len(),
+                })
+                .collect(),
+            notes: rig.report().to_vec(),
+        }
+    }
 }
 
 /// Savings of the unified structure, in percent of a separated one.
 #[derive(Debug, serde::Serialize)]
 pub struct Savings {
+    #[serde(rename = "savings_vs_2_percent")]
     pub vertices_vs_two_face_fins_percent: f64,
+    #[serde(rename = "savings_vs_n_percent")]
     pub vertices_vs_n_face_fins_percent: f64,
+    #[serde(rename = "bytes_savings_vs_2_percent")]
     pub gpu_bytes_vs_two_face_fins_percent: f64,
+    #[serde(rename = "bytes_savings_vs_n_percent")]
     pub gpu_bytes_vs_n_face_fins_percent: f64,
 }
 
@@ -57,8 +116,9 @@ pub struct Savings {
 const PAPER_BOX: (u64, u64, u64) = (5_032, 6_796, 31_492);
 
 pub fn run(args: &Args) -> anyhow::Result<()> {
-    let (mesh, report) = args.mesh.load(Builtin::Box)?;
-    let stats = measure(mesh, report, args.layers, args.fin_faces)?;
+    let (mesh, report, rig) = args.mesh.load_animated(Builtin::Box)?;
+    let mut stats = measure(mesh, report, args.layers, args.fin_faces)?;
+    stats.motion = rig.as_ref().map(Motion::of);
     let text = if args.json { serde_json::to_string_pretty(&stats)? + "\n" } else { table(&stats) };
     write_stdout(&text)
 }
@@ -96,7 +156,16 @@ pub fn measure(mesh: pelt_core::Mesh, report: MeshReport, layers: u32, fin_faces
         gpu_bytes_vs_two_face_fins_percent: unified.savings_percent(&separated_two_face_fins, bytes),
         gpu_bytes_vs_n_face_fins_percent: unified.savings_percent(&separated_n_face_fins, bytes),
     };
-    Ok(Stats { mesh: report, layers, fin_faces, unified, separated_two_face_fins, separated_n_face_fins, savings })
+    Ok(Stats {
+        mesh: report,
+        layers,
+        fin_faces,
+        unified,
+        separated_two_face_fins,
+        separated_n_face_fins,
+        savings,
+        motion: None,
+    })
 }
 
 /// The human-readable report; on the built-in Box it adds the paper's printed numbers.
@@ -105,6 +174,9 @@ pub fn table(stats: &Stats) -> String {
     let mut out = String::new();
     let r = &stats.mesh;
     let _ = writeln!(out, "{r}");
+    if let Some(motion) = &stats.motion {
+        motion_table(&mut out, motion);
+    }
     let _ = writeln!(out);
     let _ = writeln!(
         out,
@@ -167,6 +239,36 @@ pub fn table(stats: &Stats) -> String {
     out
 }
 
+/// Skins, joints and animations with their durations.
+fn motion_table(out: &mut String, motion: &Motion) {
+    let name = |n: &Option<String>| n.as_deref().map_or_else(|| "(unnamed)".to_owned(), |n| format!("{n:?}"));
+    let joints: usize = motion.skins.iter().map(|s| s.joints).sum();
+    let _ = writeln!(
+        out,
+        "  {} skins, {} joints, {} nodes, {} morph targets, {} animations",
+        motion.skins.len(),
+        joints,
+        motion.nodes,
+        motion.morph_targets,
+        motion.animations.len()
+    );
+    for (k, skin) in motion.skins.iter().enumerate() {
+        let _ = writeln!(out, "    skin {k} {}: {} joints", name(&skin.name), skin.joints);
+    }
+    for (k, animation) in motion.animations.iter().enumerate() {
+        let _ = writeln!(
+            out,
+            "    animation {k} {}: {:.3} s, {} channels",
+            name(&animation.name),
+            animation.duration_secs,
+            animation.channels
+        );
+    }
+    for note in &motion.notes {
+        let _ = writeln!(out, "    note: {note}");
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -205,9 +307,11 @@ mod tests {
         let v = stats.mesh.vertices as u64;
         let e = stats.mesh.edges as u64;
         assert_eq!(json["unified"]["vertices"], v * 5);
-        assert_eq!(json["separated_n_face_fins"]["vertices"], v * 5 + 30 * e);
+        assert_eq!(json["separated_n"]["vertices"], v * 5 + 30 * e);
+        assert_eq!(json["separated2"]["vertices"], v * 5 + 2 * e);
         assert_eq!(json["mesh"]["boundary_loops"], 1);
-        assert!(json["savings"]["vertices_vs_n_face_fins_percent"].as_f64().unwrap() > 0.0);
+        assert!(json["savings_vs_n_percent"].as_f64().unwrap() > 0.0);
+        assert!(json["bytes_savings_vs_2_percent"].as_f64().unwrap() > 0.0);
     }
 
     #[test]

@@ -40,6 +40,10 @@ pub struct Args {
     /// Start with the overlay (timings, sizes, brush and hints) hidden; O shows it.
     #[arg(long)]
     pub no_overlay: bool,
+    /// Where the fur is simulated: the CPU, the GPU (a compute pass), or auto (both timed on
+    /// this fur when the window opens, the faster runs). The panel switches it live.
+    #[arg(long, value_enum, default_value_t = crate::sim_kernel::SimChoice::Auto)]
+    pub sim: crate::sim_kernel::SimChoice,
     /// Window size in logical pixels, `WIDTHxHEIGHT`.
     #[arg(long, value_name = "WxH", default_value = "1280x800", value_parser = parse_size)]
     pub size: [u32; 2],
@@ -56,14 +60,15 @@ fn parse_size(text: &str) -> Result<[u32; 2], String> {
 
 pub fn run(args: &Args) -> anyhow::Result<()> {
     // `--builtin tryon` (as in `pelt render`) is the furry skirt on a body; the app loads it.
-    let (mesh, report) =
+    let (mesh, report, rig) =
         if args.mesh.mesh.is_none() && args.mesh.builtin.as_deref() == Some(pelt_core::mesh::builtin::TRY_ON_NAME) {
-            pelt_core::Builtin::Plane.mesh()
+            let (mesh, report) = pelt_core::Builtin::Plane.mesh();
+            (mesh, report, None)
         } else {
-            args.mesh.load(pelt_core::Builtin::Bunny)?
+            args.mesh.load_animated(pelt_core::Builtin::Bunny)?
         };
     // Files and presets are checked before the display is opened, so their errors come first.
-    let mut app = app::App::new(args, mesh, report.source)?;
+    let mut app = app::App::new(args, mesh, rig, report.source)?;
     let event_loop = winit::event_loop::EventLoop::new()
         .context("opening the display (is DISPLAY or WAYLAND_DISPLAY set? under CI use xvfb-run)")?;
     event_loop.run_app(&mut app).context("running the window's event loop")?;

@@ -5,7 +5,7 @@ use std::process::Command;
 
 use serde_json::Value;
 
-const TOP_LEVEL_KEYS: [&str; 14] = [
+const TOP_LEVEL_KEYS: [&str; 16] = [
     "pelt_version",
     "date_utc",
     "command",
@@ -16,6 +16,8 @@ const TOP_LEVEL_KEYS: [&str; 14] = [
     "adapter_unavailable_reason",
     "paper_savings_vs_2_percent",
     "paper_savings_vs_30_percent",
+    "sim_cpu_kernel",
+    "sim_large_mesh",
     "results",
     "skipped_models",
     "peak_rss_bytes",
@@ -27,7 +29,7 @@ const COUNT_KEYS: [&str; 14] = [
     "faces",
     "fur_vertices",
     "fur_edges",
-    "shared_vertices",
+    "unified_vertices",
     "separated2_vertices",
     "separated30_vertices",
     "unified_faces",
@@ -43,7 +45,7 @@ const PERCENT_KEYS: [&str; 4] =
     ["savings_vs_2_percent", "savings_vs_30_percent", "bytes_savings_vs_2_percent", "bytes_savings_vs_30_percent"];
 
 /// Measured figures, grouped by the key that says why they are null when they are.
-const MEASURED_KEYS: [(&str, &[&str]); 3] = [
+const MEASURED_KEYS: [(&str, &[&str]); 4] = [
     (
         "render_unavailable_reason",
         &[
@@ -55,18 +57,24 @@ const MEASURED_KEYS: [(&str, &[&str]); 3] = [
             "frame_ms_separated30_256x256",
             "render_frames",
             "upload_ms_per_frame",
+            "fin_edges_drawn",
         ],
     ),
     (
         "sim_unavailable_reason",
         &[
             "sim_node_updates_per_sec",
+            "sim_node_updates_per_sec_all_threads",
             "sim_literal_node_updates_per_sec",
             "sim_cpu_ms_per_frame_interpolated",
             "sim_cpu_ms_per_frame_every_frame",
         ],
     ),
     ("texture_unavailable_reason", &["texture_generation_ms", "texture_size_texels"]),
+    (
+        "gpu_sim_unavailable_reason",
+        &["gpu_sim_node_updates_per_sec", "gpu_sim_steps_per_run", "gpu_sim_cpu_ms_per_frame"],
+    ),
 ];
 
 fn count(row: &Value, key: &str) -> u64 {
@@ -104,6 +112,15 @@ fn quick_bench_writes_every_key_with_sane_values() {
         assert!(report["peak_rss_bytes"].as_u64().is_some_and(|b| b > 1 << 20));
     }
 
+    let kernel = report["sim_cpu_kernel"].as_str().unwrap();
+    assert!(kernel == "avx2+fma" || kernel == "portable", "{kernel}");
+    let large = &report["sim_large_mesh"];
+    assert_eq!(large["vertices"], 35_000);
+    assert_eq!(large["layers"], 32);
+    for key in ["sim_node_updates_per_sec", "sim_node_updates_per_sec_all_threads"] {
+        assert!(large[key].as_f64().is_some_and(|v| v.is_finite() && v > 0.0), "{key} in {large}");
+    }
+
     let results = report["results"].as_array().unwrap();
     let models: Vec<&str> = results.iter().map(|r| r["model"].as_str().unwrap()).collect();
     for model in ["box", "bunny", "spot", "skirt", "women"] {
@@ -117,7 +134,7 @@ fn quick_bench_writes_every_key_with_sane_values() {
         let layers = count(row, "layers");
         let body = count(row, "vertices") - count(row, "fur_vertices");
         let shared = count(row, "fur_vertices") * (layers + 1) + body;
-        assert_eq!(count(row, "shared_vertices"), shared, "{row}");
+        assert_eq!(count(row, "unified_vertices"), shared, "{row}");
         assert_eq!(count(row, "separated2_vertices"), shared + 2 * count(row, "fur_edges"), "{row}");
         assert_eq!(count(row, "separated30_vertices"), shared + 30 * count(row, "fur_edges"), "{row}");
         assert!(count(row, "unified_bytes") < count(row, "separated2_bytes"), "{row}");
@@ -147,7 +164,7 @@ fn quick_bench_writes_every_key_with_sane_values() {
     let box16 = results.iter().find(|r| r["model"] == "box" && r["layers"] == 16).unwrap();
     assert_eq!(count(box16, "vertices"), 296);
     assert_eq!(count(box16, "faces"), 588);
-    assert_eq!(count(box16, "shared_vertices"), 5_032);
+    assert_eq!(count(box16, "unified_vertices"), 5_032);
     assert_eq!(count(box16, "separated2_vertices"), 6_796);
     assert_eq!(count(box16, "separated30_vertices"), 31_492);
 

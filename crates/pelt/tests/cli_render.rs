@@ -78,3 +78,73 @@ fn bad_arguments_are_clear_errors() {
         assert!(text(&output).contains(message), "{args:?}: {}", text(&output));
     }
 }
+
+/// `--sim gpu` draws what `--sim cpu` draws (a windy sequence, so the fur moves), and the summary
+/// says which kernel ran; `auto` says what it measured.
+#[test]
+fn the_gpu_simulation_renders_what_the_cpu_one_does() {
+    let dir = temp_dir("sim");
+    let common = ["render", "--builtin", "bunny", "--size", "128x96", "--frames", "4", "--wind", "2,0,1"];
+    let mut frames = Vec::new();
+    for kernel in ["cpu", "gpu"] {
+        let output = pelt(&[&common[..], &["--sim", kernel, "-o", kernel]].concat(), &dir);
+        assert!(output.status.success(), "{}", text(&output));
+        let upper = kernel.to_ascii_uppercase();
+        assert!(text(&output).contains(&format!("on the {upper} (--sim {kernel})")), "{}", text(&output));
+        frames.push(image::open(dir.join(kernel).join("frame_0004.png")).expect("frame").to_rgba8());
+    }
+    let differing = frames[0].pixels().zip(frames[1].pixels()).filter(|(a, b)| a != b).count();
+    let fraction = differing as f64 / f64::from(frames[0].width() * frames[0].height());
+    assert!(fraction < 0.01, "{:.2}% of the pixels differ between the kernels", fraction * 100.0);
+    let output = pelt(&["render", "--builtin", "box", "--size", "32x32", "--sim", "auto"], &dir);
+    assert!(output.status.success(), "{}", text(&output));
+    assert!(text(&output).contains("(auto: GPU "), "{}", text(&output));
+}
+
+fn png(dir: &Path, name: &str) -> image::RgbaImage {
+    image::open(dir.join(name)).unwrap_or_else(|e| panic!("{name}: {e}")).to_rgba8()
+}
+
+/// Pixels whose colour differs by more than a small amount.
+fn differing_fraction(a: &image::RgbaImage, b: &image::RgbaImage) -> f64 {
+    let differ =
+        a.pixels().zip(b.pixels()).filter(|(p, q)| p.0.iter().zip(q.0).any(|(x, y)| x.abs_diff(y) > 24)).count();
+    differ as f64 / f64::from(a.width() * a.height())
+}
+
+#[test]
+fn the_fox_walks_and_unknown_animations_list_the_real_ones() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let fox = root.join("assets/meshes/Fox.glb");
+    let fox = fox.to_str().unwrap();
+    let dir = temp_dir("fox");
+    // Walk frames 1 and 6 (a sixth of a second apart) differ; `none` renders the rest pose.
+    let walk = ["render", fox, "--animation", "Walk", "--size", "160x120", "--frames", "6", "-o", "walk"];
+    let output = pelt(&walk, &dir);
+    assert!(output.status.success(), "{}", text(&output));
+    let output = pelt(&["render", fox, "--animation", "none", "--size", "160x120", "-o", "rest.png"], &dir);
+    assert!(output.status.success(), "{}", text(&output));
+    let (first, later) = (png(&dir, "walk/frame_0001.png"), png(&dir, "walk/frame_0006.png"));
+    let moved = differing_fraction(&first, &later);
+    assert!(moved > 0.01, "the walk moves the fox: {moved}");
+    let output = pelt(&["render", fox, "--animation", "Dance", "-o", "x.png"], &dir);
+    assert!(!output.status.success());
+    assert!(text(&output).contains("Survey") && text(&output).contains("Walk"), "{}", text(&output));
+    let output = pelt(&["render", "--builtin", "torus", "--animation", "Walk", "-o", "x.png"], &dir);
+    assert!(!output.status.success() && text(&output).contains("no animations"), "{}", text(&output));
+}
+
+#[test]
+fn the_catwalk_script_moves_the_body_and_the_skirt_together() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let script = root.join("assets/scenes/catwalk.toml");
+    let dir = temp_dir("catwalk");
+    // Frames at 0, 2, 4 and 6 seconds: walking, turned, walking back.
+    let args = ["render", "--builtin", "tryon", "--script", script.to_str().unwrap(), "--fps", "0.5", "--frames", "4"];
+    let output = pelt(&[&args[..], &["--size", "96x128", "-o", "cat"]].concat(), &dir);
+    assert!(output.status.success(), "{}", text(&output));
+    let frames: Vec<_> = (1..=4).map(|k| png(&dir, &format!("cat/frame_{k:04}.png"))).collect();
+    for pair in frames.windows(2) {
+        assert!(differing_fraction(&pair[0], &pair[1]) > 0.01, "every frame shows her elsewhere");
+    }
+}

@@ -89,10 +89,20 @@ fn mean_difference(a: &image::RgbaImage, b: &image::RgbaImage, (x0, y0, x1, y1):
 
 #[test]
 fn a_scripted_touch_flattens_the_fur_where_it_presses_and_nowhere_else() {
+    scripted_touch("cpu");
+}
+
+/// The same with the strands bent by the GPU simulation's compute pass.
+#[test]
+fn a_scripted_touch_flattens_the_fur_on_the_gpu_too() {
+    scripted_touch("gpu");
+}
+
+fn scripted_touch(kernel: &str) {
     // The plane (2 x 2, facing +Y, centred on the origin) is framed in the middle of the 3D view,
     // so the origin lands at the view's centre. The stroke presses there and drags along +X
     // within the first second and holds until after the screenshot.
-    let script = Path::new(env!("CARGO_TARGET_TMPDIR")).join("cli_view_touch.toml");
+    let script = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("cli_view_touch_{kernel}.toml"));
     std::fs::write(
         &script,
         "[[stroke]]\nstart_secs = 0.0\nend_secs = 3.0\nradius = 0.5\n\
@@ -100,15 +110,15 @@ fn a_scripted_touch_flattens_the_fur_where_it_presses_and_nowhere_else() {
     )
     .unwrap();
     // Long upright fur, so a pat shows plainly.
-    let preset = Path::new(env!("CARGO_TARGET_TMPDIR")).join("cli_view_touch_preset.toml");
+    let preset = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("cli_view_touch_preset_{kernel}.toml"));
     std::fs::write(&preset, "length = 0.2\n[direction]\nrandom_angle_deg = 0.0\ncomb_blend = 0.0\n").unwrap();
     let preset = preset.to_str().unwrap();
     let frames = 60;
     // Without the overlay, so only the fur can differ (not the timings or the brush).
-    let base = ["--builtin", "plane", "--no-overlay", "--preset", preset];
-    let untouched = screenshot("untouched", frames, &base);
+    let base = ["--builtin", "plane", "--no-overlay", "--preset", preset, "--sim", kernel];
+    let untouched = screenshot(&format!("untouched-{kernel}"), frames, &base);
     let script = script.to_str().unwrap();
-    let touched = screenshot("touched", frames, &[&base[..], &["--script", script]].concat());
+    let touched = screenshot(&format!("touched-{kernel}"), frames, &[&base[..], &["--script", script]].concat());
     let view_centre = ((WIDTH_PX - PANEL_PX) / 2, HEIGHT_PX / 2);
     let around = |half: u32, dy: i32| {
         let y = (view_centre.1 as i32 + dy) as u32;
@@ -118,7 +128,7 @@ fn a_scripted_touch_flattens_the_fur_where_it_presses_and_nowhere_else() {
     // Fur at the plane's left and far corners, well outside the touch radius.
     let left_corner = mean_difference(&untouched, &touched, (75, 315, 135, 335));
     let background = mean_difference(&untouched, &touched, (200, 470, 600, 560));
-    println!("pressed {pressed:.2}, left corner {left_corner:.2}, background {background:.2}");
+    println!("{kernel}: pressed {pressed:.2}, left corner {left_corner:.2}, background {background:.2}");
     assert!(pressed > 8.0, "the fur under the touch changed: {pressed:.2}");
     assert!(left_corner < pressed / 8.0, "fur far from the touch stays put: {left_corner:.2} vs {pressed:.2}");
     assert!(background < 0.5, "the background is untouched: {background:.2}");
@@ -139,4 +149,15 @@ fn a_missing_preset_or_script_is_named_before_any_window_opens() {
         let stderr = String::from_utf8_lossy(&output.stderr);
         assert!(stderr.contains(file), "{flag}: the error names the file: {stderr}");
     }
+}
+
+#[test]
+fn an_animated_file_moves_in_the_window() {
+    let fox = concat!(env!("CARGO_MANIFEST_DIR"), "/../../assets/meshes/Fox.glb");
+    // The first clip (Survey) plays at 60 fixed frames a second: a second apart, the fox has moved.
+    let early = screenshot("fox_early", 3, &[fox]);
+    let later = screenshot("fox_later", 63, &[fox]);
+    let view = (0, 0, WIDTH_PX - PANEL_PX, HEIGHT_PX);
+    let moved = mean_difference(&early, &later, view);
+    assert!(moved > 0.5, "the animation moves the fox: mean difference {moved}");
 }

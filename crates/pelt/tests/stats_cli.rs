@@ -56,3 +56,24 @@ fn bad_input_fails_with_a_message_not_a_panic() {
         assert!(!message.contains("panicked"), "{args:?}: {message}");
     }
 }
+
+#[test]
+fn an_animated_file_lists_its_skins_joints_and_animations() {
+    let output = pelt(&["stats", "assets/meshes/Fox.glb"]);
+    assert!(output.status.success(), "{}", stderr(&output));
+    let text = stdout(&output);
+    assert!(text.contains("1 skins, 24 joints"), "{text}");
+    for clip in ["animation 0 \"Survey\"", "animation 1 \"Walk\": 0.708 s", "animation 2 \"Run\""] {
+        assert!(text.contains(clip), "{clip} in {text}");
+    }
+    let output = pelt(&["stats", "assets/meshes/Fox.glb", "--json"]);
+    let json: serde_json::Value = serde_json::from_slice(&output.stdout).expect("valid JSON");
+    assert_eq!(json["motion"]["skins"][0]["joints"], 24);
+    let walk = &json["motion"]["animations"][1];
+    assert_eq!(walk["name"], "Walk");
+    assert!(walk["duration_secs"].as_f64().unwrap() > 0.5, "{walk}");
+    // A file that does not move has no motion section.
+    let output = pelt(&["stats", "assets/meshes/skirthelper.obj", "--json"]);
+    let json: serde_json::Value = serde_json::from_slice(&output.stdout).expect("valid JSON");
+    assert!(json.get("motion").is_none());
+}

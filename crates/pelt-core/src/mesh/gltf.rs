@@ -12,6 +12,7 @@ use glam::{Mat3, Mat4, Vec2, Vec3};
 use gltf::mesh::Mode;
 
 use super::{MeshError, RawMesh};
+use crate::anim::{RawRig, Span, read_rig};
 
 /// Deeper node hierarchies than this are treated as broken (and cannot blow the stack).
 const MAX_NODE_DEPTH: usize = 256;
@@ -24,9 +25,25 @@ pub(super) fn load(path: &Path) -> Result<RawMesh, MeshError> {
 /// Parses `.gltf` JSON or `.glb` bytes. External buffers are looked up next to `base`; without
 /// a `base` only embedded (GLB or `data:` URI) buffers can be read.
 pub(super) fn parse(bytes: &[u8], file: &Path, base: Option<&Path>) -> Result<RawMesh, MeshError> {
+    parse_with_rig(bytes, file, base, false).map(|(raw, _)| raw)
+}
+
+/// Reads the whole file: [`load`] plus its rig (nodes, skins, morph targets, animations).
+pub(super) fn load_with_rig(path: &Path) -> Result<(RawMesh, Option<RawRig>), MeshError> {
+    let bytes = std::fs::read(path).map_err(|error| MeshError::Io { file: path.to_path_buf(), error })?;
+    parse_with_rig(&bytes, path, path.parent(), true)
+}
+
+/// [`parse`], with the rig when `with_rig` is set.
+pub(super) fn parse_with_rig(
+    bytes: &[u8],
+    file: &Path,
+    base: Option<&Path>,
+    with_rig: bool,
+) -> Result<(RawMesh, Option<RawRig>), MeshError> {
     // The `gltf` crate's validation indexes unchecked in places (gltf-json 1.4.1 panics on a
     // primitive whose attribute map is emptied, for one); a broken file must stay an error.
-    std::panic::catch_unwind(|| parse_unguarded(bytes, file, base)).unwrap_or_else(|_| {
+    std::panic::catch_unwind(|| parse_unguarded(bytes, file, base, with_rig)).unwrap_or_else(|_| {
         Err(MeshError::Parse {
             file: file.to_path_buf(),
             line: None,
@@ -35,7 +52,12 @@ pub(super) fn parse(bytes: &[u8], file: &Path, base: Option<&Path>) -> Result<Ra
     })
 }
 
-fn parse_unguarded(bytes: &[u8], file: &Path, base: Option<&Path>) -> Result<RawMesh, MeshError> {
+fn parse_unguarded(
+    bytes: &[u8],
+    file: &Path,
+    base: Option<&Path>,
+    with_rig: bool,
+) -> Result<(RawMesh, Option<RawRig>), MeshError> {
     let error = |message: String| MeshError::Parse { file: file.to_path_buf(), line: None, message };
     let gltf::Gltf { document, blob } =
         gltf::Gltf::from_slice(bytes).map_err(|e| error(format!("not valid glTF: {e}")))?;
@@ -49,14 +71,15 @@ fn parse_unguarded(bytes: &[u8], file: &Path, base: Option<&Path>) -> Result<Raw
                 collect(&node, Mat4::IDENTITY, 0, &mut parts).map_err(error)?;
             }
         }
-        None => parts.extend(document.meshes().map(|mesh| (mesh, Mat4::IDENTITY))),
+        None => parts.extend(document.meshes().map(|mesh| (mesh, Mat4::IDENTITY, None, None))),
     }
 
     let mut raw = RawMesh::default();
     let mut normals = Some(Vec::new());
     let mut uvs = Some(Vec::new());
     let mut skipped_primitives = 0;
-    for (mesh, world_from_local) in parts {
+    let mut spans = Vec::new();
+    for (mesh, world_from_local, node, skin) in parts {
         for primitive in mesh.primitives() {
             let mode = primitive.mode();
             if !matches!(mode, Mode::Triangles | Mode::TriangleStrip | Mode::TriangleFan) {
@@ -80,6 +103,15 @@ fn parse_unguarded(bytes: &[u8], file: &Path, base: Option<&Path>) -> Result<Raw
                 return Err(error(format!("{} uses vertex index {bad}, but it has only {count} vertices", name())));
             }
             let base_index = raw.positions.len() as u32;
+            spans.push(Span {
+                node,
+                skin,
+                mesh: mesh.index(),
+                primitive: primitive.index(),
+                first_vertex: base_index,
+                count,
+                world_from_local,
+            });
             // A mirroring transform turns the winding inside out; swap two corners to undo it.
             let mirrored = world_from_local.determinant() < 0.0;
             for tri in triangles(mode, &indices) {
@@ -106,23 +138,23 @@ fn parse_unguarded(bytes: &[u8], file: &Path, base: Option<&Path>) -> Result<Raw
     }
     raw.normals = normals;
     raw.uvs = uvs;
-    Ok(raw)
+    let rig = if with_rig { read_rig(&document, &buffers, &spans, raw.positions.len()).map_err(error)? } else { None };
+    Ok((raw, rig))
 }
 
+/// A mesh to import with its world transform, node and skin.
+type Part<'a> = (gltf::Mesh<'a>, Mat4, Option<usize>, Option<usize>);
+
 /// Walks `node` and its children, collecting each mesh with its world transform.
-fn collect<'a>(
-    node: &gltf::Node<'a>,
-    parent: Mat4,
-    depth: usize,
-    parts: &mut Vec<(gltf::Mesh<'a>, Mat4)>,
-) -> Result<(), String> {
+fn collect<'a>(node: &gltf::Node<'a>, parent: Mat4, depth: usize, parts: &mut Vec<Part<'a>>) -> Result<(), String> {
     if depth > MAX_NODE_DEPTH {
         return Err(format!("node {} is nested more than {MAX_NODE_DEPTH} deep (a cycle?)", node.index()));
     }
     let world_from_local = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
     if let Some(mesh) = node.mesh() {
-        let transform = if node.skin().is_some() { Mat4::IDENTITY } else { world_from_local };
-        parts.push((mesh, transform));
+        let skin = node.skin().map(|s| s.index());
+        let transform = if skin.is_some() { Mat4::IDENTITY } else { world_from_local };
+        parts.push((mesh, transform, Some(node.index()), skin));
     }
     for child in node.children() {
         collect(&child, world_from_local, depth + 1, parts)?;

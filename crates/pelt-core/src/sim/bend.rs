@@ -15,6 +15,10 @@
 //! factors over a strand is about `|F| * BEND_GAIN / (2 * stability)` for any `L`). A zero force
 //! or a force parallel or opposite to a segment (zero cross product) turns nothing.
 //!
+//! This is [`Equation::Pelt`](super::Equation); [`Simulation`](super::Simulation) also offers the
+//! paper's literal gain ([`Equation::Paper`](super::Equation)) and runs a batched SIMD form of the
+//! same bend (`sim/kernel.rs`, with an exact closed form for straight strands).
+//!
 //! Since each rotation applies to every later segment, segment `k` ends up as
 //! `R_k * R_(k-1) * ... * R_0 * S_k`: [`bend_strand`] keeps that product as a running
 //! quaternion (O(L)); [`bend_strand_literal`] rotates the remaining nodes one by one (O(L^2)),

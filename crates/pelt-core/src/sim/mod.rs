@@ -8,34 +8,55 @@
 //! - [`mod@pick`]: ray picking of the base mesh, so a pointer or a script can touch the fur.
 //! - [`simulation`]: [`Simulation`], fixed steps with linear interpolation between the last two.
 //! - [`scene`]: scripted wind and touch strokes ([`Scene`]), reproducible frame by frame.
+//! - [`motion`]: scripted rigid motion of the meshes (`[[motion]]` keys of a [`Scene`]).
+//! - [`inertia`]: the force from the roots' acceleration on a moving body ([`Inertia`]).
+//! - [`mod@soak`]: many steps under extreme, changing inputs for any kernel ([`SoakSubject`]).
+//!
+//! `Simulation` bends with a batched kernel (8 strands per AVX2 register, an exact closed form
+//! for straight strands, the running quaternion for curved ones; AVX2 + FMA where the CPU has
+//! them, a portable copy giving the same bytes elsewhere: [`CpuKernel`]).
 //!
 //! The model is quasi-static, as in the paper: a strand's pose is a function of the force on it,
-//! with no velocity. So a state at time `t` never depends on earlier states, which makes every
-//! step deterministic, parallel over strands, and cheap to jump to any time.
+//! with no velocity. So a state at time `t` depends on earlier states only through the inertial
+//! force (a damped spring per strand, reset by a jump in time), which keeps every step
+//! deterministic, parallel over strands, and cheap to jump to any time.
 
-mod batch;
 pub mod bend;
+mod dispatch;
 pub mod field;
+pub mod inertia;
+mod kernel;
+mod lanes;
+pub mod motion;
 pub mod pick;
 pub mod scene;
 pub mod simulation;
+pub mod soak;
 pub mod wind;
 
 use glam::Vec3;
 
 pub use bend::{BEND_GAIN, bend_strand, bend_strand_literal, bend_weight};
+pub use dispatch::CpuKernel;
 pub use field::{ForceField, Touch};
+pub use inertia::Inertia;
+pub use motion::{Ease, MotionKey};
 pub use pick::{Hit, pick};
 pub use scene::{Scene, SceneError, Stroke, WindKey};
 pub use simulation::{SimError, Simulation};
+pub use soak::{SoakReport, SoakStep, SoakSubject, soak};
 pub use wind::{WindParams, value_noise3};
 
 /// Simulation parameters; part of a fur preset (`[simulation]` table).
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct SimParams {
-    /// Stiffness: larger is stiffer (the paper's `stability`). Default 8.
+    /// Stiffness: larger is stiffer (the paper's `stability`). Default 8. Under the default
+    /// [`Equation::Pelt`] this is not the paper's number: see [`Equation`] for the conversion.
     pub stability: f32,
+    /// Which form of the paper's Equation 1 bends the fur (`"pelt"`, the default, or
+    /// `"paper"`).
+    pub equation: Equation,
     /// Unit gravity direction. Default `-Y`.
     pub gravity_direction: Vec3,
     /// Gravity strength (0 turns gravity off). Default 1: with the default stability and 16
@@ -49,19 +70,77 @@ pub struct SimParams {
     pub wind: WindParams,
     /// Touch (`[simulation.touch]`).
     pub touch: TouchParams,
+    /// How strongly the fur lags behind the body's acceleration: the inertial force is
+    /// `-inertia * acceleration / radius` (acceleration in bounding radii per second squared,
+    /// force in gravity's units). 0 turns it off. Default 0.05.
+    pub inertia: f32,
+    /// Damping ratio of the fur's swing after the body's motion changes: below 1 it swings past
+    /// and settles, 1 or more it settles without swinging. Default 0.3.
+    pub damping: f32,
 }
 
 impl Default for SimParams {
     fn default() -> Self {
         Self {
             stability: 8.0,
+            equation: Equation::Pelt,
             gravity_direction: Vec3::NEG_Y,
             gravity_strength: 1.0,
             rate_hz: 30.0,
             interpolate: true,
             wind: WindParams::default(),
             touch: TouchParams::default(),
+            inertia: 0.05,
+            damping: 0.3,
         }
+    }
+}
+
+/// The form of the paper's Equation 1 (`equation` in `[simulation]`).
+///
+/// Root first, at node `k` of a strand of `L` segments, with `a_k` the angle between segment `k`
+/// and the force `F` (the paper's `acos(V . V2)`, computed as `atan2`, so clamped by
+/// construction) and `RN = L - k` the nodes not yet visited, the strand beyond node `k` turns
+/// toward the force by `theta_k = a_k * min(1, |F| * gain * RN / stability)`:
+///
+/// | equation | gain | at gravity strength 1 |
+/// |---|---|---|
+/// | `pelt` | `BEND_GAIN / L^2` (`8 / L^2`) | `a_k * min(1, 8 RN / (L^2 stability))` |
+/// | `paper` | `1` | `a_k * min(1, RN / stability)`: the paper's Equation 1 |
+///
+/// Both scale the angle by the force's magnitude (so wind and touch bend by their strength, as
+/// the paper's section on forces asks; gravity of strength 1 is the paper's Equation 1 exactly)
+/// and clamp the factor at 1 so no segment turns past the force. `pelt` divides by `L^2` so a
+/// fur bends about as much at any layer count (the factors of one strand sum to about
+/// `|F| * 4 / stability`), and its gain of 8 puts the default stability 8 at a visible droop.
+/// The two agree exactly when `stability_paper = stability_pelt * L^2 / 8`: Pelt's default 8 is
+/// the paper's 256 at `L = 16` and 1,024 at `L = 32`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Equation {
+    /// `gain = 8 / L^2`: the bend hardly depends on the layer count. The default.
+    #[default]
+    Pelt,
+    /// `gain = 1`: the paper's literal `acos(V . V2) * RN / stability`, for reproducing its
+    /// figures.
+    Paper,
+}
+
+impl Equation {
+    /// The gain of this form for `layers` segments (see [`Equation`]).
+    #[must_use]
+    pub fn gain(self, layers: u32) -> f32 {
+        match self {
+            Self::Pelt => BEND_GAIN / (layers.max(1) as f32).powi(2),
+            Self::Paper => 1.0,
+        }
+    }
+
+    /// The stability that gives the same bend under [`Equation::Paper`] as `stability` does
+    /// under [`Equation::Pelt`] at `layers` (`stability * L^2 / 8`).
+    #[must_use]
+    pub fn paper_stability_from_pelt(stability: f32, layers: u32) -> f32 {
+        stability * (layers as f32).powi(2) / BEND_GAIN
     }
 }
 
@@ -125,6 +204,12 @@ impl SimParams {
         if !(self.touch.release_secs.is_finite() && (0.0..=60.0).contains(&self.touch.release_secs)) {
             return error("touch.release_secs", format!("must be between 0 and 60, got {}", self.touch.release_secs));
         }
+        if !(self.inertia.is_finite() && (0.0..=100.0).contains(&self.inertia)) {
+            return error("inertia", format!("must be between 0 and 100, got {}", self.inertia));
+        }
+        if !(self.damping.is_finite() && (0.0..=100.0).contains(&self.damping)) {
+            return error("damping", format!("must be between 0 and 100, got {}", self.damping));
+        }
         Ok(())
     }
 }
@@ -152,6 +237,10 @@ mod tests {
         assert_eq!(params.validate().unwrap_err().key, "simulation.touch.release_secs");
         let params = SimParams { stability: 0.0, ..SimParams::default() };
         assert_eq!(params.validate().unwrap_err().key, "simulation.stability");
+        let params = SimParams { inertia: -1.0, ..SimParams::default() };
+        assert_eq!(params.validate().unwrap_err().key, "simulation.inertia");
+        let params = SimParams { damping: f32::INFINITY, ..SimParams::default() };
+        assert_eq!(params.validate().unwrap_err().key, "simulation.damping");
         assert!(toml::from_str::<SimParams>("[wind]\nspeeed = 1.0").is_err());
     }
 }

@@ -16,6 +16,12 @@
 //! end_secs = 2.0
 //! radius = 0.8                     # world units
 //! path = [[0.0, 5.0, 2.6], [0.0, 3.5, 2.6]]
+//!
+//! [[motion]]                       # rigid motion of the meshes, see `sim::motion`
+//! time_secs = 0.0
+//! translation = [0.0, 0.0, 0.0]
+//! rotation_deg = [0.0, 0.0, 0.0]
+//! ease = "in_out"
 //! ```
 //!
 //! Stroke points are world positions, on or near the base surface, which keeps a script
@@ -24,13 +30,16 @@
 //! the stroke's time. Wind settings not in a key (gust size and speed, seed, jitter rate) come
 //! from the simulation's parameters.
 //!
-//! Drive it as `scene.apply(t, &mut sim)?; sim.advance_to(t);` every frame.
+//! Drive it as `scene.apply(t, &mut sim)?; sim.advance_to(t);` every frame; with `[[motion]]`
+//! keys, move the base with [`Scene::motion_at`] first (`Simulation::set_base_rotations`), and
+//! draw the plain meshes with the same transform.
 
 use std::path::{Path, PathBuf};
 
-use glam::Vec3;
+use glam::{Mat4, Vec3};
 
 use super::MAX_FORCE;
+use super::motion::{self, MotionKey};
 use super::simulation::{SimError, Simulation};
 
 /// Errors from reading a scene; each names the file and, where it can, the key.
@@ -134,6 +143,9 @@ pub struct Scene {
     /// Touch strokes.
     #[serde(default, rename = "stroke")]
     pub strokes: Vec<Stroke>,
+    /// Rigid motion keyframes of the meshes, sorted by time.
+    #[serde(default)]
+    pub motion: Vec<MotionKey>,
 }
 
 impl Scene {
@@ -194,6 +206,7 @@ impl Scene {
             range(format!("wind[{i}].gust_strength"), key.gust_strength, 0.0, 1.0)?;
             range(format!("wind[{i}].jitter"), key.jitter, 0.0, 1.0)?;
         }
+        motion::validate(&self.motion)?;
         for (i, stroke) in self.strokes.iter().enumerate() {
             finite_time(format!("stroke[{i}].start_secs"), stroke.start_secs)?;
             finite_time(format!("stroke[{i}].end_secs"), stroke.end_secs)?;
@@ -216,7 +229,8 @@ impl Scene {
     pub fn duration_secs(&self) -> f64 {
         self.duration_secs.unwrap_or_else(|| {
             let wind = self.wind.last().map_or(0.0, |k| k.time_secs);
-            self.strokes.iter().map(|s| s.end_secs).fold(wind, f64::max)
+            let motion = self.motion.last().map_or(0.0, |k| k.time_secs);
+            self.strokes.iter().map(|s| s.end_secs).fold(wind.max(motion), f64::max)
         })
     }
 
@@ -242,6 +256,12 @@ impl Scene {
                 })
             }
         }
+    }
+
+    /// The meshes' rigid transform at `time_secs` (`None` when the scene has no motion keys).
+    #[must_use]
+    pub fn motion_at(&self, time_secs: f64) -> Option<Mat4> {
+        motion::motion_at(&self.motion, time_secs)
     }
 
     /// The stroke active at `time_secs` (the last one listed, where several overlap).

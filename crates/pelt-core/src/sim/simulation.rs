@@ -1,13 +1,21 @@
 //! [`Simulation`]: the strands of a [`FurStructure`] under gravity, wind and touch, stepped at a
 //! fixed rate and drawn as `lerp(previous, current, alpha)` in between.
 
+#[cfg(not(target_arch = "wasm32"))]
 use std::time::Instant;
+
+// wasm32-unknown-unknown has no clock in std (`Instant::now` panics there); web-time reads the
+// browser's `performance.now()`.
+#[cfg(target_arch = "wasm32")]
+use web_time::Instant;
 
 use glam::{Quat, Vec3};
 use rayon::prelude::*;
 
-use super::batch::{LANES, RestSegment, StrandInputs, VecLanes, bend_batch};
+use super::dispatch::{self, CpuKernel};
 use super::field::{ForceField, Touch};
+use super::inertia::Inertia;
+use super::kernel::{LANES, RestBatches, Step, VecLanes};
 use super::pick::{Hit, pick};
 use super::{ParamError, SimParams, WindParams};
 use crate::fur::FurStructure;
@@ -49,10 +57,6 @@ pub enum SimError {
     },
 }
 
-/// Batches of [`LANES`] strands per parallel task: enough work to pay for the task, small
-/// enough to balance.
-const BATCHES_PER_TASK: usize = 8;
-
 /// Strands per parallel task of the interpolation (a multiple of [`LANES`]).
 const LERP_STRANDS_PER_TASK: usize = 32 * LANES;
 
@@ -73,9 +77,11 @@ pub struct Simulation {
     params: SimParams,
     layers: u32,
     vertex_count: usize,
-    /// Rest segments of batch `b` (lanes = strands `8b..8b + 8`, zero past `V`) at `b * L + k`.
-    rest_segments: Vec<RestSegment>,
+    /// The rest shape, batch-major, in the kernel's layout.
+    rest: RestBatches,
+    cpu_kernel: CpuKernel,
     rest_normals: Vec<Vec3>,
+    rest_roots: Vec<Vec3>,
     roots: Vec<Vec3>,
     /// Rotation of each strand's rest frame into the current base frame (from `set_base`).
     frames: Vec<Quat>,
@@ -86,6 +92,8 @@ pub struct Simulation {
     touch: Option<Touch>,
     /// The external field (wind + field + touch) of the newest state.
     external: Vec<Vec3>,
+    /// The force from the roots' acceleration (the one state carried from step to step).
+    inertia: Inertia,
     /// States, batch-major like `rest_segments` with `L + 1` nodes per batch.
     previous: Vec<VecLanes>,
     current: Vec<VecLanes>,
@@ -96,6 +104,10 @@ pub struct Simulation {
     alpha: f32,
     last_step_secs: f64,
     steps_taken: u64,
+    /// Whether steps bend the strands here; off when another kernel (a GPU pass) does.
+    cpu_bending: bool,
+    /// Times of the last (up to) two steps, oldest first.
+    recent_step_times: Vec<f64>,
 }
 
 impl Simulation {
@@ -119,13 +131,6 @@ impl Simulation {
             return Err(SimError::Size { what: "the base normals", expected: v, got: fur.mesh.normals.len() });
         }
         let batches = v.div_ceil(LANES);
-        let mut rest_segments = vec![RestSegment::default(); batches * layers];
-        for j in 0..v {
-            for k in 0..layers {
-                let segment = fur.positions[(k + 1) * v + j] - fur.positions[k * v + j];
-                rest_segments[j / LANES * layers + k].set(j % LANES, segment);
-            }
-        }
         let roots = fur.positions[..v].to_vec();
         let (centre, radius) = bounding_sphere(&roots);
         debug_assert!(centre.is_finite());
@@ -135,8 +140,10 @@ impl Simulation {
             params: params.clone(),
             layers: fur.layers,
             vertex_count: v,
-            rest_segments,
+            rest: RestBatches::new(&fur.positions, v, layers),
+            cpu_kernel: CpuKernel::Auto,
             rest_normals: fur.mesh.normals.clone(),
+            rest_roots: roots.clone(),
             roots,
             frames: vec![Quat::IDENTITY; v],
             stability_map: None,
@@ -144,6 +151,7 @@ impl Simulation {
             field: ForceField::new(v),
             touch: None,
             external: vec![Vec3::ZERO; v],
+            inertia: Inertia::new(v),
             previous: vec![[[0.0; LANES]; 3]; batch_nodes],
             current: vec![[[0.0; LANES]; 3]; batch_nodes],
             output: vec![Vec3::ZERO; nodes],
@@ -152,6 +160,8 @@ impl Simulation {
             alpha: 0.0,
             last_step_secs: 0.0,
             steps_taken: 0,
+            cpu_bending: true,
+            recent_step_times: Vec::with_capacity(3),
         };
         simulation.jump_to_step(0);
         simulation.update_output();
@@ -395,7 +405,9 @@ impl Simulation {
             self.alpha = 1.0;
         }
         self.drop_faded_touch();
-        self.update_output();
+        if self.cpu_bending {
+            self.update_output();
+        }
     }
 
     /// The positions to draw, layer-major like [`FurStructure::positions`]:
@@ -442,6 +454,42 @@ impl Simulation {
         });
     }
 
+    /// Chooses the CPU kernel's instructions (AVX2 + FMA or portable; both give the same bytes).
+    /// [`CpuKernel::Auto`], the default, takes the best the CPU has; asking for AVX2 on a CPU
+    /// without it runs the portable kernel ([`Simulation::cpu_kernel`] says which runs).
+    pub fn set_cpu_kernel(&mut self, kernel: CpuKernel) {
+        self.cpu_kernel = kernel;
+    }
+
+    /// The CPU kernel that runs the steps ([`CpuKernel::Avx2Fma`] or [`CpuKernel::Portable`]).
+    #[must_use]
+    pub fn cpu_kernel(&self) -> CpuKernel {
+        self.cpu_kernel.resolve()
+    }
+
+    /// The share of strands the straight (cheaper, exact) form of the kernel bends, in `[0, 1]`:
+    /// batches of 8 strands that are all straight. Fur grown by [`FurStructure::new`] is
+    /// straight; a structure whose positions were edited to curve takes the general form.
+    #[must_use]
+    pub fn straight_share(&self) -> f32 {
+        self.rest.straight_share()
+    }
+
+    /// Runs one step at `time_secs` into the newest state (the newest becomes the previous)
+    /// without updating [`Simulation::positions`]: the simulation's whole per-step work (field,
+    /// then the bend of every strand) and nothing else, for benchmarks and soak tests. Read the
+    /// state with [`Simulation::write_lerp`] at alpha 1. The next [`Simulation::advance_to`]
+    /// recomputes its states from scratch. A non-finite time does nothing.
+    pub fn step_at(&mut self, time_secs: f64) {
+        if !time_secs.is_finite() {
+            return;
+        }
+        std::mem::swap(&mut self.previous, &mut self.current);
+        self.step_into_current(time_secs);
+        self.time_secs = time_secs;
+        self.step_index = i64::MIN;
+    }
+
     /// The interpolation weight of the current state at the last render time.
     #[must_use]
     pub fn alpha(&self) -> f32 {
@@ -478,13 +526,99 @@ impl Simulation {
         self.vertex_count
     }
 
+    /// The root positions at rest (the base mesh's vertices).
+    #[must_use]
+    pub fn rest_roots(&self) -> &[Vec3] {
+        &self.rest_roots
+    }
+
     /// The current root positions.
     #[must_use]
     pub fn roots(&self) -> &[Vec3] {
         &self.roots
     }
 
+    /// Turns the bending of strands on this CPU on or off. Off, [`Simulation::advance_to`] still
+    /// keeps the time, the steps ([`Simulation::recent_step_times`]), the touch and every input,
+    /// but bends nothing and leaves [`Simulation::positions`] and
+    /// [`Simulation::external_field`] as they were: for a host whose strands are bent by another
+    /// kernel (`pelt_render::GpuSimulation`) from this simulation's inputs. Either way the next
+    /// `advance_to` recomputes both states, so switching never mixes kernels in one pair.
+    pub fn set_cpu_bending(&mut self, on: bool) {
+        if on != self.cpu_bending {
+            self.cpu_bending = on;
+            self.step_index = i64::MIN;
+        }
+    }
+
+    /// Whether steps bend the strands on this CPU (see [`Simulation::set_cpu_bending`]).
+    #[must_use]
+    pub fn cpu_bending(&self) -> bool {
+        self.cpu_bending
+    }
+
+    /// The simulation times of the last two steps (fewer before two were taken), oldest first.
+    /// Every step makes the current state the previous one and computes the new current state
+    /// at its time; with [`Simulation::steps_taken`] another kernel can replay the steps it has
+    /// not seen (only the last two matter: a step depends on its inputs, not on earlier states).
+    #[must_use]
+    pub fn recent_step_times(&self) -> &[f64] {
+        &self.recent_step_times
+    }
+
+    /// Each strand's rotation from its rest frame into the current base frame (identity until
+    /// [`Simulation::set_base`] or [`Simulation::set_base_rotations`]).
+    #[must_use]
+    pub fn frames(&self) -> &[Quat] {
+        &self.frames
+    }
+
+    /// The per-vertex stability map, if one is set.
+    #[must_use]
+    pub fn stability_map(&self) -> Option<&[f32]> {
+        self.stability_map.as_deref()
+    }
+
+    /// The bounding radius of the base at rest (from the box centre): the unit of the wind's
+    /// gust sizes and speeds ([`WindParams::sample`]'s `radius`).
+    #[must_use]
+    pub fn bounding_radius(&self) -> f32 {
+        self.radius
+    }
+
+    /// The inertial force per strand at the newest step (see [`Inertia`]).
+    #[must_use]
+    pub fn inertial_forces(&self) -> &[Vec3] {
+        self.inertia.forces()
+    }
+
+    /// The inertial state, e.g. to count teleports.
+    #[must_use]
+    pub fn inertia(&self) -> &Inertia {
+        &self.inertia
+    }
+
+    /// Forgets the base's motion so far (call it when a new animation starts or the body is
+    /// moved somewhere else): the fur is not flung by the jump.
+    pub fn reset_motion(&mut self) {
+        self.inertia.reset();
+    }
+
+    /// Recomputes both kept states for the current base and time, forgetting the motion so far:
+    /// for a base that jumped (the first pose of an animation, a new animation, a scrubbed
+    /// timeline), so the fur starts from it at rest instead of flying to it.
+    pub fn restart(&mut self) {
+        self.inertia.reset();
+        let index = if self.step_index == i64::MIN { 0 } else { self.step_index };
+        self.jump_to_step(index);
+        if self.cpu_bending {
+            self.update_output();
+        }
+    }
+
     fn jump_to_step(&mut self, index: i64) {
+        // The inertia sees the two steps' times: a short skip forward keeps the swing going (the
+        // acceleration is taken over the uneven steps), a jump back or far ahead starts it over.
         let rate = f64::from(self.params.rate_hz);
         self.step_into_current((index as f64 - 1.0) / rate);
         std::mem::swap(&mut self.previous, &mut self.current);
@@ -494,34 +628,36 @@ impl Simulation {
 
     /// Computes the state at `time_secs` into `current`.
     fn step_into_current(&mut self, time_secs: f64) {
+        self.steps_taken += 1;
+        self.recent_step_times.push(time_secs);
+        if self.recent_step_times.len() > 2 {
+            self.recent_step_times.remove(0);
+        }
+        // The inertia is state carried from step to step: it advances whichever kernel bends.
+        let (inertia, damping) = (self.params.inertia, self.params.damping);
+        self.inertia.update(&self.roots, time_secs, inertia, damping, self.radius);
+        if !self.cpu_bending {
+            return;
+        }
         let started = Instant::now();
         let mut external = std::mem::take(&mut self.external);
         self.evaluate_field(time_secs, &mut external);
         self.external = external;
-        let gravity = self.params.gravity_direction.normalize_or_zero() * self.params.gravity_strength;
-        let layers = self.layers as usize;
-        let v = self.vertex_count;
-        let stability = self.params.stability;
-        let (roots, frames, rest, external, map) =
-            (&self.roots, &self.frames, &self.rest_segments, &self.external, self.stability_map.as_deref());
-        self.current.par_chunks_mut(layers + 1).enumerate().with_min_len(BATCHES_PER_TASK).for_each(|(b, nodes)| {
-            let inputs: [StrandInputs; LANES] = std::array::from_fn(|lane| {
-                let j = b * LANES + lane;
-                if j < v {
-                    StrandInputs {
-                        root: roots[j],
-                        frame: frames[j],
-                        force: gravity + external[j],
-                        stability: map.map_or(stability, |m| m[j]),
-                    }
-                } else {
-                    StrandInputs::default()
-                }
-            });
-            bend_batch(&inputs, &rest[b * layers..(b + 1) * layers], nodes);
-        });
+        let step = Step {
+            layers: self.layers as usize,
+            vertex_count: self.vertex_count,
+            gain: self.params.equation.gain(self.layers),
+            gravity: self.params.gravity_direction.normalize_or_zero() * self.params.gravity_strength,
+            stability: self.params.stability,
+            stability_map: self.stability_map.as_deref(),
+            roots: &self.roots,
+            frames: &self.frames,
+            external: &self.external,
+            inertial: self.inertia.forces(),
+            rest: &self.rest,
+        };
+        dispatch::bend_all(self.cpu_kernel, &step, &mut self.current);
         self.last_step_secs = started.elapsed().as_secs_f64();
-        self.steps_taken += 1;
     }
 
     fn drop_faded_touch(&mut self) {

@@ -190,6 +190,10 @@ impl Scene {
         );
 
         let Some(attachments) = &self.attachments else { return };
+        // The silhouette pass goes into the host's encoder, before the pass that draws the fur.
+        if self.options.fur {
+            self.renderer.prepare_fins(encoder, &self.view, &self.fur);
+        }
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("host frame"),
             color_attachments: &[Some(wgpu::RenderPassColorAttachment {
@@ -214,7 +218,7 @@ impl Scene {
         pass.set_vertex_buffer(0, self.host_vertices.slice(..));
         pass.draw(0..self.host_vertex_count, 0..1);
         if self.options.fur {
-            self.renderer.draw(&mut pass, &self.view, &self.fur, &FurDrawSettings::ALL);
+            self.renderer.draw(&mut pass, &self.view, &self.fur, &FurDrawSettings::SILHOUETTE);
         }
     }
 

@@ -8,10 +8,10 @@ use pelt_core::texture::FurTextures;
 use pelt_core::{FurStructure, Mesh};
 use pelt_render::{
     Backend, Camera, DEFAULT_BACKGROUND, FurDrawSettings, FurFrame, FurRenderer, FurStates, FurTarget, FurView, Gpu,
-    GpuFur, HEADLESS_FORMAT, Light, PlainMesh, RenderTargets, SeparatedFur, SeparatedRenderer,
+    GpuFur, HEADLESS_FORMAT, Light, PlainMesh, RenderTargets, SeparatedFur, SeparatedRenderer, default_sample_count,
 };
 
-use super::report::{Adapter, RenderFigures};
+use super::report::{Adapter, GpuSimFigures, RenderFigures};
 use super::table2::MANY_FIN_FACES;
 use crate::render::PLAIN_COLOUR;
 
@@ -43,12 +43,50 @@ impl Bench {
 
     pub fn adapter(&self) -> Adapter {
         let info = self.gpu.adapter.get_info();
+        let msaa_samples = default_sample_count(&info);
         Adapter {
+            msaa_samples,
             name: info.name,
             backend: format!("{:?}", info.backend),
             device_type: format!("{:?}", info.device_type),
             driver: format!("{} {}", info.driver, info.driver_info).trim().to_owned(),
         }
+    }
+
+    /// The GPU simulation's node updates per second on `fur` under `params` with wind (so the
+    /// noise is evaluated, as in a windy scene): the median of `runs` runs of `steps` steps
+    /// (`crate::sim_kernel::gpu_secs_per_step`, the code `--sim gpu` runs); and the CPU cost
+    /// per drawn frame over `drawn_frames` frames at 120 Hz with the simulation at 30 Hz.
+    pub fn measure_simulation(
+        &self,
+        fur: &FurStructure,
+        params: &pelt_core::sim::SimParams,
+        steps: u32,
+        runs: usize,
+        drawn_frames: u32,
+    ) -> anyhow::Result<GpuSimFigures> {
+        let mut windy = params.clone();
+        if windy.wind.strength == 0.0 {
+            windy.wind.strength = 0.5;
+        }
+        let (device, queue) = (&self.gpu.device, &self.gpu.queue);
+        let secs = crate::sim_kernel::gpu_secs_per_step(device, queue, fur, &windy, steps, runs)?;
+        let nodes = fur.vertex_count() as f64 * f64::from(fur.layers);
+        windy.rate_hz = super::sim::SIM_RATE_HZ;
+        let cpu_ms = crate::sim_kernel::gpu_cpu_ms_per_drawn_frame(
+            device,
+            queue,
+            fur,
+            &windy,
+            super::sim::DRAW_RATE_HZ,
+            drawn_frames,
+        )?;
+        Ok(GpuSimFigures {
+            gpu_sim_node_updates_per_sec: Some(nodes / secs),
+            gpu_sim_steps_per_run: Some(steps),
+            gpu_sim_cpu_ms_per_frame: Some(cpu_ms),
+            gpu_sim_unavailable_reason: None,
+        })
     }
 
     /// Median frame times of the three structures at both sizes, each drawing the same scene:
@@ -61,7 +99,9 @@ impl Bench {
         budget: RenderBudget,
     ) -> anyhow::Result<RenderFigures> {
         let (device, queue) = (&self.gpu.device, &self.gpu.queue);
-        let target = FurTarget::new(HEADLESS_FORMAT);
+        // The samples `pelt render` and the viewer use on this adapter.
+        let samples = default_sample_count(&self.gpu.adapter.get_info());
+        let target = FurTarget::new(HEADLESS_FORMAT).with_sample_count(samples);
         let renderer = FurRenderer::new(device, target).context("building the unified renderer")?;
         let separated_renderer =
             SeparatedRenderer::new(device, &renderer).context("building the separated renderer")?;
@@ -80,13 +120,16 @@ impl Bench {
             body.prepare(queue, glam::Mat4::IDENTITY);
         }
         let view = FurView::new(device, &renderer);
-        let settings = FurDrawSettings::ALL;
+        // What `pelt render` and the viewer draw: the unified fur with the silhouette pass (the
+        // separated structures draw their fins as geometry and ignore it).
+        let settings = FurDrawSettings::SILHOUETTE;
         // Frame the whole scene: the body where there is one (the garment sits on it).
         let (centre, radius) = body_mesh.map_or_else(|| fur.mesh.bounding_sphere(), Mesh::bounding_sphere);
         let radius = radius + fur.lengths.iter().copied().fold(0.0, f32::max);
 
         let mut medians = [[0.0; 3]; SIZES.len()];
         let mut frames_measured = u32::MAX;
+        let mut fin_edges_drawn = None;
         for ((width, height), row) in SIZES.into_iter().zip(&mut medians) {
             let targets = RenderTargets::new(device, target, width, height)?;
             let output = device.create_texture(&wgpu_output_descriptor(width, height));
@@ -95,8 +138,11 @@ impl Bench {
             let view_data = camera.view_data(targets.aspect_ratio(), &Light::default());
             // Every structure draws the same scene the same way: the view written, the body
             // (if any), then the fur, in one pass.
-            let frame = |encoder: &mut wgpu::CommandEncoder, draw_fur: &dyn Fn(&mut wgpu::RenderPass<'_>)| {
+            let frame = |encoder: &mut wgpu::CommandEncoder,
+                         before: &dyn Fn(&mut wgpu::CommandEncoder),
+                         draw_fur: &dyn Fn(&mut wgpu::RenderPass<'_>)| {
                 view.prepare(queue, &view_data);
+                before(encoder);
                 let mut pass = targets.begin_pass(encoder, &output_view, DEFAULT_BACKGROUND);
                 if let Some(body) = &body {
                     renderer.draw_plain(&mut pass, &view, body);
@@ -104,14 +150,32 @@ impl Bench {
                 draw_fur(&mut pass);
             };
             let cases: [&dyn Fn(&mut wgpu::CommandEncoder); 3] = [
-                &|encoder| frame(encoder, &|pass| renderer.draw(pass, &view, &unified, &settings)),
-                &|encoder| frame(encoder, &|pass| separated_renderer.draw(pass, &view, &separated2, &settings)),
-                &|encoder| frame(encoder, &|pass| separated_renderer.draw(pass, &view, &separated30, &settings)),
+                &|encoder| {
+                    let silhouette =
+                        |encoder: &mut wgpu::CommandEncoder| renderer.prepare_fins(encoder, &view, &unified);
+                    frame(encoder, &silhouette, &|pass| renderer.draw(pass, &view, &unified, &settings));
+                },
+                &|encoder| {
+                    frame(encoder, &|_| {}, &|pass| separated_renderer.draw(pass, &view, &separated2, &settings))
+                },
+                &|encoder| {
+                    frame(encoder, &|_| {}, &|pass| separated_renderer.draw(pass, &view, &separated30, &settings))
+                },
             ];
             for (case, median) in cases.iter().zip(row.iter_mut()) {
                 let times = self.time_frames(case, budget)?;
                 frames_measured = frames_measured.min(times.len() as u32);
                 *median = median_ms(&times);
+            }
+            if fin_edges_drawn.is_none() {
+                // The first size: the silhouette pass's count from the last unified frame.
+                if let Some(draw) = unified.silhouette_draw() {
+                    self.time_frames(
+                        cases[0],
+                        RenderBudget { warmup_frames: 0, min_frames: 1, max_frames: 1, ..budget },
+                    )?;
+                    fin_edges_drawn = Some(u64::from(self.read_u32(draw, 1)?));
+                }
             }
         }
         // The per-frame upload an animated unified fur adds: the whole shared vertex array.
@@ -127,6 +191,7 @@ impl Bench {
             frame_ms_separated2_256x256: Some(s2_small),
             frame_ms_separated30_256x256: Some(s30_small),
             render_frames: Some(frames_measured),
+            fin_edges_drawn,
             upload_ms_per_frame: Some(median_ms(&upload_times)),
             render_unavailable_reason: None,
         })
@@ -159,6 +224,35 @@ impl Bench {
             times.push(frame()?);
         }
         Ok(times)
+    }
+}
+
+impl Bench {
+    /// Word `index` of a small `COPY_SRC` buffer, read back (waits for the GPU).
+    fn read_u32(&self, buffer: &wgpu::Buffer, index: u64) -> anyhow::Result<u32> {
+        let device = &self.gpu.device;
+        let staging = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("pelt bench readback"),
+            size: 4,
+            usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+            mapped_at_creation: false,
+        });
+        let mut encoder = device.create_command_encoder(&Default::default());
+        encoder.copy_buffer_to_buffer(buffer, 4 * index, &staging, 0, 4);
+        self.gpu.queue.submit([encoder.finish()]);
+        let (sender, receiver) = std::sync::mpsc::channel();
+        staging.slice(..).map_async(wgpu::MapMode::Read, move |result| {
+            // The receiver waits below.
+            let _ = sender.send(result);
+        });
+        device.poll(wgpu::PollType::wait_indefinitely()).context("waiting for the GPU")?;
+        receiver.recv().context("reading back")?.context("mapping the readback")?;
+        let word = {
+            let bytes = staging.slice(..).get_mapped_range().context("reading the readback")?;
+            u32::from_le_bytes([bytes[0], bytes[1], bytes[2], bytes[3]])
+        };
+        staging.unmap();
+        Ok(word)
     }
 }
 

@@ -22,6 +22,10 @@ pub struct Report {
     /// The paper's claims, for the savings to be read against (constants, not measured).
     pub paper_savings_vs_2_percent: f64,
     pub paper_savings_vs_30_percent: f64,
+    /// The CPU kernel the simulation figures were taken with (`avx2+fma` or `portable`).
+    pub sim_cpu_kernel: &'static str,
+    /// Simulation throughput on a 35,000-vertex mesh; null with `--quick`.
+    pub sim_large_mesh: Option<LargeMeshFigures>,
     /// One object per model and layer count.
     pub results: Vec<ResultRow>,
     /// Models whose meshes could not be loaded.
@@ -45,6 +49,8 @@ pub struct Adapter {
     pub backend: String,
     pub device_type: String,
     pub driver: String,
+    /// MSAA samples every frame is drawn with (`pelt_render::default_sample_count`).
+    pub msaa_samples: u32,
 }
 
 #[derive(Debug, serde::Serialize)]
@@ -68,6 +74,8 @@ pub struct ResultRow {
     pub sim: SimFigures,
     #[serde(flatten)]
     pub texture: TextureFigures,
+    #[serde(flatten)]
+    pub gpu_sim: GpuSimFigures,
 }
 
 /// The Table 2 part: counts and bytes, all computed.
@@ -81,7 +89,7 @@ pub struct Table2Figures {
     pub fur_vertices: u64,
     pub fur_edges: u64,
     /// The unified structure's vertices: `V(L+1)` (plus the body's).
-    pub shared_vertices: u64,
+    pub unified_vertices: u64,
     /// The separated structure's: `V(L+1) + 2E` and `V(L+1) + 30E` (plus the body's).
     pub separated2_vertices: u64,
     pub separated30_vertices: u64,
@@ -108,7 +116,7 @@ impl From<&Table2Row> for Table2Figures {
             faces: row.faces,
             fur_vertices: row.fur_vertices,
             fur_edges: row.fur_edges,
-            shared_vertices: row.shared_vertices(),
+            unified_vertices: row.unified_vertices(),
             separated2_vertices: row.separated2_vertices(),
             separated30_vertices: row.separated30_vertices(),
             unified_faces: row.unified.faces + body_faces,
@@ -117,8 +125,8 @@ impl From<&Table2Row> for Table2Figures {
             unified_bytes: row.unified_bytes(),
             separated2_bytes: row.separated2_bytes(),
             separated30_bytes: row.separated30_bytes(),
-            savings_vs_2_percent: savings_percent(row.shared_vertices(), row.separated2_vertices()),
-            savings_vs_30_percent: savings_percent(row.shared_vertices(), row.separated30_vertices()),
+            savings_vs_2_percent: savings_percent(row.unified_vertices(), row.separated2_vertices()),
+            savings_vs_30_percent: savings_percent(row.unified_vertices(), row.separated30_vertices()),
             bytes_savings_vs_2_percent: savings_percent(row.unified_bytes(), row.separated2_bytes()),
             bytes_savings_vs_30_percent: savings_percent(row.unified_bytes(), row.separated30_bytes()),
         }
@@ -136,24 +144,54 @@ pub struct RenderFigures {
     pub frame_ms_separated30_256x256: Option<f64>,
     /// Frames each median was taken over.
     pub render_frames: Option<u32>,
+    /// Fins the unified structure drew at 1280x720: the edges the silhouette pass kept, of
+    /// `fur_edges`.
+    pub fin_edges_drawn: Option<u64>,
     /// Uploading the unified shared vertex array (what a simulated fur sends every frame),
     /// submitted and waited for.
     pub upload_ms_per_frame: Option<f64>,
     pub render_unavailable_reason: Option<String>,
 }
 
+/// The simulation's throughput on a mesh larger than the paper's.
+#[derive(Debug, serde::Serialize)]
+pub struct LargeMeshFigures {
+    pub mesh: String,
+    pub vertices: u64,
+    pub layers: u32,
+    pub sim_node_updates_per_sec: f64,
+    pub sim_node_updates_per_sec_all_threads: f64,
+}
+
 /// Simulation throughput and its CPU cost per drawn frame.
 #[derive(Debug, Default, serde::Serialize)]
 pub struct SimFigures {
-    /// Non-root nodes moved per second (`V * L` per step), O(L) bend.
+    /// Non-root nodes moved per second (`V * L` per step) by `Simulation`'s steps, one thread.
     pub sim_node_updates_per_sec: Option<f64>,
-    /// The same with the paper's literal O(L^2) loop.
+    /// The same on all threads.
+    pub sim_node_updates_per_sec_all_threads: Option<f64>,
+    /// The paper's literal O(L^2) loop, one thread, timed the same way.
     pub sim_literal_node_updates_per_sec: Option<f64>,
     /// CPU per drawn frame at 120 Hz drawing: 30 Hz simulation plus interpolation ...
     pub sim_cpu_ms_per_frame_interpolated: Option<f64>,
     /// ... against simulating every drawn frame.
     pub sim_cpu_ms_per_frame_every_frame: Option<f64>,
     pub sim_unavailable_reason: Option<String>,
+}
+
+/// The GPU simulation (`pelt_render::GpuSimulation`) on the report's adapter.
+#[derive(Debug, Default, serde::Serialize)]
+pub struct GpuSimFigures {
+    /// Non-root nodes moved per second (`V * L` per step) by the compute pass: the median of
+    /// repeated runs, each a batch of steps in one submission waited for with a fence.
+    pub gpu_sim_node_updates_per_sec: Option<f64>,
+    /// Steps per timed run.
+    pub gpu_sim_steps_per_run: Option<u32>,
+    /// CPU ms per drawn frame at 120 Hz drawing with the GPU simulating at 30 Hz (time, steps,
+    /// prepare, recording and submission; no interpolation or upload), to set beside
+    /// `sim_cpu_ms_per_frame_interpolated`.
+    pub gpu_sim_cpu_ms_per_frame: Option<f64>,
+    pub gpu_sim_unavailable_reason: Option<String>,
 }
 
 /// Shell and fin texture generation.
@@ -192,7 +230,11 @@ impl Report {
         );
         match (&self.adapter, &self.adapter_unavailable_reason) {
             (Some(a), _) => {
-                let _ = writeln!(md, "- adapter: {} ({}, {}, driver {})", a.name, a.backend, a.device_type, a.driver);
+                let _ = writeln!(
+                    md,
+                    "- adapter: {} ({}, {}, driver {}), {}x MSAA",
+                    a.name, a.backend, a.device_type, a.driver, a.msaa_samples
+                );
             }
             (None, reason) => {
                 let _ = writeln!(md, "- adapter: none ({})", reason.as_deref().unwrap_or("not searched"));
@@ -221,7 +263,7 @@ impl Report {
                 thousands(t.vertices),
                 thousands(t.faces),
                 thousands(t.fur_edges),
-                thousands(t.shared_vertices),
+                thousands(t.unified_vertices),
                 thousands(t.separated2_vertices),
                 thousands(t.separated30_vertices),
                 t.savings_vs_2_percent,
@@ -246,14 +288,14 @@ impl Report {
         let _ = writeln!(md, "\n### Frame time (median ms, GPU work waited for)\n");
         let _ = writeln!(
             md,
-            "| model | L | unified 1280x720 | sep-2 1280x720 | sep-30 1280x720 | unified 256x256 | sep-2 256x256 | sep-30 256x256 | upload of the shared array | frames |"
+            "| model | L | unified 1280x720 | sep-2 1280x720 | sep-30 1280x720 | unified 256x256 | sep-2 256x256 | sep-30 256x256 | upload of the shared array | fin edges drawn (unified) | frames |"
         );
-        let _ = writeln!(md, "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
+        let _ = writeln!(md, "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
         for r in &self.results {
             let f = &r.render;
             let _ = writeln!(
                 md,
-                "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
+                "| {} | {} | {} | {} | {} | {} | {} | {} | {} | {} | {} |",
                 r.model,
                 r.layers,
                 ms(f.frame_ms_unified_1280x720),
@@ -263,6 +305,10 @@ impl Report {
                 ms(f.frame_ms_separated2_256x256),
                 ms(f.frame_ms_separated30_256x256),
                 ms(f.upload_ms_per_frame),
+                f.fin_edges_drawn.map_or_else(
+                    || "-".to_owned(),
+                    |n| format!("{} of {}", thousands(n), thousands(r.table2.fur_edges))
+                ),
                 f.render_frames.map_or_else(|| "-".to_owned(), |n| n.to_string()),
             );
         }
@@ -271,21 +317,34 @@ impl Report {
         let _ = writeln!(md, "\n### Simulation (CPU) and texture generation\n");
         let _ = writeln!(
             md,
-            "| model | L | node updates/s, O(L) | node updates/s, literal O(L^2) | CPU ms per drawn frame, 30 Hz sim + interpolation | CPU ms per drawn frame, sim every frame | texture generation ms |"
+            "| model | L | node updates/s, 1 thread | node updates/s, all threads | literal O(L^2), 1 thread | CPU ms per drawn frame, 30 Hz sim + interpolation | CPU ms per drawn frame, sim every frame | texture generation ms |"
         );
-        let _ = writeln!(md, "|---|---:|---:|---:|---:|---:|---:|");
+        let _ = writeln!(md, "|---|---:|---:|---:|---:|---:|---:|---:|");
         for r in &self.results {
             let s = &r.sim;
             let _ = writeln!(
                 md,
-                "| {} | {} | {} | {} | {} | {} | {} |",
+                "| {} | {} | {} | {} | {} | {} | {} | {} |",
                 r.model,
                 r.layers,
                 rate(s.sim_node_updates_per_sec),
+                rate(s.sim_node_updates_per_sec_all_threads),
                 rate(s.sim_literal_node_updates_per_sec),
                 ms(s.sim_cpu_ms_per_frame_interpolated),
                 ms(s.sim_cpu_ms_per_frame_every_frame),
                 ms(r.texture.texture_generation_ms),
+            );
+        }
+        let _ = writeln!(md, "\nSimulation kernel: {}.", self.sim_cpu_kernel);
+        if let Some(large) = &self.sim_large_mesh {
+            let _ = writeln!(
+                md,
+                "Large mesh ({}, {} vertices, L = {}): {} node updates/s on 1 thread, {} on all threads.",
+                large.mesh,
+                thousands(large.vertices),
+                large.layers,
+                rate(Some(large.sim_node_updates_per_sec)),
+                rate(Some(large.sim_node_updates_per_sec_all_threads)),
             );
         }
         notes(
@@ -294,7 +353,27 @@ impl Report {
                 [(r, r.sim.sim_unavailable_reason.as_deref()), (r, r.texture.texture_unavailable_reason.as_deref())]
             }),
         );
+        self.gpu_sim_markdown(&mut md);
         md
+    }
+
+    /// The GPU simulation's table: which kernel ran where, and how fast.
+    fn gpu_sim_markdown(&self, md: &mut String) {
+        let adapter =
+            self.adapter.as_ref().map_or_else(|| "no adapter".to_owned(), |a| format!("{} ({})", a.name, a.backend));
+        let _ = writeln!(md, "\n### Simulation on the GPU (compute pass on {adapter})\n");
+        let _ = writeln!(
+            md,
+            "| model | L | node updates/s | steps per timed run | CPU ms per drawn frame, GPU sim at 30 Hz |"
+        );
+        let _ = writeln!(md, "|---|---:|---:|---:|---:|");
+        for r in &self.results {
+            let g = &r.gpu_sim;
+            let steps = g.gpu_sim_steps_per_run.map_or_else(|| "-".to_owned(), |n| n.to_string());
+            let (updates, cpu) = (rate(g.gpu_sim_node_updates_per_sec), ms(g.gpu_sim_cpu_ms_per_frame));
+            let _ = writeln!(md, "| {} | {} | {updates} | {steps} | {cpu} |", r.model, r.layers);
+        }
+        notes(md, self.results.iter().map(|r| (r, r.gpu_sim.gpu_sim_unavailable_reason.as_deref())));
     }
 }
 

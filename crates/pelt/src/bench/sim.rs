@@ -1,12 +1,13 @@
-//! Simulation figures: bend throughput (O(L) and the paper's literal loop) and the CPU cost per
-//! drawn frame with and without interpolation.
+//! Simulation figures: the throughput of the kernel `Simulation` runs (one thread and all
+//! threads), the paper's literal loop timed the same way, and the CPU cost per drawn frame with
+//! and without interpolation.
 
 use std::hint::black_box;
 use std::time::Instant;
 
 use glam::{Quat, Vec3};
 use pelt_core::FurStructure;
-use pelt_core::sim::{SimParams, Simulation, bend_strand, bend_strand_literal};
+use pelt_core::sim::{SimParams, Simulation, bend_strand_literal};
 
 use super::report::SimFigures;
 
@@ -14,27 +15,51 @@ use super::report::SimFigures;
 pub const SIM_RATE_HZ: f32 = 30.0;
 pub const DRAW_RATE_HZ: f64 = 120.0;
 
+/// A steady side force added to gravity, so no strand is parallel to the force and every node
+/// turns (the throughput of a windy scene without the wind's noise).
+const SIDE_FORCE: Vec3 = Vec3::new(0.5, 0.0, 0.0);
+
 /// How long each measurement runs.
 #[derive(Clone, Copy, Debug)]
 pub struct SimBudget {
-    /// Bend passes over every strand repeat until at least this long has passed.
-    pub min_bend_secs: f64,
+    /// Repeated runs per throughput figure; the figure is their median.
+    pub runs: u32,
+    /// Each run repeats whole passes over every strand until at least this long has passed.
+    pub min_run_secs: f64,
     /// Drawn frames the per-frame cost is averaged over.
     pub drawn_frames: u32,
 }
 
-/// Measures `fur` under `params` (its gravity and stability; wind switched on so the field is
-/// evaluated every step, as in a windy scene).
+/// Node updates per second of the product's kernel on `fur`: one thread and all threads.
+#[derive(Clone, Copy, Debug)]
+pub struct Throughput {
+    pub one_thread: f64,
+    pub all_threads: f64,
+}
+
+/// Times `Simulation`'s steps (force field, then the bend of every strand: what a step costs
+/// the product) under `params` plus [`SIDE_FORCE`], on one thread and on all.
+pub fn throughput(fur: &FurStructure, params: &SimParams, budget: SimBudget) -> anyhow::Result<Throughput> {
+    let mut simulation = Simulation::new(fur, &SimParams { interpolate: false, ..params.clone() })?;
+    simulation.field_mut().fill(SIDE_FORCE);
+    let nodes_per_step = (fur.vertex_count() * fur.layers as usize) as f64;
+    let mut time = 0.0;
+    let mut step = || {
+        time += 1.0 / f64::from(SIM_RATE_HZ);
+        simulation.step_at(time);
+        black_box(simulation.steps_taken());
+    };
+    let all_threads = median_rate(budget, nodes_per_step, &mut step);
+    let pool = rayon::ThreadPoolBuilder::new().num_threads(1).build()?;
+    let one_thread = pool.install(|| median_rate(budget, nodes_per_step, &mut step));
+    Ok(Throughput { one_thread, all_threads })
+}
+
+/// Measures `fur` under `params` (its gravity and stability; wind switched on for the per-frame
+/// costs, so the field is evaluated every step, as in a windy scene).
 pub fn measure(fur: &FurStructure, params: &SimParams, budget: SimBudget) -> anyhow::Result<SimFigures> {
-    let strands = Strands::new(fur);
-    // Gravity plus a steady side force, so no strand is parallel to the force and every node turns.
-    let force = params.gravity_direction.normalize_or_zero() * params.gravity_strength + Vec3::X * 0.5;
-    let o_l = strands.node_updates_per_sec(budget.min_bend_secs, |segments, nodes| {
-        bend_strand(nodes[0], Quat::IDENTITY, segments, force, params.stability, nodes);
-    });
-    let literal = strands.node_updates_per_sec(budget.min_bend_secs, |segments, nodes| {
-        bend_strand_literal(nodes[0], Quat::IDENTITY, segments, force, params.stability, nodes);
-    });
+    let product = throughput(fur, params, budget)?;
+    let literal = literal_rate(fur, params, budget);
 
     let mut windy = params.clone();
     windy.rate_hz = SIM_RATE_HZ;
@@ -44,7 +69,8 @@ pub fn measure(fur: &FurStructure, params: &SimParams, budget: SimBudget) -> any
     let interpolated = cpu_ms_per_drawn_frame(fur, &SimParams { interpolate: true, ..windy.clone() }, budget)?;
     let every_frame = cpu_ms_per_drawn_frame(fur, &SimParams { interpolate: false, ..windy }, budget)?;
     Ok(SimFigures {
-        sim_node_updates_per_sec: Some(o_l),
+        sim_node_updates_per_sec: Some(product.one_thread),
+        sim_node_updates_per_sec_all_threads: Some(product.all_threads),
         sim_literal_node_updates_per_sec: Some(literal),
         sim_cpu_ms_per_frame_interpolated: Some(interpolated),
         sim_cpu_ms_per_frame_every_frame: Some(every_frame),
@@ -52,46 +78,47 @@ pub fn measure(fur: &FurStructure, params: &SimParams, budget: SimBudget) -> any
     })
 }
 
-/// The rest strands of a structure, strand-major, for calling the bend functions directly.
-struct Strands {
-    layers: usize,
-    roots: Vec<Vec3>,
-    segments: Vec<Vec3>,
+/// The paper's literal O(L^2) loop (`bend_strand_literal`) over every strand, one thread, the
+/// same force per strand as [`throughput`] gives (gravity plus [`SIDE_FORCE`]), timed the same
+/// way: median of repeated runs of whole passes.
+fn literal_rate(fur: &FurStructure, params: &SimParams, budget: SimBudget) -> f64 {
+    let v = fur.vertex_count();
+    let layers = fur.layers as usize;
+    let p = &fur.positions;
+    let segments: Vec<Vec3> =
+        (0..v).flat_map(|j| (0..layers).map(move |k| p[(k + 1) * v + j] - p[k * v + j])).collect();
+    let force = params.gravity_direction.normalize_or_zero() * params.gravity_strength + SIDE_FORCE;
+    let mut nodes = vec![Vec3::ZERO; layers + 1];
+    let mut pass = || {
+        for (root, strand) in p[..v].iter().zip(segments.chunks_exact(layers)) {
+            bend_strand_literal(*root, Quat::IDENTITY, black_box(strand), force, params.stability, &mut nodes);
+            black_box(&nodes);
+        }
+    };
+    median_rate(budget, (v * layers) as f64, &mut pass)
 }
 
-impl Strands {
-    fn new(fur: &FurStructure) -> Self {
-        let v = fur.vertex_count();
-        let layers = fur.layers as usize;
-        let p = &fur.positions;
-        let segments = (0..v).flat_map(|j| (0..layers).map(move |k| p[(k + 1) * v + j] - p[k * v + j])).collect();
-        Self { layers, roots: p[..v].to_vec(), segments }
-    }
-
-    /// Non-root nodes placed per second by `bend` over every strand, on this thread alone (so
-    /// the O(L) and literal figures compare the algorithms, not the scheduling).
-    fn node_updates_per_sec(&self, min_secs: f64, bend: impl Fn(&[Vec3], &mut [Vec3])) -> f64 {
-        let mut nodes = vec![Vec3::ZERO; self.layers + 1];
-        let mut pass = || {
-            for (root, segments) in self.roots.iter().zip(self.segments.chunks_exact(self.layers)) {
-                nodes[0] = *root;
-                bend(black_box(segments), &mut nodes);
-                black_box(&nodes);
+/// The median over `budget.runs` runs of `nodes_per_pass * passes / seconds`, each run
+/// repeating `pass` for at least `budget.min_run_secs` after one untimed pass (caches, pages,
+/// thread pool).
+fn median_rate(budget: SimBudget, nodes_per_pass: f64, pass: &mut dyn FnMut()) -> f64 {
+    pass();
+    let mut rates: Vec<f64> = (0..budget.runs.max(1))
+        .map(|_| {
+            let started = Instant::now();
+            let mut passes = 0_u64;
+            loop {
+                pass();
+                passes += 1;
+                let elapsed = started.elapsed().as_secs_f64();
+                if elapsed >= budget.min_run_secs {
+                    return passes as f64 * nodes_per_pass / elapsed;
+                }
             }
-        };
-        // One untimed pass brings the strands into cache.
-        pass();
-        let started = Instant::now();
-        let mut passes = 0_u64;
-        loop {
-            pass();
-            passes += 1;
-            let elapsed = started.elapsed().as_secs_f64();
-            if elapsed >= min_secs {
-                return (passes * (self.roots.len() * self.layers) as u64) as f64 / elapsed;
-            }
-        }
-    }
+        })
+        .collect();
+    rates.sort_by(f64::total_cmp);
+    rates[rates.len() / 2]
 }
 
 /// Wall-clock CPU milliseconds per drawn frame: `advance_to` at 120 Hz render times (all threads).

@@ -101,9 +101,21 @@ mod tests {
     }
 
     #[test]
-    fn this_process_has_a_peak() {
-        if cfg!(target_os = "linux") {
-            assert!(peak_rss_bytes().is_some_and(|b| b > 0));
+    fn the_peak_follows_what_this_process_touches() {
+        if !cfg!(target_os = "linux") {
+            assert_eq!(peak_rss_bytes(), None);
+            return;
         }
+        // Touching 64 MiB more than the peak so far must raise it by about that much: the
+        // figure is this process's, in bytes (not kB, not the machine's).
+        let before = peak_rss_bytes().expect("Linux reports VmHWM");
+        let extra = 64 << 20;
+        let block = std::hint::black_box(vec![1u8; before as usize + extra]);
+        let after = peak_rss_bytes().expect("Linux reports VmHWM");
+        assert!(
+            after >= before + extra as u64 && after < 2 * (before + extra as u64) + (64 << 20),
+            "{before} -> {after}"
+        );
+        drop(block);
     }
 }

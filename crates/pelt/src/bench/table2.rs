@@ -55,7 +55,7 @@ impl Table2Row {
     }
 
     /// Vertices of the whole scene drawn with the unified structure (`V(L+1)`, plus a body).
-    pub fn shared_vertices(&self) -> u64 {
+    pub fn unified_vertices(&self) -> u64 {
         self.unified.vertices + self.body_vertices
     }
     pub fn separated2_vertices(&self) -> u64 {
@@ -109,10 +109,10 @@ mod tests {
     fn box_reproduces_the_papers_row() {
         let row = Table2Row::compute(&model(Builtin::Box, None), 16).unwrap();
         assert_eq!((row.vertices, row.faces, row.fur_edges), (296, 588, 882));
-        assert_eq!(row.shared_vertices(), 5_032);
+        assert_eq!(row.unified_vertices(), 5_032);
         assert_eq!(row.separated2_vertices(), 6_796);
         assert_eq!(row.separated30_vertices(), 31_492);
-        let saved = savings_percent(row.shared_vertices(), row.separated2_vertices());
+        let saved = savings_percent(row.unified_vertices(), row.separated2_vertices());
         assert!((saved - 25.96).abs() < 0.01, "{saved}");
         assert!(row.unified_bytes() < row.separated2_bytes());
     }
@@ -124,14 +124,14 @@ mod tests {
         let (sphere, _) = Builtin::Sphere.mesh();
         let v = sphere.vertex_count() as u64;
         assert_eq!(dressed.vertices, alone.vertices + v);
-        assert_eq!(dressed.shared_vertices(), alone.shared_vertices() + v);
+        assert_eq!(dressed.unified_vertices(), alone.unified_vertices() + v);
         assert_eq!(dressed.separated2_vertices(), alone.separated2_vertices() + v);
         assert_eq!(dressed.separated30_vertices(), alone.separated30_vertices() + v);
         let body_bytes = dressed.unified_bytes() - alone.unified_bytes();
         assert_eq!(body_bytes, v * 32 + sphere.triangles.len() as u64 * 12);
         assert_eq!(dressed.separated30_bytes() - alone.separated30_bytes(), body_bytes);
         // The body dilutes the savings, as in the paper's Women row.
-        let saved = |r: &Table2Row| savings_percent(r.shared_vertices(), r.separated2_vertices());
+        let saved = |r: &Table2Row| savings_percent(r.unified_vertices(), r.separated2_vertices());
         assert!(saved(&dressed) < saved(&alone));
         assert!(matches!(MODELS[4].body, Some(MeshSource::Asset(_))));
     }

@@ -6,6 +6,7 @@ use std::sync::Arc;
 
 use anyhow::Context as _;
 use pelt_core::Mesh;
+use pelt_core::anim::Rig;
 use winit::application::ApplicationHandler;
 use winit::event::WindowEvent;
 use winit::event_loop::ActiveEventLoop;
@@ -18,6 +19,7 @@ use super::gpu::{self, Acquired, WindowSurface};
 use super::model::{Model, smooth};
 use super::panel::{Changes, Requests};
 use super::viewport::Viewport;
+use crate::sim_kernel::SimKernel;
 
 /// Consecutive frames without a swap-chain texture before a scripted run gives up.
 const MAX_SKIPPED_FRAMES: u32 = 600;
@@ -52,8 +54,8 @@ struct Running {
 }
 
 impl App {
-    pub fn new(args: &Args, mesh: Mesh, mesh_source: String) -> anyhow::Result<Self> {
-        let model = Model::new(args, mesh, mesh_source)?;
+    pub fn new(args: &Args, mesh: Mesh, rig: Option<Rig>, mesh_source: String) -> anyhow::Result<Self> {
+        let model = Model::new(args, mesh, rig, mesh_source)?;
         let screenshot_after = args.screenshot_after.zip(args.out.clone());
         Ok(Self { window_size: args.size, screenshot_after, model, running: None, error: None })
     }
@@ -92,10 +94,18 @@ impl App {
         );
         let mut egui_renderer =
             egui_wgpu::Renderer::new(&gpu.device, surface.config.format, egui_wgpu::RendererOptions::default());
-        let viewport = Viewport::new(&gpu.device, &mut egui_renderer, [1, 1])?;
+        let target = super::viewport::target(&gpu.adapter.get_info());
+        let viewport = Viewport::new(&gpu.device, &mut egui_renderer, [1, 1], target)?;
         let textures = self.model.textures.take().context("the first textures were made before the window")?;
         let mut fur = FurScene::new(&gpu, &self.model.structure, &textures)?;
         fur.set_body(&gpu, self.model.body.as_ref())?;
+        let model = &mut self.model;
+        let (kernel, reason) =
+            crate::sim_kernel::choose(model.sim_choice, &gpu.device, &gpu.queue, &model.structure, model.sim.params())?;
+        model.settings.gpu_sim = kernel == SimKernel::Gpu;
+        model.kernel_reason = reason;
+        model.sim.set_cpu_bending(kernel == SimKernel::Cpu);
+        fur.set_gpu_simulation(&gpu, &model.structure, model.settings.gpu_sim)?;
         Ok(Running { window, gpu, surface, egui_ctx, egui_state, egui_renderer, viewport, fur, visible: true })
     }
 
@@ -139,11 +149,15 @@ impl App {
             Ok(false) => {}
             Err(error) => model.status = format!("{error:#}"),
         }
+        running.fur.set_gpu_simulation(&running.gpu, &model.structure, model.settings.gpu_sim)?;
         if let Some(textures) = model.poll_textures() {
             running.fur.set_textures(&running.gpu, &textures)?;
         }
         model.simulate(frame_secs)?;
-        running.fur.set_positions(&running.gpu, model.sim.positions())?;
+        running.fur.update(&running.gpu, &model.sim)?;
+        if model.posed {
+            running.fur.set_base_normals(&running.gpu, &model.pose.normals)?;
+        }
         if requests.screenshot {
             model.screenshot_pending = true;
         }

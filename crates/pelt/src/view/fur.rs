@@ -2,11 +2,12 @@
 //! (a new mesh or layer count rebuilds the structure, a texture setting the textures).
 
 use glam::{Mat4, Vec3};
+use pelt_core::sim::Simulation;
 use pelt_core::texture::FurTextures;
 use pelt_core::{FurStructure, Mesh};
 use pelt_render::{
-    Camera, DEFAULT_BACKGROUND, FurDrawSettings, FurFrame, FurRenderer, FurStates, FurView, GpuFur, Light, PlainMesh,
-    SeparatedFur, SeparatedRenderer,
+    Camera, DEFAULT_BACKGROUND, FurDrawSettings, FurFrame, FurRenderer, FurStates, FurView, GpuFur, GpuSimulation,
+    Light, PlainMesh, SeparatedFur, SeparatedRenderer,
 };
 
 use super::camera::OrbitCamera;
@@ -21,8 +22,11 @@ const SEPARATED_FIN_FACES: u32 = 2;
 #[derive(Debug)]
 pub struct FurScene {
     renderer: FurRenderer,
-    /// The unified structure; the CPU simulation interpolates, so one state uploaded per frame.
+    /// The unified structure: with the CPU simulation one state, its interpolated output
+    /// uploaded per frame; with the GPU one two states, written by `gpu_sim`'s compute pass and
+    /// interpolated in the vertex shader (nothing uploaded per frame).
     fur: GpuFur,
+    gpu_sim: Option<GpuSimulation>,
     /// The separated structure of Lengyel et al. and its pipelines, built when first shown; it
     /// holds the rest pose (its fins are geometry of their own and do not follow the simulation).
     separated: Option<(SeparatedRenderer, SeparatedFur)>,
@@ -35,18 +39,19 @@ pub struct FurScene {
 
 impl FurScene {
     pub fn new(gpu: &pelt_render::Gpu, structure: &FurStructure, textures: &FurTextures) -> anyhow::Result<Self> {
-        let renderer = FurRenderer::new(&gpu.device, target())?;
+        let renderer = FurRenderer::new(&gpu.device, target(&gpu.adapter.get_info()))?;
         let fur = GpuFur::new(&gpu.device, &gpu.queue, &renderer, structure, textures, FurStates::One)?;
         fur.prepare(&gpu.queue, &FurFrame::default());
         let view = FurView::new(&gpu.device, &renderer);
         Ok(Self {
             renderer,
             fur,
+            gpu_sim: None,
             separated: None,
             body: None,
             view,
             textures: textures.clone(),
-            settings: FurDrawSettings::ALL,
+            settings: FurDrawSettings::SILHOUETTE,
         })
     }
 
@@ -54,6 +59,46 @@ impl FurScene {
         self.separated = None;
         self.fur.set_structure(&gpu.device, &self.renderer, structure)?;
         self.fur.prepare(&gpu.queue, &FurFrame::default());
+        if self.gpu_sim.is_some() {
+            self.gpu_sim = Some(GpuSimulation::new(&gpu.device, &self.fur, structure)?);
+        }
+        Ok(())
+    }
+
+    /// Simulates on the GPU (two states and a compute pass) or not (one state, uploaded).
+    pub fn set_gpu_simulation(
+        &mut self,
+        gpu: &pelt_render::Gpu,
+        structure: &FurStructure,
+        on: bool,
+    ) -> anyhow::Result<()> {
+        if on == self.gpu_sim.is_some() {
+            return Ok(());
+        }
+        let states = if on { FurStates::Two } else { FurStates::One };
+        self.fur = GpuFur::new(&gpu.device, &gpu.queue, &self.renderer, structure, &self.textures, states)?;
+        self.fur.prepare(&gpu.queue, &FurFrame::default());
+        self.gpu_sim = if on { Some(GpuSimulation::new(&gpu.device, &self.fur, structure)?) } else { None };
+        Ok(())
+    }
+
+    /// This frame's shared array: the GPU simulation's new steps (a compute pass, submitted now)
+    /// and the interpolation weight, or the CPU simulation's interpolated output uploaded.
+    pub fn update(&mut self, gpu: &pelt_render::Gpu, sim: &Simulation) -> anyhow::Result<()> {
+        match &mut self.gpu_sim {
+            Some(gpu_sim) => {
+                gpu_sim.prepare(&gpu.device, &gpu.queue, sim, &self.fur)?;
+                if gpu_sim.pending_steps() > 0 {
+                    let mut encoder = gpu
+                        .device
+                        .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("simulation") });
+                    gpu_sim.dispatch(&mut encoder, &mut self.fur)?;
+                    gpu.queue.submit([encoder.finish()]);
+                }
+                self.fur.prepare(&gpu.queue, &FurFrame { interpolation: sim.alpha(), ..FurFrame::default() });
+            }
+            None => self.fur.set_positions(&gpu.queue, sim.positions())?,
+        }
         Ok(())
     }
 
@@ -107,9 +152,9 @@ impl FurScene {
         self.separated.as_ref().map(|(_, fur)| fur.gpu_bytes().structure())
     }
 
-    /// Uploads this frame's shared vertex array (the simulation's output).
-    pub fn set_positions(&self, gpu: &pelt_render::Gpu, positions: &[Vec3]) -> anyhow::Result<()> {
-        Ok(self.fur.set_positions(&gpu.queue, positions)?)
+    /// Uploads the posed base normals (skin shading of an animated mesh).
+    pub fn set_base_normals(&self, gpu: &pelt_render::Gpu, normals: &[Vec3]) -> anyhow::Result<()> {
+        Ok(self.fur.set_base_normals(&gpu.queue, normals)?)
     }
 
     /// Draws the body and the unified structure, or the separated one when `separated` and it is
@@ -126,11 +171,15 @@ impl FurScene {
         let camera =
             Camera { eye: camera.eye(), target: camera.target, up: Vec3::Y, fov_y_rad: camera.fov_y_rad, near, far };
         self.view.prepare(&gpu.queue, &camera.view_data(viewport.targets.aspect_ratio(), &Light::default()));
+        let separated = self.separated.as_ref().filter(|_| separated);
+        if separated.is_none() {
+            self.renderer.prepare_fins(encoder, &self.view, &self.fur);
+        }
         let mut pass = viewport.targets.begin_pass(encoder, &viewport.colour_view, DEFAULT_BACKGROUND);
         if let Some(body) = &self.body {
             self.renderer.draw_plain(&mut pass, &self.view, body);
         }
-        match self.separated.as_ref().filter(|_| separated) {
+        match separated {
             Some((renderer, fur)) => renderer.draw(&mut pass, &self.view, fur, &self.settings),
             None => self.renderer.draw(&mut pass, &self.view, &self.fur, &self.settings),
         }

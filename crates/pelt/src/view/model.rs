@@ -5,13 +5,15 @@ use std::time::Instant;
 
 use anyhow::Context as _;
 use glam::Vec3;
+use pelt_core::anim::{Pose, Rig};
 use pelt_core::mesh::builtin::{TRY_ON_NAME, TryOnScene, try_on_scene};
 use pelt_core::sim::{Scene, Simulation};
 use pelt_core::{Builtin, FurStructure, FurTextures, Mesh, Preset, PresetError};
 
 use super::Args;
 use super::camera::OrbitCamera;
-use super::panel::{Changes, MeshChoice, Settings};
+use super::panel::{AnimationSettings, Changes, MeshChoice, Settings};
+use crate::sim_kernel::{SimChoice, SimKernel};
 
 /// Time step of `--screenshot-after` runs, so they repeat exactly.
 const FIXED_FRAME_SECS: f64 = 1.0 / 60.0;
@@ -43,6 +45,10 @@ pub(super) struct Model {
     pub(super) sim_clock_secs: f64,
     /// Smoothed cost of one `advance_to`.
     pub(super) sim_time_secs: f64,
+    /// `--sim`, resolved once the GPU is open.
+    pub(super) sim_choice: SimChoice,
+    /// Why the kernel in use was chosen (the overlay shows it).
+    pub(super) kernel_reason: String,
     pub(super) touch: Option<TouchDrag>,
     /// Wind strength W restores after turning the wind off.
     pub(super) wind_strength_on: f32,
@@ -59,6 +65,14 @@ pub(super) struct Model {
     pub(super) quit: bool,
     pub(super) panel_hidden: bool,
     pub(super) status: String,
+    /// The command line's file's rig, when it moves.
+    pub(super) rig: Option<Rig>,
+    /// This frame's posed base (when `posed`).
+    pub(super) pose: Pose,
+    /// The base was posed this frame: the renderer takes its normals.
+    pub(super) posed: bool,
+    /// The base jumped (a new clip, the first pose): restart the simulation from it.
+    restart_pending: bool,
 }
 
 /// Wall-clock time, or exactly `FIXED_FRAME_SECS` per frame for repeatable runs.
@@ -87,7 +101,7 @@ pub(super) struct TouchDrag {
 
 impl Model {
     /// The model for `args`, with `mesh` (named `mesh_source`) as the command line's mesh.
-    pub(super) fn new(args: &Args, mesh: Mesh, mesh_source: String) -> anyhow::Result<Self> {
+    pub(super) fn new(args: &Args, mesh: Mesh, rig: Option<Rig>, mesh_source: String) -> anyhow::Result<Self> {
         let mut mesh_choices: Vec<MeshChoice> = Builtin::ALL.into_iter().map(MeshChoice::Builtin).collect();
         mesh_choices.push(MeshChoice::TryOn);
         let (choice, file_mesh) = match (&args.mesh.mesh, &args.mesh.builtin) {
@@ -103,8 +117,24 @@ impl Model {
             Some(path) => (Preset::load(path)?, path.display().to_string()),
             None => (Preset::default(), "fur.toml".to_owned()),
         };
+        let default_camera = OrbitCamera::default();
+        let camera = OrbitCamera {
+            yaw_rad: preset.render.camera_azimuth_deg.map_or(default_camera.yaw_rad, f32::to_radians),
+            pitch_rad: preset.render.camera_elevation_deg.map_or(default_camera.pitch_rad, f32::to_radians),
+            ..default_camera
+        };
         let mut settings = Settings::new(choice, preset, preset_path);
         settings.overlay = !args.no_overlay;
+        if let Some(rig) = &rig {
+            let clips: Vec<(String, f32)> = rig
+                .animations()
+                .iter()
+                .enumerate()
+                .map(|(k, a)| (a.name.clone().unwrap_or_else(|| format!("animation {k}")), a.duration_secs()))
+                .collect();
+            let clip = (!clips.is_empty()).then_some(0);
+            settings.animation = AnimationSettings { clips, clip, playing: true, speed: 1.0, time_secs: 0.0 };
+        }
         let structure = grow(mesh, &settings.preset)?;
         let sim = Simulation::new(&structure, &settings.preset.simulation)?;
         // The first textures are made before the window opens, so the first frame has them.
@@ -121,7 +151,7 @@ impl Model {
             body: None,
             unified_bytes: None,
             separated_bytes: None,
-            camera: OrbitCamera::default(),
+            camera,
             frame_pending: true,
             viewport_px: [1, 1],
             clock: Clock { fixed: args.screenshot_after.is_some(), last: Instant::now() },
@@ -130,6 +160,8 @@ impl Model {
             scene,
             sim_clock_secs: 0.0,
             sim_time_secs: 0.0,
+            sim_choice: args.sim,
+            kernel_reason: String::new(),
             touch: None,
             wind_strength_on: 1.0,
             textures: Some(textures),
@@ -142,6 +174,10 @@ impl Model {
             quit: false,
             panel_hidden: false,
             status: String::new(),
+            restart_pending: rig.is_some(),
+            rig,
+            pose: Pose::default(),
+            posed: false,
         };
         if args.mesh.mesh.is_none() && args.mesh.builtin.as_deref() == Some(TRY_ON_NAME) {
             model.settings.mesh = MeshChoice::TryOn;
@@ -215,12 +251,37 @@ impl Model {
             return Ok(());
         }
         self.sim_clock_secs += frame_secs;
+        self.pose_base(frame_secs)?;
         if let Some(scene) = &self.scene {
             scene.apply(self.sim_clock_secs, &mut self.sim)?;
         }
         let start = Instant::now();
         self.sim.advance_to(self.sim_clock_secs);
         self.sim_time_secs = smooth(self.sim_time_secs, start.elapsed().as_secs_f64());
+        Ok(())
+    }
+
+    /// Plays the animation of the command line's file and moves the fur's base with it.
+    fn pose_base(&mut self, frame_secs: f64) -> anyhow::Result<()> {
+        let rig = match &self.rig {
+            Some(rig) if matches!(self.settings.mesh, MeshChoice::File(_)) => rig,
+            _ => {
+                self.posed = false;
+                return Ok(());
+            }
+        };
+        let animation = &mut self.settings.animation;
+        let duration = animation.clip.map_or(0.0, |k| rig.animations()[k].duration_secs());
+        if animation.playing && duration > 0.0 {
+            animation.time_secs = (animation.time_secs + frame_secs as f32 * animation.speed).rem_euclid(duration);
+        }
+        animation.time_secs = animation.time_secs.clamp(0.0, duration);
+        rig.pose(&self.structure.mesh, animation.clip, f64::from(animation.time_secs), &mut self.pose);
+        self.sim.set_base_rotations(&self.pose.positions, &self.pose.rotations)?;
+        if std::mem::take(&mut self.restart_pending) {
+            self.sim.restart();
+        }
+        self.posed = true;
         Ok(())
     }
 
@@ -243,16 +304,32 @@ impl Model {
             self.structure = grow(self.structure.mesh.clone(), &self.settings.preset)?;
         }
         let rebuilt = changes.mesh || changes.structure;
+        if changes.animation {
+            self.settings.animation.time_secs = 0.0;
+        }
+        self.restart_pending |= rebuilt || changes.animation;
         if rebuilt {
             self.sim = Simulation::new(&self.structure, &self.settings.preset.simulation)?;
             self.touch = None;
         } else if changes.simulation {
             self.sim.set_params(&self.settings.preset.simulation)?;
         }
+        if changes.kernel {
+            self.kernel_reason = "panel".to_owned();
+        }
+        // The GPU bends the strands from the CPU simulation's inputs; the CPU then only keeps time.
+        self.sim.set_cpu_bending(self.kernel() == SimKernel::Cpu);
         if changes.textures {
             self.textures_stale = true;
         }
         Ok(rebuilt)
+    }
+}
+
+impl Model {
+    /// The kernel the panel's toggle selects.
+    pub(super) fn kernel(&self) -> SimKernel {
+        if self.settings.gpu_sim { SimKernel::Gpu } else { SimKernel::Cpu }
     }
 }
 
@@ -276,8 +353,8 @@ pub(super) fn test_model(args: &[&str]) -> Model {
         args: Args,
     }
     let wrapper = <Wrapper as clap::Parser>::parse_from([&["view"], args].concat());
-    let (mesh, report) = wrapper.args.mesh.load(Builtin::Bunny).unwrap();
-    Model::new(&wrapper.args, mesh, report.source).unwrap()
+    let (mesh, report, rig) = wrapper.args.mesh.load_animated(Builtin::Bunny).unwrap();
+    Model::new(&wrapper.args, mesh, rig, report.source).unwrap()
 }
 
 #[cfg(test)]
@@ -299,6 +376,29 @@ mod tests {
         model.settings.mesh = MeshChoice::TryOn;
         assert!(model.apply(Changes { mesh: true, ..Changes::default() }).unwrap());
         assert!(model.body.is_some() && model.frame_pending);
+    }
+
+    #[test]
+    fn an_animated_file_plays_pauses_and_a_new_clip_restarts() {
+        let fox = concat!(env!("CARGO_MANIFEST_DIR"), "/../../assets/meshes/Fox.glb");
+        let mut model = test_model(&[fox]);
+        assert_eq!(model.settings.animation.clips.len(), 3);
+        assert_eq!(model.settings.animation.clip, Some(0), "the first clip plays by default");
+        model.settings.animation.clip = Some(1);
+        assert!(!model.apply(Changes { animation: true, ..Changes::default() }).unwrap());
+        model.simulate(0.1).unwrap();
+        assert!(model.posed);
+        let first = model.sim.roots().to_vec();
+        model.simulate(0.1).unwrap();
+        assert!((model.settings.animation.time_secs - 0.2).abs() < 1e-5);
+        assert_ne!(model.sim.roots(), &first[..], "the walk moves the roots");
+        model.settings.animation.playing = false;
+        model.simulate(0.1).unwrap();
+        assert!((model.settings.animation.time_secs - 0.2).abs() < 1e-5, "paused");
+        model.settings.mesh = MeshChoice::Builtin(Builtin::Sphere);
+        model.apply(Changes { mesh: true, ..Changes::default() }).unwrap();
+        model.simulate(0.1).unwrap();
+        assert!(!model.posed, "a built-in mesh does not take the file's rig");
     }
 
     #[test]

@@ -73,9 +73,26 @@ pub struct Settings {
     /// Touch brush radius as a fraction of the mesh's bounding radius.
     pub brush_per_radius: f32,
     pub draw: DrawToggles,
+    /// Bend the strands on the GPU (a compute pass) rather than the CPU.
+    pub gpu_sim: bool,
     pub overlay: bool,
     /// Where Load and Save read and write the preset.
     pub preset_path: String,
+    /// The animated file's clips and what plays.
+    pub animation: AnimationSettings,
+}
+
+/// The animation controls: which clip, playing or not, speed and the timeline.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct AnimationSettings {
+    /// `(name, duration in seconds)` of every clip of the file (empty: no animation section).
+    pub clips: Vec<(String, f32)>,
+    /// The clip that plays; `None` is the rest pose.
+    pub clip: Option<usize>,
+    pub playing: bool,
+    pub speed: f32,
+    /// Time in the clip, seconds.
+    pub time_secs: f32,
 }
 
 impl Settings {
@@ -86,8 +103,10 @@ impl Settings {
             simulate: true,
             brush_per_radius: 0.25,
             draw: DrawToggles::default(),
+            gpu_sim: false,
             overlay: true,
             preset_path,
+            animation: AnimationSettings::default(),
         }
     }
 }
@@ -101,14 +120,20 @@ pub struct Changes {
     /// The strand field or its colours.
     pub textures: bool,
     pub simulation: bool,
+    /// Another clip: the fur starts over from its first pose.
+    pub animation: bool,
+    /// The CPU/GPU simulation toggle.
+    pub kernel: bool,
 }
 
 impl Changes {
     pub fn merge(&mut self, other: Self) {
+        self.animation |= other.animation;
         self.mesh |= other.mesh;
         self.structure |= other.structure;
         self.textures |= other.textures;
         self.simulation |= other.simulation;
+        self.kernel |= other.kernel;
     }
 }
 
@@ -128,6 +153,28 @@ impl Requests {
         self.save_preset |= other.save_preset;
         self.load_preset |= other.load_preset;
     }
+}
+
+/// The clip picker, play/pause, speed and timeline; true when another clip was picked.
+fn animation_ui(ui: &mut egui::Ui, animation: &mut AnimationSettings) -> bool {
+    const REST: &str = "none (rest pose)";
+    let names: Vec<String> = animation.clips.iter().map(|(name, secs)| format!("{name} ({secs:.2} s)")).collect();
+    let selected = animation.clip.map_or(REST.to_owned(), |k| names[k].clone());
+    let mut changed = false;
+    egui::ComboBox::from_label("animation").selected_text(selected).show_ui(ui, |ui| {
+        changed |= ui.selectable_value(&mut animation.clip, None, REST).changed();
+        for (k, name) in names.iter().enumerate() {
+            changed |= ui.selectable_value(&mut animation.clip, Some(k), name.as_str()).changed();
+        }
+    });
+    ui.checkbox(&mut animation.playing, "playing");
+    ui.add(egui::Slider::new(&mut animation.speed, 0.0..=3.0).text("speed"));
+    let duration = animation.clip.map_or(0.0, |k| animation.clips[k].1);
+    ui.add_enabled(
+        duration > 0.0,
+        egui::Slider::new(&mut animation.time_secs, 0.0..=duration.max(1e-3)).text("time (s)"),
+    );
+    changed
 }
 
 /// Draws the panel's contents; returns what changed and what was asked for.
@@ -165,6 +212,9 @@ pub fn show(
                 ui.label(egui::RichText::new(status).small().weak());
             }
         });
+        if !settings.animation.clips.is_empty() {
+            section(ui, "Animation", true, |ui| changes.animation |= animation_ui(ui, &mut settings.animation));
+        }
         let preset = &mut settings.preset;
         section(ui, "Shape", true, |ui| {
             let layers = ui.add(egui::Slider::new(&mut preset.layers, 1..=64).text("layers")).changed();
@@ -226,6 +276,7 @@ pub fn show(
         });
         section(ui, "Simulation", true, |ui| {
             changes.simulation |= ui.checkbox(&mut settings.simulate, "running (Space)").changed();
+            changes.kernel |= ui.checkbox(&mut settings.gpu_sim, "on the GPU (compute pass)").changed();
             let sim = &mut preset.simulation;
             let before = sim.clone();
             ui.add(egui::Slider::new(&mut sim.stability, 0.5..=200.0).logarithmic(true).text("stability"));

@@ -217,8 +217,10 @@ impl Model {
         let frame_ms = self.frame_time_secs * 1e3;
         let fps = if self.frame_time_secs > 0.0 { 1.0 / self.frame_time_secs } else { 0.0 };
         let text = format!(
-            "frame    {frame_ms:6.2} ms  ({fps:.0} fps)\nsim      {:6.2} ms\nvertices {:>9}\nfaces    {:>9}\nGPU      {:>9}  {} structure\nmesh     {}  L = {}",
+            "frame    {frame_ms:6.2} ms  ({fps:.0} fps)\nsim      {:6.2} ms CPU, bent on the {} ({})\nvertices {:>9}\nfaces    {:>9}\nGPU      {:>9}  {} structure\nmesh     {}  L = {}",
             self.sim_time_secs * 1e3,
+            self.kernel(),
+            self.kernel_reason,
             thousands(vertices),
             thousands(faces),
             bytes(structure_bytes),

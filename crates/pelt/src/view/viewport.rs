@@ -9,9 +9,10 @@ pub const COLOUR_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8UnormSr
 /// egui samples gamma-encoded textures, so it reads the same texels through a non-sRGB view.
 const EGUI_VIEW_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba8Unorm;
 
-/// What the fur renderer draws the view into (4x MSAA resolved into the texture, conventional depth).
-pub fn target() -> FurTarget {
-    FurTarget::new(COLOUR_FORMAT)
+/// What the fur renderer draws the view into (MSAA as suits the adapter, resolved into the
+/// texture; conventional depth).
+pub fn target(adapter: &wgpu::AdapterInfo) -> FurTarget {
+    FurTarget::new(COLOUR_FORMAT).with_sample_count(pelt_render::default_sample_count(adapter))
 }
 
 /// The offscreen target, its MSAA and depth attachments, and its egui texture.
@@ -22,6 +23,7 @@ pub struct Viewport {
     pub colour_view: wgpu::TextureView,
     pub targets: RenderTargets,
     pub texture_id: egui::TextureId,
+    target: FurTarget,
 }
 
 impl Viewport {
@@ -29,12 +31,13 @@ impl Viewport {
         device: &wgpu::Device,
         egui_renderer: &mut egui_wgpu::Renderer,
         size_px: [u32; 2],
+        target: FurTarget,
     ) -> anyhow::Result<Self> {
         let size_px = clamp_size(device, size_px);
         let (texture, colour_view, egui_view) = create_target(device, size_px);
-        let targets = RenderTargets::new(device, target(), size_px[0], size_px[1])?;
+        let targets = RenderTargets::new(device, target, size_px[0], size_px[1])?;
         let texture_id = egui_renderer.register_native_texture(device, &egui_view, wgpu::FilterMode::Linear);
-        Ok(Self { texture, colour_view, targets, texture_id })
+        Ok(Self { texture, colour_view, targets, texture_id, target })
     }
 
     pub fn size_px(&self) -> [u32; 2] {
@@ -53,7 +56,7 @@ impl Viewport {
             return Ok(());
         }
         let (texture, colour_view, egui_view) = create_target(device, size_px);
-        self.targets = RenderTargets::new(device, target(), size_px[0], size_px[1])?;
+        self.targets = RenderTargets::new(device, self.target, size_px[0], size_px[1])?;
         egui_renderer.update_egui_texture_from_wgpu_texture(
             device,
             &egui_view,

@@ -1,0 +1,182 @@
+//! Inertia: fur on a moving body lags when the body starts, swings past when it stops, and
+//! settles.
+//!
+//! Each root's acceleration comes from its positions at the last three steps,
+//! `a = (r_n - 2 r_n-1 + r_n-2) / dt^2` (the uneven-step form when a step was skipped). In the body's frame that is a force `-a` on the strand;
+//! in the preset's force units (gravity's default strength is 1) it is
+//! `target = -inertia * a / radius`, so the same motion relative to the body's size bends fur
+//! the same way on any mesh scale. The force on each strand follows its target as a damped
+//! spring (natural frequency [`INERTIA_FREQUENCY_HZ`], damping ratio `damping`): it builds up
+//! over a few steps, overshoots when the motion stops (the swing) and settles. This is the only
+//! state the simulation carries from step to step.
+//!
+//! Teleports must not fling the fur: a root that moves more than [`TELEPORT_RADII_PER_STEP`]
+//! bounding radii in one step, a jump in time or a host's [`Inertia::reset`] (a new animation)
+//! start over from rest, and the target is clamped to [`MAX_INERTIAL_FORCE`].
+
+use glam::Vec3;
+use rayon::prelude::*;
+
+/// Natural frequency of the fur's swing, in hertz.
+pub const INERTIA_FREQUENCY_HZ: f32 = 2.0;
+
+/// A root moving farther than this many bounding radii in one step is a teleport: the inertial
+/// state starts over instead of seeing a huge acceleration.
+pub const TELEPORT_RADII_PER_STEP: f32 = 0.5;
+
+/// The largest inertial force (in gravity's units; the default gravity is 1).
+pub const MAX_INERTIAL_FORCE: f32 = 10.0;
+
+/// Steps further apart than this (seconds) are unrelated: the state starts over.
+const MAX_STEP_GAP_SECS: f64 = 1.0;
+
+/// Strands per parallel task.
+const STRANDS_PER_TASK: usize = 1024;
+
+/// The inertial force per strand and what it needs from earlier steps.
+#[derive(Clone, Debug)]
+pub struct Inertia {
+    /// Roots at the last two steps (`[n - 1, n - 2]`), valid for `history` of them.
+    previous_roots: Vec<[Vec3; 2]>,
+    history: u8,
+    last_time_secs: Option<f64>,
+    /// Seconds between the last two steps.
+    last_dt: f32,
+    force: Vec<Vec3>,
+    force_velocity: Vec<Vec3>,
+    resets: u64,
+}
+
+impl Inertia {
+    /// At rest, for `strands` strands.
+    #[must_use]
+    pub fn new(strands: usize) -> Self {
+        Self {
+            previous_roots: vec![[Vec3::ZERO; 2]; strands],
+            history: 0,
+            last_time_secs: None,
+            last_dt: 0.0,
+            force: vec![Vec3::ZERO; strands],
+            force_velocity: vec![Vec3::ZERO; strands],
+            resets: 0,
+        }
+    }
+
+    /// Forgets the motion: no force until two more steps have been seen.
+    pub fn reset(&mut self) {
+        self.history = 0;
+        self.last_time_secs = None;
+        self.force.fill(Vec3::ZERO);
+        self.force_velocity.fill(Vec3::ZERO);
+    }
+
+    /// The inertial force per strand for the newest step.
+    #[must_use]
+    pub fn forces(&self) -> &[Vec3] {
+        &self.force
+    }
+
+    /// How many times a teleport or a time jump started the state over (not counting
+    /// [`Inertia::reset`]).
+    #[must_use]
+    pub fn teleports(&self) -> u64 {
+        self.resets
+    }
+
+    /// Takes the roots of the step at `time_secs` and updates the forces. `inertia` scales the
+    /// force, `damping` is the spring's damping ratio and `radius` the body's bounding radius.
+    pub fn update(&mut self, roots: &[Vec3], time_secs: f64, inertia: f32, damping: f32, radius: f32) {
+        assert_eq!(roots.len(), self.force.len(), "one root per strand");
+        let dt = self.last_time_secs.map(|last| time_secs - last);
+        self.last_time_secs = Some(time_secs);
+        let Some(dt) = dt.filter(|&dt| dt > 0.0 && dt <= MAX_STEP_GAP_SECS) else {
+            if self.history > 0 {
+                self.resets += 1;
+            }
+            self.start_from(roots);
+            return;
+        };
+        let teleport = TELEPORT_RADII_PER_STEP * radius;
+        if self.history > 0 && roots.iter().zip(&self.previous_roots).any(|(r, p)| r.distance(p[0]) > teleport) {
+            self.resets += 1;
+            self.start_from(roots);
+            return;
+        }
+        let (dt, dt_before) = (dt as f32, self.last_dt);
+        self.last_dt = dt;
+        if self.history < 2 || inertia == 0.0 {
+            self.history = (self.history + 1).min(2);
+            if inertia == 0.0 {
+                self.force.fill(Vec3::ZERO);
+                self.force_velocity.fill(Vec3::ZERO);
+            }
+            for (p, r) in self.previous_roots.iter_mut().zip(roots) {
+                *p = [*r, p[0]];
+            }
+            return;
+        }
+        // The spring is stepped semi-implicitly (damping implicit) and its frequency kept below
+        // the step rate, so it is stable at any rate and damping.
+        let omega = (std::f32::consts::TAU * INERTIA_FREQUENCY_HZ).min(1.0 / dt);
+        // a = 2 ((r - r1) / dt - (r1 - r2) / dt_before) / (dt + dt_before).
+        let scale = -inertia * 2.0 / (radius * (dt + dt_before));
+        let damp = 1.0 / (1.0 + 2.0 * damping * omega * dt);
+        self.previous_roots
+            .par_iter_mut()
+            .zip(self.force.par_iter_mut())
+            .zip(self.force_velocity.par_iter_mut())
+            .zip(roots.par_iter())
+            .with_min_len(STRANDS_PER_TASK)
+            .for_each(|(((previous, force), velocity), root)| {
+                let acceleration = (*root - previous[0]) / dt - (previous[0] - previous[1]) / dt_before;
+                let target = (acceleration * scale).clamp_length_max(MAX_INERTIAL_FORCE);
+                *velocity = (*velocity + (target - *force) * (omega * omega * dt)) * damp;
+                *force += *velocity * dt;
+                *previous = [*root, previous[0]];
+            });
+    }
+
+    fn start_from(&mut self, roots: &[Vec3]) {
+        self.force.fill(Vec3::ZERO);
+        self.force_velocity.fill(Vec3::ZERO);
+        for (p, r) in self.previous_roots.iter_mut().zip(roots) {
+            *p = [*r, *r];
+        }
+        self.history = 1;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_steady_acceleration_gives_the_steady_force() {
+        // Roots accelerating at 2 radii/s^2 along +X: the force settles at -inertia * 2 along X.
+        let (rate, inertia, radius) = (30.0_f64, 0.5, 3.0);
+        let mut state = Inertia::new(1);
+        for n in 0..150 {
+            let t = n as f64 / rate;
+            let x = 0.5 * 2.0 * radius * (t * t) as f32;
+            state.update(&[Vec3::new(x, 0.0, 0.0)], t, inertia, 0.7, radius);
+        }
+        let f = state.forces()[0];
+        assert!((f.x + 1.0).abs() < 1e-2 && f.y == 0.0 && f.z == 0.0, "{f}");
+    }
+
+    #[test]
+    fn a_teleport_and_a_time_jump_start_over() {
+        let mut state = Inertia::new(2);
+        let at = |x: f32| [Vec3::new(x, 0.0, 0.0), Vec3::new(x, 1.0, 0.0)];
+        for (n, x) in [0.0, 0.01, 0.03, 0.06].into_iter().enumerate() {
+            state.update(&at(x), n as f64 / 30.0, 1.0, 0.5, 1.0);
+        }
+        assert!(state.forces()[0].x < 0.0);
+        state.update(&at(5.0), 4.0 / 30.0, 1.0, 0.5, 1.0);
+        assert_eq!(state.forces(), &[Vec3::ZERO; 2], "a jump of 5 radii is a teleport");
+        assert_eq!(state.teleports(), 1);
+        state.update(&at(5.1), 60.0, 1.0, 0.5, 1.0);
+        assert_eq!(state.forces(), &[Vec3::ZERO; 2], "a minute later is unrelated");
+        assert_eq!(state.teleports(), 2);
+    }
+}

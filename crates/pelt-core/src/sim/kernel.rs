@@ -1,0 +1,439 @@
+//! The batched bend that [`Simulation`](super::Simulation) runs: [`LANES`] strands at once,
+//! structure of arrays, in two forms.
+//!
+//! - **Straight strands** (every rest segment of a strand points the same way; the structure
+//!   grows only these): all segments stay in the plane of the strand direction `d` and the force
+//!   direction `f`, so the strand is described by one angle. With `a_0 = angle(d, f)` and the
+//!   weights `w_k` below, segment `k` ends at angle `a_(k+1) = a_k * (1 - w_k)` from `f`, turned
+//!   by `phi_k = a_0 - a_(k+1)` from `d`: direction `d cos(phi_k) + e sin(phi_k)`, `e` the unit
+//!   normal to `d` toward `f`. Exact, one multiply and a sine/cosine polynomial per node.
+//! - **General strands** (curved): the running quaternion of [`super::bend_strand`], each node
+//!   turned toward the force by its weight of the angle between them.
+//!
+//! Both use the same weight, Equation 1 as Pelt defines it (see [`super::bend`]): the strand's
+//! `scale = |F| * gain / stability` (`gain = BEND_GAIN / L^2` for [`Equation::Pelt`], `1` for
+//! [`Equation::Paper`]), and at node `k`, with `RN = L - k`, `w_k = min(1, scale * RN)`. A
+//! force below [`PARALLEL_SINE`] of a segment's direction, a zero or non-finite force, and a
+//! zero-length segment turn nothing.
+//!
+//! Every function is `#[inline(always)]` over [`F`] lanes so that [`super::dispatch`] compiles it
+//! twice, once with AVX2 + FMA enabled and once portable, from this one source.
+//!
+//! [`Equation::Pelt`]: super::Equation::Pelt
+//! [`Equation::Paper`]: super::Equation::Paper
+
+use std::f32::consts::{FRAC_PI_2, PI};
+
+use glam::{Quat, Vec3};
+
+use super::bend::PARALLEL_SINE;
+use super::lanes::{F, M, V3};
+
+/// Strands per batch (one AVX2 register of `f32`).
+pub(crate) const LANES: usize = 8;
+
+/// One `f32` per strand of a batch.
+pub(crate) type Lanes = [f32; LANES];
+
+/// A vector per strand of a batch: `[x, y, z]` lanes.
+pub(crate) type VecLanes = [Lanes; 3];
+
+/// Per-strand inputs of one step.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct StrandInputs {
+    pub root: Vec3,
+    /// Rotation of the rest frame into the current base frame.
+    pub frame: Quat,
+    /// Total force (gravity plus field); non-finite counts as none.
+    pub force: Vec3,
+    pub stability: f32,
+}
+
+impl Default for StrandInputs {
+    fn default() -> Self {
+        Self { root: Vec3::ZERO, frame: Quat::IDENTITY, force: Vec3::ZERO, stability: 1.0 }
+    }
+}
+
+/// The rest shape of one batch, borrowed from the simulation's arrays.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct BatchRest<'a> {
+    /// Segment lengths, `L` entries.
+    pub lengths: &'a [Lanes],
+    /// Unit segment directions in the rest frame, `L` entries (general batches).
+    pub directions: &'a [VecLanes],
+    /// The unit strand direction in the rest frame (straight batches).
+    pub straight: &'a VecLanes,
+}
+
+/// The forces of `W` strands in lanes: unit direction, and `scale` (`|F| * gain / stability`,
+/// 0 where the force is zero or not finite). The split avoids overflow: a finite force whose
+/// length overflows `f32` still gets its direction.
+#[inline(always)]
+fn forces<const W: usize>(force: V3<W>, stability: F<W>, gain: f32) -> (V3<W>, F<W>) {
+    let largest = force.x.abs().max(force.y.abs()).max(force.z.abs());
+    let usable = largest.gt(F::splat(0.0)).and(largest.lt(F::splat(f32::INFINITY)));
+    let divisor = usable.select(largest, F::splat(1.0));
+    let scaled = V3 { x: force.x / divisor, y: force.y / divisor, z: force.z / divisor };
+    let length = scaled.dot(scaled).sqrt();
+    let length_divisor = usable.select(length, F::splat(1.0));
+    let zero = V3::splat(0.0, 0.0, 0.0);
+    let direction = V3::select(
+        usable,
+        V3 { x: scaled.x / length_divisor, y: scaled.y / length_divisor, z: scaled.z / length_divisor },
+        zero,
+    );
+    let scale = usable.select((length * largest) * F::splat(gain) / stability, F::splat(0.0));
+    (direction, scale)
+}
+
+/// `q * v` (unit `q`): `t = 2 (u x v)`, `v + w t + u x t`.
+#[inline(always)]
+fn rotate<const W: usize>(q: &[F<W>; 4], v: V3<W>) -> V3<W> {
+    let u = V3 { x: q[0], y: q[1], z: q[2] };
+    let t = u.cross(v).scale(F::splat(2.0));
+    let ut = u.cross(t);
+    t.mul_add(q[3], V3 { x: v.x + ut.x, y: v.y + ut.y, z: v.z + ut.z })
+}
+
+/// Quaternion product `a * b`.
+#[inline(always)]
+fn multiply<const W: usize>(a: &[F<W>; 4], b: &[F<W>; 4]) -> [F<W>; 4] {
+    let [ax, ay, az, aw] = *a;
+    let [bx, by, bz, bw] = *b;
+    [
+        aw.mul_add(bx, ax.mul_add(bw, ay.mul_add(bz, -(az * by)))),
+        aw.mul_add(by, ay.mul_add(bw, az.mul_add(bx, -(ax * bz)))),
+        aw.mul_add(bz, az.mul_add(bw, ax.mul_add(by, -(ay * bx)))),
+        aw.mul_add(bw, -(ax.mul_add(bx, ay.mul_add(by, az * bz)))),
+    ]
+}
+
+/// The angle in `[0, pi]` with this sine (`>= 0`) and cosine, `atan2(sine, cosine)`: the
+/// paper's `acos(dot)` with its clamp built in and accurate near 0 and pi. The odd polynomial of
+/// Abramowitz and Stegun 4.4.49 on the reduced argument (error below 1e-7 rad).
+#[inline(always)]
+fn angle<const W: usize>(sine: F<W>, cosine: F<W>) -> F<W> {
+    let (a, b) = (sine, cosine.abs());
+    let steep = a.gt(b);
+    let numerator = steep.select(b, a);
+    let denominator = steep.select(a, b);
+    // Both are zero together; 0 / 1 = 0 then.
+    let t = numerator / denominator.gt(F::splat(0.0)).select(denominator, F::splat(1.0));
+    let t2 = t * t;
+    let mut p = F::splat(0.002_866_225_7);
+    for c in [-0.016_165_737, 0.042_909_614, -0.075_289_64, 0.106_562_64, -0.142_089, 0.199_935_51, -0.333_331_45] {
+        p = p.mul_add(t2, F::splat(c));
+    }
+    let angle = (t * t2).mul_add(p, t);
+    let angle = steep.select(F::splat(FRAC_PI_2) - angle, angle);
+    cosine.lt(F::splat(0.0)).select(F::splat(PI) - angle, angle)
+}
+
+/// `(sin x, cos x)` for `x` in `[0, pi/2]`: Taylor polynomials to `x^11` and `x^12` (error
+/// below 1e-7), coefficients as reciprocal constants.
+#[inline(always)]
+fn sin_cos<const W: usize>(x: F<W>) -> (F<W>, F<W>) {
+    let x2 = x * x;
+    let mut s = F::splat(-1.0 / 39_916_800.0);
+    for c in [1.0 / 362_880.0, -1.0 / 5040.0, 1.0 / 120.0, -1.0 / 6.0, 1.0] {
+        s = s.mul_add(x2, F::splat(c));
+    }
+    let mut c = F::splat(1.0 / 479_001_600.0);
+    for k in [-1.0 / 3_628_800.0, 1.0 / 40_320.0, -1.0 / 720.0, 1.0 / 24.0, -0.5, 1.0] {
+        c = c.mul_add(x2, F::splat(k));
+    }
+    (x * s, c)
+}
+
+/// The per-strand inputs of `N` batches as `W = N * LANES` lanes.
+#[derive(Clone, Copy, Debug)]
+struct Loaded<const W: usize> {
+    root: V3<W>,
+    frame: [F<W>; 4],
+    force: V3<W>,
+    stability: F<W>,
+}
+
+#[inline(always)]
+fn load<const N: usize, const W: usize>(inputs: [&[StrandInputs; LANES]; N]) -> Loaded<W> {
+    macro_rules! lane {
+        ($($field:tt).+) => {
+            F(std::array::from_fn(|i| inputs[i / LANES][i % LANES].$($field).+))
+        };
+    }
+    Loaded {
+        root: V3 { x: lane!(root.x), y: lane!(root.y), z: lane!(root.z) },
+        frame: [lane!(frame.x), lane!(frame.y), lane!(frame.z), lane!(frame.w)],
+        force: V3 { x: lane!(force.x), y: lane!(force.y), z: lane!(force.z) },
+        stability: lane!(stability),
+    }
+}
+
+#[inline(always)]
+fn gather<const N: usize, const W: usize>(parts: [&Lanes; N]) -> F<W> {
+    F(std::array::from_fn(|i| parts[i / LANES][i % LANES]))
+}
+
+#[inline(always)]
+fn gather3<const N: usize, const W: usize>(parts: [&VecLanes; N]) -> V3<W> {
+    V3 { x: gather(parts.map(|p| &p[0])), y: gather(parts.map(|p| &p[1])), z: gather(parts.map(|p| &p[2])) }
+}
+
+#[inline(always)]
+#[allow(clippy::needless_range_loop)] // reason: lanes of two arrays by one index
+fn store<const N: usize, const W: usize>(value: V3<W>, parts: &mut [&mut [VecLanes]; N], index: usize) {
+    for (n, part) in parts.iter_mut().enumerate() {
+        let out = &mut part[index];
+        for i in 0..LANES {
+            out[0][i] = value.x.0[n * LANES + i];
+            out[1][i] = value.y.0[n * LANES + i];
+            out[2][i] = value.z.0[n * LANES + i];
+        }
+    }
+}
+
+/// Bends one batch of straight strands (see the module docs); `nodes` receives `L + 1` nodes.
+#[inline(always)]
+pub(crate) fn bend_straight(inputs: &[StrandInputs; LANES], gain: f32, rest: BatchRest<'_>, nodes: &mut [VecLanes]) {
+    const W: usize = LANES;
+    let layers = rest.lengths.len();
+    debug_assert_eq!(nodes.len(), layers + 1);
+    let input: Loaded<W> = load([inputs]);
+    let (force, scale) = forces(input.force, input.stability, gain);
+    let d = rotate(&input.frame, gather3([rest.straight]));
+    let axis = d.cross(force);
+    let sine = axis.dot(axis).sqrt();
+    let cosine = d.dot(force);
+    let start = angle(sine, cosine);
+    let active = sine.gt(F::splat(PARALLEL_SINE)).and(scale.gt(F::splat(0.0)));
+    let scale = active.select(scale, F::splat(0.0));
+    // e = (f - d cos a) / sin a, the unit normal to d in the plane, toward f.
+    let toward = d.mul_add(-cosine, force);
+    let inverse_sine = F::splat(1.0) / active.select(sine, F::splat(1.0));
+    let e = V3::select(active, toward.scale(inverse_sine), V3::splat(0.0, 0.0, 0.0));
+    let mut remaining = start;
+    let mut node = input.root;
+    let (first, rest_nodes) = nodes.split_at_mut(1);
+    put(node, &mut first[0]);
+    for (k, (length, out)) in rest.lengths.iter().zip(rest_nodes).enumerate() {
+        let weight = (scale * F::splat((layers - k) as f32)).min(F::splat(1.0));
+        remaining = remaining.mul_add(-weight, remaining);
+        let (half_sin, half_cos) = sin_cos((start - remaining) * F::splat(0.5));
+        let cos_turn = (half_sin * F::splat(-2.0)).mul_add(half_sin, F::splat(1.0));
+        let sin_turn = (half_sin * half_cos) * F::splat(2.0);
+        let direction = e.mul_add(sin_turn, d.scale(cos_turn));
+        node = direction.mul_add(F(*length), node);
+        put(node, out);
+    }
+}
+
+#[inline(always)]
+fn put(value: V3<LANES>, out: &mut VecLanes) {
+    *out = [value.x.0, value.y.0, value.z.0];
+}
+
+/// Bends `N` batches of strands of any shape, interleaved (`W = N * LANES` lanes: independent
+/// chains for the out-of-order core to overlap); `nodes[n]` receives batch `n`'s `L + 1` nodes.
+#[inline(always)]
+pub(crate) fn bend_general<const N: usize, const W: usize>(
+    inputs: [&[StrandInputs; LANES]; N],
+    gain: f32,
+    rest: [BatchRest<'_>; N],
+    mut nodes: [&mut [VecLanes]; N],
+) {
+    const { assert!(W == N * LANES) };
+    let layers = rest[0].lengths.len();
+    let input: Loaded<W> = load(inputs);
+    let (force, scale) = forces(input.force, input.stability, gain);
+    let mut turned = input.frame;
+    let mut node = input.root;
+    store(node, &mut nodes, 0);
+    let (one, zero) = (F::splat(1.0), F::splat(0.0));
+    for k in 0..layers {
+        let length: F<W> = gather(rest.map(|r| &r.lengths[k]));
+        let d = rotate(&turned, gather3(rest.map(|r| &r.directions[k])));
+        let weight = (scale * F::splat((layers - k) as f32)).min(one);
+        let axis = d.cross(force);
+        let sine = axis.dot(axis).sqrt();
+        let cosine = d.dot(force);
+        let active: M<W> = sine.gt(F::splat(PARALLEL_SINE)).and(weight.gt(zero)).and(length.gt(zero));
+        let (half_sin, half_cos) = sin_cos(angle(sine, cosine) * weight * F::splat(0.5));
+        let half_sin = active.select(half_sin, zero);
+        let half_cos = active.select(half_cos, one);
+        // The rotation's vector part is the unit axis times sin(half angle).
+        let axis_scale = half_sin / active.select(sine, one);
+        let rotation = [axis.x * axis_scale, axis.y * axis_scale, axis.z * axis_scale, half_cos];
+        let product = multiply(&rotation, &turned);
+        let norm = product[0].mul_add(
+            product[0],
+            product[1].mul_add(product[1], product[2].mul_add(product[2], product[3] * product[3])),
+        );
+        // Renormalised so rounding never lets segment lengths drift over many layers.
+        let inverse = one / norm.sqrt();
+        turned = std::array::from_fn(|c| active.select(product[c] * inverse, turned[c]));
+        // The turned segment in the plane of d and f: d cos(a) + e sin(a), e = (f - d cos) / sine;
+        // `2 cos(a/2) * axis_scale` is sin(a) / sine.
+        let cos_turn = (half_sin * F::splat(-2.0)).mul_add(half_sin, one);
+        let toward = (half_cos * axis_scale) * F::splat(2.0);
+        let direction = d.mul_add(-cosine, force).mul_add(toward, d.scale(cos_turn));
+        node = direction.mul_add(length, node);
+        store(node, &mut nodes, k + 1);
+    }
+}
+
+/// The rest shape of every strand, batch-major: batch `b` holds strands `8b..8b + 8` (padding
+/// lanes past `V` have zero lengths and stay at the origin).
+#[derive(Clone, Debug)]
+pub(crate) struct RestBatches {
+    /// Segment lengths at `b * L + k`.
+    lengths: Vec<Lanes>,
+    /// Unit segment directions (zero for a zero-length segment) at `b * L + k`.
+    directions: Vec<VecLanes>,
+    /// Each strand's unit direction (tip minus root), per batch.
+    straight: Vec<VecLanes>,
+    /// Whether every strand of the batch is straight, so the straight form bends it.
+    is_straight: Vec<bool>,
+}
+
+impl RestBatches {
+    /// From a shared vertex array of `v` strands and `layers` segments (`NV[i * V + j]`).
+    pub fn new(positions: &[Vec3], v: usize, layers: usize) -> Self {
+        let batches = v.div_ceil(LANES);
+        let mut rest = Self {
+            lengths: vec![[0.0; LANES]; batches * layers],
+            directions: vec![[[0.0; LANES]; 3]; batches * layers],
+            straight: vec![[[0.0; LANES], [1.0; LANES], [0.0; LANES]]; batches],
+            is_straight: vec![true; batches],
+        };
+        for j in 0..v {
+            let (b, lane) = (j / LANES, j % LANES);
+            let segment = |k: usize| positions[(k + 1) * v + j] - positions[k * v + j];
+            for k in 0..layers {
+                let direction = segment(k).normalize_or_zero();
+                rest.lengths[b * layers + k][lane] = if direction == Vec3::ZERO { 0.0 } else { segment(k).length() };
+                for c in 0..3 {
+                    rest.directions[b * layers + k][c][lane] = direction[c];
+                }
+            }
+            match straight_direction(positions[j], (0..layers).map(segment)) {
+                Some(direction) => {
+                    for c in 0..3 {
+                        rest.straight[b][c][lane] = direction[c];
+                    }
+                }
+                None => rest.is_straight[b] = false,
+            }
+        }
+        rest
+    }
+
+    /// The share of batches the straight form bends.
+    pub fn straight_share(&self) -> f32 {
+        if self.is_straight.is_empty() {
+            return 1.0;
+        }
+        self.is_straight.iter().filter(|s| **s).count() as f32 / self.is_straight.len() as f32
+    }
+}
+
+/// The unit direction of a strand whose rest segments all point one way, or `None` if one
+/// bends away (or has zero length). Straightness is judged against the rounding of the positions
+/// the segments were computed from: a segment may deviate from the strand's direction by
+/// `1e-6 * (|root| + strand length)`, well below anything a curved strand does, and the
+/// straight form's result then differs from the general one by no more than that.
+fn straight_direction(root: Vec3, mut segments: impl Iterator<Item = Vec3> + Clone) -> Option<Vec3> {
+    let whole: Vec3 = segments.clone().sum();
+    let direction = whole.try_normalize()?;
+    let strand_length: f32 = segments.clone().map(Vec3::length).sum();
+    let tolerance = 1e-6 * (root.length() + strand_length);
+    segments
+        .all(|segment| {
+            let length = segment.length();
+            length > 0.0 && (segment - direction * length).length() <= tolerance
+        })
+        .then_some(direction)
+}
+
+/// Everything one step needs to bend every strand; [`Step::bend_pair`] bends two batches.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Step<'a> {
+    pub layers: usize,
+    pub vertex_count: usize,
+    /// `BEND_GAIN / L^2` or 1 (see the module docs).
+    pub gain: f32,
+    pub gravity: Vec3,
+    pub stability: f32,
+    pub stability_map: Option<&'a [f32]>,
+    pub roots: &'a [Vec3],
+    pub frames: &'a [Quat],
+    /// The external field (wind, field, touch), one per strand.
+    pub external: &'a [Vec3],
+    /// The inertial force from the roots' acceleration, one per strand.
+    pub inertial: &'a [Vec3],
+    pub rest: &'a RestBatches,
+}
+
+impl Step<'_> {
+    #[inline(always)]
+    fn inputs(&self, batch: usize) -> [StrandInputs; LANES] {
+        std::array::from_fn(|lane| {
+            let j = batch * LANES + lane;
+            if j < self.vertex_count {
+                StrandInputs {
+                    root: self.roots[j],
+                    frame: self.frames[j],
+                    force: self.gravity + self.external[j] + self.inertial[j],
+                    stability: self.stability_map.map_or(self.stability, |m| m[j]),
+                }
+            } else {
+                StrandInputs::default()
+            }
+        })
+    }
+
+    #[inline(always)]
+    fn rest(&self, batch: usize) -> BatchRest<'_> {
+        let range = batch * self.layers..(batch + 1) * self.layers;
+        BatchRest {
+            lengths: &self.rest.lengths[range.clone()],
+            directions: &self.rest.directions[range],
+            straight: &self.rest.straight[batch],
+        }
+    }
+
+    /// Bends batches `2 * pair` and `2 * pair + 1` (if any) into `nodes` (`L + 1` nodes each):
+    /// straight batches by the straight form, two general ones interleaved.
+    #[inline(always)]
+    pub fn bend_pair(&self, pair: usize, nodes: &mut [VecLanes]) {
+        let count = self.layers + 1;
+        let first = 2 * pair;
+        let batches = nodes.len() / count;
+        debug_assert!(batches == 1 || batches == 2);
+        let (a, b) = nodes.split_at_mut(count);
+        let inputs_a = self.inputs(first);
+        if batches == 2 && !self.rest.is_straight[first] && !self.rest.is_straight[first + 1] {
+            let inputs_b = self.inputs(first + 1);
+            bend_general::<2, { 2 * LANES }>(
+                [&inputs_a, &inputs_b],
+                self.gain,
+                [self.rest(first), self.rest(first + 1)],
+                [a, b],
+            );
+            return;
+        }
+        self.bend_one(first, &inputs_a, a);
+        if batches == 2 {
+            self.bend_one(first + 1, &self.inputs(first + 1), b);
+        }
+    }
+
+    #[inline(always)]
+    fn bend_one(&self, batch: usize, inputs: &[StrandInputs; LANES], nodes: &mut [VecLanes]) {
+        if self.rest.is_straight[batch] {
+            bend_straight(inputs, self.gain, self.rest(batch), nodes);
+        } else {
+            bend_general::<1, LANES>([inputs], self.gain, [self.rest(batch)], [nodes]);
+        }
+    }
+}

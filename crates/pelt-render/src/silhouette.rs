@@ -1,0 +1,163 @@
+//! Silhouette fins: a compute pass decides once per edge per frame which fins show
+//! (`silhouette.wgsl`) and writes them as the instances of an indexed indirect draw, so the fin
+//! pass shades only those edges instead of every edge and every vertex testing its own edge.
+//!
+//! The pass goes into the host's encoder ([`crate::FurRenderer::prepare_fins`]) before the render
+//! pass that draws the fur; nothing is read back, nothing blocks.
+
+use crate::RenderError;
+use crate::object::check_size;
+use crate::pipeline::Layouts;
+use crate::renderer::{SHADING_WGSL, UNIFIED_WGSL};
+
+pub(crate) const SILHOUETTE_WGSL: &str = include_str!("silhouette.wgsl");
+
+/// Edges one workgroup decides (`@workgroup_size` in `silhouette.wgsl`).
+const WORKGROUP_EDGES: u32 = 64;
+/// One fin instance: the edge and its fade (f32 bits).
+pub(crate) const FIN_INSTANCE_BYTES: u64 = 8;
+/// `wgpu::util::DrawIndexedIndirectArgs`.
+const DRAW_ARGS_BYTES: u64 = 20;
+
+/// The WGSL module of the silhouette pass (the shared shading, `unified.wgsl` and
+/// `silhouette.wgsl`).
+#[must_use]
+pub fn silhouette_shader_source() -> String {
+    format!("{SHADING_WGSL}\n{UNIFIED_WGSL}\n{SILHOUETTE_WGSL}")
+}
+
+/// The vertex input of the silhouette fin pipelines: one `(edge, fade bits)` per instance.
+pub(crate) const FIN_INSTANCE_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayout {
+    array_stride: FIN_INSTANCE_BYTES,
+    step_mode: wgpu::VertexStepMode::Instance,
+    attributes: &[wgpu::VertexAttribute { format: wgpu::VertexFormat::Uint32x2, offset: 0, shader_location: 0 }],
+};
+
+/// The bind group layout of one fur's fin list (group 3 of the silhouette pass).
+pub(crate) fn fin_list_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
+    let storage = |binding| wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::COMPUTE,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Storage { read_only: false },
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    };
+    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("pelt fin list"),
+        entries: &[storage(0), storage(1)],
+    })
+}
+
+/// The silhouette pass's pipeline, one per renderer.
+pub(crate) fn silhouette_pipeline(device: &wgpu::Device, layouts: &Layouts) -> wgpu::ComputePipeline {
+    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some("pelt silhouette"),
+        source: wgpu::ShaderSource::Wgsl(silhouette_shader_source().into()),
+    });
+    let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some("pelt silhouette"),
+        bind_group_layouts: &[Some(&layouts.view), Some(&layouts.unified_object), None, Some(&layouts.fin_list)],
+        immediate_size: 0,
+    });
+    device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+        label: Some("pelt silhouette"),
+        layout: Some(&layout),
+        module: &module,
+        entry_point: Some("cs_silhouette"),
+        compilation_options: wgpu::PipelineCompilationOptions::default(),
+        cache: None,
+    })
+}
+
+/// One fur's fins as the silhouette pass leaves them: the indirect draw and its instances.
+#[derive(Debug)]
+pub(crate) struct FinList {
+    /// `DrawIndexedIndirectArgs`: `6L` indices, the instance count the pass counted.
+    pub draw: wgpu::Buffer,
+    /// Up to `E` instances of [`FIN_INSTANCE_LAYOUT`].
+    pub instances: wgpu::Buffer,
+    bind_group: wgpu::BindGroup,
+    edge_count: u32,
+}
+
+impl FinList {
+    /// The list of a fur with `edge_count` edges and `layers` layers; `None` without fins.
+    pub fn new(
+        device: &wgpu::Device,
+        layouts: &Layouts,
+        edge_count: u32,
+        layers: u32,
+    ) -> Result<Option<Self>, RenderError> {
+        if edge_count == 0 || layers == 0 {
+            return Ok(None);
+        }
+        let instance_bytes = u64::from(edge_count) * FIN_INSTANCE_BYTES;
+        check_size(device, "fin instances", instance_bytes)?;
+        let workgroups = edge_count.div_ceil(WORKGROUP_EDGES);
+        let most = device.limits().max_compute_workgroups_per_dimension;
+        if workgroups > most {
+            return Err(RenderError::Limit {
+                limit: "max_compute_workgroups_per_dimension",
+                got: most.into(),
+                needed: workgroups.into(),
+            });
+        }
+        let args: [u32; 5] = [6 * layers, 0, 0, 0, 0];
+        let draw = wgpu::util::DeviceExt::create_buffer_init(
+            device,
+            &wgpu::util::BufferInitDescriptor {
+                label: Some("pelt fin draw"),
+                contents: bytemuck::cast_slice(&args),
+                usage: wgpu::BufferUsages::STORAGE
+                    | wgpu::BufferUsages::INDIRECT
+                    | wgpu::BufferUsages::COPY_DST
+                    | wgpu::BufferUsages::COPY_SRC,
+            },
+        );
+        debug_assert_eq!(draw.size(), DRAW_ARGS_BYTES);
+        let instances = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("pelt fin instances"),
+            size: instance_bytes,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::VERTEX,
+            mapped_at_creation: false,
+        });
+        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("pelt fin list"),
+            layout: &layouts.fin_list,
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: draw.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 1, resource: instances.as_entire_binding() },
+            ],
+        });
+        Ok(Some(Self { draw, instances, bind_group, edge_count }))
+    }
+
+    /// Records the silhouette pass: zero the count, then one thread per edge.
+    pub fn record(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        pipeline: &wgpu::ComputePipeline,
+        view: &wgpu::BindGroup,
+        object: &wgpu::BindGroup,
+    ) {
+        // `instance_count`, the second word of the draw.
+        encoder.clear_buffer(&self.draw, 4, Some(4));
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("pelt silhouette"),
+            timestamp_writes: None,
+        });
+        pass.set_pipeline(pipeline);
+        pass.set_bind_group(0, view, &[]);
+        pass.set_bind_group(1, object, &[]);
+        pass.set_bind_group(3, &self.bind_group, &[]);
+        pass.dispatch_workgroups(self.edge_count.div_ceil(WORKGROUP_EDGES), 1, 1);
+    }
+
+    /// GPU bytes of the list.
+    pub fn bytes(&self) -> u64 {
+        self.draw.size() + self.instances.size()
+    }
+}

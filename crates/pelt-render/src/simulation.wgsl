@@ -1,0 +1,215 @@
+// One step of pelt-core's `Simulation` on the GPU: per strand (one invocation each) the force
+// (gravity + wind + the user field with the touch blended over it + inertia), then the bend of Equation 1 as
+// `pelt_core::sim::bend` defines it (a running quaternion, O(L)), written layer-major into the
+// shared vertex array the renderer draws from. Appended to `simulation_wind.wgsl`.
+
+// One step's inputs (a 256-byte slot of a uniform buffer, chosen by dynamic offset).
+struct Step {
+    // xyz: gravity direction times strength.
+    gravity: vec4<f32>,
+    // xyz: unit wind direction; w: wind strength (0: no wind).
+    wind_direction: vec4<f32>,
+    // x: gust strength, y: jitter force (strength * jitter; 0: none), z: jitter blend,
+    // w: 1 / gust size (world units to noise cells).
+    wind_shape: vec4<f32>,
+    // xyz: fractional part of how far the gusts travelled (cells); w: Equation 1's gain
+    // (`pelt_core::sim::Equation::gain`: 8 / L^2 for Pelt's form, 1 for the paper's).
+    travelled_fraction: vec4<f32>,
+    // Minus the whole cells travelled, as wrapping i64 (low, high) per axis: x, y here ...
+    travelled_xy: vec4<u32>,
+    // ... and z here; zw: the noise seed, already mixed once.
+    travelled_z_seed: vec4<u32>,
+    // xy: the jitter seed; zw: this step's jitter tick.
+    jitter_seed_tick: vec4<u32>,
+    // xy: the next jitter tick; z: V (strands); w: L (layers).
+    next_tick_counts: vec4<u32>,
+    // xyz: the touch force; w: its presence (0: no touch).
+    touch: vec4<f32>,
+    // x: workgroups per row of the dispatch grid.
+    grid: vec4<u32>,
+}
+
+// Per strand: root and stability, then the rotation of its rest frame (quaternion xyzw).
+struct Strand {
+    root_stability: vec4<f32>,
+    frame: vec4<f32>,
+}
+
+@group(0) @binding(0) var<uniform> inputs: Step;
+// Rest segment k of strand j at k * V + j (xyz; w unused).
+@group(0) @binding(1) var<storage, read> rest_segments: array<vec4<f32>>;
+@group(0) @binding(2) var<storage, read> strands: array<Strand>;
+// Per strand: the user field (xyz) and the touch's falloff weight (w, 0 outside it); the
+// inertial force of this step (from the roots' motion, computed on the CPU).
+struct StrandForces {
+    field_touch: vec4<f32>,
+    inertial: vec4<f32>,
+}
+
+@group(0) @binding(3) var<storage, read> forces: array<StrandForces>;
+// The shared vertex array: NV[i * V + j] as packed xyz.
+@group(0) @binding(4) var<storage, read_write> positions: array<f32>;
+
+const PARALLEL_SINE: f32 = 1e-7;
+const WORKGROUP: u32 = 64u;
+
+fn is_finite(x: f32) -> bool {
+    // Exponent bits all set: infinity or NaN (compilers may fold `x != x` away).
+    return (bitcast<u32>(x) & 0x7f800000u) != 0x7f800000u;
+}
+
+// `glam::Quat * Vec3`.
+fn rotate(q: vec4<f32>, v: vec3<f32>) -> vec3<f32> {
+    let b = q.xyz;
+    let w = q.w;
+    return v * (w * w - dot(b, b)) + b * (dot(v, b) * 2.0) + cross(b, v) * (w * 2.0);
+}
+
+// `glam::Quat * Quat` (Hamilton product).
+fn quat_mul(a: vec4<f32>, b: vec4<f32>) -> vec4<f32> {
+    return vec4<f32>(
+        a.w * b.x + a.x * b.w + a.y * b.z - a.z * b.y,
+        a.w * b.y - a.x * b.z + a.y * b.w + a.z * b.x,
+        a.w * b.z + a.x * b.y - a.y * b.x + a.z * b.w,
+        a.w * b.w - a.x * b.x - a.y * b.y - a.z * b.z,
+    );
+}
+
+// `bend::angle_from_sin_cos`: atan2(sine, cosine) in [0, pi] by the same polynomial.
+fn angle_from_sin_cos(sine: f32, cosine: f32) -> f32 {
+    let a = sine;
+    let b = abs(cosine);
+    let steep = a > b;
+    let numerator = select(a, b, steep);
+    let denominator = select(b, a, steep);
+    var t = 0.0;
+    if denominator > 0.0 {
+        t = numerator / denominator;
+    }
+    let t2 = t * t;
+    var p = 0.0028662257;
+    p = p * t2 - 0.016165737;
+    p = p * t2 + 0.042909614;
+    p = p * t2 - 0.07528964;
+    p = p * t2 + 0.10656264;
+    p = p * t2 - 0.142089;
+    p = p * t2 + 0.19993551;
+    p = p * t2 - 0.33333145;
+    var angle = t + t * t2 * p;
+    if steep {
+        angle = 1.5707964 - angle;
+    }
+    return select(angle, 3.1415927 - angle, cosine < 0.0);
+}
+
+// `bend::sin_cos_quarter_turn`: (sin x, cos x) for x in [0, pi/2].
+fn sin_cos_quarter_turn(x: f32) -> vec2<f32> {
+    let x2 = x * x;
+    let sine = x * (1.0 + x2 * (-1.0 / 6.0 + x2 * (1.0 / 120.0 + x2 * (-1.0 / 5040.0 + x2 * (1.0 / 362880.0 - x2 / 39916800.0)))));
+    let cosine = 1.0 + x2 * (-0.5 + x2 * (1.0 / 24.0 + x2 * (-1.0 / 720.0 + x2 * (1.0 / 40320.0 + x2 * (-1.0 / 3628800.0 + x2 / 479001600.0)))));
+    return vec2<f32>(sine, cosine);
+}
+
+// `bend::bend_weight`.
+fn bend_weight(magnitude: f32, remaining: u32, layers: u32, stability: f32) -> f32 {
+    let weight = magnitude * (f32(remaining) * inputs.travelled_fraction.w) / stability;
+    if !is_finite(weight) {
+        // Infinity (an overflowing force) bends fully; NaN (0 * infinity) not at all.
+        return select(0.0, 1.0, weight > 0.0);
+    }
+    return clamp(weight, 0.0, 1.0);
+}
+
+// The wind on strand `j` at `root` (`WindParams::sample`).
+fn wind(j: u32, root: vec3<f32>) -> vec3<f32> {
+    let strength = inputs.wind_direction.w;
+    if strength == 0.0 {
+        return vec3<f32>(0.0);
+    }
+    let direction = inputs.wind_direction.xyz;
+    let gust = value_noise3(
+        inputs.travelled_z_seed.zw,
+        root * inputs.wind_shape.w,
+        inputs.travelled_fraction.xyz,
+        inputs.travelled_xy.xy,
+        inputs.travelled_xy.zw,
+        inputs.travelled_z_seed.xy,
+    );
+    var force = direction * (strength * (1.0 + inputs.wind_shape.x * gust));
+    let jitter = inputs.wind_shape.y;
+    if jitter > 0.0 {
+        let mixed = mix64(inputs.jitter_seed_tick.xy ^ mix64(vec2<u32>(j, 0u)));
+        let a = random_vector(mixed, inputs.jitter_seed_tick.zw);
+        let b = random_vector(mixed, inputs.next_tick_counts.xy);
+        let blend = inputs.wind_shape.z;
+        force += (a * (1.0 - blend) + b * blend) * jitter;
+    }
+    return force;
+}
+
+@compute @workgroup_size(64)
+fn step_strands(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index) lane: u32) {
+    let v = inputs.next_tick_counts.z;
+    let layers = inputs.next_tick_counts.w;
+    let j = (group.y * inputs.grid.x + group.x) * WORKGROUP + lane;
+    if j >= v {
+        return;
+    }
+    let strand = strands[j];
+    let root = strand.root_stability.xyz;
+    let stability = strand.root_stability.w;
+
+    // The external field (wind + user field) with the touch over it (`evaluate_field`), then gravity.
+    let strand_forces = forces[j];
+    let field = strand_forces.field_touch;
+    var field_force = wind(j, root) + field.xyz;
+    let touch_weight = field.w * inputs.touch.w;
+    if touch_weight > 0.0 {
+        field_force = field_force * (1.0 - touch_weight) + inputs.touch.xyz * touch_weight;
+    }
+    let force = inputs.gravity.xyz + field_force + strand_forces.inertial.xyz;
+
+    // `bend::split_force`: unit direction and magnitude without overflow; a non-finite force
+    // has neither.
+    var force_direction = vec3<f32>(0.0);
+    var magnitude = 0.0;
+    let largest = max(max(abs(force.x), abs(force.y)), abs(force.z));
+    if is_finite(force.x) && is_finite(force.y) && is_finite(force.z) && largest > 0.0 {
+        let scaled = force / largest;
+        let scaled_length = length(scaled);
+        force_direction = scaled / scaled_length;
+        magnitude = scaled_length * largest;
+    }
+
+    // `bend::bend_strand`.
+    var turned = strand.frame;
+    var node = root;
+    positions[j * 3u] = node.x;
+    positions[j * 3u + 1u] = node.y;
+    positions[j * 3u + 2u] = node.z;
+    for (var k = 0u; k < layers; k++) {
+        let segment = rest_segments[k * v + j].xyz;
+        var current = rotate(turned, segment);
+        let current_length = length(current);
+        if current_length > 0.0 {
+            let weight = bend_weight(magnitude, layers - k, layers, stability);
+            let direction = current / current_length;
+            let axis = cross(direction, force_direction);
+            let sine = length(axis);
+            if sine > PARALLEL_SINE && weight > 0.0 {
+                let angle = angle_from_sin_cos(sine, dot(direction, force_direction));
+                let half = sin_cos_quarter_turn(0.5 * angle * weight);
+                let rotation = vec4<f32>(axis * (half.x / sine), half.y);
+                // Renormalised so rounding never lets segment lengths drift over many layers.
+                let product = quat_mul(rotation, turned);
+                turned = product * (1.0 / length(product));
+                current = rotate(turned, segment);
+            }
+        }
+        node += current;
+        let index = ((k + 1u) * v + j) * 3u;
+        positions[index] = node.x;
+        positions[index + 1u] = node.y;
+        positions[index + 2u] = node.z;
+    }
+}

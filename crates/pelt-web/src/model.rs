@@ -1,0 +1,492 @@
+//! The page's state apart from the browser: the scene, the preset with the page's overrides,
+//! the fur and its simulation, the pointers patting it and the orbit camera. Nothing here
+//! touches a browser API, so it is tested natively.
+
+use glam::{Vec2, Vec3};
+use pelt_core::mesh::builtin::{TryOnScene, try_on_scene};
+use pelt_core::sim::Touch;
+use pelt_core::texture::Rgb;
+use pelt_core::{Builtin, FurStructure, ImportOptions, Mesh, Preset, Simulation};
+use pelt_render::Camera;
+
+/// Touch radius as a fraction of the furred mesh's bounding radius (the viewer's default brush).
+const BRUSH_PER_RADIUS: f32 = 0.25;
+/// A long stall (a tab in the background) must not fast-forward the scene.
+const MAX_FRAME_SECS: f64 = 0.25;
+/// Degrees turned per CSS pixel dragged.
+const ORBIT_DEG_PER_PX: f32 = 0.4;
+
+/// What the page shows.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SceneChoice {
+    /// The Stanford bunny, furred all over.
+    Bunny,
+    /// The paper's try-on: a plain body wearing a furred skirt.
+    TryOn,
+}
+
+impl SceneChoice {
+    /// `"bunny"` or `"tryon"`.
+    #[must_use]
+    pub fn from_name(name: &str) -> Option<Self> {
+        match name {
+            "bunny" => Some(Self::Bunny),
+            "tryon" => Some(Self::TryOn),
+            _ => None,
+        }
+    }
+}
+
+/// Why the page's state could not change; the page shows the message and keeps what it had.
+#[derive(Debug, thiserror::Error)]
+pub enum ModelError {
+    /// A preset that does not fit (bad value, image the page cannot read).
+    #[error(transparent)]
+    Preset(#[from] pelt_core::PresetError),
+    /// The fur could not be grown on the mesh.
+    #[error(transparent)]
+    Fur(#[from] pelt_core::fur::FurError),
+    /// The shipped try-on meshes did not load.
+    #[error(transparent)]
+    Mesh(#[from] pelt_core::MeshError),
+    /// The simulation rejected its parameters.
+    #[error(transparent)]
+    Sim(#[from] pelt_core::SimError),
+    /// A value from a control out of its range.
+    #[error("{0}")]
+    Control(String),
+}
+
+/// An orbit about a target; angles in degrees as `Camera::orbit` takes them.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Orbit {
+    /// The point looked at.
+    pub target: Vec3,
+    /// Turn about +Y, from +Z toward +X.
+    pub azimuth_deg: f32,
+    /// Lift toward +Y.
+    pub elevation_deg: f32,
+    /// Eye to target.
+    pub distance: f32,
+}
+
+impl Orbit {
+    /// The camera of this orbit.
+    #[must_use]
+    pub fn camera(&self) -> Camera {
+        Camera::orbit(self.target, self.azimuth_deg, self.elevation_deg, self.distance)
+    }
+
+    /// Turns by a drag of `drag_css_px` (x right, y down).
+    pub fn rotate(&mut self, drag_css_px: Vec2) {
+        self.azimuth_deg -= drag_css_px.x * ORBIT_DEG_PER_PX;
+        self.elevation_deg = (self.elevation_deg + drag_css_px.y * ORBIT_DEG_PER_PX).clamp(-85.0, 85.0);
+    }
+
+    /// Moves toward the target for `factor < 1` and away for `factor > 1`, within sane bounds.
+    pub fn zoom(&mut self, factor: f32, framed_distance: f32) {
+        if factor.is_finite() && factor > 0.0 {
+            self.distance = (self.distance * factor).clamp(framed_distance * 0.15, framed_distance * 6.0);
+        }
+    }
+
+    /// The world-space ray `(origin, unit direction)` through `pixel` of a view of `size`
+    /// (same units, from the top-left corner).
+    #[must_use]
+    pub fn ray(&self, pixel: Vec2, size: Vec2) -> (Vec3, Vec3) {
+        let size = size.max(Vec2::ONE);
+        let camera = self.camera();
+        let ndc = Vec2::new(pixel.x / size.x * 2.0 - 1.0, 1.0 - pixel.y / size.y * 2.0);
+        let world_from_clip = camera.clip_from_world(size.x / size.y).inverse();
+        let near = world_from_clip.project_point3(ndc.extend(0.0));
+        let far = world_from_clip.project_point3(ndc.extend(1.0));
+        (camera.eye, (far - near).normalize_or((self.target - camera.eye).normalize_or(Vec3::NEG_Z)))
+    }
+}
+
+/// One pointer patting the fur: the touch, and the plane facing the camera it drags across.
+#[derive(Debug)]
+struct PointerTouch {
+    pointer_id: i32,
+    touch: Touch,
+    plane_normal: Vec3,
+}
+
+/// Everything the page shows, without the GPU.
+#[derive(Debug)]
+pub struct Model {
+    /// The scene shown.
+    pub scene: SceneChoice,
+    /// The preset with the page's overrides (length, colour, wind).
+    pub preset: Preset,
+    /// The fur's rest pose.
+    pub structure: FurStructure,
+    /// The try-on body, drawn plain.
+    pub body: Option<Mesh>,
+    /// The simulation of `structure`.
+    pub sim: Simulation,
+    /// The camera.
+    pub orbit: Orbit,
+    /// The distance that frames the scene (zoom is bounded around it).
+    framed_distance: f32,
+    /// Pointers on the fur, held or fading after release. Several at once: each is a `Touch`
+    /// written into the simulation's user force field, which the core leaves to applications.
+    touches: Vec<PointerTouch>,
+    /// Simulation time (seconds).
+    clock_secs: f64,
+}
+
+impl Model {
+    /// The scene with `preset`, framed for a view of `aspect` (width / height).
+    ///
+    /// # Errors
+    /// [`ModelError`] if the preset does not fit the mesh.
+    pub fn new(scene: SceneChoice, preset: Preset, aspect: f32) -> Result<Self, ModelError> {
+        let (mesh, body) = load_scene(scene)?;
+        let structure = grow(mesh, &preset)?;
+        let sim = Simulation::new(&structure, &preset.simulation)?;
+        let orbit = Orbit { target: Vec3::ZERO, azimuth_deg: 35.0, elevation_deg: 15.0, distance: 1.0 };
+        let mut model = Self {
+            scene,
+            preset,
+            structure,
+            body,
+            sim,
+            orbit,
+            framed_distance: 1.0,
+            touches: Vec::new(),
+            clock_secs: 0.0,
+        };
+        model.frame(aspect);
+        Ok(model)
+    }
+
+    /// Looks at the whole scene (the body for the try-on, else the fur) from the current angles.
+    pub fn frame(&mut self, aspect: f32) {
+        let longest = self.structure.lengths.iter().copied().fold(0.0, f32::max);
+        let (centre, radius) = match &self.body {
+            Some(body) => body.bounding_sphere(),
+            None => {
+                let (centre, radius) = self.structure.mesh.bounding_sphere();
+                (centre, radius + longest)
+            }
+        };
+        let framed = Camera::framing_distance(radius, Camera::DEFAULT_FOV_Y_RAD, aspect);
+        self.orbit.target = centre;
+        self.orbit.distance = framed;
+        self.framed_distance = framed;
+    }
+
+    /// Zooms by `factor` (below 1 comes closer).
+    pub fn zoom(&mut self, factor: f32) {
+        self.orbit.zoom(factor, self.framed_distance);
+    }
+
+    /// Switches the scene; the fur, simulation and touches start anew.
+    ///
+    /// # Errors
+    /// [`ModelError`]; the previous scene stays.
+    pub fn set_scene(&mut self, scene: SceneChoice, aspect: f32) -> Result<(), ModelError> {
+        *self = Self { orbit: self.orbit, ..Self::new(scene, self.preset.clone(), aspect)? };
+        self.frame(aspect);
+        Ok(())
+    }
+
+    /// Replaces the preset (keeping the page's wind); the structure and simulation are rebuilt.
+    ///
+    /// # Errors
+    /// [`ModelError`]; the previous preset stays.
+    pub fn set_preset(&mut self, mut preset: Preset) -> Result<(), ModelError> {
+        preset.simulation.wind = self.preset.simulation.wind.clone();
+        self.rebuild(preset)
+    }
+
+    /// Fur length as a fraction of the mesh's bounding radius (the preset's `length`).
+    ///
+    /// # Errors
+    /// [`ModelError`] outside `(0, 2]`; the previous length stays.
+    pub fn set_length(&mut self, length: f32) -> Result<(), ModelError> {
+        let mut preset = self.preset.clone();
+        preset.length = length;
+        self.rebuild(preset)
+    }
+
+    /// One colour for every strand (`#rrggbb`); textures must be remade after this.
+    ///
+    /// # Errors
+    /// [`ModelError::Control`] for text that is not a colour.
+    pub fn set_colour(&mut self, hex: &str) -> Result<(), ModelError> {
+        let colour = Rgb::parse(hex).map_err(ModelError::Control)?;
+        self.preset.colour.mode = pelt_core::texture::ColourMode::Single;
+        self.preset.colour.colour = colour;
+        Ok(())
+    }
+
+    /// Wind of `strength` (gravity units) blowing toward `direction_deg` in the ground plane
+    /// (0 = +X, 90 = +Z).
+    ///
+    /// # Errors
+    /// [`ModelError`] for a negative or non-finite strength or angle; the wind stays.
+    pub fn set_wind(&mut self, strength: f32, direction_deg: f32) -> Result<(), ModelError> {
+        if !direction_deg.is_finite() {
+            return Err(ModelError::Control(format!("wind direction must be finite, got {direction_deg}")));
+        }
+        let mut wind = self.preset.simulation.wind.clone();
+        let angle = direction_deg.to_radians();
+        wind.direction = Vec3::new(angle.cos(), 0.0, angle.sin());
+        wind.strength = strength;
+        self.sim.set_wind(&wind)?;
+        self.preset.simulation.wind = wind;
+        Ok(())
+    }
+
+    fn rebuild(&mut self, preset: Preset) -> Result<(), ModelError> {
+        preset.validate()?;
+        let structure = grow(self.structure.mesh.clone(), &preset)?;
+        let sim = Simulation::new(&structure, &preset.simulation)?;
+        self.preset = preset;
+        self.structure = structure;
+        self.sim = sim;
+        self.touches.clear();
+        Ok(())
+    }
+
+    /// A pointer went down at `pixel` of a view of `size`: on the fur it starts patting (true),
+    /// elsewhere it does nothing (false: the page orbits with it instead).
+    pub fn pointer_down(&mut self, pointer_id: i32, pixel: Vec2, size: Vec2) -> bool {
+        let (origin, direction) = self.orbit.ray(pixel, size);
+        let Some(hit) = self.sim.pick(&self.structure.mesh.triangles, origin, direction) else { return false };
+        let radius = BRUSH_PER_RADIUS * self.structure.mesh.bounding_sphere().1;
+        self.touches.retain(|t| t.pointer_id != pointer_id);
+        let touch = Touch::new(hit.point, radius, self.sim.roots());
+        self.touches.push(PointerTouch { pointer_id, touch, plane_normal: -direction });
+        true
+    }
+
+    /// A patting pointer moved: the fur under it is pushed along the drag. False when the
+    /// pointer is not patting.
+    pub fn pointer_move(&mut self, pointer_id: i32, pixel: Vec2, size: Vec2) -> bool {
+        let (origin, direction) = self.orbit.ray(pixel, size);
+        let Some(held) =
+            self.touches.iter_mut().find(|t| t.pointer_id == pointer_id && t.touch.released_at_secs.is_none())
+        else {
+            return false;
+        };
+        let denominator = direction.dot(held.plane_normal);
+        if denominator.abs() > 1e-6 {
+            let t = (held.touch.point - origin).dot(held.plane_normal) / denominator;
+            let point = origin + direction * t;
+            if t > 0.0 && point.is_finite() {
+                held.touch.drag = point;
+            }
+        }
+        true
+    }
+
+    /// A pointer went up or was cancelled: its touch fades out as the preset says.
+    pub fn pointer_up(&mut self, pointer_id: i32) {
+        let now = self.clock_secs;
+        for held in self.touches.iter_mut().filter(|t| t.pointer_id == pointer_id) {
+            held.touch.released_at_secs.get_or_insert(now);
+        }
+    }
+
+    /// Pointers patting now (held, not fading).
+    #[must_use]
+    pub fn touches_held(&self) -> usize {
+        self.touches.iter().filter(|t| t.touch.released_at_secs.is_none()).count()
+    }
+
+    /// Advances the simulation by `frame_secs` of wall time (capped, so a tab coming back from
+    /// the background does not fast-forward).
+    pub fn simulate(&mut self, frame_secs: f64) {
+        if frame_secs.is_finite() && frame_secs > 0.0 {
+            self.clock_secs += frame_secs.min(MAX_FRAME_SECS);
+        }
+        let params = &self.preset.simulation.touch;
+        let (strength, release_secs, now) = (params.strength, params.release_secs, self.clock_secs);
+        self.touches.retain(|t| t.touch.presence(now, release_secs) > 0.0);
+        let field = self.sim.field_mut();
+        field.fill(Vec3::ZERO);
+        for held in &self.touches {
+            held.touch.apply(strength, held.touch.presence(now, release_secs), field.values_mut());
+        }
+        self.sim.advance_to(self.clock_secs);
+    }
+}
+
+/// The furred mesh and the plain body (try-on only).
+fn load_scene(scene: SceneChoice) -> Result<(Mesh, Option<Mesh>), ModelError> {
+    Ok(match scene {
+        SceneChoice::Bunny => (Builtin::Bunny.mesh().0, None),
+        SceneChoice::TryOn => {
+            let TryOnScene { garment, body } = try_on_scene(&ImportOptions::default())?;
+            (garment, Some(body))
+        }
+    })
+}
+
+/// Grows the rest pose of `preset`'s fur on `mesh` (length relative to the mesh's radius).
+fn grow(mesh: Mesh, preset: &Preset) -> Result<FurStructure, ModelError> {
+    let params = preset.fur_params(&mesh);
+    Ok(FurStructure::new(mesh, &params)?)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const SIZE: Vec2 = Vec2::new(800.0, 600.0);
+    const FRAME_SECS: f64 = 1.0 / 30.0;
+
+    fn bunny() -> Model {
+        Model::new(SceneChoice::Bunny, Preset::default(), SIZE.x / SIZE.y).unwrap()
+    }
+
+    /// Tip of every strand.
+    fn tips(model: &Model) -> Vec<Vec3> {
+        let v = model.structure.vertex_count();
+        model.sim.positions()[model.structure.layers as usize * v..].to_vec()
+    }
+
+    /// The pixel of a base vertex that faces the camera and is the first thing its pixel's ray
+    /// meets, so a pointer there pats that vertex's fur.
+    fn pixel_of_visible_vertex(model: &Model, pick_from: usize) -> (usize, Vec2) {
+        let camera = model.orbit.camera();
+        let clip_from_world = camera.clip_from_world(SIZE.x / SIZE.y);
+        let mesh = &model.structure.mesh;
+        (pick_from..mesh.positions.len())
+            .find_map(|j| {
+                let root = mesh.positions[j];
+                let facing = mesh.normals[j].dot((camera.eye - root).normalize()) > 0.7;
+                let ndc = clip_from_world.project_point3(root);
+                let pixel = Vec2::new((ndc.x + 1.0) * 0.5 * SIZE.x, (1.0 - ndc.y) * 0.5 * SIZE.y);
+                let (origin, direction) = model.orbit.ray(pixel, SIZE);
+                let hit = model.sim.pick(&mesh.triangles, origin, direction)?;
+                (facing && hit.point.distance(root) < 1e-3 * mesh.bounding_sphere().1).then_some((j, pixel))
+            })
+            .expect("a visible vertex")
+    }
+
+    #[test]
+    fn a_pat_moves_the_fur_near_the_pointer_and_nothing_elsewhere_and_release_restores_it() {
+        let mut patted = bunny();
+        let mut untouched = bunny();
+        let (j, pixel) = pixel_of_visible_vertex(&patted, 0);
+        assert!(patted.pointer_down(7, pixel, SIZE));
+        assert!(patted.pointer_move(7, pixel + Vec2::new(60.0, 0.0), SIZE));
+        assert_eq!(patted.touches_held(), 1);
+        for _ in 0..10 {
+            patted.simulate(FRAME_SECS);
+            untouched.simulate(FRAME_SECS);
+        }
+        let radius = BRUSH_PER_RADIUS * patted.structure.mesh.bounding_sphere().1;
+        let root = patted.structure.mesh.positions[j];
+        let (a, b) = (tips(&patted), tips(&untouched));
+        let moved = a[j].distance(b[j]);
+        assert!(moved > 0.1 * patted.structure.lengths[j], "the patted strand moved only {moved}");
+        for (k, root_k) in patted.structure.mesh.positions.iter().enumerate() {
+            if root_k.distance(root) > radius * 1.001 {
+                assert_eq!(a[k], b[k], "strand {k} outside the touch moved");
+            }
+        }
+        patted.pointer_up(7);
+        assert_eq!(patted.touches_held(), 0);
+        for _ in 0..3 {
+            patted.simulate(FRAME_SECS);
+            untouched.simulate(FRAME_SECS);
+        }
+        // The default preset restores at once on release; the fur is exactly the untouched fur.
+        assert_eq!(tips(&patted), tips(&untouched));
+    }
+
+    #[test]
+    fn two_pointers_pat_two_places_at_once_and_a_miss_pats_nothing() {
+        let mut model = bunny();
+        let (first, first_px) = pixel_of_visible_vertex(&model, 0);
+        let far = model.structure.mesh.positions[first];
+        let radius = BRUSH_PER_RADIUS * model.structure.mesh.bounding_sphere().1;
+        let mut from = 0;
+        let (second, second_px) = loop {
+            let (k, px) = pixel_of_visible_vertex(&model, from);
+            if model.structure.mesh.positions[k].distance(far) > 3.0 * radius {
+                break (k, px);
+            }
+            from = k + 1;
+        };
+        let mut untouched = bunny();
+        assert!(!model.pointer_down(3, Vec2::new(2.0, 2.0), SIZE), "the corner of the view misses the bunny");
+        assert!(!model.pointer_move(3, Vec2::new(40.0, 2.0), SIZE));
+        assert!(model.pointer_down(1, first_px, SIZE) && model.pointer_down(2, second_px, SIZE));
+        model.pointer_move(1, first_px + Vec2::new(0.0, 50.0), SIZE);
+        model.pointer_move(2, second_px + Vec2::new(50.0, 0.0), SIZE);
+        assert_eq!(model.touches_held(), 2);
+        for _ in 0..10 {
+            model.simulate(FRAME_SECS);
+            untouched.simulate(FRAME_SECS);
+        }
+        let (a, b) = (tips(&model), tips(&untouched));
+        for j in [first, second] {
+            assert!(a[j].distance(b[j]) > 0.1 * model.structure.lengths[j], "strand {j} was not patted");
+        }
+        assert!(a.iter().chain(model.sim.positions()).all(|p| p.is_finite()));
+    }
+
+    #[test]
+    fn bad_control_values_are_messages_and_keep_the_fur() {
+        let mut model = bunny();
+        let before = model.structure.positions.clone();
+        assert!(model.set_length(0.0).unwrap_err().to_string().contains("length"));
+        assert!(model.set_length(f32::NAN).is_err());
+        assert_eq!(model.structure.positions, before);
+        assert!(model.set_wind(-1.0, 0.0).is_err());
+        assert!(model.set_wind(1.0, f32::INFINITY).is_err());
+        assert!(model.set_colour("not a colour").is_err());
+        model.set_length(0.2).unwrap();
+        assert_ne!(model.structure.positions, before);
+        let lengths = &model.structure.lengths;
+        let radius = model.structure.mesh.bounding_sphere().1;
+        assert!(lengths.iter().all(|l| (l - 0.2 * radius).abs() < 1e-4 * radius));
+    }
+
+    #[test]
+    fn wind_blows_the_tips_its_way_and_the_try_on_has_a_body_and_a_furred_skirt() {
+        let mut calm = bunny();
+        let mut windy = bunny();
+        windy.set_wind(3.0, 90.0).unwrap();
+        for _ in 0..20 {
+            calm.simulate(FRAME_SECS);
+            windy.simulate(FRAME_SECS);
+        }
+        let push: Vec3 = tips(&windy).iter().zip(tips(&calm)).map(|(w, c)| *w - c).sum();
+        assert!(push.z > push.x.abs() && push.z > 0.0, "wind toward +Z pushed {push}");
+
+        let mut model = bunny();
+        let bunny_vertices = model.structure.vertex_count();
+        model.set_wind(2.0, 0.0).unwrap();
+        model.set_scene(SceneChoice::TryOn, 1.0).unwrap();
+        assert!(model.body.is_some());
+        assert_ne!(model.structure.vertex_count(), bunny_vertices);
+        assert_eq!(model.preset.simulation.wind.strength, 2.0, "the wind stays across scenes");
+        model.simulate(FRAME_SECS);
+        assert!(model.sim.positions().iter().all(|p| p.is_finite()));
+        assert_eq!(SceneChoice::from_name("tryon"), Some(SceneChoice::TryOn));
+        assert_eq!(SceneChoice::from_name("cat"), None);
+    }
+
+    #[test]
+    fn a_background_tab_does_not_fast_forward_and_zoom_stays_bounded() {
+        let mut model = bunny();
+        model.simulate(3600.0);
+        assert!(model.clock_secs <= MAX_FRAME_SECS);
+        model.simulate(f64::NAN);
+        assert!(model.sim.positions().iter().all(|p| p.is_finite()));
+        let framed = model.orbit.distance;
+        for _ in 0..100 {
+            model.zoom(0.5);
+        }
+        assert!(model.orbit.distance >= framed * 0.1);
+        model.zoom(f32::NAN);
+        assert!(model.orbit.distance.is_finite());
+    }
+}

@@ -1,0 +1,341 @@
+// Opens the built page (web/dist) in the system's headless Chromium, on its software WebGPU
+// adapter (SwiftShader), and checks what it draws from screenshots. The pixel checks here share
+// no code with the page: they classify screenshot pixels by colour only.
+//
+//   node --test page.test.mjs        (after `bash web/build.sh`; CHROMIUM=path overrides the browser)
+import { test, before, after } from 'node:test';
+import assert from 'node:assert/strict';
+import fs from 'node:fs';
+import http from 'node:http';
+import os from 'node:os';
+import path from 'node:path';
+import { fileURLToPath } from 'node:url';
+import puppeteer from 'puppeteer-core';
+
+const here = path.dirname(fileURLToPath(import.meta.url));
+const dist = path.resolve(here, '../dist');
+const output = path.resolve(here, 'output');
+const chromium = process.env.CHROMIUM || '/usr/bin/chromium';
+// A green no other part of the scene has: the bluish grey background and the skin-toned body.
+const FUR_HEX = '#30c040';
+const VIEWPORT = { width: 960, height: 640, deviceScaleFactor: 1 };
+
+const types = { '.html': 'text/html', '.js': 'text/javascript', '.wasm': 'application/wasm' };
+let server;
+let origin;
+let browser;
+
+before(async () => {
+  assert.ok(fs.existsSync(path.join(dist, 'index.html')), 'web/dist is missing: run bash web/build.sh first');
+  fs.mkdirSync(output, { recursive: true });
+  server = http.createServer((request, response) => {
+    const name = decodeURIComponent(new URL(request.url, 'http://x').pathname);
+    const file = path.join(dist, name === '/' ? 'index.html' : name);
+    if (!file.startsWith(dist) || !fs.existsSync(file)) {
+      response.writeHead(404).end();
+      return;
+    }
+    response.writeHead(200, { 'content-type': types[path.extname(file)] || 'application/octet-stream' });
+    fs.createReadStream(file).pipe(response);
+  });
+  await new Promise((resolve) => server.listen(0, '127.0.0.1', resolve));
+  origin = `http://127.0.0.1:${server.address().port}`;
+  browser = await puppeteer.launch({
+    executablePath: chromium,
+    headless: true,
+    userDataDir: fs.mkdtempSync(path.join(os.tmpdir(), 'pelt-chromium-')),
+    args: ['--headless=new', '--enable-unsafe-webgpu', '--no-sandbox', '--disable-gpu-sandbox'],
+  });
+});
+
+after(async () => {
+  if (browser) await browser.close();
+  if (server) server.close();
+});
+
+/** A new page on the app, waiting until it draws (or fails, which fails the test). */
+async function openPage({ hasTouch = false, beforeLoad } = {}) {
+  const page = await browser.newPage();
+  await page.setViewport({ ...VIEWPORT, hasTouch });
+  const problems = [];
+  page.on('pageerror', (error) => problems.push(String(error)));
+  page.on('console', (message) => {
+    if (message.type() === 'error') problems.push(message.text());
+  });
+  if (beforeLoad) await beforeLoad(page);
+  await page.goto(origin, { waitUntil: 'load' });
+  page.problems = problems;
+  return page;
+}
+
+async function waitRunning(page) {
+  await page.waitForFunction(() => window.pelt && window.pelt.state !== 'starting', { timeout: 180_000 });
+  const state = await page.evaluate(() => ({ state: window.pelt.state, error: window.pelt.error }));
+  assert.equal(state.state, 'running', `the page did not start: ${state.error} ${page.problems.join('; ')}`);
+}
+
+/** Waits until `count` more frames are drawn. */
+async function frames(page, count) {
+  const start = await page.evaluate(() => window.pelt.stats.frames_drawn);
+  await page.waitForFunction((n) => window.pelt.stats && window.pelt.stats.frames_drawn >= n, { timeout: 120_000 },
+    start + count);
+}
+
+/** Sets a control's value as a person would and fires its event. */
+async function setControl(page, selector, value, event = 'change') {
+  await page.$eval(selector, (element, v, e) => {
+    element.value = v;
+    element.dispatchEvent(new Event(e, { bubbles: true }));
+  }, value, event);
+}
+
+/** Waits for the "making textures" note to go (texture generation blocks the page). */
+async function settled(page) {
+  await page.waitForFunction(() => document.getElementById('message').className !== 'info', { timeout: 120_000 });
+  await frames(page, 12);
+}
+
+/** The canvas as RGBA pixels (from a screenshot, so what the compositor shows), saved as `name`. */
+async function shot(page, name) {
+  const canvas = await page.$('#fur');
+  const png = await canvas.screenshot({ path: path.join(output, `${name}.png`) });
+  const decoded = await page.evaluate(async (b64) => {
+    const image = new Image();
+    image.src = `data:image/png;base64,${b64}`;
+    await image.decode();
+    const scratch = document.createElement('canvas');
+    scratch.width = image.width;
+    scratch.height = image.height;
+    const context = scratch.getContext('2d');
+    context.drawImage(image, 0, 0);
+    const bytes = context.getImageData(0, 0, image.width, image.height).data;
+    let binary = '';
+    for (let i = 0; i < bytes.length; i += 0x8000) binary += String.fromCharCode(...bytes.subarray(i, i + 0x8000));
+    return { width: image.width, height: image.height, data: btoa(binary) };
+  }, Buffer.from(png).toString('base64'));
+  return { width: decoded.width, height: decoded.height, data: Buffer.from(decoded.data, 'base64') };
+}
+
+function pixel(image, x, y) {
+  const i = (y * image.width + x) * 4;
+  return [image.data[i], image.data[i + 1], image.data[i + 2]];
+}
+
+/** Hue (degrees), saturation and value of an sRGB pixel. */
+function hsv([r, g, b]) {
+  const max = Math.max(r, g, b);
+  const min = Math.min(r, g, b);
+  const delta = max - min;
+  let hue = 0;
+  if (delta > 0) {
+    if (max === r) hue = 60 * (((g - b) / delta + 6) % 6);
+    else if (max === g) hue = 60 * ((b - r) / delta + 2);
+    else hue = 60 * ((r - g) / delta + 4);
+  }
+  return [hue, max === 0 ? 0 : delta / max, max / 255];
+}
+
+/** The background: the median colour of the four corners (the scene is framed inside them). */
+function background(image) {
+  const samples = [];
+  for (const [cx, cy] of [[2, 2], [image.width - 3, 2], [2, image.height - 3], [image.width - 3, image.height - 3]]) {
+    samples.push(pixel(image, cx, cy));
+  }
+  return [0, 1, 2].map((c) => samples.map((s) => s[c]).sort((a, b) => a - b)[2]);
+}
+
+/** Predicates over every pixel: `{count, xs, ys}` of those that pass. */
+function select(image, keep) {
+  const xs = [];
+  const ys = [];
+  for (let y = 0; y < image.height; y++) {
+    for (let x = 0; x < image.width; x++) {
+      if (keep(pixel(image, x, y), x, y)) {
+        xs.push(x);
+        ys.push(y);
+      }
+    }
+  }
+  return { count: xs.length, xs, ys };
+}
+
+const differs = (p, q, tolerance) => Math.max(...p.map((v, c) => Math.abs(v - q[c]))) > tolerance;
+const isFur = (p) => {
+  const [hue, saturation, value] = hsv(p);
+  return hue > 95 && hue < 150 && saturation > 0.3 && value > 0.08;
+};
+// Fur blended over the background at its soft edge: greener than the background's grey-blue.
+const furTinted = ([r, g, b]) => g - Math.max(r, b) > 6;
+const isSkin = (p) => {
+  const [hue, saturation, value] = hsv(p);
+  return (hue < 45 || hue > 345) && saturation > 0.08 && saturation < 0.75 && value > 0.15;
+};
+const mean = (values) => values.reduce((a, b) => a + b, 0) / Math.max(values.length, 1);
+
+let shared;
+async function bunnyPage() {
+  if (!shared) {
+    shared = await openPage();
+    await waitRunning(shared);
+    await setControl(shared, '#colour', FUR_HEX);
+    await settled(shared);
+  }
+  return shared;
+}
+
+test('fur is drawn: fur-coloured pixels stand around the bunny beyond its skin', async () => {
+  const page = await bunnyPage();
+  const furry = await shot(page, 'bunny');
+  await setControl(page, '#length', '0.01');
+  await frames(page, 12);
+  const bare = await shot(page, 'bunny-short-fur');
+  await setControl(page, '#length', '0.08');
+  await frames(page, 12);
+
+  const bg = background(furry);
+  const furryMask = (x, y) => differs(pixel(furry, x, y), bg, 10);
+  const bareMask = (x, y) => differs(pixel(bare, x, y), bg, 10);
+  const body = select(bare, (p, x, y) => bareMask(x, y));
+  assert.ok(body.count > 0.03 * furry.width * furry.height, `the bunny covers only ${body.count} pixels`);
+  // The ring the fur adds around the silhouette: drawn with fur, background without.
+  const ring = select(furry, (p, x, y) => furryMask(x, y) && !bareMask(x, y));
+  const ringFur = select(furry, (p, x, y) => furryMask(x, y) && !bareMask(x, y) && furTinted(p));
+  assert.ok(ring.count > 0.08 * body.count, `fur adds only ${ring.count} pixels around ${body.count}`);
+  assert.ok(ringFur.count > 0.6 * ring.count, `only ${ringFur.count} of ${ring.count} ring pixels are fur-coloured`);
+  const fur = select(furry, isFur);
+  assert.ok(fur.count > 0.5 * body.count, `only ${fur.count} fur-coloured pixels`);
+  assert.deepEqual(page.problems, []);
+});
+
+test('a pointer drag changes the fur where it presses and not elsewhere; release restores it', async () => {
+  const page = await bunnyPage();
+  const before = await shot(page, 'drag-before');
+  await frames(page, 10);
+  const still = await shot(page, 'drag-still');
+  const bg = background(before);
+  const noise = select(before, (p, x, y) => differs(p, pixel(still, x, y), 24));
+  assert.ok(noise.count < 50, `${noise.count} pixels change with nothing touching the fur`);
+
+  // Press on the middle of the bunny: the centroid of its pixels.
+  const body = select(before, (p) => differs(p, bg, 10));
+  const press = [Math.round(mean(body.xs)), Math.round(mean(body.ys))];
+  assert.ok(differs(pixel(before, ...press), bg, 10), 'the bunny\'s centroid is not on the bunny');
+  const radiusPx = Math.sqrt(body.count / Math.PI);
+  const box = await (await page.$('#fur')).boundingBox();
+  const drag = 40;
+  await page.mouse.move(box.x + press[0], box.y + press[1]);
+  await page.mouse.down();
+  for (let step = 1; step <= 8; step++) {
+    await page.mouse.move(box.x + press[0] + (drag * step) / 8, box.y + press[1]);
+  }
+  await page.waitForFunction(() => window.pelt.stats.touches === 1, { timeout: 10_000 });
+  await frames(page, 15);
+  const held = await shot(page, 'drag-held');
+  await page.mouse.up();
+  await frames(page, 15);
+  const released = await shot(page, 'drag-released');
+
+  const changed = select(held, (p, x, y) => differs(p, pixel(still, x, y), 24));
+  assert.ok(changed.count > 150, `the drag changed only ${changed.count} pixels`);
+  // The brush is a quarter of the bunny's radius; the fur it pushes stays within about half.
+  const reach = 0.5 * radiusPx + drag;
+  const near = changed.xs.filter((x, i) => Math.hypot(x - press[0], changed.ys[i] - press[1]) < reach).length;
+  assert.ok(near > 0.97 * changed.count,
+    `${changed.count - near} of ${changed.count} changed pixels lie farther than ${reach.toFixed(0)} px from the press`);
+  const left = select(released, (p, x, y) => differs(p, pixel(still, x, y), 24));
+  assert.ok(left.count < Math.max(50, 0.05 * changed.count), `${left.count} pixels stay changed after release`);
+  assert.deepEqual(page.problems, []);
+});
+
+test('switching to try-on draws the body plain and the skirt furred', async () => {
+  const page = await bunnyPage();
+  await page.click('input[name=scene][value=tryon]');
+  await frames(page, 15);
+  const image = await shot(page, 'tryon');
+  await page.click('input[name=scene][value=bunny]');
+  await frames(page, 5);
+
+  const area = image.width * image.height;
+  const skin = select(image, isSkin);
+  const fur = select(image, isFur);
+  assert.ok(skin.count > 0.02 * area, `only ${skin.count} body-coloured pixels`);
+  assert.ok(fur.count > 0.005 * area, `only ${fur.count} fur-coloured pixels`);
+  // The skirt sits on the hips: below the head and above the feet of the body.
+  const top = Math.min(...skin.ys);
+  const bottom = Math.max(...skin.ys);
+  const furY = (mean(fur.ys) - top) / (bottom - top);
+  assert.ok(furY > 0.3 && furY < 0.75, `the fur's centre is at ${furY.toFixed(2)} of the body's height`);
+  assert.ok(Math.min(...fur.ys) > top + 0.15 * (bottom - top), 'fur reaches the head');
+  assert.deepEqual(page.problems, []);
+});
+
+test('a bad preset file is a message naming it, and the page keeps drawing', async () => {
+  const page = await bunnyPage();
+  const file = path.join(output, 'bad-preset.toml');
+  fs.writeFileSync(file, 'layers = 9000\n');
+  const input = await page.$('#preset-file');
+  await input.uploadFile(file);
+  await page.waitForFunction(() => document.getElementById('message').className === 'error', { timeout: 60_000 });
+  const text = await page.$eval('#message', (e) => e.textContent);
+  assert.match(text, /bad-preset\.toml/);
+  assert.match(text, /layers/);
+  await frames(page, 5);
+});
+
+test('two touches at once pat two places', async () => {
+  const page = await openPage({ hasTouch: true });
+  await waitRunning(page);
+  await frames(page, 10);
+  const still = await shot(page, 'touch-still');
+  const bg = background(still);
+  const body = select(still, (p) => differs(p, bg, 10));
+  const cx = mean(body.xs);
+  const cy = mean(body.ys);
+  // Two points on the bunny, left and right of its centre.
+  const left = body.xs.map((x, i) => [x, body.ys[i]]).filter(([x, y]) => x < cx - 60 && Math.abs(y - cy) < 20)[0];
+  const right = body.xs.map((x, i) => [x, body.ys[i]]).filter(([x, y]) => x > cx + 40 && Math.abs(y - cy) < 20)[0];
+  assert.ok(left && right, 'no two points on the bunny');
+  const box = await (await page.$('#fur')).boundingBox();
+  const session = await page.createCDPSession();
+  const points = (dy) => [
+    { x: box.x + left[0] + 8, y: box.y + left[1] + dy, id: 1 },
+    { x: box.x + right[0] - 8, y: box.y + right[1] + dy, id: 2 },
+  ];
+  await session.send('Input.dispatchTouchEvent', { type: 'touchStart', touchPoints: points(0) });
+  for (let dy = 5; dy <= 30; dy += 5) {
+    await session.send('Input.dispatchTouchEvent', { type: 'touchMove', touchPoints: points(dy) });
+  }
+  await page.waitForFunction(() => window.pelt.stats.touches === 2, { timeout: 10_000 });
+  await session.send('Input.dispatchTouchEvent', { type: 'touchEnd', touchPoints: [] });
+  await page.close();
+});
+
+test('without WebGPU the page says so instead of showing a blank canvas', async () => {
+  const page = await openPage({
+    beforeLoad: (p) => p.evaluateOnNewDocument(() => {
+      delete Navigator.prototype.gpu;
+    }),
+  });
+  await page.waitForFunction(() => window.pelt && window.pelt.state === 'no-webgpu', { timeout: 30_000 });
+  const text = await page.$eval('#message', (e) => e.textContent);
+  assert.match(text, /no WebGPU/);
+  assert.ok(await page.$eval('#message', (e) => getComputedStyle(e).display !== 'none'));
+  await page.close();
+});
+
+test('figures: time to the first frame, frame time, textures and simulation', async () => {
+  const page = await openPage();
+  await waitRunning(page);
+  await frames(page, 5);
+  await page.screenshot({ path: path.join(output, 'page.png') });
+  const start = await page.evaluate(() => ({ t: performance.now(), n: window.pelt.stats.frames_drawn }));
+  await new Promise((resolve) => setTimeout(resolve, 3000));
+  const end = await page.evaluate(() => ({ t: performance.now(), n: window.pelt.stats.frames_drawn }));
+  const figures = await page.evaluate(() => ({ firstFrameMs: window.pelt.firstFrameMs, ...window.pelt.stats }));
+  figures.measuredFrameMs = (end.t - start.t) / Math.max(end.n - start.n, 1);
+  const wasm = fs.statSync(path.join(dist, 'pelt_web_bg.wasm')).size;
+  console.log(`figures: ${JSON.stringify({ wasmBytes: wasm, ...figures })}`);
+  fs.writeFileSync(path.join(output, 'figures.json'), JSON.stringify({ wasmBytes: wasm, ...figures }, null, 1));
+  assert.ok(figures.firstFrameMs > 0 && end.n > start.n);
+  await page.close();
+});
