@@ -1,0 +1,85 @@
+//! Shell-and-fin fur for Bevy 0.20: Pelt's fur (Lee et al. 2010) on any mesh, simulated in Bevy
+//! systems and drawn with `pelt-render` on Bevy's own wgpu device, in Bevy's 3D pass.
+//!
+//! ```no_run
+//! use bevy::prelude::*;
+//! use bevy_pelt::{Fur, FurWind, PeltPlugin};
+//!
+//! fn main() {
+//!     App::new()
+//!         .add_plugins((DefaultPlugins, PeltPlugin))
+//!         .insert_resource(FurWind { strength: 0.4, ..default() })
+//!         .add_systems(Startup, setup)
+//!         .run();
+//! }
+//!
+//! fn setup(mut commands: Commands, mut meshes: ResMut<Assets<Mesh>>, assets: Res<AssetServer>) {
+//!     commands.spawn((Mesh3d(meshes.add(Sphere::new(1.0))), Fur::new(assets.load("presets/mink.toml"))));
+//!     commands.spawn((Camera3d::default(), Transform::from_xyz(0.0, 1.0, 4.0).looking_at(Vec3::ZERO, Vec3::Y)));
+//! }
+//! ```
+//!
+//! - [`Fur`] on an entity with a `Mesh3d` grows fur from a [`FurPreset`] (a `.toml` asset, hot
+//!   reloaded with Bevy's `file_watcher` feature; a bad file is an asset load error naming it).
+//! - The simulation runs in `PostUpdate` after transforms: the preset's gravity (world space),
+//!   [`FurWind`], touch from a ray ([`FurTouch`]), and the entity's acceleration as inertia; the
+//!   fur follows the entity's `GlobalTransform`.
+//! - The render world draws every fur into each 3D camera's main pass between the opaque and the
+//!   transparent phase, on the camera's colour target (HDR or not), depth buffer (reverse-Z) and
+//!   MSAA, so fur and Bevy's geometry occlude each other. Fur is lit by [`FurLight`].
+
+#![warn(missing_docs)]
+// Bevy systems take their queries and resources as parameters; splitting them up to please these
+// two lints would only hide what a system reads.
+#![allow(clippy::type_complexity, clippy::too_many_arguments)]
+
+mod convert;
+mod fur;
+mod mesh;
+mod preset;
+mod render;
+
+use bevy::app::{App, Plugin, PostUpdate};
+use bevy::asset::AssetApp;
+use bevy::core_pipeline::core_3d::{main_opaque_pass_3d, main_transparent_pass_3d};
+use bevy::core_pipeline::{Core3dSystems, schedule::Core3d};
+use bevy::ecs::schedule::IntoScheduleConfigs;
+use bevy::render::{ExtractSchedule, Render, RenderApp, RenderSystems};
+use bevy::transform::TransformSystems;
+
+pub use fur::{Fur, FurState, FurTouch, FurWind};
+/// Pelt's core (presets, structure, simulation).
+pub use pelt_core;
+/// Pelt's renderer, for [`FurLight`]'s `Light`.
+pub use pelt_render;
+pub use preset::{FurPreset, FurPresetLoader};
+pub use render::FurLight;
+
+/// Adds fur: the [`FurPreset`] asset and loader, the build and simulation systems, and the
+/// render-world extraction, upload and drawing. Add it after Bevy's `DefaultPlugins`.
+#[derive(Debug, Default, Clone, Copy)]
+pub struct PeltPlugin;
+
+impl Plugin for PeltPlugin {
+    fn build(&self, app: &mut App) {
+        app.init_asset::<FurPreset>()
+            .init_asset_loader::<FurPresetLoader>()
+            .init_resource::<FurWind>()
+            .init_resource::<FurTouch>()
+            .init_resource::<FurLight>()
+            .add_systems(PostUpdate, (fur::build_furs, fur::simulate_furs).chain().after(TransformSystems::Propagate));
+        let Some(render_app) = app.get_sub_app_mut(RenderApp) else { return };
+        render_app
+            .init_resource::<render::ExtractedFurs>()
+            .init_resource::<render::FurGpu>()
+            .add_systems(ExtractSchedule, render::extract_furs)
+            .add_systems(Render, render::prepare_furs.in_set(RenderSystems::PrepareResources))
+            .add_systems(
+                Core3d,
+                render::draw_furs
+                    .after(main_opaque_pass_3d)
+                    .before(main_transparent_pass_3d)
+                    .in_set(Core3dSystems::MainPass),
+            );
+    }
+}

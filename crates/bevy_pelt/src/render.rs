@@ -1,0 +1,261 @@
+//! The render world: furs extracted each frame, uploaded with pelt-render on Bevy's own device
+//! and queue, and drawn into Bevy's 3D main pass (after the opaque phase, before the
+//! transparent one) with Bevy's camera, depth buffer (reverse-Z), MSAA and colour target.
+
+use std::collections::{HashMap, HashSet};
+use std::sync::Arc;
+
+use bevy::camera::{Camera3d, CompositingSpace};
+use bevy::ecs::prelude::*;
+use bevy::log::error;
+use bevy::prelude::{GlobalTransform, InheritedVisibility};
+use bevy::render::Extract;
+use bevy::render::camera::ExtractedCamera;
+use bevy::render::renderer::{RenderContext, RenderDevice, RenderQueue, ViewQuery};
+use bevy::render::view::{ExtractedView, Msaa, ResolvedCompositingSpace, ViewDepthStencilTexture, ViewTarget};
+use pelt_core::FurStructure;
+use pelt_core::texture::FurTextures;
+use pelt_render::{FurDrawSettings, FurFrame, FurRenderer, FurStates, FurTarget, FurView, GpuFur, Light, ViewData};
+
+use crate::convert::{to_pelt, to_pelt_mat4};
+use crate::fur::{Fur, FurState};
+
+/// The light Pelt shades fur with (Kajiya-Kay strands; Bevy's lights do not reach the fur).
+/// Pelt's default follows the camera from the upper left.
+#[derive(Resource, Clone, Copy, Debug, Default, PartialEq)]
+pub struct FurLight(pub Light);
+
+/// The depth format of Bevy's 3D views.
+const DEPTH_FORMAT: wgpu::TextureFormat = bevy::core_pipeline::core_3d::CORE_3D_DEPTH_FORMAT;
+
+/// This frame's furs, copied out of the main world.
+#[derive(Resource, Default)]
+pub(crate) struct ExtractedFurs {
+    furs: Vec<ExtractedFur>,
+    light: Light,
+}
+
+struct ExtractedFur {
+    entity: Entity,
+    revision: u64,
+    structure: Arc<FurStructure>,
+    textures: Arc<FurTextures>,
+    positions: Arc<Vec<glam::Vec3>>,
+    world_from_model: glam::Mat4,
+    origin: glam::Vec3,
+    skin: bool,
+}
+
+pub(crate) fn extract_furs(
+    mut extracted: ResMut<ExtractedFurs>,
+    light: Extract<Res<FurLight>>,
+    furs: Extract<Query<(Entity, &Fur, &FurState, &GlobalTransform, Option<&InheritedVisibility>)>>,
+) {
+    extracted.light = light.0;
+    extracted.furs.clear();
+    for (entity, fur, state, transform, visibility) in &furs {
+        if visibility.is_some_and(|v| !v.get()) {
+            continue;
+        }
+        extracted.furs.push(ExtractedFur {
+            entity,
+            revision: state.revision,
+            structure: Arc::clone(&state.structure),
+            textures: Arc::clone(&state.textures),
+            positions: Arc::clone(&state.positions),
+            world_from_model: to_pelt_mat4(&transform.to_matrix()),
+            origin: to_pelt(transform.translation()),
+            skin: fur.skin,
+        });
+    }
+}
+
+/// Pelt's GPU objects on Bevy's device.
+#[derive(Resource, Default)]
+pub(crate) struct FurGpu {
+    renderers: HashMap<FurTarget, FurRenderer>,
+    failed_targets: HashSet<FurTarget>,
+    /// One per fur and target description (a fur seen by cameras with different targets is
+    /// uploaded once for each).
+    furs: HashMap<(Entity, FurTarget), GpuFurEntry>,
+    /// One per 3D view (render-world view entity).
+    views: HashMap<Entity, ViewEntry>,
+    failed_furs: HashSet<(Entity, u64)>,
+}
+
+struct GpuFurEntry {
+    fur: GpuFur,
+    revision: u64,
+}
+
+struct ViewEntry {
+    target: FurTarget,
+    view: FurView,
+    /// Draw through an sRGB view of Bevy's `Rgba8Unorm` target, which holds sRGB-encoded colour
+    /// (Bevy's default compositing space); Pelt's shaders output linear colour.
+    srgb_view: bool,
+    camera_position: glam::Vec3,
+}
+
+/// The colour format Pelt's pipelines write for a view, and whether that is an sRGB view of a
+/// non-sRGB target.
+fn colour_format(target_format: wgpu::TextureFormat, space: Option<CompositingSpace>) -> (wgpu::TextureFormat, bool) {
+    use wgpu::TextureFormat as F;
+    match (target_format, space) {
+        (F::Rgba8Unorm, Some(CompositingSpace::Srgb)) => (F::Rgba8UnormSrgb, true),
+        (F::Bgra8Unorm, Some(CompositingSpace::Srgb)) => (F::Bgra8UnormSrgb, true),
+        (format, _) => (format, false),
+    }
+}
+
+/// Pipelines per target, a view uniform per camera, and each fur's upload and transform.
+pub(crate) fn prepare_furs(
+    device: Res<RenderDevice>,
+    queue: Res<RenderQueue>,
+    extracted: Res<ExtractedFurs>,
+    mut gpu: ResMut<FurGpu>,
+    views: Query<
+        (Entity, &ExtractedView, &Msaa, Option<&ResolvedCompositingSpace>),
+        (With<ViewTarget>, With<Camera3d>),
+    >,
+) {
+    let device = device.wgpu_device();
+    let queue: &wgpu::Queue = &queue;
+    let gpu = &mut *gpu;
+    let mut seen_views = HashSet::new();
+    let mut targets = HashSet::new();
+    for (entity, view, msaa, space) in &views {
+        let (colour, srgb_view) = colour_format(view.target_format, ResolvedCompositingSpace::space(space));
+        let target = FurTarget::new(colour)
+            .with_depth(DEPTH_FORMAT, wgpu::CompareFunction::GreaterEqual)
+            .with_sample_count(msaa.samples());
+        if !gpu.renderers.contains_key(&target) {
+            if gpu.failed_targets.contains(&target) {
+                continue;
+            }
+            match FurRenderer::new(device, target) {
+                Ok(renderer) => {
+                    gpu.renderers.insert(target, renderer);
+                }
+                Err(problem) => {
+                    error!("Pelt cannot draw fur into {target:?}: {problem}");
+                    gpu.failed_targets.insert(target);
+                    continue;
+                }
+            }
+        }
+        let renderer = &gpu.renderers[&target];
+        let entry = match gpu.views.get_mut(&entity) {
+            Some(entry) if entry.target == target => entry,
+            _ => {
+                let view = FurView::new(device, renderer);
+                gpu.views.insert(entity, ViewEntry { target, view, srgb_view, camera_position: glam::Vec3::ZERO });
+                gpu.views.get_mut(&entity).expect("just inserted")
+            }
+        };
+        entry.srgb_view = srgb_view;
+        let world_from_view = to_pelt_mat4(&view.world_from_view.to_matrix());
+        let clip_from_world = match view.clip_from_world {
+            Some(clip_from_world) => to_pelt_mat4(&clip_from_world),
+            None => to_pelt_mat4(&view.clip_from_view) * world_from_view.inverse(),
+        };
+        entry.camera_position = world_from_view.w_axis.truncate();
+        entry.view.prepare(queue, &ViewData::new(clip_from_world, world_from_view, &extracted.light));
+        seen_views.insert(entity);
+        targets.insert(target);
+    }
+    gpu.views.retain(|entity, _| seen_views.contains(entity));
+
+    let mut seen_furs = HashSet::new();
+    for fur in &extracted.furs {
+        if gpu.failed_furs.contains(&(fur.entity, fur.revision)) {
+            continue;
+        }
+        for &target in &targets {
+            let key = (fur.entity, target);
+            let renderer = &gpu.renderers[&target];
+            let stale = gpu.furs.get(&key).is_none_or(|entry| entry.revision != fur.revision);
+            if stale {
+                match GpuFur::new(device, queue, renderer, &fur.structure, &fur.textures, FurStates::One) {
+                    Ok(gpu_fur) => {
+                        gpu.furs.insert(key, GpuFurEntry { fur: gpu_fur, revision: fur.revision });
+                    }
+                    Err(problem) => {
+                        error!("Pelt cannot upload the fur of {}: {problem}", fur.entity);
+                        gpu.failed_furs.insert((fur.entity, fur.revision));
+                        gpu.furs.remove(&key);
+                        continue;
+                    }
+                }
+            }
+            let entry = &gpu.furs[&key];
+            if let Err(problem) = entry.fur.set_positions(queue, &fur.positions) {
+                error!("Pelt cannot update the fur of {}: {problem}", fur.entity);
+                continue;
+            }
+            entry.fur.prepare(queue, &FurFrame { world_from_model: fur.world_from_model, ..FurFrame::default() });
+            seen_furs.insert(key);
+        }
+    }
+    gpu.furs.retain(|key, _| seen_furs.contains(key));
+}
+
+/// Draws every fur into one 3D view's main pass: the view's colour target (through an sRGB view
+/// where Bevy stores sRGB) and its depth buffer, so fur and Bevy's geometry occlude each other.
+pub(crate) fn draw_furs(
+    view: ViewQuery<(&ExtractedCamera, &ViewTarget, &ViewDepthStencilTexture)>,
+    gpu: Res<FurGpu>,
+    extracted: Res<ExtractedFurs>,
+    mut ctx: RenderContext,
+) {
+    let view_entity = view.entity();
+    let (camera, target, depth) = view.into_inner();
+    let Some(entry) = gpu.views.get(&view_entity) else { return };
+    let Some(renderer) = gpu.renderers.get(&entry.target) else { return };
+    // Farthest first: shells and fins blend over what is behind them.
+    let mut furs: Vec<(&ExtractedFur, &GpuFur)> = extracted
+        .furs
+        .iter()
+        .filter_map(|fur| gpu.furs.get(&(fur.entity, entry.target)).map(|e| (fur, &e.fur)))
+        .collect();
+    if furs.is_empty() {
+        return;
+    }
+    furs.sort_by(|a, b| {
+        let distance = |fur: &ExtractedFur| fur.origin.distance_squared(entry.camera_position);
+        distance(b.0).total_cmp(&distance(a.0))
+    });
+
+    let format = entry.srgb_view.then_some(entry.target.colour_format);
+    let view_of = |texture: &wgpu::Texture| {
+        texture.create_view(&wgpu::TextureViewDescriptor { format, ..wgpu::TextureViewDescriptor::default() })
+    };
+    let main = view_of(target.main_texture());
+    let multisampled = target.sampled_main_texture().map(|texture| view_of(texture));
+    let (colour_view, resolve_target) = match &multisampled {
+        Some(multisampled) => (multisampled, Some(&main)),
+        None => (&main, None),
+    };
+    let colour = wgpu::RenderPassColorAttachment {
+        view: colour_view,
+        depth_slice: None,
+        resolve_target,
+        ops: wgpu::Operations { load: wgpu::LoadOp::Load, store: wgpu::StoreOp::Store },
+    };
+    let mut pass = ctx.command_encoder().begin_render_pass(&wgpu::RenderPassDescriptor {
+        label: Some("pelt fur"),
+        color_attachments: &[Some(colour)],
+        depth_stencil_attachment: Some(depth.get_attachment(wgpu::StoreOp::Store)),
+        timestamp_writes: None,
+        occlusion_query_set: None,
+        multiview_mask: None,
+    });
+    if let Some(viewport) = &camera.viewport {
+        let (position, size) = (viewport.physical_position.as_vec2(), viewport.physical_size.as_vec2());
+        pass.set_viewport(position.x, position.y, size.x, size.y, viewport.depth.start, viewport.depth.end);
+    }
+    for (fur, gpu_fur) in furs {
+        let settings = FurDrawSettings { skin: fur.skin, ..FurDrawSettings::ALL };
+        renderer.draw(&mut pass, &entry.view, gpu_fur, &settings);
+    }
+}
