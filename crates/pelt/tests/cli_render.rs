@@ -3,6 +3,10 @@
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
+// The golden-image helpers pelt-render's GPU tests use (limits, silhouette band, `PELT_UPDATE_GOLDEN=1`).
+#[path = "../../pelt-render/tests/common/mod.rs"]
+mod common;
+
 fn pelt(args: &[&str], dir: &Path) -> Output {
     Command::new(env!("CARGO_BIN_EXE_pelt")).args(args).current_dir(dir).output().expect("run pelt")
 }
@@ -112,21 +116,74 @@ fn differing_fraction(a: &image::RgbaImage, b: &image::RgbaImage) -> f64 {
     differ as f64 / f64::from(a.width() * a.height())
 }
 
+/// The rows `[top, bottom)` where either image draws anything (differs from its corner pixel).
+fn drawn_rows(a: &image::RgbaImage, b: &image::RgbaImage) -> (u32, u32) {
+    let drawn_row = |y: u32| {
+        [a, b].iter().any(|image| {
+            let background = image.get_pixel(0, 0).0;
+            (0..image.width())
+                .any(|x| image.get_pixel(x, y).0[..3].iter().zip(background).any(|(p, q)| p.abs_diff(q) > 6))
+        })
+    };
+    let rows: Vec<u32> = (0..a.height()).filter(|&y| drawn_row(y)).collect();
+    (rows[0], rows[rows.len() - 1] + 1)
+}
+
+/// Of the pixels in rows `[top, bottom)`, the fraction whose colour differs by more than a small amount.
+fn differing_fraction_in_rows(a: &image::RgbaImage, b: &image::RgbaImage, top: u32, bottom: u32) -> f64 {
+    let (mut differ, mut all) = (0_u32, 0_u32);
+    for y in top..bottom {
+        for x in 0..a.width() {
+            all += 1;
+            differ += u32::from(a.get_pixel(x, y).0.iter().zip(b.get_pixel(x, y).0).any(|(p, q)| p.abs_diff(q) > 24));
+        }
+    }
+    f64::from(differ) / f64::from(all)
+}
+
 #[test]
 fn the_fox_walks_and_unknown_animations_list_the_real_ones() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
     let fox = root.join("assets/meshes/Fox.glb");
     let fox = fox.to_str().unwrap();
     let dir = temp_dir("fox");
-    // Walk frames 1 and 6 (a sixth of a second apart) differ; `none` renders the rest pose.
-    let walk = ["render", fox, "--animation", "Walk", "--size", "160x120", "--frames", "6", "-o", "walk"];
-    let output = pelt(&walk, &dir);
+    // Walk frames 1 and 6 (a sixth of a second apart); `--sim cpu` so the golden frame does not
+    // depend on which kernel `auto` picks. `none` renders the rest pose.
+    let walk = ["render", fox, "--animation", "Walk", "--size", "160x120", "--frames", "6", "--sim", "cpu"];
+    let output = pelt(&[&walk[..], &["-o", "walk"]].concat(), &dir);
     assert!(output.status.success(), "{}", text(&output));
     let output = pelt(&["render", fox, "--animation", "none", "--size", "160x120", "-o", "rest.png"], &dir);
     assert!(output.status.success(), "{}", text(&output));
     let (first, later) = (png(&dir, "walk/frame_0001.png"), png(&dir, "walk/frame_0006.png"));
     let moved = differing_fraction(&first, &later);
     assert!(moved > 0.01, "the walk moves the fox: {moved}");
+    // The legs swing and the back barely moves: the lower 40% of the rows the fox covers
+    // (the legs, in this side view) change far more than the upper 40% (back, head, tail).
+    let (top, bottom) = drawn_rows(&first, &later);
+    let band = (bottom - top) * 2 / 5;
+    let legs = differing_fraction_in_rows(&first, &later, bottom - band, bottom);
+    let back = differing_fraction_in_rows(&first, &later, top, top + band);
+    eprintln!("fox rows {top}..{bottom}: legs differ {legs:.4}, back differs {back:.4}");
+    assert!(legs > 0.05, "the legs move between walk frames: {legs:.4}");
+    assert!(legs > 2.0 * back, "the legs move more than the back: legs {legs:.4}, back {back:.4}");
+    // Mid-walk with the default fur, against a golden frame (lavapipe; `PELT_UPDATE_GOLDEN=1`
+    // rewrites it). The same frame with the fur cut to almost nothing fails it.
+    common::check_golden("fox-walk", &later);
+    let bald = dir.join("bald.toml");
+    std::fs::write(&bald, "layers = 2\nlength = 0.001\n").expect("bald preset");
+    let output = pelt(&[&walk[..], &["--preset", bald.to_str().unwrap(), "-o", "bald"]].concat(), &dir);
+    assert!(output.status.success(), "{}", text(&output));
+    let difference = common::golden_difference("fox-walk", &png(&dir, "bald/frame_0006.png"));
+    eprintln!(
+        "bald fox against fox-walk: mean {:.2}, silhouette band mean {:.2}",
+        difference.mean, difference.silhouette_mean
+    );
+    assert!(
+        !difference.within_limits(),
+        "the fox without fur passed the golden test (mean {:.2}, silhouette band {:.2})",
+        difference.mean,
+        difference.silhouette_mean
+    );
     let output = pelt(&["render", fox, "--animation", "Dance", "-o", "x.png"], &dir);
     assert!(!output.status.success());
     assert!(text(&output).contains("Survey") && text(&output).contains("Walk"), "{}", text(&output));
