@@ -4,6 +4,7 @@
 //! generation are measured. Criterion benches stay the fine-grained tools; this is the summary
 //! a reader (or CI) runs in one go.
 
+mod anim;
 mod models;
 mod render;
 mod report;
@@ -19,7 +20,7 @@ use pelt_core::{FurStructure, Preset};
 
 use self::models::{MODELS, Model};
 use self::report::{
-    GpuSimFigures, LargeMeshFigures, Machine, RenderFigures, Report, ResultRow, SimFigures, SkippedModel,
+    AnimFigures, GpuSimFigures, LargeMeshFigures, Machine, RenderFigures, Report, ResultRow, SimFigures, SkippedModel,
     TextureFigures,
 };
 use self::table2::Table2Row;
@@ -36,7 +37,7 @@ pub struct Args {
     /// Write the report as Markdown tables.
     #[arg(long, value_name = "FILE")]
     pub md: Option<PathBuf>,
-    /// Only these models (box, bunny, spot, skirt, women); repeat for several. Default: all.
+    /// Only these models (box, bunny, spot, skirt, women, fox); repeat for several. Default: all.
     #[arg(long = "model", value_name = "NAME")]
     pub models: Vec<String>,
     /// The folder with the mesh files (default: `assets/meshes`).
@@ -185,11 +186,12 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
 }
 
 const QUICK_SKIPS: &str = "--quick times the Box only";
+const NOT_ANIMATED: &str = "a static model";
 const QUICK_DRAWS: &str = "--quick draws the Box at 16 layers only";
 
 /// Every figure for one model at one layer count.
 fn measure(model: &Model, layers: u32, plan: Plan, gpu: Result<&render::Bench, &String>) -> anyhow::Result<ResultRow> {
-    let row = |render, sim, texture, gpu_sim| -> anyhow::Result<ResultRow> {
+    let row = |render, sim, texture, gpu_sim, anim| -> anyhow::Result<ResultRow> {
         Ok(ResultRow {
             model: model.spec.key,
             paper_model: model.spec.paper_model,
@@ -200,6 +202,7 @@ fn measure(model: &Model, layers: u32, plan: Plan, gpu: Result<&render::Bench, &
             sim,
             texture,
             gpu_sim,
+            anim,
         })
     };
     if !plan.times(model.spec.key) {
@@ -209,6 +212,7 @@ fn measure(model: &Model, layers: u32, plan: Plan, gpu: Result<&render::Bench, &
             SimFigures { sim_unavailable_reason: reason(), ..SimFigures::default() },
             TextureFigures { texture_unavailable_reason: reason(), ..TextureFigures::default() },
             GpuSimFigures { gpu_sim_unavailable_reason: reason(), ..GpuSimFigures::default() },
+            measure_anim(model, layers, plan)?,
         );
     }
 
@@ -253,7 +257,19 @@ fn measure(model: &Model, layers: u32, plan: Plan, gpu: Result<&render::Bench, &
         }
         Err(reason) => GpuSimFigures { gpu_sim_unavailable_reason: Some(reason.clone()), ..GpuSimFigures::default() },
     };
-    row(render, sim, texture, gpu_sim)
+    row(render, sim, texture, gpu_sim, measure_anim(model, layers, plan)?)
+}
+
+/// The posing figures of an animated model (also under `--quick`: a few frames cost little).
+fn measure_anim(model: &Model, layers: u32, plan: Plan) -> anyhow::Result<AnimFigures> {
+    let (Some(rig), Some(clip)) = (&model.rig, model.spec.animation) else {
+        return Ok(AnimFigures { anim_unavailable_reason: Some(NOT_ANIMATED.to_owned()), ..AnimFigures::default() });
+    };
+    let mut preset = Preset::default();
+    preset.layers = layers;
+    let fur = FurStructure::new(model.fur.clone(), &preset.fur_params(&model.fur))?;
+    eprintln!("pelt bench:   {} L={layers}: posing ({clip})", model.spec.key);
+    anim::measure(&fur, rig, clip, &preset.simulation, plan.sim_budget().drawn_frames)
 }
 
 /// The simulation's throughput on the 35,000-vertex mesh at 32 layers, default preset.

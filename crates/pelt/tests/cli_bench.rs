@@ -45,7 +45,8 @@ const PERCENT_KEYS: [&str; 4] =
     ["savings_vs_2_percent", "savings_vs_30_percent", "bytes_savings_vs_2_percent", "bytes_savings_vs_30_percent"];
 
 /// Measured figures, grouped by the key that says why they are null when they are.
-const MEASURED_KEYS: [(&str, &[&str]); 4] = [
+const MEASURED_KEYS: [(&str, &[&str]); 5] = [
+    ("anim_unavailable_reason", &["anim_pose_ms_per_frame", "anim_sim_ms_per_frame", "anim_cpu_ms_per_frame"]),
     (
         "render_unavailable_reason",
         &[
@@ -123,8 +124,19 @@ fn quick_bench_writes_every_key_with_sane_values() {
 
     let results = report["results"].as_array().unwrap();
     let models: Vec<&str> = results.iter().map(|r| r["model"].as_str().unwrap()).collect();
-    for model in ["box", "bunny", "spot", "skirt", "women"] {
+    for model in ["box", "bunny", "spot", "skirt", "women", "fox"] {
         assert_eq!(models.iter().filter(|m| **m == model).count(), 2, "{model} at 16 and 32 layers");
+    }
+    // The walking Fox is posed even under --quick; the static models say why they are not.
+    for row in results {
+        let animated = row["model"] == "fox";
+        assert_eq!(row["anim_unavailable_reason"].is_null(), animated, "{row}");
+        assert_eq!(row["anim_clip"].as_str() == Some("Walk"), animated, "{row}");
+        if animated {
+            let (pose, sim) = (row["anim_pose_ms_per_frame"].as_f64(), row["anim_sim_ms_per_frame"].as_f64());
+            let cpu = row["anim_cpu_ms_per_frame"].as_f64().unwrap();
+            assert!((pose.unwrap() + sim.unwrap() - cpu).abs() < 1e-9 * cpu.max(1.0), "{row}");
+        }
     }
     for row in results {
         for key in COUNT_KEYS {

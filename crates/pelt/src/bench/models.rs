@@ -4,6 +4,7 @@ use std::path::{Path, PathBuf};
 
 use anyhow::Context as _;
 use glam::{Vec2, Vec3};
+use pelt_core::anim::Rig;
 use pelt_core::mesh::RawMesh;
 use pelt_core::{Builtin, ImportOptions, Mesh};
 
@@ -23,14 +24,15 @@ impl MeshSource {
         }
     }
 
-    fn load(self, meshes_dir: &Path) -> anyhow::Result<Mesh> {
+    /// The mesh, and its rig where the file is an animated glTF.
+    fn load(self, meshes_dir: &Path) -> anyhow::Result<(Mesh, Option<Rig>)> {
         match self {
-            Self::Builtin(builtin) => Ok(builtin.mesh().0),
+            Self::Builtin(builtin) => Ok((builtin.mesh().0, None)),
             Self::Asset(file) => {
                 let path = meshes_dir.join(file);
-                let (mesh, _) = Mesh::load(&path, &ImportOptions::default())
+                let (mesh, _, rig) = Mesh::load_animated(&path, &ImportOptions::default())
                     .with_context(|| format!("cannot load {}", path.display()))?;
-                Ok(mesh)
+                Ok((mesh, rig))
             }
         }
     }
@@ -47,19 +49,42 @@ pub struct ModelSpec {
     pub fur: MeshSource,
     /// A mesh drawn without fur under the furred one (the paper's "Women (with shawl)").
     pub body: Option<MeshSource>,
+    /// The animation posed every frame (skinning figures), for an animated file.
+    pub animation: Option<&'static str>,
 }
 
-/// The paper's five models, in its Table 2 order.
-pub const MODELS: [ModelSpec; 5] = [
-    ModelSpec { key: "box", paper_model: "Box", fur: MeshSource::Builtin(Builtin::Box), body: None },
-    ModelSpec { key: "bunny", paper_model: "Bunny", fur: MeshSource::Builtin(Builtin::Bunny), body: None },
-    ModelSpec { key: "spot", paper_model: "Boar", fur: MeshSource::Asset("spot.obj"), body: None },
-    ModelSpec { key: "skirt", paper_model: "Shawl", fur: MeshSource::Asset("skirthelper.obj"), body: None },
+/// The paper's five models, in its Table 2 order, then the walking Fox.
+pub const MODELS: [ModelSpec; 6] = [
+    ModelSpec { key: "box", paper_model: "Box", fur: MeshSource::Builtin(Builtin::Box), body: None, animation: None },
+    ModelSpec {
+        key: "bunny",
+        paper_model: "Bunny",
+        fur: MeshSource::Builtin(Builtin::Bunny),
+        body: None,
+        animation: None,
+    },
+    ModelSpec { key: "spot", paper_model: "Boar", fur: MeshSource::Asset("spot.obj"), body: None, animation: None },
+    ModelSpec {
+        key: "skirt",
+        paper_model: "Shawl",
+        fur: MeshSource::Asset("skirthelper.obj"),
+        body: None,
+        animation: None,
+    },
     ModelSpec {
         key: "women",
         paper_model: "Women (with shawl)",
         fur: MeshSource::Asset("skirthelper.obj"),
         body: Some(MeshSource::Asset("female_generic.obj")),
+        animation: None,
+    },
+    // Not in the paper: a skinned character, posed every frame (issue 10).
+    ModelSpec {
+        key: "fox",
+        paper_model: "(animated Fox, not in the paper)",
+        fur: MeshSource::Asset("Fox.glb"),
+        body: None,
+        animation: Some("Walk"),
     },
 ];
 
@@ -71,13 +96,15 @@ pub struct Model {
     pub fur: Mesh,
     /// The un-furred body, if any.
     pub body: Option<Mesh>,
+    /// The furred mesh's rig, for an animated file.
+    pub rig: Option<Rig>,
 }
 
 impl Model {
     pub fn load(spec: ModelSpec, meshes_dir: &Path) -> anyhow::Result<Self> {
-        let fur = spec.fur.load(meshes_dir)?;
-        let body = spec.body.map(|body| body.load(meshes_dir)).transpose()?;
-        Ok(Self { spec, fur, body })
+        let (fur, rig) = spec.fur.load(meshes_dir)?;
+        let body = spec.body.map(|body| body.load(meshes_dir).map(|(mesh, _)| mesh)).transpose()?;
+        Ok(Self { spec, fur, body, rig })
     }
 
     /// The mesh sources, as the report names them (`fur` or `body + fur`).

@@ -76,6 +76,8 @@ pub struct ResultRow {
     pub texture: TextureFigures,
     #[serde(flatten)]
     pub gpu_sim: GpuSimFigures,
+    #[serde(flatten)]
+    pub anim: AnimFigures,
 }
 
 /// The Table 2 part: counts and bytes, all computed.
@@ -177,6 +179,20 @@ pub struct SimFigures {
     /// ... against simulating every drawn frame.
     pub sim_cpu_ms_per_frame_every_frame: Option<f64>,
     pub sim_unavailable_reason: Option<String>,
+}
+
+/// An animated model's CPU cost per frame at 30 Hz (null for the static models).
+#[derive(Debug, Default, serde::Serialize)]
+pub struct AnimFigures {
+    /// The animation posed.
+    pub anim_clip: Option<String>,
+    /// `Rig::pose`: skinning of positions, normals and vertex frames.
+    pub anim_pose_ms_per_frame: Option<f64>,
+    /// The simulation following the pose: `set_base_rotations` and `advance_to` (all threads), as `pelt render` runs it.
+    pub anim_sim_ms_per_frame: Option<f64>,
+    /// Both: the CPU's part of an animated frame (the GPU's is `frame_ms`).
+    pub anim_cpu_ms_per_frame: Option<f64>,
+    pub anim_unavailable_reason: Option<String>,
 }
 
 /// The GPU simulation (`pelt_render::GpuSimulation`) on the report's adapter.
@@ -354,7 +370,27 @@ impl Report {
             }),
         );
         self.gpu_sim_markdown(&mut md);
+        self.anim_markdown(&mut md);
         md
+    }
+
+    /// The animated models' CPU cost per frame: posing (skinning) and the simulation following it.
+    fn anim_markdown(&self, md: &mut String) {
+        let animated: Vec<&ResultRow> = self.results.iter().filter(|r| r.anim.anim_clip.is_some()).collect();
+        if animated.is_empty() {
+            return;
+        }
+        let _ =
+            writeln!(md, "\n### Animated models (CPU per frame at 30 Hz; the GPU's part is the frame time above)\n");
+        let _ = writeln!(md, "| model | L | animation | pose (skinning) ms | simulation ms | CPU ms per frame |");
+        let _ = writeln!(md, "|---|---:|---|---:|---:|---:|");
+        for r in animated {
+            let a = &r.anim;
+            let clip = a.anim_clip.as_deref().unwrap_or("-");
+            let (pose, sim, cpu) =
+                (ms(a.anim_pose_ms_per_frame), ms(a.anim_sim_ms_per_frame), ms(a.anim_cpu_ms_per_frame));
+            let _ = writeln!(md, "| {} | {} | {clip} | {pose} | {sim} | {cpu} |", r.model, r.layers);
+        }
     }
 
     /// The GPU simulation's table: which kernel ran where, and how fast.

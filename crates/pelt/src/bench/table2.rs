@@ -102,7 +102,7 @@ mod tests {
 
     fn model(fur: Builtin, body: Option<Builtin>) -> Model {
         let spec = MODELS[0];
-        Model { spec, fur: fur.mesh().0, body: body.map(|b| b.mesh().0) }
+        Model { spec, fur: fur.mesh().0, body: body.map(|b| b.mesh().0), rig: None }
     }
 
     #[test]
