@@ -81,7 +81,7 @@ pub const MODELS: [ModelSpec; 6] = [
     // Not in the paper: a skinned character, posed every frame (issue 10).
     ModelSpec {
         key: "fox",
-        paper_model: "(animated Fox, not in the paper)",
+        paper_model: "none (animated Fox)",
         fur: MeshSource::Asset("Fox.glb"),
         body: None,
         animation: Some("Walk"),
