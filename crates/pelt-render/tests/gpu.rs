@@ -171,12 +171,20 @@ fn silhouette_fins_draw_what_every_edge_draws() {
         .count();
     assert!(kept < edges / 3, "the pass keeps a fraction of the {edges} edges: {kept}");
     assert!(kept.abs_diff(shown) <= shown / 50 + 2, "kept {kept}, the CPU finds {shown}");
-    let changed = every_edge.pixels().zip(silhouette.pixels()).filter(|(p, q)| pixel_difference(p, q) > 8).count();
-    assert!(changed < 40, "{changed} pixels differ between every edge and silhouette edges");
-    // And the fins are really there: without them the picture changes.
+    // The fins are really there: without them the picture changes ...
     let without = rig.render(&gpu_fur, &camera, &FurDrawSettings { fins: false, ..settings() });
     let fin_pixels = silhouette.pixels().zip(without.pixels()).filter(|(p, q)| pixel_difference(p, q) > 8).count();
     assert!(fin_pixels > 200, "silhouette fins change {fin_pixels} pixels");
+    // ... and the silhouette edges give every edge's picture, up to the order in which
+    // overlapping fins blend: the pass appends edges in whatever order the GPU's threads
+    // finish, so a few fin pixels may differ from run to run (0 to 105 of some 4,400 on lavapipe).
+    // A pass that lost fins would differ on a large share of the fin pixels.
+    let changed = every_edge.pixels().zip(silhouette.pixels()).filter(|(p, q)| pixel_difference(p, q) > 8).count();
+    eprintln!("silhouette vs every edge: {changed} pixels differ; fins change {fin_pixels}");
+    assert!(
+        changed * 10 < fin_pixels,
+        "{changed} pixels differ between every edge and silhouette edges (fins change {fin_pixels})"
+    );
 }
 
 /// Coverage: the mean difference from the background, 0 (nothing drawn) to 1.
