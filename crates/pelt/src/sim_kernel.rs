@@ -81,6 +81,22 @@ pub fn cpu_secs_per_step(structure: &FurStructure, params: &SimParams, steps: u3
     Ok(median(&mut samples))
 }
 
+/// A fur of its own with two states, the GPU simulation writing them, and a CPU `Simulation`
+/// that only keeps time and inputs (its bending off), for timing the GPU kernel.
+fn gpu_rig(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    structure: &FurStructure,
+    params: &SimParams,
+) -> anyhow::Result<(GpuFur, GpuSimulation, Simulation)> {
+    let renderer = FurRenderer::new(device, FurTarget::new(wgpu::TextureFormat::Rgba8UnormSrgb))?;
+    let fur = GpuFur::new(device, queue, &renderer, structure, &blank_textures(), FurStates::Two)?;
+    let gpu = GpuSimulation::new(device, &fur, structure)?;
+    let mut control = Simulation::new(structure, params)?;
+    control.set_cpu_bending(false);
+    Ok((fur, gpu, control))
+}
+
 /// Median wall seconds per step of the GPU simulation: per run, `steps` steps (each advanced,
 /// prepared and dispatched as a frame would) in one submission, then a wait for the GPU to
 /// finish (the fence), on a fur of its own.
@@ -92,11 +108,7 @@ pub fn gpu_secs_per_step(
     steps: u32,
     runs: usize,
 ) -> anyhow::Result<f64> {
-    let renderer = FurRenderer::new(device, FurTarget::new(wgpu::TextureFormat::Rgba8UnormSrgb))?;
-    let mut fur = GpuFur::new(device, queue, &renderer, structure, &blank_textures(), FurStates::Two)?;
-    let mut gpu = GpuSimulation::new(device, &fur, structure)?;
-    let mut control = Simulation::new(structure, params)?;
-    control.set_cpu_bending(false);
+    let (mut fur, mut gpu, mut control) = gpu_rig(device, queue, structure, params)?;
     let rate = f64::from(params.rate_hz);
     let mut step = 1_u32;
     let mut run = |fur: &mut GpuFur| -> anyhow::Result<f64> {
@@ -132,11 +144,7 @@ pub fn gpu_cpu_ms_per_drawn_frame(
     draw_hz: f64,
     frames: u32,
 ) -> anyhow::Result<f64> {
-    let renderer = FurRenderer::new(device, FurTarget::new(wgpu::TextureFormat::Rgba8UnormSrgb))?;
-    let mut fur = GpuFur::new(device, queue, &renderer, structure, &blank_textures(), FurStates::Two)?;
-    let mut gpu = GpuSimulation::new(device, &fur, structure)?;
-    let mut control = Simulation::new(structure, params)?;
-    control.set_cpu_bending(false);
+    let (mut fur, mut gpu, mut control) = gpu_rig(device, queue, structure, params)?;
     let frames = frames.max(1);
     let started = Instant::now();
     for frame in 1..=frames {
