@@ -124,7 +124,7 @@ pub use geometry::POSITIONS_USAGE;
 pub use gpu::{Backend, Gpu};
 #[cfg(feature = "headless")]
 pub use headless::{HEADLESS_FORMAT, Headless};
-pub use lod::{FurLevel, LodSettings, strand_pixels};
+pub use lod::{FurLevel, LodSettings, strand_pixels, strand_pixels_in_view};
 pub use object::{FurFrame, FurLook, GpuBytes};
 pub use plain::PlainMesh;
 pub use renderer::{FurDrawSettings, FurRenderer, unified_shader_source};

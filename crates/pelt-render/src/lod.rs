@@ -102,6 +102,20 @@ impl LodSettings {
     }
 }
 
+/// How many pixels a strand of `length` world units spans at most on a fur inside the sphere
+/// (`centre`, `radius`, world units) seen from `eye` (the sphere's nearest point counts).
+#[must_use]
+pub fn strand_pixels_in_view(
+    length: f32,
+    (centre, radius): (glam::Vec3, f32),
+    eye: glam::Vec3,
+    fov_y_rad: f32,
+    viewport_height: u32,
+) -> f32 {
+    let distance = (eye.distance(centre) - radius).max(1e-3 * radius.max(1e-6));
+    strand_pixels(length, distance, fov_y_rad, viewport_height)
+}
+
 /// How many pixels a strand of `length` world units spans at `distance` from a camera with
 /// vertical field of view `fov_y_rad` and a viewport `viewport_height` pixels high (seen side on,
 /// the most it can span).
