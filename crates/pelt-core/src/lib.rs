@@ -17,6 +17,6 @@ pub mod texture;
 
 pub use fur::{FurParams, FurStructure, GrowthDirection, SeparatedStructure};
 pub use mesh::{ImportOptions, Mesh, MeshError, MeshReport, builtin::Builtin};
-pub use preset::{Preset, PresetError, RenderParams};
+pub use preset::{LodParams, Preset, PresetError, RenderParams};
 pub use sim::{Scene, SimError, SimParams, Simulation};
 pub use texture::{FurTextures, TextureParams};

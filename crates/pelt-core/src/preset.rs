@@ -89,6 +89,24 @@ impl Default for DirectionParams {
     }
 }
 
+/// The `[render.lod]` table: level of detail, fewer shells and fin segments where the fur is
+/// small on screen (`pelt render`, `pelt view` and `pelt bench`; `--no-lod` turns it off).
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct LodParams {
+    /// On by default.
+    pub enabled: bool,
+    /// Screen pixels each drawn shell should span along a strand, `0.25..=16`: strands shorter
+    /// on screen than `layers * pixels_per_shell` draw fewer shells. Default 1.
+    pub pixels_per_shell: f32,
+}
+
+impl Default for LodParams {
+    fn default() -> Self {
+        Self { enabled: true, pixels_per_shell: 1.0 }
+    }
+}
+
 /// The `[render]` table: how Pelt's own commands (`pelt render`, `pelt view`) show the fur.
 #[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -101,6 +119,8 @@ pub struct RenderParams {
     /// command's own view.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub camera_elevation_deg: Option<f32>,
+    /// Level of detail.
+    pub lod: LodParams,
 }
 
 /// One fur: layer count, length, direction, textures, colour and simulation.
@@ -265,6 +285,12 @@ impl Preset {
                 format!("must be between -89 and 89, got {elevation}"),
             )?;
         }
+        let pixels = render.lod.pixels_per_shell;
+        check(
+            pixels.is_finite() && (0.25..=16.0).contains(&pixels),
+            "render.lod.pixels_per_shell",
+            format!("must be between 0.25 and 16, got {pixels}"),
+        )?;
         self.texture.validate().map_err(invalid)?;
         self.colour.validate().map_err(invalid)?;
         self.simulation.validate().map_err(invalid)

@@ -103,6 +103,7 @@ mod geometry;
 mod gpu;
 #[cfg(feature = "headless")]
 mod headless;
+mod lod;
 mod object;
 mod pipeline;
 mod plain;
@@ -123,6 +124,7 @@ pub use geometry::POSITIONS_USAGE;
 pub use gpu::{Backend, Gpu};
 #[cfg(feature = "headless")]
 pub use headless::{HEADLESS_FORMAT, Headless};
+pub use lod::{FurLevel, LodSettings, strand_pixels, strand_pixels_in_view};
 pub use object::{FurFrame, FurLook, GpuBytes};
 pub use plain::PlainMesh;
 pub use renderer::{FurDrawSettings, FurRenderer, unified_shader_source};

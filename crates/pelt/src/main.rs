@@ -2,6 +2,7 @@
 
 mod bench;
 mod format;
+mod lod;
 mod mesh_args;
 mod render;
 mod sim_kernel;
