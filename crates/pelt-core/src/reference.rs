@@ -125,10 +125,22 @@ impl StrandReference {
                     if weights.min_element() < 0.0 {
                         return;
                     }
+                    let texels_per_world = mapping.tiles_per_world * size;
                     let nodes = node_heights(strand.length_factor(), layers)
-                        .map(|height| StrandNode {
-                            barycentric: triangle.barycentric(root + strand.centre(height) - strand.root()),
-                            height,
+                        .map(|height| {
+                            let shift = strand.centre(height) - strand.root();
+                            let mut barycentric = triangle.barycentric(root + shift);
+                            // Where the tile is stretched thin over the surface (a squeezed uv
+                            // triangle), a few texels of lean would reach far across the mesh:
+                            // keep the lean within twice its length at the tile's usual scale.
+                            let offset = barycentric - weights;
+                            let reach =
+                                (corners[0] * offset.x + corners[1] * offset.y + corners[2] * offset.z).length();
+                            let limit = 2.0 * shift.length() / texels_per_world;
+                            if reach > limit {
+                                barycentric = weights + offset * (limit / reach);
+                            }
+                            StrandNode { barycentric, height }
                         })
                         .collect::<Vec<_>>();
                     let surface_uv = uvs.map(|[a, b, c]| a * weights.x + b * weights.y + c * weights.z);
