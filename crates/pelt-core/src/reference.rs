@@ -57,6 +57,10 @@ pub struct StrandNode {
     pub barycentric: Vec3,
     /// Height as a fraction of the fur length: 0 at the root.
     pub height: f32,
+    /// The farthest (model units) this node may stand sideways from the root's own column: twice
+    /// its lean at the tile's usual scale. Where the columns of a triangle splay apart, weights
+    /// far outside it would otherwise amplify the splay.
+    pub reach: f32,
 }
 
 /// Why a reference could not be made or evaluated.
@@ -140,7 +144,7 @@ impl StrandReference {
                             if reach > limit {
                                 barycentric = weights + offset * (limit / reach);
                             }
-                            StrandNode { barycentric, height }
+                            StrandNode { barycentric, height, reach: limit }
                         })
                         .collect::<Vec<_>>();
                     let surface_uv = uvs.map(|[a, b, c]| a * weights.x + b * weights.y + c * weights.z);
@@ -216,11 +220,20 @@ impl StrandReference {
         };
         chunks.into_par_iter().for_each(|(strand, out)| {
             let triangle = self.triangles[strand.triangle as usize];
-            for (node, position) in self.strand_nodes(strand).iter().zip(out.iter_mut()) {
-                let b = node.barycentric;
-                *position = columns.at(triangle[0], node.height) * b.x
-                    + columns.at(triangle[1], node.height) * b.y
-                    + columns.at(triangle[2], node.height) * b.z;
+            let nodes = self.strand_nodes(strand);
+            // The root node has no lean: its weights are the root's.
+            let root_weights = nodes[0].barycentric;
+            for (node, position) in nodes.iter().zip(out.iter_mut()) {
+                let at = |b: Vec3| {
+                    columns.at(triangle[0], node.height) * b.x
+                        + columns.at(triangle[1], node.height) * b.y
+                        + columns.at(triangle[2], node.height) * b.z
+                };
+                let column = at(root_weights);
+                let sideways = at(node.barycentric) - column;
+                let length = sideways.length();
+                *position =
+                    if length > node.reach { column + sideways * (node.reach / length) } else { column + sideways };
             }
         });
         Ok(out)

@@ -411,7 +411,7 @@ pub(crate) fn parse_size(text: &str) -> Result<(u32, u32), String> {
     }
 }
 
-fn parse_msaa(text: &str) -> Result<u32, String> {
+pub(crate) fn parse_msaa(text: &str) -> Result<u32, String> {
     match text.trim().parse() {
         Ok(samples @ (1 | 2 | 4 | 8)) => Ok(samples),
         _ => Err(format!("expected 1, 2, 4 or 8 samples, got {text:?}")),

@@ -99,6 +99,31 @@ pub fn masked_ssim(a: &RgbaImage, b: &RgbaImage, mask: &Mask) -> anyhow::Result<
     Ok((weight > 0).then(|| sum / weight as f64))
 }
 
+/// Over the 8x8 windows holding masked pixels (weighted as in [`masked_ssim`]): the mean luma and
+/// the mean standard deviation of luma in a window (the local contrast SSIM compares), 0..=255.
+pub fn luma_statistics(image: &RgbaImage, mask: &Mask) -> (f64, f64) {
+    let luma = luma(image);
+    let (mut mean_sum, mut deviation_sum, mut weight) = (0.0, 0.0, 0usize);
+    for top in (0..image.height()).step_by(WINDOW as usize) {
+        for left in (0..image.width()).step_by(WINDOW as usize) {
+            let pixels: Vec<(u32, u32)> = (top..(top + WINDOW).min(image.height()))
+                .flat_map(|y| (left..(left + WINDOW).min(image.width())).map(move |x| (x, y)))
+                .collect();
+            let inside = pixels.iter().filter(|(x, y)| mask.bits[(y * mask.width + x) as usize]).count();
+            if inside == 0 {
+                continue;
+            }
+            let values: Vec<f64> = pixels.iter().map(|(x, y)| f64::from(luma.get_pixel(*x, *y)[0])).collect();
+            let mean = values.iter().sum::<f64>() / values.len() as f64;
+            let variance = values.iter().map(|v| (v - mean).powi(2)).sum::<f64>() / values.len() as f64;
+            mean_sum += mean * inside as f64;
+            deviation_sum += variance.sqrt() * inside as f64;
+            weight += inside;
+        }
+    }
+    if weight == 0 { (0.0, 0.0) } else { (mean_sum / weight as f64, deviation_sum / weight as f64) }
+}
+
 /// Mean over `mask` of the distance between the sRGB colours, scaled to `0..=1` (black against
 /// white is 1); `None` for an empty mask.
 pub fn mean_colour_difference(a: &RgbaImage, b: &RgbaImage, mask: &Mask) -> Option<f64> {

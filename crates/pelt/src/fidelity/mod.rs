@@ -60,6 +60,10 @@ pub struct Args {
     /// The strands are rendered at this many times the size on each axis, then filtered down.
     #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(1..=8))]
     supersample: u32,
+    /// MSAA samples of the shells and fins: 1, 2, 4 or 8. Default: 1 on a CPU rasteriser
+    /// (lavapipe), 4 on a GPU (as `pelt render`).
+    #[arg(long, value_name = "N", value_parser = crate::render::parse_msaa)]
+    msaa: Option<u32>,
     /// Graphics backend: vulkan, gl (or metal, dx12); default `WGPU_BACKEND`, else the best there is.
     #[arg(long, default_value = "auto")]
     backend: Backend,
@@ -122,7 +126,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
 
     let (width, height) = args.size;
     let gpu = Gpu::new(args.backend)?;
-    let samples = default_sample_count(&gpu.adapter.get_info());
+    let samples = args.msaa.unwrap_or_else(|| default_sample_count(&gpu.adapter.get_info()));
     let shells = Headless::with_target(gpu, FurTarget::new(HEADLESS_FORMAT).with_sample_count(samples), width, height)?;
     let factor = args.supersample;
     let strands = Headless::with_target(
@@ -212,6 +216,17 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             result.mean_colour_difference,
             path.display(),
             wind = format!("{:.2},{:.2},{:.2}", wind.x, wind.y, wind.z),
+        );
+        let statistics = |image: &image::RgbaImage| {
+            let (mean, contrast) = metrics::luma_statistics(image, &fur_mask);
+            format!("{mean:.0}/{contrast:.1}")
+        };
+        println!(
+            "{:>8} {name:<5} luma mean/local contrast over the fur: shells+fins {}, shells {}, strands {}",
+            "",
+            statistics(&shells_fins),
+            statistics(&shells_only),
+            statistics(&reference_image)
         );
         results.push(result);
     }
