@@ -9,6 +9,7 @@ mod models;
 mod render;
 mod report;
 mod sim;
+mod soak;
 mod system;
 mod table2;
 
@@ -43,14 +44,23 @@ pub struct Args {
     /// The folder with the mesh files (default: `assets/meshes`).
     #[arg(long, value_name = "DIR")]
     pub meshes: Option<PathBuf>,
-    /// Instead of the report: soak the CPU simulation (the bunny at 16 layers) under extreme,
-    /// changing forces and report the worst segment length error; fails if any node is not
-    /// finite or a length moved by more than 1e-5 of its strand's length.
+    /// Instead of the report: soak the simulation (the bunny at 16 layers) under extreme,
+    /// changing forces on the CPU kernel, then on the GPU kernel, and report each one's worst
+    /// segment length error; fails if any node is not finite or a length moved by more than
+    /// 1e-5 of its strand's length.
     #[arg(long)]
     pub soak: bool,
-    /// Steps of `--soak`.
+    /// Leave out the level-of-detail measurements (the frame-time table always draws every
+    /// shell).
+    #[arg(long)]
+    pub no_lod: bool,
+    /// Steps of `--soak` on the CPU kernel.
     #[arg(long, value_name = "N", default_value_t = 1_000_000, requires = "soak")]
     pub steps: u64,
+    /// Steps of `--soak` on the GPU kernel (0: none). Fewer than the CPU's by default: every
+    /// step is read back to be checked, which costs milliseconds on a software rasteriser.
+    #[arg(long, value_name = "N", default_value_t = 100_000, requires = "soak")]
+    pub gpu_steps: u64,
 }
 
 /// The layer counts the paper's comparison is made at.
@@ -60,6 +70,8 @@ const LAYER_COUNTS: [u32; 2] = [16, 32];
 #[derive(Clone, Copy, Debug)]
 struct Plan {
     quick: bool,
+    /// `--no-lod`.
+    no_lod: bool,
 }
 
 impl Plan {
@@ -104,7 +116,7 @@ impl Plan {
 
 pub fn run(args: &Args) -> anyhow::Result<()> {
     if args.soak {
-        return soak(args.steps);
+        return soak::run(args.steps, args.gpu_steps);
     }
     let started = Instant::now();
     for name in &args.models {
@@ -114,7 +126,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             MODELS.iter().map(|m| m.key).collect::<Vec<_>>().join(", ")
         );
     }
-    let plan = Plan { quick: args.quick };
+    let plan = Plan { quick: args.quick, no_lod: args.no_lod };
     let meshes_dir = models::meshes_dir(args.meshes.as_deref());
 
     // One GPU for the whole run; without one the frame times are null with the reason.
@@ -243,7 +255,8 @@ fn measure(model: &Model, layers: u32, plan: Plan, gpu: Result<&render::Bench, &
         }
         Ok(gpu) => {
             eprintln!("pelt bench:   {key} L={layers}: frame time");
-            gpu.measure(&fur, model.body.as_ref(), &textures, plan.render_budget())?
+            let lod = crate::lod::settings(&preset.render.lod, plan.no_lod);
+            gpu.measure(&fur, model.body.as_ref(), &textures, plan.render_budget(), lod)?
         }
         Err(reason) => RenderFigures { render_unavailable_reason: Some(reason.clone()), ..RenderFigures::default() },
     };
@@ -287,37 +300,4 @@ fn measure_large_mesh(plan: Plan) -> anyhow::Result<LargeMeshFigures> {
         sim_node_updates_per_sec: throughput.one_thread,
         sim_node_updates_per_sec_all_threads: throughput.all_threads,
     })
-}
-
-/// The most a segment's length may move in the soak, as a fraction of its strand's length.
-const SOAK_TOLERANCE: f64 = 1e-5;
-
-/// `pelt bench --soak`: the bunny at 16 layers through `steps` soak steps.
-fn soak(steps: u64) -> anyhow::Result<()> {
-    let started = Instant::now();
-    let (mesh, _) = pelt_core::Builtin::Bunny.mesh();
-    let preset = Preset::default();
-    let fur = FurStructure::new(mesh.clone(), &preset.fur_params(&mesh))?;
-    let mut simulation = pelt_core::Simulation::new(&fur, &preset.simulation)?;
-    eprintln!(
-        "pelt bench --soak: bunny, {} strands x {} layers, {steps} steps, {} kernel",
-        fur.vertex_count(),
-        fur.layers,
-        simulation.cpu_kernel().name()
-    );
-    let report = pelt_core::sim::soak(&fur, &mut simulation, steps, |done| {
-        if done % 100_000 == 0 {
-            eprintln!("pelt bench --soak: {done} steps, {:.0} s", started.elapsed().as_secs_f64());
-        }
-    })?;
-    println!(
-        "soak: {} steps in {:.1} s; worst segment length error {:.3e} of the strand length (step {}); steps with a non-finite node: {}",
-        report.steps,
-        started.elapsed().as_secs_f64(),
-        report.worst_length_error,
-        report.worst_step,
-        report.non_finite_steps
-    );
-    anyhow::ensure!(report.passed(SOAK_TOLERANCE), "soak failed (tolerance {SOAK_TOLERANCE:e}): {report:?}");
-    Ok(())
 }
