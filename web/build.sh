@@ -18,7 +18,8 @@ if ! { [ -x "$bindgen" ] && "$bindgen" --version | grep -qx "wasm-bindgen $versi
   echo "installing wasm-bindgen-cli $version"
   # --locked: the CLI's own lock file, so its build is the one its authors tested. (0.2.130's lock
   # names webpki-roots 1.0.11, missing from some registry mirrors; hence wasm-bindgen 0.2.129.)
-  cargo install --quiet --locked wasm-bindgen-cli --version "=$version"
+  # Only the bindgen binary, without the TLS its test runner downloads drivers with.
+  cargo install --quiet --locked --no-default-features --bin wasm-bindgen wasm-bindgen-cli --version "=$version"
 fi
 
 # Its own target dir: the web build's profile and target do not churn the native build's.
