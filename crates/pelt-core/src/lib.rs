@@ -11,12 +11,13 @@ pub mod anim;
 pub mod fur;
 pub mod mesh;
 pub mod preset;
+pub mod reference;
 pub mod rng;
 pub mod sim;
 pub mod texture;
 
 pub use fur::{FurParams, FurStructure, GrowthDirection, SeparatedStructure};
 pub use mesh::{ImportOptions, Mesh, MeshError, MeshReport, builtin::Builtin};
-pub use preset::{Preset, PresetError, RenderParams};
+pub use preset::{LodParams, Preset, PresetError, RenderParams};
 pub use sim::{Scene, SimError, SimParams, Simulation};
 pub use texture::{FurTextures, TextureParams};

@@ -20,7 +20,9 @@ use glam::Vec3;
 use crate::fur::{FurLength, FurParams, GrowthDirection, MAX_LAYERS};
 use crate::mesh::Mesh;
 use crate::sim::{ParamError, SimParams};
-use crate::texture::{self, ColourMode, ColourParams, FurTextures, ImageRgba8, TextureInputs, TextureParams};
+use crate::texture::{
+    self, ColourMode, ColourParams, FurTextures, ImageRgba8, StrandField, TextureInputs, TextureParams,
+};
 
 /// Why a preset could not be read, checked or used. Every message starts with the file.
 #[derive(Debug, thiserror::Error)]
@@ -89,6 +91,24 @@ impl Default for DirectionParams {
     }
 }
 
+/// The `[render.lod]` table: level of detail, fewer shells and fin segments where the fur is
+/// small on screen (`pelt render`, `pelt view` and `pelt bench`; `--no-lod` turns it off).
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct LodParams {
+    /// On by default.
+    pub enabled: bool,
+    /// Screen pixels each drawn shell should span along a strand, `0.25..=16`: strands shorter
+    /// on screen than `layers * pixels_per_shell` draw fewer shells. Default 1.
+    pub pixels_per_shell: f32,
+}
+
+impl Default for LodParams {
+    fn default() -> Self {
+        Self { enabled: true, pixels_per_shell: 1.0 }
+    }
+}
+
 /// The `[render]` table: how Pelt's own commands (`pelt render`, `pelt view`) show the fur.
 #[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -101,6 +121,8 @@ pub struct RenderParams {
     /// command's own view.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub camera_elevation_deg: Option<f32>,
+    /// Level of detail.
+    pub lod: LodParams,
 }
 
 /// One fur: layer count, length, direction, textures, colour and simulation.
@@ -265,6 +287,12 @@ impl Preset {
                 format!("must be between -89 and 89, got {elevation}"),
             )?;
         }
+        let pixels = render.lod.pixels_per_shell;
+        check(
+            pixels.is_finite() && (0.25..=16.0).contains(&pixels),
+            "render.lod.pixels_per_shell",
+            format!("must be between 0.25 and 16, got {pixels}"),
+        )?;
         self.texture.validate().map_err(invalid)?;
         self.colour.validate().map_err(invalid)?;
         self.simulation.validate().map_err(invalid)
@@ -291,6 +319,15 @@ impl Preset {
     /// # Errors
     /// [`PresetError`] for out-of-range values or an image that cannot be read, naming the key.
     pub fn generate_textures(&self) -> Result<FurTextures, PresetError> {
+        Ok(texture::generate_from(self.layers, &self.strand_field()?))
+    }
+
+    /// Loads the images the preset refers to and grows its seeded strand field: what
+    /// [`Preset::generate_textures`] rasterises, and what the explicit strand reference places.
+    ///
+    /// # Errors
+    /// As [`Preset::generate_textures`].
+    pub fn strand_field(&self) -> Result<StrandField, PresetError> {
         self.validate()?;
         let load = |key: &str, path: &Option<PathBuf>| -> Result<Option<ImageRgba8>, PresetError> {
             let Some(path) = path else { return Ok(None) };
@@ -313,7 +350,7 @@ impl Preset {
                 _ => None,
             },
         };
-        texture::generate(self.layers, &self.texture, &self.colour, &inputs).map_err(|e| {
+        StrandField::new(&self.texture, &self.colour, &inputs).map_err(|e| {
             let (key, problem) = match e {
                 texture::TextureError::Param(ParamError { key, problem }) => (key, problem),
                 texture::TextureError::Layers { got } => {

@@ -7,6 +7,7 @@ use pelt_core::texture::FurTextures;
 
 use crate::RenderError;
 use crate::geometry::UnifiedGeometry;
+use crate::lod::PreparedLevel;
 use crate::object::{FurFrame, GpuBytes};
 use crate::renderer::FurRenderer;
 use crate::requirements::ErrorScope;
@@ -44,6 +45,8 @@ pub struct GpuFur {
     textures: GpuTextures,
     /// The silhouette pass's output (none without fins).
     fins: Option<FinList>,
+    /// The level of detail of the last `prepare`.
+    level: PreparedLevel,
 }
 
 impl GpuFur {
@@ -67,7 +70,7 @@ impl GpuFur {
         let textures = GpuTextures::new(device, queue, renderer.layouts(), textures);
         let fins = fin_list(device, renderer, structure);
         scope.pop("uploading the fur")?;
-        Ok(Self { geometry: geometry?, textures: textures?, fins: fins? })
+        Ok(Self { geometry: geometry?, textures: textures?, fins: fins?, level: PreparedLevel::new() })
     }
 
     /// Replaces the structure (new mesh, layer count or rest pose), keeping the textures and the
@@ -115,6 +118,7 @@ impl GpuFur {
         // One state has nothing to interpolate; 1 lets the shader fetch it once.
         let frame = if self.geometry.state_count() == 1 { FurFrame { interpolation: 1.0, ..*frame } } else { *frame };
         self.geometry.write_uniform(queue, &self.geometry.shape.uniform(&frame, self.textures.root_colour, textures));
+        self.level.set(frame.level, self.geometry.shape.layers);
     }
 
     /// Writes `positions` (`(L + 1) * V`, layer-major, model space) into both states: the
@@ -223,6 +227,12 @@ impl GpuFur {
 
     pub(crate) fn fin_list(&self) -> Option<&FinList> {
         self.fins.as_ref()
+    }
+
+    /// Shells (and fin segments) drawn at the level of the last [`GpuFur::prepare`].
+    #[must_use]
+    pub fn drawn_shells(&self) -> u32 {
+        self.level.get().shells(self.geometry.shape.layers)
     }
 }
 

@@ -232,11 +232,11 @@ impl UnifiedGeometry {
         }
     }
 
-    /// Draws every fin (instance = edge).
-    pub fn draw_fins(&self, pass: &mut wgpu::RenderPass<'_>) {
+    /// Draws every fin (instance = edge) with `segments` segments (the level of detail's).
+    pub fn draw_fins(&self, pass: &mut wgpu::RenderPass<'_>, segments: u32) {
         if let Some(strip) = &self.fin_indices {
             pass.set_index_buffer(strip.slice(..), wgpu::IndexFormat::Uint32);
-            pass.draw_indexed(0..6 * self.shape.layers, 0, 0..self.shape.edge_count);
+            pass.draw_indexed(0..6 * segments.min(self.shape.layers), 0, 0..self.shape.edge_count);
         }
     }
 }

@@ -5,6 +5,8 @@
 use glam::{Mat3, Mat4, Vec3, Vec4};
 use pelt_core::Mesh;
 
+use crate::lod::FurLevel;
+
 /// How one fur looks, beyond its textures: lighting response, fading and strand density.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct FurLook {
@@ -47,11 +49,13 @@ pub struct FurFrame {
     pub interpolation: f32,
     /// Lighting, fading and density.
     pub look: FurLook,
+    /// Level of detail: which shells and fin segments to draw ([`FurLevel::FULL`]: all).
+    pub level: FurLevel,
 }
 
 impl Default for FurFrame {
     fn default() -> Self {
-        Self { world_from_model: Mat4::IDENTITY, interpolation: 1.0, look: FurLook::default() }
+        Self { world_from_model: Mat4::IDENTITY, interpolation: 1.0, look: FurLook::default(), level: FurLevel::FULL }
     }
 }
 
@@ -110,7 +114,9 @@ pub(crate) struct ObjectUniform {
     root_occlusion: f32,
     specular: f32,
     shininess: f32,
-    _padding_1: [f32; 3],
+    lod_blend: f32,
+    lod_stride: u32,
+    lod_shells: u32,
 }
 const _: () = assert!(size_of::<ObjectUniform>() == 208, "matches `Object` in shading.wgsl");
 
@@ -147,6 +153,7 @@ impl ObjectShape {
     /// `textures`: `(shell slices, has a surface texture)`.
     pub fn uniform(&self, frame: &FurFrame, colour: Vec3, (shell_slices, has_surface): (u32, bool)) -> ObjectUniform {
         let look = &frame.look;
+        let level = frame.level.clamped(self.layers);
         let tiles_per_world = look.tiles_per_radius / self.radius;
         // The inverse transpose keeps normals perpendicular under non-uniform scale; a singular
         // transform (a flattened model) keeps the plain 3x3 rather than producing infinities.
@@ -177,9 +184,21 @@ impl ObjectShape {
             root_occlusion: look.root_occlusion,
             specular: look.specular,
             shininess: look.shininess,
-            _padding_1: [0.0; 3],
+            lod_blend: level.blend,
+            lod_stride: level.stride,
+            lod_shells: level.shells(self.layers),
         }
     }
+}
+
+/// How the shells lay the tile on `mesh` with `look`: what the explicit strand reference
+/// (`pelt_core::reference::StrandReference`) needs to place the same strands where the shells
+/// show them.
+#[must_use]
+pub fn tile_mapping(mesh: &Mesh, look: &FurLook) -> pelt_core::reference::TileMapping {
+    let shape = ObjectShape::new(mesh, 1);
+    let uniform = shape.uniform(&FurFrame { look: *look, ..FurFrame::default() }, Vec3::ONE, (1, false));
+    pelt_core::reference::TileMapping { tiles_per_uv: uniform.tiles_per_uv, tiles_per_world: uniform.tiles_per_world }
 }
 
 /// sqrt(surface area / uv area), or 1 without uvs.

@@ -179,7 +179,7 @@ impl FurRenderer {
         let layers = geometry.shape.layers;
         if settings.shells && layers > 0 {
             pass.set_pipeline(&surface.shells[which]);
-            geometry.draw_surface(pass, 0..layers);
+            geometry.draw_surface(pass, 0..fur.drawn_shells());
         }
         // Fins after the shells: at the silhouette, where fins matter, they stand outside the
         // shells and must not be covered by the faded outer layers.
@@ -191,7 +191,7 @@ impl FurRenderer {
                 }
                 _ => {
                     pass.set_pipeline(&self.fins[which]);
-                    geometry.draw_fins(pass);
+                    geometry.draw_fins(pass, fur.drawn_shells());
                 }
             }
         }

@@ -19,6 +19,7 @@ use pelt_core::texture::FurTextures;
 use wgpu::util::DeviceExt as _;
 
 use crate::RenderError;
+use crate::lod::PreparedLevel;
 use crate::object::{FurFrame, GpuBytes, ObjectShape, check_size, uniform_buffer};
 use crate::pipeline::{PassKind, PipelineSource, Transparency, create_pipeline};
 use crate::renderer::{FurDrawSettings, FurRenderer, SHADING_WGSL};
@@ -119,7 +120,7 @@ impl SeparatedRenderer {
         }
         if settings.shells {
             pass.set_pipeline(&self.shells[which]);
-            for layer in 1..=fur.shape.layers {
+            for layer in fur.level.shell_layers(fur.shape.layers) {
                 pass.draw_indexed(0..fur.index_count, (layer * fur.shape.vertex_count) as i32, layer..layer + 1);
             }
         }
@@ -145,6 +146,8 @@ pub struct SeparatedFur {
     fin_vertex_count: u32,
     index_count: u32,
     bytes: GpuBytes,
+    /// The level of detail of the last `prepare` (shells only: these fins are fixed geometry).
+    level: PreparedLevel,
 }
 
 impl SeparatedFur {
@@ -200,6 +203,7 @@ impl SeparatedFur {
             fin_vertex_count: fin.len() as u32,
             index_count: indices.len() as u32,
             bytes,
+            level: PreparedLevel::new(),
         })
     }
 
@@ -212,6 +216,7 @@ impl SeparatedFur {
             (self.textures.shell_slices, self.textures.has_surface),
         );
         queue.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&uniform));
+        self.level.set(frame.level, self.shape.layers);
     }
 
     /// Bytes of the separated structure on the GPU (shell and fin vertices, shell indices) and

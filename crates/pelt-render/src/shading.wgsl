@@ -53,9 +53,11 @@ struct Object {
     specular: f32,
     // Kajiya-Kay specular exponent.
     shininess: f32,
-    padding_1: f32,
-    padding_2: f32,
-    padding_3: f32,
+    // Level of detail (`lod.rs`): every `lod_stride`-th layer counted down from the tips,
+    // `lod_shells` of them, fading toward twice the stride by `lod_blend`.
+    lod_blend: f32,
+    lod_stride: u32,
+    lod_shells: u32,
 }
 
 // Set per pipeline: shells and fins with alpha-to-coverage output straight colour, blended ones
@@ -129,6 +131,39 @@ fn shell_slice(layer: u32) -> i32 {
 
 fn layer_height(layer: u32) -> f32 {
     return f32(layer) / f32(max(object.layers, 1u));
+}
+
+// Shell `k` (0..lod_shells) of the level of detail: counted down from the tips, so they show.
+fn lod_shell_layer(k: u32) -> u32 {
+    return object.layers - (object.lod_shells - 1u - k) * object.lod_stride;
+}
+
+// Fin node `n` (0..=lod_shells): the root, then the level's shells.
+fn lod_fin_layer(n: u32) -> u32 {
+    if n == 0u {
+        return 0u;
+    }
+    return lod_shell_layer(n - 1u);
+}
+
+// Whether the next coarser level drops `layer` (it fades out by `lod_blend`).
+fn lod_dropped(layer: u32) -> bool {
+    return ((object.layers - layer) / object.lod_stride) % 2u == 1u;
+}
+
+// A shell's alpha at the level of detail: each drawn shell stands for `lod_stride` layers (the
+// opacity of that many), the ones the next level drops fade out while the kept ones take on
+// their opacity. Exactly `alpha` at full detail.
+fn lod_alpha(alpha: f32, layer: u32) -> f32 {
+    if object.lod_stride == 1u && object.lod_blend == 0.0 {
+        return alpha;
+    }
+    let clear = 1.0 - clamp(alpha, 0.0, 1.0);
+    let stride = f32(object.lod_stride);
+    if lod_dropped(layer) {
+        return (1.0 - pow(clear, stride)) * (1.0 - object.lod_blend);
+    }
+    return 1.0 - pow(clear, stride * (1.0 + object.lod_blend));
 }
 
 // Shells fade where the surface is seen edge-on (where the sheets would show).
@@ -220,7 +255,7 @@ fn fs_skin(in: Varyings) -> @location(0) vec4<f32> {
 @fragment
 fn fs_shell(in: Varyings) -> @location(0) vec4<f32> {
     let texel = shell_texel(in);
-    let alpha = texel.a * in.fade;
+    let alpha = lod_alpha(texel.a * in.fade, in.layer);
     let normal = normalize(in.normal);
     let albedo = texel.rgb * surface_tint(in.surface_uv);
     let colour = hair_lighting(albedo, normalize(in.tangent), normal, in.world_position, in.height);

@@ -19,6 +19,10 @@ struct FinDraw {
 @compute @workgroup_size(64)
 fn cs_silhouette(@builtin(global_invocation_id) id: vec3<u32>) {
     let edge = id.x;
+    if edge == 0u {
+        // The fins' segments at this frame's level of detail (6 indices each).
+        fin_draw.index_count = 6u * object.lod_shells;
+    }
     if edge >= object.edge_count {
         return;
     }

@@ -117,17 +117,17 @@ fn vs_skin_indexed(@builtin(vertex_index) vertex: u32) -> Varyings {
     return surface_varyings(vertex, 0u, 0u);
 }
 
-// Shells: instance i draws layer i + 1.
+// Shells: instance k draws the level of detail's shell k (layer k + 1 at full detail).
 @vertex
 fn vs_shell_corners(@builtin(vertex_index) corner: u32, @builtin(instance_index) instance: u32) -> Varyings {
-    var out = surface_varyings(triangle_vertex(corner), corner, instance + 1u);
+    var out = surface_varyings(triangle_vertex(corner), corner, lod_shell_layer(instance));
     out.fade = shell_fade(out.normal, out.world_position);
     return out;
 }
 
 @vertex
 fn vs_shell_indexed(@builtin(vertex_index) vertex: u32, @builtin(instance_index) instance: u32) -> Varyings {
-    var out = surface_varyings(vertex, 0u, instance + 1u);
+    var out = surface_varyings(vertex, 0u, lod_shell_layer(instance));
     out.fade = shell_fade(out.normal, out.world_position);
     return out;
 }
@@ -167,17 +167,28 @@ fn fin_fade(edge: u32) -> f32 {
     return 1.0 - smoothstep(0.0, object.fin_fade_cos, edge_on);
 }
 
-// The fin vertex `index` of a shown `edge` (fade > 0).
+// Where a fin's strand node is drawn: the shared vertex, or, for a node the next coarser level
+// drops, moved toward the line between its neighbours by `lod_blend` (so segments merge smoothly).
+fn fin_node(layer: u32, vertex: u32) -> vec3<f32> {
+    let here = model_vertex(layer, vertex);
+    if object.lod_blend > 0.0 && layer > 0u && lod_dropped(layer) {
+        let between = 0.5 * (model_vertex(layer - object.lod_stride, vertex) + model_vertex(layer + object.lod_stride, vertex));
+        return mix(here, between, object.lod_blend);
+    }
+    return here;
+}
+
+// The fin vertex `index` of a shown `edge` (fade > 0): node `index / 2` of the level of detail.
 fn fin_varyings(index: u32, edge: u32, fade: f32) -> Varyings {
     let side = index % 2u;
-    let layer = index / 2u;
+    let layer = lod_fin_layer(index / 2u);
     let edges_start = 3u * object.triangle_count;
     let a = topology[edges_start + 2u * edge];
     let b = topology[edges_start + 2u * edge + 1u];
     let vertex = select(a, b, side == 1u);
 
     var out: Varyings;
-    let here = model_vertex(layer, vertex);
+    let here = fin_node(layer, vertex);
     let position = world_from_model_point(here);
     out.clip_position = view.clip_from_world * vec4<f32>(position, 1.0);
     out.world_position = position;

@@ -50,6 +50,10 @@ pub struct Args {
     /// 1e-5 of its strand's length.
     #[arg(long)]
     pub soak: bool,
+    /// Leave out the level-of-detail measurements (the frame-time table always draws every
+    /// shell).
+    #[arg(long)]
+    pub no_lod: bool,
     /// Steps of `--soak` on the CPU kernel.
     #[arg(long, value_name = "N", default_value_t = 1_000_000, requires = "soak")]
     pub steps: u64,
@@ -66,6 +70,8 @@ const LAYER_COUNTS: [u32; 2] = [16, 32];
 #[derive(Clone, Copy, Debug)]
 struct Plan {
     quick: bool,
+    /// `--no-lod`.
+    no_lod: bool,
 }
 
 impl Plan {
@@ -120,7 +126,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             MODELS.iter().map(|m| m.key).collect::<Vec<_>>().join(", ")
         );
     }
-    let plan = Plan { quick: args.quick };
+    let plan = Plan { quick: args.quick, no_lod: args.no_lod };
     let meshes_dir = models::meshes_dir(args.meshes.as_deref());
 
     // One GPU for the whole run; without one the frame times are null with the reason.
@@ -249,7 +255,8 @@ fn measure(model: &Model, layers: u32, plan: Plan, gpu: Result<&render::Bench, &
         }
         Ok(gpu) => {
             eprintln!("pelt bench:   {key} L={layers}: frame time");
-            gpu.measure(&fur, model.body.as_ref(), &textures, plan.render_budget())?
+            let lod = crate::lod::settings(&preset.render.lod, plan.no_lod);
+            gpu.measure(&fur, model.body.as_ref(), &textures, plan.render_budget(), lod)?
         }
         Err(reason) => RenderFigures { render_unavailable_reason: Some(reason.clone()), ..RenderFigures::default() },
     };

@@ -16,6 +16,7 @@ use pelt_render::{
     GpuSimulation, HEADLESS_FORMAT, Headless, Light, PlainMesh, SAMPLE_COUNT, default_sample_count,
 };
 
+use crate::lod;
 use crate::mesh_args::MeshArgs;
 use crate::sim_kernel::{self, SimChoice, SimKernel};
 
@@ -83,6 +84,10 @@ pub struct Args {
     /// Leave out the fins (shells only).
     #[arg(long)]
     no_fins: bool,
+    /// Every shell and fin segment however small the fur is on screen (the preset's
+    /// `[render.lod]` is on by default).
+    #[arg(long)]
+    no_lod: bool,
     /// Output: a .png (one frame), a .gif (animated) or a folder (numbered PNGs).
     #[arg(short, long, default_value = "pelt.png")]
     output: PathBuf,
@@ -169,7 +174,6 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     // GPU one writes two states and the vertex shader interpolates.
     let states = if kernel == SimKernel::Gpu { FurStates::Two } else { FurStates::One };
     let mut gpu_fur = GpuFur::new(device, queue, &renderer, &fur, &textures, states)?;
-    gpu_fur.prepare(queue, &FurFrame::default());
     let mut gpu_simulation = match kernel {
         SimKernel::Gpu => {
             simulation.set_cpu_bending(false);
@@ -189,6 +193,9 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let mut pose = Pose::default();
     let view = FurView::new(device, &renderer);
     view.prepare(queue, &camera.view_data(headless.aspect_ratio(), &Light::default()));
+    // The camera stays put, so one level serves every frame.
+    let level = lod::level(&lod::settings(&preset.render.lod, args.no_lod), &fur, camera.eye, camera.fov_y_rad, height);
+    gpu_fur.prepare(queue, &FurFrame { level, ..FurFrame::default() });
     let settings = FurDrawSettings {
         alpha_to_coverage: args.alpha_to_coverage,
         fins: !args.no_fins,
@@ -239,7 +246,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                 let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor::default());
                 gpu_simulation.dispatch(&mut encoder, &mut gpu_fur)?;
                 queue.submit([encoder.finish()]);
-                gpu_fur.prepare(queue, &FurFrame { interpolation: simulation.alpha(), ..FurFrame::default() });
+                gpu_fur.prepare(queue, &FurFrame { interpolation: simulation.alpha(), level, ..FurFrame::default() });
             }
             None => gpu_fur.set_positions(queue, simulation.positions())?,
         }
@@ -279,12 +286,13 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     }
     let per_frame = |total: Duration| total.as_secs_f64() * 1000.0 / f64::from(frames);
     println!(
-        "{}: {frames} frame{} of {width}x{height}, {} shell layers on {} triangles; mean frame {:.1} ms \
+        "{}: {frames} frame{} of {width}x{height}, {} shell layers on {} triangles (level of detail: {}); mean frame {:.1} ms \
          (render and read back), simulation {:.1} ms a frame on the {kernel} ({kernel_reason}); {:.1} s in all on {}, {}x MSAA",
         args.output.display(),
         if frames == 1 { "" } else { "s" },
         fur.layers,
         fur.mesh.triangles.len(),
+        level.describe(fur.layers),
         per_frame(render_time),
         per_frame(simulation_time),
         started.elapsed().as_secs_f64(),
@@ -403,7 +411,7 @@ fn save_png(image: &image::RgbaImage, path: &Path) -> anyhow::Result<()> {
     image.save(path).with_context(|| format!("cannot write {}", path.display()))
 }
 
-fn parse_size(text: &str) -> Result<(u32, u32), String> {
+pub(crate) fn parse_size(text: &str) -> Result<(u32, u32), String> {
     let parsed = text.split_once(['x', 'X']).and_then(|(w, h)| Some((w.trim().parse().ok()?, h.trim().parse().ok()?)));
     match parsed {
         Some((w, h)) if w > 0 && h > 0 => Ok((w, h)),
@@ -411,14 +419,14 @@ fn parse_size(text: &str) -> Result<(u32, u32), String> {
     }
 }
 
-fn parse_msaa(text: &str) -> Result<u32, String> {
+pub(crate) fn parse_msaa(text: &str) -> Result<u32, String> {
     match text.trim().parse() {
         Ok(samples @ (1 | 2 | 4 | 8)) => Ok(samples),
         _ => Err(format!("expected 1, 2, 4 or 8 samples, got {text:?}")),
     }
 }
 
-fn parse_vec3(text: &str) -> Result<Vec3, String> {
+pub(crate) fn parse_vec3(text: &str) -> Result<Vec3, String> {
     let values: Vec<f32> = text
         .split(',')
         .map(|v| v.trim().parse::<f32>())

@@ -44,6 +44,10 @@ pub struct Args {
     /// this fur when the window opens, the faster runs). The panel switches it live.
     #[arg(long, value_enum, default_value_t = crate::sim_kernel::SimChoice::Auto)]
     pub sim: crate::sim_kernel::SimChoice,
+    /// Every shell and fin segment however small the fur is on screen (the preset's
+    /// `[render.lod]` is on by default; the overlay shows the level in use).
+    #[arg(long)]
+    pub no_lod: bool,
     /// Window size in logical pixels, `WIDTHxHEIGHT`.
     #[arg(long, value_name = "WxH", default_value = "1280x800", value_parser = parse_size)]
     pub size: [u32; 2],

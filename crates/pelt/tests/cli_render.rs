@@ -149,7 +149,7 @@ fn the_fox_walks_and_unknown_animations_list_the_real_ones() {
     let dir = temp_dir("fox");
     // Walk frames 1 and 6 (a sixth of a second apart); `--sim cpu` so the golden frame does not
     // depend on which kernel `auto` picks. `none` renders the rest pose.
-    let walk = ["render", fox, "--animation", "Walk", "--size", "160x120", "--frames", "6", "--sim", "cpu"];
+    let walk = ["render", fox, "--animation", "Walk", "--size", "160x120", "--frames", "6", "--sim", "cpu", "--no-lod"];
     let output = pelt(&[&walk[..], &["-o", "walk"]].concat(), &dir);
     assert!(output.status.success(), "{}", text(&output));
     let output = pelt(&["render", fox, "--animation", "none", "--size", "160x120", "-o", "rest.png"], &dir);

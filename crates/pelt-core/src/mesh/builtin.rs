@@ -21,7 +21,8 @@ const TRY_ON_BODY_OBJ: &str = include_str!("../../assets/meshes/female_generic.o
 pub struct TryOnScene {
     /// `skirthelper.obj`: an open cloth tube around the hips (MakeHuman, CC0).
     pub garment: Mesh,
-    /// `female_generic.obj`: the body, in the same space (MakeHuman, CC0).
+    /// `female_generic.obj`: the body, in the same space (MakeHuman, CC0), with the vertices
+    /// that poked through the garment tucked under it ([`super::tuck_under`]).
     pub body: Mesh,
 }
 
@@ -31,7 +32,11 @@ pub struct TryOnScene {
 /// Only if `options` make the shipped meshes unusable (e.g. a weld tolerance that collapses them).
 pub fn try_on_scene(options: &ImportOptions) -> Result<TryOnScene, super::MeshError> {
     let garment = Mesh::from_obj_str(TRY_ON_GARMENT_OBJ, Path::new("builtin:tryon/skirthelper.obj"), options)?.0;
-    let body = Mesh::from_obj_str(TRY_ON_BODY_OBJ, Path::new("builtin:tryon/female_generic.obj"), options)?.0;
+    let mut body = Mesh::from_obj_str(TRY_ON_BODY_OBJ, Path::new("builtin:tryon/female_generic.obj"), options)?.0;
+    // The thighs press through the skirt's front; tucked under it they no longer show through
+    // the fur as pale specks.
+    let radius = garment.bounding_sphere().1;
+    super::tuck_under(&mut body, &garment, 0.01 * radius, 0.1 * radius);
     Ok(TryOnScene { garment, body })
 }
 
@@ -192,6 +197,61 @@ fn torus(segments: u32, sides: u32, major_radius: f32, minor_radius: f32) -> Raw
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Body vertices that poke through the skirt: cast from the skirt's axis (vertical, through
+    /// its centroid) out through the vertex, the ray meets the skirt before it reaches the
+    /// vertex, by at most `reach` (farther out are the hands, beside the skirt, not through it).
+    /// Rows within `border` of the skirt's top and hem are left out.
+    fn poking_through(body: &Mesh, garment: &Mesh, reach: f32, border: f32) -> usize {
+        let centroid = garment.positions.iter().sum::<glam::Vec3>() / garment.positions.len() as f32;
+        let (bottom, top) =
+            garment.positions.iter().fold((f32::MAX, f32::MIN), |(lo, hi), p| (lo.min(p.y), hi.max(p.y)));
+        let hit = |origin: glam::Vec3, direction: glam::Vec3| -> Option<f32> {
+            // Moller-Trumbore, both sides.
+            garment
+                .triangles
+                .iter()
+                .filter_map(|t| {
+                    let [a, b, c] = t.map(|i| garment.positions[i as usize]);
+                    let (e1, e2) = (b - a, c - a);
+                    let p = direction.cross(e2);
+                    let det = e1.dot(p);
+                    if det.abs() < 1e-12 {
+                        return None;
+                    }
+                    let s = origin - a;
+                    let u = s.dot(p) / det;
+                    let q = s.cross(e1);
+                    let v = direction.dot(q) / det;
+                    let t = e2.dot(q) / det;
+                    (u >= 0.0 && v >= 0.0 && u + v <= 1.0 && t > 0.0).then_some(t)
+                })
+                .min_by(f32::total_cmp)
+        };
+        body.positions
+            .iter()
+            .filter(|v| v.y > bottom + border && v.y < top - border)
+            .filter(|v| {
+                let axis = glam::Vec3::new(centroid.x, v.y, centroid.z);
+                let out = **v - axis;
+                let Some(direction) = out.try_normalize() else { return false };
+                hit(axis, direction).is_some_and(|t| t < out.length() && out.length() - t < reach)
+            })
+            .count()
+    }
+
+    #[test]
+    fn the_try_on_body_stays_under_the_skirt() {
+        let options = ImportOptions::default();
+        let scene = try_on_scene(&options).expect("try-on scene");
+        let reach = 0.1 * scene.garment.bounding_sphere().1;
+        let raw_body = Mesh::from_obj_str(TRY_ON_BODY_OBJ, Path::new("body"), &options).expect("body").0;
+        // The shipped body pokes through (the pale specks this guards against).
+        let before = poking_through(&raw_body, &scene.garment, reach, 0.3);
+        assert!(before > 20, "the untucked body pokes through at {before} vertices");
+        assert_eq!(poking_through(&scene.body, &scene.garment, reach, 0.3), 0);
+        assert!(scene.body.positions.iter().chain(&scene.body.normals).all(|p| p.is_finite()));
+    }
 
     #[test]
     fn paper_box_has_the_papers_counts() {

@@ -15,6 +15,7 @@ mod obj;
 mod repair;
 mod report;
 mod topology;
+mod tuck;
 
 use std::path::Path;
 
@@ -26,6 +27,7 @@ pub use error::MeshError;
 pub use repair::smooth_normals;
 pub use report::{MeshReport, NormalSource};
 pub use topology::{NO_FACE, Topology};
+pub use tuck::tuck_under;
 
 /// An indexed triangle list as read from a file, before any repair.
 ///

@@ -11,7 +11,7 @@ use pelt_render::{
     GpuFur, HEADLESS_FORMAT, Light, PlainMesh, RenderTargets, SeparatedFur, SeparatedRenderer, default_sample_count,
 };
 
-use super::report::{Adapter, GpuSimFigures, RenderFigures};
+use super::report::{Adapter, GpuSimFigures, LodFigures, RenderFigures};
 use super::table2::MANY_FIN_FACES;
 use crate::render::PLAIN_COLOUR;
 
@@ -97,6 +97,7 @@ impl Bench {
         body_mesh: Option<&Mesh>,
         textures: &FurTextures,
         budget: RenderBudget,
+        lod: pelt_render::LodSettings,
     ) -> anyhow::Result<RenderFigures> {
         let (device, queue) = (&self.gpu.device, &self.gpu.queue);
         // The samples `pelt render` and the viewer use on this adapter.
@@ -130,6 +131,7 @@ impl Bench {
         let mut medians = [[0.0; 3]; SIZES.len()];
         let mut frames_measured = u32::MAX;
         let mut fin_edges_drawn = None;
+        let mut lod_figures = Vec::new();
         for ((width, height), row) in SIZES.into_iter().zip(&mut medians) {
             let targets = RenderTargets::new(device, target, width, height)?;
             let output = device.create_texture(&wgpu_output_descriptor(width, height));
@@ -167,6 +169,43 @@ impl Bench {
                 frames_measured = frames_measured.min(times.len() as u32);
                 *median = median_ms(&times);
             }
+            if lod.enabled {
+                // The unified fur alone (as above) at its level of detail, near and at 4x the
+                // distance, then far with every shell; the counts from the silhouette pass.
+                let far_camera = Camera { eye: centre + (camera.eye - centre) * 4.0, ..camera };
+                let far_view = far_camera.view_data(targets.aspect_ratio(), &Light::default());
+                let level = |camera: &Camera| crate::lod::level(&lod, fur, camera.eye, camera.fov_y_rad, height);
+                let (near_level, far_level) = (level(&camera), level(&far_camera));
+                let timed = |view_data: &pelt_render::ViewData, level: pelt_render::FurLevel| {
+                    unified.prepare(queue, &FurFrame { level, ..FurFrame::default() });
+                    let record = |encoder: &mut wgpu::CommandEncoder| {
+                        view.prepare(queue, view_data);
+                        renderer.prepare_fins(encoder, &view, &unified);
+                        let mut pass = targets.begin_pass(encoder, &output_view, DEFAULT_BACKGROUND);
+                        if let Some(body) = &body {
+                            renderer.draw_plain(&mut pass, &view, body);
+                        }
+                        renderer.draw(&mut pass, &view, &unified, &settings);
+                    };
+                    let times = self.time_frames(&record, budget)?;
+                    let triangles = self.triangles_drawn(fur, &unified)?;
+                    anyhow::Ok((median_ms(&times), triangles))
+                };
+                let (near_ms, _) = timed(&view_data, near_level)?;
+                let (far_lod_ms, far_lod_triangles) = timed(&far_view, far_level)?;
+                let (far_full_ms, far_full_triangles) = timed(&far_view, pelt_render::FurLevel::FULL)?;
+                unified.prepare(queue, &FurFrame::default());
+                lod_figures.push(LodFigures {
+                    size: format!("{width}x{height}"),
+                    level_near: near_level.describe(fur.layers),
+                    frame_ms_near_lod: near_ms,
+                    level_far: far_level.describe(fur.layers),
+                    frame_ms_far_full: far_full_ms,
+                    frame_ms_far_lod: far_lod_ms,
+                    triangles_far_full: far_full_triangles,
+                    triangles_far_lod: far_lod_triangles,
+                });
+            }
             if fin_edges_drawn.is_none() {
                 // The first size: the silhouette pass's count from the last unified frame.
                 if let Some(draw) = unified.silhouette_draw() {
@@ -193,6 +232,7 @@ impl Bench {
             render_frames: Some(frames_measured),
             fin_edges_drawn,
             upload_ms_per_frame: Some(median_ms(&upload_times)),
+            lod: lod_figures,
             render_unavailable_reason: None,
         })
     }
@@ -228,6 +268,18 @@ impl Bench {
 }
 
 impl Bench {
+    /// Triangles the last unified frame drew: the skin, the shells and the fins the silhouette
+    /// pass kept, at the level `unified` was prepared with.
+    fn triangles_drawn(&self, fur: &FurStructure, unified: &GpuFur) -> anyhow::Result<u64> {
+        let faces = fur.mesh.triangles.len() as u64;
+        let shells = u64::from(unified.drawn_shells());
+        let fin_edges = match unified.silhouette_draw() {
+            Some(draw) => u64::from(self.read_u32(draw, 1)?),
+            None => 0,
+        };
+        Ok(faces * (1 + shells) + fin_edges * 2 * shells)
+    }
+
     /// Word `index` of a small `COPY_SRC` buffer, read back (waits for the GPU).
     fn read_u32(&self, buffer: &wgpu::Buffer, index: u64) -> anyhow::Result<u32> {
         let device = &self.gpu.device;

@@ -152,7 +152,28 @@ pub struct RenderFigures {
     /// Uploading the unified shared vertex array (what a simulated fur sends every frame),
     /// submitted and waited for.
     pub upload_ms_per_frame: Option<f64>,
+    /// The level of detail, unified structure, per size (1280x720, then 256x256): at the
+    /// default framing and at 4x its distance, with LOD on and off (the columns above are off).
+    pub lod: Vec<LodFigures>,
     pub render_unavailable_reason: Option<String>,
+}
+
+/// One size's level-of-detail figures (unified structure, the default preset's `[render.lod]`).
+#[derive(Debug, Default, serde::Serialize)]
+pub struct LodFigures {
+    /// `WIDTHxHEIGHT`.
+    pub size: String,
+    /// The level at the default framing, e.g. `8/16 shells`.
+    pub level_near: String,
+    pub frame_ms_near_lod: f64,
+    /// The level at 4x the distance.
+    pub level_far: String,
+    pub frame_ms_far_full: f64,
+    pub frame_ms_far_lod: f64,
+    /// Triangles drawn at 4x the distance (skin, shells, fins on the silhouette pass's edges),
+    /// full and at the level of detail.
+    pub triangles_far_full: u64,
+    pub triangles_far_lod: u64,
 }
 
 /// The simulation's throughput on a mesh larger than the paper's.
@@ -329,6 +350,33 @@ impl Report {
             );
         }
         notes(&mut md, self.results.iter().map(|r| (r, r.render.render_unavailable_reason.as_deref())));
+
+        if self.results.iter().any(|r| !r.render.lod.is_empty()) {
+            let _ = writeln!(md, "\n### Level of detail (unified, median ms; the table above draws every shell)\n");
+            let _ = writeln!(
+                md,
+                "| model | L | size | level, default framing | LOD on | level, 4x distance | LOD off, 4x | LOD on, 4x | triangles off / on, 4x |"
+            );
+            let _ = writeln!(md, "|---|---:|---|---|---:|---|---:|---:|---:|");
+            for r in &self.results {
+                for f in &r.render.lod {
+                    let _ = writeln!(
+                        md,
+                        "| {} | {} | {} | {} | {} | {} | {} | {} | {} / {} |",
+                        r.model,
+                        r.layers,
+                        f.size,
+                        f.level_near,
+                        ms(Some(f.frame_ms_near_lod)),
+                        f.level_far,
+                        ms(Some(f.frame_ms_far_full)),
+                        ms(Some(f.frame_ms_far_lod)),
+                        thousands(f.triangles_far_full),
+                        thousands(f.triangles_far_lod),
+                    );
+                }
+            }
+        }
 
         let _ = writeln!(md, "\n### Simulation (CPU) and texture generation\n");
         let _ = writeln!(

@@ -6,8 +6,8 @@ use pelt_core::sim::Simulation;
 use pelt_core::texture::FurTextures;
 use pelt_core::{FurStructure, Mesh};
 use pelt_render::{
-    Camera, DEFAULT_BACKGROUND, FurDrawSettings, FurFrame, FurRenderer, FurStates, FurView, GpuFur, GpuSimulation,
-    Light, PlainMesh, SeparatedFur, SeparatedRenderer,
+    Camera, DEFAULT_BACKGROUND, FurDrawSettings, FurFrame, FurLevel, FurRenderer, FurStates, FurView, GpuFur,
+    GpuSimulation, Light, PlainMesh, SeparatedFur, SeparatedRenderer,
 };
 
 use super::camera::OrbitCamera;
@@ -35,6 +35,8 @@ pub struct FurScene {
     view: FurView,
     textures: FurTextures,
     pub settings: FurDrawSettings,
+    /// Where this frame falls between the GPU simulation's two states (1 with one state).
+    interpolation: f32,
 }
 
 impl FurScene {
@@ -52,6 +54,7 @@ impl FurScene {
             view,
             textures: textures.clone(),
             settings: FurDrawSettings::SILHOUETTE,
+            interpolation: 1.0,
         })
     }
 
@@ -95,9 +98,12 @@ impl FurScene {
                     gpu_sim.dispatch(&mut encoder, &mut self.fur)?;
                     gpu.queue.submit([encoder.finish()]);
                 }
-                self.fur.prepare(&gpu.queue, &FurFrame { interpolation: sim.alpha(), ..FurFrame::default() });
+                self.interpolation = sim.alpha();
             }
-            None => self.fur.set_positions(&gpu.queue, sim.positions())?,
+            None => {
+                self.interpolation = 1.0;
+                self.fur.set_positions(&gpu.queue, sim.positions())?;
+            }
         }
         Ok(())
     }
@@ -158,7 +164,7 @@ impl FurScene {
     }
 
     /// Draws the body and the unified structure, or the separated one when `separated` and it is
-    /// built, into the viewport.
+    /// built, into the viewport, at the level of detail `level`.
     pub fn draw(
         &self,
         gpu: &pelt_render::Gpu,
@@ -166,12 +172,18 @@ impl FurScene {
         viewport: &Viewport,
         camera: &OrbitCamera,
         separated: bool,
+        level: FurLevel,
     ) {
         let (near, far) = camera.near_far();
         let camera =
             Camera { eye: camera.eye(), target: camera.target, up: Vec3::Y, fov_y_rad: camera.fov_y_rad, near, far };
         self.view.prepare(&gpu.queue, &camera.view_data(viewport.targets.aspect_ratio(), &Light::default()));
         let separated = self.separated.as_ref().filter(|_| separated);
+        let frame = FurFrame { interpolation: self.interpolation, level, ..FurFrame::default() };
+        match separated {
+            Some((_, fur)) => fur.prepare(&gpu.queue, &frame),
+            None => self.fur.prepare(&gpu.queue, &frame),
+        }
         if separated.is_none() {
             self.renderer.prepare_fins(encoder, &self.view, &self.fur);
         }

@@ -29,6 +29,10 @@ pub(super) struct Model {
     pub(super) body: Option<Mesh>,
     /// GPU bytes of the unified structure as the renderer holds it.
     pub(super) unified_bytes: Option<u64>,
+    /// `--no-lod`: every shell whatever the preset says.
+    pub(super) no_lod: bool,
+    /// The level of detail of the last frame drawn (the overlay shows it).
+    pub(super) level: pelt_render::FurLevel,
     /// GPU bytes of the separated structure while it is shown.
     pub(super) separated_bytes: Option<u64>,
     pub(super) camera: OrbitCamera,
@@ -150,6 +154,8 @@ impl Model {
             structure,
             body: None,
             unified_bytes: None,
+            no_lod: args.no_lod,
+            level: pelt_render::FurLevel::FULL,
             separated_bytes: None,
             camera,
             frame_pending: true,

@@ -217,7 +217,7 @@ impl Model {
         let frame_ms = self.frame_time_secs * 1e3;
         let fps = if self.frame_time_secs > 0.0 { 1.0 / self.frame_time_secs } else { 0.0 };
         let text = format!(
-            "frame    {frame_ms:6.2} ms  ({fps:.0} fps)\nsim      {:6.2} ms CPU, bent on the {} ({})\nvertices {:>9}\nfaces    {:>9}\nGPU      {:>9}  {} structure\nmesh     {}  L = {}",
+            "frame    {frame_ms:6.2} ms  ({fps:.0} fps)\nsim      {:6.2} ms CPU, bent on the {} ({})\nvertices {:>9}\nfaces    {:>9}\nGPU      {:>9}  {} structure\nmesh     {}  L = {}\nLOD      {}",
             self.sim_time_secs * 1e3,
             self.kernel(),
             self.kernel_reason,
@@ -227,6 +227,7 @@ impl Model {
             if draw.unified { "unified" } else { "separated" },
             self.settings.mesh.label(),
             self.structure.layers,
+            if self.no_lod { "off (--no-lod)".to_owned() } else { self.level.describe(self.structure.layers) },
         );
         let galley = painter.layout_no_wrap(text, egui::FontId::monospace(12.0), egui::Color32::from_gray(225));
         let origin = rect.left_top() + egui::vec2(12.0, 12.0);

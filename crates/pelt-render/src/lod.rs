@@ -1,0 +1,212 @@
+//! Level of detail: fewer shells and fin segments where the fur is small on screen (the paper's
+//! future work). The host measures how many pixels a strand spans ([`strand_pixels`]), picks a
+//! [`FurLevel`] with [`LodSettings::level`] and passes it in [`crate::FurFrame::level`].
+//!
+//! A level draws every `stride`-th layer counted down from the tips (so the tips always show),
+//! and each drawn shell stands for `stride` layers: its alpha is raised to the opacity of that
+//! many (`1 - (1 - a)^stride`). Strides are powers of two; between two strides `blend` fades the
+//! layers the coarser stride drops (and moves the fins' dropped nodes onto the line between their
+//! neighbours) while the kept layers gain the dropped ones' opacity, so the picture changes
+//! continuously with distance and nothing pops.
+
+/// The level a fur is drawn at in one frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FurLevel {
+    /// Draw every `stride`-th layer (a power of two, at least 1).
+    pub stride: u32,
+    /// `0..1`: how far toward twice the stride (the layers `2 * stride` drops fade out).
+    pub blend: f32,
+}
+
+impl FurLevel {
+    /// Every layer and every fin segment.
+    pub const FULL: Self = Self { stride: 1, blend: 0.0 };
+
+    /// The level with `stride` made a power of two no coarser than `layers` allow and `blend`
+    /// clamped to `0..1` (0 at the coarsest stride).
+    #[must_use]
+    pub fn clamped(self, layers: u32) -> Self {
+        let max_stride = max_stride(layers);
+        let stride = self.stride.clamp(1, max_stride).next_power_of_two().min(max_stride);
+        let blend = if stride >= max_stride || !self.blend.is_finite() { 0.0 } else { self.blend.clamp(0.0, 1.0) };
+        Self { stride, blend }
+    }
+
+    /// Shells drawn at this level for a fur of `layers` layers (also its fin segments).
+    #[must_use]
+    pub fn shells(self, layers: u32) -> u32 {
+        if layers == 0 { 0 } else { (layers / self.clamped(layers).stride).max(1) }
+    }
+
+    /// The level as the viewer and `pelt bench` show it: `shells drawn / layers`.
+    #[must_use]
+    pub fn describe(self, layers: u32) -> String {
+        let level = self.clamped(layers);
+        if level.blend > 0.0 {
+            format!("{}/{} shells (fading to {})", level.shells(layers), layers, layers / (2 * level.stride).max(1))
+        } else {
+            format!("{}/{} shells", level.shells(layers), layers)
+        }
+    }
+}
+
+impl Default for FurLevel {
+    fn default() -> Self {
+        Self::FULL
+    }
+}
+
+/// The coarsest power-of-two stride that still leaves two shells (one for `layers` < 2).
+fn max_stride(layers: u32) -> u32 {
+    let mut stride = 1;
+    while layers / (stride * 2) >= 2 {
+        stride *= 2;
+    }
+    stride
+}
+
+/// How a level is picked from the fur's size on screen (`[render] lod` in presets).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LodSettings {
+    /// Off: every frame draws [`FurLevel::FULL`].
+    pub enabled: bool,
+    /// Screen pixels each drawn shell should span along a strand: a fur whose strands cover
+    /// fewer than `layers * pixels_per_shell` pixels drops layers.
+    pub pixels_per_shell: f32,
+}
+
+impl Default for LodSettings {
+    fn default() -> Self {
+        Self { enabled: true, pixels_per_shell: 1.0 }
+    }
+}
+
+impl LodSettings {
+    /// No level of detail.
+    pub const OFF: Self = Self { enabled: false, pixels_per_shell: 1.0 };
+
+    /// The level for a fur of `layers` layers whose strands span `strand_pixels` on screen.
+    #[must_use]
+    pub fn level(&self, layers: u32, strand_pixels: f32) -> FurLevel {
+        if !self.enabled || layers < 2 || !strand_pixels.is_finite() {
+            return FurLevel::FULL;
+        }
+        let wanted = (strand_pixels / self.pixels_per_shell.max(1e-3)).max(1e-3);
+        let stride = f64::from(layers) / f64::from(wanted);
+        if stride <= 1.0 {
+            return FurLevel::FULL;
+        }
+        let octave = stride.log2();
+        let whole = octave.floor();
+        FurLevel { stride: 1 << (whole as u32).min(16), blend: (octave - whole) as f32 }.clamped(layers)
+    }
+}
+
+/// How many pixels a strand of `length` world units spans at most on a fur inside the sphere
+/// (`centre`, `radius`, world units) seen from `eye` (the sphere's nearest point counts).
+#[must_use]
+pub fn strand_pixels_in_view(
+    length: f32,
+    (centre, radius): (glam::Vec3, f32),
+    eye: glam::Vec3,
+    fov_y_rad: f32,
+    viewport_height: u32,
+) -> f32 {
+    let distance = (eye.distance(centre) - radius).max(1e-3 * radius.max(1e-6));
+    strand_pixels(length, distance, fov_y_rad, viewport_height)
+}
+
+/// How many pixels a strand of `length` world units spans at `distance` from a camera with
+/// vertical field of view `fov_y_rad` and a viewport `viewport_height` pixels high (seen side on,
+/// the most it can span).
+#[must_use]
+pub fn strand_pixels(length: f32, distance: f32, fov_y_rad: f32, viewport_height: u32) -> f32 {
+    let pixels_per_unit = viewport_height as f32 / (2.0 * (fov_y_rad * 0.5).tan() * distance.max(1e-6));
+    length * pixels_per_unit
+}
+
+/// The stride a fur was last prepared with, read back when its draw is recorded (`prepare` takes
+/// `&self`, so hosts can prepare and draw through shared references).
+#[derive(Debug)]
+pub(crate) struct PreparedLevel(std::sync::atomic::AtomicU32);
+
+impl PreparedLevel {
+    pub fn new() -> Self {
+        Self(std::sync::atomic::AtomicU32::new(1))
+    }
+
+    pub fn set(&self, level: FurLevel, layers: u32) {
+        self.0.store(level.clamped(layers).stride, std::sync::atomic::Ordering::Relaxed);
+    }
+
+    pub fn get(&self) -> FurLevel {
+        FurLevel { stride: self.0.load(std::sync::atomic::Ordering::Relaxed), blend: 0.0 }
+    }
+
+    /// The layers drawn (as `lod_shell_layer` in `shading.wgsl`), innermost first.
+    pub fn shell_layers(&self, layers: u32) -> impl Iterator<Item = u32> {
+        let level = self.get().clamped(layers);
+        let shells = level.shells(layers);
+        (0..shells).map(move |k| layers - (shells - 1 - k) * level.stride)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn full_until_strands_are_small_then_powers_of_two() {
+        let lod = LodSettings::default();
+        assert_eq!(lod.level(16, 40.0), FurLevel::FULL);
+        assert_eq!(lod.level(16, 16.0), FurLevel::FULL);
+        let half = lod.level(16, 8.0);
+        assert_eq!((half.stride, half.blend), (2, 0.0));
+        assert_eq!(half.shells(16), 8);
+        let between = lod.level(16, 6.0);
+        assert_eq!(between.stride, 2);
+        assert!(between.blend > 0.0 && between.blend < 1.0, "{between:?}");
+        // Never fewer than two shells.
+        let far = lod.level(16, 0.01);
+        assert_eq!((far.stride, far.blend, far.shells(16)), (8, 0.0, 2));
+        assert_eq!(LodSettings::OFF.level(16, 0.01), FurLevel::FULL);
+        assert_eq!(lod.level(1, 0.01), FurLevel::FULL);
+    }
+
+    #[test]
+    fn blend_rises_continuously_with_distance() {
+        // As strands shrink, (stride, blend) read as stride * 2^blend grows without jumps.
+        let lod = LodSettings::default();
+        let mut last = 1.0_f32;
+        for step in 0..400 {
+            let pixels = 16.0 * 0.99_f32.powi(step);
+            let level = lod.level(16, pixels);
+            let effective = level.stride as f32 * 2_f32.powf(level.blend);
+            assert!(effective >= last - 1e-4, "at {pixels} px: {effective} after {last}");
+            assert!(effective - last < 0.02 * last, "a jump at {pixels} px: {last} -> {effective}");
+            last = effective;
+        }
+    }
+
+    #[test]
+    fn odd_layer_counts_and_bad_input() {
+        assert_eq!(FurLevel { stride: 3, blend: 2.0 }.clamped(16), FurLevel { stride: 4, blend: 1.0 });
+        // 12 layers keep at least two shells: stride 4 is the coarsest, with nothing to blend to.
+        assert_eq!(FurLevel { stride: 3, blend: 0.5 }.clamped(12), FurLevel { stride: 4, blend: 0.0 });
+        assert_eq!(FurLevel { stride: 64, blend: 0.5 }.clamped(12), FurLevel { stride: 4, blend: 0.0 });
+        assert_eq!(FurLevel { stride: 0, blend: f32::NAN }.clamped(12), FurLevel { stride: 1, blend: 0.0 });
+        assert_eq!(FurLevel { stride: 4, blend: 0.0 }.shells(12), 3);
+        assert_eq!(LodSettings::default().level(16, f32::NAN), FurLevel::FULL);
+        assert!(strand_pixels(0.1, 0.0, 0.8, 720).is_finite());
+    }
+
+    #[test]
+    fn drawn_layers_end_at_the_tips() {
+        let prepared = PreparedLevel::new();
+        assert_eq!(prepared.shell_layers(4).collect::<Vec<_>>(), [1, 2, 3, 4]);
+        prepared.set(FurLevel { stride: 4, blend: 0.3 }, 12);
+        assert_eq!(prepared.shell_layers(12).collect::<Vec<_>>(), [4, 8, 12]);
+        prepared.set(FurLevel { stride: 4, blend: 0.0 }, 10);
+        assert_eq!(prepared.shell_layers(10).collect::<Vec<_>>(), [6, 10]);
+    }
+}

@@ -1,0 +1,88 @@
+//! Where a unified frame's time goes on this adapter: the bunny drawn whole and with parts left
+//! out (skin, shells, fins), with fewer layers and at several sizes. A profiling aid for
+//! BENCHMARKS.md, not part of the report: `cargo run --release --example frame_profile`.
+
+use std::time::Instant;
+
+use pelt_core::{Builtin, FurStructure, Preset};
+use pelt_render::{
+    Backend, Camera, DEFAULT_BACKGROUND, FurDrawSettings, FurFrame, FurRenderer, FurStates, FurTarget, FurView, Gpu,
+    GpuFur, HEADLESS_FORMAT, Light, RenderTargets, default_sample_count,
+};
+
+fn main() -> anyhow::Result<()> {
+    let gpu = Gpu::new(Backend::Auto)?;
+    let (device, queue) = (&gpu.device, &gpu.queue);
+    let samples = default_sample_count(&gpu.adapter.get_info());
+    let target = FurTarget::new(HEADLESS_FORMAT).with_sample_count(samples);
+    let renderer = FurRenderer::new(device, target)?;
+    let view = FurView::new(device, &renderer);
+    let mesh = Builtin::Bunny.mesh().0;
+    let frames: usize = std::env::var("FRAMES").ok().and_then(|s| s.parse().ok()).unwrap_or(5);
+    let sizes = [(1280, 720), (256, 256), (64, 64)];
+    let distances: &[f32] = &[1.0, 4.0];
+    for layers in [16, 8, 4] {
+        let mut preset = Preset::default();
+        preset.layers = layers;
+        let fur = FurStructure::new(mesh.clone(), &preset.fur_params(&mesh))?;
+        let textures = preset.generate_textures()?;
+        let unified = GpuFur::new(device, queue, &renderer, &fur, &textures, FurStates::One)?;
+        unified.prepare(queue, &FurFrame::default());
+        let (centre, radius) = fur.mesh.bounding_sphere();
+        let radius = radius + fur.lengths.iter().copied().fold(0.0, f32::max);
+        for (width, height) in sizes {
+            let targets = RenderTargets::new(device, target, width, height)?;
+            let output = device.create_texture(&wgpu::TextureDescriptor {
+                label: None,
+                size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
+                mip_level_count: 1,
+                sample_count: 1,
+                dimension: wgpu::TextureDimension::D2,
+                format: HEADLESS_FORMAT,
+                usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
+                view_formats: &[],
+            });
+            let output_view = output.create_view(&Default::default());
+            for &distance in distances {
+                let mut camera = Camera::framing(centre, radius, 35.0, 20.0, targets.aspect_ratio());
+                camera.eye = centre + (camera.eye - centre) * distance;
+                let view_data = camera.view_data(targets.aspect_ratio(), &Light::default());
+                let all = FurDrawSettings::SILHOUETTE;
+                let cases: [(&str, FurDrawSettings); 6] = [
+                    ("all", all),
+                    ("skin", FurDrawSettings { shells: false, fins: false, ..all }),
+                    ("skin+shells", FurDrawSettings { fins: false, ..all }),
+                    ("skin+fins", FurDrawSettings { shells: false, ..all }),
+                    ("all, every-edge fins", FurDrawSettings { silhouette_fins: false, ..all }),
+                    ("nothing (clear)", FurDrawSettings { skin: false, shells: false, fins: false, ..all }),
+                ];
+                for (name, settings) in cases {
+                    let mut times = Vec::new();
+                    for _ in 0..frames + 1 {
+                        let started = Instant::now();
+                        let mut encoder = device.create_command_encoder(&Default::default());
+                        view.prepare(queue, &view_data);
+                        if settings.fins && settings.silhouette_fins {
+                            renderer.prepare_fins(&mut encoder, &view, &unified);
+                        }
+                        {
+                            let mut pass = targets.begin_pass(&mut encoder, &output_view, DEFAULT_BACKGROUND);
+                            renderer.draw(&mut pass, &view, &unified, &settings);
+                        }
+                        queue.submit([encoder.finish()]);
+                        device.poll(wgpu::PollType::wait_indefinitely())?;
+                        times.push(started.elapsed().as_secs_f64() * 1000.0);
+                    }
+                    times.remove(0);
+                    times.sort_by(f64::total_cmp);
+                    println!(
+                        "L={layers:2} {width}x{height} dist x{distance}: {name:22} {:8.2} ms (min {:.2})",
+                        times[times.len() / 2],
+                        times[0]
+                    );
+                }
+            }
+        }
+    }
+    Ok(())
+}
