@@ -26,6 +26,8 @@ fi
 export CARGO_TARGET_DIR="${PELT_WEB_TARGET_DIR:-target/web}"
 # Line tables help nobody in a download; size matters more there.
 export CARGO_PROFILE_RELEASE_DEBUG=false
+# CI sets PELT_WEB_RUSTFLAGS="-D warnings" (only for this build, not the CLI install above).
+export RUSTFLAGS="${PELT_WEB_RUSTFLAGS:-${RUSTFLAGS:-}}"
 cargo build --locked --release -p pelt-web --target wasm32-unknown-unknown
 
 out=web/dist
