@@ -16,8 +16,9 @@ fi
 bindgen="$HOME/.cargo/bin/wasm-bindgen"
 if ! { [ -x "$bindgen" ] && "$bindgen" --version | grep -qx "wasm-bindgen $version"; }; then
   echo "installing wasm-bindgen-cli $version"
-  # Not --locked: its lock file can name versions newer than the registry a machine reaches.
-  cargo install --quiet wasm-bindgen-cli --version "=$version"
+  # --locked: the CLI's own lock file, so its build is the one its authors tested. (0.2.130's lock
+  # names webpki-roots 1.0.11, missing from some registry mirrors; hence wasm-bindgen 0.2.129.)
+  cargo install --quiet --locked wasm-bindgen-cli --version "=$version"
 fi
 
 # Its own target dir: the web build's profile and target do not churn the native build's.

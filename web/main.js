@@ -219,6 +219,21 @@ async function main() {
     overlay.textContent = 'no WebGPU';
     return;
   }
+  // WebGPU can be there and still offer no adapter (switched off, or the GPU is blocklisted):
+  // say so before downloading the WebAssembly.
+  let adapter = null;
+  try {
+    adapter = await navigator.gpu.requestAdapter();
+  } catch (_) {
+    adapter = null;
+  }
+  if (!adapter) {
+    page.state = 'no-webgpu';
+    show('This browser has WebGPU but offers no adapter to draw with (WebGPU switched off, or this GPU ' +
+      'blocklisted). Check chrome://gpu or your browser\'s WebGPU setting.');
+    overlay.textContent = 'no WebGPU adapter';
+    return;
+  }
   try {
     await init();
   } catch (error) {

@@ -11,6 +11,7 @@ pub mod anim;
 pub mod fur;
 pub mod mesh;
 pub mod preset;
+pub mod reference;
 pub mod rng;
 pub mod sim;
 pub mod texture;

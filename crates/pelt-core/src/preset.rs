@@ -20,7 +20,9 @@ use glam::Vec3;
 use crate::fur::{FurLength, FurParams, GrowthDirection, MAX_LAYERS};
 use crate::mesh::Mesh;
 use crate::sim::{ParamError, SimParams};
-use crate::texture::{self, ColourMode, ColourParams, FurTextures, ImageRgba8, TextureInputs, TextureParams};
+use crate::texture::{
+    self, ColourMode, ColourParams, FurTextures, ImageRgba8, StrandField, TextureInputs, TextureParams,
+};
 
 /// Why a preset could not be read, checked or used. Every message starts with the file.
 #[derive(Debug, thiserror::Error)]
@@ -317,6 +319,15 @@ impl Preset {
     /// # Errors
     /// [`PresetError`] for out-of-range values or an image that cannot be read, naming the key.
     pub fn generate_textures(&self) -> Result<FurTextures, PresetError> {
+        Ok(texture::generate_from(self.layers, &self.strand_field()?))
+    }
+
+    /// Loads the images the preset refers to and grows its seeded strand field: what
+    /// [`Preset::generate_textures`] rasterises, and what the explicit strand reference places.
+    ///
+    /// # Errors
+    /// As [`Preset::generate_textures`].
+    pub fn strand_field(&self) -> Result<StrandField, PresetError> {
         self.validate()?;
         let load = |key: &str, path: &Option<PathBuf>| -> Result<Option<ImageRgba8>, PresetError> {
             let Some(path) = path else { return Ok(None) };
@@ -339,7 +350,7 @@ impl Preset {
                 _ => None,
             },
         };
-        texture::generate(self.layers, &self.texture, &self.colour, &inputs).map_err(|e| {
+        StrandField::new(&self.texture, &self.colour, &inputs).map_err(|e| {
             let (key, problem) = match e {
                 texture::TextureError::Param(ParamError { key, problem }) => (key, problem),
                 texture::TextureError::Layers { got } => {

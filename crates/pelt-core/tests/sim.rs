@@ -439,10 +439,11 @@ fn soak_catches_a_kernel_that_stretches_strands() {
         fn step(&mut self, step: &SoakStep) -> Result<(), pelt_core::SimError> {
             self.0.step(step)
         }
-        fn read_state(&mut self, out: &mut [Vec3]) {
-            self.0.read_state(out);
+        fn read_state(&mut self, out: &mut [Vec3]) -> Result<(), pelt_core::SimError> {
+            self.0.read_state(out)?;
             let v = self.0.vertex_count();
             out[2 * v + 5] += (out[2 * v + 5] - out[v + 5]) * 1e-3;
+            Ok(())
         }
     }
     let fur = grow(Builtin::Sphere, 8, 0.3);

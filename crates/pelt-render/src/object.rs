@@ -191,6 +191,16 @@ impl ObjectShape {
     }
 }
 
+/// How the shells lay the tile on `mesh` with `look`: what the explicit strand reference
+/// (`pelt_core::reference::StrandReference`) needs to place the same strands where the shells
+/// show them.
+#[must_use]
+pub fn tile_mapping(mesh: &Mesh, look: &FurLook) -> pelt_core::reference::TileMapping {
+    let shape = ObjectShape::new(mesh, 1);
+    let uniform = shape.uniform(&FurFrame { look: *look, ..FurFrame::default() }, Vec3::ONE, (1, false));
+    pelt_core::reference::TileMapping { tiles_per_uv: uniform.tiles_per_uv, tiles_per_world: uniform.tiles_per_world }
+}
+
 /// sqrt(surface area / uv area), or 1 without uvs.
 pub(crate) fn world_per_uv(mesh: &Mesh) -> f32 {
     let Some(uvs) = &mesh.corner_uvs else { return 1.0 };

@@ -9,7 +9,7 @@
 //! read back and the shared array never crosses the bus.
 
 use glam::Vec3;
-use pelt_core::sim::Simulation;
+use pelt_core::sim::{Simulation, kernel_rest};
 use pelt_core::{FurStructure, rng};
 
 use crate::RenderError;
@@ -203,12 +203,18 @@ impl GpuSimulation {
                 needed: grid[1].into(),
             });
         }
-        let mut rest = vec![[0.0_f32; 4]; (v * layers).max(1)];
-        for k in 0..layers {
-            for j in 0..v {
-                let segment = structure.positions[(k + 1) * v + j] - structure.positions[k * v + j];
-                rest[k * v + j] = segment.extend(0.0).to_array();
-            }
+        // The CPU kernel's rest shape and forms, so the GPU bends every strand as it does.
+        let kernel_rest = kernel_rest(structure).map_err(|_| RenderError::Count {
+            what: "shared vertex positions",
+            expected: v * (layers + 1),
+            got: structure.positions.len(),
+            rule: "(L + 1) * V",
+        })?;
+        let mut rest: Vec<[f32; 4]> =
+            kernel_rest.segments.iter().map(|(d, length)| d.extend(*length).to_array()).collect();
+        rest.extend(kernel_rest.straight.iter().map(|s| s.map_or([0.0; 4], |d| d.extend(1.0).to_array())));
+        if rest.is_empty() {
+            rest.push([0.0; 4]);
         }
         check_size(device, "simulation rest segments", rest.len() as u64 * 16)?;
         check_size(device, "simulation strands and forces", v.max(1) as u64 * 32)?;

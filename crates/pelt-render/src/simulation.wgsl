@@ -1,6 +1,7 @@
 // One step of pelt-core's `Simulation` on the GPU: per strand (one invocation each) the force
 // (gravity + wind + the user field with the touch blended over it + inertia), then the bend of Equation 1 as
-// `pelt_core::sim::bend` defines it (a running quaternion, O(L)), written layer-major into the
+// `pelt_core::sim::bend` defines it, in the CPU kernel's two forms (the exact straight form,
+// the running quaternion for curved strands, O(L) both), written layer-major into the
 // shared vertex array the renderer draws from. Appended to `simulation_wind.wgsl`.
 
 // One step's inputs (a 256-byte slot of a uniform buffer, chosen by dynamic offset).
@@ -36,7 +37,10 @@ struct Strand {
 }
 
 @group(0) @binding(0) var<uniform> inputs: Step;
-// Rest segment k of strand j at k * V + j (xyz; w unused).
+// Rest segment k of strand j at k * V + j: unit direction (xyz, zero for a zero-length segment)
+// and length (w), as `sim/kernel.rs` keeps them. Then per strand j at L * V + j: the strand's unit
+// direction (xyz) and w = 1 where the CPU bends it by the straight form (`sim::straight_directions`),
+// 0 where by the running quaternion, so both kernels bend every strand the same way.
 @group(0) @binding(1) var<storage, read> rest_segments: array<vec4<f32>>;
 @group(0) @binding(2) var<storage, read> strands: array<Strand>;
 // Per strand: the user field (xyz) and the touch's falloff weight (w, 0 outside it); the
@@ -58,11 +62,10 @@ fn is_finite(x: f32) -> bool {
     return (bitcast<u32>(x) & 0x7f800000u) != 0x7f800000u;
 }
 
-// `glam::Quat * Vec3`.
+// `q * v` for a unit `q` as `sim/kernel.rs` computes it: `t = 2 (u x v)`, `v + w t + u x t`.
 fn rotate(q: vec4<f32>, v: vec3<f32>) -> vec3<f32> {
-    let b = q.xyz;
-    let w = q.w;
-    return v * (w * w - dot(b, b)) + b * (dot(v, b) * 2.0) + cross(b, v) * (w * 2.0);
+    let t = cross(q.xyz, v) * 2.0;
+    return v + t * q.w + cross(q.xyz, t);
 }
 
 // `glam::Quat * Quat` (Hamilton product).
@@ -108,16 +111,6 @@ fn sin_cos_quarter_turn(x: f32) -> vec2<f32> {
     let sine = x * (1.0 + x2 * (-1.0 / 6.0 + x2 * (1.0 / 120.0 + x2 * (-1.0 / 5040.0 + x2 * (1.0 / 362880.0 - x2 / 39916800.0)))));
     let cosine = 1.0 + x2 * (-0.5 + x2 * (1.0 / 24.0 + x2 * (-1.0 / 720.0 + x2 * (1.0 / 40320.0 + x2 * (-1.0 / 3628800.0 + x2 / 479001600.0)))));
     return vec2<f32>(sine, cosine);
-}
-
-// `bend::bend_weight`.
-fn bend_weight(magnitude: f32, remaining: u32, layers: u32, stability: f32) -> f32 {
-    let weight = magnitude * (f32(remaining) * inputs.travelled_fraction.w) / stability;
-    if !is_finite(weight) {
-        // Infinity (an overflowing force) bends fully; NaN (0 * infinity) not at all.
-        return select(0.0, 1.0, weight > 0.0);
-    }
-    return clamp(weight, 0.0, 1.0);
 }
 
 // The wind on strand `j` at `root` (`WindParams::sample`).
@@ -181,35 +174,89 @@ fn step_strands(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocati
         magnitude = scaled_length * largest;
     }
 
-    // `bend::bend_strand`.
-    var turned = strand.frame;
+    // Equation 1's factor per remaining node (`sim/kernel.rs`'s `scale`).
+    let scale = magnitude * inputs.travelled_fraction.w / stability;
+
+    positions[j * 3u] = root.x;
+    positions[j * 3u + 1u] = root.y;
+    positions[j * 3u + 2u] = root.z;
+    let straight = rest_segments[layers * v + j];
+    if straight.w > 0.0 {
+        bend_straight(j, v, layers, root, strand.frame, straight.xyz, force_direction, scale);
+    } else {
+        bend_general(j, v, layers, root, strand.frame, force_direction, scale);
+    }
+}
+
+// The fraction of the angle to the force that a node with `remaining` nodes to go turns by.
+fn weight_of(scale: f32, remaining: u32) -> f32 {
+    let weight = scale * f32(remaining);
+    if !is_finite(weight) {
+        // Infinity (an overflowing force) bends fully; NaN (0 * infinity) not at all.
+        return select(0.0, 1.0, weight > 0.0);
+    }
+    return clamp(weight, 0.0, 1.0);
+}
+
+fn write_node(j: u32, v: u32, k: u32, node: vec3<f32>) {
+    let index = (k * v + j) * 3u;
+    positions[index] = node.x;
+    positions[index + 1u] = node.y;
+    positions[index + 2u] = node.z;
+}
+
+// `sim/kernel.rs`'s `bend_straight`: a strand whose rest segments all point along `rest_direction`
+// stays in the plane of its direction `d` and the force `f`: segment k ends at the angle
+// `a_(k+1) = a_k (1 - w_k)` from f, turned by `a_0 - a_(k+1)` from d toward `e`, the unit normal
+// to d in that plane (built from its own length, so lengths hold near an antiparallel force).
+fn bend_straight(j: u32, v: u32, layers: u32, root: vec3<f32>, frame: vec4<f32>, rest_direction: vec3<f32>, f: vec3<f32>, scale: f32) {
+    let d = rotate(frame, rest_direction);
+    let axis = cross(d, f);
+    let sine = length(axis);
+    let cosine = dot(d, f);
+    let start = angle_from_sin_cos(sine, cosine);
+    let toward_f = f - d * cosine;
+    let toward = toward_f - d * dot(d, toward_f);
+    let norm = length(toward);
+    var e = vec3<f32>(0.0);
+    var strand_scale = 0.0;
+    if sine > PARALLEL_SINE && scale > 0.0 && norm > 0.0 {
+        e = toward * (1.0 / norm);
+        strand_scale = scale;
+    }
+    var remaining = start;
     var node = root;
-    positions[j * 3u] = node.x;
-    positions[j * 3u + 1u] = node.y;
-    positions[j * 3u + 2u] = node.z;
     for (var k = 0u; k < layers; k++) {
-        let segment = rest_segments[k * v + j].xyz;
-        var current = rotate(turned, segment);
-        let current_length = length(current);
-        if current_length > 0.0 {
-            let weight = bend_weight(magnitude, layers - k, layers, stability);
-            let direction = current / current_length;
-            let axis = cross(direction, force_direction);
-            let sine = length(axis);
-            if sine > PARALLEL_SINE && weight > 0.0 {
-                let angle = angle_from_sin_cos(sine, dot(direction, force_direction));
-                let half = sin_cos_quarter_turn(0.5 * angle * weight);
-                let rotation = vec4<f32>(axis * (half.x / sine), half.y);
-                // Renormalised so rounding never lets segment lengths drift over many layers.
-                let product = quat_mul(rotation, turned);
-                turned = product * (1.0 / length(product));
-                current = rotate(turned, segment);
-            }
+        let weight = weight_of(strand_scale, layers - k);
+        remaining = remaining - remaining * weight;
+        let half = sin_cos_quarter_turn((start - remaining) * 0.5);
+        let cos_turn = 1.0 - 2.0 * half.x * half.x;
+        let sin_turn = 2.0 * half.x * half.y;
+        node += (e * sin_turn + d * cos_turn) * rest_segments[k * v + j].w;
+        write_node(j, v, k + 1u, node);
+    }
+}
+
+// `sim/kernel.rs`'s `bend_general` (and `bend::bend_strand`): any strand, by a running
+// quaternion; each segment is its rest direction under the turned frame, so it keeps its length.
+fn bend_general(j: u32, v: u32, layers: u32, root: vec3<f32>, frame: vec4<f32>, f: vec3<f32>, scale: f32) {
+    var turned = frame;
+    var node = root;
+    for (var k = 0u; k < layers; k++) {
+        let rest = rest_segments[k * v + j];
+        let d = rotate(turned, rest.xyz);
+        let weight = weight_of(scale, layers - k);
+        let axis = cross(d, f);
+        let sine = length(axis);
+        if sine > PARALLEL_SINE && weight > 0.0 && rest.w > 0.0 {
+            let angle = angle_from_sin_cos(sine, dot(d, f));
+            let half = sin_cos_quarter_turn(angle * weight * 0.5);
+            let rotation = vec4<f32>(axis * (half.x / sine), half.y);
+            // Renormalised so rounding never lets segment lengths drift over many layers.
+            let product = quat_mul(rotation, turned);
+            turned = product * (1.0 / length(product));
         }
-        node += current;
-        let index = ((k + 1u) * v + j) * 3u;
-        positions[index] = node.x;
-        positions[index + 1u] = node.y;
-        positions[index + 2u] = node.z;
+        node += rotate(turned, rest.xyz) * rest.w;
+        write_node(j, v, k + 1u, node);
     }
 }

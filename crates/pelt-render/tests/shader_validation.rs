@@ -29,12 +29,18 @@ fn silhouette_module_validates() {
 }
 
 #[test]
+fn strands_module_validates() {
+    validate("shading.wgsl + strands.wgsl", &pelt_render::strands_shader_source());
+}
+
+#[test]
 fn every_wgsl_file_is_part_of_a_validated_module() {
     let sources = [
         pelt_render::unified_shader_source(),
         pelt_render::separated_shader_source(),
         pelt_render::simulation_shader_source(),
         pelt_render::silhouette_shader_source(),
+        pelt_render::strands_shader_source(),
     ];
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
     let mut checked = 0;
@@ -46,5 +52,5 @@ fn every_wgsl_file_is_part_of_a_validated_module() {
             checked += 1;
         }
     }
-    assert_eq!(checked, 6, "shading, unified, separated, silhouette, simulation_wind and simulation");
+    assert_eq!(checked, 7, "shading, unified, separated, silhouette, simulation_wind, simulation and strands");
 }

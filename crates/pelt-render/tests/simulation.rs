@@ -6,7 +6,7 @@ mod common;
 
 use common::{BROWN_ROOT, BROWN_TIP, builtin_fur, strand_textures};
 use glam::{Quat, Vec3};
-use pelt_core::sim::{Equation, SimParams, Simulation, TouchParams, WindParams};
+use pelt_core::sim::{Equation, SimError, SimParams, Simulation, SoakStep, SoakSubject, TouchParams, WindParams, soak};
 use pelt_core::{Builtin, FurStructure};
 use pelt_render::{
     Backend, FurRenderer, FurStates, FurTarget, Gpu, GpuFur, GpuSimulation, HEADLESS_FORMAT, POSITIONS_USAGE,
@@ -71,43 +71,16 @@ fn cpu_state(simulation: &Simulation, alpha: f32) -> Vec<Vec3> {
 }
 
 /// The largest `|gpu - cpu| / strand length` over every node.
-fn worst_relative_difference(structure: &FurStructure, gpu: &[Vec3], cpu: &[Vec3], conditioning: &[f32]) -> f32 {
+fn worst_relative_difference(structure: &FurStructure, gpu: &[Vec3], cpu: &[Vec3]) -> f32 {
     let v = structure.vertex_count();
     gpu.iter()
         .zip(cpu)
         .enumerate()
         .map(|(n, (g, c))| {
-            let difference = g.distance(*c) / structure.lengths[n % v] / conditioning[n % v];
+            let difference = g.distance(*c) / structure.lengths[n % v];
             if difference.is_nan() { f32::INFINITY } else { difference }
         })
         .fold(0.0, f32::max)
-}
-
-/// Per strand, how far the bound widens where the bend is ill-conditioned. A force within a
-/// degree or so of antiparallel to the strand leaves the bend's plane to rounding: the CPU bends
-/// straight strands by a closed form and the GPU by the running quaternion, and their f32
-/// roundings tilt that plane differently, by about 1e-7 / sin(angle). So the bound is 1e-4 of
-/// the strand length, times `1 + 0.05 / sin(angle)` (1.05 at 90 degrees, 5 at 179.3 degrees).
-fn conditioning(structure: &FurStructure, cpu: &Simulation) -> Vec<f32> {
-    let v = structure.vertex_count();
-    let params = cpu.params();
-    let gravity = params.gravity_direction.normalize_or_zero() * params.gravity_strength;
-    (0..v)
-        .map(|j| {
-            let segment = cpu.frames()[j] * (structure.positions[v + j] - structure.positions[j]);
-            let force = gravity + cpu.external_field()[j] + cpu.inertial_forces()[j];
-            if force == Vec3::ZERO {
-                return 1.0;
-            }
-            let sine = segment.normalize_or_zero().cross(force.normalize()).length();
-            1.0 + 0.05 / sine.max(1e-6)
-        })
-        .collect()
-}
-
-/// The bound's plain form, for comparisons with the rest pose.
-fn unconditioned(structure: &FurStructure) -> Vec<f32> {
-    vec![1.0; structure.vertex_count()]
 }
 
 /// The same script on both simulations: wind with gusts and jitter throughout; a touch that is
@@ -195,23 +168,17 @@ fn agreement(backend: Backend) {
         control.advance_to(time_of(step));
         let (previous, current) = rig.step(&control);
         let expected = cpu_state(&cpu, 1.0);
-        let bound = conditioning(&structure, &cpu);
-        let difference = worst_relative_difference(&structure, &current, &expected, &bound);
+        let difference = worst_relative_difference(&structure, &current, &expected);
         assert!(difference <= 1e-4, "{backend}: step {step}: a node is {difference} strand lengths from the CPU's");
         if step == 150 {
-            let difference = worst_relative_difference(&structure, &previous, &cpu_state(&cpu, 0.0), &bound);
+            let difference = worst_relative_difference(&structure, &previous, &cpu_state(&cpu, 0.0));
             assert!(difference <= 1e-4, "{backend}: after the jump the previous state is {difference} off");
         }
         if step == 270 {
             assert!(control.inertial_forces().iter().any(|f| f.length() > 0.01), "the sway gives an inertial force");
         }
         worst = worst.max(difference);
-        moved = moved.max(worst_relative_difference(
-            &structure,
-            &current,
-            &structure.positions,
-            &unconditioned(&structure),
-        ));
+        moved = moved.max(worst_relative_difference(&structure, &current, &structure.positions));
     }
     // The script bends the fur well away from its rest pose, so agreement means something.
     assert!(moved > 0.3, "{backend}: the fur hardly moved ({moved} strand lengths)");
@@ -226,6 +193,53 @@ fn gpu_and_cpu_agree_on_vulkan() {
 #[test]
 fn gpu_and_cpu_agree_on_gl() {
     agreement(Backend::Gl);
+}
+
+/// Curved strands (each segment turned a little more than the last, as a groomed or simulated
+/// rest pose would be) take both kernels' general form, the running quaternion: they agree there
+/// too, under gravity, gusty wind and a touch, on the default adapter.
+#[test]
+fn gpu_and_cpu_agree_on_curved_strands() {
+    let mut structure = builtin_fur(Builtin::Bunny, 16);
+    let (v, layers) = (structure.vertex_count(), structure.layers as usize);
+    for j in 0..v {
+        let axis = structure.directions[j].any_orthonormal_vector();
+        let segment = structure.positions[v + j] - structure.positions[j];
+        for k in 1..layers {
+            let turned = Quat::from_axis_angle(axis, 0.08 * k as f32) * segment;
+            structure.positions[(k + 1) * v + j] = structure.positions[k * v + j] + turned;
+        }
+    }
+    let rest = pelt_core::sim::kernel_rest(&structure).expect("rest");
+    assert!(rest.straight.iter().all(Option::is_none), "every strand curved takes the general form");
+    let params = SimParams {
+        wind: WindParams {
+            direction: Vec3::new(-0.4, 0.1, 1.0),
+            strength: 3.0,
+            gust_strength: 0.8,
+            seed: 3,
+            ..WindParams::default()
+        },
+        ..SimParams::default()
+    };
+    let mut cpu = Simulation::new(&structure, &params).expect("simulation");
+    let mut control = Simulation::new(&structure, &params).expect("simulation");
+    control.set_cpu_bending(false);
+    let mut rig = GpuRig::new(Backend::Auto, &structure);
+    let (mut worst, mut moved) = (0.0_f32, 0.0_f32);
+    for step in 1..=60 {
+        script(step, &mut cpu, &structure);
+        script(step, &mut control, &structure);
+        cpu.advance_to(time_of(step));
+        control.advance_to(time_of(step));
+        let (_, current) = rig.step(&control);
+        let difference = worst_relative_difference(&structure, &current, &cpu_state(&cpu, 1.0));
+        assert!(difference <= 1e-4, "step {step}: a node of a curved strand is {difference} strand lengths off");
+        worst = worst.max(difference);
+        moved = moved.max(worst_relative_difference(&structure, &current, &structure.positions));
+    }
+    assert!(moved > 0.3, "the curved fur hardly moved ({moved} strand lengths)");
+    eprintln!("curved strands: worst GPU/CPU difference {worst:e} strand lengths over 60 steps");
 }
 
 /// 10,000 steps of the bunny under extreme, changing inputs stay finite and keep every segment's
@@ -285,6 +299,51 @@ fn gpu_soak_stays_finite_and_keeps_lengths() {
         }
     }
     eprintln!("GPU soak: worst segment length error {worst:e} strand lengths over 10,000 steps");
+}
+
+/// The GPU kernel through `pelt_core::sim::soak`, the schedule `pelt bench --soak` and the CPU's
+/// soak test run: the control simulation takes each step's inputs, the GPU bends, the state is
+/// read back and checked every step.
+struct GpuSubject {
+    rig: GpuRig,
+    control: Simulation,
+}
+
+impl SoakSubject for GpuSubject {
+    fn step(&mut self, step: &SoakStep) -> Result<(), SimError> {
+        SoakSubject::step(&mut self.control, step)?;
+        self.rig
+            .simulation
+            .prepare(&self.rig.gpu.device, &self.rig.gpu.queue, &self.control, &self.rig.fur)
+            .expect("prepare");
+        let mut encoder = self.rig.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor::default());
+        self.rig.simulation.dispatch(&mut encoder, &mut self.rig.fur).expect("dispatch");
+        self.rig.gpu.queue.submit([encoder.finish()]);
+        Ok(())
+    }
+
+    fn read_state(&mut self, out: &mut [Vec3]) -> Result<(), SimError> {
+        out.copy_from_slice(&self.rig.read(self.rig.fur.current_positions()));
+        Ok(())
+    }
+}
+
+/// 3,000 steps of `sim::soak`'s schedule (gravity x 1000, gusts to 1e4, huge fields, touches,
+/// stability down to 1e-6, a teleported and turned base) on the GPU kernel: every node finite
+/// and every segment's length kept to 1e-5 of its strand's, as on the CPU.
+#[test]
+fn gpu_kernel_passes_the_cpu_soak_schedule() {
+    let structure = builtin_fur(Builtin::Bunny, 16);
+    let mut control = Simulation::new(&structure, &SimParams::default()).expect("simulation");
+    control.set_cpu_bending(false);
+    let mut subject = GpuSubject { rig: GpuRig::new(Backend::Auto, &structure), control };
+    let report = soak(&structure, &mut subject, 3_000, |_| {}).expect("soak");
+    assert_eq!(report.steps, 3_000);
+    assert!(report.passed(1e-5), "{report:?}");
+    eprintln!(
+        "GPU soak (sim::soak schedule): worst segment length error {:e} over 3,000 steps",
+        report.worst_length_error
+    );
 }
 
 /// The largest error of a segment's length against the rest pose, in lengths of its strand (NaN

@@ -1,6 +1,7 @@
 //! `pelt`: render, view, measure and author real-time fur.
 
 mod bench;
+mod fidelity;
 mod format;
 mod lod;
 mod mesh_args;
@@ -30,6 +31,8 @@ enum Command {
     Stats(stats::Args),
     /// Write a preset's shell and fin textures as PNGs, plus a contact sheet.
     Textures(textures::Args),
+    /// Measure how close shells and fins come to the explicit strands they stand for (SSIM).
+    Fidelity(fidelity::Args),
     /// Measure memory, frame time, simulation and texture generation side by side.
     Bench(bench::Args),
 }
@@ -41,5 +44,6 @@ fn main() -> anyhow::Result<()> {
         Command::Stats(args) => stats::run(&args),
         Command::Textures(args) => textures::run(&args),
         Command::Bench(args) => bench::run(&args),
+        Command::Fidelity(args) => fidelity::run(&args),
     }
 }

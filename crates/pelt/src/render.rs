@@ -411,7 +411,7 @@ fn save_png(image: &image::RgbaImage, path: &Path) -> anyhow::Result<()> {
     image.save(path).with_context(|| format!("cannot write {}", path.display()))
 }
 
-fn parse_size(text: &str) -> Result<(u32, u32), String> {
+pub(crate) fn parse_size(text: &str) -> Result<(u32, u32), String> {
     let parsed = text.split_once(['x', 'X']).and_then(|(w, h)| Some((w.trim().parse().ok()?, h.trim().parse().ok()?)));
     match parsed {
         Some((w, h)) if w > 0 && h > 0 => Ok((w, h)),
@@ -419,14 +419,14 @@ fn parse_size(text: &str) -> Result<(u32, u32), String> {
     }
 }
 
-fn parse_msaa(text: &str) -> Result<u32, String> {
+pub(crate) fn parse_msaa(text: &str) -> Result<u32, String> {
     match text.trim().parse() {
         Ok(samples @ (1 | 2 | 4 | 8)) => Ok(samples),
         _ => Err(format!("expected 1, 2, 4 or 8 samples, got {text:?}")),
     }
 }
 
-fn parse_vec3(text: &str) -> Result<Vec3, String> {
+pub(crate) fn parse_vec3(text: &str) -> Result<Vec3, String> {
     let values: Vec<f32> = text
         .split(',')
         .map(|v| v.trim().parse::<f32>())

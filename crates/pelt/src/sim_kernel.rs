@@ -83,7 +83,7 @@ pub fn cpu_secs_per_step(structure: &FurStructure, params: &SimParams, steps: u3
 
 /// A fur of its own with two states, the GPU simulation writing them, and a CPU `Simulation`
 /// that only keeps time and inputs (its bending off), for timing the GPU kernel.
-fn gpu_rig(
+pub fn gpu_rig(
     device: &wgpu::Device,
     queue: &wgpu::Queue,
     structure: &FurStructure,

@@ -183,3 +183,22 @@ fn quick_bench_writes_every_key_with_sane_values() {
     let _ = std::fs::remove_file(json_path);
     let _ = std::fs::remove_file(md_path);
 }
+
+/// `pelt bench --soak` soaks both kernels and names each with its kernel (and the GPU's adapter):
+/// a short run, as CI has lavapipe.
+#[test]
+fn soak_reports_the_cpu_and_the_gpu_kernel() {
+    let output = Command::new(env!("CARGO_BIN_EXE_pelt"))
+        .args(["bench", "--soak", "--steps", "300", "--gpu-steps", "100"])
+        .output()
+        .expect("run pelt");
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    assert!(output.status.success(), "{stdout}\n{}", String::from_utf8_lossy(&output.stderr));
+    let lines: Vec<&str> = stdout.lines().filter(|l| l.starts_with("soak (")).collect();
+    assert_eq!(lines.len(), 2, "{stdout}");
+    assert!(lines[0].starts_with("soak (CPU kernel, ") && lines[0].contains("300 steps"), "{}", lines[0]);
+    assert!(lines[1].starts_with("soak (GPU kernel, ") && lines[1].contains("100 steps"), "{}", lines[1]);
+    for line in lines {
+        assert!(line.ends_with("steps with a non-finite node: 0"), "{line}");
+    }
+}

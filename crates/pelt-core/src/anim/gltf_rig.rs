@@ -315,7 +315,7 @@ fn rigid_entry(
 
 /// What was repaired in the influences, for one report line each.
 #[derive(Debug, Default)]
-struct InfluenceCounts {
+pub(super) struct InfluenceCounts {
     over_four: usize,
     zero_sum: usize,
     out_of_range: usize,
@@ -324,7 +324,7 @@ struct InfluenceCounts {
 }
 
 impl InfluenceCounts {
-    fn report(&self, report: &mut Vec<String>) {
+    pub(super) fn report(&self, report: &mut Vec<String>) {
         if self.over_four > 0 {
             report.push(format!(
                 "{} vertices have more than 4 influences: the 4 largest kept, renormalised",
@@ -353,7 +353,7 @@ impl InfluenceCounts {
 }
 
 /// The four largest valid influences, weights summing to 1, joints offset into the palette.
-fn normalise(
+pub(super) fn normalise(
     pairs: impl Iterator<Item = (u32, f32)>,
     joint_count: usize,
     offset: u32,

@@ -6,6 +6,7 @@
 //! - [`Rig`]: what a glTF file says about how its mesh moves, per base vertex of the repaired
 //!   [`Mesh`] (welding and repair are followed, so the rig lines up with the fur's vertices).
 //! - [`Pose`]: one posed base, reused frame after frame.
+//! - [`Skin`]: the same skinning with joint matrices a host computes (a game engine's skeleton).
 //!
 //! Per frame: each node's local transform is its rest TRS with the animation's channels over it
 //! (time looped over the clip); world transforms parent first; every joint's matrix is
@@ -16,12 +17,14 @@
 //! that transform in. So the rest pose reproduces the static mesh.
 
 mod gltf_rig;
+mod joints;
 pub mod sampler;
 mod skin;
 
 use glam::{Mat3, Mat4, Quat, Vec3};
 
 pub(crate) use gltf_rig::{RawRig, Span, read_rig};
+pub use joints::{Skin, SkinError};
 pub use sampler::{Interpolation, Sampler};
 
 use crate::mesh::Mesh;

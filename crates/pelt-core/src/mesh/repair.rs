@@ -19,6 +19,20 @@ impl Mesh {
         Self::repair(raw, file, options).map(|(mesh, report, _)| (mesh, report))
     }
 
+    /// [`Mesh::from_raw`], also returning for each base vertex the raw vertex it was taken from,
+    /// so per-vertex data kept beside the raw mesh (a game engine's skin weights, for
+    /// [`crate::anim::Skin`]) follows welding and repair.
+    ///
+    /// # Errors
+    /// As [`Mesh::from_raw`].
+    pub fn from_raw_traced(
+        raw: RawMesh,
+        file: &Path,
+        options: &ImportOptions,
+    ) -> Result<(Self, MeshReport, Vec<u32>), MeshError> {
+        Self::repair(raw, file, options)
+    }
+
     /// [`Mesh::from_raw`], also returning for each kept vertex the raw vertex it was taken from
     /// (so per-vertex data read beside the mesh, like skin weights, follows welding and repair).
     pub(super) fn repair(

@@ -26,8 +26,10 @@ use std::f32::consts::{FRAC_PI_2, PI};
 
 use glam::{Quat, Vec3};
 
+use super::SimError;
 use super::bend::PARALLEL_SINE;
 use super::lanes::{F, M, V3};
+use crate::fur::FurStructure;
 
 /// Strands per batch (one AVX2 register of `f32`).
 pub(crate) const LANES: usize = 8;
@@ -206,12 +208,18 @@ pub(crate) fn bend_straight(inputs: &[StrandInputs; LANES], gain: f32, rest: Bat
     let sine = axis.dot(axis).sqrt();
     let cosine = d.dot(force);
     let start = angle(sine, cosine);
-    let active = sine.gt(F::splat(PARALLEL_SINE)).and(scale.gt(F::splat(0.0)));
-    let scale = active.select(scale, F::splat(0.0));
-    // e = (f - d cos a) / sin a, the unit normal to d in the plane, toward f.
+    // e: the unit normal to d in the plane of d and f, toward f: `f - d cos a`, with what rounding
+    // left along d taken out, over its own length. Not over `sine`: near an antiparallel force
+    // both are tiny and `f - d cos a` carries ~1e-7 of rounding, so that `e` was off unit length
+    // and off perpendicular by ~1e-7 / sin a, and stretched segments (1.5e-5 of the strand at
+    // 179.97 degrees in the million-step soak). Unit and perpendicular, `e` keeps every length.
     let toward = d.mul_add(-cosine, force);
-    let inverse_sine = F::splat(1.0) / active.select(sine, F::splat(1.0));
-    let e = V3::select(active, toward.scale(inverse_sine), V3::splat(0.0, 0.0, 0.0));
+    let toward = d.mul_add(-d.dot(toward), toward);
+    let norm = toward.dot(toward).sqrt();
+    let active = sine.gt(F::splat(PARALLEL_SINE)).and(scale.gt(F::splat(0.0))).and(norm.gt(F::splat(0.0)));
+    let scale = active.select(scale, F::splat(0.0));
+    let inverse_norm = F::splat(1.0) / active.select(norm, F::splat(1.0));
+    let e = V3::select(active, toward.scale(inverse_norm), V3::splat(0.0, 0.0, 0.0));
     let mut remaining = start;
     let mut node = input.root;
     let (first, rest_nodes) = nodes.split_at_mut(1);
@@ -252,7 +260,8 @@ pub(crate) fn bend_general<const N: usize, const W: usize>(
     let (one, zero) = (F::splat(1.0), F::splat(0.0));
     for k in 0..layers {
         let length: F<W> = gather(rest.map(|r| &r.lengths[k]));
-        let d = rotate(&turned, gather3(rest.map(|r| &r.directions[k])));
+        let rest_direction = gather3(rest.map(|r| &r.directions[k]));
+        let d = rotate(&turned, rest_direction);
         let weight = (scale * F::splat((layers - k) as f32)).min(one);
         let axis = d.cross(force);
         let sine = axis.dot(axis).sqrt();
@@ -272,11 +281,10 @@ pub(crate) fn bend_general<const N: usize, const W: usize>(
         // Renormalised so rounding never lets segment lengths drift over many layers.
         let inverse = one / norm.sqrt();
         turned = std::array::from_fn(|c| active.select(product[c] * inverse, turned[c]));
-        // The turned segment in the plane of d and f: d cos(a) + e sin(a), e = (f - d cos) / sine;
-        // `2 cos(a/2) * axis_scale` is sin(a) / sine.
-        let cos_turn = (half_sin * F::splat(-2.0)).mul_add(half_sin, one);
-        let toward = (half_cos * axis_scale) * F::splat(2.0);
-        let direction = d.mul_add(-cosine, force).mul_add(toward, d.scale(cos_turn));
+        // The turned segment is the rest direction under the new unit rotation, which keeps its
+        // length whatever the rounding of the axis (the closed form in the plane of d and f,
+        // `d cos + (f - d cos) sin / sine`, loses it by ~1e-7 / sine near an antiparallel force).
+        let direction = rotate(&turned, rest_direction);
         node = direction.mul_add(length, node);
         store(node, &mut nodes, k + 1);
     }
@@ -335,6 +343,51 @@ impl RestBatches {
         }
         self.is_straight.iter().filter(|s| **s).count() as f32 / self.is_straight.len() as f32
     }
+}
+
+/// The rest shape of every strand as the CPU kernel bends it ([`kernel_rest`]): for another
+/// kernel (the GPU's) that must bend each strand by the same form from the same numbers.
+#[derive(Clone, Debug, PartialEq)]
+pub struct KernelRest {
+    /// Per segment, layer-major (`k * V + j`): its unit rest direction (zero for a zero-length
+    /// segment) and its length.
+    pub segments: Vec<(Vec3, f32)>,
+    /// Per strand: its unit direction where the kernel bends it by the exact straight form,
+    /// `None` where by the running quaternion (the 8 strands of a batch share one form).
+    pub straight: Vec<Option<Vec3>>,
+}
+
+/// The rest shape of `fur`'s strands as [`Simulation`](super::Simulation)'s kernel holds it.
+///
+/// # Errors
+/// [`SimError::Size`] if the shared vertex array is not `(L + 1) * V` long.
+pub fn kernel_rest(fur: &FurStructure) -> Result<KernelRest, SimError> {
+    let (v, layers) = (fur.vertex_count(), fur.layers as usize);
+    if fur.positions.len() != v * (layers + 1) {
+        return Err(SimError::Size {
+            what: "the shared vertex array",
+            expected: v * (layers + 1),
+            got: fur.positions.len(),
+        });
+    }
+    let rest = RestBatches::new(&fur.positions, v, layers);
+    let lane = |j: usize, k: usize| ((j / LANES) * layers + k, j % LANES);
+    let segments = (0..layers)
+        .flat_map(|k| (0..v).map(move |j| (k, j)))
+        .map(|(k, j)| {
+            let (at, i) = lane(j, k);
+            let d = &rest.directions[at];
+            (Vec3::new(d[0][i], d[1][i], d[2][i]), rest.lengths[at][i])
+        })
+        .collect();
+    let straight = (0..v)
+        .map(|j| {
+            let (b, i) = (j / LANES, j % LANES);
+            let d = &rest.straight[b];
+            rest.is_straight[b].then(|| Vec3::new(d[0][i], d[1][i], d[2][i]))
+        })
+        .collect();
+    Ok(KernelRest { segments, straight })
 }
 
 /// The unit direction of a strand whose rest segments all point one way, or `None` if one
@@ -434,6 +487,74 @@ impl Step<'_> {
             bend_straight(inputs, self.gain, self.rest(batch), nodes);
         } else {
             bend_general::<1, LANES>([inputs], self.gain, [self.rest(batch)], [nodes]);
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const LAYERS: usize = 16;
+    const SEGMENT: f32 = 0.033;
+
+    /// Eight strands along `directions`, rooted near the origin (so node rounding stays far below
+    /// what is measured), under forces `off[i]` radians from antiparallel to them; returns the
+    /// worst `| |segment| - rest | / rest` of the straight and of the general form.
+    #[allow(clippy::needless_range_loop)] // reason: a lane of two nodes by one index
+    fn worst_stretch(off: [f32; LANES], stability: f32, frame: Quat) -> (f64, f64) {
+        let directions: [Vec3; LANES] =
+            std::array::from_fn(|i| Vec3::new(0.3 + 0.1 * i as f32, 0.8, -0.5 + 0.13 * i as f32).normalize());
+        let inputs: [StrandInputs; LANES] = std::array::from_fn(|i| {
+            let d = frame * directions[i];
+            let side = d.any_orthonormal_vector();
+            StrandInputs {
+                root: Vec3::new(0.01, -0.02, 0.03) * i as f32,
+                frame,
+                force: (-d * off[i].cos() + side * off[i].sin()) * 1.7,
+                stability,
+            }
+        });
+        let lengths = vec![[SEGMENT; LANES]; LAYERS];
+        let unit: VecLanes = std::array::from_fn(|c| std::array::from_fn(|i| directions[i][c]));
+        let rest_directions = vec![unit; LAYERS];
+        let rest = BatchRest { lengths: &lengths, directions: &rest_directions, straight: &unit };
+        let worst = |nodes: &[VecLanes]| {
+            let mut worst = 0.0_f64;
+            for pair in nodes.windows(2) {
+                for i in 0..LANES {
+                    let length = (0..3)
+                        .map(|c| (f64::from(pair[1][c][i]) - f64::from(pair[0][c][i])).powi(2))
+                        .sum::<f64>()
+                        .sqrt();
+                    worst = worst.max((length - f64::from(SEGMENT)).abs() / f64::from(SEGMENT));
+                }
+            }
+            worst
+        };
+        let mut straight = vec![[[0.0; LANES]; 3]; LAYERS + 1];
+        bend_straight(&inputs, 1.0, rest, &mut straight);
+        let mut general = vec![[[0.0; LANES]; 3]; LAYERS + 1];
+        bend_general::<1, LANES>([&inputs], 1.0, [rest], [&mut general]);
+        (worst(&straight), worst(&general))
+    }
+
+    /// Forces from 2e-7 to 3e-3 radians short of antiparallel, bending the strands up to a
+    /// right angle and past: segments keep their lengths to 1e-5 of themselves in both forms.
+    /// (Before `e` was built from its own length, the straight form stretched them by up to 0.3
+    /// here, and the general form, which built segments the same way, too.)
+    #[test]
+    fn nearly_antiparallel_forces_keep_segment_lengths() {
+        let frame = Quat::from_axis_angle(Vec3::new(1.0, 2.0, 3.0).normalize(), 0.9);
+        for stability in [20.0, 60.0, 200.0, 1000.0] {
+            for decade in 0..4 {
+                let off = std::array::from_fn(|i| 2e-7 * 10f32.powf(decade as f32 + i as f32 / 8.0));
+                for frame in [Quat::IDENTITY, frame] {
+                    let (straight, general) = worst_stretch(off, stability, frame);
+                    assert!(straight <= 1e-5, "straight form: {straight:e} at stability {stability}, {off:?}");
+                    assert!(general <= 1e-5, "general form: {general:e} at stability {stability}, {off:?}");
+                }
+            }
         }
     }
 }

@@ -40,6 +40,7 @@ pub use bend::{BEND_GAIN, bend_strand, bend_strand_literal, bend_weight};
 pub use dispatch::CpuKernel;
 pub use field::{ForceField, Touch};
 pub use inertia::Inertia;
+pub use kernel::{KernelRest, kernel_rest};
 pub use motion::{Ease, MotionKey};
 pub use pick::{Hit, pick};
 pub use scene::{Scene, SceneError, Stroke, WindKey};

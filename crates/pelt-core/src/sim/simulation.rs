@@ -47,6 +47,15 @@ pub enum SimError {
     /// A touch radius that is not finite and positive.
     #[error("touch radius must be finite and positive, got {0}")]
     TouchRadius(f32),
+    /// Another kernel bending the strands (a GPU pass driven through
+    /// [`SoakSubject`](super::SoakSubject)) failed.
+    #[error("the {kernel} simulation kernel failed: {message}")]
+    Kernel {
+        /// Which kernel, e.g. `GPU`.
+        kernel: String,
+        /// What went wrong.
+        message: String,
+    },
     /// A stability map entry out of range.
     #[error("stability map entry {vertex} is {value}: must be between 1e-6 and 1e9")]
     Stability {

@@ -149,7 +149,10 @@ pub trait SoakSubject {
     fn step(&mut self, step: &SoakStep) -> Result<(), SimError>;
 
     /// Writes the newest state, layer-major like [`FurStructure::positions`], into `out`.
-    fn read_state(&mut self, out: &mut [Vec3]);
+    ///
+    /// # Errors
+    /// A kernel that cannot read its state back (a GPU readback that failed).
+    fn read_state(&mut self, out: &mut [Vec3]) -> Result<(), SimError>;
 }
 
 impl SoakSubject for Simulation {
@@ -184,8 +187,9 @@ impl SoakSubject for Simulation {
         Ok(())
     }
 
-    fn read_state(&mut self, out: &mut [Vec3]) {
+    fn read_state(&mut self, out: &mut [Vec3]) -> Result<(), SimError> {
         self.write_lerp(1.0, out);
+        Ok(())
     }
 }
 
@@ -240,7 +244,7 @@ pub fn soak(
     };
     for index in 0..steps {
         subject.step(&SoakStep::at(index, v, radius))?;
-        subject.read_state(&mut state);
+        subject.read_state(&mut state)?;
         let mut finite = true;
         for k in 0..layers {
             for j in 0..v {

@@ -24,6 +24,7 @@ use rayon::prelude::*;
 pub use self::colour::{ColourMode, ColourParams, Rgb, height_table};
 pub use self::image::{ImageRgba8, downsample_rgba8, mip_level_count};
 pub use self::pattern::leopard_pattern;
+pub use self::strands::Strand;
 use crate::sim::ParamError;
 
 /// Smallest tile edge (texels).
@@ -324,6 +325,76 @@ pub enum TextureError {
     },
 }
 
+/// The seeded strand field of a texture set, as data: every strand the shell slices and the fin
+/// are drawn from, and the colour each has at each height. [`generate`] rasterises it; the
+/// explicit strand reference ([`crate::reference`]) places the same strands on a mesh.
+#[derive(Clone, Debug)]
+pub struct StrandField {
+    /// The texture parameters the field was grown with (tile size, taper, ...).
+    pub params: TextureParams,
+    /// The strands in row order of their root texels.
+    pub strands: Vec<Strand>,
+    mode: ColourMode,
+    single: Vec3,
+    /// Height mode: the colour table from root to tip.
+    heights: Vec<Vec3>,
+    /// Surface mode: the mesh's colour texture.
+    surface: Option<ImageRgba8>,
+}
+
+impl StrandField {
+    /// Grows the field of these parameters (validated as [`generate`] does).
+    ///
+    /// # Errors
+    /// As [`generate`].
+    pub fn new(params: &TextureParams, colour: &ColourParams, inputs: &TextureInputs) -> Result<Self, TextureError> {
+        params.validate()?;
+        colour.validate()?;
+        let heights = match colour.mode {
+            ColourMode::Height => {
+                if colour.height_colours.is_empty() && inputs.gradient.is_none() {
+                    return Err(TextureError::MissingImage { key: "colour.gradient", mode: "height" });
+                }
+                height_table(&colour.height_colours, inputs.gradient.as_ref(), colour.height_levels)
+            }
+            _ => Vec::new(),
+        };
+        let surface = match colour.mode {
+            ColourMode::Surface => Some(
+                inputs.surface.clone().ok_or(TextureError::MissingImage { key: "colour.surface", mode: "surface" })?,
+            ),
+            _ => None,
+        };
+        let strands = strands::seed_strands(params, inputs.pattern.as_ref(), colour.brightness_variation);
+        Ok(Self {
+            params: params.clone(),
+            strands,
+            mode: colour.mode,
+            single: colour.colour.to_vec3(),
+            heights,
+            surface,
+        })
+    }
+
+    /// The colour `strand` has at height `t` (straight RGB, `0..=1`; the textures' RGB). In
+    /// surface mode this is the grey brightness that the mesh's texture multiplies.
+    #[must_use]
+    pub fn colour(&self, strand: &Strand, t: f32) -> Vec3 {
+        let base = match self.mode {
+            ColourMode::Single => self.single,
+            ColourMode::Surface => Vec3::ONE,
+            ColourMode::Height => self.heights[((t * self.heights.len() as f32) as usize).min(self.heights.len() - 1)],
+        };
+        base * strand.tint * strand.brightness
+    }
+
+    /// Surface mode: the mesh's colour texture (see [`FurTextures::surface`]).
+    #[must_use]
+    pub fn surface(&self) -> Option<&ImageRgba8> {
+        self.surface.as_ref()
+    }
+}
+
 /// Generates the shell slices and the fin texture of `layers` shells.
 ///
 /// # Errors
@@ -338,43 +409,25 @@ pub fn generate(
     if layers == 0 || layers > crate::fur::MAX_LAYERS {
         return Err(TextureError::Layers { got: layers });
     }
-    params.validate()?;
-    colour.validate()?;
-    let heights = match colour.mode {
-        ColourMode::Height => {
-            if colour.height_colours.is_empty() && inputs.gradient.is_none() {
-                return Err(TextureError::MissingImage { key: "colour.gradient", mode: "height" });
-            }
-            height_table(&colour.height_colours, inputs.gradient.as_ref(), colour.height_levels)
-        }
-        _ => Vec::new(),
-    };
-    let surface = match colour.mode {
-        ColourMode::Surface => {
-            Some(inputs.surface.clone().ok_or(TextureError::MissingImage { key: "colour.surface", mode: "surface" })?)
-        }
-        _ => None,
-    };
-    let single = colour.colour.to_vec3();
-    let colour_at = |strand: &strands::Strand, t: f32| -> Vec3 {
-        let base = match colour.mode {
-            ColourMode::Single => single,
-            ColourMode::Surface => Vec3::ONE,
-            ColourMode::Height => heights[((t * heights.len() as f32) as usize).min(heights.len() - 1)],
-        };
-        base * strand.tint * strand.brightness
-    };
+    let field = StrandField::new(params, colour, inputs)?;
+    Ok(generate_from(layers, &field))
+}
 
-    let strands = strands::seed_strands(params, inputs.pattern.as_ref(), colour.brightness_variation);
+/// Rasterises `field` into the shell slices of `layers` shells and the fin texture.
+#[must_use]
+pub fn generate_from(layers: u32, field: &StrandField) -> FurTextures {
+    let params = &field.params;
+    let colour_at = |strand: &Strand, t: f32| field.colour(strand, t);
+    let strands = &field.strands;
     let size = params.size;
     let slice_bytes = size as usize * size as usize * 4;
     let mut shell = vec![0u8; slice_bytes * layers as usize];
     shell.par_chunks_mut(slice_bytes).enumerate().for_each(|(k, slice)| {
         let t = (k + 1) as f32 / layers as f32;
-        strands::draw_slice(params, &strands, t, &colour_at, slice);
+        strands::draw_slice(params, strands, t, &colour_at, slice);
     });
     let fin_height = (size / 2).max(MIN_TILE_SIZE);
     let mut fin = vec![0u8; size as usize * fin_height as usize * 4];
-    strands::draw_fin(params, &strands, fin_height, &colour_at, &mut fin);
-    Ok(FurTextures { size, layers, shell, fin_width: size, fin_height, fin, surface })
+    strands::draw_fin(params, strands, fin_height, &colour_at, &mut fin);
+    FurTextures { size, layers, shell, fin_width: size, fin_height, fin, surface: field.surface.clone() }
 }

@@ -27,9 +27,11 @@ const SALT_CURL: u64 = 0x6375_726c;
 const SALT_LOOK: u64 = 0x6c6f_6f6b;
 const SALT_CLUMP: u64 = 0x636c_756d;
 
-/// One texture strand: where it roots and how it moves through the layers (texel units).
+/// One strand of the seeded field: where it roots in the tile and how it moves through the
+/// layers (texel units). The shell slices and the fin are drawn from these, and the explicit
+/// reference (`crate::reference`) places the very same strands on a mesh.
 #[derive(Clone, Copy, Debug)]
-pub(super) struct Strand {
+pub struct Strand {
     root: Vec2,
     /// Offset of the tip from the root by lean alone.
     lean: Vec2,
@@ -47,8 +49,29 @@ pub(super) struct Strand {
 }
 
 impl Strand {
-    /// The cross-section centre at height `t` (0 = root, 1 = the fur's tip layer).
-    fn centre(&self, t: f32) -> Vec2 {
+    /// Where the strand roots in the tile, texels (`0..size` on both axes).
+    #[must_use]
+    pub fn root(&self) -> Vec2 {
+        self.root
+    }
+
+    /// The strand's length as a fraction of the fur's length (its height where it ends).
+    #[must_use]
+    pub fn length_factor(&self) -> f32 {
+        self.length
+    }
+
+    /// Radius of the cross-section at height `t` (texels), tapering toward the strand's end by
+    /// `taper` ([`TextureParams::taper`]); the texture's soft edge and root blur are left out.
+    #[must_use]
+    pub fn radius_at(&self, t: f32, taper: f32) -> f32 {
+        self.radius * (1.0 - taper * (t / self.length).clamp(0.0, 1.0))
+    }
+
+    /// The cross-section centre at height `t` (0 = root, 1 = the fur's tip layer), texels:
+    /// lean, clumping pull and curl.
+    #[must_use]
+    pub fn centre(&self, t: f32) -> Vec2 {
         let mut centre = self.root + (self.lean + self.pull) * t;
         if self.curl_radius > 0.0 {
             let start = Vec2::from_angle(self.curl_phase);

@@ -1,0 +1,237 @@
+//! The strand renderer: the explicit strand reference (`pelt_core::reference`) drawn strand by
+//! strand as camera-facing ribbons, with the shells' camera, object uniform and lighting
+//! (`hair_lighting` in `shading.wgsl`). Offline quality, not real time: it is the ground truth
+//! shells and fins are measured against, so hosts render it supersampled (e.g. at 4x the size,
+//! filtered down).
+//!
+//! Ribbons are built on the CPU once per shape of the fur (a state of the shared array) and serve
+//! every view: each node carries its position, direction, root normal, colour and half width,
+//! and the vertex shader turns the width toward the camera.
+
+use bytemuck::{Pod, Zeroable};
+use glam::{Vec3, Vec4};
+use pelt_core::reference::StrandReference;
+
+use crate::RenderError;
+use crate::fur::GpuFur;
+use crate::object::check_size;
+use crate::renderer::{FurRenderer, SHADING_WGSL};
+use crate::requirements::ErrorScope;
+use crate::textures::srgb_to_linear;
+use crate::view::FurView;
+
+const STRANDS_WGSL: &str = include_str!("strands.wgsl");
+
+/// The WGSL module of the strand renderer (the shared shading plus `strands.wgsl`).
+#[must_use]
+pub fn strands_shader_source() -> String {
+    format!("{SHADING_WGSL}\n{STRANDS_WGSL}")
+}
+
+/// One ribbon vertex; matches `StrandVertex` in `strands.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Pod, Zeroable)]
+struct RibbonVertex {
+    position: [f32; 3],
+    tangent: [f32; 3],
+    normal: [f32; 3],
+    colour_height: [f32; 4],
+    half_width: f32,
+}
+
+const VERTEX_ATTRIBUTES: [wgpu::VertexAttribute; 5] = wgpu::vertex_attr_array![
+    0 => Float32x3, 1 => Float32x3, 2 => Float32x3, 3 => Float32x4, 4 => Float32
+];
+
+/// The strand pipeline for the target of a [`FurRenderer`] (its layouts, so it draws with the
+/// same [`FurView`]s and [`GpuFur`] uniforms).
+#[derive(Debug)]
+pub struct StrandRenderer {
+    pipeline: wgpu::RenderPipeline,
+}
+
+impl StrandRenderer {
+    /// Builds the pipeline for `renderer`'s target.
+    ///
+    /// # Errors
+    /// [`RenderError::Gpu`] when the device rejects it.
+    pub fn new(device: &wgpu::Device, renderer: &FurRenderer) -> Result<Self, RenderError> {
+        let scope = ErrorScope::push(device);
+        let layouts = renderer.layouts();
+        let layout = layouts.pipeline_layout(device, "pelt strands", &layouts.unified_object, false);
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("pelt strands"),
+            source: wgpu::ShaderSource::Wgsl(strands_shader_source().into()),
+        });
+        let target = renderer.target();
+        let constants = [("ALPHA_TO_COVERAGE", 0.0)];
+        let compilation_options = wgpu::PipelineCompilationOptions { constants: &constants, ..Default::default() };
+        let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+            label: Some("pelt strands"),
+            layout: Some(&layout),
+            vertex: wgpu::VertexState {
+                module: &module,
+                entry_point: Some("vs_strand"),
+                compilation_options: compilation_options.clone(),
+                buffers: &[Some(wgpu::VertexBufferLayout {
+                    array_stride: size_of::<RibbonVertex>() as u64,
+                    step_mode: wgpu::VertexStepMode::Vertex,
+                    attributes: &VERTEX_ATTRIBUTES,
+                })],
+            },
+            primitive: wgpu::PrimitiveState {
+                topology: wgpu::PrimitiveTopology::TriangleList,
+                // Ribbons face the camera, but their winding depends on the strand's direction.
+                cull_mode: None,
+                ..wgpu::PrimitiveState::default()
+            },
+            depth_stencil: Some(wgpu::DepthStencilState {
+                format: target.depth_format,
+                depth_write_enabled: Some(true),
+                depth_compare: Some(target.depth_compare),
+                stencil: wgpu::StencilState::default(),
+                bias: wgpu::DepthBiasState::default(),
+            }),
+            multisample: wgpu::MultisampleState {
+                count: target.sample_count,
+                mask: !0,
+                alpha_to_coverage_enabled: false,
+            },
+            fragment: Some(wgpu::FragmentState {
+                module: &module,
+                entry_point: Some("fs_strand"),
+                compilation_options,
+                targets: &[Some(wgpu::ColorTargetState {
+                    format: target.colour_format,
+                    blend: None,
+                    write_mask: wgpu::ColorWrites::ALL,
+                })],
+            }),
+            multiview_mask: None,
+            cache: None,
+        });
+        scope.pop("building the strand pipeline")?;
+        Ok(Self { pipeline })
+    }
+
+    /// Records `ribbons` as seen from `view`, with `fur`'s object uniform (model transform and
+    /// look: call [`GpuFur::prepare`] first). Opaque: draw the fur's skin in the same pass
+    /// (`FurDrawSettings::SKIN`) so the strands stand on it.
+    pub fn draw(&self, pass: &mut wgpu::RenderPass<'_>, view: &FurView, fur: &GpuFur, ribbons: &StrandRibbons) {
+        if ribbons.index_count == 0 {
+            return;
+        }
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, view.bind_group(), &[]);
+        pass.set_bind_group(1, fur.geometry().bind_group(), &[]);
+        pass.set_vertex_buffer(0, ribbons.vertices.slice(..));
+        pass.set_index_buffer(ribbons.indices.slice(..), wgpu::IndexFormat::Uint32);
+        pass.draw_indexed(0..ribbons.index_count, 0, 0..1);
+    }
+}
+
+/// The ribbons of every strand of a reference in one shape of the fur, on the GPU.
+#[derive(Debug)]
+pub struct StrandRibbons {
+    vertices: wgpu::Buffer,
+    indices: wgpu::Buffer,
+    index_count: u32,
+    strands: usize,
+}
+
+impl StrandRibbons {
+    /// Builds the ribbons of `reference` for the shared array `positions` (the rest pose or a
+    /// simulation state) of the fur whose base normals are `normals`.
+    ///
+    /// # Errors
+    /// [`RenderError::Textures`] for a shared array or normals of the wrong size,
+    /// [`RenderError::TooLarge`] for more ribbon data than a buffer may hold.
+    pub fn new(
+        device: &wgpu::Device,
+        reference: &StrandReference,
+        positions: &[Vec3],
+        normals: &[Vec3],
+        triangles: &[[u32; 3]],
+    ) -> Result<Self, RenderError> {
+        let nodes = reference.node_positions(positions).map_err(|e| RenderError::Textures(e.to_string()))?;
+        let taper = reference.field.params.taper;
+        let surface = reference.field.surface();
+        let mut vertices = Vec::with_capacity(nodes.len() * 2);
+        let mut indices = Vec::with_capacity(nodes.len() * 6);
+        for placed in &reference.strands {
+            let strand = reference.field_strand(placed);
+            let triangle = triangles
+                .get(placed.triangle as usize)
+                .ok_or_else(|| RenderError::Textures(format!("no triangle {} in the mesh", placed.triangle)))?;
+            let strand_nodes = reference.strand_nodes(placed);
+            let root_weights = strand_nodes[0].barycentric;
+            let mut normal = Vec3::ZERO;
+            for (k, weight) in triangle.iter().zip(root_weights.to_array()) {
+                let n = normals.get(*k as usize).ok_or_else(|| RenderError::Textures("too few normals".to_owned()))?;
+                normal += *n * weight;
+            }
+            let normal = normal.normalize_or_zero();
+            // Surface mode: the mesh's texture at the root tints the strand, as on the shells.
+            let tint = match (surface, placed.surface_uv) {
+                (Some(image), Some(uv)) => image.sample_wrapped(uv.x, uv.y).truncate().map(srgb_to_linear),
+                _ => Vec3::ONE,
+            };
+            let first = placed.first_node as usize;
+            let points = &nodes[first..first + strand_nodes.len()];
+            for (k, node) in strand_nodes.iter().enumerate() {
+                let tangent = if k + 1 < points.len() { points[k + 1] - points[k] } else { points[k] - points[k - 1] };
+                // The texture's 8-bit sRGB colour, as the shells sample it.
+                let albedo = reference
+                    .field
+                    .colour(strand, node.height)
+                    .map(|c| srgb_to_linear((c.clamp(0.0, 1.0) * 255.0).round() / 255.0))
+                    * tint;
+                let half_width = strand.radius_at(node.height, taper) * reference.world_per_texel;
+                let colour_height = Vec4::from((albedo, node.height)).to_array();
+                let base = vertices.len() as u32;
+                for side in [-1.0, 1.0] {
+                    vertices.push(RibbonVertex {
+                        position: points[k].to_array(),
+                        tangent: tangent.to_array(),
+                        normal: normal.to_array(),
+                        colour_height,
+                        half_width: half_width * side,
+                    });
+                }
+                if k + 1 < points.len() {
+                    indices.extend_from_slice(&[base, base + 1, base + 3, base, base + 3, base + 2]);
+                }
+            }
+        }
+        let vertex_bytes: &[u8] = bytemuck::cast_slice(&vertices);
+        let index_bytes: &[u8] = bytemuck::cast_slice(&indices);
+        check_size(device, "strand ribbon vertices", vertex_bytes.len() as u64)?;
+        check_size(device, "strand ribbon indices", index_bytes.len() as u64)?;
+        let buffer = |label, contents: &[u8], usage| {
+            wgpu::util::DeviceExt::create_buffer_init(
+                device,
+                &wgpu::util::BufferInitDescriptor { label: Some(label), contents, usage },
+            )
+        };
+        // An empty reference still gets (unused) buffers of a valid size.
+        let pad = |bytes: &[u8]| if bytes.is_empty() { vec![0u8; 4] } else { bytes.to_vec() };
+        Ok(Self {
+            vertices: buffer("pelt strand ribbons", &pad(vertex_bytes), wgpu::BufferUsages::VERTEX),
+            indices: buffer("pelt strand ribbon indices", &pad(index_bytes), wgpu::BufferUsages::INDEX),
+            index_count: indices.len() as u32,
+            strands: reference.strands.len(),
+        })
+    }
+
+    /// Strands drawn.
+    #[must_use]
+    pub fn strand_count(&self) -> usize {
+        self.strands
+    }
+
+    /// Triangles drawn (two per strand segment).
+    #[must_use]
+    pub fn triangle_count(&self) -> usize {
+        self.index_count as usize / 3
+    }
+}

@@ -1,0 +1,50 @@
+// The explicit strand reference: every strand of the seeded field as a camera-facing ribbon, lit
+// by the same `hair_lighting` as the shells and fins. Appended to `shading.wgsl`; reads the view
+// (group 0) and the fur's object uniform (group 1, binding 0: transform and look), no textures.
+
+struct StrandVertex {
+    // Strand node, model space.
+    @location(0) position: vec3<f32>,
+    // Strand direction at the node (model space).
+    @location(1) tangent: vec3<f32>,
+    // Base surface normal at the strand's root (model space).
+    @location(2) normal: vec3<f32>,
+    // Linear RGB albedo and the node's height (0 at the root, 1 at the fur's tip layer).
+    @location(3) colour_height: vec4<f32>,
+    // Half the ribbon's width (world units), signed: the side of the strand this vertex is on.
+    @location(4) half_width: f32,
+}
+
+@vertex
+fn vs_strand(in: StrandVertex) -> Varyings {
+    let centre = world_from_model_point(in.position);
+    let normal = world_from_model_normal(in.normal);
+    let tangent = safe_normalize(world_from_model_direction(in.tangent), normal);
+    let to_camera = safe_normalize(view.camera_position - centre, normal);
+    // Facing the camera: widen across the strand, in the plane that faces the eye.
+    let side = safe_normalize(cross(tangent, to_camera), safe_normalize(cross(tangent, normal), vec3<f32>(1.0, 0.0, 0.0)));
+    let position = centre + side * in.half_width;
+    var out: Varyings;
+    out.clip_position = view.clip_from_world * vec4<f32>(position, 1.0);
+    out.world_position = position;
+    out.normal = normal;
+    out.tangent = tangent;
+    out.tile_position = in.colour_height.rgb;
+    out.tile_normal = vec3<f32>(0.0);
+    out.uv = vec2<f32>(0.0);
+    out.layer = 0u;
+    out.slice = 0;
+    out.height = in.colour_height.a;
+    out.fade = 1.0;
+    out.surface_uv = vec2<f32>(0.0);
+    return out;
+}
+
+// Opaque: the supersampled target resolves a strand's partial coverage of a pixel.
+@fragment
+fn fs_strand(in: Varyings) -> @location(0) vec4<f32> {
+    // The albedo travels in `tile_position`, which strands do not otherwise use.
+    let albedo = in.tile_position;
+    let colour = hair_lighting(albedo, normalize(in.tangent), normalize(in.normal), in.world_position, in.height);
+    return vec4<f32>(colour, 1.0);
+}

@@ -1,0 +1,319 @@
+//! `pelt fidelity`: how close shells and fins come to the strands they stand for. The same
+//! seeded strand field is rendered three ways from each view (shells + fins, shells alone, and
+//! every strand as a supersampled ribbon: the reference), then compared with SSIM over the fur
+//! and over the silhouette band, and by mean colour difference.
+
+mod metrics;
+
+use std::path::PathBuf;
+
+use anyhow::{Context as _, bail};
+use glam::{Mat4, Vec3};
+use pelt_core::mesh::builtin::{TRY_ON_NAME, try_on_scene};
+use pelt_core::reference::StrandReference;
+use pelt_core::sim::{Simulation, WindParams};
+use pelt_core::{Builtin, FurStructure, ImportOptions, Mesh, Preset, texture};
+use pelt_render::{
+    Backend, Camera, DEFAULT_BACKGROUND, FurDrawSettings, FurFrame, FurLook, FurRenderer, FurStates, FurTarget,
+    FurView, Gpu, GpuFur, HEADLESS_FORMAT, Headless, Light, PlainMesh, StrandRenderer, StrandRibbons,
+    default_sample_count, tile_mapping,
+};
+
+use self::metrics::Mask;
+use crate::mesh_args::MeshArgs;
+use crate::render::PLAIN_COLOUR;
+
+/// Seconds simulated before the pictures are taken (the fur settles under gravity and wind).
+const SETTLE_SECS: f64 = 1.5;
+/// Colour difference (0..=1) a channel must pass for a pixel to count as changed.
+const CHANGED: u8 = 3;
+
+/// Arguments of `pelt fidelity`.
+#[derive(Debug, clap::Args)]
+#[command(after_help = "\
+Renders shells + fins, shells alone and the explicit strands (the same seeded strands, as
+supersampled ribbons) from each view; writes MODEL-VIEW.png (shells + fins | shells | strands |
+difference heat map) into --out and prints SSIM over the fur and over the silhouette band.
+Example: `pelt fidelity assets/meshes/spot.obj --preset assets/presets/spot.toml --json spot.json`.")]
+pub struct Args {
+    #[command(flatten)]
+    mesh: MeshArgs,
+    /// The fur preset (TOML); the built-in default fur without one.
+    #[arg(long, value_name = "P")]
+    preset: Option<PathBuf>,
+    /// Views, comma separated: front (the default framing's angle), side (90 degrees round),
+    /// back (180).
+    #[arg(long, default_value = "front,side,back", value_name = "front,side,back")]
+    views: String,
+    /// Wind x,y,z (direction and strength); calm without it.
+    #[arg(long, value_name = "X,Y,Z", value_parser = crate::render::parse_vec3, allow_hyphen_values = true)]
+    wind: Option<Vec3>,
+    /// Write the results as JSON here.
+    #[arg(long, value_name = "FILE")]
+    json: Option<PathBuf>,
+    /// Folder for the side-by-side images.
+    #[arg(long, default_value = "fidelity", value_name = "DIR")]
+    out: PathBuf,
+    /// Image size, WIDTHxHEIGHT.
+    #[arg(long, default_value = "512x512", value_parser = crate::render::parse_size)]
+    size: (u32, u32),
+    /// The strands are rendered at this many times the size on each axis, then filtered down.
+    #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(1..=8))]
+    supersample: u32,
+    /// MSAA samples of the shells and fins: 1, 2, 4 or 8. Default: 1 on a CPU rasteriser
+    /// (lavapipe), 4 on a GPU (as `pelt render`).
+    #[arg(long, value_name = "N", value_parser = crate::render::parse_msaa)]
+    msaa: Option<u32>,
+    /// Graphics backend: vulkan, gl (or metal, dx12); default `WGPU_BACKEND`, else the best there is.
+    #[arg(long, default_value = "auto")]
+    backend: Backend,
+}
+
+/// One model and view's figures (the `--json` keys).
+#[derive(Debug, serde::Serialize)]
+struct Figures {
+    model: String,
+    view: String,
+    wind: [f32; 3],
+    ssim_fur_shells_fins: f64,
+    ssim_fur_shells: f64,
+    ssim_silhouette_shells_fins: f64,
+    ssim_silhouette_shells: f64,
+    mean_colour_difference: f64,
+}
+
+#[derive(Debug, serde::Serialize)]
+struct Report {
+    results: Vec<Figures>,
+}
+
+/// Degrees round from the front (the default framing's azimuth).
+fn view_turn(name: &str) -> anyhow::Result<f32> {
+    Ok(match name.trim() {
+        "front" => 0.0,
+        "side" => 90.0,
+        "back" => 180.0,
+        other => bail!("--views: unknown view {other:?}; choose from front, side, back"),
+    })
+}
+
+pub fn run(args: &Args) -> anyhow::Result<()> {
+    // Each view's turn from the front.
+    let views: Vec<(String, f32)> = args
+        .views
+        .split(',')
+        .map(|name| Ok((name.trim().to_owned(), view_turn(name)?)))
+        .collect::<anyhow::Result<_>>()?;
+    let preset = match &args.preset {
+        Some(path) => Preset::load(path)?,
+        None => Preset::default(),
+    };
+    let (model, mesh, plain) = load_meshes(&args.mesh)?;
+    let params = preset.fur_params(&mesh);
+    let fur = FurStructure::new(mesh, &params)?;
+    // One strand field: the textures are drawn from it and the reference places it.
+    let field = preset.strand_field()?;
+    let textures = texture::generate_from(preset.layers, &field);
+    let look = FurLook::default();
+    let reference = StrandReference::new(&fur, field, tile_mapping(&fur.mesh, &look))?;
+
+    let mut simulation = Simulation::new(&fur, &preset.simulation)?;
+    let wind = args.wind.unwrap_or(Vec3::ZERO);
+    let direction = wind.try_normalize().unwrap_or(Vec3::X);
+    simulation.set_wind(&WindParams { direction, strength: wind.length(), ..preset.simulation.wind.clone() })?;
+    simulation.advance_to(SETTLE_SECS);
+    let positions = simulation.positions().to_vec();
+
+    let (width, height) = args.size;
+    let gpu = Gpu::new(args.backend)?;
+    let samples = args.msaa.unwrap_or_else(|| default_sample_count(&gpu.adapter.get_info()));
+    let shells = Headless::with_target(gpu, FurTarget::new(HEADLESS_FORMAT).with_sample_count(samples), width, height)?;
+    let factor = args.supersample;
+    let strands = Headless::with_target(
+        Gpu::new(args.backend)?,
+        FurTarget::new(HEADLESS_FORMAT).with_sample_count(1),
+        width * factor,
+        height * factor,
+    )?;
+    let shell_side = Side::new(&shells, &fur, &textures, &positions, &plain)?;
+    let strand_side = Side::new(&strands, &fur, &textures, &positions, &plain)?;
+    let strand_renderer = StrandRenderer::new(&strands.gpu.device, &strand_side.renderer)?;
+    let ribbons =
+        StrandRibbons::new(&strands.gpu.device, &reference, &positions, &fur.mesh.normals, &fur.mesh.triangles)?;
+
+    std::fs::create_dir_all(&args.out).with_context(|| format!("cannot create {}", args.out.display()))?;
+    let front = preset.render.camera_azimuth_deg.unwrap_or(30.0);
+    let elevation = preset.render.camera_elevation_deg.unwrap_or(15.0);
+    let fur_length = fur.lengths.iter().copied().fold(0.0, f32::max);
+    let points: Vec<Vec3> =
+        std::iter::once(&fur.mesh).chain(&plain).flat_map(|m| m.positions.iter().copied()).collect();
+    let (low, high) = points
+        .iter()
+        .fold((Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)), |(l, h), p| (l.min(*p), h.max(*p)));
+    let centre = (low + high) * 0.5;
+    let aspect = width as f32 / height as f32;
+    let wind_tag = if wind == Vec3::ZERO { String::new() } else { "-wind".to_owned() };
+    let mut results = Vec::new();
+    for (name, azimuth) in &views {
+        let camera =
+            Camera::framing_points(centre, points.iter().copied(), fur_length, front + azimuth, elevation, aspect);
+        let view_data = camera.view_data(aspect, &Light::default());
+        shell_side.view.prepare(&shells.gpu.queue, &view_data);
+        strand_side.view.prepare(&strands.gpu.queue, &view_data);
+        let empty = shells.render(DEFAULT_BACKGROUND, |_| {})?;
+        let skin = shell_side.render(&shells, FurDrawSettings::SKIN, true)?;
+        let fur_skin = shell_side.render(&shells, FurDrawSettings::SKIN, false)?;
+        let shells_fins = shell_side.render(&shells, FurDrawSettings::SILHOUETTE, true)?;
+        let shells_only =
+            shell_side.render(&shells, FurDrawSettings { fins: false, ..FurDrawSettings::SILHOUETTE }, true)?;
+        let big = strands.render(DEFAULT_BACKGROUND, |pass| {
+            for mesh in &strand_side.plain {
+                strand_side.renderer.draw_plain(pass, &strand_side.view, mesh);
+            }
+            strand_side.renderer.draw(pass, &strand_side.view, &strand_side.fur, &FurDrawSettings::SKIN);
+            strand_renderer.draw(pass, &strand_side.view, &strand_side.fur, &ribbons);
+        })?;
+        let reference_image = metrics::downsample(&big, factor);
+
+        let fur_mask = Mask::differing(&reference_image, &skin, CHANGED)
+            .union(&Mask::differing(&shells_fins, &skin, CHANGED))
+            .union(&Mask::differing(&shells_only, &skin, CHANGED));
+        // The silhouette band: within the fur's projected length (and 2 pixels) of the outline.
+        let body = Mask::differing(&fur_skin, &empty, 1);
+        let distance = camera.eye.distance(camera.target);
+        let pixels_per_unit = height as f32 / (2.0 * distance * (camera.fov_y_rad * 0.5).tan());
+        let band_radius = (fur_length * pixels_per_unit).ceil() as u32 + 2;
+        let band = body.dilate(band_radius).minus(&body.erode(band_radius));
+        if fur_mask.count() == 0 || body.count() == 0 {
+            bail!("{model} {name}: nothing was drawn (the fur is out of view or the render failed)");
+        }
+        let ssim = |image: &image::RgbaImage, mask: &Mask| -> anyhow::Result<f64> {
+            metrics::masked_ssim(image, &reference_image, mask)?
+                .with_context(|| format!("{model} {name}: the mask is empty"))
+        };
+        let result = Figures {
+            model: model.clone(),
+            view: name.clone(),
+            wind: wind.to_array(),
+            ssim_fur_shells_fins: ssim(&shells_fins, &fur_mask)?,
+            ssim_fur_shells: ssim(&shells_only, &fur_mask)?,
+            ssim_silhouette_shells_fins: ssim(&shells_fins, &band)?,
+            ssim_silhouette_shells: ssim(&shells_only, &band)?,
+            mean_colour_difference: metrics::mean_colour_difference(&shells_fins, &reference_image, &fur_mask)
+                .unwrap_or(0.0),
+        };
+        let heat = metrics::heat_map(&shells_fins, &reference_image, 0.25);
+        let sheet = metrics::side_by_side(&[&shells_fins, &shells_only, &reference_image, &heat], 4, [255, 255, 255]);
+        let path = args.out.join(format!("{model}-{name}{wind_tag}.png"));
+        sheet.save(&path).with_context(|| format!("cannot write {}", path.display()))?;
+        println!(
+            "{model:>8} {name:<5} wind {wind:<14} SSIM fur: shells+fins {:.3}, shells {:.3}; silhouette: shells+fins {:.3}, \
+             shells {:.3}; mean colour difference {:.3}  -> {}",
+            result.ssim_fur_shells_fins,
+            result.ssim_fur_shells,
+            result.ssim_silhouette_shells_fins,
+            result.ssim_silhouette_shells,
+            result.mean_colour_difference,
+            path.display(),
+            wind = format!("{:.2},{:.2},{:.2}", wind.x, wind.y, wind.z),
+        );
+        let statistics = |image: &image::RgbaImage| {
+            let (mean, contrast) = metrics::luma_statistics(image, &fur_mask);
+            format!("{mean:.0}/{contrast:.1}")
+        };
+        println!(
+            "{:>8} {name:<5} luma mean/local contrast over the fur: shells+fins {}, shells {}, strands {}",
+            "",
+            statistics(&shells_fins),
+            statistics(&shells_only),
+            statistics(&reference_image)
+        );
+        results.push(result);
+    }
+    println!(
+        "{} strands ({} ribbon triangles) at {}x supersampling; shells at {}x MSAA on {}",
+        ribbons.strand_count(),
+        ribbons.triangle_count(),
+        factor,
+        samples,
+        shells.gpu.summary()
+    );
+    if let Some(path) = &args.json {
+        let text = serde_json::to_string_pretty(&Report { results })?;
+        std::fs::write(path, text + "\n").with_context(|| format!("cannot write {}", path.display()))?;
+    }
+    Ok(())
+}
+
+/// The model's name, its furry mesh and any plain ones (the try-on body).
+fn load_meshes(args: &MeshArgs) -> anyhow::Result<(String, Mesh, Vec<Mesh>)> {
+    if args.mesh.is_none() && args.builtin.as_deref() == Some(TRY_ON_NAME) {
+        let scene = try_on_scene(&ImportOptions { weld: !args.no_weld, ..ImportOptions::default() })?;
+        return Ok((TRY_ON_NAME.to_owned(), scene.garment, vec![scene.body]));
+    }
+    let (mesh, _, _) = args.load_animated(Builtin::Bunny)?;
+    let name = match (&args.mesh, &args.builtin) {
+        (Some(path), _) => path.file_stem().map_or_else(|| "mesh".to_owned(), |s| s.to_string_lossy().into_owned()),
+        (None, Some(name)) => name.clone(),
+        (None, None) => Builtin::Bunny.name().to_owned(),
+    };
+    Ok((name, mesh, Vec::new()))
+}
+
+/// One headless target's renderer, fur, view and plain meshes.
+struct Side {
+    renderer: FurRenderer,
+    fur: GpuFur,
+    view: FurView,
+    plain: Vec<PlainMesh>,
+}
+
+impl Side {
+    fn new(
+        headless: &Headless,
+        fur: &FurStructure,
+        textures: &pelt_core::FurTextures,
+        positions: &[Vec3],
+        plain: &[Mesh],
+    ) -> anyhow::Result<Self> {
+        let (device, queue) = (&headless.gpu.device, &headless.gpu.queue);
+        let renderer = headless.renderer()?;
+        let gpu_fur = GpuFur::new(device, queue, &renderer, fur, textures, FurStates::One)?;
+        gpu_fur.set_positions(queue, positions)?;
+        gpu_fur.prepare(queue, &FurFrame::default());
+        let plain = plain
+            .iter()
+            .map(|mesh| PlainMesh::new(device, &renderer, mesh, PLAIN_COLOUR))
+            .collect::<Result<Vec<_>, _>>()?;
+        for mesh in &plain {
+            mesh.prepare(queue, Mat4::IDENTITY);
+        }
+        let view = FurView::new(device, &renderer);
+        Ok(Self { renderer, fur: gpu_fur, view, plain })
+    }
+
+    /// The shells' side: `settings` for the fur, with or without the plain meshes.
+    fn render(
+        &self,
+        headless: &Headless,
+        settings: FurDrawSettings,
+        with_plain: bool,
+    ) -> anyhow::Result<image::RgbaImage> {
+        Ok(headless.render_with(
+            DEFAULT_BACKGROUND,
+            |encoder| {
+                if settings.fins {
+                    self.renderer.prepare_fins(encoder, &self.view, &self.fur);
+                }
+            },
+            |pass| {
+                if with_plain {
+                    for mesh in &self.plain {
+                        self.renderer.draw_plain(pass, &self.view, mesh);
+                    }
+                }
+                self.renderer.draw(pass, &self.view, &self.fur, &settings);
+            },
+        )?)
+    }
+}
