@@ -21,7 +21,12 @@ fn main() -> anyhow::Result<()> {
     let frames: usize = std::env::var("FRAMES").ok().and_then(|s| s.parse().ok()).unwrap_or(5);
     let sizes = [(1280, 720), (256, 256), (64, 64)];
     let distances: &[f32] = &[1.0, 4.0];
-    for layers in [16, 8, 4] {
+    // `LAYERS=16,8` picks the layer counts (default 16, 8 and 4).
+    let layer_counts: Vec<u32> = std::env::var("LAYERS")
+        .ok()
+        .map(|s| s.split(',').filter_map(|n| n.trim().parse().ok()).collect())
+        .unwrap_or_else(|| vec![16, 8, 4]);
+    for &layers in &layer_counts {
         let mut preset = Preset::default();
         preset.layers = layers;
         let fur = FurStructure::new(mesh.clone(), &preset.fur_params(&mesh))?;
