@@ -1,10 +1,10 @@
 //! The main world: the [`Fur`] component, building a fur from its mesh and preset, and the
-//! simulation systems (gravity, [`FurWind`], [`FurTouch`], following the entity's transform with
-//! inertia).
+//! simulation systems (gravity, [`FurWind`], [`FurTouch`], the base following the entity's
+//! transform or Bevy's skeleton, with pelt-core's inertia).
 //!
-//! pelt-core simulates in the mesh's own (model) space; the world's gravity, wind, touch ray and
-//! the entity's acceleration are turned into model space each frame, and the renderer draws the
-//! result through the entity's `GlobalTransform`.
+//! pelt-core simulates the base where it is in the world (divided by one uniform scale, see
+//! [`crate::base`]), so the roots' acceleration is the body's and pelt-core's `Inertia` makes the
+//! fur lag, swing and settle; gravity, wind and the touch ray keep their world directions.
 
 use std::collections::HashSet;
 use std::sync::Arc;
@@ -12,16 +12,19 @@ use std::sync::Arc;
 use bevy::asset::{AssetEvent, AssetId, Assets, Handle};
 use bevy::ecs::prelude::*;
 use bevy::log::error;
-use bevy::math::{Affine3A, Vec3};
+use bevy::math::Vec3;
+use bevy::mesh::skinning::{SkinnedMesh, SkinnedMeshInverseBindposes};
 use bevy::mesh::{Mesh, Mesh3d};
 use bevy::prelude::{GlobalTransform, Name, Time};
 use bevy::shape::Ray3d;
+use pelt_core::anim::Skin;
 use pelt_core::sim::WindParams;
 use pelt_core::texture::FurTextures;
 use pelt_core::{FurStructure, Simulation};
 
-use crate::convert::{to_pelt, to_pelt_affine};
-use crate::mesh::pelt_mesh;
+use crate::base::Base;
+use crate::convert::{to_pelt, to_pelt_affine, to_pelt_mat4};
+use crate::mesh::{pelt_mesh, pelt_skin};
 use crate::preset::FurPreset;
 
 /// Grows fur on this entity's [`Mesh3d`] from a [`FurPreset`].
@@ -114,18 +117,20 @@ pub struct FurState {
     pub(crate) revision: u64,
     preset: AssetId<FurPreset>,
     mesh: AssetId<Mesh>,
-    /// The positions to draw this frame (model space, layer-major).
+    /// The positions to draw this frame (simulation space, layer-major).
     pub(crate) positions: Arc<Vec<glam::Vec3>>,
-    motion: Option<Motion>,
+    /// The base's normals this frame (world directions), for lighting.
+    pub(crate) normals: Arc<Vec<glam::Vec3>>,
+    /// Simulation space to world space (a uniform scale; see [`crate::base`]).
+    pub(crate) world_from_simulation: glam::Mat4,
+    /// The base's bounding-box centre in world space, to draw far furs first.
+    pub(crate) centre_world: glam::Vec3,
+    /// The skin when the entity has a `SkinnedMesh`: the base follows Bevy's joints.
+    skin: Option<Skin>,
+    base: Base,
+    /// Whether the simulation has started from a posed base (it restarts at rest there first).
+    started: bool,
     radius: f32,
-}
-
-/// Where the entity was, for its acceleration.
-#[derive(Clone, Copy, Debug)]
-struct Motion {
-    translation: Vec3,
-    velocity: Vec3,
-    time_secs: f64,
 }
 
 impl FurState {
@@ -135,17 +140,20 @@ impl FurState {
         &self.simulation
     }
 
+    /// Takes the simulation's positions to world space: the simulation runs where the fur is in
+    /// the world, divided by one uniform scale (the entity's or its skeleton's), so strands keep
+    /// their length relative to the body.
+    #[must_use]
+    pub fn world_from_simulation(&self) -> glam::Mat4 {
+        self.world_from_simulation
+    }
+
     /// The unified shell-and-fin structure at rest.
     #[must_use]
     pub fn structure(&self) -> &FurStructure {
         &self.structure
     }
 }
-
-/// Standard gravity: the entity's acceleration is felt in units of it.
-const STANDARD_GRAVITY: f32 = 9.81;
-/// Inertial forces are capped (units of gravity strength) so a teleport is a jolt, not a blow-up.
-const MAX_INERTIA: f32 = 4.0;
 
 /// Builds (or rebuilds) the fur of every [`Fur`] entity whose mesh and preset are loaded and new
 /// or changed. Failures are logged once per change, naming the entity, and leave the entity bare.
@@ -155,20 +163,21 @@ pub(crate) fn build_furs(
     mut mesh_events: MessageReader<AssetEvent<Mesh>>,
     presets: Res<Assets<FurPreset>>,
     meshes: Res<Assets<Mesh>>,
-    furs: Query<(Entity, &Fur, &Mesh3d, Option<&FurState>, Option<&Name>)>,
+    furs: Query<(Entity, &Fur, &Mesh3d, Option<&SkinnedMesh>, Option<&FurState>, Option<&Name>)>,
     mut failed: Local<HashSet<(Entity, AssetId<FurPreset>, AssetId<Mesh>)>>,
     mut next_revision: Local<u64>,
 ) {
     let changed_presets: HashSet<AssetId<FurPreset>> = preset_events.read().filter_map(changed_id).collect();
     let changed_meshes: HashSet<AssetId<Mesh>> = mesh_events.read().filter_map(changed_id).collect();
     failed.retain(|(_, preset, mesh)| !changed_presets.contains(preset) && !changed_meshes.contains(mesh));
-    for (entity, fur, mesh3d, state, name) in &furs {
+    for (entity, fur, mesh3d, skinned, state, name) in &furs {
         let (preset_id, mesh_id) = (fur.preset.id(), mesh3d.id());
         let stale = match state {
             None => true,
             Some(state) => {
                 state.preset != preset_id
                     || state.mesh != mesh_id
+                    || state.skin.as_ref().map(Skin::joint_count) != skinned.map(|s| s.joints.len())
                     || changed_presets.contains(&preset_id)
                     || changed_meshes.contains(&mesh_id)
             }
@@ -179,7 +188,8 @@ pub(crate) fn build_furs(
         let (Some(preset), Some(mesh)) = (presets.get(preset_id), meshes.get(mesh_id)) else { continue };
         let label = name.map_or_else(|| format!("entity {entity}"), |n| format!("{n} ({entity})"));
         *next_revision += 1;
-        match build(&label, preset, mesh, preset_id, mesh_id, *next_revision) {
+        let joint_count = skinned.map(|s| s.joints.len());
+        match build(&label, preset, mesh, joint_count, preset_id, mesh_id, *next_revision) {
             Ok(state) => {
                 commands.entity(entity).insert(state);
             }
@@ -201,12 +211,19 @@ fn changed_id<A: bevy::asset::Asset>(event: &AssetEvent<A>) -> Option<AssetId<A>
 fn build(
     label: &str,
     preset: &FurPreset,
-    mesh: &Mesh,
+    bevy_mesh: &Mesh,
+    joint_count: Option<usize>,
     preset_id: AssetId<FurPreset>,
     mesh_id: AssetId<Mesh>,
     revision: u64,
 ) -> Result<FurState, String> {
-    let mesh = pelt_mesh(mesh, label).map_err(|e| e.to_string())?;
+    let (mesh, source) = pelt_mesh(bevy_mesh, label).map_err(|e| e.to_string())?;
+    let skin = joint_count.map(|joints| pelt_skin(bevy_mesh, &source, joints)).transpose()?;
+    if let Some(skin) = &skin {
+        for line in skin.report() {
+            bevy::log::warn!("{label}: {line}");
+        }
+    }
     let params = preset.preset.fur_params(&mesh);
     let radius = mesh.bounding_sphere().1;
     let structure = FurStructure::new(mesh, &params).map_err(|e| format!("{}: {e}", preset.preset.file().display()))?;
@@ -221,36 +238,55 @@ fn build(
         preset: preset_id,
         mesh: mesh_id,
         positions,
-        motion: None,
+        normals: Arc::new(Vec::new()),
+        world_from_simulation: glam::Mat4::IDENTITY,
+        centre_world: glam::Vec3::ZERO,
+        skin,
+        base: Base::default(),
+        started: false,
         radius,
     })
 }
 
-/// Steps every fur to the current time: gravity and wind turned into the fur's model space, the
-/// entity's acceleration as an inertial force, and the touch ray.
+/// Steps every fur to the current time: the base posed from the entity's transform or Bevy's
+/// joints, the preset's gravity and the [`FurWind`] in world directions, and the touch ray.
 pub(crate) fn simulate_furs(
     time: Res<Time>,
     wind: Res<FurWind>,
     presets: Res<Assets<FurPreset>>,
+    bindposes: Res<Assets<SkinnedMeshInverseBindposes>>,
+    joints: Query<&GlobalTransform>,
     mut touch: ResMut<FurTouch>,
-    mut furs: Query<(Entity, &Fur, &GlobalTransform, &mut FurState)>,
+    mut furs: FurQuery,
 ) {
     let now = time.elapsed_secs_f64();
     update_touch(&mut touch, &mut furs);
-    for (entity, fur, transform, mut state) in &mut furs {
+    let mut joint_matrices = Vec::new();
+    for (entity, fur, transform, skinned, mut state) in &mut furs {
         let state = &mut *state;
-        let world_from_model = transform.affine();
-        let model_from_world = world_from_model.inverse();
-        let to_model = |v: Vec3| to_pelt(model_from_world.transform_vector3(v));
+        match pose_base(state, transform, skinned, &bindposes, &joints, &mut joint_matrices) {
+            Ok(true) => {}
+            Ok(false) => continue,
+            Err(problem) => {
+                error!("fur on {entity}: {problem}");
+                continue;
+            }
+        }
+        let base = &state.base;
+        if let Err(problem) = state.simulation.set_base_rotations(&base.positions, &base.rotations) {
+            error!("fur on {entity}: {problem}");
+            continue;
+        }
+        state.world_from_simulation = base.world_from_simulation();
+        state.centre_world = state.world_from_simulation.transform_point3(box_centre(&base.positions));
         let mut params = state.simulation.params().clone();
-        // The preset's gravity direction is the world's (Bevy's +Y is up); the simulation needs
-        // it in the mesh's space, which turns with the entity.
+        // The preset's gravity direction is the world's (Bevy's +Y is up), and so is the
+        // simulation's frame.
         if let Some(preset) = presets.get(fur.preset.id()) {
-            let gravity = bevy::math::Vec3::from_array(preset.preset.simulation.gravity_direction.to_array());
-            params.gravity_direction = to_model(gravity).normalize_or(glam::Vec3::NEG_Y);
+            params.gravity_direction = preset.preset.simulation.gravity_direction;
         }
         params.wind = WindParams {
-            direction: to_model(wind.direction).normalize_or(glam::Vec3::X),
+            direction: to_pelt(wind.direction).normalize_or(glam::Vec3::X),
             strength: wind.strength,
             gust_strength: wind.gust_strength,
             ..params.wind
@@ -258,45 +294,69 @@ pub(crate) fn simulate_furs(
         if let Err(problem) = state.simulation.set_params(&params) {
             error!("fur on {entity}: {problem}");
         }
-        let inertia = inertial_force(&mut state.motion, transform.translation(), now, params.gravity_strength);
-        state.simulation.field_mut().fill(to_model(inertia));
         state.simulation.advance_to(now);
+        if !std::mem::replace(&mut state.started, true) {
+            // The first pose: start there at rest rather than swinging in from the rest pose.
+            state.simulation.restart();
+        }
         state.positions = Arc::new(state.simulation.positions().to_vec());
+        state.normals = Arc::new(state.base.normals.clone());
     }
 }
 
-/// The force the fur feels from the entity's acceleration (world space, units of gravity
-/// strength): `-a / g`, capped.
-fn inertial_force(motion: &mut Option<Motion>, translation: Vec3, now: f64, gravity_strength: f32) -> Vec3 {
-    let Some(last) = *motion else {
-        *motion = Some(Motion { translation, velocity: Vec3::ZERO, time_secs: now });
-        return Vec3::ZERO;
+/// Poses the fur's base for this frame: Bevy's joints through the skin, or the entity's
+/// transform. False (and no pose) while a skin's inverse bind matrices are not loaded.
+fn pose_base(
+    state: &mut FurState,
+    transform: &GlobalTransform,
+    skinned: Option<&SkinnedMesh>,
+    bindposes: &Assets<SkinnedMeshInverseBindposes>,
+    joints: &Query<&GlobalTransform>,
+    joint_matrices: &mut Vec<glam::Mat4>,
+) -> Result<bool, String> {
+    let (Some(skin), Some(skinned)) = (&state.skin, skinned) else {
+        let mesh = &state.structure.mesh;
+        state.base.rigid(&mesh.positions, &mesh.normals, &to_pelt_affine(&transform.affine()));
+        return Ok(true);
     };
-    let dt = (now - last.time_secs) as f32;
-    if dt <= 1e-5 {
-        return Vec3::ZERO;
+    let Some(inverse_binds) = bindposes.get(&skinned.inverse_bindposes) else { return Ok(false) };
+    joint_matrices.clear();
+    for (joint, inverse_bind) in skinned.joints.iter().zip(inverse_binds.iter()) {
+        let world = joints.get(*joint).map_err(|_| format!("its joint {joint} has no transform"))?;
+        joint_matrices.push(to_pelt_mat4(&(world.to_matrix() * *inverse_bind)));
     }
-    let velocity = (translation - last.translation) / dt;
-    let acceleration = (velocity - last.velocity) / dt;
-    *motion = Some(Motion { translation, velocity, time_secs: now });
-    (-acceleration / STANDARD_GRAVITY * gravity_strength).clamp_length_max(MAX_INERTIA * gravity_strength.max(0.0))
+    state.base.skinned(skin, &state.structure.mesh, joint_matrices).map_err(|e| e.to_string())?;
+    Ok(true)
 }
 
-fn update_touch(touch: &mut FurTouch, furs: &mut Query<(Entity, &Fur, &GlobalTransform, &mut FurState)>) {
+fn box_centre(points: &[glam::Vec3]) -> glam::Vec3 {
+    let (min, max) = points
+        .iter()
+        .fold((glam::Vec3::splat(f32::MAX), glam::Vec3::splat(f32::MIN)), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
+    if points.is_empty() { glam::Vec3::ZERO } else { (min + max) * 0.5 }
+}
+
+type FurQuery<'w, 's> = Query<
+    'w,
+    's,
+    (Entity, &'static Fur, &'static GlobalTransform, Option<&'static SkinnedMesh>, &'static mut FurState),
+>;
+
+fn update_touch(touch: &mut FurTouch, furs: &mut FurQuery) {
     let radius_fraction = touch.radius;
     match (touch.ray, touch.active) {
         (None, None) => {}
         (None, Some(active)) => {
-            if let Ok((_, _, _, mut state)) = furs.get_mut(active.entity) {
+            if let Ok((.., mut state)) = furs.get_mut(active.entity) {
                 state.simulation.touch_end();
             }
             touch.active = None;
         }
         (Some(ray), Some(active)) => {
             let point = ray.get_point(active.distance);
-            if let Ok((_, _, transform, mut state)) = furs.get_mut(active.entity) {
-                let model = to_pelt_affine(&transform.affine()).inverse().transform_point3(to_pelt(point));
-                if let Err(problem) = state.simulation.touch_drag(model) {
+            if let Ok((.., mut state)) = furs.get_mut(active.entity) {
+                let point = state.world_from_simulation.inverse().transform_point3(to_pelt(point));
+                if let Err(problem) = state.simulation.touch_drag(point) {
                     error!("fur touch: {problem}");
                 }
             } else {
@@ -306,17 +366,13 @@ fn update_touch(touch: &mut FurTouch, furs: &mut Query<(Entity, &Fur, &GlobalTra
         (Some(ray), None) => {
             let nearest = furs
                 .iter()
-                .filter_map(|(entity, _, transform, state)| {
-                    let world_from_model = transform.affine();
-                    let hit = pick(state, &world_from_model, &ray)?;
-                    Some((entity, hit))
-                })
+                .filter_map(|(entity, .., state)| Some((entity, pick(state, &ray)?)))
                 .min_by(|a, b| a.1.1.total_cmp(&b.1.1));
-            if let Some((entity, (model_point, distance))) = nearest
-                && let Ok((_, _, _, mut state)) = furs.get_mut(entity)
+            if let Some((entity, (point, distance))) = nearest
+                && let Ok((.., mut state)) = furs.get_mut(entity)
             {
                 let radius = (radius_fraction * state.radius).max(1e-6);
-                match state.simulation.touch_begin(model_point, radius) {
+                match state.simulation.touch_begin(point, radius) {
                     Ok(()) => touch.active = Some(ActiveTouch { entity, distance }),
                     Err(problem) => error!("fur touch: {problem}"),
                 }
@@ -325,12 +381,12 @@ fn update_touch(touch: &mut FurTouch, furs: &mut Query<(Entity, &Fur, &GlobalTra
     }
 }
 
-/// The model-space hit of a world ray with the fur's base surface and its world distance.
-fn pick(state: &FurState, world_from_model: &Affine3A, ray: &Ray3d) -> Option<(glam::Vec3, f32)> {
-    let model_from_world = to_pelt_affine(world_from_model).inverse();
-    let origin = model_from_world.transform_point3(to_pelt(ray.origin));
-    let direction = model_from_world.transform_vector3(to_pelt(*ray.direction));
+/// The simulation-space hit of a world ray with the fur's base surface, and its world distance.
+fn pick(state: &FurState, ray: &Ray3d) -> Option<(glam::Vec3, f32)> {
+    let simulation_from_world = state.world_from_simulation.inverse();
+    let origin = simulation_from_world.transform_point3(to_pelt(ray.origin));
+    let direction = simulation_from_world.transform_vector3(to_pelt(*ray.direction));
     let hit = state.simulation.pick(&state.structure.mesh.triangles, origin, direction)?;
-    let world_point = world_from_model.transform_point3(bevy::math::Vec3::from_array(hit.point.to_array()));
-    Some((hit.point, world_point.distance(ray.origin)))
+    let world_point = state.world_from_simulation.transform_point3(hit.point);
+    Some((hit.point, world_point.distance(to_pelt(ray.origin))))
 }

@@ -21,18 +21,24 @@
 //!
 //! - [`Fur`] on an entity with a `Mesh3d` grows fur from a [`FurPreset`] (a `.toml` asset, hot
 //!   reloaded with Bevy's `file_watcher` feature; a bad file is an asset load error naming it).
-//! - The simulation runs in `PostUpdate` after transforms: the preset's gravity (world space),
-//!   [`FurWind`], touch from a ray ([`FurTouch`]), and the entity's acceleration as inertia; the
-//!   fur follows the entity's `GlobalTransform`.
+//! - The simulation runs in `PostUpdate` after transforms (and after Bevy's animation): the
+//!   preset's gravity (world space), [`FurWind`], touch from a ray ([`FurTouch`]), and pelt-core's
+//!   inertia (the fur lags, swings and settles as the base accelerates). The base follows the
+//!   entity's `GlobalTransform`, or, on an entity with Bevy's `SkinnedMesh`, Bevy's joints: their
+//!   matrices skin the base with pelt-core each frame, so fur walks with an `AnimationPlayer`.
 //! - The render world draws every fur into each 3D camera's main pass between the opaque and the
 //!   transparent phase, on the camera's colour target (HDR or not), depth buffer (reverse-Z) and
-//!   MSAA, so fur and Bevy's geometry occlude each other. Fur is lit by [`FurLight`].
+//!   MSAA, so fur and Bevy's geometry occlude each other. Fur is lit by the scene's first
+//!   `DirectionalLight` (its direction and colour, its illuminance times the camera's exposure
+//!   over pi, as Bevy lights a white diffuse surface facing it), or by [`FurLight`]'s light when
+//!   there is none; [`FurLight`]'s ambient applies either way.
 
 #![warn(missing_docs)]
 // Bevy systems take their queries and resources as parameters; splitting them up to please these
 // two lints would only hide what a system reads.
 #![allow(clippy::type_complexity, clippy::too_many_arguments)]
 
+mod base;
 mod convert;
 mod fur;
 mod mesh;

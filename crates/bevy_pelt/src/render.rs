@@ -5,8 +5,9 @@
 use std::collections::{HashMap, HashSet};
 use std::sync::Arc;
 
-use bevy::camera::{Camera3d, CompositingSpace};
+use bevy::camera::{Camera3d, CompositingSpace, Exposure};
 use bevy::ecs::prelude::*;
+use bevy::light::DirectionalLight;
 use bevy::log::error;
 use bevy::prelude::{GlobalTransform, InheritedVisibility};
 use bevy::render::Extract;
@@ -15,13 +16,22 @@ use bevy::render::renderer::{RenderContext, RenderDevice, RenderQueue, ViewQuery
 use bevy::render::view::{ExtractedView, Msaa, ResolvedCompositingSpace, ViewDepthStencilTexture, ViewTarget};
 use pelt_core::FurStructure;
 use pelt_core::texture::FurTextures;
-use pelt_render::{FurDrawSettings, FurFrame, FurRenderer, FurStates, FurTarget, FurView, GpuFur, Light, ViewData};
+use pelt_render::{
+    FurDrawSettings, FurFrame, FurRenderer, FurStates, FurTarget, FurView, GpuFur, Light, LightDirection, ViewData,
+};
 
 use crate::convert::{to_pelt, to_pelt_mat4};
 use crate::fur::{Fur, FurState};
 
-/// The light Pelt shades fur with (Kajiya-Kay strands; Bevy's lights do not reach the fur).
-/// Pelt's default follows the camera from the upper left.
+/// The light Pelt shades fur with (Kajiya-Kay strands) when the scene has no
+/// `DirectionalLight`, and the ambient term always. Pelt's default follows the camera from the
+/// upper left.
+///
+/// With a directional light in the scene (the first one by entity, among the visible), the fur
+/// takes its direction and its colour times `illuminance * exposure / pi`, the camera's exposure
+/// (Bevy's `Exposure`) included: the brightness Bevy gives a white diffuse surface facing the
+/// light, so fur and Bevy's materials agree. Other lights (point, spot, more directional
+/// lights, environment maps) do not reach the fur.
 #[derive(Resource, Clone, Copy, Debug, Default, PartialEq)]
 pub struct FurLight(pub Light);
 
@@ -33,6 +43,27 @@ const DEPTH_FORMAT: wgpu::TextureFormat = bevy::core_pipeline::core_3d::CORE_3D_
 pub(crate) struct ExtractedFurs {
     furs: Vec<ExtractedFur>,
     light: Light,
+    sun: Option<Sun>,
+}
+
+/// The scene's first directional light.
+#[derive(Clone, Copy, Debug)]
+struct Sun {
+    /// Unit vector toward the light, world space.
+    toward_light: glam::Vec3,
+    /// Linear colour times illuminance (lux).
+    colour_lux: glam::Vec3,
+}
+
+impl Sun {
+    /// Pelt's light for a camera with `exposure` (Bevy's `Exposure::exposure()`).
+    fn light(&self, exposure: f32, ambient: f32) -> Light {
+        Light {
+            direction: LightDirection::World(self.toward_light),
+            colour: self.colour_lux * (exposure / std::f32::consts::PI),
+            ambient,
+        }
+    }
 }
 
 struct ExtractedFur {
@@ -41,19 +72,32 @@ struct ExtractedFur {
     structure: Arc<FurStructure>,
     textures: Arc<FurTextures>,
     positions: Arc<Vec<glam::Vec3>>,
-    world_from_model: glam::Mat4,
-    origin: glam::Vec3,
+    normals: Arc<Vec<glam::Vec3>>,
+    world_from_simulation: glam::Mat4,
+    centre_world: glam::Vec3,
     skin: bool,
 }
 
 pub(crate) fn extract_furs(
     mut extracted: ResMut<ExtractedFurs>,
     light: Extract<Res<FurLight>>,
-    furs: Extract<Query<(Entity, &Fur, &FurState, &GlobalTransform, Option<&InheritedVisibility>)>>,
+    furs: Extract<Query<(Entity, &Fur, &FurState, Option<&InheritedVisibility>)>>,
+    suns: Extract<Query<(Entity, &DirectionalLight, &GlobalTransform, Option<&InheritedVisibility>)>>,
 ) {
     extracted.light = light.0;
+    extracted.sun = suns
+        .iter()
+        .filter(|(.., visibility)| visibility.is_none_or(|v| v.get()))
+        .min_by_key(|(entity, ..)| *entity)
+        .and_then(|(_, sun, transform, _)| {
+            // A directional light shines along its forward (-Z) axis.
+            let toward_light = to_pelt(transform.back().as_vec3()).try_normalize()?;
+            let colour = sun.color.to_linear();
+            let colour_lux = glam::Vec3::new(colour.red, colour.green, colour.blue) * sun.illuminance;
+            colour_lux.is_finite().then_some(Sun { toward_light, colour_lux })
+        });
     extracted.furs.clear();
-    for (entity, fur, state, transform, visibility) in &furs {
+    for (entity, fur, state, visibility) in &furs {
         if visibility.is_some_and(|v| !v.get()) {
             continue;
         }
@@ -63,8 +107,9 @@ pub(crate) fn extract_furs(
             structure: Arc::clone(&state.structure),
             textures: Arc::clone(&state.textures),
             positions: Arc::clone(&state.positions),
-            world_from_model: to_pelt_mat4(&transform.to_matrix()),
-            origin: to_pelt(transform.translation()),
+            normals: Arc::clone(&state.normals),
+            world_from_simulation: state.world_from_simulation,
+            centre_world: state.centre_world,
             skin: fur.skin,
         });
     }
@@ -115,7 +160,7 @@ pub(crate) fn prepare_furs(
     extracted: Res<ExtractedFurs>,
     mut gpu: ResMut<FurGpu>,
     views: Query<
-        (Entity, &ExtractedView, &Msaa, Option<&ResolvedCompositingSpace>),
+        (Entity, &ExtractedView, &Msaa, Option<&ResolvedCompositingSpace>, Option<&ExtractedCamera>),
         (With<ViewTarget>, With<Camera3d>),
     >,
 ) {
@@ -124,7 +169,7 @@ pub(crate) fn prepare_furs(
     let gpu = &mut *gpu;
     let mut seen_views = HashSet::new();
     let mut targets = HashSet::new();
-    for (entity, view, msaa, space) in &views {
+    for (entity, view, msaa, space, camera) in &views {
         let (colour, srgb_view) = colour_format(view.target_format, ResolvedCompositingSpace::space(space));
         let target = FurTarget::new(colour)
             .with_depth(DEPTH_FORMAT, wgpu::CompareFunction::GreaterEqual)
@@ -160,7 +205,9 @@ pub(crate) fn prepare_furs(
             None => to_pelt_mat4(&view.clip_from_view) * world_from_view.inverse(),
         };
         entry.camera_position = world_from_view.w_axis.truncate();
-        entry.view.prepare(queue, &ViewData::new(clip_from_world, world_from_view, &extracted.light));
+        let exposure = camera.map_or_else(|| Exposure::default().exposure(), |camera| camera.exposure);
+        let light = extracted.sun.map_or(extracted.light, |sun| sun.light(exposure, extracted.light.ambient));
+        entry.view.prepare(queue, &ViewData::new(clip_from_world, world_from_view, &light));
         seen_views.insert(entity);
         targets.insert(target);
     }
@@ -189,11 +236,19 @@ pub(crate) fn prepare_furs(
                 }
             }
             let entry = &gpu.furs[&key];
+            // Before the first simulated frame the normals are the rest ones GpuFur starts with.
+            if !fur.normals.is_empty()
+                && let Err(problem) = entry.fur.set_base_normals(queue, &fur.normals)
+            {
+                error!("Pelt cannot update the fur of {}: {problem}", fur.entity);
+                continue;
+            }
             if let Err(problem) = entry.fur.set_positions(queue, &fur.positions) {
                 error!("Pelt cannot update the fur of {}: {problem}", fur.entity);
                 continue;
             }
-            entry.fur.prepare(queue, &FurFrame { world_from_model: fur.world_from_model, ..FurFrame::default() });
+            let frame = FurFrame { world_from_model: fur.world_from_simulation, ..FurFrame::default() };
+            entry.fur.prepare(queue, &frame);
             seen_furs.insert(key);
         }
     }
@@ -222,7 +277,7 @@ pub(crate) fn draw_furs(
         return;
     }
     furs.sort_by(|a, b| {
-        let distance = |fur: &ExtractedFur| fur.origin.distance_squared(entry.camera_position);
+        let distance = |fur: &ExtractedFur| fur.centre_world.distance_squared(entry.camera_position);
         distance(b.0).total_cmp(&distance(a.0))
     });
 
