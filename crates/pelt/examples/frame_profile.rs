@@ -14,13 +14,33 @@ fn main() -> anyhow::Result<()> {
     let gpu = Gpu::new(Backend::Auto)?;
     let (device, queue) = (&gpu.device, &gpu.queue);
     let samples = default_sample_count(&gpu.adapter.get_info());
-    let target = FurTarget::new(HEADLESS_FORMAT).with_sample_count(samples);
+    let format = match std::env::var("FORMAT").as_deref() {
+        Ok("unorm") => wgpu::TextureFormat::Rgba8Unorm,
+        Ok("f16") => wgpu::TextureFormat::Rgba16Float,
+        _ => HEADLESS_FORMAT,
+    };
+    let target = FurTarget::new(format).with_sample_count(samples);
     let renderer = FurRenderer::new(device, target)?;
     let view = FurView::new(device, &renderer);
     let mesh = Builtin::Bunny.mesh().0;
     let frames: usize = std::env::var("FRAMES").ok().and_then(|s| s.parse().ok()).unwrap_or(5);
-    let sizes = [(1280, 720), (256, 256), (64, 64)];
-    let distances: &[f32] = &[1.0, 4.0];
+    // `SIZES=256x256,64x64` picks the sizes, `DISTANCES=1` the distances, `CASES=skin,skin+shells`
+    // the parts (default: all of them).
+    let sizes: Vec<(u32, u32)> = std::env::var("SIZES")
+        .ok()
+        .map(|s| {
+            s.split(',')
+                .filter_map(|size| size.split_once('x'))
+                .filter_map(|(w, h)| Some((w.trim().parse().ok()?, h.trim().parse().ok()?)))
+                .collect()
+        })
+        .unwrap_or_else(|| vec![(1280, 720), (256, 256), (64, 64)]);
+    let distances: Vec<f32> = std::env::var("DISTANCES")
+        .ok()
+        .map(|s| s.split(',').filter_map(|d| d.trim().parse().ok()).collect())
+        .unwrap_or_else(|| vec![1.0, 4.0]);
+    let chosen: Option<Vec<String>> =
+        std::env::var("CASES").ok().map(|s| s.split(',').map(|c| c.trim().to_owned()).collect());
     // `LAYERS=16,8` picks the layer counts (default 16, 8 and 4).
     let layer_counts: Vec<u32> = std::env::var("LAYERS")
         .ok()
@@ -35,7 +55,7 @@ fn main() -> anyhow::Result<()> {
         unified.prepare(queue, &FurFrame::default());
         let (centre, radius) = fur.mesh.bounding_sphere();
         let radius = radius + fur.lengths.iter().copied().fold(0.0, f32::max);
-        for (width, height) in sizes {
+        for &(width, height) in &sizes {
             let targets = RenderTargets::new(device, target, width, height)?;
             let output = device.create_texture(&wgpu::TextureDescriptor {
                 label: None,
@@ -43,12 +63,12 @@ fn main() -> anyhow::Result<()> {
                 mip_level_count: 1,
                 sample_count: 1,
                 dimension: wgpu::TextureDimension::D2,
-                format: HEADLESS_FORMAT,
+                format,
                 usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
                 view_formats: &[],
             });
             let output_view = output.create_view(&Default::default());
-            for &distance in distances {
+            for &distance in &distances {
                 let mut camera = Camera::framing(centre, radius, 35.0, 20.0, targets.aspect_ratio());
                 camera.eye = centre + (camera.eye - centre) * distance;
                 let view_data = camera.view_data(targets.aspect_ratio(), &Light::default());
@@ -62,6 +82,9 @@ fn main() -> anyhow::Result<()> {
                     ("nothing (clear)", FurDrawSettings { skin: false, shells: false, fins: false, ..all }),
                 ];
                 for (name, settings) in cases {
+                    if chosen.as_ref().is_some_and(|chosen| !chosen.iter().any(|c| c == name)) {
+                        continue;
+                    }
                     let mut times = Vec::new();
                     for _ in 0..frames + 1 {
                         let started = Instant::now();
