@@ -94,8 +94,8 @@ struct Varyings {
     @location(8) @interpolate(flat) slice: i32,
     // The mesh uv at the strand's root (surface colour mode).
     @location(9) surface_uv: vec2<f32>,
-    // Shells: the base normal in model space, weighting the triplanar projections (which are
-    // fixed to the model, so they move with it).
+    // Shells without mesh uvs: the base normal in model space, which picks the axis-aligned
+    // projection of the tiles (fixed to the model, so it moves with it).
     @location(10) tile_normal: vec3<f32>,
 }
 
@@ -203,21 +203,30 @@ fn surface_lighting(albedo: vec3<f32>, normal: vec3<f32>) -> vec3<f32> {
     return albedo * (view.ambient + view.light_colour * wrapped);
 }
 
+// The axis-aligned projection of the tiles for a surface with model-space normal `n`: the axis it
+// faces most (0 = x, 1 = y, 2 = z).
+fn tile_axis(n: vec3<f32>) -> u32 {
+    let a = abs(n);
+    if a.x >= a.y && a.x >= a.z {
+        return 0u;
+    }
+    return select(2u, 1u, a.y >= a.z);
+}
+
 fn shell_texel(in: Varyings) -> vec4<f32> {
     let slice = in.slice;
     // `uses_mesh_uvs` reads a uniform, so sampling stays in uniform control flow.
     if uses_mesh_uvs() {
         return textureSample(shell_texture, shell_sampler, in.uv, slice);
     }
-    // Triplanar: three axis-aligned projections of the tile, blended with sharp weights so the
-    // strands stay crisp and only narrow bands mix two projections.
-    let weights_raw = pow(abs(in.tile_normal), vec3<f32>(6.0));
-    let weights = weights_raw / max(weights_raw.x + weights_raw.y + weights_raw.z, 1e-6);
+    // Without uvs, the one axis-aligned projection the surface faces most: one texture fetch a
+    // fragment, the largest part of a shell fragment's cost on software rasterisers (a blend of
+    // all three cost three). The tiles are strand dots, so the seams where the projection
+    // changes do not show (SSIM test in tests/lean.rs).
     let p = in.tile_position;
-    let x = textureSample(shell_texture, shell_sampler, p.yz, slice);
-    let y = textureSample(shell_texture, shell_sampler, p.zx, slice);
-    let z = textureSample(shell_texture, shell_sampler, p.xy, slice);
-    return x * weights.x + y * weights.y + z * weights.z;
+    let axis = tile_axis(in.tile_normal);
+    let uv = select(select(p.xy, p.zx, axis == 1u), p.yz, axis == 0u);
+    return textureSample(shell_texture, shell_sampler, uv, slice);
 }
 
 // Surface colour mode: the mesh's texture at the strand's root tints the strand's brightness.
