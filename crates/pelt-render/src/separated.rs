@@ -77,6 +77,7 @@ impl SeparatedRenderer {
         })];
         let build = |label: &str, (vertex_entry, fragment_entry), kind| {
             let source = PipelineSource {
+                mesh_uvs: None,
                 layout: &layout,
                 module: &module,
                 vertex_entry,

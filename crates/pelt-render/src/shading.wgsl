@@ -99,8 +99,23 @@ struct Varyings {
     @location(10) tile_normal: vec3<f32>,
 }
 
+// Set per pipeline where every mesh it draws has uvs (1) or none has (2), so the shaders drop
+// the other case's varyings and fetches; 0 reads `object.has_uvs`.
+override MESH_UVS: u32 = 0u;
+
 fn uses_mesh_uvs() -> bool {
-    return object.has_uvs != 0u;
+    if MESH_UVS == 0u {
+        return object.has_uvs != 0u;
+    }
+    return MESH_UVS == 1u;
+}
+
+// The mesh uv at the strand's root: always the origin for meshes without uvs.
+fn root_surface_uv(in: Varyings) -> vec2<f32> {
+    if MESH_UVS == 2u {
+        return vec2<f32>(0.0);
+    }
+    return in.surface_uv;
 }
 
 fn safe_normalize(v: vec3<f32>, fallback: vec3<f32>) -> vec3<f32> {
@@ -256,7 +271,7 @@ fn fs_plain(in: Varyings) -> @location(0) vec4<f32> {
 @fragment
 fn fs_skin(in: Varyings) -> @location(0) vec4<f32> {
     let normal = normalize(in.normal);
-    let albedo = object.colour.rgb * surface_tint(in.surface_uv);
+    let albedo = object.colour.rgb * surface_tint(root_surface_uv(in));
     let colour = surface_lighting(albedo, normal) * object.root_occlusion;
     return vec4<f32>(colour, 1.0);
 }
@@ -266,7 +281,7 @@ fn fs_shell(in: Varyings) -> @location(0) vec4<f32> {
     let texel = shell_texel(in);
     let alpha = lod_alpha(texel.a * in.fade, in.layer);
     let normal = normalize(in.normal);
-    let albedo = texel.rgb * surface_tint(in.surface_uv);
+    let albedo = texel.rgb * surface_tint(root_surface_uv(in));
     let colour = hair_lighting(albedo, normalize(in.tangent), normal, in.world_position, in.height);
     return fur_output(colour, alpha);
 }
@@ -281,7 +296,7 @@ fn fs_fin(in: Varyings) -> @location(0) vec4<f32> {
     let normal = normalize(in.normal);
     // Seen from the side the roots are less hidden than from above: lift the occlusion.
     let height = sqrt(in.height);
-    let albedo = texel.rgb * surface_tint(in.surface_uv);
+    let albedo = texel.rgb * surface_tint(root_surface_uv(in));
     let colour = hair_lighting(albedo, normalize(in.tangent), normal, in.world_position, height);
     return fur_output(colour, alpha);
 }

@@ -81,7 +81,7 @@ fn surface_varyings(vertex: u32, corner: u32, layer: u32) -> Varyings {
         out.tangent = strand_tangent(layer, vertex, here, out.normal);
     }
     out.tile_normal = rest_normal;
-    if object.has_uvs != 0u {
+    if uses_mesh_uvs() {
         out.tile_position = vec3<f32>(0.0);
         out.surface_uv = corner_uvs[corner];
         out.uv = out.surface_uv * object.tiles_per_uv;
@@ -204,7 +204,7 @@ fn fin_varyings(index: u32, edge: u32, fade: f32) -> Varyings {
     out.slice = 0;
     // The surface uv of this end of the edge, from its corner in the first face.
     out.surface_uv = vec2<f32>(0.0);
-    if object.has_uvs != 0u && object.has_surface != 0u {
+    if uses_mesh_uvs() && object.has_surface != 0u {
         let face_a = topology[edges_start + 2u * object.edge_count + 2u * edge];
         for (var k = 0u; k < 3u; k++) {
             if topology[3u * face_a + k] == vertex {
