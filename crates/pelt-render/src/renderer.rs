@@ -139,13 +139,14 @@ impl FurRenderer {
         let surface = |walk: &str, mesh_uvs: bool| {
             let skin = format!("vs_skin_{walk}");
             let shell = format!("vs_shell_{walk}");
+            let shell_fragment = if mesh_uvs { "fs_shell_uvs" } else { "fs_shell_tiles" };
             let surface =
                 |label, layout, entries, kind| build_with(label, layout, entries, kind, (&[], Some(mesh_uvs)));
             SurfacePipelines {
                 plain: surface("pelt plain", &plain_layout, (&skin, "fs_plain"), PassKind::Opaque),
                 skin: surface("pelt skin", &fur_layout, (&skin, "fs_skin"), PassKind::Opaque),
                 shells: Transparency::BOTH
-                    .map(|t| surface("pelt shells", &fur_layout, (&shell, "fs_shell"), PassKind::Shells(t))),
+                    .map(|t| surface("pelt shells", &fur_layout, (&shell, shell_fragment), PassKind::Shells(t))),
             }
         };
         let corners = surface("corners", true);

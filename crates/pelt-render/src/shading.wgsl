@@ -99,6 +99,34 @@ struct Varyings {
     @location(10) tile_normal: vec3<f32>,
 }
 
+// What a unified shell fragment reads and nothing more: software rasterisers set up and
+// interpolate every declared varying of every triangle, read or not, and the shells are most of
+// the fur's triangles (BENCHMARKS.md: the full `Varyings` cost the shells about a quarter of
+// their frame). One struct per way of finding the texel; `height` and `slice` follow from the
+// flat layer.
+struct ShellTileVaryings {
+    @builtin(position) clip_position: vec4<f32>,
+    @location(0) world_position: vec3<f32>,
+    @location(1) normal: vec3<f32>,
+    @location(2) tangent: vec3<f32>,
+    // The root in tiles, model space, and the base normal picking its projection.
+    @location(3) tile_position: vec3<f32>,
+    @location(4) tile_normal: vec3<f32>,
+    @location(5) fade: f32,
+    @location(6) @interpolate(flat) layer: u32,
+}
+
+struct ShellUvVaryings {
+    @builtin(position) clip_position: vec4<f32>,
+    @location(0) world_position: vec3<f32>,
+    @location(1) normal: vec3<f32>,
+    @location(2) tangent: vec3<f32>,
+    // The mesh uv in tiles (xy) and at the strand's root (zw, surface colour mode).
+    @location(3) uvs: vec4<f32>,
+    @location(5) fade: f32,
+    @location(6) @interpolate(flat) layer: u32,
+}
+
 // Set per pipeline where every mesh it draws has uvs (1) or none has (2), so the shaders drop
 // the other case's varyings and fetches; 0 reads `object.has_uvs`.
 override MESH_UVS: u32 = 0u;
@@ -228,20 +256,16 @@ fn tile_axis(n: vec3<f32>) -> u32 {
     return select(2u, 1u, a.y >= a.z);
 }
 
-fn shell_texel(in: Varyings) -> vec4<f32> {
-    let slice = in.slice;
-    // `uses_mesh_uvs` reads a uniform, so sampling stays in uniform control flow.
-    if uses_mesh_uvs() {
-        return textureSample(shell_texture, shell_sampler, in.uv, slice);
-    }
-    // Without uvs, the one axis-aligned projection the surface faces most: one texture fetch a
-    // fragment, the largest part of a shell fragment's cost on software rasterisers (a blend of
-    // all three cost three). The tiles are strand dots, so the seams where the projection
-    // changes do not show (SSIM test in tests/lean.rs).
-    let p = in.tile_position;
-    let axis = tile_axis(in.tile_normal);
+// The shell texel of a mesh without uvs at `tile_position` (the root in tiles, model space).
+fn tile_texel(tile_position: vec3<f32>, tile_normal: vec3<f32>, layer: u32) -> vec4<f32> {
+    // The one axis-aligned projection the surface faces most: one texture fetch a fragment,
+    // the largest part of a shell fragment's cost on software rasterisers (a blend of all three
+    // cost three). The tiles are strand dots, so the seams where the projection changes do not
+    // show (SSIM test in tests/lean.rs).
+    let p = tile_position;
+    let axis = tile_axis(tile_normal);
     let uv = select(select(p.xy, p.zx, axis == 1u), p.yz, axis == 0u);
-    return textureSample(shell_texture, shell_sampler, uv, slice);
+    return textureSample(shell_texture, shell_sampler, uv, shell_slice(layer));
 }
 
 // Surface colour mode: the mesh's texture at the strand's root tints the strand's brightness.
@@ -276,14 +300,47 @@ fn fs_skin(in: Varyings) -> @location(0) vec4<f32> {
     return vec4<f32>(colour, 1.0);
 }
 
+// A shell fragment of `layer` from its texel: fading, level of detail and hair lighting.
+fn shell_colour(
+    texel: vec4<f32>,
+    surface_uv: vec2<f32>,
+    fade: f32,
+    layer: u32,
+    normal: vec3<f32>,
+    tangent: vec3<f32>,
+    world_position: vec3<f32>,
+) -> vec4<f32> {
+    let alpha = lod_alpha(texel.a * fade, layer);
+    let albedo = texel.rgb * surface_tint(surface_uv);
+    let colour = hair_lighting(albedo, normalize(tangent), normalize(normal), world_position, layer_height(layer));
+    return fur_output(colour, alpha);
+}
+
+// Shells of either kind of mesh (the separated structure), the kind read from the object.
 @fragment
 fn fs_shell(in: Varyings) -> @location(0) vec4<f32> {
-    let texel = shell_texel(in);
-    let alpha = lod_alpha(texel.a * in.fade, in.layer);
-    let normal = normalize(in.normal);
-    let albedo = texel.rgb * surface_tint(root_surface_uv(in));
-    let colour = hair_lighting(albedo, normalize(in.tangent), normal, in.world_position, in.height);
-    return fur_output(colour, alpha);
+    var texel: vec4<f32>;
+    // `uses_mesh_uvs` reads a uniform (or a constant), so sampling stays in uniform control flow.
+    if uses_mesh_uvs() {
+        texel = textureSample(shell_texture, shell_sampler, in.uv, shell_slice(in.layer));
+    } else {
+        texel = tile_texel(in.tile_position, in.tile_normal, in.layer);
+    }
+    return shell_colour(texel, root_surface_uv(in), in.fade, in.layer, in.normal, in.tangent, in.world_position);
+}
+
+// Unified shells of meshes without uvs (`vs_shell_indexed`).
+@fragment
+fn fs_shell_tiles(in: ShellTileVaryings) -> @location(0) vec4<f32> {
+    let texel = tile_texel(in.tile_position, in.tile_normal, in.layer);
+    return shell_colour(texel, vec2<f32>(0.0), in.fade, in.layer, in.normal, in.tangent, in.world_position);
+}
+
+// Unified shells of meshes with uvs (`vs_shell_corners`).
+@fragment
+fn fs_shell_uvs(in: ShellUvVaryings) -> @location(0) vec4<f32> {
+    let texel = textureSample(shell_texture, shell_sampler, in.uvs.xy, shell_slice(in.layer));
+    return shell_colour(texel, in.uvs.zw, in.fade, in.layer, in.normal, in.tangent, in.world_position);
 }
 
 @fragment
