@@ -127,6 +127,19 @@ struct ShellUvVaryings {
     @location(6) @interpolate(flat) layer: u32,
 }
 
+// What a unified fin fragment reads, for the same reason as the shells' structs.
+struct FinVaryings {
+    @builtin(position) clip_position: vec4<f32>,
+    @location(0) world_position: vec3<f32>,
+    @location(1) normal: vec3<f32>,
+    @location(2) tangent: vec3<f32>,
+    // (along the edge in tiles, height: 0 at the roots, 1 at the tips).
+    @location(3) uv: vec2<f32>,
+    @location(4) fade: f32,
+    // The mesh uv at this end of the edge (surface colour mode).
+    @location(5) surface_uv: vec2<f32>,
+}
+
 // Set per pipeline where every mesh it draws has uvs (1) or none has (2), so the shaders drop
 // the other case's varyings and fetches; 0 reads `object.has_uvs`.
 override MESH_UVS: u32 = 0u;
@@ -344,16 +357,16 @@ fn fs_shell_uvs(in: ShellUvVaryings) -> @location(0) vec4<f32> {
 }
 
 @fragment
-fn fs_fin(in: Varyings) -> @location(0) vec4<f32> {
+fn fs_fin(in: FinVaryings) -> @location(0) vec4<f32> {
     // Fin texture rows run from the tips (v = 0) to the roots (v = 1).
     let texel = textureSample(fin_texture, fin_sampler, vec2<f32>(in.uv.x, 1.0 - in.uv.y));
     // Several fins overlap along a silhouette; thinning them keeps the fringe from reading as a
     // solid band, most of all at the roots where the shells already cover.
-    let alpha = texel.a * in.fade * mix(0.15, 0.6, in.height);
+    let alpha = texel.a * in.fade * mix(0.15, 0.6, in.uv.y);
     let normal = normalize(in.normal);
     // Seen from the side the roots are less hidden than from above: lift the occlusion.
-    let height = sqrt(in.height);
-    let albedo = texel.rgb * surface_tint(root_surface_uv(in));
+    let height = sqrt(in.uv.y);
+    let albedo = texel.rgb * surface_tint(in.surface_uv);
     let colour = hair_lighting(albedo, normalize(in.tangent), normal, in.world_position, height);
     return fur_output(colour, alpha);
 }
