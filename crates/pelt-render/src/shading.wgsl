@@ -99,7 +99,7 @@ struct Varyings {
     @location(10) tile_normal: vec3<f32>,
 }
 
-// What a unified shell fragment reads and nothing more: software rasterisers set up and
+// What a shell fragment reads and nothing more: software rasterisers set up and
 // interpolate every declared varying of every triangle, read or not, and the shells are most of
 // the fur's triangles (BENCHMARKS.md: the full `Varyings` cost the shells about a quarter of
 // their frame). One struct per way of finding the texel; `height` and `slice` follow from the
@@ -329,27 +329,14 @@ fn shell_colour(
     return fur_output(colour, alpha);
 }
 
-// Shells of either kind of mesh (the separated structure), the kind read from the object.
-@fragment
-fn fs_shell(in: Varyings) -> @location(0) vec4<f32> {
-    var texel: vec4<f32>;
-    // `uses_mesh_uvs` reads a uniform (or a constant), so sampling stays in uniform control flow.
-    if uses_mesh_uvs() {
-        texel = textureSample(shell_texture, shell_sampler, in.uv, shell_slice(in.layer));
-    } else {
-        texel = tile_texel(in.tile_position, in.tile_normal, in.layer);
-    }
-    return shell_colour(texel, root_surface_uv(in), in.fade, in.layer, in.normal, in.tangent, in.world_position);
-}
-
-// Unified shells of meshes without uvs (`vs_shell_indexed`).
+// Shells of meshes without uvs (`vs_shell_indexed`, `vs_separated_shell_tiles`).
 @fragment
 fn fs_shell_tiles(in: ShellTileVaryings) -> @location(0) vec4<f32> {
     let texel = tile_texel(in.tile_position, in.tile_normal, in.layer);
     return shell_colour(texel, vec2<f32>(0.0), in.fade, in.layer, in.normal, in.tangent, in.world_position);
 }
 
-// Unified shells of meshes with uvs (`vs_shell_corners`).
+// Shells of meshes with uvs (`vs_shell_corners`, `vs_separated_shell_uvs`).
 @fragment
 fn fs_shell_uvs(in: ShellUvVaryings) -> @location(0) vec4<f32> {
     let texel = textureSample(shell_texture, shell_sampler, in.uvs.xy, shell_slice(in.layer));
