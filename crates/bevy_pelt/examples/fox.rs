@@ -8,46 +8,39 @@
 //! Right-drag orbits, the wheel zooms. 1, 2 and 3 play Survey, Walk and Run; Space pauses.
 //! `--screenshot PNG` saves a frame and exits.
 
-use std::path::Path;
+mod common;
 
-use bevy::core_pipeline::tonemapping::Tonemapping;
-use bevy::input::mouse::{AccumulatedMouseMotion, AccumulatedMouseScroll};
 use bevy::mesh::skinning::SkinnedMesh;
 use bevy::prelude::*;
-use bevy::render::view::screenshot::{Screenshot, save_to_disk};
 use bevy::world_serialization::WorldInstanceReady;
 use bevy_pelt::{Fur, PeltPlugin};
+use common::{Args, ExamplePlugin, Orbit};
 
 const FOX: &str = "meshes/Fox.glb";
 /// The Fox is about 100 units long; the scene is scaled to about a metre.
 const FOX_SCALE: f32 = 0.01;
 
 fn main() {
-    let args: Vec<String> = std::env::args().skip(1).collect();
-    let screenshot = args.iter().position(|a| a == "--screenshot").and_then(|i| args.get(i + 1)).cloned();
-    let preset = args.iter().find(|a| a.ends_with(".toml")).cloned().unwrap_or_else(|| "presets/mink.toml".to_owned());
-    let assets = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets");
     App::new()
         .add_plugins((
-            DefaultPlugins.set(AssetPlugin { file_path: assets.to_string_lossy().into_owned(), ..default() }).set(
-                WindowPlugin {
-                    primary_window: Some(Window { title: "Pelt in Bevy: Fox".into(), ..default() }),
-                    ..default()
-                },
-            ),
+            common::default_plugins("Pelt in Bevy: Fox"),
             PeltPlugin,
+            ExamplePlugin {
+                orbit: Orbit {
+                    yaw: 0.9,
+                    pitch: 0.2,
+                    distance: 2.6,
+                    distance_range: (0.8, 10.0),
+                    focus: Vec3::new(0.0, 0.5, 0.0),
+                },
+                sun_lux: 6000.0,
+                screenshot_frame: 120,
+            },
         ))
-        .insert_resource(Settings { preset, screenshot })
-        .init_resource::<Orbit>()
+        .insert_resource(Args::from_env())
         .add_systems(Startup, setup)
-        .add_systems(Update, (grow_fur, orbit, animation_keys, screenshot_then_exit))
+        .add_systems(Update, (grow_fur, animation_keys))
         .run();
-}
-
-#[derive(Resource)]
-struct Settings {
-    preset: String,
-    screenshot: Option<String>,
 }
 
 /// The clips (Survey, Walk, Run) as nodes of one animation graph.
@@ -57,26 +50,7 @@ struct Clips {
     graph: Handle<AnimationGraph>,
 }
 
-#[derive(Resource)]
-struct Orbit {
-    yaw: f32,
-    pitch: f32,
-    distance: f32,
-}
-
-impl Default for Orbit {
-    fn default() -> Self {
-        Self { yaw: 0.9, pitch: 0.2, distance: 2.6 }
-    }
-}
-
-fn setup(
-    mut commands: Commands,
-    mut meshes: ResMut<Assets<Mesh>>,
-    mut materials: ResMut<Assets<StandardMaterial>>,
-    mut graphs: ResMut<Assets<AnimationGraph>>,
-    assets: Res<AssetServer>,
-) {
+fn setup(mut commands: Commands, mut graphs: ResMut<Assets<AnimationGraph>>, assets: Res<AssetServer>) {
     let (graph, nodes) =
         AnimationGraph::from_clips((0..3).map(|k| assets.load(GltfAssetLabel::Animation(k).from_asset(FOX))));
     commands.insert_resource(Clips { nodes, graph: graphs.add(graph) });
@@ -86,16 +60,6 @@ fn setup(
             Transform::from_scale(Vec3::splat(FOX_SCALE)),
         ))
         .observe(play_walk);
-    commands.spawn((
-        Mesh3d(meshes.add(Plane3d::default().mesh().size(8.0, 8.0))),
-        MeshMaterial3d(materials.add(Color::srgb(0.35, 0.42, 0.3))),
-    ));
-    commands.spawn((
-        DirectionalLight { illuminance: 6000.0, shadow_maps_enabled: true, ..default() },
-        Transform::from_xyz(3.0, 6.0, 2.0).looking_at(Vec3::ZERO, Vec3::Y),
-    ));
-    // ACES needs no lookup tables (the crate leaves Bevy's `tonemapping_luts` feature off).
-    commands.spawn((Camera3d::default(), Tonemapping::AcesFitted, Transform::default()));
     info!("right-drag orbits, wheel zooms; 1/2/3 Survey/Walk/Run, Space pauses");
 }
 
@@ -119,11 +83,11 @@ fn play_walk(
 fn grow_fur(
     mut commands: Commands,
     skinned: Query<Entity, Added<SkinnedMesh>>,
-    settings: Res<Settings>,
+    args: Res<Args>,
     assets: Res<AssetServer>,
 ) {
     for entity in &skinned {
-        commands.entity(entity).insert(Fur::new(assets.load(settings.preset.clone())).without_skin());
+        commands.entity(entity).insert(Fur::new(assets.load(args.preset.clone())).without_skin());
     }
 }
 
@@ -142,40 +106,5 @@ fn animation_keys(keys: Res<ButtonInput<KeyCode>>, clips: Res<Clips>, mut player
                 player.pause_all();
             }
         }
-    }
-}
-
-fn orbit(
-    mut orbit: ResMut<Orbit>,
-    buttons: Res<ButtonInput<MouseButton>>,
-    motion: Res<AccumulatedMouseMotion>,
-    scroll: Res<AccumulatedMouseScroll>,
-    mut cameras: Query<&mut Transform, With<Camera3d>>,
-) {
-    if buttons.pressed(MouseButton::Right) {
-        orbit.yaw -= motion.delta.x * 0.008;
-        orbit.pitch = (orbit.pitch + motion.delta.y * 0.008).clamp(-0.2, 1.4);
-    }
-    orbit.distance = (orbit.distance * (1.0 - scroll.delta.y * 0.1)).clamp(0.8, 10.0);
-    let focus = Vec3::new(0.0, 0.5, 0.0);
-    let offset = Quat::from_euler(EulerRot::YXZ, orbit.yaw, -orbit.pitch, 0.0) * Vec3::Z * orbit.distance;
-    for mut transform in &mut cameras {
-        *transform = Transform::from_translation(focus + offset).looking_at(focus, Vec3::Y);
-    }
-}
-
-fn screenshot_then_exit(
-    mut commands: Commands,
-    settings: Res<Settings>,
-    mut frames: Local<u32>,
-    mut exit: MessageWriter<AppExit>,
-) {
-    let Some(path) = &settings.screenshot else { return };
-    *frames += 1;
-    if *frames == 120 {
-        commands.spawn(Screenshot::primary_window()).observe(save_to_disk(path.clone()));
-    }
-    if *frames == 130 {
-        exit.write(AppExit::Success);
     }
 }

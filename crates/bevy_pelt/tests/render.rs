@@ -386,6 +386,10 @@ fn the_foxs_fur_follows_bevys_animation() {
     const FOX: &str = "meshes/Fox.glb";
     let repository_assets = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets");
     let mut app = headless_app(&repository_assets);
+    // Each frame a sixtieth of a second, however fast the machine draws: the simulation steps
+    // at its own rate, so on wall-clock time a fast frame would not step it, and the roots
+    // would still be where the last step left them.
+    app.insert_resource(bevy::time::TimeUpdateStrategy::ManualDuration(std::time::Duration::from_secs_f64(1.0 / 60.0)));
     let world = app.world_mut();
     let mut target = Image::new_target_texture(SIZE, SIZE, TextureFormat::Rgba8UnormSrgb, None);
     target.asset_usage = RenderAssetUsages::RENDER_WORLD;
@@ -439,7 +443,8 @@ fn the_foxs_fur_follows_bevys_animation() {
             }
             std::thread::sleep(std::time::Duration::from_millis(10));
         }
-        for _ in 0..3 {
+        // Enough steps for the simulation's interpolated positions to be the new pose's.
+        for _ in 0..6 {
             update(&mut app);
         }
         let world = app.world_mut();
@@ -451,8 +456,36 @@ fn the_foxs_fur_follows_bevys_animation() {
             .map(|p| Vec3::from_array(world_from_simulation.transform_point3(*p).to_array()))
             .collect();
         let expected = bevy_skinned_positions(world, fox);
+        let (camera, camera_transform) = world.query::<(&Camera, &GlobalTransform)>().single(world).unwrap();
+        // The vertices in the picture (the tail's tip leaves it), two pixels from its edges.
+        let inside = |p: &Vec2| p.min_element() >= 2.0 && p.max_element() <= (SIZE - 2) as f32;
+        let pixels: Vec<Vec2> = expected
+            .iter()
+            .filter_map(|p| camera.world_to_viewport(camera_transform, *p).ok())
+            .filter(inside)
+            .collect();
+        assert!(pixels.len() * 10 > expected.len() * 8, "{} of {} vertices in view", pixels.len(), expected.len());
         let image = capture_now(&mut app, &target);
         save(&image, &format!("fox-{time_secs}"));
+        // The drawn fur is where Bevy's skinning puts the mesh now: every skinned vertex lies on
+        // a pixel the fur's skin or strands cover (or next to one: rasteriser edges).
+        let clear = *image.get_pixel(0, 0);
+        let covered = |x: i64, y: i64| {
+            let (Ok(x), Ok(y)) = (u32::try_from(x), u32::try_from(y)) else { return false };
+            x < SIZE && y < SIZE && image.get_pixel(x, y).0.iter().zip(clear.0).take(3).any(|(&a, b)| a.abs_diff(b) > 8)
+        };
+        let on_fur = pixels
+            .iter()
+            .filter(|p| {
+                let (x, y) = (p.x.floor() as i64, p.y.floor() as i64);
+                (-1..=1).any(|dy| (-1..=1).any(|dx| covered(x + dx, y + dy)))
+            })
+            .count();
+        assert!(
+            on_fur as f32 >= 0.99 * pixels.len() as f32,
+            "at {time_secs} s only {on_fur} of {} skinned vertices fall on drawn fur",
+            pixels.len()
+        );
         poses.push((roots, expected, image));
     }
     let size = farthest_nearest(&poses[0].1, &[Vec3::ZERO]);
@@ -463,6 +496,14 @@ fn the_foxs_fur_follows_bevys_animation() {
     }
     let moved = farthest_nearest(&poses[0].1, &poses[1].1);
     assert!(moved > 0.02 * size, "the walk moves the mesh ({moved} of {size})");
+    // The fur is drawn (the Fox's own material is gone, so nothing else covers the clear
+    // colour in the corner), and the drawn fur moves with the walk.
+    for (_, _, image) in &poses {
+        let clear = *image.get_pixel(0, 0);
+        let covered =
+            image.pixels().filter(|p| p.0.iter().zip(clear.0).take(3).any(|(&a, b)| a.abs_diff(b) > 8)).count();
+        assert!(covered > 1000, "the Fox's fur covers {covered} pixels");
+    }
     let changed = poses[0].2.pixels().zip(poses[1].2.pixels()).filter(|(a, b)| a != b).count();
     assert!(changed > 200, "{changed} pixels changed between the two times");
 }
