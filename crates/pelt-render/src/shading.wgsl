@@ -203,20 +203,29 @@ fn surface_lighting(albedo: vec3<f32>, normal: vec3<f32>) -> vec3<f32> {
     return albedo * (view.ambient + view.light_colour * wrapped);
 }
 
+// Shell slices are sampled a mip level sharper than the hardware's choice: trilinear filtering
+// at its level spreads a strand over about twice a pixel's footprint, which `pelt fidelity`
+// measures as the largest loss against the explicit strands (FIDELITY.md).
+const SHELL_LOD_BIAS: f32 = -1.0;
+
+fn sample_shell(uv: vec2<f32>, slice: i32) -> vec4<f32> {
+    return textureSampleBias(shell_texture, shell_sampler, uv, slice, SHELL_LOD_BIAS);
+}
+
 fn shell_texel(in: Varyings) -> vec4<f32> {
     let slice = in.slice;
     // `uses_mesh_uvs` reads a uniform, so sampling stays in uniform control flow.
     if uses_mesh_uvs() {
-        return textureSample(shell_texture, shell_sampler, in.uv, slice);
+        return sample_shell(in.uv, slice);
     }
     // Triplanar: three axis-aligned projections of the tile, blended with sharp weights so the
     // strands stay crisp and only narrow bands mix two projections.
     let weights_raw = pow(abs(in.tile_normal), vec3<f32>(6.0));
     let weights = weights_raw / max(weights_raw.x + weights_raw.y + weights_raw.z, 1e-6);
     let p = in.tile_position;
-    let x = textureSample(shell_texture, shell_sampler, p.yz, slice);
-    let y = textureSample(shell_texture, shell_sampler, p.zx, slice);
-    let z = textureSample(shell_texture, shell_sampler, p.xy, slice);
+    let x = sample_shell(p.yz, slice);
+    let y = sample_shell(p.zx, slice);
+    let z = sample_shell(p.xy, slice);
     return x * weights.x + y * weights.y + z * weights.z;
 }
 
