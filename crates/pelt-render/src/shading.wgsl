@@ -203,10 +203,11 @@ fn surface_lighting(albedo: vec3<f32>, normal: vec3<f32>) -> vec3<f32> {
     return albedo * (view.ambient + view.light_colour * wrapped);
 }
 
-// Shell slices are sampled a mip level sharper than the hardware's choice: trilinear filtering
-// at its level spreads a strand over about twice a pixel's footprint, which `pelt fidelity`
-// measures as the largest loss against the explicit strands (FIDELITY.md).
-const SHELL_LOD_BIAS: f32 = -1.0;
+// Shell slices are sampled half a mip level sharper than the hardware's choice: trilinear
+// filtering at its level spreads a strand over about twice a pixel's footprint, which `pelt
+// fidelity` measures as the largest loss against the explicit strands (FIDELITY.md). A whole
+// level sharper measures closer still but makes moving fur flicker (cli_render's fox test).
+const SHELL_LOD_BIAS: f32 = -0.5;
 
 fn sample_shell(uv: vec2<f32>, slice: i32) -> vec4<f32> {
     return textureSampleBias(shell_texture, shell_sampler, uv, slice, SHELL_LOD_BIAS);
