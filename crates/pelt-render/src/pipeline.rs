@@ -143,6 +143,10 @@ pub(crate) enum PassKind {
 
 /// One pipeline's shader and vertex input.
 pub(crate) struct PipelineSource<'a> {
+    /// Whether every mesh the pipeline draws has uvs, where that is known (the unified
+    /// renderer walks meshes with and without them through separate pipelines): the shaders
+    /// then drop the other case's varyings and fetches (`MESH_UVS` in `shading.wgsl`).
+    pub mesh_uvs: Option<bool>,
     pub layout: &'a wgpu::PipelineLayout,
     pub module: &'a wgpu::ShaderModule,
     pub vertex_entry: &'a str,
@@ -170,7 +174,12 @@ pub(crate) fn create_pipeline(
         PassKind::Fins(_) => None,
         PassKind::Opaque | PassKind::Shells(_) => Some(wgpu::Face::Back),
     };
-    let constants = [("ALPHA_TO_COVERAGE", if coverage { 1.0 } else { 0.0 })];
+    let mesh_uvs = match source.mesh_uvs {
+        None => 0.0,
+        Some(true) => 1.0,
+        Some(false) => 2.0,
+    };
+    let constants = [("ALPHA_TO_COVERAGE", if coverage { 1.0 } else { 0.0 }), ("MESH_UVS", mesh_uvs)];
     let compilation_options = wgpu::PipelineCompilationOptions { constants: &constants, ..Default::default() };
     device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
         label: Some(label),

@@ -121,34 +121,41 @@ impl FurRenderer {
         });
         let fur_layout = layouts.pipeline_layout(device, "pelt unified", &layouts.unified_object, true);
         let plain_layout = layouts.pipeline_layout(device, "pelt plain", &layouts.unified_object, false);
-        let build_with = |label: &str,
-                          layout: &wgpu::PipelineLayout,
-                          (vertex_entry, fragment_entry): (&str, &str),
-                          kind: PassKind,
-                          buffers: &[Option<wgpu::VertexBufferLayout<'_>>]| {
-            let source = PipelineSource { layout, module: &module, vertex_entry, fragment_entry, buffers };
-            create_pipeline(device, &target, label, &source, kind)
-        };
+        let build_with =
+            |label: &str,
+             layout: &wgpu::PipelineLayout,
+             (vertex_entry, fragment_entry): (&str, &str),
+             kind: PassKind,
+             (buffers, mesh_uvs): (&[Option<wgpu::VertexBufferLayout<'_>>], Option<bool>)| {
+                let source =
+                    PipelineSource { mesh_uvs, layout, module: &module, vertex_entry, fragment_entry, buffers };
+                create_pipeline(device, &target, label, &source, kind)
+            };
         let build = |label: &str, layout: &wgpu::PipelineLayout, entries: (&str, &str), kind: PassKind| {
-            build_with(label, layout, entries, kind, &[])
+            build_with(label, layout, entries, kind, (&[], None))
         };
-        let surface = |walk: &str| {
+        // Meshes with uvs walk the corners, meshes without are indexed: each walk's pipelines
+        // know which, and drop the other's work.
+        let surface = |walk: &str, mesh_uvs: bool| {
             let skin = format!("vs_skin_{walk}");
             let shell = format!("vs_shell_{walk}");
+            let shell_fragment = if mesh_uvs { "fs_shell_uvs" } else { "fs_shell_tiles" };
+            let surface =
+                |label, layout, entries, kind| build_with(label, layout, entries, kind, (&[], Some(mesh_uvs)));
             SurfacePipelines {
-                plain: build("pelt plain", &plain_layout, (&skin, "fs_plain"), PassKind::Opaque),
-                skin: build("pelt skin", &fur_layout, (&skin, "fs_skin"), PassKind::Opaque),
+                plain: surface("pelt plain", &plain_layout, (&skin, "fs_plain"), PassKind::Opaque),
+                skin: surface("pelt skin", &fur_layout, (&skin, "fs_skin"), PassKind::Opaque),
                 shells: Transparency::BOTH
-                    .map(|t| build("pelt shells", &fur_layout, (&shell, "fs_shell"), PassKind::Shells(t))),
+                    .map(|t| surface("pelt shells", &fur_layout, (&shell, shell_fragment), PassKind::Shells(t))),
             }
         };
-        let corners = surface("corners");
-        let indexed = surface("indexed");
+        let corners = surface("corners", true);
+        let indexed = surface("indexed", false);
         let fins = Transparency::BOTH.map(|t| build("pelt fins", &fur_layout, ("vs_fin", "fs_fin"), PassKind::Fins(t)));
         let instances = [Some(FIN_INSTANCE_LAYOUT)];
         let silhouette_fins = Transparency::BOTH.map(|t| {
             let entries = ("vs_fin_silhouette", "fs_fin");
-            build_with("pelt silhouette fins", &fur_layout, entries, PassKind::Fins(t), &instances)
+            build_with("pelt silhouette fins", &fur_layout, entries, PassKind::Fins(t), (&instances, None))
         });
         let silhouette = silhouette_pipeline(device, &layouts);
         scope.pop("building the fur pipelines")?;

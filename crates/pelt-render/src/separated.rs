@@ -52,7 +52,8 @@ pub struct SeparatedRenderer {
     target: FurTarget,
     skin: wgpu::RenderPipeline,
     /// Blended, alpha-to-coverage.
-    shells: [wgpu::RenderPipeline; 2],
+    /// Meshes without uvs, with uvs; each blended, alpha-to-coverage.
+    shells: [[wgpu::RenderPipeline; 2]; 2],
     fins: [wgpu::RenderPipeline; 2],
 }
 
@@ -75,8 +76,9 @@ impl SeparatedRenderer {
             step_mode: wgpu::VertexStepMode::Vertex,
             attributes: &wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x2],
         })];
-        let build = |label: &str, (vertex_entry, fragment_entry), kind| {
+        let build_for = |label: &str, (vertex_entry, fragment_entry), kind, mesh_uvs| {
             let source = PipelineSource {
+                mesh_uvs,
                 layout: &layout,
                 module: &module,
                 vertex_entry,
@@ -85,9 +87,16 @@ impl SeparatedRenderer {
             };
             create_pipeline(device, &target, label, &source, kind)
         };
+        let build = |label: &str, entries, kind| build_for(label, entries, kind, None);
         let skin = build("pelt separated skin", ("vs_separated_skin", "fs_skin"), PassKind::Opaque);
-        let shells = Transparency::BOTH
-            .map(|t| build("pelt separated shells", ("vs_separated_shell", "fs_shell"), PassKind::Shells(t)));
+        // Without uvs, with uvs: each passes on only what its fragments read.
+        let shells = [("vs_separated_shell_tiles", "fs_shell_tiles"), ("vs_separated_shell_uvs", "fs_shell_uvs")].map(
+            |entries| {
+                let mesh_uvs = entries.1 == "fs_shell_uvs";
+                Transparency::BOTH
+                    .map(|t| build_for("pelt separated shells", entries, PassKind::Shells(t), Some(mesh_uvs)))
+            },
+        );
         let fins = Transparency::BOTH
             .map(|t| build("pelt separated fins", ("vs_separated_fin", "fs_separated_fin"), PassKind::Fins(t)));
         scope.pop("building the separated pipelines")?;
@@ -119,7 +128,7 @@ impl SeparatedRenderer {
             pass.draw_indexed(0..fur.index_count, 0, 0..1);
         }
         if settings.shells {
-            pass.set_pipeline(&self.shells[which]);
+            pass.set_pipeline(&self.shells[usize::from(fur.shape.has_uvs)][which]);
             for layer in fur.level.shell_layers(fur.shape.layers) {
                 pass.draw_indexed(0..fur.index_count, (layer * fur.shape.vertex_count) as i32, layer..layer + 1);
             }

@@ -31,8 +31,31 @@ fn vs_separated_skin(in: VertexIn) -> Varyings {
 }
 
 // Shells: one draw per layer with a base-vertex offset; the instance index carries the layer.
+// Meshes without uvs and with them pass on what `fs_shell_tiles` and `fs_shell_uvs` read, as
+// the unified shells do.
 @vertex
-fn vs_separated_shell(in: VertexIn, @builtin(instance_index) layer: u32) -> Varyings {
+fn vs_separated_shell_tiles(in: VertexIn, @builtin(instance_index) layer: u32) -> ShellTileVaryings {
+    let v = separated_shell(in, layer);
+    return ShellTileVaryings(
+        v.clip_position,
+        v.world_position,
+        v.normal,
+        v.tangent,
+        v.tile_position,
+        v.tile_normal,
+        v.fade,
+        v.layer,
+    );
+}
+
+@vertex
+fn vs_separated_shell_uvs(in: VertexIn, @builtin(instance_index) layer: u32) -> ShellUvVaryings {
+    let v = separated_shell(in, layer);
+    let uvs = vec4<f32>(v.uv, v.surface_uv);
+    return ShellUvVaryings(v.clip_position, v.world_position, v.normal, v.tangent, uvs, v.fade, v.layer);
+}
+
+fn separated_shell(in: VertexIn, layer: u32) -> Varyings {
     var out: Varyings;
     let position = world_from_model_point(in.position);
     out.clip_position = view.clip_from_world * vec4<f32>(position, 1.0);

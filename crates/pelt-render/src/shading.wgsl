@@ -94,13 +94,69 @@ struct Varyings {
     @location(8) @interpolate(flat) slice: i32,
     // The mesh uv at the strand's root (surface colour mode).
     @location(9) surface_uv: vec2<f32>,
-    // Shells: the base normal in model space, weighting the triplanar projections (which are
-    // fixed to the model, so they move with it).
+    // Shells without mesh uvs: the base normal in model space, which picks the axis-aligned
+    // projection of the tiles (fixed to the model, so it moves with it).
     @location(10) tile_normal: vec3<f32>,
 }
 
+// What a shell fragment reads and nothing more: software rasterisers set up and
+// interpolate every declared varying of every triangle, read or not, and the shells are most of
+// the fur's triangles (BENCHMARKS.md: the full `Varyings` cost the shells about a quarter of
+// their frame). One struct per way of finding the texel; `height` and `slice` follow from the
+// flat layer.
+struct ShellTileVaryings {
+    @builtin(position) clip_position: vec4<f32>,
+    @location(0) world_position: vec3<f32>,
+    @location(1) normal: vec3<f32>,
+    @location(2) tangent: vec3<f32>,
+    // The root in tiles, model space, and the base normal picking its projection.
+    @location(3) tile_position: vec3<f32>,
+    @location(4) tile_normal: vec3<f32>,
+    @location(5) fade: f32,
+    @location(6) @interpolate(flat) layer: u32,
+}
+
+struct ShellUvVaryings {
+    @builtin(position) clip_position: vec4<f32>,
+    @location(0) world_position: vec3<f32>,
+    @location(1) normal: vec3<f32>,
+    @location(2) tangent: vec3<f32>,
+    // The mesh uv in tiles (xy) and at the strand's root (zw, surface colour mode).
+    @location(3) uvs: vec4<f32>,
+    @location(5) fade: f32,
+    @location(6) @interpolate(flat) layer: u32,
+}
+
+// What a unified fin fragment reads, for the same reason as the shells' structs.
+struct FinVaryings {
+    @builtin(position) clip_position: vec4<f32>,
+    @location(0) world_position: vec3<f32>,
+    @location(1) normal: vec3<f32>,
+    @location(2) tangent: vec3<f32>,
+    // (along the edge in tiles, height: 0 at the roots, 1 at the tips).
+    @location(3) uv: vec2<f32>,
+    @location(4) fade: f32,
+    // The mesh uv at this end of the edge (surface colour mode).
+    @location(5) surface_uv: vec2<f32>,
+}
+
+// Set per pipeline where every mesh it draws has uvs (1) or none has (2), so the shaders drop
+// the other case's varyings and fetches; 0 reads `object.has_uvs`.
+override MESH_UVS: u32 = 0u;
+
 fn uses_mesh_uvs() -> bool {
-    return object.has_uvs != 0u;
+    if MESH_UVS == 0u {
+        return object.has_uvs != 0u;
+    }
+    return MESH_UVS == 1u;
+}
+
+// The mesh uv at the strand's root: always the origin for meshes without uvs.
+fn root_surface_uv(in: Varyings) -> vec2<f32> {
+    if MESH_UVS == 2u {
+        return vec2<f32>(0.0);
+    }
+    return in.surface_uv;
 }
 
 fn safe_normalize(v: vec3<f32>, fallback: vec3<f32>) -> vec3<f32> {
@@ -213,21 +269,26 @@ fn sample_shell(uv: vec2<f32>, slice: i32) -> vec4<f32> {
     return textureSampleBias(shell_texture, shell_sampler, uv, slice, SHELL_LOD_BIAS);
 }
 
-fn shell_texel(in: Varyings) -> vec4<f32> {
-    let slice = in.slice;
-    // `uses_mesh_uvs` reads a uniform, so sampling stays in uniform control flow.
-    if uses_mesh_uvs() {
-        return sample_shell(in.uv, slice);
+// The axis-aligned projection of the tiles for a surface with model-space normal `n`: the axis it
+// faces most (0 = x, 1 = y, 2 = z).
+fn tile_axis(n: vec3<f32>) -> u32 {
+    let a = abs(n);
+    if a.x >= a.y && a.x >= a.z {
+        return 0u;
     }
-    // Triplanar: three axis-aligned projections of the tile, blended with sharp weights so the
-    // strands stay crisp and only narrow bands mix two projections.
-    let weights_raw = pow(abs(in.tile_normal), vec3<f32>(6.0));
-    let weights = weights_raw / max(weights_raw.x + weights_raw.y + weights_raw.z, 1e-6);
-    let p = in.tile_position;
-    let x = sample_shell(p.yz, slice);
-    let y = sample_shell(p.zx, slice);
-    let z = sample_shell(p.xy, slice);
-    return x * weights.x + y * weights.y + z * weights.z;
+    return select(2u, 1u, a.y >= a.z);
+}
+
+// The shell texel of a mesh without uvs at `tile_position` (the root in tiles, model space).
+fn tile_texel(tile_position: vec3<f32>, tile_normal: vec3<f32>, layer: u32) -> vec4<f32> {
+    // The one axis-aligned projection the surface faces most: one texture fetch a fragment,
+    // the largest part of a shell fragment's cost on software rasterisers (a blend of all three
+    // cost three). The tiles are strand dots, so the seams where the projection changes do not
+    // show (SSIM test in tests/lean.rs).
+    let p = tile_position;
+    let axis = tile_axis(tile_normal);
+    let uv = select(select(p.xy, p.zx, axis == 1u), p.yz, axis == 0u);
+    return sample_shell(uv, shell_slice(layer));
 }
 
 // Surface colour mode: the mesh's texture at the strand's root tints the strand's brightness.
@@ -257,31 +318,51 @@ fn fs_plain(in: Varyings) -> @location(0) vec4<f32> {
 @fragment
 fn fs_skin(in: Varyings) -> @location(0) vec4<f32> {
     let normal = normalize(in.normal);
-    let albedo = object.colour.rgb * surface_tint(in.surface_uv);
+    let albedo = object.colour.rgb * surface_tint(root_surface_uv(in));
     let colour = surface_lighting(albedo, normal) * object.root_occlusion;
     return vec4<f32>(colour, 1.0);
 }
 
-@fragment
-fn fs_shell(in: Varyings) -> @location(0) vec4<f32> {
-    let texel = shell_texel(in);
-    let alpha = lod_alpha(texel.a * in.fade, in.layer);
-    let normal = normalize(in.normal);
-    let albedo = texel.rgb * surface_tint(in.surface_uv);
-    let colour = hair_lighting(albedo, normalize(in.tangent), normal, in.world_position, in.height);
+// A shell fragment of `layer` from its texel: fading, level of detail and hair lighting.
+fn shell_colour(
+    texel: vec4<f32>,
+    surface_uv: vec2<f32>,
+    fade: f32,
+    layer: u32,
+    normal: vec3<f32>,
+    tangent: vec3<f32>,
+    world_position: vec3<f32>,
+) -> vec4<f32> {
+    let alpha = lod_alpha(texel.a * fade, layer);
+    let albedo = texel.rgb * surface_tint(surface_uv);
+    let colour = hair_lighting(albedo, normalize(tangent), normalize(normal), world_position, layer_height(layer));
     return fur_output(colour, alpha);
 }
 
+// Shells of meshes without uvs (`vs_shell_indexed`, `vs_separated_shell_tiles`).
 @fragment
-fn fs_fin(in: Varyings) -> @location(0) vec4<f32> {
+fn fs_shell_tiles(in: ShellTileVaryings) -> @location(0) vec4<f32> {
+    let texel = tile_texel(in.tile_position, in.tile_normal, in.layer);
+    return shell_colour(texel, vec2<f32>(0.0), in.fade, in.layer, in.normal, in.tangent, in.world_position);
+}
+
+// Shells of meshes with uvs (`vs_shell_corners`, `vs_separated_shell_uvs`).
+@fragment
+fn fs_shell_uvs(in: ShellUvVaryings) -> @location(0) vec4<f32> {
+    let texel = sample_shell(in.uvs.xy, shell_slice(in.layer));
+    return shell_colour(texel, in.uvs.zw, in.fade, in.layer, in.normal, in.tangent, in.world_position);
+}
+
+@fragment
+fn fs_fin(in: FinVaryings) -> @location(0) vec4<f32> {
     // Fin texture rows run from the tips (v = 0) to the roots (v = 1).
     let texel = textureSample(fin_texture, fin_sampler, vec2<f32>(in.uv.x, 1.0 - in.uv.y));
     // Several fins overlap along a silhouette; thinning them keeps the fringe from reading as a
     // solid band, most of all at the roots where the shells already cover.
-    let alpha = texel.a * in.fade * mix(0.15, 0.6, in.height);
+    let alpha = texel.a * in.fade * mix(0.15, 0.6, in.uv.y);
     let normal = normalize(in.normal);
     // Seen from the side the roots are less hidden than from above: lift the occlusion.
-    let height = sqrt(in.height);
+    let height = sqrt(in.uv.y);
     let albedo = texel.rgb * surface_tint(in.surface_uv);
     let colour = hair_lighting(albedo, normalize(in.tangent), normal, in.world_position, height);
     return fur_output(colour, alpha);

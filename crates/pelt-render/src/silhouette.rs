@@ -121,7 +121,10 @@ impl FinList {
         let instances = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("pelt fin instances"),
             size: instance_bytes,
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::VERTEX,
+            usage: wgpu::BufferUsages::STORAGE
+                | wgpu::BufferUsages::VERTEX
+                | wgpu::BufferUsages::COPY_DST
+                | wgpu::BufferUsages::COPY_SRC,
             mapped_at_creation: false,
         });
         let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
@@ -154,6 +157,17 @@ impl FinList {
         pass.set_bind_group(1, object, &[]);
         pass.set_bind_group(3, &self.bind_group, &[]);
         pass.dispatch_workgroups(self.edge_count.div_ceil(WORKGROUP_EDGES), 1, 1);
+    }
+
+    /// Writes a list decided on the CPU (`(edge, fade bits)` per fin, at most `E`) and its
+    /// indirect draw of `segments` segments a fin, in place of the compute pass.
+    pub fn write(&self, queue: &wgpu::Queue, fins: &[[u32; 2]], segments: u32) {
+        let fins = &fins[..fins.len().min(self.edge_count as usize)];
+        if !fins.is_empty() {
+            queue.write_buffer(&self.instances, 0, bytemuck::cast_slice(fins));
+        }
+        let args: [u32; 5] = [6 * segments, fins.len() as u32, 0, 0, 0];
+        queue.write_buffer(&self.draw, 0, bytemuck::cast_slice(&args));
     }
 
     /// GPU bytes of the list.

@@ -81,7 +81,7 @@ fn surface_varyings(vertex: u32, corner: u32, layer: u32) -> Varyings {
         out.tangent = strand_tangent(layer, vertex, here, out.normal);
     }
     out.tile_normal = rest_normal;
-    if object.has_uvs != 0u {
+    if uses_mesh_uvs() {
         out.tile_position = vec3<f32>(0.0);
         out.surface_uv = corner_uvs[corner];
         out.uv = out.surface_uv * object.tiles_per_uv;
@@ -117,19 +117,30 @@ fn vs_skin_indexed(@builtin(vertex_index) vertex: u32) -> Varyings {
     return surface_varyings(vertex, 0u, 0u);
 }
 
-// Shells: instance k draws the level of detail's shell k (layer k + 1 at full detail).
+// Shells: instance k draws the level of detail's shell k (layer k + 1 at full detail), passing
+// on only what their fragments read (the rest of `surface_varyings` is compiled away).
 @vertex
-fn vs_shell_corners(@builtin(vertex_index) corner: u32, @builtin(instance_index) instance: u32) -> Varyings {
-    var out = surface_varyings(triangle_vertex(corner), corner, lod_shell_layer(instance));
-    out.fade = shell_fade(out.normal, out.world_position);
-    return out;
+fn vs_shell_corners(@builtin(vertex_index) corner: u32, @builtin(instance_index) instance: u32) -> ShellUvVaryings {
+    let v = surface_varyings(triangle_vertex(corner), corner, lod_shell_layer(instance));
+    let fade = shell_fade(v.normal, v.world_position);
+    let uvs = vec4<f32>(v.uv, v.surface_uv);
+    return ShellUvVaryings(v.clip_position, v.world_position, v.normal, v.tangent, uvs, fade, v.layer);
 }
 
 @vertex
-fn vs_shell_indexed(@builtin(vertex_index) vertex: u32, @builtin(instance_index) instance: u32) -> Varyings {
-    var out = surface_varyings(vertex, 0u, lod_shell_layer(instance));
-    out.fade = shell_fade(out.normal, out.world_position);
-    return out;
+fn vs_shell_indexed(@builtin(vertex_index) vertex: u32, @builtin(instance_index) instance: u32) -> ShellTileVaryings {
+    let v = surface_varyings(vertex, 0u, lod_shell_layer(instance));
+    let fade = shell_fade(v.normal, v.world_position);
+    return ShellTileVaryings(
+        v.clip_position,
+        v.world_position,
+        v.normal,
+        v.tangent,
+        v.tile_position,
+        v.tile_normal,
+        fade,
+        v.layer,
+    );
 }
 
 fn hash(x: u32) -> u32 {
@@ -179,7 +190,7 @@ fn fin_node(layer: u32, vertex: u32) -> vec3<f32> {
 }
 
 // The fin vertex `index` of a shown `edge` (fade > 0): node `index / 2` of the level of detail.
-fn fin_varyings(index: u32, edge: u32, fade: f32) -> Varyings {
+fn fin_varyings(index: u32, edge: u32, fade: f32) -> FinVaryings {
     let side = index % 2u;
     let layer = lod_fin_layer(index / 2u);
     let edges_start = 3u * object.triangle_count;
@@ -187,7 +198,7 @@ fn fin_varyings(index: u32, edge: u32, fade: f32) -> Varyings {
     let b = topology[edges_start + 2u * edge + 1u];
     let vertex = select(a, b, side == 1u);
 
-    var out: Varyings;
+    var out: FinVaryings;
     let here = fin_node(layer, vertex);
     let position = world_from_model_point(here);
     out.clip_position = view.clip_from_world * vec4<f32>(position, 1.0);
@@ -195,16 +206,12 @@ fn fin_varyings(index: u32, edge: u32, fade: f32) -> Varyings {
     let normal_a = world_from_model_normal(model_normal(a));
     out.normal = safe_normalize(normal_a + world_from_model_normal(model_normal(b)), normal_a);
     out.tangent = strand_tangent(layer, vertex, here, out.normal);
-    out.tile_position = vec3<f32>(0.0);
-    out.tile_normal = vec3<f32>(0.0);
     let offset = f32(hash(edge) & 0xffffu) / 65536.0;
     let along = f32(side) * distance(model_vertex(0u, a), model_vertex(0u, b)) * object.tiles_per_world;
     out.uv = vec2<f32>(offset + along, layer_height(layer));
-    out.layer = 0u;
-    out.slice = 0;
     // The surface uv of this end of the edge, from its corner in the first face.
     out.surface_uv = vec2<f32>(0.0);
-    if object.has_uvs != 0u && object.has_surface != 0u {
+    if uses_mesh_uvs() && object.has_surface != 0u {
         let face_a = topology[edges_start + 2u * object.edge_count + 2u * edge];
         for (var k = 0u; k < 3u; k++) {
             if topology[3u * face_a + k] == vertex {
@@ -212,7 +219,6 @@ fn fin_varyings(index: u32, edge: u32, fade: f32) -> Varyings {
             }
         }
     }
-    out.height = out.uv.y;
     out.fade = fade;
     return out;
 }
@@ -220,12 +226,12 @@ fn fin_varyings(index: u32, edge: u32, fade: f32) -> Varyings {
 // Every edge (instance = edge), each vertex deciding whether its edge shows: for hosts that
 // record no silhouette pass.
 @vertex
-fn vs_fin(@builtin(vertex_index) index: u32, @builtin(instance_index) edge: u32) -> Varyings {
+fn vs_fin(@builtin(vertex_index) index: u32, @builtin(instance_index) edge: u32) -> FinVaryings {
     let fade = fin_fade(edge);
     if fade <= 0.0 {
         // Invisible fin (most of them): every vertex of the edge lands outside the clip volume,
         // so it costs no rasterisation, and returning now skips the rest of the shading.
-        var out: Varyings;
+        var out: FinVaryings;
         out.clip_position = vec4<f32>(2.0, 2.0, 2.0, 1.0);
         return out;
     }
@@ -235,6 +241,6 @@ fn vs_fin(@builtin(vertex_index) index: u32, @builtin(instance_index) edge: u32)
 // Silhouette edges only: `fin` = (edge, fade bits), one instance per edge the silhouette pass
 // (`silhouette.wgsl`) kept this frame.
 @vertex
-fn vs_fin_silhouette(@builtin(vertex_index) index: u32, @location(0) fin: vec2<u32>) -> Varyings {
+fn vs_fin_silhouette(@builtin(vertex_index) index: u32, @location(0) fin: vec2<u32>) -> FinVaryings {
     return fin_varyings(index, fin.x, bitcast<f32>(fin.y));
 }

@@ -6,21 +6,43 @@ use std::time::Instant;
 
 use pelt_core::{Builtin, FurStructure, Preset};
 use pelt_render::{
-    Backend, Camera, DEFAULT_BACKGROUND, FurDrawSettings, FurFrame, FurRenderer, FurStates, FurTarget, FurView, Gpu,
-    GpuFur, HEADLESS_FORMAT, Light, RenderTargets, default_sample_count,
+    Backend, Camera, CpuSilhouette, DEFAULT_BACKGROUND, FurDrawSettings, FurFrame, FurRenderer, FurStates, FurTarget,
+    FurView, Gpu, GpuFur, HEADLESS_FORMAT, Light, RenderTargets, default_sample_count,
 };
 
 fn main() -> anyhow::Result<()> {
     let gpu = Gpu::new(Backend::Auto)?;
     let (device, queue) = (&gpu.device, &gpu.queue);
     let samples = default_sample_count(&gpu.adapter.get_info());
-    let target = FurTarget::new(HEADLESS_FORMAT).with_sample_count(samples);
+    let format = match std::env::var("FORMAT").as_deref() {
+        Ok("unorm") => wgpu::TextureFormat::Rgba8Unorm,
+        Ok("f16") => wgpu::TextureFormat::Rgba16Float,
+        _ => HEADLESS_FORMAT,
+    };
+    let target = FurTarget::new(format).with_sample_count(samples);
     let renderer = FurRenderer::new(device, target)?;
     let view = FurView::new(device, &renderer);
-    let mesh = Builtin::Bunny.mesh().0;
+    // `MODEL=box` profiles the small Box instead of the bunny.
+    let builtin = if std::env::var("MODEL").is_ok_and(|m| m == "box") { Builtin::Box } else { Builtin::Bunny };
+    let mesh = builtin.mesh().0;
     let frames: usize = std::env::var("FRAMES").ok().and_then(|s| s.parse().ok()).unwrap_or(5);
-    let sizes = [(1280, 720), (256, 256), (64, 64)];
-    let distances: &[f32] = &[1.0, 4.0];
+    // `SIZES=256x256,64x64` picks the sizes, `DISTANCES=1` the distances, `CASES=skin,skin+shells`
+    // the parts (default: all of them).
+    let sizes: Vec<(u32, u32)> = std::env::var("SIZES")
+        .ok()
+        .map(|s| {
+            s.split(',')
+                .filter_map(|size| size.split_once('x'))
+                .filter_map(|(w, h)| Some((w.trim().parse().ok()?, h.trim().parse().ok()?)))
+                .collect()
+        })
+        .unwrap_or_else(|| vec![(1280, 720), (256, 256), (64, 64)]);
+    let distances: Vec<f32> = std::env::var("DISTANCES")
+        .ok()
+        .map(|s| s.split(',').filter_map(|d| d.trim().parse().ok()).collect())
+        .unwrap_or_else(|| vec![1.0, 4.0]);
+    let chosen: Option<Vec<String>> =
+        std::env::var("CASES").ok().map(|s| s.split(',').map(|c| c.trim().to_owned()).collect());
     // `LAYERS=16,8` picks the layer counts (default 16, 8 and 4).
     let layer_counts: Vec<u32> = std::env::var("LAYERS")
         .ok()
@@ -32,10 +54,27 @@ fn main() -> anyhow::Result<()> {
         let fur = FurStructure::new(mesh.clone(), &preset.fur_params(&mesh))?;
         let textures = preset.generate_textures()?;
         let unified = GpuFur::new(device, queue, &renderer, &fur, &textures, FurStates::One)?;
-        unified.prepare(queue, &FurFrame::default());
+        let frame = FurFrame::default();
+        unified.prepare(queue, &frame);
+        let mut silhouette = CpuSilhouette::new(&fur.mesh);
+        let base = &fur.positions[..fur.mesh.vertex_count()];
+        // The CPU silhouette decision alone (no upload), from the default framing.
+        let (centre, radius) = fur.mesh.bounding_sphere();
+        let eye = Camera::framing(centre, radius * 1.2, 35.0, 20.0, 1.0).eye;
+        let started = Instant::now();
+        let repeats = 200;
+        let mut kept = 0;
+        for _ in 0..repeats {
+            kept = silhouette.decide(base, &frame, eye)?.len();
+        }
+        println!(
+            "L={layers:2} CPU silhouette decision: {:.1} us ({kept} of {} edges kept)",
+            started.elapsed().as_secs_f64() * 1e6 / f64::from(repeats),
+            silhouette.edge_count()
+        );
         let (centre, radius) = fur.mesh.bounding_sphere();
         let radius = radius + fur.lengths.iter().copied().fold(0.0, f32::max);
-        for (width, height) in sizes {
+        for &(width, height) in &sizes {
             let targets = RenderTargets::new(device, target, width, height)?;
             let output = device.create_texture(&wgpu::TextureDescriptor {
                 label: None,
@@ -43,32 +82,44 @@ fn main() -> anyhow::Result<()> {
                 mip_level_count: 1,
                 sample_count: 1,
                 dimension: wgpu::TextureDimension::D2,
-                format: HEADLESS_FORMAT,
+                format,
                 usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
                 view_formats: &[],
             });
             let output_view = output.create_view(&Default::default());
-            for &distance in distances {
+            for &distance in &distances {
                 let mut camera = Camera::framing(centre, radius, 35.0, 20.0, targets.aspect_ratio());
                 camera.eye = centre + (camera.eye - centre) * distance;
                 let view_data = camera.view_data(targets.aspect_ratio(), &Light::default());
                 let all = FurDrawSettings::SILHOUETTE;
-                let cases: [(&str, FurDrawSettings); 6] = [
-                    ("all", all),
-                    ("skin", FurDrawSettings { shells: false, fins: false, ..all }),
-                    ("skin+shells", FurDrawSettings { fins: false, ..all }),
-                    ("skin+fins", FurDrawSettings { shells: false, ..all }),
-                    ("all, every-edge fins", FurDrawSettings { silhouette_fins: false, ..all }),
-                    ("nothing (clear)", FurDrawSettings { skin: false, shells: false, fins: false, ..all }),
+                let skin_fins = FurDrawSettings { shells: false, ..all };
+                // The last field: the silhouette decided on the CPU instead of the compute pass.
+                let cases: [(&str, FurDrawSettings, bool); 8] = [
+                    ("all", all, false),
+                    ("all (CPU silhouette)", all, true),
+                    ("skin", FurDrawSettings { shells: false, fins: false, ..all }, false),
+                    ("skin+shells", FurDrawSettings { fins: false, ..all }, false),
+                    ("skin+fins", skin_fins, false),
+                    ("skin+fins (CPU silhouette)", skin_fins, true),
+                    ("all (every-edge fins)", FurDrawSettings { silhouette_fins: false, ..all }, false),
+                    ("nothing (clear)", FurDrawSettings { skin: false, shells: false, fins: false, ..all }, false),
                 ];
-                for (name, settings) in cases {
+                for (name, settings, on_cpu) in cases {
+                    if chosen.as_ref().is_some_and(|chosen| !chosen.iter().any(|c| c == name)) {
+                        continue;
+                    }
                     let mut times = Vec::new();
                     for _ in 0..frames + 1 {
                         let started = Instant::now();
                         let mut encoder = device.create_command_encoder(&Default::default());
                         view.prepare(queue, &view_data);
                         if settings.fins && settings.silhouette_fins {
-                            renderer.prepare_fins(&mut encoder, &view, &unified);
+                            if on_cpu {
+                                let camera_position = view_data.camera_position_world;
+                                unified.prepare_fins_on_cpu(queue, &mut silhouette, base, &frame, camera_position)?;
+                            } else {
+                                renderer.prepare_fins(&mut encoder, &view, &unified);
+                            }
                         }
                         {
                             let mut pass = targets.begin_pass(&mut encoder, &output_view, DEFAULT_BACKGROUND);
