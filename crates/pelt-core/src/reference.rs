@@ -48,6 +48,10 @@ pub struct PlacedStrand {
     pub node_count: u32,
     /// Cross-section radius at the root, model units.
     pub root_radius: f32,
+    /// Model units per texel on this strand's triangle: `sqrt(surface area / tile area)` of the
+    /// triangle, so a strand is as wide as the shell texels that draw it there (a stretched uv
+    /// triangle or a tilted triplanar projection widens them).
+    pub world_per_texel: f32,
 }
 
 /// Where one node of a placed strand is, relative to its triangle.
@@ -88,7 +92,8 @@ pub struct StrandReference {
     pub strands: Vec<PlacedStrand>,
     /// Every strand's nodes, strand after strand.
     pub nodes: Vec<StrandNode>,
-    /// Model units per texel (the scale of the strands' widths).
+    /// Model units per texel at the tile's usual scale (each strand's own scale, which sets its
+    /// width, is [`PlacedStrand::world_per_texel`]).
     pub world_per_texel: f32,
     triangles: Vec<[u32; 3]>,
     vertex_count: usize,
@@ -121,6 +126,8 @@ impl StrandReference {
                     None => (triplanar(corners, mapping.tiles_per_world * size), None),
                 };
                 let Some(triangle) = Param::new(params) else { return Vec::new() };
+                let surface_area = (corners[1] - corners[0]).cross(corners[2] - corners[0]).length();
+                let local_world_per_texel = (surface_area * triangle.inverse_area.abs()).sqrt();
                 let mut placed = Vec::new();
                 buckets.visit(triangle.low, triangle.high, |index, shift| {
                     let strand = &field.strands[index as usize];
@@ -155,6 +162,7 @@ impl StrandReference {
                         first_node: 0,
                         node_count: nodes.len() as u32,
                         root_radius: 0.0,
+                        world_per_texel: local_world_per_texel,
                     };
                     placed.push((strand, nodes));
                 });
@@ -168,7 +176,8 @@ impl StrandReference {
         let mut nodes = Vec::new();
         for (mut strand, strand_nodes) in per_triangle.into_iter().flatten() {
             strand.first_node = nodes.len() as u32;
-            strand.root_radius = field.strands[strand.field_index as usize].radius_at(0.0, 0.0) * world_per_texel;
+            strand.root_radius =
+                field.strands[strand.field_index as usize].radius_at(0.0, 0.0) * strand.world_per_texel;
             strands.push(strand);
             nodes.extend(strand_nodes);
         }

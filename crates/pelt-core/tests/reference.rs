@@ -206,3 +206,42 @@ fn bad_inputs_are_errors() {
     let bad = TileMapping { tiles_per_uv: f32::NAN, tiles_per_world: 1.0 };
     assert!(StrandReference::new(&fur, field, bad).is_err());
 }
+
+#[test]
+fn strands_are_as_wide_as_the_texels_that_draw_them() {
+    // The plane (2 x 2 units, uvs 0..1) with the uvs of its left half squeezed to half their
+    // width: there the tile's texels are twice as wide on the surface (sqrt 2 in area terms).
+    let mut mesh = Builtin::Plane.mesh().0;
+    let left: Vec<bool> =
+        mesh.triangles.iter().map(|t| t.iter().map(|&j| mesh.positions[j as usize].x).sum::<f32>() < 0.0).collect();
+    for (uvs, squeezed) in mesh.corner_uvs.as_mut().unwrap().iter_mut().zip(&left) {
+        if *squeezed {
+            for uv in uvs {
+                uv.x *= 0.5;
+            }
+        }
+    }
+    let texture = straight_params();
+    let mapping = mapping(&mesh);
+    let (_, reference) = place(mesh, &Preset::default(), &texture);
+    // Written out: 2 units of surface over 1 uv unit, times the tile's texels per uv unit.
+    let usual = 2.0 / (mapping.tiles_per_uv * texture.size as f32);
+    let mut seen = [0usize; 2];
+    for strand in &reference.strands {
+        let squeezed = left[strand.triangle as usize];
+        let expected = if squeezed { usual * 2f32.sqrt() } else { usual };
+        let got = strand.world_per_texel;
+        assert!(
+            (got / expected - 1.0).abs() < 1e-3,
+            "squeezed {squeezed}: {got} model units per texel, expected {expected}"
+        );
+        let radius = reference.field_strand(strand).radius_at(0.0, 0.0) * expected;
+        assert!(
+            (strand.root_radius / radius - 1.0).abs() < 1e-3,
+            "root radius {} expected {radius}",
+            strand.root_radius
+        );
+        seen[usize::from(squeezed)] += 1;
+    }
+    assert!(seen[0] > 100 && seen[1] > 100, "strands on each half: {seen:?}");
+}

@@ -259,6 +259,16 @@ fn surface_lighting(albedo: vec3<f32>, normal: vec3<f32>) -> vec3<f32> {
     return albedo * (view.ambient + view.light_colour * wrapped);
 }
 
+// Shell slices are sampled half a mip level sharper than the hardware's choice: trilinear
+// filtering at its level spreads a strand over about twice a pixel's footprint, which `pelt
+// fidelity` measures as the largest loss against the explicit strands (FIDELITY.md). A whole
+// level sharper measures closer still but makes moving fur flicker (cli_render's fox test).
+const SHELL_LOD_BIAS: f32 = -0.5;
+
+fn sample_shell(uv: vec2<f32>, slice: i32) -> vec4<f32> {
+    return textureSampleBias(shell_texture, shell_sampler, uv, slice, SHELL_LOD_BIAS);
+}
+
 // The axis-aligned projection of the tiles for a surface with model-space normal `n`: the axis it
 // faces most (0 = x, 1 = y, 2 = z).
 fn tile_axis(n: vec3<f32>) -> u32 {
@@ -278,7 +288,7 @@ fn tile_texel(tile_position: vec3<f32>, tile_normal: vec3<f32>, layer: u32) -> v
     let p = tile_position;
     let axis = tile_axis(tile_normal);
     let uv = select(select(p.xy, p.zx, axis == 1u), p.yz, axis == 0u);
-    return textureSample(shell_texture, shell_sampler, uv, shell_slice(layer));
+    return sample_shell(uv, shell_slice(layer));
 }
 
 // Surface colour mode: the mesh's texture at the strand's root tints the strand's brightness.
@@ -339,7 +349,7 @@ fn fs_shell_tiles(in: ShellTileVaryings) -> @location(0) vec4<f32> {
 // Shells of meshes with uvs (`vs_shell_corners`, `vs_separated_shell_uvs`).
 @fragment
 fn fs_shell_uvs(in: ShellUvVaryings) -> @location(0) vec4<f32> {
-    let texel = textureSample(shell_texture, shell_sampler, in.uvs.xy, shell_slice(in.layer));
+    let texel = sample_shell(in.uvs.xy, shell_slice(in.layer));
     return shell_colour(texel, in.uvs.zw, in.fade, in.layer, in.normal, in.tangent, in.world_position);
 }
 

@@ -186,7 +186,7 @@ impl StrandRibbons {
                     .colour(strand, node.height)
                     .map(|c| srgb_to_linear((c.clamp(0.0, 1.0) * 255.0).round() / 255.0))
                     * tint;
-                let half_width = strand.radius_at(node.height, taper) * reference.world_per_texel;
+                let half_width = strand.radius_at(node.height, taper) * placed.world_per_texel;
                 let colour_height = Vec4::from((albedo, node.height)).to_array();
                 let base = vertices.len() as u32;
                 for side in [-1.0, 1.0] {

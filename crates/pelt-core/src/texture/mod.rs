@@ -5,7 +5,7 @@
 //! brightness drawn from the same seed. Slice `k` (drawn on shell layer `k + 1` of `L`) holds the
 //! strands' cross-sections at height `t = (k + 1) / L`, centred on
 //! `root + (lean + clump pull) * t + helix(t)`, with a radius tapering toward each strand's tip
-//! and a soft halo at the roots (the paper's alpha blur, Figure 10). Geometry is in texels, so a
+//! and optionally a soft halo at the roots (the paper's alpha blur, Figure 10). Geometry is in texels, so a
 //! larger tile at the same density holds more, finer strands (the paper's "resizing").
 //!
 //! Generation runs one slice (and one fin row) per rayon task, each drawing its strands in a
@@ -199,8 +199,9 @@ pub struct TextureParams {
     /// How much the radius shrinks from root to the strand's tip: 0 = cylinder, 1 = a point.
     /// `0..=1`, default 0.75.
     pub taper: f32,
-    /// Extra soft width at the roots, texels, fading out by 40 % of the height (Figure 10).
-    /// `0..=8`, default 1.0.
+    /// Extra soft width at the roots, texels, fading out by 40 % of the height (the paper's
+    /// alpha blur, Figure 10; e.g. 1.0). `0..=8`, default 0: `pelt fidelity` measures every
+    /// model closer to its explicit strands without it, as it hides the skin between them.
     pub root_blur: f32,
     /// Spread of strand lengths, as a fraction of the fur's length: lengths are uniform in
     /// `1 - length_variation ..= 1 + length_variation / 3` (a quarter of the strands reach past
@@ -239,7 +240,7 @@ impl Default for TextureParams {
             density: 0.55,
             thickness: 1.4,
             taper: 0.75,
-            root_blur: 1.0,
+            root_blur: 0.0,
             length_variation: 0.3,
             style: Style::Mixed,
             mixed_ratio: 0.6,
