@@ -36,23 +36,13 @@ fn vs_separated_skin(in: VertexIn) -> Varyings {
 @vertex
 fn vs_separated_shell_tiles(in: VertexIn, @builtin(instance_index) layer: u32) -> ShellTileVaryings {
     let v = separated_shell(in, layer);
-    return ShellTileVaryings(
-        v.clip_position,
-        v.world_position,
-        v.normal,
-        v.tangent,
-        v.tile_position,
-        v.tile_normal,
-        v.fade,
-        v.layer,
-    );
+    return shell_tile_varyings(v, v.fade);
 }
 
 @vertex
 fn vs_separated_shell_uvs(in: VertexIn, @builtin(instance_index) layer: u32) -> ShellUvVaryings {
     let v = separated_shell(in, layer);
-    let uvs = vec4<f32>(v.uv, v.surface_uv);
-    return ShellUvVaryings(v.clip_position, v.world_position, v.normal, v.tangent, uvs, v.fade, v.layer);
+    return shell_uv_varyings(v, v.fade);
 }
 
 fn separated_shell(in: VertexIn, layer: u32) -> Varyings {

@@ -127,6 +127,17 @@ struct ShellUvVaryings {
     @location(6) @interpolate(flat) layer: u32,
 }
 
+// The lean shell interfaces from the full surface varyings (the unified and separated shells
+// build theirs the same way); `fade` is the caller's, computed or carried.
+fn shell_tile_varyings(v: Varyings, fade: f32) -> ShellTileVaryings {
+    return ShellTileVaryings(v.clip_position, v.world_position, v.normal, v.tangent, v.tile_position, v.tile_normal, fade, v.layer);
+}
+
+fn shell_uv_varyings(v: Varyings, fade: f32) -> ShellUvVaryings {
+    let uvs = vec4<f32>(v.uv, v.surface_uv);
+    return ShellUvVaryings(v.clip_position, v.world_position, v.normal, v.tangent, uvs, fade, v.layer);
+}
+
 // What a unified fin fragment reads, for the same reason as the shells' structs.
 struct FinVaryings {
     @builtin(position) clip_position: vec4<f32>,

@@ -122,25 +122,13 @@ fn vs_skin_indexed(@builtin(vertex_index) vertex: u32) -> Varyings {
 @vertex
 fn vs_shell_corners(@builtin(vertex_index) corner: u32, @builtin(instance_index) instance: u32) -> ShellUvVaryings {
     let v = surface_varyings(triangle_vertex(corner), corner, lod_shell_layer(instance));
-    let fade = shell_fade(v.normal, v.world_position);
-    let uvs = vec4<f32>(v.uv, v.surface_uv);
-    return ShellUvVaryings(v.clip_position, v.world_position, v.normal, v.tangent, uvs, fade, v.layer);
+    return shell_uv_varyings(v, shell_fade(v.normal, v.world_position));
 }
 
 @vertex
 fn vs_shell_indexed(@builtin(vertex_index) vertex: u32, @builtin(instance_index) instance: u32) -> ShellTileVaryings {
     let v = surface_varyings(vertex, 0u, lod_shell_layer(instance));
-    let fade = shell_fade(v.normal, v.world_position);
-    return ShellTileVaryings(
-        v.clip_position,
-        v.world_position,
-        v.normal,
-        v.tangent,
-        v.tile_position,
-        v.tile_normal,
-        fade,
-        v.layer,
-    );
+    return shell_tile_varyings(v, shell_fade(v.normal, v.world_position));
 }
 
 fn hash(x: u32) -> u32 {
