@@ -101,11 +101,19 @@ pub struct LodParams {
     /// Screen pixels each drawn shell should span along a strand, `0.25..=16`: strands shorter
     /// on screen than `layers * pixels_per_shell` draw fewer shells. Default 1.
     pub pixels_per_shell: f32,
+    /// Shells by view angle (Yang et al.): where the surface faces the eye, the layers the next
+    /// coarser level drops fade out (and are not drawn where gone). On by default (with `enabled`).
+    pub view_angle: bool,
+    /// `|cos|` between the surface normal and the view where that fading starts, `0..1`,
+    /// below `facing_full`. Default 0.4.
+    pub facing_start: f32,
+    /// `|cos|` where those layers are gone, `0..=1`. Default 0.7.
+    pub facing_full: f32,
 }
 
 impl Default for LodParams {
     fn default() -> Self {
-        Self { enabled: true, pixels_per_shell: 1.0 }
+        Self { enabled: true, pixels_per_shell: 1.0, view_angle: true, facing_start: 0.4, facing_full: 0.7 }
     }
 }
 
@@ -292,6 +300,17 @@ impl Preset {
             pixels.is_finite() && (0.25..=16.0).contains(&pixels),
             "render.lod.pixels_per_shell",
             format!("must be between 0.25 and 16, got {pixels}"),
+        )?;
+        let (start, full) = (render.lod.facing_start, render.lod.facing_full);
+        check(
+            start.is_finite() && (0.0..1.0).contains(&start),
+            "render.lod.facing_start",
+            format!("must be at least 0 and below 1, got {start}"),
+        )?;
+        check(
+            full.is_finite() && start < full && full <= 1.0,
+            "render.lod.facing_full",
+            format!("must be above facing_start ({start}) and at most 1, got {full}"),
         )?;
         self.texture.validate().map_err(invalid)?;
         self.colour.validate().map_err(invalid)?;

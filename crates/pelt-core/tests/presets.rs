@@ -180,6 +180,8 @@ fn out_of_range_values_name_the_key_and_the_range() {
         ("[simulation]\nstability = -1", "simulation.stability", "between"),
         ("[render]\ncamera_elevation_deg = 95", "render.camera_elevation_deg", "between -89 and 89"),
         ("[render.lod]\npixels_per_shell = 0", "render.lod.pixels_per_shell", "between 0.25 and 16"),
+        ("[render.lod]\nfacing_start = 1.5", "render.lod.facing_start", "below 1"),
+        ("[render.lod]\nfacing_full = 0.3", "render.lod.facing_full", "above facing_start"),
     ];
     for (text, key, range) in cases {
         let message = bad(text, key);

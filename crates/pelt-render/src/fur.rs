@@ -14,6 +14,7 @@ use crate::requirements::ErrorScope;
 use crate::silhouette::FinList;
 use crate::silhouette_cpu::CpuSilhouette;
 use crate::textures::GpuTextures;
+use crate::view_lod::ShellList;
 
 /// How many simulation states a [`GpuFur`] keeps on the GPU.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -48,6 +49,8 @@ pub struct GpuFur {
     fins: Option<FinList>,
     /// The level of detail of the last `prepare`.
     level: PreparedLevel,
+    /// The view-angle pass's output (none without layers to thin).
+    shells: Option<ShellList>,
 }
 
 impl GpuFur {
@@ -70,8 +73,9 @@ impl GpuFur {
         let geometry = geometry(device, renderer, structure, states);
         let textures = GpuTextures::new(device, queue, renderer.layouts(), textures);
         let fins = fin_list(device, renderer, structure);
+        let shells = shell_list(device, renderer, structure);
         scope.pop("uploading the fur")?;
-        Ok(Self { geometry: geometry?, textures: textures?, fins: fins?, level: PreparedLevel::new() })
+        Ok(Self { geometry: geometry?, textures: textures?, fins: fins?, level: PreparedLevel::new(), shells: shells? })
     }
 
     /// Replaces the structure (new mesh, layer count or rest pose), keeping the textures and the
@@ -89,8 +93,9 @@ impl GpuFur {
         let scope = ErrorScope::push(device);
         let geometry = geometry(device, renderer, structure, states);
         let fins = fin_list(device, renderer, structure);
+        let shells = shell_list(device, renderer, structure);
         scope.pop("uploading the fur")?;
-        (self.geometry, self.fins) = (geometry?, fins?);
+        (self.geometry, self.fins, self.shells) = (geometry?, fins?, shells?);
         Ok(())
     }
 
@@ -120,6 +125,9 @@ impl GpuFur {
         let frame = if self.geometry.state_count() == 1 { FurFrame { interpolation: 1.0, ..*frame } } else { *frame };
         self.geometry.write_uniform(queue, &self.geometry.shape.uniform(&frame, self.textures.root_colour, textures));
         self.level.set(frame.level, self.geometry.shape.layers);
+        if let Some(list) = &self.shells {
+            list.invalidate();
+        }
     }
 
     /// Writes `positions` (`(L + 1) * V`, layer-major, model space) into both states: the
@@ -228,10 +236,39 @@ impl GpuFur {
         Ok(fins.len() as u32)
     }
 
-    /// Bytes of the silhouette pass's fin list (the edges it keeps and their indirect draw).
+    /// Bytes of the silhouette pass's fin list (the edges it keeps and their indirect draw) and
+    /// of the view-angle pass's shell list (12 bytes a triangle, 20 a layer).
     #[must_use]
     pub fn silhouette_list_bytes(&self) -> u64 {
-        self.fins.as_ref().map_or(0, FinList::bytes)
+        self.fins.as_ref().map_or(0, FinList::bytes) + self.shells.as_ref().map_or(0, ShellList::bytes)
+    }
+
+    /// The view-angle pass's count (one little-endian `u32`, `COPY_SRC`): three times the
+    /// triangles drawn in each shell the view angle thins, when [`GpuFur::shells_thinned`].
+    /// For hosts and benchmarks that read it back; `None` for a fur with fewer than two layers.
+    #[must_use]
+    pub fn view_lod_count(&self) -> Option<&wgpu::Buffer> {
+        self.shells.as_ref().map(|list| &list.listed)
+    }
+
+    /// The view-angle pass's list (`COPY_SRC`): as many little-endian `u32`s as
+    /// [`GpuFur::view_lod_count`] says, three a triangle, each a triangle corner (meshes with
+    /// uvs: `3 * triangle + k`) or a base vertex (meshes without), in no particular order.
+    #[must_use]
+    pub fn view_lod_indices(&self) -> Option<&wgpu::Buffer> {
+        self.shells.as_ref().map(|list| &list.indices)
+    }
+
+    /// The shells the level of the last [`GpuFur::prepare`] thins by view angle (drawn over the
+    /// view-angle pass's list when [`crate::FurRenderer::prepare_fins`] was recorded after it);
+    /// 0 without view-angle LOD.
+    #[must_use]
+    pub fn shells_thinned(&self) -> u32 {
+        let layers = self.geometry.shape.layers;
+        if !self.level.by_view() {
+            return 0;
+        }
+        (0..self.drawn_shells()).filter(|&k| self.level.dropped_shell(layers, k)).count() as u32
     }
 
     /// The silhouette pass's indirect draw (`wgpu::util::DrawIndexedIndirectArgs`, 20 bytes,
@@ -275,6 +312,14 @@ impl GpuFur {
         self.fins.as_ref()
     }
 
+    pub(crate) fn shell_list(&self) -> Option<&ShellList> {
+        self.shells.as_ref()
+    }
+
+    pub(crate) fn prepared_level(&self) -> &PreparedLevel {
+        &self.level
+    }
+
     /// Shells (and fin segments) drawn at the level of the last [`GpuFur::prepare`].
     #[must_use]
     pub fn drawn_shells(&self) -> u32 {
@@ -288,6 +333,17 @@ fn fin_list(
     structure: &FurStructure,
 ) -> Result<Option<FinList>, RenderError> {
     FinList::new(device, renderer.layouts(), structure.mesh.edges.len() as u32, structure.layers)
+}
+
+fn shell_list(
+    device: &wgpu::Device,
+    renderer: &FurRenderer,
+    structure: &FurStructure,
+) -> Result<Option<ShellList>, RenderError> {
+    let triangles = structure.mesh.triangles.len() as u32;
+    let per_shell =
+        if structure.mesh.corner_uvs.is_some() { 3 * triangles } else { structure.mesh.vertex_count() as u32 };
+    ShellList::new(device, renderer.layouts(), (triangles, per_shell), structure.layers)
 }
 
 fn geometry(

@@ -117,6 +117,7 @@ mod strands;
 mod targets;
 mod textures;
 mod view;
+mod view_lod;
 
 pub use camera::Camera;
 pub use error::RenderError;
@@ -138,3 +139,4 @@ pub use simulation::{GpuSimulation, simulation_shader_source};
 pub use strands::{StrandRenderer, StrandRibbons, strands_shader_source};
 pub use targets::{DEFAULT_BACKGROUND, DEPTH_FORMAT, FurTarget, RenderTargets, SAMPLE_COUNT, default_sample_count};
 pub use view::{FurView, Light, LightDirection, ViewData};
+pub use view_lod::view_lod_shader_source;

@@ -117,8 +117,12 @@ pub(crate) struct ObjectUniform {
     lod_blend: f32,
     lod_stride: u32,
     lod_shells: u32,
+    lod_view: f32,
+    lod_view_start: f32,
+    lod_view_full: f32,
+    _padding_1: u32,
 }
-const _: () = assert!(size_of::<ObjectUniform>() == 208, "matches `Object` in shading.wgsl");
+const _: () = assert!(size_of::<ObjectUniform>() == 224, "matches `Object` in shading.wgsl");
 
 pub(crate) const OBJECT_UNIFORM_BYTES: u64 = size_of::<ObjectUniform>() as u64;
 
@@ -187,6 +191,10 @@ impl ObjectShape {
             lod_blend: level.blend,
             lod_stride: level.stride,
             lod_shells: level.shells(self.layers),
+            lod_view: if level.facing.is_some() { 1.0 } else { 0.0 },
+            lod_view_start: level.facing.map_or(0.0, |[start, _]| start),
+            lod_view_full: level.facing.map_or(1.0, |[_, full]| full),
+            _padding_1: 0,
         }
     }
 }

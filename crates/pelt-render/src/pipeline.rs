@@ -17,6 +17,8 @@ pub(crate) struct Layouts {
     pub textures: wgpu::BindGroupLayout,
     /// Group 3 of the silhouette pass: a fur's fin list.
     pub fin_list: wgpu::BindGroupLayout,
+    /// Group 3 of the view-angle pass: a fur's shell list.
+    pub shell_list: wgpu::BindGroupLayout,
     pub shell_sampler: wgpu::Sampler,
     pub fin_sampler: wgpu::Sampler,
 }
@@ -92,6 +94,7 @@ impl Layouts {
             separated_object,
             textures,
             fin_list: crate::silhouette::fin_list_layout(device),
+            shell_list: crate::view_lod::shell_list_layout(device),
             shell_sampler: sampler("pelt shell sampler", wgpu::AddressMode::Repeat),
             // Fin rows run root to tip: clamp so the tips do not bleed into the roots.
             fin_sampler: sampler("pelt fin sampler", wgpu::AddressMode::ClampToEdge),

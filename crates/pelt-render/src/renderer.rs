@@ -18,6 +18,7 @@ use crate::requirements::{ErrorScope, check_features_and_limits};
 use crate::silhouette::{FIN_INSTANCE_LAYOUT, silhouette_pipeline};
 use crate::targets::FurTarget;
 use crate::view::FurView;
+use crate::view_lod::{SHELL_DRAW_BYTES, ViewLodPipelines};
 
 pub(crate) const SHADING_WGSL: &str = include_str!("shading.wgsl");
 pub(crate) const UNIFIED_WGSL: &str = include_str!("unified.wgsl");
@@ -79,6 +80,8 @@ struct SurfacePipelines {
     skin: wgpu::RenderPipeline,
     /// Blended, alpha-to-coverage.
     shells: [wgpu::RenderPipeline; 2],
+    /// Blended, alpha-to-coverage: shells over the view-angle pass's list.
+    listed_shells: [wgpu::RenderPipeline; 2],
 }
 
 /// The unified structure's pipelines for one [`FurTarget`], shared by every [`GpuFur`],
@@ -99,6 +102,7 @@ pub struct FurRenderer {
     /// Blended, alpha-to-coverage: the silhouette pass's edges.
     silhouette_fins: [wgpu::RenderPipeline; 2],
     silhouette: wgpu::ComputePipeline,
+    view_lod: ViewLodPipelines,
 }
 
 impl FurRenderer {
@@ -139,6 +143,7 @@ impl FurRenderer {
         let surface = |walk: &str, mesh_uvs: bool| {
             let skin = format!("vs_skin_{walk}");
             let shell = format!("vs_shell_{walk}");
+            let listed = format!("vs_shell_{walk}_listed");
             let shell_fragment = if mesh_uvs { "fs_shell_uvs" } else { "fs_shell_tiles" };
             let surface =
                 |label, layout, entries, kind| build_with(label, layout, entries, kind, (&[], Some(mesh_uvs)));
@@ -147,6 +152,9 @@ impl FurRenderer {
                 skin: surface("pelt skin", &fur_layout, (&skin, "fs_skin"), PassKind::Opaque),
                 shells: Transparency::BOTH
                     .map(|t| surface("pelt shells", &fur_layout, (&shell, shell_fragment), PassKind::Shells(t))),
+                listed_shells: Transparency::BOTH.map(|t| {
+                    surface("pelt listed shells", &fur_layout, (&listed, shell_fragment), PassKind::Shells(t))
+                }),
             }
         };
         let corners = surface("corners", true);
@@ -158,8 +166,9 @@ impl FurRenderer {
             build_with("pelt silhouette fins", &fur_layout, entries, PassKind::Fins(t), (&instances, None))
         });
         let silhouette = silhouette_pipeline(device, &layouts);
+        let view_lod = ViewLodPipelines::new(device, &layouts);
         scope.pop("building the fur pipelines")?;
-        Ok(Self { target, layouts, corners, indexed, fins, silhouette_fins, silhouette })
+        Ok(Self { target, layouts, corners, indexed, fins, silhouette_fins, silhouette, view_lod })
     }
 
     /// The target description the pipelines were built for.
@@ -185,8 +194,15 @@ impl FurRenderer {
         }
         let layers = geometry.shape.layers;
         if settings.shells && layers > 0 {
-            pass.set_pipeline(&surface.shells[which]);
-            geometry.draw_surface(pass, 0..fur.drawn_shells());
+            match fur.shell_list() {
+                Some(list) if list.recorded() && fur.prepared_level().by_view() => {
+                    draw_thinned_shells(pass, fur, surface, which, list);
+                }
+                _ => {
+                    pass.set_pipeline(&surface.shells[which]);
+                    geometry.draw_surface(pass, 0..fur.drawn_shells());
+                }
+            }
         }
         // Fins after the shells: at the silhouette, where fins matter, they stand outside the
         // shells and must not be covered by the faded outer layers.
@@ -209,9 +225,18 @@ impl FurRenderer {
     /// [`FurDrawSettings::silhouette_fins`] in a render pass recorded after it. Call it every
     /// frame, after [`FurView::prepare`] and [`GpuFur::prepare`] (it reads both uniforms), once per
     /// view that draws the fur, each before that view's pass. Nothing blocks or is read back.
+    ///
+    /// When the level thins shells by view angle ([`crate::FurLevel::facing`]) it also records
+    /// the pass that lists the triangles the thinned shells still need, and the next draws of
+    /// `fur` (until its next [`GpuFur::prepare`]) draw those shells over that list only.
     pub fn prepare_fins(&self, encoder: &mut wgpu::CommandEncoder, view: &FurView, fur: &GpuFur) {
         if let Some(list) = fur.fin_list() {
             list.record(encoder, &self.silhouette, view.bind_group(), fur.geometry().bind_group());
+        }
+        if let Some(list) = fur.shell_list()
+            && fur.prepared_level().by_view()
+        {
+            list.record(encoder, &self.view_lod, view.bind_group(), fur.geometry().bind_group());
         }
     }
 
@@ -231,5 +256,28 @@ impl FurRenderer {
 
     pub(crate) fn layouts(&self) -> &Layouts {
         &self.layouts
+    }
+}
+
+/// The shells one at a time from the innermost out (blending needs the order): those the view
+/// angle thins over the pass's list of triangles, the others over every triangle.
+fn draw_thinned_shells(
+    pass: &mut wgpu::RenderPass<'_>,
+    fur: &GpuFur,
+    surface: &SurfacePipelines,
+    which: usize,
+    list: &crate::view_lod::ShellList,
+) {
+    let geometry = fur.geometry();
+    let layers = geometry.shape.layers;
+    for shell in 0..fur.drawn_shells() {
+        if fur.prepared_level().dropped_shell(layers, shell) {
+            pass.set_pipeline(&surface.listed_shells[which]);
+            pass.set_index_buffer(list.indices.slice(..), wgpu::IndexFormat::Uint32);
+            pass.draw_indexed_indirect(&list.draws, u64::from(shell) * SHELL_DRAW_BYTES);
+        } else {
+            pass.set_pipeline(&surface.shells[which]);
+            geometry.draw_surface(pass, shell..shell + 1);
+        }
     }
 }

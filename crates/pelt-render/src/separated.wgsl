@@ -36,13 +36,24 @@ fn vs_separated_skin(in: VertexIn) -> Varyings {
 @vertex
 fn vs_separated_shell_tiles(in: VertexIn, @builtin(instance_index) layer: u32) -> ShellTileVaryings {
     let v = separated_shell(in, layer);
-    return shell_tile_varyings(v, v.fade);
+    return shell_tile_varyings(v, v.fade, separated_lod_blend(v));
 }
 
 @vertex
 fn vs_separated_shell_uvs(in: VertexIn, @builtin(instance_index) layer: u32) -> ShellUvVaryings {
     let v = separated_shell(in, layer);
-    return shell_uv_varyings(v, v.fade);
+    return shell_uv_varyings(v, v.fade, separated_lod_blend(v));
+}
+
+// Shells by view angle as the unified shells fade them, from the shell vertex itself (these
+// vertices do not know their root; the difference is the strand's length against the camera's
+// distance). Nothing is culled here: every layer's triangles are drawn.
+fn separated_lod_blend(v: Varyings) -> f32 {
+    var weight = 0.0;
+    if object.lod_view > 0.0 {
+        weight = lod_view_weight(v.normal, v.world_position);
+    }
+    return lod_vertex_blend(weight);
 }
 
 fn separated_shell(in: VertexIn, layer: u32) -> Varyings {

@@ -58,6 +58,11 @@ struct Object {
     lod_blend: f32,
     lod_stride: u32,
     lod_shells: u32,
+    // Shells by view angle: 1 when on, and the |n . v| range over which the layers twice the
+    // stride drops fade out.
+    lod_view: f32,
+    lod_view_start: f32,
+    lod_view_full: f32,
 }
 
 // Set per pipeline: shells and fins with alpha-to-coverage output straight colour, blended ones
@@ -114,6 +119,8 @@ struct ShellTileVaryings {
     @location(4) tile_normal: vec3<f32>,
     @location(5) fade: f32,
     @location(6) @interpolate(flat) layer: u32,
+    // How far the layers the next coarser stride drops have faded here (`lod_vertex_blend`).
+    @location(7) lod_blend: f32,
 }
 
 struct ShellUvVaryings {
@@ -125,17 +132,19 @@ struct ShellUvVaryings {
     @location(3) uvs: vec4<f32>,
     @location(5) fade: f32,
     @location(6) @interpolate(flat) layer: u32,
+    // How far the layers the next coarser stride drops have faded here (`lod_vertex_blend`).
+    @location(7) lod_blend: f32,
 }
 
 // The lean shell interfaces from the full surface varyings (the unified and separated shells
-// build theirs the same way); `fade` is the caller's, computed or carried.
-fn shell_tile_varyings(v: Varyings, fade: f32) -> ShellTileVaryings {
-    return ShellTileVaryings(v.clip_position, v.world_position, v.normal, v.tangent, v.tile_position, v.tile_normal, fade, v.layer);
+// build theirs the same way); `fade` and `lod_blend` are the caller's, computed or carried.
+fn shell_tile_varyings(v: Varyings, fade: f32, lod_blend: f32) -> ShellTileVaryings {
+    return ShellTileVaryings(v.clip_position, v.world_position, v.normal, v.tangent, v.tile_position, v.tile_normal, fade, v.layer, lod_blend);
 }
 
-fn shell_uv_varyings(v: Varyings, fade: f32) -> ShellUvVaryings {
+fn shell_uv_varyings(v: Varyings, fade: f32, lod_blend: f32) -> ShellUvVaryings {
     let uvs = vec4<f32>(v.uv, v.surface_uv);
-    return ShellUvVaryings(v.clip_position, v.world_position, v.normal, v.tangent, uvs, fade, v.layer);
+    return ShellUvVaryings(v.clip_position, v.world_position, v.normal, v.tangent, uvs, fade, v.layer, lod_blend);
 }
 
 // What a unified fin fragment reads, for the same reason as the shells' structs.
@@ -218,19 +227,36 @@ fn lod_dropped(layer: u32) -> bool {
     return ((object.layers - layer) / object.lod_stride) % 2u == 1u;
 }
 
+// Shells by view angle (Yang et al.): 0..1, how far the layers the next coarser stride drops
+// have faded at a strand whose root is at `root` (world) with base normal `normal` (world, unit):
+// 0 where the surface is seen edge-on, 1 where it faces the eye (`lod_view_full` of |n . v|).
+// `view_lod.wgsl` culls with the same function, so it must stay a function of the root alone.
+fn lod_view_weight(normal: vec3<f32>, root: vec3<f32>) -> f32 {
+    let to_camera = safe_normalize(view.camera_position - root, normal);
+    let facing = abs(dot(normal, to_camera));
+    return object.lod_view * smoothstep(object.lod_view_start, object.lod_view_full, facing);
+}
+
+// The blend toward the next stride at a shell vertex: the distance level's and the view
+// angle's composed, so either alone fades the dropped layers and both together never exceed 1.
+fn lod_vertex_blend(view_weight: f32) -> f32 {
+    return 1.0 - (1.0 - object.lod_blend) * (1.0 - view_weight);
+}
+
 // A shell's alpha at the level of detail: each drawn shell stands for `lod_stride` layers (the
-// opacity of that many), the ones the next level drops fade out while the kept ones take on
-// their opacity. Exactly `alpha` at full detail.
-fn lod_alpha(alpha: f32, layer: u32) -> f32 {
-    if object.lod_stride == 1u && object.lod_blend == 0.0 {
+// opacity of that many), the ones the next level drops fade out by `blend` (`lod_vertex_blend`,
+// interpolated) while the kept ones take on their opacity. Exactly `alpha` at full detail.
+fn lod_alpha(alpha: f32, layer: u32, blend: f32) -> f32 {
+    if object.lod_stride == 1u && blend <= 0.0 {
         return alpha;
     }
     let clear = 1.0 - clamp(alpha, 0.0, 1.0);
     let stride = f32(object.lod_stride);
+    let b = clamp(blend, 0.0, 1.0);
     if lod_dropped(layer) {
-        return (1.0 - pow(clear, stride)) * (1.0 - object.lod_blend);
+        return (1.0 - pow(clear, stride)) * (1.0 - b);
     }
-    return 1.0 - pow(clear, stride * (1.0 + object.lod_blend));
+    return 1.0 - pow(clear, stride * (1.0 + b));
 }
 
 // Shells fade where the surface is seen edge-on (where the sheets would show).
@@ -340,11 +366,12 @@ fn shell_colour(
     surface_uv: vec2<f32>,
     fade: f32,
     layer: u32,
+    lod_blend: f32,
     normal: vec3<f32>,
     tangent: vec3<f32>,
     world_position: vec3<f32>,
 ) -> vec4<f32> {
-    let alpha = lod_alpha(texel.a * fade, layer);
+    let alpha = lod_alpha(texel.a * fade, layer, lod_blend);
     let albedo = texel.rgb * surface_tint(surface_uv);
     let colour = hair_lighting(albedo, normalize(tangent), normalize(normal), world_position, layer_height(layer));
     return fur_output(colour, alpha);
@@ -354,14 +381,14 @@ fn shell_colour(
 @fragment
 fn fs_shell_tiles(in: ShellTileVaryings) -> @location(0) vec4<f32> {
     let texel = tile_texel(in.tile_position, in.tile_normal, in.layer);
-    return shell_colour(texel, vec2<f32>(0.0), in.fade, in.layer, in.normal, in.tangent, in.world_position);
+    return shell_colour(texel, vec2<f32>(0.0), in.fade, in.layer, in.lod_blend, in.normal, in.tangent, in.world_position);
 }
 
 // Shells of meshes with uvs (`vs_shell_corners`, `vs_separated_shell_uvs`).
 @fragment
 fn fs_shell_uvs(in: ShellUvVaryings) -> @location(0) vec4<f32> {
     let texel = sample_shell(in.uvs.xy, shell_slice(in.layer));
-    return shell_colour(texel, in.uvs.zw, in.fade, in.layer, in.normal, in.tangent, in.world_position);
+    return shell_colour(texel, in.uvs.zw, in.fade, in.layer, in.lod_blend, in.normal, in.tangent, in.world_position);
 }
 
 @fragment

@@ -121,14 +121,48 @@ fn vs_skin_indexed(@builtin(vertex_index) vertex: u32) -> Varyings {
 // on only what their fragments read (the rest of `surface_varyings` is compiled away).
 @vertex
 fn vs_shell_corners(@builtin(vertex_index) corner: u32, @builtin(instance_index) instance: u32) -> ShellUvVaryings {
-    let v = surface_varyings(triangle_vertex(corner), corner, lod_shell_layer(instance));
-    return shell_uv_varyings(v, shell_fade(v.normal, v.world_position));
+    return shell_corner(corner, instance);
 }
 
 @vertex
 fn vs_shell_indexed(@builtin(vertex_index) vertex: u32, @builtin(instance_index) instance: u32) -> ShellTileVaryings {
-    let v = surface_varyings(vertex, 0u, lod_shell_layer(instance));
-    return shell_tile_varyings(v, shell_fade(v.normal, v.world_position));
+    return shell_vertex(vertex, instance);
+}
+
+// Shells through the view-angle list (`view_lod.wgsl`): one indirect draw per shell the view
+// angle thins, over the listed triangles, with base vertex `shell * N`, so `vertex_index`
+// carries the shell and the corner (N = 3F) or base vertex (N = V).
+@vertex
+fn vs_shell_corners_listed(@builtin(vertex_index) index: u32) -> ShellUvVaryings {
+    let corners = 3u * object.triangle_count;
+    return shell_corner(index % corners, index / corners);
+}
+
+@vertex
+fn vs_shell_indexed_listed(@builtin(vertex_index) index: u32) -> ShellTileVaryings {
+    return shell_vertex(index % object.vertex_count, index / object.vertex_count);
+}
+
+fn shell_corner(corner: u32, shell: u32) -> ShellUvVaryings {
+    let vertex = triangle_vertex(corner);
+    let v = surface_varyings(vertex, corner, lod_shell_layer(shell));
+    return shell_uv_varyings(v, shell_fade(v.normal, v.world_position), lod_shell_blend(vertex, v.normal));
+}
+
+fn shell_vertex(vertex: u32, shell: u32) -> ShellTileVaryings {
+    let v = surface_varyings(vertex, 0u, lod_shell_layer(shell));
+    return shell_tile_varyings(v, shell_fade(v.normal, v.world_position), lod_shell_blend(vertex, v.normal));
+}
+
+// The level of detail's blend at base vertex `vertex` (world normal `normal`): the view angle
+// weighed at the strand's root, the same for every layer (what the culling pass decides on).
+fn lod_shell_blend(vertex: u32, normal: vec3<f32>) -> f32 {
+    var weight = 0.0;
+    // A uniform branch: without view-angle LOD no root is fetched.
+    if object.lod_view > 0.0 {
+        weight = lod_view_weight(normal, world_from_model_point(model_vertex(0u, vertex)));
+    }
+    return lod_vertex_blend(weight);
 }
 
 fn hash(x: u32) -> u32 {

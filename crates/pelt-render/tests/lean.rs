@@ -63,7 +63,11 @@ fn cpu_and_compute_silhouettes_keep_the_same_fins() {
         let mut silhouette = CpuSilhouette::new(&fur.mesh);
         let turned = Mat4::from_rotation_y(0.7) * Mat4::from_scale(Vec3::new(1.0, 1.6, 0.8));
         for world_from_model in [Mat4::IDENTITY, turned] {
-            let frame = FurFrame { world_from_model, level: FurLevel { stride: 2, blend: 0.0 }, ..FurFrame::default() };
+            let frame = FurFrame {
+                world_from_model,
+                level: FurLevel { stride: 2, blend: 0.0, ..FurLevel::FULL },
+                ..FurFrame::default()
+            };
             gpu_fur.prepare(rig.queue(), &frame);
             let camera = framed(&fur, 1.0);
             rig.render_silhouette(&gpu_fur, &camera, &FurDrawSettings::SILHOUETTE);

@@ -29,6 +29,11 @@ fn silhouette_module_validates() {
 }
 
 #[test]
+fn view_lod_module_validates() {
+    validate("shading.wgsl + unified.wgsl + view_lod.wgsl", &pelt_render::view_lod_shader_source());
+}
+
+#[test]
 fn strands_module_validates() {
     validate("shading.wgsl + strands.wgsl", &pelt_render::strands_shader_source());
 }
@@ -40,6 +45,7 @@ fn every_wgsl_file_is_part_of_a_validated_module() {
         pelt_render::separated_shader_source(),
         pelt_render::simulation_shader_source(),
         pelt_render::silhouette_shader_source(),
+        pelt_render::view_lod_shader_source(),
         pelt_render::strands_shader_source(),
     ];
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
@@ -52,5 +58,8 @@ fn every_wgsl_file_is_part_of_a_validated_module() {
             checked += 1;
         }
     }
-    assert_eq!(checked, 7, "shading, unified, separated, silhouette, simulation_wind, simulation and strands");
+    assert_eq!(
+        checked, 8,
+        "shading, unified, separated, silhouette, view_lod, simulation_wind, simulation and strands"
+    );
 }

@@ -7,7 +7,11 @@ use pelt_render::{FurLevel, LodSettings, strand_pixels_in_view};
 
 /// The settings `[render.lod]` and `--no-lod` give.
 pub fn settings(params: &LodParams, no_lod: bool) -> LodSettings {
-    LodSettings { enabled: params.enabled && !no_lod, pixels_per_shell: params.pixels_per_shell }
+    LodSettings {
+        enabled: params.enabled && !no_lod,
+        pixels_per_shell: params.pixels_per_shell,
+        facing: params.view_angle.then_some([params.facing_start, params.facing_full]),
+    }
 }
 
 /// The level for `fur` (model space = world space, as Pelt's commands draw it) seen from `eye`

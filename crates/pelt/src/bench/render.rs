@@ -191,14 +191,18 @@ impl Bench {
                     let triangles = self.triangles_drawn(fur, &unified)?;
                     anyhow::Ok((median_ms(&times), triangles))
                 };
-                let (near_ms, _) = timed(&view_data, near_level)?;
+                let (near_full_ms, near_full_triangles) = timed(&view_data, pelt_render::FurLevel::FULL)?;
+                let (near_ms, near_triangles) = timed(&view_data, near_level)?;
                 let (far_lod_ms, far_lod_triangles) = timed(&far_view, far_level)?;
                 let (far_full_ms, far_full_triangles) = timed(&far_view, pelt_render::FurLevel::FULL)?;
                 unified.prepare(queue, &FurFrame::default());
                 lod_figures.push(LodFigures {
                     size: format!("{width}x{height}"),
                     level_near: near_level.describe(fur.layers),
+                    frame_ms_near_full: near_full_ms,
                     frame_ms_near_lod: near_ms,
+                    triangles_near_full: near_full_triangles,
+                    triangles_near_lod: near_triangles,
                     level_far: far_level.describe(fur.layers),
                     frame_ms_far_full: far_full_ms,
                     frame_ms_far_lod: far_lod_ms,
@@ -268,8 +272,9 @@ impl Bench {
 }
 
 impl Bench {
-    /// Triangles the last unified frame drew: the skin, the shells and the fins the silhouette
-    /// pass kept, at the level `unified` was prepared with.
+    /// Triangles the last unified frame drew: the skin, the shells (those thinned by view angle
+    /// over the triangles the view-angle pass listed) and the fins the silhouette pass kept, at
+    /// the level `unified` was prepared with.
     fn triangles_drawn(&self, fur: &FurStructure, unified: &GpuFur) -> anyhow::Result<u64> {
         let faces = fur.mesh.triangles.len() as u64;
         let shells = u64::from(unified.drawn_shells());
@@ -277,7 +282,12 @@ impl Bench {
             Some(draw) => u64::from(self.read_u32(draw, 1)?),
             None => 0,
         };
-        Ok(faces * (1 + shells) + fin_edges * 2 * shells)
+        let thinned = u64::from(unified.shells_thinned());
+        let listed = match unified.view_lod_count() {
+            Some(count) if thinned > 0 => u64::from(self.read_u32(count, 0)?) / 3,
+            _ => 0,
+        };
+        Ok(faces * (1 + shells - thinned) + listed * thinned + fin_edges * 2 * shells)
     }
 
     /// Word `index` of a small `COPY_SRC` buffer, read back (waits for the GPU).

@@ -165,7 +165,13 @@ pub struct LodFigures {
     pub size: String,
     /// The level at the default framing, e.g. `8/16 shells`.
     pub level_near: String,
+    /// Every shell at the default framing (LOD off), then at its level.
+    pub frame_ms_near_full: f64,
     pub frame_ms_near_lod: f64,
+    /// Triangles drawn at the default framing, full and at the level (the shells the view
+    /// angle thins drawn over the view-angle pass's list only).
+    pub triangles_near_full: u64,
+    pub triangles_near_lod: u64,
     /// The level at 4x the distance.
     pub level_far: String,
     pub frame_ms_far_full: f64,
@@ -355,19 +361,22 @@ impl Report {
             let _ = writeln!(md, "\n### Level of detail (unified, median ms; the table above draws every shell)\n");
             let _ = writeln!(
                 md,
-                "| model | L | size | level, default framing | LOD on | level, 4x distance | LOD off, 4x | LOD on, 4x | triangles off / on, 4x |"
+                "| model | L | size | level, default framing | LOD off | LOD on | triangles off / on | level, 4x distance | LOD off, 4x | LOD on, 4x | triangles off / on, 4x |"
             );
-            let _ = writeln!(md, "|---|---:|---|---|---:|---|---:|---:|---:|");
+            let _ = writeln!(md, "|---|---:|---|---|---:|---:|---:|---|---:|---:|---:|");
             for r in &self.results {
                 for f in &r.render.lod {
                     let _ = writeln!(
                         md,
-                        "| {} | {} | {} | {} | {} | {} | {} | {} | {} / {} |",
+                        "| {} | {} | {} | {} | {} | {} | {} / {} | {} | {} | {} | {} / {} |",
                         r.model,
                         r.layers,
                         f.size,
                         f.level_near,
+                        ms(Some(f.frame_ms_near_full)),
                         ms(Some(f.frame_ms_near_lod)),
+                        thousands(f.triangles_near_full),
+                        thousands(f.triangles_near_lod),
                         f.level_far,
                         ms(Some(f.frame_ms_far_full)),
                         ms(Some(f.frame_ms_far_lod)),

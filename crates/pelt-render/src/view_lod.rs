@@ -1,0 +1,185 @@
+//! Shells by view angle, the culling half: a compute pass lists, once per frame and view, the
+//! triangles that still show in the layers the next coarser stride drops (`view_lod.wgsl`), and
+//! writes one indexed indirect draw per shell over that list. The renderer then draws the kept
+//! shells over every triangle and the thinned ones over the list, one shell at a time from the
+//! innermost out (blending needs that order). Facing the eye, most triangles leave the list.
+//!
+//! The pass is recorded by [`crate::FurRenderer::prepare_fins`] beside the silhouette pass;
+//! nothing is read back, nothing blocks. A fur drawn without it (or whose mesh is too large to
+//! number every shell's vertices in one `u32`) draws every triangle in every shell, with the
+//! same view-angle fading: the same picture, without the savings.
+
+use std::sync::atomic::{AtomicBool, Ordering};
+
+use crate::RenderError;
+use crate::object::check_size;
+use crate::pipeline::Layouts;
+use crate::renderer::{SHADING_WGSL, UNIFIED_WGSL};
+
+pub(crate) const VIEW_LOD_WGSL: &str = include_str!("view_lod.wgsl");
+
+/// Triangles (and shells) one workgroup handles (`@workgroup_size` in `view_lod.wgsl`).
+const WORKGROUP: u32 = 64;
+/// `wgpu::util::DrawIndexedIndirectArgs`.
+pub(crate) const SHELL_DRAW_BYTES: u64 = 20;
+
+/// The WGSL module of the view-angle pass (the shared shading, `unified.wgsl` and
+/// `view_lod.wgsl`).
+#[must_use]
+pub fn view_lod_shader_source() -> String {
+    format!("{SHADING_WGSL}\n{UNIFIED_WGSL}\n{VIEW_LOD_WGSL}")
+}
+
+/// The bind group layout of one fur's shell list (group 3 of the pass).
+pub(crate) fn shell_list_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
+    let storage = |binding| wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::COMPUTE,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Storage { read_only: false },
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
+    };
+    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("pelt shell list"),
+        entries: &[storage(0), storage(1), storage(2)],
+    })
+}
+
+/// The pass's two pipelines (the list, then the draws), one pair per renderer.
+#[derive(Debug)]
+pub(crate) struct ViewLodPipelines {
+    list: wgpu::ComputePipeline,
+    draws: wgpu::ComputePipeline,
+}
+
+impl ViewLodPipelines {
+    pub fn new(device: &wgpu::Device, layouts: &Layouts) -> Self {
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("pelt view lod"),
+            source: wgpu::ShaderSource::Wgsl(view_lod_shader_source().into()),
+        });
+        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("pelt view lod"),
+            bind_group_layouts: &[Some(&layouts.view), Some(&layouts.unified_object), None, Some(&layouts.shell_list)],
+            immediate_size: 0,
+        });
+        let pipeline = |entry_point| {
+            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some(entry_point),
+                layout: Some(&layout),
+                module: &module,
+                entry_point: Some(entry_point),
+                compilation_options: wgpu::PipelineCompilationOptions::default(),
+                cache: None,
+            })
+        };
+        Self { list: pipeline("cs_view_lod_list"), draws: pipeline("cs_view_lod_draws") }
+    }
+}
+
+/// One fur's shell list as the pass leaves it.
+#[derive(Debug)]
+pub(crate) struct ShellList {
+    /// Indices listed (3 a triangle), one `u32`; `COPY_SRC` for hosts that count.
+    pub listed: wgpu::Buffer,
+    /// The listed triangles' corners or base vertices (the index buffer of the thinned shells).
+    pub indices: wgpu::Buffer,
+    /// One `DrawIndexedIndirectArgs` per shell, [`SHELL_DRAW_BYTES`] apart.
+    pub draws: wgpu::Buffer,
+    bind_group: wgpu::BindGroup,
+    triangle_count: u32,
+    layers: u32,
+    /// Whether the pass was recorded since the fur's last `prepare` (else the list may be from
+    /// another level or view, and the shells are drawn whole).
+    recorded: AtomicBool,
+}
+
+impl ShellList {
+    /// The list of a fur of `triangle_count` triangles, `layers` layers and `per_shell` vertex
+    /// indices a shell (3F with uvs, V without); `None` where there is nothing to thin (fewer
+    /// than two layers) or the shells' vertex indices would not fit an `i32` base vertex.
+    pub fn new(
+        device: &wgpu::Device,
+        layouts: &Layouts,
+        (triangle_count, per_shell): (u32, u32),
+        layers: u32,
+    ) -> Result<Option<Self>, RenderError> {
+        let numbered = u64::from(layers) * u64::from(per_shell);
+        if layers < 2 || triangle_count == 0 || numbered > i32::MAX as u64 {
+            return Ok(None);
+        }
+        let index_bytes = u64::from(triangle_count) * 12;
+        check_size(device, "view-angle shell list", index_bytes)?;
+        let workgroups = triangle_count.div_ceil(WORKGROUP);
+        let most = device.limits().max_compute_workgroups_per_dimension;
+        if workgroups > most {
+            return Err(RenderError::Limit {
+                limit: "max_compute_workgroups_per_dimension",
+                got: most.into(),
+                needed: workgroups.into(),
+            });
+        }
+        let buffer = |label, size, usage| {
+            device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size,
+                usage: usage | wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+                mapped_at_creation: false,
+            })
+        };
+        let listed = buffer("pelt shell list count", 4, wgpu::BufferUsages::COPY_DST);
+        let indices = buffer("pelt shell list", index_bytes, wgpu::BufferUsages::INDEX);
+        let draws = buffer("pelt shell draws", u64::from(layers) * SHELL_DRAW_BYTES, wgpu::BufferUsages::INDIRECT);
+        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("pelt shell list"),
+            layout: &layouts.shell_list,
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: listed.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 1, resource: indices.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 2, resource: draws.as_entire_binding() },
+            ],
+        });
+        Ok(Some(Self { listed, indices, draws, bind_group, triangle_count, layers, recorded: AtomicBool::new(false) }))
+    }
+
+    /// Records the pass: zero the count, list the triangles, write the draws.
+    pub fn record(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        pipelines: &ViewLodPipelines,
+        view: &wgpu::BindGroup,
+        object: &wgpu::BindGroup,
+    ) {
+        encoder.clear_buffer(&self.listed, 0, None);
+        let mut pass = encoder
+            .begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("pelt view lod"), timestamp_writes: None });
+        pass.set_bind_group(0, view, &[]);
+        pass.set_bind_group(1, object, &[]);
+        pass.set_bind_group(3, &self.bind_group, &[]);
+        pass.set_pipeline(&pipelines.list);
+        pass.dispatch_workgroups(self.triangle_count.div_ceil(WORKGROUP), 1, 1);
+        // A new dispatch sees every write of the last one.
+        pass.set_pipeline(&pipelines.draws);
+        pass.dispatch_workgroups(self.layers.div_ceil(WORKGROUP), 1, 1);
+        drop(pass);
+        self.recorded.store(true, Ordering::Relaxed);
+    }
+
+    /// Forgets the last pass (a new level or frame is being prepared).
+    pub fn invalidate(&self) {
+        self.recorded.store(false, Ordering::Relaxed);
+    }
+
+    /// Whether the pass was recorded since the last [`ShellList::invalidate`].
+    pub fn recorded(&self) -> bool {
+        self.recorded.load(Ordering::Relaxed)
+    }
+
+    /// GPU bytes of the list.
+    pub fn bytes(&self) -> u64 {
+        self.listed.size() + self.indices.size() + self.draws.size()
+    }
+}
