@@ -87,7 +87,7 @@ function frame(nowMs) {
   overlay.textContent =
     `frame ${stats.frame_ms.toFixed(1)} ms   simulation ${stats.sim_ms.toFixed(2)} ms\n` +
     `textures ${stats.texture_ms.toFixed(0)} ms (${stats.tile_px} px tiles)   ${stats.layers} layers, ${stats.vertices} vertices\n` +
-    `${stats.adapter}`;
+    `${stats.adapter || page.adapterLabel}`;
   requestAnimationFrame(frame);
 }
 
@@ -213,6 +213,17 @@ $('colour').addEventListener('change', (event) => {
 $('wind').addEventListener('input', applyWind);
 $('wind-dir').addEventListener('input', applyWind);
 
+/** "vendor architecture (description)" from WebGPU's adapter info, or "" when it says nothing. */
+function adapterLabel(adapter) {
+  const info = adapter && adapter.info;
+  if (!info) {
+    return '';
+  }
+  const name = [info.vendor, info.architecture].filter((s) => s).join(' ');
+  const description = info.description && info.description !== name ? info.description : '';
+  return [name, description && `(${description})`].filter((s) => s).join(' ');
+}
+
 async function main() {
   if (!navigator.gpu) {
     page.state = 'no-webgpu';
@@ -229,6 +240,9 @@ async function main() {
   } catch (_) {
     adapter = null;
   }
+  // wgpu leaves the adapter's name empty on some browsers (SwiftShader in Chromium): the page
+  // asks WebGPU itself for what to show instead.
+  page.adapterLabel = adapterLabel(adapter);
   if (!adapter) {
     page.state = 'no-webgpu';
     show('This browser has WebGPU but offers no adapter to draw with (WebGPU switched off, or this GPU ' +

@@ -374,6 +374,17 @@ test('figures: time to the first frame, frame time, textures and simulation', as
   await waitRunning(page);
   await frames(page, 5);
   await page.screenshot({ path: path.join(output, 'page.png') });
+  // The overlay names the adapter (its last line), even where wgpu's adapter info is empty.
+  const adapterLine = await page.$eval('#overlay', (e) => e.textContent.split('\n')[2] || '');
+  assert.ok(adapterLine.trim().length > 0, `the overlay names no adapter: ${JSON.stringify(adapterLine)}`);
+  // Every control stays inside the side panel (a wide preset list once pushed them past it).
+  const overflow = await page.evaluate(() => {
+    const panel = document.getElementById('panel').getBoundingClientRect();
+    return [...document.querySelectorAll('#panel fieldset, #panel select, #panel input')]
+      .filter((e) => e.getBoundingClientRect().right > panel.right + 0.5)
+      .map((e) => e.id || e.tagName);
+  });
+  assert.deepEqual(overflow, [], 'controls reach past the panel');
   const count = 8;
   const start = await page.evaluate(() => ({ t: performance.now(), n: window.pelt.stats.frames_drawn }));
   await frames(page, count);

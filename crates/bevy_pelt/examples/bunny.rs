@@ -31,7 +31,7 @@ fn main() {
                 screenshot_frame: 90,
             },
         ))
-        .insert_resource(Args::from_env())
+        .insert_resource(Args::from_env("presets/mink.toml"))
         .insert_resource(FurWind { direction: Vec3::new(1.0, 0.0, 0.3), strength: 0.0, gust_strength: 0.5 })
         .add_systems(Startup, setup)
         .add_systems(Update, (wind_keys, touch))

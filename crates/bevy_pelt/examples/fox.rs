@@ -3,7 +3,8 @@
 //! with pelt-core and simulates it (the fur swings as the Fox moves).
 //!
 //! `cargo run --release -p bevy_pelt --example fox [--ignore-rust-version] -- [PRESET] [--screenshot PNG]`
-//! (PRESET is relative to the repository's `assets/`, default `presets/mink.toml`).
+//! (PRESET is relative to the repository's `assets/`, default `presets/fox.toml`: the Fox's own
+//! texture carried into its fur).
 //!
 //! Right-drag orbits, the wheel zooms. 1, 2 and 3 play Survey, Walk and Run; Space pauses.
 //! `--screenshot PNG` saves a frame and exits.
@@ -37,7 +38,7 @@ fn main() {
                 screenshot_frame: 120,
             },
         ))
-        .insert_resource(Args::from_env())
+        .insert_resource(Args::from_env("presets/fox.toml"))
         .add_systems(Startup, setup)
         .add_systems(Update, (grow_fur, animation_keys))
         .run();
@@ -79,7 +80,8 @@ fn play_walk(
     }
 }
 
-/// Fur on every skinned mesh the scene spawns, over the Fox's own textured surface.
+/// Fur on every skinned mesh the scene spawns, over the Fox's own textured surface (the default
+/// preset colours the fur from that texture, so the two agree where the surface shows through).
 fn grow_fur(
     mut commands: Commands,
     skinned: Query<Entity, Added<SkinnedMesh>>,

@@ -54,7 +54,7 @@ fn round_trip_through_toml_and_a_file() {
 #[test]
 fn every_shipped_preset_loads_and_they_differ() {
     let mut presets = Vec::new();
-    for name in ["mink", "shaggy", "lamb", "spotted", "dyed", "spot"] {
+    for name in ["mink", "shaggy", "lamb", "spotted", "dyed", "spot", "fox"] {
         let path = presets_folder().join(format!("{name}.toml"));
         let preset = Preset::load(&path).unwrap_or_else(|e| panic!("{e}"));
         presets.push(preset);
@@ -64,13 +64,16 @@ fn every_shipped_preset_loads_and_they_differ() {
             assert_ne!(a, b);
         }
     }
-    let [mink, shaggy, lamb, spotted, dyed, spot] = &presets[..] else { unreachable!() };
+    let [mink, shaggy, lamb, spotted, dyed, spot, fox] = &presets[..] else { unreachable!() };
     assert!(mink.length < shaggy.length && mink.texture.density > shaggy.texture.density);
     assert!(lamb.texture.curl_radius > 0.0);
     assert!(spotted.texture.pattern.is_some());
     assert_eq!(dyed.colour.mode, ColourMode::Height);
     assert_eq!(spot.colour.mode, ColourMode::Surface);
     assert!(spot.generate_textures().unwrap().surface.is_some(), "spot.toml finds Spot's texture");
+    assert_eq!(fox.colour.mode, ColourMode::Surface);
+    let fox_surface = fox.colour.surface.as_deref().map(|file| presets_folder().join(file));
+    assert!(fox_surface.is_some_and(|path| path.is_file()), "fox.toml names the Fox's texture beside it");
 }
 
 #[test]

@@ -10,8 +10,8 @@ use pelt_core::{Preset, PresetError};
 /// generation runs on the page's one thread, and a 256 tile takes a quarter of the time.
 pub const WEB_TILE_PX: u32 = 256;
 
-/// `(name, TOML)` of every preset on the page. `spot` is left out: it is made for Spot's mesh
-/// and its texture, and the page has the bunny and the try-on scene.
+/// `(name, TOML)` of every preset on the page. `spot` and `fox` are left out: they are made for
+/// Spot's and the Fox's meshes and textures, and the page has the bunny and the try-on scene.
 pub const SHIPPED: [(&str, &str); 6] = [
     ("default", ""),
     ("mink", include_str!("../../../assets/presets/mink.toml")),

@@ -20,11 +20,11 @@ pub struct Args {
 }
 
 impl Args {
-    pub fn from_env() -> Self {
+    /// `default_preset` (relative to `assets/`) where the command line names none.
+    pub fn from_env(default_preset: &str) -> Self {
         let args: Vec<String> = std::env::args().skip(1).collect();
         let screenshot = args.iter().position(|a| a == "--screenshot").and_then(|i| args.get(i + 1)).cloned();
-        let preset =
-            args.iter().find(|a| a.ends_with(".toml")).cloned().unwrap_or_else(|| "presets/mink.toml".to_owned());
+        let preset = args.iter().find(|a| a.ends_with(".toml")).cloned().unwrap_or_else(|| default_preset.to_owned());
         Self { preset, screenshot }
     }
 }
