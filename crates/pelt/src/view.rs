@@ -9,6 +9,7 @@ mod fur;
 mod gpu;
 mod model;
 mod panel;
+mod shell_share;
 mod ui;
 mod viewport;
 

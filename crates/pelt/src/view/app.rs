@@ -228,6 +228,9 @@ impl App {
             Some(FrameCopy::encode(&gpu.device, &mut encoder, &offscreen))
         };
         gpu.queue.submit(callback_buffers.into_iter().chain([encoder.finish()]));
+        running.fur.after_submit();
+        model.shell_share =
+            if separated { None } else { running.fur.shell_share(model.structure.mesh.triangles.len() as u32) };
         running.window.pre_present_notify();
         gpu.queue.present(frame);
         model.frames_drawn += 1;

@@ -11,6 +11,7 @@ use pelt_render::{
 };
 
 use super::camera::OrbitCamera;
+use super::shell_share::ShellShare;
 use super::viewport::{Viewport, target};
 
 /// Colour of a plain (furless) body, linear RGB.
@@ -37,6 +38,8 @@ pub struct FurScene {
     pub settings: FurDrawSettings,
     /// Where this frame falls between the GPU simulation's two states (1 with one state).
     interpolation: f32,
+    /// The view-angle pass's count, read back for the overlay.
+    shell_share: ShellShare,
 }
 
 impl FurScene {
@@ -55,6 +58,7 @@ impl FurScene {
             textures: textures.clone(),
             settings: FurDrawSettings::SILHOUETTE,
             interpolation: 1.0,
+            shell_share: ShellShare::new(&gpu.device),
         })
     }
 
@@ -187,13 +191,29 @@ impl FurScene {
         if separated.is_none() {
             self.renderer.prepare_fins(encoder, &self.view, &self.fur);
         }
-        let mut pass = viewport.targets.begin_pass(encoder, &viewport.colour_view, DEFAULT_BACKGROUND);
-        if let Some(body) = &self.body {
-            self.renderer.draw_plain(&mut pass, &self.view, body);
+        {
+            let mut pass = viewport.targets.begin_pass(encoder, &viewport.colour_view, DEFAULT_BACKGROUND);
+            if let Some(body) = &self.body {
+                self.renderer.draw_plain(&mut pass, &self.view, body);
+            }
+            match separated {
+                Some((renderer, fur)) => renderer.draw(&mut pass, &self.view, fur, &self.settings),
+                None => self.renderer.draw(&mut pass, &self.view, &self.fur, &self.settings),
+            }
         }
-        match separated {
-            Some((renderer, fur)) => renderer.draw(&mut pass, &self.view, fur, &self.settings),
-            None => self.renderer.draw(&mut pass, &self.view, &self.fur, &self.settings),
+        if separated.is_none() {
+            self.shell_share.record(encoder, &self.fur);
         }
+    }
+
+    /// After the frame's submission: moves the overlay's shell count readback along.
+    pub fn after_submit(&mut self) {
+        self.shell_share.after_submit();
+    }
+
+    /// The share of shell triangles the unified fur drew lately (view-angle LOD), for a mesh of
+    /// `faces` triangles; `None` without view-angle LOD.
+    pub fn shell_share(&self, faces: u32) -> Option<f64> {
+        self.shell_share.share(&self.fur, faces)
     }
 }

@@ -33,6 +33,8 @@ pub(super) struct Model {
     pub(super) no_lod: bool,
     /// The level of detail of the last frame drawn (the overlay shows it).
     pub(super) level: pelt_render::FurLevel,
+    /// The share of shell triangles the last counted frame drew (view-angle LOD), if known.
+    pub(super) shell_share: Option<f64>,
     /// GPU bytes of the separated structure while it is shown.
     pub(super) separated_bytes: Option<u64>,
     pub(super) camera: OrbitCamera,
@@ -156,6 +158,7 @@ impl Model {
             unified_bytes: None,
             no_lod: args.no_lod,
             level: pelt_render::FurLevel::FULL,
+            shell_share: None,
             separated_bytes: None,
             camera,
             frame_pending: true,

@@ -197,6 +197,16 @@ impl Model {
     }
 
     /// Frame time, simulation time, what is drawn and what it costs on the GPU.
+    /// The overlay's LOD line: the level, and with view-angle LOD the share of shell triangles
+    /// drawn (`LOD 16/16 shells, to 8 facing the eye, 81% of shell triangles`).
+    fn lod_line(&self) -> String {
+        let level = self.level.describe(self.structure.layers);
+        match self.shell_share {
+            Some(share) if self.level.facing.is_some() => format!("{level}, {:.0}% of shell triangles", share * 100.0),
+            _ => level,
+        }
+    }
+
     fn overlay(&self, painter: &egui::Painter, rect: egui::Rect) {
         let draw = self.settings.draw;
         let footprint = if draw.unified {
@@ -227,7 +237,7 @@ impl Model {
             if draw.unified { "unified" } else { "separated" },
             self.settings.mesh.label(),
             self.structure.layers,
-            if self.no_lod { "off (--no-lod)".to_owned() } else { self.level.describe(self.structure.layers) },
+            if self.no_lod { "off (--no-lod)".to_owned() } else { self.lod_line() },
         );
         let galley = painter.layout_no_wrap(text, egui::FontId::monospace(12.0), egui::Color32::from_gray(225));
         let origin = rect.left_top() + egui::vec2(12.0, 12.0);
