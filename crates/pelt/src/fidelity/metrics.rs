@@ -169,6 +169,16 @@ pub fn downsample(image: &RgbaImage, factor: u32) -> RgbaImage {
     })
 }
 
+/// `image` moved `offset` pixels left and up (the right and bottom edges repeat): the
+/// supersampled reference moved by a fraction of an output pixel, to measure how much of SSIM's
+/// loss sub-pixel placement alone costs.
+pub fn shifted(image: &RgbaImage, offset: u32) -> RgbaImage {
+    let (width, height) = image.dimensions();
+    RgbaImage::from_fn(width, height, |x, y| {
+        *image.get_pixel((x + offset).min(width - 1), (y + offset).min(height - 1))
+    })
+}
+
 /// A heat map of `a` against `b`: black where they agree, through red and yellow to white at a
 /// colour distance of `full` (0..=1) or more.
 pub fn heat_map(a: &RgbaImage, b: &RgbaImage, full: f32) -> RgbaImage {
@@ -238,6 +248,16 @@ mod tests {
         assert_eq!(mask.dilate(1).erode(1).count(), 1);
         assert_eq!(mask.dilate(2).minus(&mask.dilate(1)).count(), 16);
         assert_eq!(mask.union(&mask.dilate(1)).count(), 9);
+    }
+
+    #[test]
+    fn shifting_moves_the_picture_and_repeats_the_edge() {
+        let image = RgbaImage::from_fn(3, 2, |x, y| Rgba([x as u8, y as u8, 7, 255]));
+        let moved = shifted(&image, 1);
+        assert_eq!(moved.dimensions(), (3, 2));
+        assert_eq!(moved.get_pixel(0, 0).0, [1, 1, 7, 255]);
+        assert_eq!(moved.get_pixel(2, 1).0, [2, 1, 7, 255]);
+        assert_eq!(shifted(&image, 0), image);
     }
 
     #[test]

@@ -80,6 +80,9 @@ struct Figures {
     ssim_silhouette_shells_fins: f64,
     ssim_silhouette_shells: f64,
     mean_colour_difference: f64,
+    /// The reference against itself moved a quarter pixel (with 4x supersampling; `1 /
+    /// supersample` pixel below that): how much SSIM sub-pixel placement alone costs.
+    ssim_fur_reference_shifted: f64,
 }
 
 #[derive(Debug, serde::Serialize)]
@@ -129,6 +132,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let samples = args.msaa.unwrap_or_else(|| default_sample_count(&gpu.adapter.get_info()));
     let shells = Headless::with_target(gpu, FurTarget::new(HEADLESS_FORMAT).with_sample_count(samples), width, height)?;
     let factor = args.supersample;
+    let shift = (factor / 4).max(1);
     let strands = Headless::with_target(
         Gpu::new(args.backend)?,
         FurTarget::new(HEADLESS_FORMAT).with_sample_count(1),
@@ -174,6 +178,8 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             strand_renderer.draw(pass, &strand_side.view, &strand_side.fur, &ribbons);
         })?;
         let reference_image = metrics::downsample(&big, factor);
+        // The same strands a quarter pixel off: the measurement's own precision.
+        let shifted_reference = metrics::downsample(&metrics::shifted(&big, shift), factor);
 
         let fur_mask = Mask::differing(&reference_image, &skin, CHANGED)
             .union(&Mask::differing(&shells_fins, &skin, CHANGED))
@@ -201,6 +207,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             ssim_silhouette_shells: ssim(&shells_only, &band)?,
             mean_colour_difference: metrics::mean_colour_difference(&shells_fins, &reference_image, &fur_mask)
                 .unwrap_or(0.0),
+            ssim_fur_reference_shifted: ssim(&shifted_reference, &fur_mask)?,
         };
         let heat = metrics::heat_map(&shells_fins, &reference_image, 0.25);
         let sheet = metrics::side_by_side(&[&shells_fins, &shells_only, &reference_image, &heat], 4, [255, 255, 255]);
@@ -221,6 +228,10 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             let (mean, contrast) = metrics::luma_statistics(image, &fur_mask);
             format!("{mean:.0}/{contrast:.1}")
         };
+        println!(
+            "{:>8} {name:<5} the strands against themselves {shift}/{factor} pixel off: SSIM fur {:.3}",
+            "", result.ssim_fur_reference_shifted
+        );
         println!(
             "{:>8} {name:<5} luma mean/local contrast over the fur: shells+fins {}, shells {}, strands {}",
             "",
