@@ -220,8 +220,6 @@ pub(crate) fn create_pipeline(
                 blend,
                 // Coverage already says how much of a pixel a strand covers; writing its alpha
                 // too would leave the target (and a PNG read from it) translucent.
-                // Coverage already says how much of a pixel a strand covers; writing its alpha
-                // too would leave the target (and a PNG read from it) translucent.
                 write_mask: if coverage { wgpu::ColorWrites::COLOR } else { wgpu::ColorWrites::ALL },
             })],
         }),
