@@ -104,60 +104,63 @@ struct Varyings {
     @location(10) tile_normal: vec3<f32>,
 }
 
-// What a shell fragment reads and nothing more: software rasterisers set up and
-// interpolate every declared varying of every triangle, read or not, and the shells are most of
-// the fur's triangles (BENCHMARKS.md: the full `Varyings` cost the shells about a quarter of
-// their frame). One struct per way of finding the texel; `height` and `slice` follow from the
-// flat layer.
+// What a shell fragment reads and nothing more, packed four to a location: software
+// rasterisers set up and interpolate every declared varying of every triangle, read or not, and
+// the shells are most of the fur's triangles. The lighting's geometric terms come from the
+// vertex (`hair_terms`), not the normal, tangent and position they are made of. One struct per
+// way of finding the texel; the layer rides as a float (the same value at every corner, so
+// interpolation keeps it), and `height` and `slice` follow from it.
 struct ShellTileVaryings {
     @builtin(position) clip_position: vec4<f32>,
-    @location(0) world_position: vec3<f32>,
-    @location(1) normal: vec3<f32>,
-    @location(2) tangent: vec3<f32>,
+    // `hair_terms` at the vertex.
+    @location(0) lighting: vec4<f32>,
+    // The opacity from the view angle (`shell_fade`), how far the layers the next coarser stride
+    // drops have faded here (`lod_vertex_blend`), and the layer.
+    @location(1) fade_blend_layer: vec3<f32>,
     // The root in tiles, model space, and the base normal picking its projection.
-    @location(3) tile_position: vec3<f32>,
-    @location(4) tile_normal: vec3<f32>,
-    @location(5) fade: f32,
-    @location(6) @interpolate(flat) layer: u32,
-    // How far the layers the next coarser stride drops have faded here (`lod_vertex_blend`).
-    @location(7) lod_blend: f32,
+    @location(2) tile_position: vec3<f32>,
+    @location(3) tile_normal: vec3<f32>,
 }
 
 struct ShellUvVaryings {
     @builtin(position) clip_position: vec4<f32>,
-    @location(0) world_position: vec3<f32>,
-    @location(1) normal: vec3<f32>,
-    @location(2) tangent: vec3<f32>,
+    @location(0) lighting: vec4<f32>,
+    @location(1) fade_blend_layer: vec3<f32>,
     // The mesh uv in tiles (xy) and at the strand's root (zw, surface colour mode).
-    @location(3) uvs: vec4<f32>,
-    @location(5) fade: f32,
-    @location(6) @interpolate(flat) layer: u32,
-    // How far the layers the next coarser stride drops have faded here (`lod_vertex_blend`).
-    @location(7) lod_blend: f32,
+    @location(2) uvs: vec4<f32>,
 }
 
 // The lean shell interfaces from the full surface varyings (the unified and separated shells
 // build theirs the same way); `fade` and `lod_blend` are the caller's, computed or carried.
+fn shell_lighting(v: Varyings) -> vec4<f32> {
+    return hair_terms(v.tangent, v.normal, v.world_position, layer_height(v.layer));
+}
+
 fn shell_tile_varyings(v: Varyings, fade: f32, lod_blend: f32) -> ShellTileVaryings {
-    return ShellTileVaryings(v.clip_position, v.world_position, v.normal, v.tangent, v.tile_position, v.tile_normal, fade, v.layer, lod_blend);
+    let fade_blend_layer = vec3<f32>(fade, lod_blend, f32(v.layer));
+    return ShellTileVaryings(v.clip_position, shell_lighting(v), fade_blend_layer, v.tile_position, v.tile_normal);
 }
 
 fn shell_uv_varyings(v: Varyings, fade: f32, lod_blend: f32) -> ShellUvVaryings {
-    let uvs = vec4<f32>(v.uv, v.surface_uv);
-    return ShellUvVaryings(v.clip_position, v.world_position, v.normal, v.tangent, uvs, fade, v.layer, lod_blend);
+    let fade_blend_layer = vec3<f32>(fade, lod_blend, f32(v.layer));
+    return ShellUvVaryings(v.clip_position, shell_lighting(v), fade_blend_layer, vec4<f32>(v.uv, v.surface_uv));
+}
+
+// The layer a shell fragment carries: interpolated from three equal corners, so within rounding.
+fn varying_layer(value: f32) -> u32 {
+    return u32(round(value));
 }
 
 // What a unified fin fragment reads, for the same reason as the shells' structs.
 struct FinVaryings {
     @builtin(position) clip_position: vec4<f32>,
-    @location(0) world_position: vec3<f32>,
-    @location(1) normal: vec3<f32>,
-    @location(2) tangent: vec3<f32>,
+    // `hair_terms` at the vertex, as the shells have them.
+    @location(0) lighting: vec4<f32>,
     // (along the edge in tiles, height: 0 at the roots, 1 at the tips).
-    @location(3) uv: vec2<f32>,
-    @location(4) fade: f32,
+    @location(1) uv: vec2<f32>,
     // The mesh uv at this end of the edge (surface colour mode).
-    @location(5) surface_uv: vec2<f32>,
+    @location(2) surface_uv: vec2<f32>,
+    @location(3) fade: f32,
 }
 
 // Set per pipeline where every mesh it draws has uvs (1) or none has (2), so the shaders drop
@@ -272,18 +275,36 @@ fn occlusion(height: f32) -> f32 {
 }
 
 // Kajiya-Kay hair lighting around the strand tangent, gated by the surface normal so the side
-// of the body facing away from the light stays dark.
+// of the body facing away from the light stays dark. Split in two: the geometric terms, smooth
+// over a triangle, which the shells compute per vertex (`hair_terms`), and the colour from them
+// per fragment (`hair_colour`), which takes the texel's albedo.
 fn hair_lighting(albedo: vec3<f32>, tangent: vec3<f32>, normal: vec3<f32>, world_position: vec3<f32>, height: f32) -> vec3<f32> {
+    return hair_colour(albedo, hair_terms(tangent, normal, world_position, height), height);
+}
+
+// (sin of the angle between strand and light, its square toward the half vector, how lit the
+// side is, occlusion) for a unit strand tangent and surface normal: the Kajiya-Kay terms
+// themselves, so that interpolating them across a shell triangle is exact at the corners and
+// unbiased between them (interpolating `t . l` instead reads the shortened interpolated tangent
+// and brightens the fur). The fragment is left two square roots, a normalisation, a power and a
+// smoothstep fewer (BENCHMARKS.md: a quarter of the shells' frame at 1280x720 on lavapipe).
+fn hair_terms(tangent: vec3<f32>, normal: vec3<f32>, world_position: vec3<f32>, height: f32) -> vec4<f32> {
     let to_light = view.light_direction;
     let to_camera = safe_normalize(view.camera_position - world_position, normal);
-    let t_dot_l = dot(tangent, to_light);
-    let diffuse = sqrt(max(1.0 - t_dot_l * t_dot_l, 0.0));
     let half_vector = safe_normalize(to_light + to_camera, to_light);
+    let t_dot_l = dot(tangent, to_light);
     let t_dot_h = dot(tangent, half_vector);
-    let specular = pow(sqrt(max(1.0 - t_dot_h * t_dot_h, 0.0)), object.shininess);
+    let diffuse = sqrt(max(1.0 - t_dot_l * t_dot_l, 0.0));
     let lit_side = smoothstep(-0.25, 0.6, dot(normal, to_light));
-    let ao = occlusion(height);
-    let light = view.light_colour * lit_side;
+    return vec4<f32>(diffuse, max(1.0 - t_dot_h * t_dot_h, 0.0), lit_side, occlusion(height));
+}
+
+fn hair_colour(albedo: vec3<f32>, terms: vec4<f32>, height: f32) -> vec3<f32> {
+    let diffuse = terms.x;
+    // sin^shininess of the angle to the half vector, as (sin^2)^(shininess / 2).
+    let specular = pow(max(terms.y, 0.0), 0.5 * object.shininess);
+    let ao = terms.w;
+    let light = view.light_colour * terms.z;
     let colour = albedo * (view.ambient + light * diffuse * 0.85) * ao;
     // The highlight takes some of the strand's colour, as light scattered in hair does.
     let highlight = mix(vec3<f32>(1.0), albedo / max(max(albedo.r, albedo.g), max(albedo.b, 1e-3)), 0.5);
@@ -360,35 +381,32 @@ fn fs_skin(in: Varyings) -> @location(0) vec4<f32> {
     return vec4<f32>(colour, 1.0);
 }
 
-// A shell fragment of `layer` from its texel: fading, level of detail and hair lighting.
-fn shell_colour(
-    texel: vec4<f32>,
-    surface_uv: vec2<f32>,
-    fade: f32,
-    layer: u32,
-    lod_blend: f32,
-    normal: vec3<f32>,
-    tangent: vec3<f32>,
-    world_position: vec3<f32>,
-) -> vec4<f32> {
-    let alpha = lod_alpha(texel.a * fade, layer, lod_blend);
+// A shell fragment from its texel: fading, level of detail and hair lighting.
+fn shell_colour(texel: vec4<f32>, surface_uv: vec2<f32>, lighting: vec4<f32>, fade_blend_layer: vec3<f32>) -> vec4<f32> {
+    let layer = varying_layer(fade_blend_layer.z);
+    let alpha = lod_alpha(texel.a * fade_blend_layer.x, layer, fade_blend_layer.y);
     let albedo = texel.rgb * surface_tint(surface_uv);
-    let colour = hair_lighting(albedo, normalize(tangent), normalize(normal), world_position, layer_height(layer));
-    return fur_output(colour, alpha);
+    return fur_output(hair_colour(albedo, lighting, layer_height(layer)), alpha);
 }
 
 // Shells of meshes without uvs (`vs_shell_indexed`, `vs_separated_shell_tiles`).
 @fragment
 fn fs_shell_tiles(in: ShellTileVaryings) -> @location(0) vec4<f32> {
-    let texel = tile_texel(in.tile_position, in.tile_normal, in.layer);
-    return shell_colour(texel, vec2<f32>(0.0), in.fade, in.layer, in.lod_blend, in.normal, in.tangent, in.world_position);
+    let texel = tile_texel(in.tile_position, in.tile_normal, varying_layer(in.fade_blend_layer.z));
+    return shell_colour(texel, vec2<f32>(0.0), in.lighting, in.fade_blend_layer);
 }
 
 // Shells of meshes with uvs (`vs_shell_corners`, `vs_separated_shell_uvs`).
 @fragment
 fn fs_shell_uvs(in: ShellUvVaryings) -> @location(0) vec4<f32> {
-    let texel = sample_shell(in.uvs.xy, shell_slice(in.layer));
-    return shell_colour(texel, in.uvs.zw, in.fade, in.layer, in.lod_blend, in.normal, in.tangent, in.world_position);
+    let texel = sample_shell(in.uvs.xy, shell_slice(varying_layer(in.fade_blend_layer.z)));
+    return shell_colour(texel, in.uvs.zw, in.lighting, in.fade_blend_layer);
+}
+
+// Seen from the side the roots are less hidden than from above: fins light and occlude their
+// strands as if they stood higher.
+fn fin_lighting_height(height: f32) -> f32 {
+    return sqrt(max(height, 0.0));
 }
 
 @fragment
@@ -398,10 +416,6 @@ fn fs_fin(in: FinVaryings) -> @location(0) vec4<f32> {
     // Several fins overlap along a silhouette; thinning them keeps the fringe from reading as a
     // solid band, most of all at the roots where the shells already cover.
     let alpha = texel.a * in.fade * mix(0.15, 0.6, in.uv.y);
-    let normal = normalize(in.normal);
-    // Seen from the side the roots are less hidden than from above: lift the occlusion.
-    let height = sqrt(in.uv.y);
     let albedo = texel.rgb * surface_tint(in.surface_uv);
-    let colour = hair_lighting(albedo, normalize(in.tangent), normal, in.world_position, height);
-    return fur_output(colour, alpha);
+    return fur_output(hair_colour(albedo, in.lighting, fin_lighting_height(in.uv.y)), alpha);
 }

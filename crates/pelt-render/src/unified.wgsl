@@ -224,10 +224,10 @@ fn fin_varyings(index: u32, edge: u32, fade: f32) -> FinVaryings {
     let here = fin_node(layer, vertex);
     let position = world_from_model_point(here);
     out.clip_position = view.clip_from_world * vec4<f32>(position, 1.0);
-    out.world_position = position;
     let normal_a = world_from_model_normal(model_normal(a));
-    out.normal = safe_normalize(normal_a + world_from_model_normal(model_normal(b)), normal_a);
-    out.tangent = strand_tangent(layer, vertex, here, out.normal);
+    let normal = safe_normalize(normal_a + world_from_model_normal(model_normal(b)), normal_a);
+    let tangent = strand_tangent(layer, vertex, here, normal);
+    out.lighting = hair_terms(tangent, normal, position, fin_lighting_height(layer_height(layer)));
     let offset = f32(hash(edge) & 0xffffu) / 65536.0;
     let along = f32(side) * distance(model_vertex(0u, a), model_vertex(0u, b)) * object.tiles_per_world;
     out.uv = vec2<f32>(offset + along, layer_height(layer));

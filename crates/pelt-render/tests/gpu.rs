@@ -5,7 +5,6 @@ mod common;
 use common::*;
 use glam::Vec3;
 use pelt_core::Builtin;
-use pelt_core::sim::{SimParams, Simulation, WindParams};
 use pelt_render::{Camera, DEFAULT_BACKGROUND, FurDrawSettings, FurFrame, SeparatedFur, SeparatedRenderer};
 
 const SIZE: u32 = 256;
@@ -60,23 +59,12 @@ fn golden_tryon() {
     check_golden("tryon", &rig.render_scene(&[&body], Some(&fur), &camera, &settings()));
 }
 
-/// The simulation with a steady wind along `direction` (no gusts or shake, so the pose is exact).
-fn windy_simulation(fur: &pelt_core::FurStructure, direction: Vec3, strength: f32, frames: u32) -> Simulation {
-    let wind = WindParams { direction, strength, gust_strength: 0.0, jitter: 0.0, ..WindParams::default() };
-    let mut simulation = Simulation::new(fur, &SimParams { wind, ..SimParams::default() }).expect("simulation");
-    for frame in 0..=frames {
-        simulation.advance_to(f64::from(frame) / 30.0);
-    }
-    simulation
-}
-
 #[test]
 fn golden_bunny_in_wind() {
     let fur = builtin_fur(Builtin::Bunny, 16);
     let rig = Rig::new(SIZE, SIZE);
     let gpu_fur = rig.fur(&fur, &strand_textures(256, 16, BROWN_ROOT, BROWN_TIP));
-    let simulation = windy_simulation(&fur, Vec3::new(1.0, 0.0, 0.3), 1.5, 12);
-    gpu_fur.set_positions(rig.queue(), simulation.positions()).expect("positions");
+    gpu_fur.set_positions(rig.queue(), golden_wind(&fur).positions()).expect("positions");
     check_golden("bunny-wind", &rig.render(&gpu_fur, &framed(&fur, 1.0), &settings()));
 }
 

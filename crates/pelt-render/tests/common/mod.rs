@@ -7,6 +7,7 @@ use std::path::{Path, PathBuf};
 
 use glam::Vec3;
 use pelt_core::fur::FurLength;
+use pelt_core::sim::{SimParams, Simulation, WindParams};
 use pelt_core::texture::FurTextures;
 use pelt_core::{Builtin, FurParams, FurStructure, GrowthDirection, Mesh};
 use pelt_render::{
@@ -385,4 +386,19 @@ pub fn check_golden(name: &str, image: &image::RgbaImage) {
 /// Loads one of the repository's meshes.
 pub fn load_asset(name: &str) -> Mesh {
     Mesh::load(&asset(name), &pelt_core::ImportOptions::default()).expect("asset mesh").0
+}
+
+/// The simulation with a steady wind along `direction` (no gusts or shake, so the pose is exact).
+pub fn windy_simulation(fur: &FurStructure, direction: Vec3, strength: f32, frames: u32) -> Simulation {
+    let wind = WindParams { direction, strength, gust_strength: 0.0, jitter: 0.0, ..WindParams::default() };
+    let mut simulation = Simulation::new(fur, &SimParams { wind, ..SimParams::default() }).expect("simulation");
+    for frame in 0..=frames {
+        simulation.advance_to(f64::from(frame) / 30.0);
+    }
+    simulation
+}
+
+/// The wind of the `bunny-wind` golden image.
+pub fn golden_wind(fur: &FurStructure) -> Simulation {
+    windy_simulation(fur, Vec3::new(1.0, 0.0, 0.3), 1.5, 12)
 }
