@@ -92,10 +92,10 @@ impl App {
             window.theme(),
             Some(max_texture_side),
         );
-        let mut egui_renderer =
+        let egui_renderer =
             egui_wgpu::Renderer::new(&gpu.device, surface.config.format, egui_wgpu::RendererOptions::default());
         let target = super::viewport::target(&gpu.adapter.get_info());
-        let viewport = Viewport::new(&gpu.device, &mut egui_renderer, [1, 1], target)?;
+        let viewport = Viewport::new(&gpu.device, surface.config.format, target)?;
         let textures = self.model.textures.take().context("the first textures were made before the window")?;
         let mut fur = FurScene::new(&gpu, &self.model.structure, &textures)?;
         fur.set_body(&gpu, self.model.body.as_ref())?;
@@ -117,9 +117,8 @@ impl App {
         model.frame_time_secs = smooth(model.frame_time_secs, wall_secs);
 
         let raw_input = running.egui_state.take_egui_input(&running.window);
-        let texture_id = running.viewport.texture_id;
         let mut outcome = (Changes::default(), Requests::default(), Ok(()));
-        let mut full_output = running.egui_ctx.run_ui(raw_input, |ui| outcome = model.ui(ui, texture_id));
+        let mut full_output = running.egui_ctx.run_ui(raw_input, |ui| outcome = model.ui(ui));
         // egui's texture changes apply whether or not this frame gets drawn.
         let mut textures_delta = std::mem::take(&mut full_output.textures_delta);
         for (id, deltas) in &textures_delta.set {
@@ -177,7 +176,7 @@ impl App {
         };
         model.skipped_frames = 0;
         let gpu = &running.gpu;
-        running.viewport.resize(&gpu.device, &mut running.egui_renderer, model.viewport_px)?;
+        running.viewport.resize(&gpu.device, model.viewport_px)?;
 
         let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
         running.fur.settings.skin = model.settings.draw.skin;
@@ -206,7 +205,11 @@ impl App {
             self.screenshot_after.as_ref().is_some_and(|(after, _)| model.frames_drawn + 1 >= *after);
         let capture = model.screenshot_pending || is_last_scripted_frame;
         let frame_view = frame.texture.create_view(&wgpu::TextureViewDescriptor::default());
-        draw_egui(&mut encoder, &running.egui_renderer, &frame_view, &paint_jobs, &screen);
+        let compose = |encoder: &mut wgpu::CommandEncoder, target: &wgpu::TextureView| {
+            running.viewport.copy_into(encoder, target, screen.size_in_pixels, model.viewport_origin_px);
+            draw_egui(encoder, &running.egui_renderer, target, &paint_jobs, &screen);
+        };
+        compose(&mut encoder, &frame_view);
         let copy = if !capture {
             None
         } else if running.surface.can_copy_frame() {
@@ -224,7 +227,7 @@ impl App {
                 view_formats: &[],
             });
             let view = offscreen.create_view(&wgpu::TextureViewDescriptor::default());
-            draw_egui(&mut encoder, &running.egui_renderer, &view, &paint_jobs, &screen);
+            compose(&mut encoder, &view);
             Some(FrameCopy::encode(&gpu.device, &mut encoder, &offscreen))
         };
         gpu.queue.submit(callback_buffers.into_iter().chain([encoder.finish()]));
@@ -335,7 +338,8 @@ fn draw_egui(
                 view: target,
                 depth_slice: None,
                 resolve_target: None,
-                ops: wgpu::Operations { load: wgpu::LoadOp::Clear(wgpu::Color::BLACK), store: wgpu::StoreOp::Store },
+                // Over the 3D view `Viewport::copy_into` left there.
+                ops: wgpu::Operations { load: wgpu::LoadOp::Load, store: wgpu::StoreOp::Store },
             })],
             depth_stencil_attachment: None,
             timestamp_writes: None,

@@ -42,6 +42,8 @@ pub(super) struct Model {
     pub(super) frame_pending: bool,
     /// Size of the 3D view in physical pixels, from the last panel pass.
     pub(super) viewport_px: [u32; 2],
+    /// Where the 3D view's top-left corner lies in the window, in pixels.
+    pub(super) viewport_origin_px: [u32; 2],
     pub(super) clock: Clock,
     pub(super) frame_time_secs: f64,
     pub(super) sim: Simulation,
@@ -163,6 +165,7 @@ impl Model {
             camera,
             frame_pending: true,
             viewport_px: [1, 1],
+            viewport_origin_px: [0, 0],
             clock: Clock { fixed: args.screenshot_after.is_some(), last: Instant::now() },
             frame_time_secs: 0.0,
             sim,

@@ -11,11 +11,7 @@ use crate::format::thousands;
 
 impl Model {
     /// The panel, the 3D view with its overlay, and the shortcuts.
-    pub(super) fn ui(
-        &mut self,
-        ui: &mut egui::Ui,
-        texture_id: egui::TextureId,
-    ) -> (Changes, Requests, anyhow::Result<()>) {
+    pub(super) fn ui(&mut self, ui: &mut egui::Ui) -> (Changes, Requests, anyhow::Result<()>) {
         let mut outcome = (Changes::default(), Requests::default());
         let shortcuts = self.shortcuts(ui.ctx());
         outcome.1.frame |= shortcuts.frame;
@@ -29,7 +25,7 @@ impl Model {
             });
         }
         outcome.0.simulation |= shortcuts.simulation;
-        let view = egui::CentralPanel::no_frame().show(ui, |ui| self.view_3d(ui, texture_id));
+        let view = egui::CentralPanel::no_frame().show(ui, |ui| self.view_3d(ui));
         (outcome.0, outcome.1, view.inner)
     }
 
@@ -102,15 +98,16 @@ struct ShortcutOutcome {
 
 impl Model {
     /// The fur image, camera controls and the overlay.
-    fn view_3d(&mut self, ui: &mut egui::Ui, texture_id: egui::TextureId) -> anyhow::Result<()> {
+    fn view_3d(&mut self, ui: &mut egui::Ui) -> anyhow::Result<()> {
         let rect = ui.max_rect();
         let pixels_per_point = ui.ctx().pixels_per_point();
         self.viewport_px =
             [rect.width(), rect.height()].map(|points| (points * pixels_per_point).round().max(1.0) as u32);
+        // The view itself is copied in under egui's shapes (`Viewport::copy_into`), not painted here.
+        self.viewport_origin_px =
+            [rect.min.x, rect.min.y].map(|points| (points * pixels_per_point).round().max(0.0) as u32);
         let response = ui.allocate_rect(rect, egui::Sense::click_and_drag());
         let painter = ui.painter_at(rect);
-        let full_uv = egui::Rect::from_min_max(egui::pos2(0.0, 0.0), egui::pos2(1.0, 1.0));
-        painter.image(texture_id, rect, full_uv, egui::Color32::WHITE);
 
         let size = Vec2::new(rect.width(), rect.height()).max(Vec2::ONE);
         if self.frame_pending {
@@ -282,7 +279,7 @@ mod tests {
         ];
         let input = egui::RawInput { screen_rect: Some(screen), events, ..egui::RawInput::default() };
         let mut outcome = None;
-        let mut output = ctx.run_ui(input, |ui| outcome = Some(model.ui(ui, egui::TextureId::default())));
+        let mut output = ctx.run_ui(input, |ui| outcome = Some(model.ui(ui)));
         // No GPU here: the font atlas is not uploaded anywhere.
         output.textures_delta.clear();
         let (changes, requests, result) = outcome.unwrap();
