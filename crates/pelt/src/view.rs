@@ -11,6 +11,7 @@ mod model;
 mod panel;
 mod shell_share;
 mod ui;
+mod ui_layer;
 mod viewport;
 
 use std::path::PathBuf;

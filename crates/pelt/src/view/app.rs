@@ -18,6 +18,7 @@ use super::fur::FurScene;
 use super::gpu::{self, Acquired, WindowSurface};
 use super::model::{Model, smooth};
 use super::panel::{Changes, Requests};
+use super::ui_layer::UiLayer;
 use super::viewport::Viewport;
 use crate::sim_kernel::SimKernel;
 
@@ -48,6 +49,8 @@ struct Running {
     egui_state: egui_winit::State,
     egui_renderer: egui_wgpu::Renderer,
     viewport: Viewport,
+    /// egui's picture, drawn again only when its output changes.
+    ui_layer: UiLayer,
     fur: FurScene,
     /// False while minimised or hidden: no redraws are asked for.
     visible: bool,
@@ -96,6 +99,7 @@ impl App {
             egui_wgpu::Renderer::new(&gpu.device, surface.config.format, egui_wgpu::RendererOptions::default());
         let target = super::viewport::target(&gpu.adapter.get_info());
         let viewport = Viewport::new(&gpu.device, surface.config.format, target)?;
+        let ui_layer = UiLayer::new(&gpu.device, surface.config.format);
         let textures = self.model.textures.take().context("the first textures were made before the window")?;
         let mut fur = FurScene::new(&gpu, &self.model.structure, &textures)?;
         fur.set_body(&gpu, self.model.body.as_ref())?;
@@ -106,7 +110,18 @@ impl App {
         model.kernel_reason = reason;
         model.sim.set_cpu_bending(kernel == SimKernel::Cpu);
         fur.set_gpu_simulation(&gpu, &model.structure, model.settings.gpu_sim)?;
-        Ok(Running { window, gpu, surface, egui_ctx, egui_state, egui_renderer, viewport, fur, visible: true })
+        Ok(Running {
+            window,
+            gpu,
+            surface,
+            egui_ctx,
+            egui_state,
+            egui_renderer,
+            viewport,
+            ui_layer,
+            fur,
+            visible: true,
+        })
     }
 
     /// One frame: the panel pass, the fur, egui on top, present; a screenshot when due.
@@ -115,12 +130,14 @@ impl App {
         let model = &mut self.model;
         let (wall_secs, frame_secs) = model.clock.tick();
         model.frame_time_secs = smooth(model.frame_time_secs, wall_secs);
+        model.refresh_shown_times(std::time::Instant::now());
 
         let raw_input = running.egui_state.take_egui_input(&running.window);
         let mut outcome = (Changes::default(), Requests::default(), Ok(()));
         let mut full_output = running.egui_ctx.run_ui(raw_input, |ui| outcome = model.ui(ui));
         // egui's texture changes apply whether or not this frame gets drawn.
         let mut textures_delta = std::mem::take(&mut full_output.textures_delta);
+        let egui_textures_changed = !textures_delta.set.is_empty() || !textures_delta.free.is_empty();
         for (id, deltas) in &textures_delta.set {
             for delta in deltas {
                 running.egui_renderer.update_texture(&running.gpu.device, &running.gpu.queue, *id, delta);
@@ -198,8 +215,17 @@ impl App {
             pixels_per_point: full_output.pixels_per_point,
         };
         let paint_jobs = running.egui_ctx.tessellate(full_output.shapes, full_output.pixels_per_point);
-        let callback_buffers =
-            running.egui_renderer.update_buffers(&gpu.device, &gpu.queue, &mut encoder, &paint_jobs, &screen);
+        // egui draws into its layer only when its output differs from the picture there.
+        let mut callback_buffers = Vec::new();
+        let (size_px, pixels_per_point) = (screen.size_in_pixels, screen.pixels_per_point);
+        if egui_textures_changed || !running.ui_layer.holds(&paint_jobs, size_px, pixels_per_point) {
+            callback_buffers =
+                running.egui_renderer.update_buffers(&gpu.device, &gpu.queue, &mut encoder, &paint_jobs, &screen);
+            let layer = running.ui_layer.target(&gpu.device, size_px);
+            let clear = wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT);
+            draw_egui(&mut encoder, &running.egui_renderer, layer, &paint_jobs, &screen, clear);
+            running.ui_layer.keep(&gpu.device, &gpu.queue, &paint_jobs, size_px, pixels_per_point);
+        }
 
         let is_last_scripted_frame =
             self.screenshot_after.as_ref().is_some_and(|(after, _)| model.frames_drawn + 1 >= *after);
@@ -207,7 +233,7 @@ impl App {
         let frame_view = frame.texture.create_view(&wgpu::TextureViewDescriptor::default());
         let compose = |encoder: &mut wgpu::CommandEncoder, target: &wgpu::TextureView| {
             running.viewport.copy_into(encoder, target, screen.size_in_pixels, model.viewport_origin_px);
-            draw_egui(encoder, &running.egui_renderer, target, &paint_jobs, &screen);
+            running.ui_layer.draw_over(encoder, target);
         };
         compose(&mut encoder, &frame_view);
         let copy = if !capture {
@@ -242,6 +268,14 @@ impl App {
             let image = copy.read(&gpu.device)?;
             if is_last_scripted_frame && let Some((_, path)) = &self.screenshot_after {
                 image.save(path).with_context(|| format!("writing {}", path.display()))?;
+                // The overlay's figure, for scripts that time the viewer (BENCHMARKS.md).
+                let frame_ms = model.frame_time_secs * 1e3;
+                println!(
+                    "wrote {} after {} frames: frame {frame_ms:.1} ms ({:.1} fps)",
+                    path.display(),
+                    model.frames_drawn,
+                    1e3 / frame_ms
+                );
                 model.quit = true;
             }
             if model.screenshot_pending {
@@ -323,13 +357,14 @@ impl ApplicationHandler for App {
     }
 }
 
-/// Draws egui (panel, the 3D image, overlay) into `target`.
-fn draw_egui(
+/// Draws egui (panel, overlay, brush) into `target`, over what `load` leaves there.
+pub(super) fn draw_egui(
     encoder: &mut wgpu::CommandEncoder,
     renderer: &egui_wgpu::Renderer,
     target: &wgpu::TextureView,
     paint_jobs: &[egui::ClippedPrimitive],
     screen: &egui_wgpu::ScreenDescriptor,
+    load: wgpu::LoadOp<wgpu::Color>,
 ) {
     let mut pass = encoder
         .begin_render_pass(&wgpu::RenderPassDescriptor {
@@ -338,8 +373,7 @@ fn draw_egui(
                 view: target,
                 depth_slice: None,
                 resolve_target: None,
-                // Over the 3D view `Viewport::copy_into` left there.
-                ops: wgpu::Operations { load: wgpu::LoadOp::Load, store: wgpu::StoreOp::Store },
+                ops: wgpu::Operations { load, store: wgpu::StoreOp::Store },
             })],
             depth_stencil_attachment: None,
             timestamp_writes: None,

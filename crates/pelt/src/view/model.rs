@@ -53,6 +53,11 @@ pub(super) struct Model {
     pub(super) sim_clock_secs: f64,
     /// Smoothed cost of one `advance_to`.
     pub(super) sim_time_secs: f64,
+    /// The frame and simulation times the overlay shows, and when they were taken from the live
+    /// figures: twice a second, so that between edits egui's output, and with it the picture
+    /// `UiLayer` keeps, stays the same.
+    pub(super) shown_times_secs: [f64; 2],
+    pub(super) shown_at: Option<Instant>,
     /// `--sim`, resolved once the GPU is open.
     pub(super) sim_choice: SimChoice,
     /// Why the kernel in use was chosen (the overlay shows it).
@@ -172,6 +177,8 @@ impl Model {
             scene,
             sim_clock_secs: 0.0,
             sim_time_secs: 0.0,
+            shown_times_secs: [0.0; 2],
+            shown_at: None,
             sim_choice: args.sim,
             kernel_reason: String::new(),
             touch: None,
@@ -352,6 +359,21 @@ fn grow(mesh: Mesh, preset: &Preset) -> anyhow::Result<FurStructure> {
 }
 
 /// Exponential moving average, so the overlay's numbers are readable.
+/// How often the overlay's timings refresh.
+const SHOWN_TIMES_REFRESH_SECS: f64 = 0.5;
+
+impl Model {
+    /// Takes the live frame and simulation times for the overlay when `SHOWN_TIMES_REFRESH_SECS`
+    /// have passed since they were last taken.
+    pub(super) fn refresh_shown_times(&mut self, now: Instant) {
+        let due = self.shown_at.is_none_or(|at| now.duration_since(at).as_secs_f64() >= SHOWN_TIMES_REFRESH_SECS);
+        if due {
+            self.shown_times_secs = [self.frame_time_secs, self.sim_time_secs];
+            self.shown_at = Some(now);
+        }
+    }
+}
+
 pub(super) fn smooth(previous: f64, sample: f64) -> f64 {
     if previous == 0.0 { sample } else { previous * 0.9 + sample * 0.1 }
 }

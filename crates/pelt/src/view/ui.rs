@@ -221,11 +221,12 @@ impl Model {
         // vertex; the unified one a fin strip).
         let renderer_bytes = if draw.unified { self.unified_bytes } else { self.separated_bytes };
         let structure_bytes = renderer_bytes.unwrap_or_else(|| footprint.total_bytes());
-        let frame_ms = self.frame_time_secs * 1e3;
-        let fps = if self.frame_time_secs > 0.0 { 1.0 / self.frame_time_secs } else { 0.0 };
+        let [frame_secs, sim_secs] = self.shown_times_secs;
+        let frame_ms = frame_secs * 1e3;
+        let fps = if frame_secs > 0.0 { 1.0 / frame_secs } else { 0.0 };
         let text = format!(
             "frame    {frame_ms:6.2} ms  ({fps:.0} fps)\nsim      {:6.2} ms CPU, bent on the {} ({})\nvertices {:>9}\nfaces    {:>9}\nGPU      {:>9}  {} structure\nmesh     {}  L = {}\nLOD      {}",
-            self.sim_time_secs * 1e3,
+            sim_secs * 1e3,
             self.kernel(),
             self.kernel_reason,
             thousands(vertices),
