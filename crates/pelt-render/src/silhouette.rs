@@ -11,19 +11,18 @@ use crate::pipeline::Layouts;
 use crate::renderer::{SHADING_WGSL, UNIFIED_WGSL};
 
 pub(crate) const SILHOUETTE_WGSL: &str = include_str!("silhouette.wgsl");
-
-/// Edges one workgroup decides (`@workgroup_size` in `silhouette.wgsl`).
-const WORKGROUP_EDGES: u32 = 64;
+/// The ordered listing both compute passes share (`scan.wgsl`).
+pub(crate) const SCAN_WGSL: &str = include_str!("scan.wgsl");
 /// One fin instance: the edge and its fade (f32 bits).
 pub(crate) const FIN_INSTANCE_BYTES: u64 = 8;
 /// `wgpu::util::DrawIndexedIndirectArgs`.
 const DRAW_ARGS_BYTES: u64 = 20;
 
-/// The WGSL module of the silhouette pass (the shared shading, `unified.wgsl` and
+/// The WGSL module of the silhouette pass (the shared shading, `unified.wgsl`, `scan.wgsl` and
 /// `silhouette.wgsl`).
 #[must_use]
 pub fn silhouette_shader_source() -> String {
-    format!("{SHADING_WGSL}\n{UNIFIED_WGSL}\n{SILHOUETTE_WGSL}")
+    format!("{SHADING_WGSL}\n{UNIFIED_WGSL}\n{SCAN_WGSL}\n{SILHOUETTE_WGSL}")
 }
 
 /// The vertex input of the silhouette fin pipelines: one `(edge, fade bits)` per instance.
@@ -96,15 +95,7 @@ impl FinList {
         }
         let instance_bytes = u64::from(edge_count) * FIN_INSTANCE_BYTES;
         check_size(device, "fin instances", instance_bytes)?;
-        let workgroups = edge_count.div_ceil(WORKGROUP_EDGES);
-        let most = device.limits().max_compute_workgroups_per_dimension;
-        if workgroups > most {
-            return Err(RenderError::Limit {
-                limit: "max_compute_workgroups_per_dimension",
-                got: most.into(),
-                needed: workgroups.into(),
-            });
-        }
+        check_scan_width(device)?;
         let args: [u32; 5] = [6 * layers, 0, 0, 0, 0];
         let draw = wgpu::util::DeviceExt::create_buffer_init(
             device,
@@ -138,7 +129,8 @@ impl FinList {
         Ok(Some(Self { draw, instances, bind_group, edge_count }))
     }
 
-    /// Records the silhouette pass: zero the count, then one thread per edge.
+    /// Records the silhouette pass: one workgroup lists the shown fins in edge order and writes
+    /// the draw's count.
     pub fn record(
         &self,
         encoder: &mut wgpu::CommandEncoder,
@@ -146,8 +138,6 @@ impl FinList {
         view: &wgpu::BindGroup,
         object: &wgpu::BindGroup,
     ) {
-        // `instance_count`, the second word of the draw.
-        encoder.clear_buffer(&self.draw, 4, Some(4));
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("pelt silhouette"),
             timestamp_writes: None,
@@ -156,7 +146,7 @@ impl FinList {
         pass.set_bind_group(0, view, &[]);
         pass.set_bind_group(1, object, &[]);
         pass.set_bind_group(3, &self.bind_group, &[]);
-        pass.dispatch_workgroups(self.edge_count.div_ceil(WORKGROUP_EDGES), 1, 1);
+        pass.dispatch_workgroups(1, 1, 1);
     }
 
     /// Writes a list decided on the CPU (`(edge, fade bits)` per fin, at most `E`) and its
@@ -174,4 +164,21 @@ impl FinList {
     pub fn bytes(&self) -> u64 {
         self.draw.size() + self.instances.size()
     }
+}
+
+/// Threads of the one workgroup that lists what shows (`SCAN_WIDTH` in `scan.wgsl`).
+pub(crate) const SCAN_WIDTH: u32 = 256;
+
+/// The listing passes need one workgroup of `SCAN_WIDTH` threads (WebGPU's default limits allow it).
+pub(crate) fn check_scan_width(device: &wgpu::Device) -> Result<(), RenderError> {
+    let limits = device.limits();
+    let most = limits.max_compute_invocations_per_workgroup.min(limits.max_compute_workgroup_size_x);
+    if most < SCAN_WIDTH {
+        return Err(RenderError::Limit {
+            limit: "max_compute_invocations_per_workgroup",
+            got: most.into(),
+            needed: SCAN_WIDTH.into(),
+        });
+    }
+    Ok(())
 }

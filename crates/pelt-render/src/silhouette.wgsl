@@ -1,11 +1,15 @@
 // The silhouette pass: once per edge per frame, decide whether the edge's fin shows (`fin_fade`
-// in `unified.wgsl`) and append the shown ones to the fins' instance list, counting them into an
-// indexed indirect draw. Appended to `shading.wgsl` and `unified.wgsl`.
+// in `unified.wgsl`) and list the shown ones, in edge order, as the fins' instances, counting them
+// into an indexed indirect draw. Appended to `shading.wgsl`, `unified.wgsl` and `scan.wgsl`.
+//
+// One workgroup walks the edges `SCAN_WIDTH` at a time and places each round's fins by a prefix
+// sum: fins overlap along the silhouette and blend in instance order, so an order that followed
+// the threads' timing (an atomic append) made the same frame differ from run to run.
 
-// `wgpu::util::DrawIndexedIndirectArgs`; the host's encoder zeroes `instance_count` first.
+// `wgpu::util::DrawIndexedIndirectArgs`.
 struct FinDraw {
     index_count: u32,
-    instance_count: atomic<u32>,
+    instance_count: u32,
     first_index: u32,
     base_vertex: i32,
     first_instance: u32,
@@ -13,22 +17,28 @@ struct FinDraw {
 
 // Group 2 holds textures in the render pipelines; the silhouette pass leaves it empty.
 @group(3) @binding(0) var<storage, read_write> fin_draw: FinDraw;
-// (edge, fade as f32 bits) per shown fin, in no particular order.
+// (edge, fade as f32 bits) per shown fin, in edge order.
 @group(3) @binding(1) var<storage, read_write> fin_instances: array<vec2<u32>>;
 
-@compute @workgroup_size(64)
-fn cs_silhouette(@builtin(global_invocation_id) id: vec3<u32>) {
-    let edge = id.x;
-    if edge == 0u {
+@compute @workgroup_size(256)
+fn cs_silhouette(@builtin(local_invocation_index) lane: u32) {
+    var listed = 0u;
+    let rounds = (object.edge_count + SCAN_WIDTH - 1u) / SCAN_WIDTH;
+    for (var round = 0u; round < rounds; round++) {
+        let edge = round * SCAN_WIDTH + lane;
+        var fade = 0.0;
+        if edge < object.edge_count {
+            fade = fin_fade(edge);
+        }
+        let scan = workgroup_scan(lane, u32(fade > 0.0));
+        if fade > 0.0 {
+            fin_instances[listed + scan.x - 1u] = vec2<u32>(edge, bitcast<u32>(fade));
+        }
+        listed += scan.y;
+    }
+    if lane == 0u {
         // The fins' segments at this frame's level of detail (6 indices each).
         fin_draw.index_count = 6u * object.lod_shells;
-    }
-    if edge >= object.edge_count {
-        return;
-    }
-    let fade = fin_fade(edge);
-    if fade > 0.0 {
-        let slot = atomicAdd(&fin_draw.instance_count, 1u);
-        fin_instances[slot] = vec2<u32>(edge, bitcast<u32>(fade));
+        fin_draw.instance_count = listed;
     }
 }

@@ -18,7 +18,7 @@ use crate::renderer::{SHADING_WGSL, UNIFIED_WGSL};
 
 pub(crate) const VIEW_LOD_WGSL: &str = include_str!("view_lod.wgsl");
 
-/// Triangles (and shells) one workgroup handles (`@workgroup_size` in `view_lod.wgsl`).
+/// Shells one workgroup writes draws for (`cs_view_lod_draws` in `view_lod.wgsl`).
 const WORKGROUP: u32 = 64;
 /// `wgpu::util::DrawIndexedIndirectArgs`.
 pub(crate) const SHELL_DRAW_BYTES: u64 = 20;
@@ -27,7 +27,7 @@ pub(crate) const SHELL_DRAW_BYTES: u64 = 20;
 /// `view_lod.wgsl`).
 #[must_use]
 pub fn view_lod_shader_source() -> String {
-    format!("{SHADING_WGSL}\n{UNIFIED_WGSL}\n{VIEW_LOD_WGSL}")
+    format!("{SHADING_WGSL}\n{UNIFIED_WGSL}\n{}\n{VIEW_LOD_WGSL}", crate::silhouette::SCAN_WGSL)
 }
 
 /// The bind group layout of one fur's shell list (group 3 of the pass).
@@ -90,7 +90,6 @@ pub(crate) struct ShellList {
     /// One `DrawIndexedIndirectArgs` per shell, [`SHELL_DRAW_BYTES`] apart.
     pub draws: wgpu::Buffer,
     bind_group: wgpu::BindGroup,
-    triangle_count: u32,
     layers: u32,
     /// Whether the pass was recorded since the fur's last `prepare` (else the list may be from
     /// another level or view, and the shells are drawn whole).
@@ -113,15 +112,7 @@ impl ShellList {
         }
         let index_bytes = u64::from(triangle_count) * 12;
         check_size(device, "view-angle shell list", index_bytes)?;
-        let workgroups = triangle_count.div_ceil(WORKGROUP);
-        let most = device.limits().max_compute_workgroups_per_dimension;
-        if workgroups > most {
-            return Err(RenderError::Limit {
-                limit: "max_compute_workgroups_per_dimension",
-                got: most.into(),
-                needed: workgroups.into(),
-            });
-        }
+        crate::silhouette::check_scan_width(device)?;
         let buffer = |label, size, usage| {
             device.create_buffer(&wgpu::BufferDescriptor {
                 label: Some(label),
@@ -142,10 +133,10 @@ impl ShellList {
                 wgpu::BindGroupEntry { binding: 2, resource: draws.as_entire_binding() },
             ],
         });
-        Ok(Some(Self { listed, indices, draws, bind_group, triangle_count, layers, recorded: AtomicBool::new(false) }))
+        Ok(Some(Self { listed, indices, draws, bind_group, layers, recorded: AtomicBool::new(false) }))
     }
 
-    /// Records the pass: zero the count, list the triangles, write the draws.
+    /// Records the pass: one workgroup lists the triangles in order, then the draws are written.
     pub fn record(
         &self,
         encoder: &mut wgpu::CommandEncoder,
@@ -153,14 +144,13 @@ impl ShellList {
         view: &wgpu::BindGroup,
         object: &wgpu::BindGroup,
     ) {
-        encoder.clear_buffer(&self.listed, 0, None);
         let mut pass = encoder
             .begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("pelt view lod"), timestamp_writes: None });
         pass.set_bind_group(0, view, &[]);
         pass.set_bind_group(1, object, &[]);
         pass.set_bind_group(3, &self.bind_group, &[]);
         pass.set_pipeline(&pipelines.list);
-        pass.dispatch_workgroups(self.triangle_count.div_ceil(WORKGROUP), 1, 1);
+        pass.dispatch_workgroups(1, 1, 1);
         // A new dispatch sees every write of the last one.
         pass.set_pipeline(&pipelines.draws);
         pass.dispatch_workgroups(self.layers.div_ceil(WORKGROUP), 1, 1);

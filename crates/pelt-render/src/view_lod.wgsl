@@ -1,8 +1,9 @@
 // Shells by view angle, the culling half: once per triangle per frame, list the triangles that
 // still show in the layers the next coarser stride drops (where `lod_view_weight` is below 1 at
 // any corner: elsewhere those layers' alpha is 0 at all three corners, so everywhere between),
-// then write one indexed indirect draw per shell over that list. Appended to `shading.wgsl` and
-// `unified.wgsl`.
+// then write one indexed indirect draw per shell over that list. Appended to `shading.wgsl`,
+// `unified.wgsl` and `scan.wgsl`: the list keeps triangle order, since triangles of one shell
+// overlap near the outline and blend in list order.
 
 // `wgpu::util::DrawIndexedIndirectArgs`.
 struct ShellDraw {
@@ -14,20 +15,16 @@ struct ShellDraw {
 }
 
 // Group 2 holds textures in the render pipelines; this pass leaves it empty.
-// Indices listed so far (3 a triangle); the host's encoder zeroes it first.
-@group(3) @binding(0) var<storage, read_write> listed: atomic<u32>;
-// The listed triangles' corners (meshes with uvs) or base vertices (meshes without), in no
-// particular order.
+// Indices listed (3 a triangle).
+@group(3) @binding(0) var<storage, read_write> listed: u32;
+// The listed triangles' corners (meshes with uvs) or base vertices (meshes without), in triangle
+// order.
 @group(3) @binding(1) var<storage, read_write> listed_indices: array<u32>;
 // One draw per shell of the level (only the dropped shells' are used).
 @group(3) @binding(2) var<storage, read_write> shell_draws: array<ShellDraw>;
 
-@compute @workgroup_size(64)
-fn cs_view_lod_list(@builtin(global_invocation_id) id: vec3<u32>) {
-    let triangle = id.x;
-    if triangle >= object.triangle_count {
-        return;
-    }
+// Whether triangle `triangle` still shows in the layers the next coarser stride drops.
+fn view_lod_shows(triangle: u32) -> bool {
     var shows = false;
     for (var k = 0u; k < 3u; k++) {
         let vertex = topology[3u * triangle + k];
@@ -38,12 +35,29 @@ fn cs_view_lod_list(@builtin(global_invocation_id) id: vec3<u32>) {
             shows = true;
         }
     }
-    if shows {
-        let first = atomicAdd(&listed, 3u);
-        for (var k = 0u; k < 3u; k++) {
-            let corner = 3u * triangle + k;
-            listed_indices[first + k] = select(topology[corner], corner, object.has_uvs != 0u);
+    return shows;
+}
+
+// One workgroup walks the triangles `SCAN_WIDTH` at a time (as `cs_silhouette` walks the edges).
+@compute @workgroup_size(256)
+fn cs_view_lod_list(@builtin(local_invocation_index) lane: u32) {
+    var count = 0u;
+    let rounds = (object.triangle_count + SCAN_WIDTH - 1u) / SCAN_WIDTH;
+    for (var round = 0u; round < rounds; round++) {
+        let triangle = round * SCAN_WIDTH + lane;
+        let shows = triangle < object.triangle_count && view_lod_shows(triangle);
+        let scan = workgroup_scan(lane, u32(shows));
+        if shows {
+            let first = 3u * (count + scan.x - 1u);
+            for (var k = 0u; k < 3u; k++) {
+                let corner = 3u * triangle + k;
+                listed_indices[first + k] = select(topology[corner], corner, object.has_uvs != 0u);
+            }
         }
+        count += scan.y;
+    }
+    if lane == 0u {
+        listed = 3u * count;
     }
 }
 
@@ -56,5 +70,5 @@ fn cs_view_lod_draws(@builtin(global_invocation_id) id: vec3<u32>) {
         return;
     }
     let per_shell = select(object.vertex_count, 3u * object.triangle_count, object.has_uvs != 0u);
-    shell_draws[shell] = ShellDraw(atomicLoad(&listed), 1u, 0u, i32(shell * per_shell), 0u);
+    shell_draws[shell] = ShellDraw(listed, 1u, 0u, i32(shell * per_shell), 0u);
 }

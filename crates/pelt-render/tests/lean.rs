@@ -86,12 +86,16 @@ fn per_vertex_lighting_looks_like_per_fragment() {
     }
 }
 
-/// `(edge, fade)` of the fins the last silhouette decision kept, sorted by edge.
+/// `(edge, fade)` of the fins the last silhouette decision kept, which must be in edge order:
+/// fins overlap along the outline and blend in list order, so an order that followed the
+/// threads' timing (the compute pass's atomic append before) changed the picture between runs.
 fn kept_fins(rig: &Rig, fur: &GpuFur) -> Vec<(u32, f32)> {
     let count = rig.read_u32s(fur.silhouette_draw().expect("fins"))[1] as usize;
     let words = rig.read_u32s(fur.silhouette_instances().expect("fins"));
-    let mut fins: Vec<(u32, f32)> = words[..2 * count].chunks_exact(2).map(|w| (w[0], f32::from_bits(w[1]))).collect();
-    fins.sort_by_key(|&(edge, _)| edge);
+    let fins: Vec<(u32, f32)> = words[..2 * count].chunks_exact(2).map(|w| (w[0], f32::from_bits(w[1]))).collect();
+    for pair in fins.windows(2) {
+        assert!(pair[0].0 < pair[1].0, "fins out of edge order: {} before {}", pair[0].0, pair[1].0);
+    }
     fins
 }
 

@@ -60,6 +60,22 @@ fn listed_triangles(rig: &Rig, gpu_fur: &GpuFur, has_uvs: bool) -> std::collecti
     indices[..count].chunks_exact(3).map(|t| triangle_key([t[0], t[1], t[2]], has_uvs)).collect()
 }
 
+/// The list keeps the mesh's triangle order: triangles of one shell overlap near the outline and
+/// blend in list order, so an order that followed the threads' timing changed the picture
+/// between runs.
+fn assert_in_triangle_order(rig: &Rig, gpu_fur: &GpuFur, triangles: &[[u32; 3]], has_uvs: bool) {
+    let count = rig.read_u32s(gpu_fur.view_lod_count().expect("a shell list"))[0] as usize;
+    let indices = rig.read_u32s(gpu_fur.view_lod_indices().expect("a shell list"));
+    let mut next = 0;
+    for triple in indices[..count].chunks_exact(3) {
+        let found = (next..triangles.len()).find(|&t| {
+            if has_uvs { triple[0] as usize == 3 * t } else { triangles[t] == [triple[0], triple[1], triple[2]] }
+        });
+        let Some(t) = found else { panic!("{triple:?} is not a later triangle than triangle {next}") };
+        next = t + 1;
+    }
+}
+
 /// A listed triple as a comparable key: meshes with uvs list the corners `3t..3t + 3` (the key
 /// is `[t, t, t]`), meshes without list the base vertices (the key is them, sorted).
 fn triangle_key(triple: [u32; 3], has_uvs: bool) -> [usize; 3] {
@@ -187,6 +203,7 @@ fn view_angle_culling_keeps_every_triangle_that_still_shows() {
             render_at(&rig, &gpu_fur, &camera, FurLevel { facing: Some(facing), ..FurLevel::FULL });
             let has_uvs = fur.mesh.corner_uvs.is_some();
             let listed = listed_triangles(&rig, &gpu_fur, has_uvs);
+            assert_in_triangle_order(&rig, &gpu_fur, &fur.mesh.triangles, has_uvs);
             let (mut needed, mut borderline) = (0, 0);
             for (t, triangle) in fur.mesh.triangles.iter().enumerate() {
                 let weights: Vec<(f32, f32)> = triangle
