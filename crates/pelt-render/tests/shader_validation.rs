@@ -59,7 +59,7 @@ fn every_wgsl_file_is_part_of_a_validated_module() {
         }
     }
     assert_eq!(
-        checked, 8,
-        "shading, unified, separated, silhouette, view_lod, simulation_wind, simulation and strands"
+        checked, 9,
+        "shading, unified, separated, scan, silhouette, view_lod, simulation_wind, simulation and strands"
     );
 }
