@@ -56,9 +56,10 @@ impl Layouts {
                 entry(5, vertex, storage),
             ],
         });
+        // The separated fins' vertices, read back by each fin vertex to decide for its whole fin.
         let separated_object = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("pelt separated object"),
-            entries: &[entry(0, both, uniform)],
+            entries: &[entry(0, both, uniform), entry(1, vertex, storage)],
         });
         let texture = |view_dimension| wgpu::BindingType::Texture {
             sample_type: wgpu::TextureSampleType::Float { filterable: true },

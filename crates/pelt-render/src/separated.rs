@@ -183,13 +183,20 @@ impl SeparatedFur {
         };
         let shell_vertices = buffer("pelt separated shells", bytemuck::cast_slice(&shell), wgpu::BufferUsages::VERTEX);
         let shell_indices = buffer("pelt separated indices", bytemuck::cast_slice(&indices), wgpu::BufferUsages::INDEX);
-        let fin_vertices = buffer("pelt separated fins", bytemuck::cast_slice(&fin), wgpu::BufferUsages::VERTEX);
+        // Never empty: a storage binding needs at least one word (a mesh without edges has no fins).
+        let fin_bytes: &[u8] =
+            if fin.is_empty() { &[0; SEPARATED_VERTEX_BYTES as usize] } else { bytemuck::cast_slice(&fin) };
+        let fin_usage = wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::STORAGE;
+        let fin_vertices = buffer("pelt separated fins", fin_bytes, fin_usage);
         let uniform = uniform_buffer(device);
         let layouts = renderer.layouts();
         let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("pelt separated object"),
             layout: &layouts.separated_object,
-            entries: &[wgpu::BindGroupEntry { binding: 0, resource: uniform.as_entire_binding() }],
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: uniform.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 1, resource: fin_vertices.as_entire_binding() },
+            ],
         });
         let textures = GpuTextures::new(device, queue, layouts, textures);
         scope.pop("uploading the separated structure")?;

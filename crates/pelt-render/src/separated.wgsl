@@ -1,6 +1,6 @@
 // The separated structure of Lengyel et al. 2001: shells and fins as their own static vertex
 // buffers (position, normal, uv: 32 bytes a vertex, model space). Appended to `shading.wgsl`;
-// group 1 holds only the object uniform.
+// group 1 holds the object uniform and the fin vertices again as storage (`vs_separated_fin`).
 
 struct VertexIn {
     @location(0) position: vec3<f32>,
@@ -74,13 +74,37 @@ fn separated_shell(in: VertexIn, layer: u32) -> Varyings {
     return out;
 }
 
+// The fin vertices as 8 floats each (position, normal, uv): fin `f` is vertices
+// `f * n .. (f + 1) * n`, its first two the roots of its edge's ends.
+@group(1) @binding(1) var<storage, read> fin_vertex_floats: array<f32>;
+
+// Lengyel's fade of the fin that vertex `index` belongs to, decided once for the fin (at the
+// middle of its edge, with its plane normal `normal`, world space), so all its vertices agree.
+fn separated_fin_fade(index: u32, normal: vec3<f32>) -> f32 {
+    let per_fin = (arrayLength(&fin_vertex_floats) / 8u) / max(object.edge_count, 1u);
+    let first = (index / max(per_fin, 1u)) * per_fin * 8u;
+    let root_a = vec3<f32>(fin_vertex_floats[first], fin_vertex_floats[first + 1u], fin_vertex_floats[first + 2u]);
+    let root_b = vec3<f32>(fin_vertex_floats[first + 8u], fin_vertex_floats[first + 9u], fin_vertex_floats[first + 10u]);
+    let middle = world_from_model_point(0.5 * (root_a + root_b));
+    let to_camera = safe_normalize(view.camera_position - middle, normal);
+    return smoothstep(1.0 - object.fin_fade_cos, 1.0, abs(dot(normal, to_camera)));
+}
+
 @vertex
-fn vs_separated_fin(in: VertexIn) -> Varyings {
+fn vs_separated_fin(in: VertexIn, @builtin(vertex_index) index: u32) -> Varyings {
     var out: Varyings;
+    out.normal = world_from_model_normal(in.normal);
+    // Lengyel's fade: a fin shows where it faces the viewer, i.e. stands on a silhouette edge.
+    // Culled as the unified fins are: a fin that does not show lands outside the clip volume,
+    // every vertex of it, so it costs no rasterisation (`vs_fin` in `unified.wgsl`).
+    out.fade = separated_fin_fade(index, out.normal);
+    if out.fade <= 0.0 {
+        out.clip_position = vec4<f32>(2.0, 2.0, 2.0, 1.0);
+        return out;
+    }
     let position = world_from_model_point(in.position);
     out.clip_position = view.clip_from_world * vec4<f32>(position, 1.0);
     out.world_position = position;
-    out.normal = world_from_model_normal(in.normal);
     out.tangent = out.normal;
     out.tile_position = vec3<f32>(0.0);
     out.tile_normal = vec3<f32>(0.0);
@@ -90,9 +114,6 @@ fn vs_separated_fin(in: VertexIn) -> Varyings {
     // Separated fins keep no mesh uv: surface colour mode tints them with the texture's corner.
     out.surface_uv = vec2<f32>(0.0);
     out.height = in.uv.y;
-    // Lengyel's fade: a fin shows where it faces the viewer, i.e. stands on a silhouette edge.
-    let to_camera = safe_normalize(view.camera_position - position, out.normal);
-    out.fade = smoothstep(1.0 - object.fin_fade_cos, 1.0, abs(dot(out.normal, to_camera)));
     return out;
 }
 
