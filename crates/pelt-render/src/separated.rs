@@ -5,7 +5,9 @@
 //!
 //! Each fin is a strip of `N / 2` quads up the rest strands with vertices of its own (they carry
 //! the fin's plane normal for Lengyel's fade and uvs along the fin), stored as a plain triangle
-//! list: 6 vertices a quad. (The paper counts `N` vertices a fin, sharing strip vertices; the
+//! list: 6 vertices a quad, the first two the roots of the edge's ends. The same buffer is bound
+//! as storage too, so every vertex of a fin decides the fade for the whole fin and fins that do
+//! not show are culled, as the unified fins are. (The paper counts `N` vertices a fin, sharing strip vertices; the
 //! drawn cost is the same.) Layer 0 of the shell vertices is the opaque skin; it carries the base
 //! normal where the shells carry the growing vector, so the skin is lit as the unified one.
 //!
