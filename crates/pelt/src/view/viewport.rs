@@ -42,28 +42,7 @@ struct CopyPass {
 
 impl CopyPass {
     fn new(device: &wgpu::Device, window_format: wgpu::TextureFormat) -> Self {
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("pelt view copy"),
-            entries: &[wgpu::BindGroupLayoutEntry {
-                binding: 0,
-                visibility: wgpu::ShaderStages::FRAGMENT,
-                ty: wgpu::BindingType::Texture {
-                    sample_type: wgpu::TextureSampleType::Float { filterable: false },
-                    view_dimension: wgpu::TextureViewDimension::D2,
-                    multisampled: false,
-                },
-                count: None,
-            }],
-        });
-        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("pelt view copy"),
-            source: wgpu::ShaderSource::Wgsl(SHADER.into()),
-        });
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("pelt view copy"),
-            bind_group_layouts: &[Some(&layout)],
-            immediate_size: 0,
-        });
+        let (layout, module, pipeline_layout) = texel_pass(device, "pelt view copy", SHADER);
         let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
             label: Some("pelt view copy"),
             layout: Some(&pipeline_layout),
@@ -166,6 +145,39 @@ impl Viewport {
         pass.set_bind_group(0, &self.copy_source, &[]);
         pass.draw(0..3, 0..1);
     }
+}
+
+/// The bind group layout (one texture, read with `textureLoad`), the shader module and the
+/// pipeline layout of a pass that draws a texture into the window texel for texel: the view's
+/// copy here, egui's layer in `ui_layer.rs`.
+pub(super) fn texel_pass(
+    device: &wgpu::Device,
+    label: &str,
+    shader: &str,
+) -> (wgpu::BindGroupLayout, wgpu::ShaderModule, wgpu::PipelineLayout) {
+    let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some(label),
+        entries: &[wgpu::BindGroupLayoutEntry {
+            binding: 0,
+            visibility: wgpu::ShaderStages::FRAGMENT,
+            ty: wgpu::BindingType::Texture {
+                sample_type: wgpu::TextureSampleType::Float { filterable: false },
+                view_dimension: wgpu::TextureViewDimension::D2,
+                multisampled: false,
+            },
+            count: None,
+        }],
+    });
+    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some(label),
+        source: wgpu::ShaderSource::Wgsl(shader.into()),
+    });
+    let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some(label),
+        bind_group_layouts: &[Some(&layout)],
+        immediate_size: 0,
+    });
+    (layout, module, pipeline_layout)
 }
 
 fn clamp_size(device: &wgpu::Device, size_px: [u32; 2]) -> [u32; 2] {
