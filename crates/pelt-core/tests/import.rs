@@ -522,3 +522,52 @@ fn obj_relative_indices_to_missing_elements_are_errors() {
     let (mesh, _) = Mesh::from_obj_str(text, Path::new("comments.obj"), &ImportOptions::default()).unwrap();
     assert_eq!(mesh.triangles.len(), 1);
 }
+
+/// Vertices shaded by a cache like lavapipe's (256 entries picked by index modulo 256, emptied
+/// every 1,023 indices), written here apart from the importer's own cache model.
+fn direct_mapped_cache_shading(mesh: &Mesh) -> usize {
+    let indices: Vec<u32> = mesh.triangles.iter().flatten().copied().collect();
+    let mut shaded = 0;
+    for segment in indices.chunks(1023) {
+        let mut slots = [u32::MAX; 256];
+        for &i in segment {
+            if slots[i as usize % 256] != i {
+                slots[i as usize % 256] = i;
+                shaded += 1;
+            }
+        }
+    }
+    shaded
+}
+
+type Triangle = [u32; 3];
+type CornerUvs = [[f32; 2]; 3];
+
+#[test]
+fn triangles_are_reordered_for_the_vertex_cache_and_nothing_else_changes() {
+    for name in ["bunny.obj", "spot.obj"] {
+        let (ordered, report) = load(&asset(name));
+        let as_read = ImportOptions { vertex_cache_order: false, ..ImportOptions::default() };
+        let (file_order, file_report) = Mesh::load(&asset(name), &as_read).unwrap();
+        assert_eq!(report, file_report, "{name}: the report does not depend on the order");
+        assert_eq!(ordered.positions, file_order.positions, "{name}: vertices keep their indices");
+        assert_eq!(ordered.normals, file_order.normals, "{name}");
+        assert_eq!(ordered.edges, file_order.edges, "{name}");
+        // The same triangles with the same corners in the same turn, each with its own uvs.
+        let corners = |mesh: &Mesh| {
+            let mut all: Vec<(Triangle, Option<CornerUvs>)> = (0..mesh.triangles.len())
+                .map(|t| (mesh.triangles[t], mesh.corner_uvs.as_ref().map(|uvs| uvs[t].map(|uv| uv.to_array()))))
+                .collect();
+            all.sort_by_key(|corner| corner.0);
+            all
+        };
+        assert_eq!(corners(&ordered), corners(&file_order), "{name}");
+        assert_ne!(ordered.triangles, file_order.triangles, "{name}: the order changed");
+        let (before, after) = (direct_mapped_cache_shading(&file_order), direct_mapped_cache_shading(&ordered));
+        let vertices = ordered.vertex_count();
+        assert!(
+            after as f64 <= 1.4 * vertices as f64 && (after as f64) < 0.7 * before as f64,
+            "{name}: {before} vertex shadings in the file's order, {after} reordered ({vertices} vertices)"
+        );
+    }
+}

@@ -16,6 +16,7 @@ mod repair;
 mod report;
 mod topology;
 mod tuck;
+mod vertex_cache;
 
 use std::path::Path;
 
@@ -54,11 +55,15 @@ pub struct ImportOptions {
     /// Flip triangles so neighbours agree on winding and closed parts face outward (fur grows
     /// along normals computed from the winding, and fins need consistent neighbours).
     pub orient: bool,
+    /// Reorder the triangles so neighbours follow each other (`vertex_cache.rs`): every shell
+    /// draws them through an index buffer, and a vertex leaves the GPU's vertex cache (to be
+    /// shaded again) unless its triangles come close together. Off keeps the file's order.
+    pub vertex_cache_order: bool,
 }
 
 impl Default for ImportOptions {
     fn default() -> Self {
-        Self { weld: true, weld_tolerance: 1e-6, orient: true }
+        Self { weld: true, weld_tolerance: 1e-6, orient: true, vertex_cache_order: true }
     }
 }
 

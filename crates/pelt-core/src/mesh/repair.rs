@@ -7,6 +7,7 @@ use std::path::Path;
 use glam::Vec3;
 
 use super::topology::sorted_half_edges;
+use super::vertex_cache::{CACHE_SIZE, tipsify_order};
 use super::{ImportOptions, Mesh, MeshError, MeshReport, NormalSource, RawMesh, Topology, bounds};
 
 impl Mesh {
@@ -153,6 +154,14 @@ impl Mesh {
             }
             None => (computed, NormalSource::Computed),
         };
+        // After the normals, which sum the faces in order: the order changes no bit of them.
+        if options.vertex_cache_order {
+            let order = tipsify_order(&triangles, positions.len(), CACHE_SIZE);
+            triangles = order.iter().map(|&t| triangles[t as usize]).collect();
+            if let Some(uvs) = &mut corner_uvs {
+                *uvs = order.iter().map(|&t| uvs[t as usize]).collect();
+            }
+        }
 
         let topology = Topology::build(&triangles);
         let boundary_loops = topology.boundary_loops();
