@@ -164,10 +164,11 @@ impl Bench {
                     frame(encoder, &|_| {}, &|pass| separated_renderer.draw(pass, &view, &separated30, &settings))
                 },
             ];
-            for (case, median) in cases.iter().zip(row.iter_mut()) {
-                let times = self.time_frames(case, budget)?;
+            // Frame by frame in turn, so the machine's slow spells (10-20% on a shared VM) fall
+            // on the three structures alike and their ratios hold.
+            for (times, median) in self.time_interleaved(&cases, budget)?.iter().zip(row.iter_mut()) {
                 frames_measured = frames_measured.min(times.len() as u32);
-                *median = median_ms(&times);
+                *median = median_ms(times);
             }
             if lod.enabled {
                 // The unified fur alone (as above) at its level of detail, near and at 4x the
@@ -272,6 +273,32 @@ impl Bench {
 }
 
 impl Bench {
+    /// [`Bench::time_frames`] for several cases at once, one frame of each in turn (after each
+    /// one's warm-up), for `budget`'s frames or time per case: one list of times per case.
+    fn time_interleaved(
+        &self,
+        cases: &[&dyn Fn(&mut wgpu::CommandEncoder)],
+        budget: RenderBudget,
+    ) -> anyhow::Result<Vec<Vec<Duration>>> {
+        let one = RenderBudget { warmup_frames: 0, min_frames: 1, max_frames: 1, ..budget };
+        for case in cases {
+            for _ in 0..budget.warmup_frames {
+                self.time_frames(case, one)?;
+            }
+        }
+        let started = Instant::now();
+        let mut times = vec![Vec::new(); cases.len()];
+        let seconds = budget.max_secs_per_case * cases.len() as f64;
+        let mut rounds = 0;
+        while rounds < budget.max_frames && (rounds < budget.min_frames || started.elapsed().as_secs_f64() < seconds) {
+            for (case, times) in cases.iter().zip(&mut times) {
+                times.extend(self.time_frames(case, one)?);
+            }
+            rounds += 1;
+        }
+        Ok(times)
+    }
+
     /// Triangles the last unified frame drew: the skin, the shells (those thinned by view angle
     /// over the triangles the view-angle pass listed) and the fins the silhouette pass kept, at
     /// the level `unified` was prepared with.
