@@ -7,7 +7,7 @@ use std::time::Instant;
 use pelt_core::{Builtin, FurStructure, Preset};
 use pelt_render::{
     Backend, Camera, CpuSilhouette, DEFAULT_BACKGROUND, FurDrawSettings, FurFrame, FurRenderer, FurStates, FurTarget,
-    FurView, Gpu, GpuFur, HEADLESS_FORMAT, Light, RenderTargets, default_sample_count,
+    FurView, Gpu, GpuFur, HEADLESS_FORMAT, Light, RenderTargets, SeparatedFur, SeparatedRenderer, default_sample_count,
 };
 
 fn main() -> anyhow::Result<()> {
@@ -56,6 +56,10 @@ fn main() -> anyhow::Result<()> {
         let unified = GpuFur::new(device, queue, &renderer, &fur, &textures, FurStates::One)?;
         let frame = FurFrame::default();
         unified.prepare(queue, &frame);
+        // The separated structure with 2-face fins, drawn as `pelt bench` draws it.
+        let separated_renderer = SeparatedRenderer::new(device, &renderer)?;
+        let separated = SeparatedFur::new(device, queue, &renderer, &fur, &textures, 2)?;
+        separated.prepare(queue, &frame);
         let mut silhouette = CpuSilhouette::new(&fur.mesh);
         let base = &fur.positions[..fur.mesh.vertex_count()];
         // The CPU silhouette decision alone (no upload), from the default framing.
@@ -94,7 +98,8 @@ fn main() -> anyhow::Result<()> {
                 let all = FurDrawSettings::SILHOUETTE;
                 let skin_fins = FurDrawSettings { shells: false, ..all };
                 // The last field: the silhouette decided on the CPU instead of the compute pass.
-                let cases: [(&str, FurDrawSettings, bool); 8] = [
+                // `sep2` cases draw the separated structure with 2-face fins.
+                let cases: [(&str, FurDrawSettings, bool); 12] = [
                     ("all", all, false),
                     ("all (CPU silhouette)", all, true),
                     ("skin", FurDrawSettings { shells: false, fins: false, ..all }, false),
@@ -103,8 +108,14 @@ fn main() -> anyhow::Result<()> {
                     ("skin+fins (CPU silhouette)", skin_fins, true),
                     ("all (every-edge fins)", FurDrawSettings { silhouette_fins: false, ..all }, false),
                     ("nothing (clear)", FurDrawSettings { skin: false, shells: false, fins: false, ..all }, false),
+                    ("sep2 all", all, false),
+                    ("sep2 skin", FurDrawSettings { shells: false, fins: false, ..all }, false),
+                    ("sep2 skin+shells", FurDrawSettings { fins: false, ..all }, false),
+                    ("sep2 skin+fins", skin_fins, false),
                 ];
-                for (name, settings, on_cpu) in cases {
+                // `ROUNDS=3` walks the cases that many times in turn (interleaved A/B on a noisy machine).
+                let rounds: usize = std::env::var("ROUNDS").ok().and_then(|s| s.parse().ok()).unwrap_or(1);
+                for (name, settings, on_cpu) in (0..rounds).flat_map(|_| cases) {
                     if chosen.as_ref().is_some_and(|chosen| !chosen.iter().any(|c| c == name)) {
                         continue;
                     }
@@ -113,7 +124,7 @@ fn main() -> anyhow::Result<()> {
                         let started = Instant::now();
                         let mut encoder = device.create_command_encoder(&Default::default());
                         view.prepare(queue, &view_data);
-                        if settings.fins && settings.silhouette_fins {
+                        if settings.fins && settings.silhouette_fins && !name.starts_with("sep2") {
                             if on_cpu {
                                 let camera_position = view_data.camera_position_world;
                                 unified.prepare_fins_on_cpu(queue, &mut silhouette, base, &frame, camera_position)?;
@@ -123,13 +134,20 @@ fn main() -> anyhow::Result<()> {
                         }
                         {
                             let mut pass = targets.begin_pass(&mut encoder, &output_view, DEFAULT_BACKGROUND);
-                            renderer.draw(&mut pass, &view, &unified, &settings);
+                            if name.starts_with("sep2") {
+                                separated_renderer.draw(&mut pass, &view, &separated, &settings);
+                            } else {
+                                renderer.draw(&mut pass, &view, &unified, &settings);
+                            }
                         }
                         queue.submit([encoder.finish()]);
                         device.poll(wgpu::PollType::wait_indefinitely())?;
                         times.push(started.elapsed().as_secs_f64() * 1000.0);
                     }
                     times.remove(0);
+                    if std::env::var("ALL_TIMES").is_ok() {
+                        println!("{name}: {times:.1?}");
+                    }
                     times.sort_by(f64::total_cmp);
                     println!(
                         "L={layers:2} {width}x{height} dist x{distance}: {name:22} {:8.2} ms (min {:.2})",
