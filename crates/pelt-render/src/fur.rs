@@ -73,7 +73,8 @@ impl GpuFur {
         let geometry = geometry(device, renderer, structure, states);
         let textures = GpuTextures::new(device, queue, renderer.layouts(), textures);
         let fins = fin_list(device, renderer, structure);
-        let shells = shell_list(device, renderer, structure);
+        let shells =
+            shell_list(device, renderer, structure, geometry.as_ref().map_or(0, |g| g.shape.vertices_per_shell()));
         scope.pop("uploading the fur")?;
         Ok(Self { geometry: geometry?, textures: textures?, fins: fins?, level: PreparedLevel::new(), shells: shells? })
     }
@@ -93,7 +94,8 @@ impl GpuFur {
         let scope = ErrorScope::push(device);
         let geometry = geometry(device, renderer, structure, states);
         let fins = fin_list(device, renderer, structure);
-        let shells = shell_list(device, renderer, structure);
+        let shells =
+            shell_list(device, renderer, structure, geometry.as_ref().map_or(0, |g| g.shape.vertices_per_shell()));
         scope.pop("uploading the fur")?;
         (self.geometry, self.fins, self.shells) = (geometry?, fins?, shells?);
         Ok(())
@@ -339,10 +341,9 @@ fn shell_list(
     device: &wgpu::Device,
     renderer: &FurRenderer,
     structure: &FurStructure,
+    per_shell: u32,
 ) -> Result<Option<ShellList>, RenderError> {
     let triangles = structure.mesh.triangles.len() as u32;
-    let per_shell =
-        if structure.mesh.corner_uvs.is_some() { 3 * triangles } else { structure.mesh.vertex_count() as u32 };
     ShellList::new(device, renderer.layouts(), (triangles, per_shell), structure.layers)
 }
 

@@ -104,7 +104,7 @@ pub(crate) struct ObjectUniform {
     has_uvs: u32,
     has_surface: u32,
     shell_slices: u32,
-    _padding_0: u32,
+    wedge_count: u32,
     tiles_per_uv: f32,
     tiles_per_world: f32,
     world_per_uv: f32,
@@ -134,6 +134,8 @@ pub(crate) struct ObjectShape {
     pub triangle_count: u32,
     pub edge_count: u32,
     pub has_uvs: bool,
+    /// Meshes with uvs on the GPU: the wedges the shells walk (`geometry.rs`); 0 otherwise.
+    pub wedge_count: u32,
     /// Model units per uv unit (sqrt of surface area over uv area): uv tiles match model tiles.
     pub world_per_uv: f32,
     /// Bounding radius of the base mesh, model units.
@@ -148,9 +150,15 @@ impl ObjectShape {
             triangle_count: mesh.triangles.len() as u32,
             edge_count: mesh.edges.len() as u32,
             has_uvs: mesh.corner_uvs.is_some(),
+            wedge_count: 0,
             world_per_uv: world_per_uv(mesh),
             radius: mesh.bounding_sphere().1.max(1e-6),
         }
+    }
+
+    /// The vertex indices one shell walks: the wedges of a mesh with uvs, else the base vertices.
+    pub fn vertices_per_shell(&self) -> u32 {
+        if self.has_uvs { self.wedge_count } else { self.vertex_count }
     }
 
     /// The uniform for one frame. `colour`: the skin's (furs) or the mesh's (plain) colour;
@@ -178,7 +186,7 @@ impl ObjectShape {
             has_uvs: u32::from(self.has_uvs),
             has_surface: u32::from(has_surface),
             shell_slices,
-            _padding_0: 0,
+            wedge_count: self.wedge_count,
             tiles_per_uv: tiles_per_world * self.world_per_uv,
             tiles_per_world,
             world_per_uv: self.world_per_uv,

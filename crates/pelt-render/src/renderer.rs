@@ -3,7 +3,7 @@
 //!
 //! A fur draws, in order:
 //! 1. the opaque skin (layer 0, coloured like the roots);
-//! 2. shells, instanced per layer from the innermost out, over the same `3F` triangle corners,
+//! 2. shells, instanced per layer from the innermost out, over the same `3F` indexed corners,
 //!    alpha-blended with depth test on and depth writes off (or alpha-to-coverage), faded where
 //!    the surface turns edge-on;
 //! 3. fins, instanced per edge over one shared strip of `6L` indices, faded in near the silhouette:
@@ -93,8 +93,8 @@ struct SurfacePipelines {
 pub struct FurRenderer {
     target: FurTarget,
     layouts: Layouts,
-    /// Meshes with uvs: non-indexed over the triangle corners.
-    corners: SurfacePipelines,
+    /// Meshes with uvs: indexed by the corners' wedges (base vertex and uv).
+    wedges: SurfacePipelines,
     /// Meshes without uvs: indexed by the base triangles.
     indexed: SurfacePipelines,
     /// Blended, alpha-to-coverage: every edge.
@@ -138,8 +138,8 @@ impl FurRenderer {
         let build = |label: &str, layout: &wgpu::PipelineLayout, entries: (&str, &str), kind: PassKind| {
             build_with(label, layout, entries, kind, (&[], None))
         };
-        // Meshes with uvs walk the corners, meshes without are indexed: each walk's pipelines
-        // know which, and drop the other's work.
+        // Meshes with uvs walk wedges, meshes without base vertices: each walk's pipelines know
+        // which, and drop the other's work.
         let surface = |walk: &str, mesh_uvs: bool| {
             let skin = format!("vs_skin_{walk}");
             let shell = format!("vs_shell_{walk}");
@@ -157,7 +157,7 @@ impl FurRenderer {
                 }),
             }
         };
-        let corners = surface("corners", true);
+        let wedges = surface("wedges", true);
         let indexed = surface("indexed", false);
         let fins = Transparency::BOTH.map(|t| build("pelt fins", &fur_layout, ("vs_fin", "fs_fin"), PassKind::Fins(t)));
         let instances = [Some(FIN_INSTANCE_LAYOUT)];
@@ -168,7 +168,7 @@ impl FurRenderer {
         let silhouette = silhouette_pipeline(device, &layouts);
         let view_lod = ViewLodPipelines::new(device, &layouts);
         scope.pop("building the fur pipelines")?;
-        Ok(Self { target, layouts, corners, indexed, fins, silhouette_fins, silhouette, view_lod })
+        Ok(Self { target, layouts, wedges, indexed, fins, silhouette_fins, silhouette, view_lod })
     }
 
     /// The target description the pipelines were built for.
@@ -251,7 +251,7 @@ impl FurRenderer {
     }
 
     fn surface(&self, has_uvs: bool) -> &SurfacePipelines {
-        if has_uvs { &self.corners } else { &self.indexed }
+        if has_uvs { &self.wedges } else { &self.indexed }
     }
 
     pub(crate) fn layouts(&self) -> &Layouts {

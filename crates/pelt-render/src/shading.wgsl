@@ -35,7 +35,8 @@ struct Object {
     has_surface: u32,
     // Slices in the shell texture (may differ from `layers` while a viewer edits them).
     shell_slices: u32,
-    padding_0: u32,
+    // Meshes with uvs: the wedges the corner walk draws (`unified.wgsl`).
+    wedge_count: u32,
     // Mesh uv -> tiles.
     tiles_per_uv: f32,
     // Model units -> tiles (triplanar projection and fins).
@@ -396,7 +397,7 @@ fn fs_shell_tiles(in: ShellTileVaryings) -> @location(0) vec4<f32> {
     return shell_colour(texel, vec2<f32>(0.0), in.lighting, in.fade_blend_layer);
 }
 
-// Shells of meshes with uvs (`vs_shell_corners`, `vs_separated_shell_uvs`).
+// Shells of meshes with uvs (`vs_shell_wedges`, `vs_separated_shell_uvs`).
 @fragment
 fn fs_shell_uvs(in: ShellUvVaryings) -> @location(0) vec4<f32> {
     let texel = sample_shell(in.uvs.xy, shell_slice(varying_layer(in.fade_blend_layer.z)));

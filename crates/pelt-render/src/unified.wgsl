@@ -13,9 +13,11 @@
 // Base normals of the base vertices, packed xyz, model space: the rest normals, or the posed ones
 // of an animated mesh.
 @group(1) @binding(3) var<storage, read> base_normals: array<f32>;
-// Mesh uvs per triangle corner (3F), or one dummy entry.
-@group(1) @binding(4) var<storage, read> corner_uvs: array<vec2<f32>>;
-// Triangles (3F), then edges (2E), then the two faces beside each edge (2E).
+// Meshes with uvs: the uv of each wedge (a base vertex with one uv; a vertex on a uv seam has
+// one wedge per side), or one dummy entry.
+@group(1) @binding(4) var<storage, read> wedge_uvs: array<vec2<f32>>;
+// Triangles (3F), then edges (2E), then the two faces beside each edge (2E); with uvs, then each
+// wedge's base vertex (W) and each triangle corner's wedge (3F, the shells' index buffer).
 @group(1) @binding(5) var<storage, read> topology: array<u32>;
 
 const NO_FACE: u32 = 0xffffffffu;
@@ -52,8 +54,17 @@ fn strand_tangent(layer: u32, vertex: u32, here: vec3<f32>, fallback: vec3<f32>)
     return safe_normalize(world_from_model_direction(segment), fallback);
 }
 
-fn triangle_vertex(corner: u32) -> u32 {
-    return topology[corner];
+fn wedges_start() -> u32 {
+    return 3u * object.triangle_count + 4u * object.edge_count;
+}
+
+fn wedge_vertex(wedge: u32) -> u32 {
+    return topology[wedges_start() + wedge];
+}
+
+// The wedge of triangle corner `corner` (3 * triangle + k).
+fn corner_wedge(corner: u32) -> u32 {
+    return topology[wedges_start() + object.wedge_count + corner];
 }
 
 // World-space face normal of a base triangle (unit, or zero for a degenerate one).
@@ -64,10 +75,10 @@ fn face_normal(face: u32) -> vec3<f32> {
     return world_from_model_normal(cross(b - a, c - a));
 }
 
-// `corner` indexes the per-corner uvs; it is only read when the mesh has uvs. Every branch here
-// is on the object uniform, so whole draws take one side: a vertex fetches only what its draw
-// uses (the tangent for shells, the root for the triplanar projection without uvs).
-fn surface_varyings(vertex: u32, corner: u32, layer: u32) -> Varyings {
+// `wedge` indexes the wedge uvs; it is only read when the mesh has uvs. Every branch here is on
+// the object uniform, so whole draws take one side: a vertex fetches only what its draw uses
+// (the tangent for shells, the root for the triplanar projection without uvs).
+fn surface_varyings(vertex: u32, wedge: u32, layer: u32) -> Varyings {
     let here = model_vertex(layer, vertex);
     let position = world_from_model_point(here);
     let rest_normal = model_normal(vertex);
@@ -83,7 +94,7 @@ fn surface_varyings(vertex: u32, corner: u32, layer: u32) -> Varyings {
     out.tile_normal = rest_normal;
     if uses_mesh_uvs() {
         out.tile_position = vec3<f32>(0.0);
-        out.surface_uv = corner_uvs[corner];
+        out.surface_uv = wedge_uvs[wedge];
         out.uv = out.surface_uv * object.tiles_per_uv;
     } else {
         // Shells are textured from their strand's root, the skin from itself.
@@ -102,14 +113,15 @@ fn surface_varyings(vertex: u32, corner: u32, layer: u32) -> Varyings {
     return out;
 }
 
-// Two ways to walk the base triangles. Meshes with uvs: non-indexed over the 3F corners
-// (`vertex_index` = corner, so seams keep their own uvs). Meshes without: indexed by the base
-// triangles themselves (`vertex_index` = base vertex), so each vertex is shaded once a layer.
+// Two ways to walk the base triangles, both indexed so that each index is shaded once a layer
+// (as long as the vertex cache holds it). Meshes with uvs: by the corners' wedges
+// (`vertex_index` = wedge, so seams keep their own uvs). Meshes without: by the base triangles
+// themselves (`vertex_index` = base vertex).
 
 // The opaque skin (and plain meshes): layer 0.
 @vertex
-fn vs_skin_corners(@builtin(vertex_index) corner: u32) -> Varyings {
-    return surface_varyings(triangle_vertex(corner), corner, 0u);
+fn vs_skin_wedges(@builtin(vertex_index) wedge: u32) -> Varyings {
+    return surface_varyings(wedge_vertex(wedge), wedge, 0u);
 }
 
 @vertex
@@ -120,8 +132,8 @@ fn vs_skin_indexed(@builtin(vertex_index) vertex: u32) -> Varyings {
 // Shells: instance k draws the level of detail's shell k (layer k + 1 at full detail), passing
 // on only what their fragments read (the rest of `surface_varyings` is compiled away).
 @vertex
-fn vs_shell_corners(@builtin(vertex_index) corner: u32, @builtin(instance_index) instance: u32) -> ShellUvVaryings {
-    return shell_corner(corner, instance);
+fn vs_shell_wedges(@builtin(vertex_index) wedge: u32, @builtin(instance_index) instance: u32) -> ShellUvVaryings {
+    return shell_wedge(wedge, instance);
 }
 
 @vertex
@@ -131,11 +143,10 @@ fn vs_shell_indexed(@builtin(vertex_index) vertex: u32, @builtin(instance_index)
 
 // Shells through the view-angle list (`view_lod.wgsl`): one indirect draw per shell the view
 // angle thins, over the listed triangles, with base vertex `shell * N`, so `vertex_index`
-// carries the shell and the corner (N = 3F) or base vertex (N = V).
+// carries the shell and the wedge (N = W) or base vertex (N = V).
 @vertex
-fn vs_shell_corners_listed(@builtin(vertex_index) index: u32) -> ShellUvVaryings {
-    let corners = 3u * object.triangle_count;
-    return shell_corner(index % corners, index / corners);
+fn vs_shell_wedges_listed(@builtin(vertex_index) index: u32) -> ShellUvVaryings {
+    return shell_wedge(index % object.wedge_count, index / object.wedge_count);
 }
 
 @vertex
@@ -143,9 +154,9 @@ fn vs_shell_indexed_listed(@builtin(vertex_index) index: u32) -> ShellTileVaryin
     return shell_vertex(index % object.vertex_count, index / object.vertex_count);
 }
 
-fn shell_corner(corner: u32, shell: u32) -> ShellUvVaryings {
-    let vertex = triangle_vertex(corner);
-    let v = surface_varyings(vertex, corner, lod_shell_layer(shell));
+fn shell_wedge(wedge: u32, shell: u32) -> ShellUvVaryings {
+    let vertex = wedge_vertex(wedge);
+    let v = surface_varyings(vertex, wedge, lod_shell_layer(shell));
     return shell_uv_varyings(v, shell_fade(v.normal, v.world_position), lod_shell_blend(vertex, v.normal));
 }
 
@@ -237,7 +248,7 @@ fn fin_varyings(index: u32, edge: u32, fade: f32) -> FinVaryings {
         let face_a = topology[edges_start + 2u * object.edge_count + 2u * edge];
         for (var k = 0u; k < 3u; k++) {
             if topology[3u * face_a + k] == vertex {
-                out.surface_uv = corner_uvs[3u * face_a + k];
+                out.surface_uv = wedge_uvs[corner_wedge(3u * face_a + k)];
             }
         }
     }

@@ -98,7 +98,7 @@ pub(crate) struct ShellList {
 
 impl ShellList {
     /// The list of a fur of `triangle_count` triangles, `layers` layers and `per_shell` vertex
-    /// indices a shell (3F with uvs, V without); `None` where there is nothing to thin (fewer
+    /// indices a shell (the wedges with uvs, V without); `None` where there is nothing to thin (fewer
     /// than two layers) or the shells' vertex indices would not fit an `i32` base vertex.
     pub fn new(
         device: &wgpu::Device,

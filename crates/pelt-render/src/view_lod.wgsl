@@ -17,8 +17,8 @@ struct ShellDraw {
 // Group 2 holds textures in the render pipelines; this pass leaves it empty.
 // Indices listed (3 a triangle).
 @group(3) @binding(0) var<storage, read_write> listed: u32;
-// The listed triangles' corners (meshes with uvs) or base vertices (meshes without), in triangle
-// order.
+// The listed triangles' corners' wedges (meshes with uvs) or base vertices (meshes without), in
+// triangle order.
 @group(3) @binding(1) var<storage, read_write> listed_indices: array<u32>;
 // One draw per shell of the level (only the dropped shells' are used).
 @group(3) @binding(2) var<storage, read_write> shell_draws: array<ShellDraw>;
@@ -51,7 +51,7 @@ fn cs_view_lod_list(@builtin(local_invocation_index) lane: u32) {
             let first = 3u * (count + scan.x - 1u);
             for (var k = 0u; k < 3u; k++) {
                 let corner = 3u * triangle + k;
-                listed_indices[first + k] = select(topology[corner], corner, object.has_uvs != 0u);
+                listed_indices[first + k] = select(topology[corner], corner_wedge(corner), object.has_uvs != 0u);
             }
         }
         count += scan.y;
@@ -69,6 +69,6 @@ fn cs_view_lod_draws(@builtin(global_invocation_id) id: vec3<u32>) {
     if shell >= object.lod_shells {
         return;
     }
-    let per_shell = select(object.vertex_count, 3u * object.triangle_count, object.has_uvs != 0u);
+    let per_shell = select(object.vertex_count, object.wedge_count, object.has_uvs != 0u);
     shell_draws[shell] = ShellDraw(listed, 1u, 0u, i32(shell * per_shell), 0u);
 }

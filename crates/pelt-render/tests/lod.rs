@@ -4,7 +4,9 @@
 mod common;
 
 use common::*;
-use pelt_core::{Builtin, FurStructure};
+use std::collections::HashMap;
+
+use pelt_core::{Builtin, FurStructure, Mesh};
 use pelt_render::{Camera, FurDrawSettings, FurFrame, FurLevel, GpuFur, LodSettings, strand_pixels_in_view};
 
 const SIZE: u32 = 256;
@@ -47,43 +49,63 @@ fn triangles(rig: &Rig, fur: &FurStructure, gpu_fur: &GpuFur) -> u64 {
     let shells = u64::from(gpu_fur.drawn_shells());
     assert_eq!(u64::from(draw[0]), 6 * shells, "the indirect draw has the level's fin segments");
     let thinned = u64::from(gpu_fur.shells_thinned());
-    let listed =
-        if thinned > 0 { listed_triangles(rig, gpu_fur, fur.mesh.corner_uvs.is_some()).len() as u64 } else { 0 };
+    let listed = if thinned > 0 { listed_triangles(rig, gpu_fur, &fur.mesh).len() as u64 } else { 0 };
     faces * (1 + shells - thinned) + listed * thinned + u64::from(draw[1]) * 2 * shells
 }
 
 /// The triangles the view-angle pass listed in the last frame, as [`triangle_key`]s.
-fn listed_triangles(rig: &Rig, gpu_fur: &GpuFur, has_uvs: bool) -> std::collections::BTreeSet<[usize; 3]> {
+fn listed_triangles(rig: &Rig, gpu_fur: &GpuFur, mesh: &Mesh) -> std::collections::BTreeSet<[usize; 3]> {
     let count = rig.read_u32s(gpu_fur.view_lod_count().expect("a shell list"))[0] as usize;
     let indices = rig.read_u32s(gpu_fur.view_lod_indices().expect("a shell list"));
     assert_eq!(count % 3, 0, "whole triangles");
-    indices[..count].chunks_exact(3).map(|t| triangle_key([t[0], t[1], t[2]], has_uvs)).collect()
+    let by_wedges: Option<HashMap<[u32; 3], usize>> =
+        wedge_triangles(mesh).map(|wedges| wedges.into_iter().enumerate().map(|(t, w)| (w, t)).collect());
+    indices[..count].chunks_exact(3).map(|t| triangle_key([t[0], t[1], t[2]], by_wedges.as_ref())).collect()
+}
+
+/// Meshes with uvs: each triangle's corners as the shells index them, by wedge (a base vertex
+/// with one uv), numbered here in the order the corners first use them; `None` without uvs.
+fn wedge_triangles(mesh: &Mesh) -> Option<Vec<[u32; 3]>> {
+    let uvs = mesh.corner_uvs.as_ref()?;
+    let mut numbered = HashMap::new();
+    let mut number = |vertex: u32, uv: glam::Vec2| {
+        let next = numbered.len() as u32;
+        *numbered.entry((vertex, uv.to_array().map(f32::to_bits))).or_insert(next)
+    };
+    Some(
+        mesh.triangles
+            .iter()
+            .zip(uvs)
+            .map(|(t, uv)| [number(t[0], uv[0]), number(t[1], uv[1]), number(t[2], uv[2])])
+            .collect(),
+    )
 }
 
 /// The list keeps the mesh's triangle order: triangles of one shell overlap near the outline and
 /// blend in list order, so an order that followed the threads' timing changed the picture
 /// between runs.
-fn assert_in_triangle_order(rig: &Rig, gpu_fur: &GpuFur, triangles: &[[u32; 3]], has_uvs: bool) {
+fn assert_in_triangle_order(rig: &Rig, gpu_fur: &GpuFur, mesh: &Mesh) {
     let count = rig.read_u32s(gpu_fur.view_lod_count().expect("a shell list"))[0] as usize;
     let indices = rig.read_u32s(gpu_fur.view_lod_indices().expect("a shell list"));
+    // What the list holds for each triangle: its wedges with uvs, its base vertices without.
+    let triangles = wedge_triangles(mesh).unwrap_or_else(|| mesh.triangles.clone());
     let mut next = 0;
     for triple in indices[..count].chunks_exact(3) {
-        let found = (next..triangles.len()).find(|&t| {
-            if has_uvs { triple[0] as usize == 3 * t } else { triangles[t] == [triple[0], triple[1], triple[2]] }
-        });
+        let found = (next..triangles.len()).find(|&t| triangles[t] == [triple[0], triple[1], triple[2]]);
         let Some(t) = found else { panic!("{triple:?} is not a later triangle than triangle {next}") };
         next = t + 1;
     }
 }
 
-/// A listed triple as a comparable key: meshes with uvs list the corners `3t..3t + 3` (the key
-/// is `[t, t, t]`), meshes without list the base vertices (the key is them, sorted).
-fn triangle_key(triple: [u32; 3], has_uvs: bool) -> [usize; 3] {
-    let mut key = triple.map(|i| i as usize);
-    if has_uvs {
-        assert!(key[0] % 3 == 0 && key[1] == key[0] + 1 && key[2] == key[0] + 2, "corners {key:?}");
-        return [key[0] / 3; 3];
+/// A listed triple as a comparable key: meshes with uvs list triangle `t`'s wedges (the key is
+/// `[t, t, t]`; `by_wedges` finds `t`), meshes without list the base vertices (the key is them,
+/// sorted).
+fn triangle_key(triple: [u32; 3], by_wedges: Option<&HashMap<[u32; 3], usize>>) -> [usize; 3] {
+    if let Some(by_wedges) = by_wedges {
+        let t = by_wedges.get(&triple).unwrap_or_else(|| panic!("wedges {triple:?} are no triangle's"));
+        return [*t; 3];
     }
+    let mut key = triple.map(|i| i as usize);
     key.sort_unstable();
     key
 }
@@ -180,7 +202,7 @@ fn view_angle_lod_is_unseen_and_draws_fewer_triangles() {
             );
             assert!(similarity >= 0.98, "{name}: {level:?} vs full: SSIM {similarity:.4} < 0.98");
             assert!(shift.abs() < SHIFT_LIMIT, "{name}: {level:?} shifts the mean luma by {shift:.2}");
-            let listed = listed_triangles(&rig, &gpu_fur, fur.mesh.corner_uvs.is_some()).len();
+            let listed = listed_triangles(&rig, &gpu_fur, &fur.mesh).len();
             let faces = fur.mesh.triangles.len();
             assert!(10 * listed < 9 * faces, "{name}: the thinned shells still draw {listed} of {faces} triangles");
             assert!(work < full_work, "{name}: {work} triangles against {full_work}");
@@ -202,8 +224,8 @@ fn view_angle_culling_keeps_every_triangle_that_still_shows() {
             let camera = Camera::framing(centre, radius * 1.1, azimuth, elevation, 1.0);
             render_at(&rig, &gpu_fur, &camera, FurLevel { facing: Some(facing), ..FurLevel::FULL });
             let has_uvs = fur.mesh.corner_uvs.is_some();
-            let listed = listed_triangles(&rig, &gpu_fur, has_uvs);
-            assert_in_triangle_order(&rig, &gpu_fur, &fur.mesh.triangles, has_uvs);
+            let listed = listed_triangles(&rig, &gpu_fur, &fur.mesh);
+            assert_in_triangle_order(&rig, &gpu_fur, &fur.mesh);
             let (mut needed, mut borderline) = (0, 0);
             for (t, triangle) in fur.mesh.triangles.iter().enumerate() {
                 let weights: Vec<(f32, f32)> = triangle
@@ -212,7 +234,7 @@ fn view_angle_culling_keeps_every_triangle_that_still_shows() {
                         facing_weight(fur.mesh.normals[v as usize], fur.positions[v as usize], camera.eye, facing)
                     })
                     .collect();
-                let key = if has_uvs { [t; 3] } else { triangle_key(*triangle, false) };
+                let key = if has_uvs { [t; 3] } else { triangle_key(*triangle, None) };
                 // Far from the edge of the range the answer cannot depend on rounding.
                 let shows = weights.iter().any(|&(f, _)| f < facing[1] - 1e-4);
                 let gone = weights.iter().all(|&(f, w)| f > facing[1] + 1e-4 && w == 1.0);
