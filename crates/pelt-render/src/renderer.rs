@@ -15,7 +15,7 @@ use crate::fur::GpuFur;
 use crate::pipeline::{Layouts, PassKind, PipelineSource, Transparency, create_pipeline};
 use crate::plain::PlainMesh;
 use crate::requirements::{ErrorScope, check_features_and_limits};
-use crate::silhouette::{FIN_INSTANCE_LAYOUT, silhouette_pipeline};
+use crate::silhouette::{FIN_INSTANCE_LAYOUT, SilhouettePipelines};
 use crate::targets::FurTarget;
 use crate::view::FurView;
 use crate::view_lod::{SHELL_DRAW_BYTES, ViewLodPipelines};
@@ -101,7 +101,7 @@ pub struct FurRenderer {
     fins: [wgpu::RenderPipeline; 2],
     /// Blended, alpha-to-coverage: the silhouette pass's edges.
     silhouette_fins: [wgpu::RenderPipeline; 2],
-    silhouette: wgpu::ComputePipeline,
+    silhouette: SilhouettePipelines,
     view_lod: ViewLodPipelines,
 }
 
@@ -165,7 +165,7 @@ impl FurRenderer {
             let entries = ("vs_fin_silhouette", "fs_fin");
             build_with("pelt silhouette fins", &fur_layout, entries, PassKind::Fins(t), (&instances, None))
         });
-        let silhouette = silhouette_pipeline(device, &layouts);
+        let silhouette = SilhouettePipelines::new(device, &layouts);
         let view_lod = ViewLodPipelines::new(device, &layouts);
         scope.pop("building the fur pipelines")?;
         Ok(Self { target, layouts, wedges, indexed, fins, silhouette_fins, silhouette, view_lod })

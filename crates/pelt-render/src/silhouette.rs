@@ -50,25 +50,49 @@ pub(crate) fn fin_list_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
     })
 }
 
-/// The silhouette pass's pipeline, one per renderer.
-pub(crate) fn silhouette_pipeline(device: &wgpu::Device, layouts: &Layouts) -> wgpu::ComputePipeline {
-    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-        label: Some("pelt silhouette"),
-        source: wgpu::ShaderSource::Wgsl(silhouette_shader_source().into()),
-    });
-    let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-        label: Some("pelt silhouette"),
-        bind_group_layouts: &[Some(&layouts.view), Some(&layouts.unified_object), None, Some(&layouts.fin_list)],
-        immediate_size: 0,
-    });
-    device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-        label: Some("pelt silhouette"),
-        layout: Some(&layout),
-        module: &module,
-        entry_point: Some("cs_silhouette"),
-        compilation_options: wgpu::PipelineCompilationOptions::default(),
-        cache: None,
-    })
+/// The silhouette pass's two pipelines (`silhouette.wgsl`), one pair per renderer.
+#[derive(Debug)]
+pub(crate) struct SilhouettePipelines {
+    /// Each edge's fade, one thread an edge.
+    fades: wgpu::ComputePipeline,
+    /// The shown fins listed in edge order, and the draw's count.
+    list: wgpu::ComputePipeline,
+}
+
+/// Workgroup width of `cs_fin_fades`, and the most workgroups in one row of its dispatch.
+const FADES_WIDTH: u32 = 64;
+const MOST_GROUPS_PER_ROW: u32 = 65_535;
+
+impl SilhouettePipelines {
+    pub fn new(device: &wgpu::Device, layouts: &Layouts) -> Self {
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("pelt silhouette"),
+            source: wgpu::ShaderSource::Wgsl(silhouette_shader_source().into()),
+        });
+        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("pelt silhouette"),
+            bind_group_layouts: &[Some(&layouts.view), Some(&layouts.unified_object), None, Some(&layouts.fin_list)],
+            immediate_size: 0,
+        });
+        let pipeline = |entry_point| {
+            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some(entry_point),
+                layout: Some(&layout),
+                module: &module,
+                entry_point: Some(entry_point),
+                compilation_options: wgpu::PipelineCompilationOptions::default(),
+                cache: None,
+            })
+        };
+        Self { fades: pipeline("cs_fin_fades"), list: pipeline("cs_silhouette") }
+    }
+}
+
+/// The workgroups of `cs_fin_fades` for `edges` edges: `(per row, rows)`.
+fn fade_groups(edges: u32) -> (u32, u32) {
+    let groups = edges.div_ceil(FADES_WIDTH).max(1);
+    let per_row = groups.min(MOST_GROUPS_PER_ROW);
+    (per_row, groups.div_ceil(per_row))
 }
 
 /// One fur's fins as the silhouette pass leaves them: the indirect draw and its instances.
@@ -129,12 +153,12 @@ impl FinList {
         Ok(Some(Self { draw, instances, bind_group, edge_count }))
     }
 
-    /// Records the silhouette pass: one workgroup lists the shown fins in edge order and writes
-    /// the draw's count.
+    /// Records the silhouette pass: every edge's fade, then one workgroup lists the shown fins
+    /// in edge order and writes the draw's count.
     pub fn record(
         &self,
         encoder: &mut wgpu::CommandEncoder,
-        pipeline: &wgpu::ComputePipeline,
+        pipelines: &SilhouettePipelines,
         view: &wgpu::BindGroup,
         object: &wgpu::BindGroup,
     ) {
@@ -142,10 +166,14 @@ impl FinList {
             label: Some("pelt silhouette"),
             timestamp_writes: None,
         });
-        pass.set_pipeline(pipeline);
         pass.set_bind_group(0, view, &[]);
         pass.set_bind_group(1, object, &[]);
         pass.set_bind_group(3, &self.bind_group, &[]);
+        pass.set_pipeline(&pipelines.fades);
+        let (per_row, rows) = fade_groups(self.edge_count);
+        pass.dispatch_workgroups(per_row, rows, 1);
+        // wgpu orders the two dispatches: both write the instances.
+        pass.set_pipeline(&pipelines.list);
         pass.dispatch_workgroups(1, 1, 1);
     }
 
@@ -181,4 +209,21 @@ pub(crate) fn check_scan_width(device: &wgpu::Device) -> Result<(), RenderError>
         });
     }
     Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn fade_dispatch_covers_every_edge_within_the_row_limit() {
+        assert_eq!(fade_groups(0), (1, 1));
+        assert_eq!(fade_groups(5_511), (87, 1));
+        for edges in [1, 64, 65, 4_194_240, 4_194_241, 40_000_000] {
+            let (per_row, rows) = fade_groups(edges);
+            assert!(per_row <= MOST_GROUPS_PER_ROW);
+            let threads = u64::from(per_row) * u64::from(rows) * u64::from(FADES_WIDTH);
+            assert!(threads >= u64::from(edges) && threads < u64::from(edges) + u64::from(per_row * FADES_WIDTH));
+        }
+    }
 }

@@ -2,9 +2,12 @@
 // in `unified.wgsl`) and list the shown ones, in edge order, as the fins' instances, counting them
 // into an indexed indirect draw. Appended to `shading.wgsl`, `unified.wgsl` and `scan.wgsl`.
 //
-// One workgroup walks the edges `SCAN_WIDTH` at a time and places each round's fins by a prefix
-// sum: fins overlap along the silhouette and blend in instance order, so an order that followed
-// the threads' timing (an atomic append) made the same frame differ from run to run.
+// Two dispatches. The first decides, one thread an edge over as many workgroups as it takes,
+// and leaves each edge's fade in the edge's own slot of the list. The second, one workgroup,
+// walks the slots `SCAN_WIDTH` at a time and moves each round's shown fins down to their places
+// by a prefix sum: fins overlap along the silhouette and blend in instance order, so an order
+// that followed the threads' timing (an atomic append) made the same frame differ from run to
+// run. Deciding in the one workgroup too left the whole mesh to one thread on a CPU rasteriser.
 
 // `wgpu::util::DrawIndexedIndirectArgs`.
 struct FinDraw {
@@ -20,6 +23,18 @@ struct FinDraw {
 // (edge, fade as f32 bits) per shown fin, in edge order.
 @group(3) @binding(1) var<storage, read_write> fin_instances: array<vec2<u32>>;
 
+// Threads a workgroup of the first dispatch.
+const FADES_WIDTH: u32 = 64u;
+
+@compute @workgroup_size(64)
+fn cs_fin_fades(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
+    // Rows of workgroups where one row would pass the dispatch limit (65,535).
+    let edge = id.y * groups.x * FADES_WIDTH + id.x;
+    if edge < object.edge_count {
+        fin_instances[edge] = vec2<u32>(edge, bitcast<u32>(fin_fade(edge)));
+    }
+}
+
 @compute @workgroup_size(256)
 fn cs_silhouette(@builtin(local_invocation_index) lane: u32) {
     var listed = 0u;
@@ -28,9 +43,12 @@ fn cs_silhouette(@builtin(local_invocation_index) lane: u32) {
         let edge = round * SCAN_WIDTH + lane;
         var fade = 0.0;
         if edge < object.edge_count {
-            fade = fin_fade(edge);
+            fade = bitcast<f32>(fin_instances[edge].y);
         }
         let scan = workgroup_scan(lane, u32(fade > 0.0));
+        // Every thread has read its slot: a round writes only to slots below its end, and to
+        // none a later round reads.
+        storageBarrier();
         if fade > 0.0 {
             fin_instances[listed + scan.x - 1u] = vec2<u32>(edge, bitcast<u32>(fade));
         }
