@@ -219,9 +219,10 @@ impl SeparatedStructure {
 ///
 /// The vertex counts follow the paper's Table 2: unified `V(L+1)`; separated `V(L+1) + N*E` with
 /// `N` faces per fin. GPU bytes follow the layouts Pelt draws:
-/// - unified: positions `12 * V(L+1)`; attributes the base normals `12V` plus uvs (`8` per
-///   triangle corner, when the mesh has them); indices the base triangles `3F` and the edges `2E`
-///   plus each edge's two faces `2E` (for the silhouette test), 4 bytes each;
+/// - unified: positions `12 * V(L+1)`; attributes the base normals `12V` plus, when the mesh has
+///   uvs, `8` per wedge (each distinct (vertex, uv) pair, [`crate::mesh::Wedges`]); indices the
+///   base triangles `3F` and the edges `2E` plus each edge's two faces `2E` (for the silhouette
+///   test), and with uvs each wedge's vertex `W` and each corner's wedge `3F`, 4 bytes each;
 /// - separated: every vertex a full vertex (position, normal, uv: 32 bytes), split here into
 ///   positions (12) and attributes (20); indices one shell index buffer `3F` reused per layer
 ///   with a base-vertex offset, and `3N` per fin.
@@ -247,7 +248,9 @@ impl Footprint {
     fn unified(mesh: &Mesh, layers: u32) -> Self {
         let (v, f, e, l) = counts(mesh, layers);
         let vertices = v * (l + 1);
-        let uv_bytes = if mesh.corner_uvs.is_some() { 3 * f * 8 } else { 0 };
+        // Meshes with uvs: the wedges' uvs, their vertices and each corner's wedge.
+        let wedges = mesh.wedges().map_or(0, |w| w.vertices.len() as u64);
+        let (uv_bytes, wedge_indices) = if mesh.corner_uvs.is_some() { (8 * wedges, wedges + 3 * f) } else { (0, 0) };
         let shell_faces = f * l;
         let fin_faces = 2 * l * e;
         Self {
@@ -257,7 +260,7 @@ impl Footprint {
             fin_faces,
             position_bytes: vertices * POSITION_BYTES,
             attribute_bytes: v * 12 + uv_bytes,
-            index_bytes: (3 * f + 2 * e + 2 * e) * INDEX_BYTES,
+            index_bytes: (3 * f + 2 * e + 2 * e + wedge_indices) * INDEX_BYTES,
         }
     }
 

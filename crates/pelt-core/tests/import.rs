@@ -571,3 +571,31 @@ fn triangles_are_reordered_for_the_vertex_cache_and_nothing_else_changes() {
         );
     }
 }
+
+#[test]
+fn wedges_give_every_corner_its_vertex_and_uv_and_split_only_at_seams() {
+    let (mesh, _) = load(&asset("spot.obj"));
+    let corner_uvs = mesh.corner_uvs.as_ref().unwrap();
+    let wedges = mesh.wedges().unwrap();
+    assert_eq!(wedges.corners.len(), 3 * mesh.triangles.len());
+    for (corner, &wedge) in wedges.corners.iter().enumerate() {
+        let (triangle, k) = (corner / 3, corner % 3);
+        assert_eq!(wedges.vertices[wedge as usize], mesh.triangles[triangle][k], "corner {corner}");
+        assert_eq!(wedges.uvs[wedge as usize], corner_uvs[triangle][k], "corner {corner}");
+    }
+    // Distinct (vertex, uv) pairs, counted here another way: every wedge is one.
+    let mut pairs: Vec<(u32, [u32; 2])> = mesh
+        .triangles
+        .iter()
+        .zip(corner_uvs)
+        .flat_map(|(t, uvs)| (0..3).map(move |k| (t[k], uvs[k].to_array().map(f32::to_bits))))
+        .collect();
+    pairs.sort_unstable();
+    pairs.dedup();
+    assert_eq!(wedges.vertices.len(), pairs.len());
+    // Spot's file has 3,225 distinct (v, vt) pairs over 2,930 vertices.
+    assert_eq!(wedges.vertices.len(), 3_225);
+    // Numbered by first use: the first corners' wedges count up from 0.
+    assert_eq!(&wedges.corners[..3], &[0, 1, 2]);
+    assert!(load(&asset("bunny.obj")).0.wedges().is_none(), "no uvs, no wedges");
+}

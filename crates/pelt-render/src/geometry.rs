@@ -2,8 +2,6 @@
 //! [`crate::PlainMesh`] (layer 0 only): the shared vertex array (one or two states), base
 //! normals, corner uvs and topology as storage buffers, and the object uniform.
 
-use std::collections::HashMap;
-
 use glam::{Vec2, Vec3};
 use pelt_core::Mesh;
 use pelt_core::fur::POSITION_BYTES;
@@ -65,7 +63,7 @@ impl UnifiedGeometry {
         let mut topology: Vec<u32> = mesh.triangles.iter().flatten().copied().collect();
         topology.extend(mesh.edges.iter().flatten());
         topology.extend(mesh.edge_faces.iter().flatten());
-        let wedge_uvs = match Wedges::of(mesh) {
+        let wedge_uvs = match mesh.wedges() {
             Some(wedges) => {
                 shape.wedge_count = wedges.vertices.len() as u32;
                 topology.extend(wedges.vertices);
@@ -251,77 +249,5 @@ impl UnifiedGeometry {
             pass.set_index_buffer(strip.slice(..), wgpu::IndexFormat::Uint32);
             pass.draw_indexed(0..6 * segments.min(self.shape.layers), 0, 0..self.shape.edge_count);
         }
-    }
-}
-
-/// What the shells of a mesh with uvs walk: its wedges, each a distinct (base vertex, uv) pair
-/// that corners use (a vertex on a uv seam has one per side), numbered in the order the corners
-/// first use them, so the triangles' vertex-cache order carries over. Drawn indexed by the
-/// corners' wedges, each wedge is shaded once a layer, where walking the `3F` corners shaded
-/// every corner (Spot: 3,225 wedges a layer, against 17,568 corners).
-struct Wedges {
-    /// The base vertex of each wedge.
-    vertices: Vec<u32>,
-    uvs: Vec<Vec2>,
-    /// The wedge of each triangle corner (`3F`).
-    corners: Vec<u32>,
-}
-
-impl Wedges {
-    /// `None` for a mesh without uvs.
-    fn of(mesh: &Mesh) -> Option<Self> {
-        let corner_uvs = mesh.corner_uvs.as_ref()?;
-        let mut numbered: HashMap<(u32, [u32; 2]), u32> = HashMap::with_capacity(2 * mesh.vertex_count());
-        let mut wedges =
-            Self { vertices: Vec::new(), uvs: Vec::new(), corners: Vec::with_capacity(3 * corner_uvs.len()) };
-        for (triangle, uvs) in mesh.triangles.iter().zip(corner_uvs) {
-            for (&vertex, &uv) in triangle.iter().zip(uvs) {
-                let next = wedges.vertices.len() as u32;
-                let wedge = *numbered.entry((vertex, uv.to_array().map(f32::to_bits))).or_insert(next);
-                if wedge == next {
-                    wedges.vertices.push(vertex);
-                    wedges.uvs.push(uv);
-                }
-                wedges.corners.push(wedge);
-            }
-        }
-        Some(wedges)
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use std::path::Path;
-
-    use pelt_core::{ImportOptions, Mesh};
-
-    use super::Wedges;
-
-    #[test]
-    fn wedges_give_every_corner_its_vertex_and_uv_and_split_only_at_seams() {
-        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets/meshes/spot.obj");
-        let (mesh, _) = Mesh::load(&path, &ImportOptions::default()).unwrap();
-        let corner_uvs = mesh.corner_uvs.as_ref().unwrap();
-        let wedges = Wedges::of(&mesh).unwrap();
-        assert_eq!(wedges.corners.len(), 3 * mesh.triangles.len());
-        for (corner, &wedge) in wedges.corners.iter().enumerate() {
-            let (triangle, k) = (corner / 3, corner % 3);
-            assert_eq!(wedges.vertices[wedge as usize], mesh.triangles[triangle][k], "corner {corner}");
-            assert_eq!(wedges.uvs[wedge as usize], corner_uvs[triangle][k], "corner {corner}");
-        }
-        // Distinct (vertex, uv) pairs, counted here another way: every wedge is one.
-        let mut pairs: Vec<(u32, [u32; 2])> = mesh
-            .triangles
-            .iter()
-            .zip(corner_uvs)
-            .flat_map(|(t, uvs)| (0..3).map(move |k| (t[k], uvs[k].to_array().map(f32::to_bits))))
-            .collect();
-        pairs.sort_unstable();
-        pairs.dedup();
-        assert_eq!(wedges.vertices.len(), pairs.len());
-        assert!(wedges.vertices.len() >= mesh.vertex_count() && wedges.vertices.len() < 2 * mesh.vertex_count());
-        // Numbered by first use: the first corners' wedges count up from 0.
-        assert_eq!(&wedges.corners[..3], &[0, 1, 2]);
-        assert!(Wedges::of(&pelt_core::Builtin::Bunny.mesh().0).is_none(), "no uvs, no wedges");
     }
 }

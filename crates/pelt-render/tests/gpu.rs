@@ -397,3 +397,21 @@ fn separated_fins_show_where_lengyels_fade_says() {
     assert!(shown >= 10, "only {shown} fins clearly show: the check means little");
     assert!(hidden_drawn * 4 < hidden, "{hidden_drawn} of {hidden} hidden fins' centres are drawn");
 }
+
+/// The unified structure's bytes on the GPU are what `Footprint` (the memory table's model)
+/// says, with and without uvs (wedges), apart from the two small buffers it leaves out: the fin
+/// strip (`6L` indices) and, without uvs, the one dummy uv.
+#[test]
+fn unified_gpu_bytes_are_the_footprints() {
+    let rig = Rig::new(64, 64);
+    for (builtin, layers) in [(Builtin::Sphere, 8), (Builtin::Bunny, 16)] {
+        let fur = builtin_fur(builtin, layers);
+        let gpu_fur = rig.fur(&fur, &strand_textures(64, layers, BROWN_ROOT, BROWN_TIP));
+        let footprint = fur.footprint();
+        let bytes = gpu_fur.gpu_bytes();
+        let has_uvs = fur.mesh.corner_uvs.is_some();
+        assert_eq!(bytes.positions, footprint.position_bytes, "{builtin:?}");
+        assert_eq!(bytes.attributes, footprint.attribute_bytes + if has_uvs { 0 } else { 8 }, "{builtin:?}");
+        assert_eq!(bytes.indices, footprint.index_bytes + 6 * u64::from(layers) * 4, "{builtin:?}");
+    }
+}

@@ -17,6 +17,7 @@ mod report;
 mod topology;
 mod tuck;
 mod vertex_cache;
+mod wedges;
 
 use std::path::Path;
 
@@ -29,6 +30,7 @@ pub use repair::smooth_normals;
 pub use report::{MeshReport, NormalSource};
 pub use topology::{NO_FACE, Topology};
 pub use tuck::tuck_under;
+pub use wedges::Wedges;
 
 /// An indexed triangle list as read from a file, before any repair.
 ///
