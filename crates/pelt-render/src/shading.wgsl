@@ -152,16 +152,17 @@ fn varying_layer(value: f32) -> u32 {
     return u32(round(value));
 }
 
-// What a unified fin fragment reads, for the same reason as the shells' structs.
+// What a unified fin fragment reads, for the same reason as the shells' structs, in two
+// locations (four before: 0.1-0.25 ms less of the bunny's fins on lavapipe, whose `2L` small
+// triangles a fin carry each location).
 struct FinVaryings {
     @builtin(position) clip_position: vec4<f32>,
-    // `hair_terms` at the vertex, as the shells have them.
-    @location(0) lighting: vec4<f32>,
-    // (along the edge in tiles, height: 0 at the roots, 1 at the tips).
-    @location(1) uv: vec2<f32>,
-    // The mesh uv at this end of the edge (surface colour mode).
-    @location(2) surface_uv: vec2<f32>,
-    @location(3) fade: f32,
+    // `hair_terms` at the vertex without the occlusion (the fragment takes it from the height),
+    // and the fin's fade.
+    @location(0) lighting_fade: vec4<f32>,
+    // Along the edge in tiles, the height (0 at the roots, 1 at the tips), and the mesh uv at
+    // this end of the edge (surface colour mode).
+    @location(1) uvs: vec4<f32>,
 }
 
 // Set per pipeline where every mesh it draws has uvs (1) or none has (2), so the shaders drop
@@ -412,11 +413,14 @@ fn fin_lighting_height(height: f32) -> f32 {
 
 @fragment
 fn fs_fin(in: FinVaryings) -> @location(0) vec4<f32> {
+    let height = in.uvs.y;
     // Fin texture rows run from the tips (v = 0) to the roots (v = 1).
-    let texel = textureSample(fin_texture, fin_sampler, vec2<f32>(in.uv.x, 1.0 - in.uv.y));
+    let texel = textureSample(fin_texture, fin_sampler, vec2<f32>(in.uvs.x, 1.0 - height));
     // Several fins overlap along a silhouette; thinning them keeps the fringe from reading as a
     // solid band, most of all at the roots where the shells already cover.
-    let alpha = texel.a * in.fade * mix(0.15, 0.6, in.uv.y);
-    let albedo = texel.rgb * surface_tint(in.surface_uv);
-    return fur_output(hair_colour(albedo, in.lighting, fin_lighting_height(in.uv.y)), alpha);
+    let alpha = texel.a * in.lighting_fade.w * mix(0.15, 0.6, height);
+    let albedo = texel.rgb * surface_tint(in.uvs.zw);
+    let lit_height = fin_lighting_height(height);
+    let lighting = vec4<f32>(in.lighting_fade.xyz, occlusion(lit_height));
+    return fur_output(hair_colour(albedo, lighting, lit_height), alpha);
 }

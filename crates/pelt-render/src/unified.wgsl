@@ -238,21 +238,22 @@ fn fin_varyings(index: u32, edge: u32, fade: f32) -> FinVaryings {
     let normal_a = world_from_model_normal(model_normal(a));
     let normal = safe_normalize(normal_a + world_from_model_normal(model_normal(b)), normal_a);
     let tangent = strand_tangent(layer, vertex, here, normal);
-    out.lighting = hair_terms(tangent, normal, position, fin_lighting_height(layer_height(layer)));
+    // The occlusion (`w`) is the fragment's, from the interpolated height.
+    let terms = hair_terms(tangent, normal, position, 0.0);
+    out.lighting_fade = vec4<f32>(terms.xyz, fade);
     let offset = f32(hash(edge) & 0xffffu) / 65536.0;
     let along = f32(side) * distance(model_vertex(0u, a), model_vertex(0u, b)) * object.tiles_per_world;
-    out.uv = vec2<f32>(offset + along, layer_height(layer));
     // The surface uv of this end of the edge, from its corner in the first face.
-    out.surface_uv = vec2<f32>(0.0);
+    var surface_uv = vec2<f32>(0.0);
     if uses_mesh_uvs() && object.has_surface != 0u {
         let face_a = topology[edges_start + 2u * object.edge_count + 2u * edge];
         for (var k = 0u; k < 3u; k++) {
             if topology[3u * face_a + k] == vertex {
-                out.surface_uv = wedge_uvs[corner_wedge(3u * face_a + k)];
+                surface_uv = wedge_uvs[corner_wedge(3u * face_a + k)];
             }
         }
     }
-    out.fade = fade;
+    out.uvs = vec4<f32>(offset + along, layer_height(layer), surface_uv);
     return out;
 }
 
