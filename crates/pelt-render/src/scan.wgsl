@@ -26,3 +26,12 @@ fn workgroup_scan(lane: u32, value: u32) -> vec2<u32> {
     workgroupBarrier();
     return result;
 }
+
+// Threads a workgroup of the one-thread-an-item dispatches that come before a listing.
+const ITEMS_WIDTH: u32 = 64u;
+
+// The item of thread `id` in such a dispatch: rows of workgroups where one row would pass the
+// dispatch limit (65,535 workgroups).
+fn item_index(id: vec3<u32>, groups: vec3<u32>) -> u32 {
+    return id.y * groups.x * ITEMS_WIDTH + id.x;
+}

@@ -59,8 +59,9 @@ pub(crate) struct SilhouettePipelines {
     list: wgpu::ComputePipeline,
 }
 
-/// Workgroup width of `cs_fin_fades`, and the most workgroups in one row of its dispatch.
-const FADES_WIDTH: u32 = 64;
+/// Workgroup width of the one-thread-an-item dispatches (`cs_fin_fades`, `cs_view_lod_flags`),
+/// and the most workgroups in one row of a dispatch.
+const ITEMS_WIDTH: u32 = 64;
 const MOST_GROUPS_PER_ROW: u32 = 65_535;
 
 impl SilhouettePipelines {
@@ -88,9 +89,9 @@ impl SilhouettePipelines {
     }
 }
 
-/// The workgroups of `cs_fin_fades` for `edges` edges: `(per row, rows)`.
-fn fade_groups(edges: u32) -> (u32, u32) {
-    let groups = edges.div_ceil(FADES_WIDTH).max(1);
+/// The workgroups of a one-thread-an-item dispatch over `items`: `(per row, rows)`.
+pub(crate) fn item_groups(items: u32) -> (u32, u32) {
+    let groups = items.div_ceil(ITEMS_WIDTH).max(1);
     let per_row = groups.min(MOST_GROUPS_PER_ROW);
     (per_row, groups.div_ceil(per_row))
 }
@@ -170,7 +171,7 @@ impl FinList {
         pass.set_bind_group(1, object, &[]);
         pass.set_bind_group(3, &self.bind_group, &[]);
         pass.set_pipeline(&pipelines.fades);
-        let (per_row, rows) = fade_groups(self.edge_count);
+        let (per_row, rows) = item_groups(self.edge_count);
         pass.dispatch_workgroups(per_row, rows, 1);
         // wgpu orders the two dispatches: both write the instances.
         pass.set_pipeline(&pipelines.list);
@@ -217,13 +218,13 @@ mod tests {
 
     #[test]
     fn fade_dispatch_covers_every_edge_within_the_row_limit() {
-        assert_eq!(fade_groups(0), (1, 1));
-        assert_eq!(fade_groups(5_511), (87, 1));
+        assert_eq!(item_groups(0), (1, 1));
+        assert_eq!(item_groups(5_511), (87, 1));
         for edges in [1, 64, 65, 4_194_240, 4_194_241, 40_000_000] {
-            let (per_row, rows) = fade_groups(edges);
+            let (per_row, rows) = item_groups(edges);
             assert!(per_row <= MOST_GROUPS_PER_ROW);
-            let threads = u64::from(per_row) * u64::from(rows) * u64::from(FADES_WIDTH);
-            assert!(threads >= u64::from(edges) && threads < u64::from(edges) + u64::from(per_row * FADES_WIDTH));
+            let threads = u64::from(per_row) * u64::from(rows) * u64::from(ITEMS_WIDTH);
+            assert!(threads >= u64::from(edges) && threads < u64::from(edges) + u64::from(per_row * ITEMS_WIDTH));
         }
     }
 }

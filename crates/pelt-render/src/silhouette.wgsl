@@ -23,13 +23,9 @@ struct FinDraw {
 // (edge, fade as f32 bits) per shown fin, in edge order.
 @group(3) @binding(1) var<storage, read_write> fin_instances: array<vec2<u32>>;
 
-// Threads a workgroup of the first dispatch.
-const FADES_WIDTH: u32 = 64u;
-
 @compute @workgroup_size(64)
 fn cs_fin_fades(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
-    // Rows of workgroups where one row would pass the dispatch limit (65,535).
-    let edge = id.y * groups.x * FADES_WIDTH + id.x;
+    let edge = item_index(id, groups);
     if edge < object.edge_count {
         fin_instances[edge] = vec2<u32>(edge, bitcast<u32>(fin_fade(edge)));
     }

@@ -48,9 +48,11 @@ pub(crate) fn shell_list_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout 
     })
 }
 
-/// The pass's two pipelines (the list, then the draws), one pair per renderer.
+/// The pass's three pipelines (each triangle's flag, the list, then the draws), one set per
+/// renderer.
 #[derive(Debug)]
 pub(crate) struct ViewLodPipelines {
+    flags: wgpu::ComputePipeline,
     list: wgpu::ComputePipeline,
     draws: wgpu::ComputePipeline,
 }
@@ -76,7 +78,11 @@ impl ViewLodPipelines {
                 cache: None,
             })
         };
-        Self { list: pipeline("cs_view_lod_list"), draws: pipeline("cs_view_lod_draws") }
+        Self {
+            flags: pipeline("cs_view_lod_flags"),
+            list: pipeline("cs_view_lod_list"),
+            draws: pipeline("cs_view_lod_draws"),
+        }
     }
 }
 
@@ -91,6 +97,7 @@ pub(crate) struct ShellList {
     pub draws: wgpu::Buffer,
     bind_group: wgpu::BindGroup,
     layers: u32,
+    triangle_count: u32,
     /// Whether the pass was recorded since the fur's last `prepare` (else the list may be from
     /// another level or view, and the shells are drawn whole).
     recorded: AtomicBool,
@@ -133,10 +140,11 @@ impl ShellList {
                 wgpu::BindGroupEntry { binding: 2, resource: draws.as_entire_binding() },
             ],
         });
-        Ok(Some(Self { listed, indices, draws, bind_group, layers, recorded: AtomicBool::new(false) }))
+        Ok(Some(Self { listed, indices, draws, bind_group, layers, triangle_count, recorded: AtomicBool::new(false) }))
     }
 
-    /// Records the pass: one workgroup lists the triangles in order, then the draws are written.
+    /// Records the pass: every triangle's flag, then one workgroup lists the triangles in order,
+    /// then the draws are written.
     pub fn record(
         &self,
         encoder: &mut wgpu::CommandEncoder,
@@ -149,6 +157,9 @@ impl ShellList {
         pass.set_bind_group(0, view, &[]);
         pass.set_bind_group(1, object, &[]);
         pass.set_bind_group(3, &self.bind_group, &[]);
+        pass.set_pipeline(&pipelines.flags);
+        let (per_row, rows) = crate::silhouette::item_groups(self.triangle_count);
+        pass.dispatch_workgroups(per_row, rows, 1);
         pass.set_pipeline(&pipelines.list);
         pass.dispatch_workgroups(1, 1, 1);
         // A new dispatch sees every write of the last one.

@@ -38,15 +38,29 @@ fn view_lod_shows(triangle: u32) -> bool {
     return shows;
 }
 
-// One workgroup walks the triangles `SCAN_WIDTH` at a time (as `cs_silhouette` walks the edges).
+// First, one thread a triangle over as many workgroups as it takes: whether it shows, in the
+// first of its own three slots of the list (deciding inside the one listing workgroup left the
+// whole mesh to one thread of a CPU rasteriser).
+@compute @workgroup_size(64)
+fn cs_view_lod_flags(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
+    let triangle = item_index(id, groups);
+    if triangle < object.triangle_count {
+        listed_indices[3u * triangle] = u32(view_lod_shows(triangle));
+    }
+}
+
+// Then one workgroup walks the triangles `SCAN_WIDTH` at a time (as `cs_silhouette` walks the
+// edges) and moves the shown ones down to their places, in place: a round writes only below its
+// own end, and every thread has read its flag before any writes.
 @compute @workgroup_size(256)
 fn cs_view_lod_list(@builtin(local_invocation_index) lane: u32) {
     var count = 0u;
     let rounds = (object.triangle_count + SCAN_WIDTH - 1u) / SCAN_WIDTH;
     for (var round = 0u; round < rounds; round++) {
         let triangle = round * SCAN_WIDTH + lane;
-        let shows = triangle < object.triangle_count && view_lod_shows(triangle);
+        let shows = triangle < object.triangle_count && listed_indices[3u * triangle] != 0u;
         let scan = workgroup_scan(lane, u32(shows));
+        storageBarrier();
         if shows {
             let first = 3u * (count + scan.x - 1u);
             for (var k = 0u; k < 3u; k++) {
