@@ -1,6 +1,6 @@
 //! A mesh in the unified layout on the GPU, shared by [`crate::GpuFur`] (`L` layers) and
 //! [`crate::PlainMesh`] (layer 0 only): the shared vertex array (one or two states), base
-//! normals, corner uvs and topology as storage buffers, and the object uniform.
+//! normals, wedge uvs and topology as storage buffers, and the object uniform.
 
 use glam::{Vec2, Vec3};
 use pelt_core::Mesh;

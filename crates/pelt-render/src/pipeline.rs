@@ -9,7 +9,7 @@ pub(crate) struct Layouts {
     /// Group 0: the view uniform.
     pub view: wgpu::BindGroupLayout,
     /// Group 1 of the unified structure and plain meshes: the object uniform and the storage
-    /// buffers (positions twice, base normals, corner uvs, topology).
+    /// buffers (positions twice, base normals, wedge uvs, topology).
     pub unified_object: wgpu::BindGroupLayout,
     /// Group 1 of the separated structure: the object uniform alone.
     pub separated_object: wgpu::BindGroupLayout,

@@ -3,7 +3,7 @@
 
 use crate::RenderError;
 
-/// Storage buffers the unified vertex shaders read: two position states, base normals, corner
+/// Storage buffers the unified vertex shaders read: two position states, base normals, wedge
 /// uvs and topology.
 const STORAGE_BUFFERS_PER_STAGE: u32 = 5;
 /// View, object and textures; the silhouette pass's fin list is group 3.
