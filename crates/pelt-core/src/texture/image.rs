@@ -79,8 +79,11 @@ impl ImageRgba8 {
     }
 }
 
-/// Halves `count` stacked `width x height` RGBA8 images (straight alpha) with an alpha-weighted
-/// 2x2 box filter, so transparent texels do not darken the colour of their neighbours.
+/// Halves `count` stacked `width x height` RGBA8 images (straight alpha, sRGB-encoded colour, as
+/// the renderer uploads them) with an alpha-weighted 2x2 box filter, so transparent texels do
+/// not darken the colour of their neighbours. Colour is averaged in linear light: averaging the
+/// encoded bytes darkened every level (a black and white checker came out 128, not 188), so
+/// distant fur, sampled from the smaller levels, lost brightness where strands and gaps mix.
 ///
 /// Odd sizes keep their last row or column out of the average; a size of 1 stays 1.
 ///
@@ -90,34 +93,73 @@ impl ImageRgba8 {
 pub fn downsample_rgba8(rgba: &[u8], width: u32, height: u32, count: u32) -> Vec<u8> {
     let (w, h) = (width as usize, height as usize);
     assert_eq!(rgba.len(), count as usize * w * h * 4, "image stack size");
+    let linear = srgb_to_linear_table();
     let (half_w, half_h) = ((w / 2).max(1), (h / 2).max(1));
     let mut out = Vec::with_capacity(count as usize * half_w * half_h * 4);
     for image in rgba.chunks_exact(w * h * 4) {
         for y in 0..half_h {
             for x in 0..half_w {
-                let mut colour = [0u32; 3];
+                let mut colour = [0.0f32; 3];
                 let mut alpha = 0u32;
-                let mut plain = [0u32; 3];
+                let mut plain = [0.0f32; 3];
                 for (dx, dy) in [(0, 0), (1, 0), (0, 1), (1, 1)] {
                     let (sx, sy) = ((2 * x + dx).min(w - 1), (2 * y + dy).min(h - 1));
                     let p = &image[(sy * w + sx) * 4..(sy * w + sx) * 4 + 4];
                     let a = u32::from(p[3]);
                     for c in 0..3 {
-                        colour[c] += u32::from(p[c]) * a;
-                        plain[c] += u32::from(p[c]);
+                        let value = linear[usize::from(p[c])];
+                        colour[c] += value * a as f32;
+                        plain[c] += value;
                     }
                     alpha += a;
                 }
                 for c in 0..3 {
                     // Fully transparent blocks keep their plain mean so filtering never bleeds black.
-                    let value = (colour[c] + alpha / 2).checked_div(alpha).unwrap_or((plain[c] + 2) / 4);
-                    out.push(value as u8);
+                    let mean = if alpha > 0 { colour[c] / alpha as f32 } else { plain[c] / 4.0 };
+                    out.push(linear_to_srgb_byte(mean, linear));
                 }
                 out.push(((alpha + 2) / 4) as u8);
             }
         }
     }
     out
+}
+
+/// Linear light of each sRGB-encoded byte (IEC 61966-2-1).
+fn srgb_to_linear_table() -> &'static [f32; 256] {
+    static TABLE: std::sync::OnceLock<[f32; 256]> = std::sync::OnceLock::new();
+    TABLE.get_or_init(|| {
+        std::array::from_fn(|byte| {
+            let v = byte as f32 / 255.0;
+            if v <= 0.04045 { v / 12.92 } else { ((v + 0.055) / 1.055).powf(2.4) }
+        })
+    })
+}
+
+/// Buckets of linear light for [`linear_to_srgb_byte`]'s first guess: narrower than the step
+/// between any two bytes, so the nearest byte is the guess or one beside it.
+const ENCODE_BUCKETS: usize = 4096;
+
+/// The sRGB byte whose linear light is nearest `value`: the table's inverse, so a block of equal
+/// texels keeps its byte exactly. A bucket table gives the guess (a mip chain encodes millions of
+/// channels; searching the 256 bytes each time added a quarter to `pelt render`'s start).
+fn linear_to_srgb_byte(value: f32, linear: &[f32; 256]) -> u8 {
+    static GUESS: std::sync::OnceLock<Vec<u8>> = std::sync::OnceLock::new();
+    let guess = GUESS.get_or_init(|| {
+        (0..ENCODE_BUCKETS).map(|i| nearest_byte((i as f32 + 0.5) / ENCODE_BUCKETS as f32, linear)).collect()
+    });
+    let value = value.clamp(0.0, 1.0);
+    let byte = guess[((value * ENCODE_BUCKETS as f32) as usize).min(ENCODE_BUCKETS - 1)];
+    let distance = |b: u8| (linear[usize::from(b)] - value).abs();
+    [byte.saturating_sub(1), byte.saturating_add(1)]
+        .into_iter()
+        .fold(byte, |best, b| if distance(b) < distance(best) { b } else { best })
+}
+
+/// The byte nearest `value` by search (ties to the darker byte).
+fn nearest_byte(value: f32, linear: &[f32; 256]) -> u8 {
+    let above = linear.partition_point(|&l| l < value).min(255);
+    if above > 0 && value - linear[above - 1] <= linear[above] - value { (above - 1) as u8 } else { above as u8 }
 }
 
 /// Number of levels in a full mip chain of a `size x size` image (`size` a power of two).
@@ -138,6 +180,32 @@ mod tests {
         assert_eq!(downsample_rgba8(&rgba, 2, 2, 1), vec![255, 0, 0, 64]);
         let transparent = [0, 255, 0, 0].repeat(4);
         assert_eq!(downsample_rgba8(&transparent, 2, 2, 1), vec![0, 255, 0, 0]);
+    }
+
+    #[test]
+    fn downsample_averages_light_not_bytes() {
+        // A black and white checker is half the light: sRGB 188, where the bytes' mean is 128.
+        let checker = [[0, 0, 0, 255], [255, 255, 255, 255], [255, 255, 255, 255], [0, 0, 0, 255]].concat();
+        assert_eq!(downsample_rgba8(&checker, 2, 2, 1), vec![188, 188, 188, 255]);
+        // Equal texels keep their byte, every byte.
+        for byte in 0..=255u8 {
+            let block = [byte, byte, byte, 255].repeat(4);
+            assert_eq!(downsample_rgba8(&block, 2, 2, 1), vec![byte, byte, byte, 255]);
+        }
+    }
+
+    #[test]
+    fn the_bucketed_encoding_is_the_nearest_byte() {
+        let linear = srgb_to_linear_table();
+        for i in 0..=100_000 {
+            let value = i as f32 / 100_000.0;
+            let distance = |b: u8| (linear[usize::from(b)] - value).abs();
+            // Every byte tried, the first nearest kept.
+            let nearest = (0..=255u8).fold(0, |best, b| if distance(b) < distance(best) { b } else { best });
+            let fast = linear_to_srgb_byte(value, linear);
+            // Equal distance either way is a tie, which the two may break differently.
+            assert!(fast == nearest || distance(fast) == distance(nearest), "{value}: {fast} against {nearest}");
+        }
     }
 
     #[test]
