@@ -15,7 +15,8 @@ window.pelt = page;
 
 function show(text, kind = 'error') {
   messageBox.textContent = text;
-  messageBox.className = kind;
+  // A cleared message keeps no kind: an 'error' class left on the hidden box read as an error.
+  messageBox.className = text ? kind : '';
   messageBox.style.display = text ? 'block' : 'none';
   if (kind === 'error' && text) page.error = text;
 }

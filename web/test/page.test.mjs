@@ -303,7 +303,14 @@ test('a bad preset file is a message naming it, and the page keeps drawing', asy
   fs.writeFileSync(file, 'layers = 9000\n');
   const input = await page.$('#preset-file');
   await input.uploadFile(file);
-  await page.waitForFunction(() => document.getElementById('message').className === 'error', { timeout: 60_000 });
+  // The error about this file: the wait must not end on an earlier state of the message box.
+  await page.waitForFunction(
+    () => {
+      const message = document.getElementById('message');
+      return message.className === 'error' && message.textContent.includes('bad-preset.toml');
+    },
+    { timeout: 60_000 },
+  );
   const text = await page.$eval('#message', (e) => e.textContent);
   assert.match(text, /bad-preset\.toml/);
   assert.match(text, /layers/);
