@@ -7,7 +7,7 @@
 
 use crate::RenderError;
 use crate::object::check_size;
-use crate::pipeline::Layouts;
+use crate::pipeline::{Layouts, listing_pipelines};
 use crate::renderer::{SHADING_WGSL, UNIFIED_WGSL};
 
 pub(crate) const SILHOUETTE_WGSL: &str = include_str!("silhouette.wgsl");
@@ -66,26 +66,10 @@ const MOST_GROUPS_PER_ROW: u32 = 65_535;
 
 impl SilhouettePipelines {
     pub fn new(device: &wgpu::Device, layouts: &Layouts) -> Self {
-        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("pelt silhouette"),
-            source: wgpu::ShaderSource::Wgsl(silhouette_shader_source().into()),
-        });
-        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("pelt silhouette"),
-            bind_group_layouts: &[Some(&layouts.view), Some(&layouts.unified_object), None, Some(&layouts.fin_list)],
-            immediate_size: 0,
-        });
-        let pipeline = |entry_point| {
-            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some(entry_point),
-                layout: Some(&layout),
-                module: &module,
-                entry_point: Some(entry_point),
-                compilation_options: wgpu::PipelineCompilationOptions::default(),
-                cache: None,
-            })
-        };
-        Self { fades: pipeline("cs_fin_fades"), list: pipeline("cs_silhouette") }
+        let source = ("pelt silhouette", silhouette_shader_source());
+        let [fades, list] =
+            listing_pipelines(device, layouts, source, &layouts.fin_list, ["cs_fin_fades", "cs_silhouette"]);
+        Self { fades, list }
     }
 }
 

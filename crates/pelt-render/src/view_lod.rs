@@ -13,7 +13,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 
 use crate::RenderError;
 use crate::object::check_size;
-use crate::pipeline::Layouts;
+use crate::pipeline::{Layouts, listing_pipelines};
 use crate::renderer::{SHADING_WGSL, UNIFIED_WGSL};
 
 pub(crate) const VIEW_LOD_WGSL: &str = include_str!("view_lod.wgsl");
@@ -59,30 +59,10 @@ pub(crate) struct ViewLodPipelines {
 
 impl ViewLodPipelines {
     pub fn new(device: &wgpu::Device, layouts: &Layouts) -> Self {
-        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("pelt view lod"),
-            source: wgpu::ShaderSource::Wgsl(view_lod_shader_source().into()),
-        });
-        let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("pelt view lod"),
-            bind_group_layouts: &[Some(&layouts.view), Some(&layouts.unified_object), None, Some(&layouts.shell_list)],
-            immediate_size: 0,
-        });
-        let pipeline = |entry_point| {
-            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some(entry_point),
-                layout: Some(&layout),
-                module: &module,
-                entry_point: Some(entry_point),
-                compilation_options: wgpu::PipelineCompilationOptions::default(),
-                cache: None,
-            })
-        };
-        Self {
-            flags: pipeline("cs_view_lod_flags"),
-            list: pipeline("cs_view_lod_list"),
-            draws: pipeline("cs_view_lod_draws"),
-        }
+        let source = ("pelt view lod", view_lod_shader_source());
+        let entries = ["cs_view_lod_flags", "cs_view_lod_list", "cs_view_lod_draws"];
+        let [flags, list, draws] = listing_pipelines(device, layouts, source, &layouts.shell_list, entries);
+        Self { flags, list, draws }
     }
 }
 
