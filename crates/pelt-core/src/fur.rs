@@ -249,8 +249,10 @@ impl Footprint {
         let (v, f, e, l) = counts(mesh, layers);
         let vertices = v * (l + 1);
         // Meshes with uvs: the wedges' uvs, their vertices and each corner's wedge.
-        let wedges = mesh.wedges().map_or(0, |w| w.vertices.len() as u64);
-        let (uv_bytes, wedge_indices) = if mesh.corner_uvs.is_some() { (8 * wedges, wedges + 3 * f) } else { (0, 0) };
+        let (uv_bytes, wedge_indices) = match mesh.wedges() {
+            Some(wedges) => (8 * wedges.vertices.len() as u64, wedges.vertices.len() as u64 + 3 * f),
+            None => (0, 0),
+        };
         let shell_faces = f * l;
         let fin_faces = 2 * l * e;
         Self {

@@ -25,6 +25,9 @@ pub(super) struct Model {
     /// The mesh from the command line, kept to switch back to.
     pub(super) file_mesh: Option<Mesh>,
     pub(super) structure: FurStructure,
+    /// `structure`'s unified footprint, taken when it is grown (the overlay reads it every
+    /// frame; counting a mesh's wedges is a pass over its corners).
+    pub(super) footprint: pelt_core::fur::Footprint,
     /// The try-on scene's body, drawn without fur under the furry garment.
     pub(super) body: Option<Mesh>,
     /// GPU bytes of the unified structure as the renderer holds it.
@@ -160,6 +163,7 @@ impl Model {
             settings,
             mesh_choices,
             file_mesh,
+            footprint: structure.footprint(),
             structure,
             body: None,
             unified_bytes: None,
@@ -328,6 +332,7 @@ impl Model {
         }
         self.restart_pending |= rebuilt || changes.animation;
         if rebuilt {
+            self.footprint = self.structure.footprint();
             self.sim = Simulation::new(&self.structure, &self.settings.preset.simulation)?;
             self.touch = None;
         } else if changes.simulation {

@@ -207,7 +207,7 @@ impl Model {
     fn overlay(&self, painter: &egui::Painter, rect: egui::Rect) {
         let draw = self.settings.draw;
         let footprint = if draw.unified {
-            self.structure.footprint()
+            self.footprint
         } else {
             SeparatedStructure { layers: self.structure.layers, fin_faces: 2 }.footprint(&self.structure.mesh)
         };
