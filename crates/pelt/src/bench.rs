@@ -54,6 +54,10 @@ pub struct Args {
     /// shell).
     #[arg(long)]
     pub no_lod: bool,
+    /// Also time every structure at this frame size (repeat for several), with frames per
+    /// second as a game loop gets them: frames submitted back to back, waited for once.
+    #[arg(long = "size", value_name = "WIDTHxHEIGHT", value_parser = crate::render::parse_size)]
+    pub sizes: Vec<(u32, u32)>,
     /// Steps of `--soak` on the CPU kernel.
     #[arg(long, value_name = "N", default_value_t = 1_000_000, requires = "soak")]
     pub steps: u64,
@@ -68,13 +72,15 @@ const LAYER_COUNTS: [u32; 2] = [16, 32];
 
 /// How much work each measurement does.
 #[derive(Clone, Copy, Debug)]
-struct Plan {
+struct Plan<'a> {
     quick: bool,
     /// `--no-lod`.
     no_lod: bool,
+    /// `--size`: frame sizes timed besides the two standard ones.
+    extra_sizes: &'a [(u32, u32)],
 }
 
-impl Plan {
+impl Plan<'_> {
     /// Whether `model` gets timings (Table 2 is computed for all).
     fn times(self, model: &str) -> bool {
         !self.quick || model == "box"
@@ -126,7 +132,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             MODELS.iter().map(|m| m.key).collect::<Vec<_>>().join(", ")
         );
     }
-    let plan = Plan { quick: args.quick, no_lod: args.no_lod };
+    let plan = Plan { quick: args.quick, no_lod: args.no_lod, extra_sizes: &args.sizes };
     let meshes_dir = models::meshes_dir(args.meshes.as_deref());
 
     // One GPU for the whole run; without one the frame times are null with the reason.
@@ -202,7 +208,7 @@ const NOT_ANIMATED: &str = "a static model";
 const QUICK_DRAWS: &str = "--quick draws the Box at 16 layers only";
 
 /// Every figure for one model at one layer count.
-fn measure(model: &Model, layers: u32, plan: Plan, gpu: Result<&render::Bench, &String>) -> anyhow::Result<ResultRow> {
+fn measure(model: &Model, layers: u32, plan: Plan<'_>, gpu: Result<&render::Bench, &String>) -> anyhow::Result<ResultRow> {
     let row = |render, sim, texture, gpu_sim, anim| -> anyhow::Result<ResultRow> {
         Ok(ResultRow {
             model: model.spec.key,
@@ -256,7 +262,7 @@ fn measure(model: &Model, layers: u32, plan: Plan, gpu: Result<&render::Bench, &
         Ok(gpu) => {
             eprintln!("pelt bench:   {key} L={layers}: frame time");
             let lod = crate::lod::settings(&preset.render.lod, plan.no_lod);
-            gpu.measure(&fur, model.body.as_ref(), &textures, plan.render_budget(), lod)?
+            gpu.measure(&fur, model.body.as_ref(), &textures, plan.render_budget(), lod, plan.extra_sizes)?
         }
         Err(reason) => RenderFigures { render_unavailable_reason: Some(reason.clone()), ..RenderFigures::default() },
     };
@@ -274,7 +280,7 @@ fn measure(model: &Model, layers: u32, plan: Plan, gpu: Result<&render::Bench, &
 }
 
 /// The posing figures of an animated model (also under `--quick`: a few frames cost little).
-fn measure_anim(model: &Model, layers: u32, plan: Plan) -> anyhow::Result<AnimFigures> {
+fn measure_anim(model: &Model, layers: u32, plan: Plan<'_>) -> anyhow::Result<AnimFigures> {
     let (Some(rig), Some(clip)) = (&model.rig, model.spec.animation) else {
         return Ok(AnimFigures { anim_unavailable_reason: Some(NOT_ANIMATED.to_owned()), ..AnimFigures::default() });
     };
@@ -286,7 +292,7 @@ fn measure_anim(model: &Model, layers: u32, plan: Plan) -> anyhow::Result<AnimFi
 }
 
 /// The simulation's throughput on the 35,000-vertex mesh at 32 layers, default preset.
-fn measure_large_mesh(plan: Plan) -> anyhow::Result<LargeMeshFigures> {
+fn measure_large_mesh(plan: Plan<'_>) -> anyhow::Result<LargeMeshFigures> {
     let mesh = models::large_mesh()?;
     let mut preset = Preset::default();
     preset.layers = 32;

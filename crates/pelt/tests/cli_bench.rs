@@ -88,7 +88,7 @@ fn quick_bench_writes_every_key_with_sane_values() {
     let json_path = dir.join(format!("bench-quick-{}.json", std::process::id()));
     let md_path = dir.join(format!("bench-quick-{}.md", std::process::id()));
     let output = Command::new(env!("CARGO_BIN_EXE_pelt"))
-        .args(["bench", "--quick", "--json"])
+        .args(["bench", "--quick", "--size", "96x64", "--json"])
         .arg(&json_path)
         .arg("--md")
         .arg(&md_path)
@@ -172,6 +172,31 @@ fn quick_bench_writes_every_key_with_sane_values() {
             }
         }
     }
+
+    // `--size`: the rows that were drawn time that size too, with frames per second near what
+    // the frames waited for one by one give (pipelining gains or noise, not orders of magnitude).
+    for row in results {
+        let sizes = row["extra_sizes"].as_array().unwrap_or_else(|| panic!("extra_sizes in {row}"));
+        if row["render_unavailable_reason"].is_string() {
+            assert!(sizes.is_empty(), "{row}");
+            continue;
+        }
+        assert_eq!(sizes.len(), 1, "{row}");
+        let size = &sizes[0];
+        assert_eq!(size["size"], "96x64");
+        assert!(size["fps_frames"].as_u64().is_some_and(|n| n >= 3), "{size}");
+        assert!(size["level"].as_str().is_some_and(|l| l.contains("shells")), "{size}");
+        for structure in ["unified", "separated2", "separated30"] {
+            let frame_ms = size[format!("frame_ms_{structure}")].as_f64().unwrap();
+            let fps = size[format!("fps_{structure}")].as_f64().unwrap();
+            assert!(frame_ms.is_finite() && frame_ms > 0.0 && fps.is_finite() && fps > 0.0, "{size}");
+            let waited_fps = 1000.0 / frame_ms;
+            assert!(fps > 0.2 * waited_fps && fps < 20.0 * waited_fps, "{structure}: {size}");
+        }
+        assert!(size["fps_unified_lod"].as_f64().is_some_and(|fps| fps.is_finite() && fps > 0.0), "{size}");
+    }
+    assert!(markdown.contains("Frames per second at other sizes"), "{markdown}");
+    assert!(markdown.contains("| box | 16 | 96x64 |"), "{markdown}");
 
     let box16 = results.iter().find(|r| r["model"] == "box" && r["layers"] == 16).unwrap();
     assert_eq!(count(box16, "vertices"), 296);

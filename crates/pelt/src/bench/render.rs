@@ -11,12 +11,21 @@ use pelt_render::{
     GpuFur, HEADLESS_FORMAT, Light, PlainMesh, RenderTargets, SeparatedFur, SeparatedRenderer, default_sample_count,
 };
 
-use super::report::{Adapter, GpuSimFigures, LodFigures, RenderFigures};
+use super::report::{Adapter, GpuSimFigures, LodFigures, RenderFigures, SizeFigures};
 use super::table2::MANY_FIN_FACES;
 use crate::render::PLAIN_COLOUR;
 
 /// The two frame sizes: a typical window and a small one where vertex work dominates.
 pub const SIZES: [(u32, u32); 2] = [(1280, 720), (256, 256)];
+
+/// Frames a game loop keeps in flight (a swapchain's usual depth): the frames-per-second
+/// measurement waits for frame `n - FRAMES_IN_FLIGHT` before it submits frame `n`.
+const FRAMES_IN_FLIGHT: usize = 2;
+
+/// About how long one structure's frames-per-second run lasts, and its frame count's bounds.
+const FPS_RUN_SECS: f64 = 0.4;
+const FPS_FRAMES: std::ops::RangeInclusive<u32> = 3..=240;
+const FPS_ROUNDS: usize = 3;
 
 /// How many frames each median is taken over.
 #[derive(Clone, Copy, Debug)]
@@ -90,7 +99,8 @@ impl Bench {
     }
 
     /// Median frame times of the three structures at both sizes, each drawing the same scene:
-    /// the fur and, for the try-on model, the plain `body` under it.
+    /// the fur and, for the try-on model, the plain `body` under it; at `extra_sizes` also
+    /// frames per second (`SizeFigures`).
     pub fn measure(
         &self,
         fur: &FurStructure,
@@ -98,6 +108,7 @@ impl Bench {
         textures: &FurTextures,
         budget: RenderBudget,
         lod: pelt_render::LodSettings,
+        extra_sizes: &[(u32, u32)],
     ) -> anyhow::Result<RenderFigures> {
         let (device, queue) = (&self.gpu.device, &self.gpu.queue);
         // The samples `pelt render` and the viewer use on this adapter.
@@ -132,7 +143,8 @@ impl Bench {
         let mut frames_measured = u32::MAX;
         let mut fin_edges_drawn = None;
         let mut lod_figures = Vec::new();
-        for ((width, height), row) in SIZES.into_iter().zip(&mut medians) {
+        let mut size_figures = Vec::new();
+        for (index, (width, height)) in SIZES.into_iter().chain(extra_sizes.iter().copied()).enumerate() {
             let targets = RenderTargets::new(device, target, width, height)?;
             let output = device.create_texture(&wgpu_output_descriptor(width, height));
             let output_view = output.create_view(&Default::default());
@@ -166,7 +178,40 @@ impl Bench {
             ];
             // Frame by frame in turn, so the machine's slow spells (10-20% on a shared VM) fall
             // on the three structures alike and their ratios hold.
-            for (times, median) in self.time_interleaved(&cases, budget)?.iter().zip(row.iter_mut()) {
+            let times = self.time_interleaved(&cases, budget)?;
+            let Some(row) = medians.get_mut(index) else {
+                // A `--size`: the medians, then frames per second, the unified fur also at its
+                // level of detail for this framing (as `pelt render` and the viewer draw it).
+                let [unified_ms, separated2_ms, separated30_ms] = [0, 1, 2].map(|case| median_ms(&times[case]));
+                let slowest_ms = unified_ms.max(separated2_ms).max(separated30_ms);
+                let frames =
+                    ((FPS_RUN_SECS * 1000.0 / slowest_ms).ceil() as u32).clamp(*FPS_FRAMES.start(), *FPS_FRAMES.end());
+                let [fps_unified, fps_separated2, fps_separated30] =
+                    <[f64; 3]>::try_from(self.frames_per_second(&cases, frames)?).expect("one rate per case");
+                let (level, fps_unified_lod) = if lod.enabled {
+                    let level = crate::lod::level(&lod, fur, camera.eye, camera.fov_y_rad, height);
+                    unified.prepare(queue, &FurFrame { level, ..FurFrame::default() });
+                    let fps = self.frames_per_second(&cases[..1], frames);
+                    unified.prepare(queue, &FurFrame::default());
+                    (Some(level.describe(fur.layers)), Some(fps?[0]))
+                } else {
+                    (None, None)
+                };
+                size_figures.push(SizeFigures {
+                    size: format!("{width}x{height}"),
+                    frame_ms_unified: unified_ms,
+                    frame_ms_separated2: separated2_ms,
+                    frame_ms_separated30: separated30_ms,
+                    fps_unified,
+                    fps_separated2,
+                    fps_separated30,
+                    level,
+                    fps_unified_lod,
+                    fps_frames: frames,
+                });
+                continue;
+            };
+            for (times, median) in times.iter().zip(row.iter_mut()) {
                 frames_measured = frames_measured.min(times.len() as u32);
                 *median = median_ms(times);
             }
@@ -238,6 +283,7 @@ impl Bench {
             fin_edges_drawn,
             upload_ms_per_frame: Some(median_ms(&upload_times)),
             lod: lod_figures,
+            extra_sizes: size_figures,
             render_unavailable_reason: None,
         })
     }
@@ -297,6 +343,51 @@ impl Bench {
             rounds += 1;
         }
         Ok(times)
+    }
+
+    /// Frames per second of each case as a game loop draws them: `frames` frames recorded and
+    /// submitted back to back, at most `FRAMES_IN_FLIGHT` unfinished, the last waited for; the
+    /// cases in turn for `FPS_ROUNDS` rounds, each case's median round. Whichever of the CPU's
+    /// recording and submission or the GPU's work is slower sets the rate, as in an app.
+    fn frames_per_second(
+        &self,
+        cases: &[&dyn Fn(&mut wgpu::CommandEncoder)],
+        frames: u32,
+    ) -> anyhow::Result<Vec<f64>> {
+        let device = &self.gpu.device;
+        let run = |record: &dyn Fn(&mut wgpu::CommandEncoder)| -> anyhow::Result<f64> {
+            let started = Instant::now();
+            let mut in_flight = std::collections::VecDeque::with_capacity(FRAMES_IN_FLIGHT + 1);
+            for _ in 0..frames {
+                if in_flight.len() == FRAMES_IN_FLIGHT {
+                    let oldest = in_flight.pop_front();
+                    let wait = wgpu::PollType::Wait { submission_index: oldest, timeout: None };
+                    device.poll(wait).context("waiting for the GPU")?;
+                }
+                let mut encoder = device.create_command_encoder(&Default::default());
+                record(&mut encoder);
+                in_flight.push_back(self.gpu.queue.submit([encoder.finish()]));
+            }
+            device.poll(wgpu::PollType::wait_indefinitely()).context("waiting for the GPU")?;
+            Ok(f64::from(frames) / started.elapsed().as_secs_f64())
+        };
+        // A first run of each unmeasured: its queue starts empty and its pipelines warm.
+        for case in cases {
+            run(case)?;
+        }
+        let mut rates = vec![Vec::with_capacity(FPS_ROUNDS); cases.len()];
+        for _ in 0..FPS_ROUNDS {
+            for (case, rates) in cases.iter().zip(&mut rates) {
+                rates.push(run(case)?);
+            }
+        }
+        Ok(rates
+            .into_iter()
+            .map(|mut rates| {
+                rates.sort_by(f64::total_cmp);
+                rates[rates.len() / 2]
+            })
+            .collect())
     }
 
     /// Triangles the last unified frame drew: the skin, the shells (those thinned by view angle

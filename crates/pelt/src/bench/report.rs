@@ -155,7 +155,30 @@ pub struct RenderFigures {
     /// The level of detail, unified structure, per size (1280x720, then 256x256): at the
     /// default framing and at 4x its distance, with LOD on and off (the columns above are off).
     pub lod: Vec<LodFigures>,
+    /// The sizes `--size` asked for (empty without it), each with frames per second.
+    pub extra_sizes: Vec<SizeFigures>,
     pub render_unavailable_reason: Option<String>,
+}
+
+/// One `--size` frame size: the three structures' median frame times (each frame waited for,
+/// as in the table of the two standard sizes) and their frames per second with frames
+/// submitted back to back, two in flight, as a game loop without vsync draws them.
+#[derive(Debug, Default, serde::Serialize)]
+pub struct SizeFigures {
+    /// `WIDTHxHEIGHT`.
+    pub size: String,
+    pub frame_ms_unified: f64,
+    pub frame_ms_separated2: f64,
+    pub frame_ms_separated30: f64,
+    pub fps_unified: f64,
+    pub fps_separated2: f64,
+    pub fps_separated30: f64,
+    /// The unified fur's level of detail at the default framing, e.g. `8/16 shells` (null under
+    /// `--no-lod`), and its frames per second there.
+    pub level: Option<String>,
+    pub fps_unified_lod: Option<f64>,
+    /// Frames in each timed run of the frames-per-second figures.
+    pub fps_frames: u32,
 }
 
 /// One size's level-of-detail figures (unified structure, the default preset's `[render.lod]`).
@@ -387,6 +410,44 @@ impl Report {
             }
         }
 
+        if self.results.iter().any(|r| !r.render.extra_sizes.is_empty()) {
+            let _ = writeln!(
+                md,
+                "\n### Frames per second at other sizes (frames submitted back to back, two in flight; median ms with each frame waited for in brackets)\n"
+            );
+            let _ = writeln!(
+                md,
+                "| model | L | size | unified | sep-2 | sep-30 | unified, LOD on (level) | frames a run | the paper's fps (its Table 2, L = 16, GeForce 8800 GTX) |"
+            );
+            let _ = writeln!(md, "|---|---:|---|---:|---:|---:|---:|---:|---:|");
+            for r in &self.results {
+                let paper_fps = PAPER_TABLE_2
+                    .iter()
+                    .find(|row| row.0 == r.paper_model && r.layers == 16)
+                    .map_or("-", |row| row.6);
+                for f in &r.render.extra_sizes {
+                    let lod = match (&f.level, f.fps_unified_lod) {
+                        (Some(level), Some(fps)) => format!("{} ({level})", fps_text(fps)),
+                        _ => "-".to_owned(),
+                    };
+                    let _ = writeln!(
+                        md,
+                        "| {} | {} | {} | {} ({}) | {} ({}) | {} ({}) | {lod} | {} | {paper_fps} |",
+                        r.model,
+                        r.layers,
+                        f.size,
+                        fps_text(f.fps_unified),
+                        ms(Some(f.frame_ms_unified)),
+                        fps_text(f.fps_separated2),
+                        ms(Some(f.frame_ms_separated2)),
+                        fps_text(f.fps_separated30),
+                        ms(Some(f.frame_ms_separated30)),
+                        f.fps_frames,
+                    );
+                }
+            }
+        }
+
         let _ = writeln!(md, "\n### Simulation (CPU) and texture generation\n");
         let _ = writeln!(
             md,
@@ -492,6 +553,10 @@ fn notes<'a>(md: &mut String, reasons: impl Iterator<Item = (&'a ResultRow, Opti
 
 fn ms(value: Option<f64>) -> String {
     value.map_or_else(|| "-".to_owned(), |v| if v < 1.0 { format!("{v:.3}") } else { format!("{v:.2}") })
+}
+
+fn fps_text(fps: f64) -> String {
+    if fps < 10.0 { format!("{fps:.2}") } else { format!("{fps:.0}") }
 }
 
 fn rate(value: Option<f64>) -> String {
