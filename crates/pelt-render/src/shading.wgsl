@@ -114,21 +114,21 @@ struct Varyings {
 struct ShellTileVaryings {
     @builtin(position) clip_position: vec4<f32>,
     // `hair_terms` at the vertex.
-    @location(0) lighting: vec4<f32>,
+    @location(0) @interpolate(perspective, centroid) lighting: vec4<f32>,
     // The opacity from the view angle (`shell_fade`), how far the layers the next coarser stride
     // drops have faded here (`lod_vertex_blend`), and the layer.
-    @location(1) fade_blend_layer: vec3<f32>,
+    @location(1) @interpolate(perspective, centroid) fade_blend_layer: vec3<f32>,
     // The root in tiles, model space, and the base normal picking its projection.
-    @location(2) tile_position: vec3<f32>,
-    @location(3) tile_normal: vec3<f32>,
+    @location(2) @interpolate(perspective, centroid) tile_position: vec3<f32>,
+    @location(3) @interpolate(perspective, centroid) tile_normal: vec3<f32>,
 }
 
 struct ShellUvVaryings {
     @builtin(position) clip_position: vec4<f32>,
-    @location(0) lighting: vec4<f32>,
-    @location(1) fade_blend_layer: vec3<f32>,
+    @location(0) @interpolate(perspective, centroid) lighting: vec4<f32>,
+    @location(1) @interpolate(perspective, centroid) fade_blend_layer: vec3<f32>,
     // The mesh uv in tiles (xy) and at the strand's root (zw, surface colour mode).
-    @location(2) uvs: vec4<f32>,
+    @location(2) @interpolate(perspective, centroid) uvs: vec4<f32>,
 }
 
 // The lean shell interfaces from the full surface varyings (the unified and separated shells
@@ -159,10 +159,10 @@ struct FinVaryings {
     @builtin(position) clip_position: vec4<f32>,
     // `hair_terms` at the vertex without the occlusion (the fragment takes it from the height),
     // and the fin's fade.
-    @location(0) lighting_fade: vec4<f32>,
+    @location(0) @interpolate(perspective, centroid) lighting_fade: vec4<f32>,
     // Along the edge in tiles, the height (0 at the roots, 1 at the tips), and the mesh uv at
     // this end of the edge (surface colour mode).
-    @location(1) uvs: vec4<f32>,
+    @location(1) @interpolate(perspective, centroid) uvs: vec4<f32>,
 }
 
 // Set per pipeline where every mesh it draws has uvs (1) or none has (2), so the shaders drop
