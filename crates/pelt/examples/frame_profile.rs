@@ -13,7 +13,12 @@ use pelt_render::{
 fn main() -> anyhow::Result<()> {
     let gpu = Gpu::new(Backend::Auto)?;
     let (device, queue) = (&gpu.device, &gpu.queue);
-    let samples = default_sample_count(&gpu.adapter.get_info());
+    // `MSAA=1` (or 2, 4, 8) overrides the adapter's default sample count.
+    let samples = std::env::var("MSAA")
+        .ok()
+        .and_then(|s| s.parse().ok())
+        .unwrap_or_else(|| default_sample_count(&gpu.adapter.get_info()));
+    println!("{} ({:?}), {samples}x MSAA", gpu.adapter.get_info().name, gpu.adapter.get_info().backend);
     let format = match std::env::var("FORMAT").as_deref() {
         Ok("unorm") => wgpu::TextureFormat::Rgba8Unorm,
         Ok("f16") => wgpu::TextureFormat::Rgba16Float,
