@@ -165,7 +165,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     }
 
     eprintln!("pelt bench: simulation on a {}-vertex mesh", models::LARGE_MESH_VERTICES);
-    let sim_large_mesh = Some(measure_large_mesh(plan)?);
+    let sim_large_mesh = Some(measure_large_mesh(plan, gpu.as_ref())?);
 
     let report = Report {
         pelt_version: env!("CARGO_PKG_VERSION"),
@@ -292,18 +292,27 @@ fn measure_anim(model: &Model, layers: u32, plan: Plan<'_>) -> anyhow::Result<An
 }
 
 /// The simulation's throughput on the 35,000-vertex mesh at 32 layers, default preset.
-fn measure_large_mesh(plan: Plan<'_>) -> anyhow::Result<LargeMeshFigures> {
+fn measure_large_mesh(plan: Plan<'_>, gpu: Result<&render::Bench, &String>) -> anyhow::Result<LargeMeshFigures> {
     let mesh = models::large_mesh()?;
     let mut preset = Preset::default();
     preset.layers = 32;
     let params = preset.fur_params(&mesh);
     let fur = FurStructure::new(mesh, &params)?;
     let throughput = sim::throughput(&fur, &preset.simulation, plan.sim_budget())?;
+    // The GPU kernel on a mesh big enough to fill a GPU (the bench's models are launch-bound).
+    let gpu_sim_node_updates_per_sec = match gpu {
+        Ok(gpu) => {
+            let (steps, runs) = plan.gpu_sim_runs();
+            Some(gpu.node_updates_per_sec(&fur, &preset.simulation, steps, runs)?)
+        }
+        Err(_) => None,
+    };
     Ok(LargeMeshFigures {
         mesh: models::LARGE_MESH.to_owned(),
         vertices: fur.vertex_count() as u64,
         layers: preset.layers,
         sim_node_updates_per_sec: throughput.one_thread,
         sim_node_updates_per_sec_all_threads: throughput.all_threads,
+        gpu_sim_node_updates_per_sec,
     })
 }

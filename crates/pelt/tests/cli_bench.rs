@@ -121,6 +121,10 @@ fn quick_bench_writes_every_key_with_sane_values() {
     for key in ["sim_node_updates_per_sec", "sim_node_updates_per_sec_all_threads"] {
         assert!(large[key].as_f64().is_some_and(|v| v.is_finite() && v > 0.0), "{key} in {large}");
     }
+    // The GPU kernel on the large mesh wherever there is an adapter.
+    let gpu_updates = &large["gpu_sim_node_updates_per_sec"];
+    assert_eq!(gpu_updates.is_null(), report["adapter"].is_null(), "{large}");
+    assert!(gpu_updates.is_null() || gpu_updates.as_f64().is_some_and(|v| v.is_finite() && v > 0.0), "{large}");
 
     let results = report["results"].as_array().unwrap();
     let models: Vec<&str> = results.iter().map(|r| r["model"].as_str().unwrap()).collect();

@@ -74,13 +74,12 @@ impl Bench {
         runs: usize,
         drawn_frames: u32,
     ) -> anyhow::Result<GpuSimFigures> {
+        let updates_per_sec = self.node_updates_per_sec(fur, params, steps, runs)?;
+        let (device, queue) = (&self.gpu.device, &self.gpu.queue);
         let mut windy = params.clone();
         if windy.wind.strength == 0.0 {
             windy.wind.strength = 0.5;
         }
-        let (device, queue) = (&self.gpu.device, &self.gpu.queue);
-        let secs = crate::sim_kernel::gpu_secs_per_step(device, queue, fur, &windy, steps, runs)?;
-        let nodes = fur.vertex_count() as f64 * f64::from(fur.layers);
         windy.rate_hz = super::sim::SIM_RATE_HZ;
         let cpu_ms = crate::sim_kernel::gpu_cpu_ms_per_drawn_frame(
             device,
@@ -91,11 +90,28 @@ impl Bench {
             drawn_frames,
         )?;
         Ok(GpuSimFigures {
-            gpu_sim_node_updates_per_sec: Some(nodes / secs),
+            gpu_sim_node_updates_per_sec: Some(updates_per_sec),
             gpu_sim_steps_per_run: Some(steps),
             gpu_sim_cpu_ms_per_frame: Some(cpu_ms),
             gpu_sim_unavailable_reason: None,
         })
+    }
+
+    /// The GPU kernel's node updates per second on `fur` under `params` with wind (the figure
+    /// `measure_simulation` reports, alone): the median of `runs` runs of `steps` steps.
+    pub fn node_updates_per_sec(
+        &self,
+        fur: &FurStructure,
+        params: &pelt_core::sim::SimParams,
+        steps: u32,
+        runs: usize,
+    ) -> anyhow::Result<f64> {
+        let mut windy = params.clone();
+        if windy.wind.strength == 0.0 {
+            windy.wind.strength = 0.5;
+        }
+        let secs = crate::sim_kernel::gpu_secs_per_step(&self.gpu.device, &self.gpu.queue, fur, &windy, steps, runs)?;
+        Ok(fur.vertex_count() as f64 * f64::from(fur.layers) / secs)
     }
 
     /// Median frame times of the three structures at both sizes, each drawing the same scene:

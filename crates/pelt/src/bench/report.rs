@@ -213,6 +213,9 @@ pub struct LargeMeshFigures {
     pub layers: u32,
     pub sim_node_updates_per_sec: f64,
     pub sim_node_updates_per_sec_all_threads: f64,
+    /// The GPU kernel (`--sim gpu`) with wind, as `gpu_sim_node_updates_per_sec`; null without an
+    /// adapter (`adapter_unavailable_reason`).
+    pub gpu_sim_node_updates_per_sec: Option<f64>,
 }
 
 /// Simulation throughput and its CPU cost per drawn frame.
@@ -473,12 +476,13 @@ impl Report {
         if let Some(large) = &self.sim_large_mesh {
             let _ = writeln!(
                 md,
-                "Large mesh ({}, {} vertices, L = {}): {} node updates/s on 1 thread, {} on all threads.",
+                "Large mesh ({}, {} vertices, L = {}): {} node updates/s on 1 thread, {} on all threads, {} on the GPU.",
                 large.mesh,
                 thousands(large.vertices),
                 large.layers,
                 rate(Some(large.sim_node_updates_per_sec)),
                 rate(Some(large.sim_node_updates_per_sec_all_threads)),
+                rate(large.gpu_sim_node_updates_per_sec),
             );
         }
         notes(
