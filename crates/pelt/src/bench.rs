@@ -208,7 +208,12 @@ const NOT_ANIMATED: &str = "a static model";
 const QUICK_DRAWS: &str = "--quick draws the Box at 16 layers only";
 
 /// Every figure for one model at one layer count.
-fn measure(model: &Model, layers: u32, plan: Plan<'_>, gpu: Result<&render::Bench, &String>) -> anyhow::Result<ResultRow> {
+fn measure(
+    model: &Model,
+    layers: u32,
+    plan: Plan<'_>,
+    gpu: Result<&render::Bench, &String>,
+) -> anyhow::Result<ResultRow> {
     let row = |render, sim, texture, gpu_sim, anim| -> anyhow::Result<ResultRow> {
         Ok(ResultRow {
             model: model.spec.key,

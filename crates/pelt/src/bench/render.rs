@@ -365,11 +365,7 @@ impl Bench {
     /// submitted back to back, at most `FRAMES_IN_FLIGHT` unfinished, the last waited for; the
     /// cases in turn for `FPS_ROUNDS` rounds, each case's median round. Whichever of the CPU's
     /// recording and submission or the GPU's work is slower sets the rate, as in an app.
-    fn frames_per_second(
-        &self,
-        cases: &[&dyn Fn(&mut wgpu::CommandEncoder)],
-        frames: u32,
-    ) -> anyhow::Result<Vec<f64>> {
+    fn frames_per_second(&self, cases: &[&dyn Fn(&mut wgpu::CommandEncoder)], frames: u32) -> anyhow::Result<Vec<f64>> {
         let device = &self.gpu.device;
         let run = |record: &dyn Fn(&mut wgpu::CommandEncoder)| -> anyhow::Result<f64> {
             let started = Instant::now();

@@ -424,10 +424,8 @@ impl Report {
             );
             let _ = writeln!(md, "|---|---:|---|---:|---:|---:|---:|---:|---:|");
             for r in &self.results {
-                let paper_fps = PAPER_TABLE_2
-                    .iter()
-                    .find(|row| row.0 == r.paper_model && r.layers == 16)
-                    .map_or("-", |row| row.6);
+                let paper_fps =
+                    PAPER_TABLE_2.iter().find(|row| row.0 == r.paper_model && r.layers == 16).map_or("-", |row| row.6);
                 for f in &r.render.extra_sizes {
                     let lod = match (&f.level, f.fps_unified_lod) {
                         (Some(level), Some(fps)) => format!("{} ({level})", fps_text(fps)),
