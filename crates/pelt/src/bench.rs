@@ -55,7 +55,8 @@ pub struct Args {
     #[arg(long)]
     pub no_lod: bool,
     /// Also time every structure at this frame size (repeat for several), with frames per
-    /// second as a game loop gets them: frames submitted back to back, waited for once.
+    /// second as a game loop without vsync gets them: frames submitted back to back, two in
+    /// flight.
     #[arg(long = "size", value_name = "WIDTHxHEIGHT", value_parser = crate::render::parse_size)]
     pub sizes: Vec<(u32, u32)>,
     /// Steps of `--soak` on the CPU kernel.
