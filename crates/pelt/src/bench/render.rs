@@ -76,10 +76,7 @@ impl Bench {
     ) -> anyhow::Result<GpuSimFigures> {
         let updates_per_sec = self.node_updates_per_sec(fur, params, steps, runs)?;
         let (device, queue) = (&self.gpu.device, &self.gpu.queue);
-        let mut windy = params.clone();
-        if windy.wind.strength == 0.0 {
-            windy.wind.strength = 0.5;
-        }
+        let mut windy = windy(params);
         windy.rate_hz = super::sim::SIM_RATE_HZ;
         let cpu_ms = crate::sim_kernel::gpu_cpu_ms_per_drawn_frame(
             device,
@@ -106,11 +103,8 @@ impl Bench {
         steps: u32,
         runs: usize,
     ) -> anyhow::Result<f64> {
-        let mut windy = params.clone();
-        if windy.wind.strength == 0.0 {
-            windy.wind.strength = 0.5;
-        }
-        let secs = crate::sim_kernel::gpu_secs_per_step(&self.gpu.device, &self.gpu.queue, fur, &windy, steps, runs)?;
+        let secs =
+            crate::sim_kernel::gpu_secs_per_step(&self.gpu.device, &self.gpu.queue, fur, &windy(params), steps, runs)?;
         Ok(fur.vertex_count() as f64 * f64::from(fur.layers) / secs)
     }
 
@@ -446,6 +440,16 @@ impl Bench {
         staging.unmap();
         Ok(word)
     }
+}
+
+/// `params` with wind where it has none, so the kernel's timings include the noise it evaluates
+/// in a windy scene.
+fn windy(params: &pelt_core::sim::SimParams) -> pelt_core::sim::SimParams {
+    let mut windy = params.clone();
+    if windy.wind.strength == 0.0 {
+        windy.wind.strength = 0.5;
+    }
+    windy
 }
 
 fn wgpu_output_descriptor(width: u32, height: u32) -> wgpu::TextureDescriptor<'static> {
