@@ -1,4 +1,4 @@
-//! The simulation invariants of PAPER-NOTES section 4, plus touch, interpolation, picking and
+//! The simulation invariants of docs/paper-notes.md section 4, plus touch, interpolation, picking and
 //! scene scripts.
 
 use std::path::Path;

@@ -1,4 +1,4 @@
-//! Fur simulation (PAPER-NOTES section 4): gravity, wind and touch bend every strand of the
+//! Fur simulation (docs/paper-notes.md section 4): gravity, wind and touch bend every strand of the
 //! shared vertex array by rotating its nodes about the node before them, root first.
 //!
 //! - [`bend`]: the rotation scheme of the paper's Equation 1, in O(L) per strand

@@ -1,4 +1,4 @@
-//! Seeded shell and fin textures (PAPER-NOTES section 3).
+//! Seeded shell and fin textures (docs/paper-notes.md section 3).
 //!
 //! A strand field over a seamless `size x size` tile: every texel draws a seed; where it passes
 //! the density threshold a strand roots, with its lean, curl, clump, thickness, length and
