@@ -33,7 +33,7 @@ pub struct TryOnScene {
 pub fn try_on_scene(options: &ImportOptions) -> Result<TryOnScene, super::MeshError> {
     let garment = Mesh::from_obj_str(TRY_ON_GARMENT_OBJ, Path::new("builtin:tryon/skirthelper.obj"), options)?.0;
     let mut body = Mesh::from_obj_str(TRY_ON_BODY_OBJ, Path::new("builtin:tryon/female_generic.obj"), options)?.0;
-    // The thighs press through the skirt's front; tucked under it they no longer show through
+    // The thighs press through the skirt's front; tucked under it they do not show through
     // the fur as pale specks.
     let radius = garment.bounding_sphere().1;
     super::tuck_under(&mut body, &garment, 0.01 * radius, 0.1 * radius);

@@ -168,7 +168,7 @@ mod tests {
     #[test]
     fn a_vertex_with_a_huge_fan_comes_out_whole() {
         // A disc of 200,000 triangles around vertex 0 (a search of the fan's vertices for each
-        // new one made this quadratic: minutes, where it now takes milliseconds).
+        // new one would make this quadratic: minutes instead of milliseconds).
         let n = 200_000u32;
         let triangles: Vec<[u32; 3]> = (0..n).map(|i| [0, 1 + i, 1 + (i + 1) % n]).collect();
         let mut order = tipsify_order(&triangles, n as usize + 1, CACHE_SIZE);

@@ -78,7 +78,7 @@ pub const MODELS: [ModelSpec; 6] = [
         body: Some(MeshSource::Asset("female_generic.obj")),
         animation: None,
     },
-    // Not in the paper: a skinned character, posed every frame (issue 10).
+    // Not in the paper: a skinned character, posed every frame.
     ModelSpec {
         key: "fox",
         paper_model: "none (animated Fox)",
