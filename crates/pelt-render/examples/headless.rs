@@ -2,10 +2,10 @@
 //! `cargo run -p pelt-render --example headless [-- OUT.png]`.
 
 use glam::Vec3;
-use pelt_core::sim::WindParams;
-use pelt_core::{Builtin, FurStructure, Preset, Simulation};
+use pelt_core::sim::{FurStepper, SimParams, WindParams};
+use pelt_core::{Builtin, FurStructure, Preset};
 use pelt_render::{
-    Backend, Camera, DEFAULT_BACKGROUND, FurDrawSettings, FurFrame, FurStates, FurView, GpuFur, Headless, Light,
+    Backend, Camera, DEFAULT_BACKGROUND, FurDrawSettings, FurDriver, FurView, Headless, KernelChoice, Light,
 };
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
@@ -18,30 +18,31 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let structure = FurStructure::new(mesh, &params)?;
     let textures = preset.generate_textures()?;
 
-    // One second of a steady breeze from the left, simulated on the CPU at 30 frames a second.
-    let mut simulation = Simulation::new(&structure, &preset.simulation)?;
-    simulation.set_wind(&WindParams { direction: Vec3::X, strength: 1.0, ..preset.simulation.wind.clone() })?;
-    for frame in 0..=30 {
-        simulation.advance_to(f64::from(frame) / 30.0);
-    }
+    // A steady breeze from the left.
+    let wind = WindParams { direction: Vec3::X, strength: 1.0, ..preset.simulation.wind.clone() };
+    let simulation = SimParams { wind, ..preset.simulation.clone() };
 
-    // A GPU without a window, the pipelines for its target, the fur and a view on it.
+    // A GPU without a window, the pipelines for its target, the fur (simulated on the CPU) and a
+    // view on it.
     let headless = Headless::new(Backend::Auto, 800, 600)?;
     let (device, queue) = (&headless.gpu.device, &headless.gpu.queue);
     let renderer = headless.renderer()?;
-    let fur = GpuFur::new(device, queue, &renderer, &structure, &textures, FurStates::One)?;
-    fur.set_positions(queue, simulation.positions())?;
-    fur.prepare(queue, &FurFrame::default());
+    let mut driver = FurDriver::new(device, queue, &renderer, &structure, &textures, &simulation, KernelChoice::Cpu)?;
+    let mut stepper = FurStepper::new(&structure, &preset.simulation)?;
+    stepper.simulation_mut().set_wind(&simulation.wind)?;
     let (centre, radius) = structure.mesh.bounding_sphere();
     let camera = Camera::framing(centre, radius * 1.1, 30.0, 15.0, headless.aspect_ratio());
     let view = FurView::new(device, &renderer);
     view.prepare(queue, &camera.view_data(headless.aspect_ratio(), &Light::default()));
 
-    // Draw into a pass and read the frame back.
+    // One second at 30 frames a second; the last one is drawn into a pass and read back.
+    for frame in 0..=30 {
+        driver.advance_to(device, queue, &mut stepper, f64::from(frame) / 30.0)?;
+    }
     let image = headless.render_with(
         DEFAULT_BACKGROUND,
-        |encoder| renderer.prepare_fins(encoder, &view, &fur),
-        |pass| renderer.draw(pass, &view, &fur, &FurDrawSettings::SILHOUETTE),
+        |encoder| driver.record_view(encoder, &renderer, &view),
+        |pass| driver.draw(pass, &renderer, &view, &FurDrawSettings::SILHOUETTE),
     )?;
     image.save(&output)?;
     println!("wrote {output} on {}", headless.gpu.summary());

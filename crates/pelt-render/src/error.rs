@@ -113,6 +113,9 @@ pub enum RenderError {
         /// The device's largest 2D texture side.
         limit: u32,
     },
+    /// The simulation refused an input (a non-finite pose or script key, bad parameters).
+    #[error("simulation: {0}")]
+    Simulation(#[source] pelt_core::sim::SimError),
     /// Reading a frame back failed (headless only).
     #[error("reading the frame back from the GPU failed: {0}")]
     Readback(String),

@@ -96,6 +96,7 @@
 #![warn(missing_docs)]
 
 mod camera;
+mod driver;
 mod error;
 mod fur;
 mod geometry;
@@ -120,6 +121,7 @@ mod view;
 mod view_lod;
 
 pub use camera::Camera;
+pub use driver::{FurDriver, KernelChoice, SimKernel, cpu_secs_per_step, gpu_secs_per_step};
 pub use error::RenderError;
 pub use fur::{FurStates, GpuFur};
 pub use geometry::POSITIONS_USAGE;

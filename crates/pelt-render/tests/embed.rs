@@ -16,7 +16,7 @@ fn screenshot(options: SceneOptions) -> image::RgbaImage {
     let gpu = gpu();
     let mut scene =
         Scene::new(&gpu.device, &gpu.queue, wgpu::TextureFormat::Rgba8UnormSrgb, options).expect("the scene");
-    scene.advance(&gpu.queue, 1.0).expect("simulation");
+    scene.advance(&gpu.device, &gpu.queue, 1.0).expect("simulation");
     scene.screenshot(&gpu.device, &gpu.queue, SIZE, 30.0).expect("screenshot")
 }
 

@@ -1,12 +1,13 @@
-//! Where the GPU simulation's step goes on the CPU: the controlling `Simulation` advancing
-//! (forces, touch and inertia per strand, its bending off), `GpuSimulation::prepare` (the per-strand
-//! inputs and the step uniforms uploaded) and recording the dispatch, per step and per strand.
-//! A profiling aid for BENCHMARKS.md: `cargo run --release --example gpu_sim_profile`.
+//! Where the GPU simulation's step goes on the CPU: `FurDriver::advance_to` (the stepper's
+//! forces, touch and inertia per strand with its bending off, then the per-strand inputs and the
+//! step uniforms uploaded) and `FurDriver::record` (the dispatch recorded), per step and per
+//! strand. A profiling aid for BENCHMARKS.md: `cargo run --release --example gpu_sim_profile`.
 
 use std::time::Instant;
 
-use pelt_core::{Builtin, FurStructure, Preset, Simulation};
-use pelt_render::{Backend, FurRenderer, FurStates, FurTarget, Gpu, GpuFur, GpuSimulation};
+use pelt_core::sim::FurStepper;
+use pelt_core::{Builtin, FurStructure, Preset};
+use pelt_render::{Backend, FurDriver, FurRenderer, FurTarget, Gpu, KernelChoice};
 
 fn main() -> anyhow::Result<()> {
     let gpu = Gpu::new(Backend::Auto)?;
@@ -21,34 +22,28 @@ fn main() -> anyhow::Result<()> {
         params.wind.strength = 0.5;
         let renderer = FurRenderer::new(device, FurTarget::new(wgpu::TextureFormat::Rgba8UnormSrgb))?;
         let textures = preset.generate_textures()?;
-        let mut gfur = GpuFur::new(device, queue, &renderer, &fur, &textures, FurStates::Two)?;
-        let mut sim = GpuSimulation::new(device, &gfur, &fur)?;
-        let mut control = Simulation::new(&fur, &params)?;
-        control.set_cpu_bending(false);
+        let mut driver = FurDriver::new(device, queue, &renderer, &fur, &textures, &params, KernelChoice::Gpu)?;
+        let mut stepper = FurStepper::new(&fur, &params)?;
         let rate = f64::from(params.rate_hz);
         let steps = 60;
-        let (mut t_adv, mut t_prep, mut t_disp) = (0.0, 0.0, 0.0);
+        let (mut t_advance, mut t_record) = (0.0, 0.0);
         let mut encoder = device.create_command_encoder(&Default::default());
         for step in 1..=steps {
             let t = Instant::now();
-            control.advance_to(f64::from(step) / rate);
-            t_adv += t.elapsed().as_secs_f64();
+            driver.advance_to(device, queue, &mut stepper, f64::from(step) / rate)?;
+            t_advance += t.elapsed().as_secs_f64();
             let t = Instant::now();
-            sim.prepare(device, queue, &control, &gfur)?;
-            t_prep += t.elapsed().as_secs_f64();
-            let t = Instant::now();
-            sim.dispatch(&mut encoder, &mut gfur)?;
-            t_disp += t.elapsed().as_secs_f64();
+            driver.record(&mut encoder)?;
+            t_record += t.elapsed().as_secs_f64();
         }
         queue.submit([encoder.finish()]);
         device.poll(wgpu::PollType::wait_indefinitely())?;
         let n = fur.vertex_count();
         println!(
-            "{builtin}: {n} strands; per step: advance {:.3} ms, prepare {:.3} ms, dispatch rec {:.3} ms; per strand advance {:.1} ns",
-            t_adv * 1e3 / f64::from(steps),
-            t_prep * 1e3 / f64::from(steps),
-            t_disp * 1e3 / f64::from(steps),
-            t_adv * 1e9 / f64::from(steps) / n as f64
+            "{builtin}: {n} strands; per step: advance {:.3} ms, record {:.3} ms; per strand advance {:.1} ns",
+            t_advance * 1e3 / f64::from(steps),
+            t_record * 1e3 / f64::from(steps),
+            t_advance * 1e9 / f64::from(steps) / n as f64
         );
     }
     Ok(())

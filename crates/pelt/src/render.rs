@@ -6,19 +6,19 @@ use std::path::{Path, PathBuf};
 use std::time::{Duration, Instant};
 
 use anyhow::{Context as _, bail};
-use glam::{Mat4, Quat, Vec3};
-use pelt_core::anim::{Pose, Rig};
+use glam::{Mat4, Vec3};
+use pelt_core::anim::Rig;
 use pelt_core::mesh::builtin::{TRY_ON_NAME, try_on_scene};
-use pelt_core::sim::{Scene, Simulation, WindParams};
+use pelt_core::sim::{FurStepper, Scene, WindParams};
 use pelt_core::{Builtin, FurStructure, ImportOptions, Mesh, Preset};
 use pelt_render::{
-    Backend, Camera, DEFAULT_BACKGROUND, FurDrawSettings, FurFrame, FurStates, FurTarget, FurView, Gpu, GpuFur,
-    GpuSimulation, HEADLESS_FORMAT, Headless, Light, PlainMesh, SAMPLE_COUNT, default_sample_count,
+    Backend, Camera, DEFAULT_BACKGROUND, FurDrawSettings, FurDriver, FurTarget, FurView, Gpu, HEADLESS_FORMAT,
+    Headless, Light, PlainMesh, SAMPLE_COUNT, default_sample_count,
 };
 
 use crate::lod;
 use crate::mesh_args::MeshArgs;
-use crate::sim_kernel::{self, SimChoice, SimKernel};
+use crate::sim_kernel::SimChoice;
 
 /// Skin tone of plain meshes (linear RGB).
 pub const PLAIN_COLOUR: Vec3 = Vec3::new(0.62, 0.46, 0.38);
@@ -140,11 +140,10 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         let secs = scene.as_ref().map(Scene::duration_secs).or(clip_secs).unwrap_or(2.0);
         ((secs * args.fps).round() as u32).max(1)
     };
-    let moves = clip.is_some() || scene.as_ref().is_some_and(|s| !s.motion.is_empty());
     let params = preset.fur_params(&mesh);
     let fur = FurStructure::new(mesh, &params)?;
     let textures = preset.generate_textures()?;
-    let mut simulation = Simulation::new(&fur, &preset.simulation)?;
+    let mut simulation_params = preset.simulation.clone();
     let wind = match args.wind {
         Some(wind) => Some(wind),
         None if preset.simulation.wind.strength > 0.0 => None,
@@ -152,7 +151,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     };
     if let Some(wind) = wind {
         let direction = wind.try_normalize().unwrap_or(Vec3::X);
-        simulation.set_wind(&WindParams { direction, strength: wind.length(), ..preset.simulation.wind.clone() })?;
+        simulation_params.wind = WindParams { direction, strength: wind.length(), ..preset.simulation.wind.clone() };
     }
 
     let (width, height) = args.size;
@@ -169,18 +168,17 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         Headless::with_target(gpu, FurTarget::new(HEADLESS_FORMAT).with_sample_count(samples), width, height)?;
     let (device, queue) = (&headless.gpu.device, &headless.gpu.queue);
     let renderer = headless.renderer()?;
-    let (kernel, kernel_reason) = sim_kernel::choose(args.sim, device, queue, &fur, simulation.params())?;
-    // The CPU simulation interpolates, so one state uploaded per frame is all the GPU needs; the
-    // GPU one writes two states and the vertex shader interpolates.
-    let states = if kernel == SimKernel::Gpu { FurStates::Two } else { FurStates::One };
-    let mut gpu_fur = GpuFur::new(device, queue, &renderer, &fur, &textures, states)?;
-    let mut gpu_simulation = match kernel {
-        SimKernel::Gpu => {
-            simulation.set_cpu_bending(false);
-            Some(GpuSimulation::new(device, &gpu_fur, &fur)?)
-        }
-        SimKernel::Cpu => None,
-    };
+    let mut driver = FurDriver::new(device, queue, &renderer, &fur, &textures, &simulation_params, args.sim.into())?;
+    // The wind is set after the state at time 0 is made, as a host changing it live would.
+    let mut stepper = FurStepper::new(&fur, &preset.simulation)?;
+    stepper.simulation_mut().set_wind(&simulation_params.wind)?;
+    // A rig poses the base only while it plays a clip or the script moves it.
+    if let Some(rig) = rig.filter(|_| clip.is_some() || scene.as_ref().is_some_and(|s| !s.motion.is_empty())) {
+        stepper.set_clip(rig, clip);
+    }
+    let motion_keys = scene.as_ref().map_or(Vec::new(), |s| s.motion.clone());
+    stepper.set_scene(scene);
+    let moves = stepper.moves();
     let plain_meshes = plain
         .iter()
         .map(|mesh| PlainMesh::new(device, &renderer, mesh, PLAIN_COLOUR))
@@ -188,14 +186,12 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     for mesh in &plain_meshes {
         mesh.prepare(queue, Mat4::IDENTITY);
     }
-    let motion_keys = scene.as_ref().map_or(&[][..], |s| &s.motion[..]);
-    let camera = camera(args, &preset, &fur, &plain, motion_keys, frames, headless.aspect_ratio());
-    let mut pose = Pose::default();
+    let camera = camera(args, &preset, &fur, &plain, &motion_keys, frames, headless.aspect_ratio());
     let view = FurView::new(device, &renderer);
     view.prepare(queue, &camera.view_data(headless.aspect_ratio(), &Light::default()));
     // The camera stays put, so one level serves every frame.
     let level = lod::level(&lod::settings(&preset.render.lod, args.no_lod), &fur, camera.eye, camera.fov_y_rad, height);
-    gpu_fur.prepare(queue, &FurFrame { level, ..FurFrame::default() });
+    driver.set_level(level);
     let settings = FurDrawSettings {
         alpha_to_coverage: args.alpha_to_coverage,
         fins: !args.no_fins,
@@ -226,44 +222,27 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     for frame in 0..frames {
         let time_secs = f64::from(frame) / args.fps;
         let sim_started = Instant::now();
-        let world_from_model = scene.as_ref().and_then(|s| s.motion_at(time_secs)).unwrap_or(Mat4::IDENTITY);
-        if moves {
-            pose_base(&fur, rig.as_ref(), clip, time_secs, world_from_model, &mut pose);
-            simulation.set_base_rotations(&pose.positions, &pose.rotations)?;
-            if frame == 0 {
-                simulation.restart();
-            }
-        }
-        if let Some(scene) = &scene {
-            scene.apply(time_secs, &mut simulation)?;
-        }
-        simulation.advance_to(time_secs);
+        driver.advance_to(device, queue, &mut stepper, time_secs)?;
         simulation_time += sim_started.elapsed();
         let render_started = Instant::now();
-        match &mut gpu_simulation {
-            Some(gpu_simulation) => {
-                gpu_simulation.prepare(device, queue, &simulation, &gpu_fur)?;
-                let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor::default());
-                gpu_simulation.dispatch(&mut encoder, &mut gpu_fur)?;
-                queue.submit([encoder.finish()]);
-                gpu_fur.prepare(queue, &FurFrame { interpolation: simulation.alpha(), level, ..FurFrame::default() });
-            }
-            None => gpu_fur.set_positions(queue, simulation.positions())?,
-        }
+        // The simulation's GPU steps in a submission of their own: the frame's closures below
+        // only read the driver.
+        let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("simulation") });
+        driver.record(&mut encoder)?;
+        queue.submit([encoder.finish()]);
         if moves {
-            gpu_fur.set_base_normals(queue, &pose.normals)?;
             for mesh in &plain_meshes {
-                mesh.prepare(queue, world_from_model);
+                mesh.prepare(queue, stepper.world_from_model());
             }
         }
         let image = headless.render_with(
             DEFAULT_BACKGROUND,
-            |encoder| renderer.prepare_fins(encoder, &view, &gpu_fur),
+            |encoder| driver.record_view(encoder, &renderer, &view),
             |pass| {
                 for mesh in &plain_meshes {
                     renderer.draw_plain(pass, &view, mesh);
                 }
-                renderer.draw(pass, &view, &gpu_fur, &settings);
+                driver.draw(pass, &renderer, &view, &settings);
             },
         )?;
         render_time += render_started.elapsed();
@@ -287,7 +266,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let per_frame = |total: Duration| total.as_secs_f64() * 1000.0 / f64::from(frames);
     println!(
         "{}: {frames} frame{} of {width}x{height}, {} shell layers on {} triangles (level of detail: {}); mean frame {:.1} ms \
-         (render and read back), simulation {:.1} ms a frame on the {kernel} ({kernel_reason}); {:.1} s in all on {}, {}x MSAA",
+         (render and read back), simulation {:.1} ms a frame on the {} ({}); {:.1} s in all on {}, {}x MSAA",
         args.output.display(),
         if frames == 1 { "" } else { "s" },
         fur.layers,
@@ -295,6 +274,8 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         level.describe(fur.layers),
         per_frame(render_time),
         per_frame(simulation_time),
+        driver.kernel(),
+        driver.kernel_reason(),
         started.elapsed().as_secs_f64(),
         headless.gpu.summary(),
         headless.target().sample_count,
@@ -331,38 +312,6 @@ fn choose_animation(args: &Args, rig: Option<&Rig>) -> anyhow::Result<Option<usi
         }
         (Some(name), _) => bail!("--animation {name:?}: the mesh has no animations"),
         (None, _) => Ok((clips > 0).then_some(0)),
-    }
-}
-
-/// The base this frame: the rig's pose (or the rest mesh), moved by the script's transform.
-fn pose_base(
-    fur: &FurStructure,
-    rig: Option<&Rig>,
-    clip: Option<usize>,
-    time_secs: f64,
-    world_from_model: Mat4,
-    pose: &mut Pose,
-) {
-    match rig {
-        Some(rig) => rig.pose(&fur.mesh, clip, time_secs, pose),
-        None => {
-            pose.positions.clone_from(&fur.mesh.positions);
-            pose.normals.clone_from(&fur.mesh.normals);
-            pose.rotations.clear();
-            pose.rotations.resize(fur.mesh.vertex_count(), Quat::IDENTITY);
-        }
-    }
-    if world_from_model != Mat4::IDENTITY {
-        let (_, turn, _) = world_from_model.to_scale_rotation_translation();
-        for p in &mut pose.positions {
-            *p = world_from_model.transform_point3(*p);
-        }
-        for n in &mut pose.normals {
-            *n = turn * *n;
-        }
-        for q in &mut pose.rotations {
-            *q = (turn * *q).normalize();
-        }
     }
 }
 

@@ -7,6 +7,7 @@
 //! - [`field`]: the per-vertex [`ForceField`] and the touch (patting) overlay.
 //! - [`mod@pick`]: ray picking of the base mesh, so a pointer or a script can touch the fur.
 //! - [`simulation`]: [`Simulation`], fixed steps with linear interpolation between the last two.
+//! - [`stepper`]: [`FurStepper`], one fur driven through time: its base posed, the script played.
 //! - [`scene`]: scripted wind and touch strokes ([`Scene`]), reproducible frame by frame.
 //! - [`motion`]: scripted rigid motion of the meshes (`[[motion]]` keys of a [`Scene`]).
 //! - [`inertia`]: the force from the roots' acceleration on a moving body ([`Inertia`]).
@@ -32,6 +33,7 @@ pub mod pick;
 pub mod scene;
 pub mod simulation;
 pub mod soak;
+pub mod stepper;
 pub mod wind;
 
 use glam::Vec3;
@@ -46,6 +48,7 @@ pub use pick::{Hit, pick};
 pub use scene::{Scene, SceneError, Stroke, WindKey};
 pub use simulation::{SimError, Simulation};
 pub use soak::{SoakReport, SoakStep, SoakSubject, soak};
+pub use stepper::FurStepper;
 pub use wind::{WindParams, value_noise3};
 
 /// Simulation parameters; part of a fur preset (`[simulation]` table).

@@ -58,6 +58,15 @@ pub struct FurTextures {
     pub surface: Option<ImageRgba8>,
 }
 
+impl FurTextures {
+    /// The smallest valid textures (4x4 texels, one slice, fully transparent): for a fur that is
+    /// simulated or measured but never looked at.
+    #[must_use]
+    pub fn blank() -> Self {
+        Self { size: 4, layers: 1, shell: vec![0; 64], fin_width: 4, fin_height: 4, fin: vec![0; 64], surface: None }
+    }
+}
+
 // Sizes only: the derived form would print megabytes of texels.
 impl std::fmt::Debug for FurTextures {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {

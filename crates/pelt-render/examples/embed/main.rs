@@ -38,7 +38,7 @@ fn screenshot(path: &str) -> Result<(), Error> {
     let (device, queue) = open_device(&adapter)?;
     let format = wgpu::TextureFormat::Rgba8UnormSrgb;
     let mut scene = Scene::new(&device, &queue, format, SceneOptions::default())?;
-    scene.advance(&queue, 1.0)?;
+    scene.advance(&device, &queue, 1.0)?;
     scene.screenshot(&device, &queue, (800, 600), 30.0)?.save(path)?;
     println!("wrote {path}");
     Ok(())
@@ -94,7 +94,7 @@ impl App {
     fn redraw(&mut self) -> Result<(), Error> {
         let Some(running) = self.running.as_mut() else { return Ok(()) };
         let time_secs = self.started.elapsed().as_secs_f64();
-        running.scene.advance(&running.queue, time_secs)?;
+        running.scene.advance(&running.device, &running.queue, time_secs)?;
         let frame = match running.surface.get_current_texture() {
             wgpu::CurrentSurfaceTexture::Success(frame) | wgpu::CurrentSurfaceTexture::Suboptimal(frame) => frame,
             wgpu::CurrentSurfaceTexture::Outdated | wgpu::CurrentSurfaceTexture::Lost => {

@@ -8,9 +8,10 @@
 
 use glam::{Mat4, Vec3};
 use pelt_core::sim::WindParams;
-use pelt_core::{Builtin, FurStructure, Preset, Simulation};
+use pelt_core::sim::{FurStepper, SimParams};
+use pelt_core::{Builtin, FurStructure, Preset};
 use pelt_render::{
-    FurDrawSettings, FurFrame, FurRenderer, FurStates, FurTarget, FurView, GpuFur, Light, LightDirection, ViewData,
+    FurDrawSettings, FurDriver, FurRenderer, FurTarget, FurView, KernelChoice, Light, LightDirection, ViewData,
 };
 use wgpu::util::DeviceExt as _;
 
@@ -73,12 +74,10 @@ pub struct Scene {
     host_camera: wgpu::Buffer,
     host_bind_group: wgpu::BindGroup,
     renderer: FurRenderer,
-    fur: GpuFur,
+    /// The fur on the GPU, simulated on the CPU by `stepper`.
+    fur: FurDriver,
+    stepper: FurStepper,
     view: FurView,
-    world_from_model: Mat4,
-    simulation: Simulation,
-    steps_uploaded: u64,
-    scratch: Vec<Vec3>,
     attachments: Option<Attachments>,
 }
 
@@ -107,16 +106,18 @@ impl Scene {
         let params = preset.fur_params(&mesh);
         let (low, high) = mesh.bounds();
         let structure = FurStructure::new(mesh, &params)?;
-        let fur = GpuFur::new(device, queue, &renderer, &structure, &preset.generate_textures()?, FurStates::Two)?;
+        let wind = WindParams { direction: Vec3::X, strength: 1.2, ..preset.simulation.wind.clone() };
+        let simulation = SimParams { wind, ..preset.simulation.clone() };
+        let textures = preset.generate_textures()?;
+        let mut fur = FurDriver::new(device, queue, &renderer, &structure, &textures, &simulation, KernelChoice::Cpu)?;
+        let mut stepper = FurStepper::new(&structure, &preset.simulation)?;
+        stepper.simulation_mut().set_wind(&simulation.wind)?;
         let view = FurView::new(device, &renderer);
         // The bunny's model space (about 10 units long) to the host's world: 1 unit tall, feet
         // on the ground at the origin.
         let scale = 1.0 / (high.y - low.y);
         let foot = Vec3::new((low.x + high.x) * 0.5, low.y, (low.z + high.z) * 0.5);
-        let world_from_model = Mat4::from_scale(Vec3::splat(scale)) * Mat4::from_translation(-foot);
-        let mut simulation = Simulation::new(&structure, &preset.simulation)?;
-        simulation.set_wind(&WindParams { direction: Vec3::X, strength: 1.2, ..preset.simulation.wind.clone() })?;
-        let scratch = vec![Vec3::ZERO; structure.positions.len()];
+        fur.set_world_from_model(Mat4::from_scale(Vec3::splat(scale)) * Mat4::from_translation(-foot));
         Ok(Self {
             options,
             colour_format,
@@ -127,30 +128,15 @@ impl Scene {
             host_bind_group,
             renderer,
             fur,
+            stepper,
             view,
-            world_from_model,
-            simulation,
-            steps_uploaded: 0,
-            scratch,
             attachments: None,
         })
     }
 
-    /// Steps the simulation to `time_secs`. The GPU keeps the last two states: one upload per
-    /// simulation step, and frames in between only move the interpolation.
-    pub fn advance(&mut self, queue: &wgpu::Queue, time_secs: f64) -> Result<(), Error> {
-        self.simulation.advance_to(time_secs);
-        let steps = self.simulation.steps_taken();
-        if steps == self.steps_uploaded + 1 {
-            self.simulation.write_lerp(1.0, &mut self.scratch);
-            self.fur.push_state(queue, &self.scratch)?;
-        } else if steps != self.steps_uploaded {
-            self.simulation.write_lerp(0.0, &mut self.scratch);
-            let previous = self.scratch.clone();
-            self.simulation.write_lerp(1.0, &mut self.scratch);
-            self.fur.set_states(queue, &previous, &self.scratch)?;
-        }
-        self.steps_uploaded = steps;
+    /// Steps the simulation to `time_secs` and uploads what the fur draws.
+    pub fn advance(&mut self, device: &wgpu::Device, queue: &wgpu::Queue, time_secs: f64) -> Result<(), Error> {
+        self.fur.advance_to(device, queue, &mut self.stepper, time_secs)?;
         Ok(())
     }
 
@@ -181,18 +167,14 @@ impl Scene {
         let light = Light { direction: LightDirection::World(SUN.normalize()), colour: Vec3::ONE, ambient: 0.3 };
         let camera = HostCamera { clip_from_world, light_direction: SUN.normalize(), padding: 0.0 };
         queue.write_buffer(&self.host_camera, 0, bytemuck::bytes_of(&camera));
-        // Pelt's per-frame data: the view from the host's camera, the fur's transform.
+        // Pelt's per-frame data: the view from the host's camera (the fur's was written by
+        // `advance`).
         self.view.prepare(queue, &ViewData::new(clip_from_world, view_from_world.inverse(), &light));
-        let interpolation = self.simulation.alpha();
-        self.fur.prepare(
-            queue,
-            &FurFrame { world_from_model: self.world_from_model, interpolation, ..FurFrame::default() },
-        );
 
         let Some(attachments) = &self.attachments else { return };
         // The silhouette pass goes into the host's encoder, before the pass that draws the fur.
         if self.options.fur {
-            self.renderer.prepare_fins(encoder, &self.view, &self.fur);
+            self.fur.record_view(encoder, &self.renderer, &self.view);
         }
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("host frame"),
@@ -218,7 +200,7 @@ impl Scene {
         pass.set_vertex_buffer(0, self.host_vertices.slice(..));
         pass.draw(0..self.host_vertex_count, 0..1);
         if self.options.fur {
-            self.renderer.draw(&mut pass, &self.view, &self.fur, &FurDrawSettings::SILHOUETTE);
+            self.fur.draw(&mut pass, &self.renderer, &self.view, &FurDrawSettings::SILHOUETTE);
         }
     }
 

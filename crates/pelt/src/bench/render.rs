@@ -64,7 +64,7 @@ impl Bench {
 
     /// The GPU simulation's node updates per second on `fur` under `params` with wind (so the
     /// noise is evaluated, as in a windy scene): the median of `runs` runs of `steps` steps
-    /// (`crate::sim_kernel::gpu_secs_per_step`, the code `--sim gpu` runs); and the CPU cost
+    /// (`pelt_render::gpu_secs_per_step`, through the driver `--sim gpu` runs); and the CPU cost
     /// per drawn frame over `drawn_frames` frames at 120 Hz with the simulation at 30 Hz.
     pub fn measure_simulation(
         &self,
@@ -103,8 +103,16 @@ impl Bench {
         steps: u32,
         runs: usize,
     ) -> anyhow::Result<f64> {
-        let secs =
-            crate::sim_kernel::gpu_secs_per_step(&self.gpu.device, &self.gpu.queue, fur, &windy(params), steps, runs)?;
+        let renderer = crate::sim_kernel::timing_renderer(&self.gpu.device)?;
+        let secs = pelt_render::gpu_secs_per_step(
+            &self.gpu.device,
+            &self.gpu.queue,
+            &renderer,
+            fur,
+            &windy(params),
+            steps,
+            runs,
+        )?;
         Ok(fur.vertex_count() as f64 * f64::from(fur.layers) / secs)
     }
 

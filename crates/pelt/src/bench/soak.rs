@@ -5,20 +5,21 @@ use std::time::Instant;
 
 use glam::Vec3;
 use pelt_core::sim::{SimError, SoakReport, SoakStep, SoakSubject};
+use pelt_core::texture::FurTextures;
 use pelt_core::{FurStructure, Preset, Simulation};
-use pelt_render::{Backend, Gpu, GpuFur, GpuSimulation, RenderError};
+use pelt_render::{Backend, FurDriver, Gpu, KernelChoice, RenderError};
 
 /// The most a segment's length may move in the soak, as a fraction of its strand's length.
 pub const SOAK_TOLERANCE: f64 = 1e-5;
 
-/// The GPU kernel as a soak subject: a CPU [`Simulation`] with its bending off takes each step's
-/// inputs (as `pelt view --sim gpu` drives it), [`GpuSimulation`] bends the strands in its
-/// compute pass, and the new state is read back from the buffer the renderer would draw.
+/// The GPU kernel as a soak subject: a [`FurDriver`] with the GPU kernel takes each step's
+/// inputs, its compute pass bends the strands, and the new state is read back from the buffer
+/// the renderer would draw.
 pub struct GpuSoak<'a> {
     device: &'a wgpu::Device,
     queue: &'a wgpu::Queue,
-    fur: GpuFur,
-    gpu: GpuSimulation,
+    driver: FurDriver,
+    /// Keeps time and the inputs; the GPU bends.
     control: Simulation,
     staging: wgpu::Buffer,
     bytes: u64,
@@ -30,7 +31,16 @@ impl<'a> GpuSoak<'a> {
     /// # Errors
     /// Whatever the fur, the GPU simulation or the controlling `Simulation` refuse.
     pub fn new(device: &'a wgpu::Device, queue: &'a wgpu::Queue, structure: &FurStructure) -> anyhow::Result<Self> {
-        let (fur, gpu, control) = crate::sim_kernel::gpu_rig(device, queue, structure, &Preset::default().simulation)?;
+        let renderer = crate::sim_kernel::timing_renderer(device)?;
+        let driver = FurDriver::new(
+            device,
+            queue,
+            &renderer,
+            structure,
+            &FurTextures::blank(),
+            &Preset::default().simulation,
+            KernelChoice::Gpu,
+        )?;
         let bytes = structure.positions.len() as u64 * 12;
         let staging = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("pelt soak readback"),
@@ -38,7 +48,8 @@ impl<'a> GpuSoak<'a> {
             usage: wgpu::BufferUsages::MAP_READ | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        Ok(Self { device, queue, fur, gpu, control, staging, bytes })
+        let control = Simulation::new(structure, &Preset::default().simulation)?;
+        Ok(Self { device, queue, driver, control, staging, bytes })
     }
 }
 
@@ -48,10 +59,14 @@ fn failed(error: impl std::fmt::Display) -> SimError {
 
 impl SoakSubject for GpuSoak<'_> {
     fn step(&mut self, step: &SoakStep) -> Result<(), SimError> {
-        SoakSubject::step(&mut self.control, step)?;
-        self.gpu.prepare(self.device, self.queue, &self.control, &self.fur).map_err(failed)?;
+        self.driver
+            .step_with(self.device, self.queue, &mut self.control, |simulation| SoakSubject::step(simulation, step))
+            .map_err(|error| match error {
+                RenderError::Simulation(error) => error,
+                other => failed(other),
+            })?;
         let mut encoder = self.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("soak") });
-        self.gpu.dispatch(&mut encoder, &mut self.fur).map_err(failed)?;
+        self.driver.record(&mut encoder).map_err(failed)?;
         self.queue.submit([encoder.finish()]);
         Ok(())
     }
@@ -69,7 +84,7 @@ impl SoakSubject for GpuSoak<'_> {
             return Ok(());
         }
         let mut encoder = self.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("soak") });
-        encoder.copy_buffer_to_buffer(self.fur.current_positions(), 0, &self.staging, 0, self.bytes);
+        encoder.copy_buffer_to_buffer(self.driver.fur().current_positions(), 0, &self.staging, 0, self.bytes);
         self.queue.submit([encoder.finish()]);
         let slice = self.staging.slice(..self.bytes);
         let (sender, receiver) = std::sync::mpsc::channel();

@@ -11,12 +11,12 @@ use anyhow::{Context as _, bail};
 use glam::{Mat4, Vec3};
 use pelt_core::mesh::builtin::{TRY_ON_NAME, try_on_scene};
 use pelt_core::reference::StrandReference;
-use pelt_core::sim::{Simulation, WindParams};
+use pelt_core::sim::{FurStepper, SimParams, WindParams};
 use pelt_core::{Builtin, FurStructure, ImportOptions, Mesh, Preset, texture};
 use pelt_render::{
-    Backend, Camera, DEFAULT_BACKGROUND, FurDrawSettings, FurFrame, FurLook, FurRenderer, FurStates, FurTarget,
-    FurView, Gpu, GpuFur, HEADLESS_FORMAT, Headless, Light, PlainMesh, StrandRenderer, StrandRibbons,
-    default_sample_count, tile_mapping,
+    Backend, Camera, DEFAULT_BACKGROUND, FurDrawSettings, FurDriver, FurLook, FurRenderer, FurTarget, FurView, Gpu,
+    HEADLESS_FORMAT, Headless, KernelChoice, Light, PlainMesh, StrandRenderer, StrandRibbons, default_sample_count,
+    tile_mapping,
 };
 
 use self::metrics::Mask;
@@ -120,12 +120,14 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let look = FurLook::default();
     let reference = StrandReference::new(&fur, field, tile_mapping(&fur.mesh, &look))?;
 
-    let mut simulation = Simulation::new(&fur, &preset.simulation)?;
     let wind = args.wind.unwrap_or(Vec3::ZERO);
     let direction = wind.try_normalize().unwrap_or(Vec3::X);
-    simulation.set_wind(&WindParams { direction, strength: wind.length(), ..preset.simulation.wind.clone() })?;
-    simulation.advance_to(SETTLE_SECS);
-    let positions = simulation.positions().to_vec();
+    let simulation_params = SimParams {
+        wind: WindParams { direction, strength: wind.length(), ..preset.simulation.wind.clone() },
+        ..preset.simulation.clone()
+    };
+    let mut stepper = FurStepper::new(&fur, &preset.simulation)?;
+    stepper.simulation_mut().set_wind(&simulation_params.wind)?;
 
     let (width, height) = args.size;
     let gpu = Gpu::new(args.backend)?;
@@ -139,8 +141,9 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         width * factor,
         height * factor,
     )?;
-    let shell_side = Side::new(&shells, &fur, &textures, &positions, &plain)?;
-    let strand_side = Side::new(&strands, &fur, &textures, &positions, &plain)?;
+    let shell_side = Side::new(&shells, &fur, &textures, &mut stepper, &plain)?;
+    let strand_side = Side::new(&strands, &fur, &textures, &mut stepper, &plain)?;
+    let positions = stepper.simulation().positions();
     let strand_renderer = StrandRenderer::new(&strands.gpu.device, &strand_side.renderer)?;
     let ribbons =
         StrandRibbons::new(&strands.gpu.device, &reference, &positions, &fur.mesh.normals, &fur.mesh.triangles)?;
@@ -174,8 +177,8 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             for mesh in &strand_side.plain {
                 strand_side.renderer.draw_plain(pass, &strand_side.view, mesh);
             }
-            strand_side.renderer.draw(pass, &strand_side.view, &strand_side.fur, &FurDrawSettings::SKIN);
-            strand_renderer.draw(pass, &strand_side.view, &strand_side.fur, &ribbons);
+            strand_side.fur.draw(pass, &strand_side.renderer, &strand_side.view, &FurDrawSettings::SKIN);
+            strand_renderer.draw(pass, &strand_side.view, strand_side.fur.fur(), &ribbons);
         })?;
         let reference_image = metrics::downsample(&big, factor);
         // The same strands a quarter pixel off: the measurement's own precision.
@@ -274,7 +277,7 @@ fn load_meshes(args: &MeshArgs) -> anyhow::Result<(String, Mesh, Vec<Mesh>)> {
 /// One headless target's renderer, fur, view and plain meshes.
 struct Side {
     renderer: FurRenderer,
-    fur: GpuFur,
+    fur: FurDriver,
     view: FurView,
     plain: Vec<PlainMesh>,
 }
@@ -284,14 +287,15 @@ impl Side {
         headless: &Headless,
         fur: &FurStructure,
         textures: &pelt_core::FurTextures,
-        positions: &[Vec3],
+        stepper: &mut FurStepper,
         plain: &[Mesh],
     ) -> anyhow::Result<Self> {
         let (device, queue) = (&headless.gpu.device, &headless.gpu.queue);
         let renderer = headless.renderer()?;
-        let gpu_fur = GpuFur::new(device, queue, &renderer, fur, textures, FurStates::One)?;
-        gpu_fur.set_positions(queue, positions)?;
-        gpu_fur.prepare(queue, &FurFrame::default());
+        // The fur settled under gravity (and `--wind`): a still frame.
+        let params = stepper.simulation().params().clone();
+        let mut gpu_fur = FurDriver::new(device, queue, &renderer, fur, textures, &params, KernelChoice::Cpu)?;
+        gpu_fur.advance_to(device, queue, stepper, SETTLE_SECS)?;
         let plain = plain
             .iter()
             .map(|mesh| PlainMesh::new(device, &renderer, mesh, PLAIN_COLOUR))
@@ -314,7 +318,7 @@ impl Side {
             DEFAULT_BACKGROUND,
             |encoder| {
                 if settings.fins {
-                    self.renderer.prepare_fins(encoder, &self.view, &self.fur);
+                    self.fur.record_view(encoder, &self.renderer, &self.view);
                 }
             },
             |pass| {
@@ -323,7 +327,7 @@ impl Side {
                         self.renderer.draw_plain(pass, &self.view, mesh);
                     }
                 }
-                self.renderer.draw(pass, &self.view, &self.fur, &settings);
+                self.fur.draw(pass, &self.renderer, &self.view, &settings);
             },
         )?)
     }

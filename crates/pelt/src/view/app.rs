@@ -20,7 +20,7 @@ use super::model::{Model, smooth};
 use super::panel::{Changes, Requests};
 use super::ui_layer::UiLayer;
 use super::viewport::Viewport;
-use crate::sim_kernel::SimKernel;
+use pelt_render::SimKernel;
 
 /// Consecutive frames without a swap-chain texture before a scripted run gives up.
 const MAX_SKIPPED_FRAMES: u32 = 600;
@@ -101,15 +101,13 @@ impl App {
         let viewport = Viewport::new(&gpu.device, surface.config.format, target)?;
         let ui_layer = UiLayer::new(&gpu.device, surface.config.format);
         let textures = self.model.textures.take().context("the first textures were made before the window")?;
-        let mut fur = FurScene::new(&gpu, &self.model.structure, &textures)?;
-        fur.set_body(&gpu, self.model.body.as_ref())?;
         let model = &mut self.model;
-        let (kernel, reason) =
-            crate::sim_kernel::choose(model.sim_choice, &gpu.device, &gpu.queue, &model.structure, model.sim.params())?;
+        let params = model.stepper.simulation().params().clone();
+        let mut fur = FurScene::new(&gpu, &model.structure, &textures, &params, model.sim_choice.into())?;
+        fur.set_body(&gpu, model.body.as_ref())?;
+        let (kernel, reason) = fur.kernel();
         model.settings.gpu_sim = kernel == SimKernel::Gpu;
-        model.kernel_reason = reason;
-        model.sim.set_cpu_bending(kernel == SimKernel::Cpu);
-        fur.set_gpu_simulation(&gpu, &model.structure, model.settings.gpu_sim)?;
+        model.kernel_reason = reason.to_owned();
         Ok(Running {
             window,
             gpu,
@@ -169,10 +167,10 @@ impl App {
         if let Some(textures) = model.poll_textures() {
             running.fur.set_textures(&running.gpu, &textures)?;
         }
-        model.simulate(frame_secs)?;
-        running.fur.update(&running.gpu, &model.sim)?;
-        if model.posed {
-            running.fur.set_base_normals(&running.gpu, &model.pose.normals)?;
+        if let Some((time_secs, clip_secs)) = model.simulate(frame_secs) {
+            let started = std::time::Instant::now();
+            running.fur.advance(&running.gpu, &mut model.stepper, time_secs, clip_secs)?;
+            model.took(started.elapsed().as_secs_f64());
         }
         if requests.screenshot {
             model.screenshot_pending = true;

@@ -2,12 +2,12 @@
 //! (a new mesh or layer count rebuilds the structure, a texture setting the textures).
 
 use glam::{Mat4, Vec3};
-use pelt_core::sim::Simulation;
+use pelt_core::sim::{FurStepper, SimParams};
 use pelt_core::texture::FurTextures;
 use pelt_core::{FurStructure, Mesh};
 use pelt_render::{
-    Camera, DEFAULT_BACKGROUND, FurDrawSettings, FurFrame, FurLevel, FurRenderer, FurStates, FurView, GpuFur,
-    GpuSimulation, Light, PlainMesh, SeparatedFur, SeparatedRenderer,
+    Camera, DEFAULT_BACKGROUND, FurDrawSettings, FurDriver, FurFrame, FurLevel, FurRenderer, FurView, KernelChoice,
+    Light, PlainMesh, SeparatedFur, SeparatedRenderer, SimKernel,
 };
 
 use super::camera::OrbitCamera;
@@ -23,11 +23,8 @@ const SEPARATED_FIN_FACES: u32 = 2;
 #[derive(Debug)]
 pub struct FurScene {
     renderer: FurRenderer,
-    /// The unified structure: with the CPU simulation one state, its interpolated output
-    /// uploaded per frame; with the GPU one two states, written by `gpu_sim`'s compute pass and
-    /// interpolated in the vertex shader (nothing uploaded per frame).
-    fur: GpuFur,
-    gpu_sim: Option<GpuSimulation>,
+    /// The unified structure on the GPU and the kernel bending it.
+    driver: FurDriver,
     /// The separated structure of Lengyel et al. and its pipelines, built when first shown; it
     /// holds the rest pose (its fins are geometry of their own and do not follow the simulation).
     separated: Option<(SeparatedRenderer, SeparatedFur)>,
@@ -36,39 +33,42 @@ pub struct FurScene {
     view: FurView,
     textures: FurTextures,
     pub settings: FurDrawSettings,
-    /// Where this frame falls between the GPU simulation's two states (1 with one state).
-    interpolation: f32,
     /// The view-angle pass's count, read back for the overlay.
     shell_share: ShellShare,
 }
 
 impl FurScene {
-    pub fn new(gpu: &pelt_render::Gpu, structure: &FurStructure, textures: &FurTextures) -> anyhow::Result<Self> {
+    /// The fur on `gpu`, simulated on the kernel `choice` picks (`auto` times both here).
+    pub fn new(
+        gpu: &pelt_render::Gpu,
+        structure: &FurStructure,
+        textures: &FurTextures,
+        params: &SimParams,
+        choice: KernelChoice,
+    ) -> anyhow::Result<Self> {
         let renderer = FurRenderer::new(&gpu.device, target(&gpu.adapter.get_info()))?;
-        let fur = GpuFur::new(&gpu.device, &gpu.queue, &renderer, structure, textures, FurStates::One)?;
-        fur.prepare(&gpu.queue, &FurFrame::default());
+        let driver = FurDriver::new(&gpu.device, &gpu.queue, &renderer, structure, textures, params, choice)?;
         let view = FurView::new(&gpu.device, &renderer);
         Ok(Self {
             renderer,
-            fur,
-            gpu_sim: None,
+            driver,
             separated: None,
             body: None,
             view,
             textures: textures.clone(),
             settings: FurDrawSettings::SILHOUETTE,
-            interpolation: 1.0,
             shell_share: ShellShare::new(&gpu.device),
         })
     }
 
+    /// The kernel bending the fur, and why.
+    pub fn kernel(&self) -> (SimKernel, &str) {
+        (self.driver.kernel(), self.driver.kernel_reason())
+    }
+
     pub fn set_structure(&mut self, gpu: &pelt_render::Gpu, structure: &FurStructure) -> anyhow::Result<()> {
         self.separated = None;
-        self.fur.set_structure(&gpu.device, &self.renderer, structure)?;
-        self.fur.prepare(&gpu.queue, &FurFrame::default());
-        if self.gpu_sim.is_some() {
-            self.gpu_sim = Some(GpuSimulation::new(&gpu.device, &self.fur, structure)?);
-        }
+        self.driver.set_structure(&gpu.device, &gpu.queue, &self.renderer, structure)?;
         Ok(())
     }
 
@@ -79,45 +79,36 @@ impl FurScene {
         structure: &FurStructure,
         on: bool,
     ) -> anyhow::Result<()> {
-        if on == self.gpu_sim.is_some() {
+        let kernel = if on { SimKernel::Gpu } else { SimKernel::Cpu };
+        if kernel == self.driver.kernel() {
             return Ok(());
         }
-        let states = if on { FurStates::Two } else { FurStates::One };
-        self.fur = GpuFur::new(&gpu.device, &gpu.queue, &self.renderer, structure, &self.textures, states)?;
-        self.fur.prepare(&gpu.queue, &FurFrame::default());
-        self.gpu_sim = if on { Some(GpuSimulation::new(&gpu.device, &self.fur, structure)?) } else { None };
+        self.driver.set_kernel(&gpu.device, &gpu.queue, &self.renderer, structure, &self.textures, kernel, "panel")?;
         Ok(())
     }
 
-    /// This frame's shared array: the GPU simulation's new steps (a compute pass, submitted now)
-    /// and the interpolation weight, or the CPU simulation's interpolated output uploaded.
-    pub fn update(&mut self, gpu: &pelt_render::Gpu, sim: &Simulation) -> anyhow::Result<()> {
-        match &mut self.gpu_sim {
-            Some(gpu_sim) => {
-                gpu_sim.prepare(&gpu.device, &gpu.queue, sim, &self.fur)?;
-                if gpu_sim.pending_steps() > 0 {
-                    let mut encoder = gpu
-                        .device
-                        .create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("simulation") });
-                    gpu_sim.dispatch(&mut encoder, &mut self.fur)?;
-                    gpu.queue.submit([encoder.finish()]);
-                }
-                self.interpolation = sim.alpha();
-            }
-            None => {
-                self.interpolation = 1.0;
-                self.fur.set_positions(&gpu.queue, sim.positions())?;
-            }
-        }
+    /// Steps the fur to `time_secs` (its clip at `clip_time_secs`) and writes this frame's state:
+    /// the GPU simulation's new steps (a compute pass, submitted now) or the CPU's interpolated
+    /// output.
+    pub fn advance(
+        &mut self,
+        gpu: &pelt_render::Gpu,
+        stepper: &mut FurStepper,
+        time_secs: f64,
+        clip_time_secs: f64,
+    ) -> anyhow::Result<()> {
+        self.driver.advance_with_clip_at(&gpu.device, &gpu.queue, stepper, time_secs, clip_time_secs)?;
+        let mut encoder =
+            gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("simulation") });
+        self.driver.record(&mut encoder)?;
+        gpu.queue.submit([encoder.finish()]);
         Ok(())
     }
 
     pub fn set_textures(&mut self, gpu: &pelt_render::Gpu, textures: &FurTextures) -> anyhow::Result<()> {
         self.separated = None;
         self.textures = textures.clone();
-        self.fur.set_textures(&gpu.device, &gpu.queue, &self.renderer, textures)?;
-        // The root colour (the skin's) and the slice count live in the fur's uniform.
-        self.fur.prepare(&gpu.queue, &FurFrame::default());
+        self.driver.set_textures(&gpu.device, &gpu.queue, &self.renderer, textures)?;
         Ok(())
     }
 
@@ -154,7 +145,7 @@ impl FurScene {
 
     /// GPU bytes of the unified structure as the renderer holds it.
     pub fn unified_bytes(&self) -> u64 {
-        self.fur.gpu_bytes().structure()
+        self.driver.fur().gpu_bytes().structure()
     }
 
     /// GPU bytes of the separated geometry, once built.
@@ -162,15 +153,10 @@ impl FurScene {
         self.separated.as_ref().map(|(_, fur)| fur.gpu_bytes().structure())
     }
 
-    /// Uploads the posed base normals (skin shading of an animated mesh).
-    pub fn set_base_normals(&self, gpu: &pelt_render::Gpu, normals: &[Vec3]) -> anyhow::Result<()> {
-        Ok(self.fur.set_base_normals(&gpu.queue, normals)?)
-    }
-
     /// Draws the body and the unified structure, or the separated one when `separated` and it is
     /// built, into the viewport, at the level of detail `level`.
     pub fn draw(
-        &self,
+        &mut self,
         gpu: &pelt_render::Gpu,
         encoder: &mut wgpu::CommandEncoder,
         viewport: &Viewport,
@@ -183,13 +169,13 @@ impl FurScene {
             Camera { eye: camera.eye(), target: camera.target, up: Vec3::Y, fov_y_rad: camera.fov_y_rad, near, far };
         self.view.prepare(&gpu.queue, &camera.view_data(viewport.targets.aspect_ratio(), &Light::default()));
         let separated = self.separated.as_ref().filter(|_| separated);
-        let frame = FurFrame { interpolation: self.interpolation, level, ..FurFrame::default() };
         match separated {
-            Some((_, fur)) => fur.prepare(&gpu.queue, &frame),
-            None => self.fur.prepare(&gpu.queue, &frame),
-        }
-        if separated.is_none() {
-            self.renderer.prepare_fins(encoder, &self.view, &self.fur);
+            Some((_, fur)) => fur.prepare(&gpu.queue, &FurFrame { level, ..*self.driver.frame() }),
+            None => {
+                self.driver.set_level(level);
+                self.driver.prepare(&gpu.queue);
+                self.driver.record_view(encoder, &self.renderer, &self.view);
+            }
         }
         {
             let mut pass = viewport.targets.begin_pass(encoder, &viewport.colour_view, DEFAULT_BACKGROUND);
@@ -198,11 +184,11 @@ impl FurScene {
             }
             match separated {
                 Some((renderer, fur)) => renderer.draw(&mut pass, &self.view, fur, &self.settings),
-                None => self.renderer.draw(&mut pass, &self.view, &self.fur, &self.settings),
+                None => self.driver.draw(&mut pass, &self.renderer, &self.view, &self.settings),
             }
         }
         if separated.is_none() {
-            self.shell_share.record(encoder, &self.fur);
+            self.shell_share.record(encoder, self.driver.fur());
         }
     }
 
@@ -214,6 +200,6 @@ impl FurScene {
     /// The share of shell triangles the unified fur drew lately (view-angle LOD), for a mesh of
     /// `faces` triangles; `None` without view-angle LOD.
     pub fn shell_share(&self, faces: u32) -> Option<f64> {
-        self.shell_share.share(&self.fur, faces)
+        self.shell_share.share(self.driver.fur(), faces)
     }
 }

@@ -5,15 +5,17 @@ use std::time::Instant;
 
 use anyhow::Context as _;
 use glam::Vec3;
-use pelt_core::anim::{Pose, Rig};
+use pelt_core::anim::Rig;
 use pelt_core::mesh::builtin::{TRY_ON_NAME, TryOnScene, try_on_scene};
-use pelt_core::sim::{Scene, Simulation};
+use pelt_core::sim::{FurStepper, Scene};
 use pelt_core::{Builtin, FurStructure, FurTextures, Mesh, Preset, PresetError};
 
 use super::Args;
 use super::camera::OrbitCamera;
 use super::panel::{AnimationSettings, Changes, MeshChoice, Settings};
-use crate::sim_kernel::{SimChoice, SimKernel};
+use pelt_render::SimKernel;
+
+use crate::sim_kernel::SimChoice;
 
 /// Time step of `--screenshot-after` runs, so they repeat exactly.
 const FIXED_FRAME_SECS: f64 = 1.0 / 60.0;
@@ -49,9 +51,9 @@ pub(super) struct Model {
     pub(super) viewport_origin_px: [u32; 2],
     pub(super) clock: Clock,
     pub(super) frame_time_secs: f64,
-    pub(super) sim: Simulation,
-    /// Scripted wind and touch strokes (`--script`), played on the simulation clock.
-    pub(super) scene: Option<Scene>,
+    /// The simulation with its posing (the file's clip) and script (`--script`: wind, touch
+    /// strokes and motion, played on the simulation clock).
+    pub(super) stepper: FurStepper,
     /// Simulation time: advances only while the simulation runs.
     pub(super) sim_clock_secs: f64,
     /// Smoothed cost of one `advance_to`.
@@ -81,14 +83,9 @@ pub(super) struct Model {
     pub(super) quit: bool,
     pub(super) panel_hidden: bool,
     pub(super) status: String,
-    /// The command line's file's rig, when it moves.
+    /// The command line's file's rig, when it moves (the stepper plays it while that file's
+    /// mesh is shown).
     pub(super) rig: Option<Rig>,
-    /// This frame's posed base (when `posed`).
-    pub(super) pose: Pose,
-    /// The base was posed this frame: the renderer takes its normals.
-    pub(super) posed: bool,
-    /// The base jumped (a new clip, the first pose): restart the simulation from it.
-    restart_pending: bool,
 }
 
 /// Wall-clock time, or exactly `FIXED_FRAME_SECS` per frame for repeatable runs.
@@ -152,13 +149,17 @@ impl Model {
             settings.animation = AnimationSettings { clips, clip, playing: true, speed: 1.0, time_secs: 0.0 };
         }
         let structure = grow(mesh, &settings.preset)?;
-        let sim = Simulation::new(&structure, &settings.preset.simulation)?;
+        let mut stepper = FurStepper::new(&structure, &settings.preset.simulation)?;
         // The first textures are made before the window opens, so the first frame has them.
         let textures = settings.preset.generate_textures()?;
         let scene = match &args.script {
             Some(path) => Some(Scene::load(path)?),
             None => None,
         };
+        stepper.set_scene(scene);
+        if let Some(rig) = &rig {
+            stepper.set_clip(rig.clone(), settings.animation.clip);
+        }
         let mut model = Self {
             settings,
             mesh_choices,
@@ -177,8 +178,7 @@ impl Model {
             viewport_origin_px: [0, 0],
             clock: Clock { fixed: args.screenshot_after.is_some(), last: Instant::now() },
             frame_time_secs: 0.0,
-            sim,
-            scene,
+            stepper,
             sim_clock_secs: 0.0,
             sim_time_secs: 0.0,
             shown_times_secs: [0.0; 2],
@@ -197,10 +197,7 @@ impl Model {
             quit: false,
             panel_hidden: false,
             status: String::new(),
-            restart_pending: rig.is_some(),
             rig,
-            pose: Pose::default(),
-            posed: false,
         };
         if args.mesh.mesh.is_none() && args.mesh.builtin.as_deref() == Some(TRY_ON_NAME) {
             model.settings.mesh = MeshChoice::TryOn;
@@ -268,44 +265,28 @@ impl Model {
         };
     }
 
-    /// Plays the script and steps the simulation to this frame's time.
-    pub(super) fn simulate(&mut self, frame_secs: f64) -> anyhow::Result<()> {
+    /// Moves the simulation's and the animation's clocks on by `frame_secs`: the times the
+    /// fur is to be stepped to (simulation, clip), or `None` while the simulation is paused.
+    pub(super) fn simulate(&mut self, frame_secs: f64) -> Option<(f64, f64)> {
         if !self.settings.simulate {
-            return Ok(());
+            return None;
         }
         self.sim_clock_secs += frame_secs;
-        self.pose_base(frame_secs)?;
-        if let Some(scene) = &self.scene {
-            scene.apply(self.sim_clock_secs, &mut self.sim)?;
-        }
-        let start = Instant::now();
-        self.sim.advance_to(self.sim_clock_secs);
-        self.sim_time_secs = smooth(self.sim_time_secs, start.elapsed().as_secs_f64());
-        Ok(())
-    }
-
-    /// Plays the animation of the command line's file and moves the fur's base with it.
-    fn pose_base(&mut self, frame_secs: f64) -> anyhow::Result<()> {
-        let rig = match &self.rig {
-            Some(rig) if matches!(self.settings.mesh, MeshChoice::File(_)) => rig,
-            _ => {
-                self.posed = false;
-                return Ok(());
-            }
-        };
         let animation = &mut self.settings.animation;
-        let duration = animation.clip.map_or(0.0, |k| rig.animations()[k].duration_secs());
+        let duration = match (&self.rig, animation.clip) {
+            (Some(rig), Some(k)) => rig.animations()[k].duration_secs(),
+            _ => 0.0,
+        };
         if animation.playing && duration > 0.0 {
             animation.time_secs = (animation.time_secs + frame_secs as f32 * animation.speed).rem_euclid(duration);
         }
         animation.time_secs = animation.time_secs.clamp(0.0, duration);
-        rig.pose(&self.structure.mesh, animation.clip, f64::from(animation.time_secs), &mut self.pose);
-        self.sim.set_base_rotations(&self.pose.positions, &self.pose.rotations)?;
-        if std::mem::take(&mut self.restart_pending) {
-            self.sim.restart();
-        }
-        self.posed = true;
-        Ok(())
+        Some((self.sim_clock_secs, f64::from(animation.time_secs)))
+    }
+
+    /// Smooths the measured cost of one step into the overlay's figure.
+    pub(super) fn took(&mut self, step_secs: f64) {
+        self.sim_time_secs = smooth(self.sim_time_secs, step_secs);
     }
 
     /// Rebuilds what the panel's changes touch; true when the structure is new.
@@ -329,20 +310,23 @@ impl Model {
         let rebuilt = changes.mesh || changes.structure;
         if changes.animation {
             self.settings.animation.time_secs = 0.0;
+            self.stepper.change_clip(self.settings.animation.clip);
         }
-        self.restart_pending |= rebuilt || changes.animation;
         if rebuilt {
             self.footprint = self.structure.footprint();
-            self.sim = Simulation::new(&self.structure, &self.settings.preset.simulation)?;
+            self.stepper.set_structure(&self.structure, &self.settings.preset.simulation)?;
+            // The file's clip poses only the file's mesh.
+            match (&self.rig, &self.settings.mesh) {
+                (Some(rig), MeshChoice::File(_)) => self.stepper.set_clip(rig.clone(), self.settings.animation.clip),
+                _ => self.stepper.clear_clip(),
+            }
             self.touch = None;
         } else if changes.simulation {
-            self.sim.set_params(&self.settings.preset.simulation)?;
+            self.stepper.simulation_mut().set_params(&self.settings.preset.simulation)?;
         }
         if changes.kernel {
             self.kernel_reason = "panel".to_owned();
         }
-        // The GPU bends the strands from the CPU simulation's inputs; the CPU then only keeps time.
-        self.sim.set_cpu_bending(self.kernel() == SimKernel::Cpu);
         if changes.textures {
             self.textures_stale = true;
         }
@@ -409,7 +393,7 @@ mod tests {
         model.settings.preset.length *= 2.0;
         assert!(model.apply(Changes { structure: true, ..Changes::default() }).unwrap());
         assert_ne!(model.structure.positions, before);
-        assert_eq!(model.sim.positions().len(), model.structure.positions.len());
+        assert_eq!(model.stepper.simulation().positions().len(), model.structure.positions.len());
         assert!(!model.apply(Changes { textures: true, ..Changes::default() }).unwrap());
         assert!(model.textures_stale);
         model.settings.mesh = MeshChoice::TryOn;
@@ -425,19 +409,23 @@ mod tests {
         assert_eq!(model.settings.animation.clip, Some(0), "the first clip plays by default");
         model.settings.animation.clip = Some(1);
         assert!(!model.apply(Changes { animation: true, ..Changes::default() }).unwrap());
-        model.simulate(0.1).unwrap();
-        assert!(model.posed);
-        let first = model.sim.roots().to_vec();
-        model.simulate(0.1).unwrap();
+        let step = |model: &mut Model| {
+            let (time_secs, clip_secs) = model.simulate(0.1).expect("the simulation runs");
+            model.stepper.advance_with_clip_at(time_secs, clip_secs).unwrap();
+        };
+        step(&mut model);
+        assert!(model.stepper.moved_pose().is_some());
+        let first = model.stepper.simulation().roots().to_vec();
+        step(&mut model);
         assert!((model.settings.animation.time_secs - 0.2).abs() < 1e-5);
-        assert_ne!(model.sim.roots(), &first[..], "the walk moves the roots");
+        assert_ne!(model.stepper.simulation().roots(), &first[..], "the walk moves the roots");
         model.settings.animation.playing = false;
-        model.simulate(0.1).unwrap();
+        step(&mut model);
         assert!((model.settings.animation.time_secs - 0.2).abs() < 1e-5, "paused");
         model.settings.mesh = MeshChoice::Builtin(Builtin::Sphere);
         model.apply(Changes { mesh: true, ..Changes::default() }).unwrap();
-        model.simulate(0.1).unwrap();
-        assert!(!model.posed, "a built-in mesh does not take the file's rig");
+        step(&mut model);
+        assert!(model.stepper.moved_pose().is_none(), "a built-in mesh does not take the file's rig");
     }
 
     #[test]

@@ -123,12 +123,12 @@ impl Model {
         let brush_radius = self.settings.brush_per_radius * self.structure.mesh.bounding_sphere().1;
         let hover_hit = ray
             .filter(|_| self.touch.is_none() && !modifiers.alt && !modifiers.shift)
-            .and_then(|ray| self.sim.pick(&self.structure.mesh.triangles, ray.origin, ray.direction));
+            .and_then(|ray| self.stepper.simulation().pick(&self.structure.mesh.triangles, ray.origin, ray.direction));
 
         if response.drag_started_by(egui::PointerButton::Primary)
             && let Some(hit) = hover_hit
         {
-            self.sim.touch_begin(hit.point, brush_radius)?;
+            self.stepper.simulation_mut().touch_begin(hit.point, brush_radius)?;
             let plane_normal = (self.camera.target - self.camera.eye()).normalize_or(Vec3::NEG_Z);
             self.touch = Some(TouchDrag { hit: hit.point, plane_normal });
         }
@@ -137,10 +137,10 @@ impl Model {
                 let along = ray.direction.dot(touch.plane_normal);
                 if along.abs() > 1e-6 {
                     let distance = (touch.hit - ray.origin).dot(touch.plane_normal) / along;
-                    self.sim.touch_drag(ray.origin + ray.direction * distance.max(0.0))?;
+                    self.stepper.simulation_mut().touch_drag(ray.origin + ray.direction * distance.max(0.0))?;
                 }
             } else {
-                self.sim.touch_end();
+                self.stepper.simulation_mut().touch_end();
                 self.touch = None;
             }
         } else if response.dragged_by(egui::PointerButton::Middle) || (primary && modifiers.shift) {
@@ -179,7 +179,7 @@ impl Model {
         };
         let accent = egui::Color32::from_rgb(255, 190, 90);
         // The simulation's touch, so scripted strokes show as well as the pointer's.
-        if let Some(touch) = self.sim.touch().filter(|t| t.released_at_secs.is_none()) {
+        if let Some(touch) = self.stepper.simulation().touch().filter(|t| t.released_at_secs.is_none()) {
             let centre = to_screen(touch.point);
             let radius_px = touch.radius * self.camera.px_per_world_at(touch.point, size.y);
             painter.circle_stroke(centre, radius_px, egui::Stroke::new(2.0, accent));

@@ -1,0 +1,251 @@
+//! [`FurStepper`]: one fur's simulation driven through time. It poses the base (a skinned clip, a
+//! script's rigid motion, or a pose the host supplies), plays the script's wind and touch keys,
+//! and steps the strands: the CPU half of every host's frame, in one place.
+
+use glam::{Mat4, Quat, Vec3};
+
+use super::SimParams;
+use super::scene::Scene;
+use super::simulation::{SimError, Simulation};
+use crate::anim::{Pose, Rig};
+use crate::fur::FurStructure;
+use crate::mesh::Mesh;
+
+/// Where the base's pose comes from each step.
+#[derive(Debug, Default)]
+enum Posing {
+    /// The rest mesh (moved only by a script's `[[motion]]`).
+    #[default]
+    Rest,
+    /// A rig playing a clip (or its rest pose with no clip).
+    Rig { rig: Box<Rig>, clip: Option<usize> },
+    /// The host writes the pose ([`FurStepper::set_pose`]), e.g. from its own skinning.
+    Host,
+}
+
+/// One fur's simulation with what moves it: the posed base and a scene script.
+///
+/// Each frame a host calls [`FurStepper::advance_to`] with the frame's time. The stepper poses
+/// the base when anything moves it (a clip, the script's motion, a host pose), restarts the
+/// simulation from the first pose (no fling from the rest pose), applies the script's keys,
+/// then advances the [`Simulation`]. The pose's normals, for shading the skin, are
+/// [`FurStepper::moved_pose`].
+#[derive(Debug)]
+pub struct FurStepper {
+    simulation: Simulation,
+    /// The rest base the rig poses and the script moves.
+    mesh: Mesh,
+    posing: Posing,
+    scene: Option<Scene>,
+    pose: Pose,
+    world_from_model: Mat4,
+    /// The base moved this step (the pose is new).
+    moved: bool,
+    /// The next pose jumps (a new clip, the first pose): restart the simulation from it.
+    restart_pending: bool,
+    /// The host set a pose since the last step.
+    host_posed: bool,
+}
+
+impl FurStepper {
+    /// The simulation of `structure` at rest, with nothing moving it yet.
+    ///
+    /// # Errors
+    /// As [`Simulation::new`].
+    pub fn new(structure: &FurStructure, params: &SimParams) -> Result<Self, SimError> {
+        Ok(Self {
+            simulation: Simulation::new(structure, params)?,
+            mesh: structure.mesh.clone(),
+            posing: Posing::Rest,
+            scene: None,
+            pose: Pose::default(),
+            world_from_model: Mat4::IDENTITY,
+            moved: false,
+            restart_pending: true,
+            host_posed: false,
+        })
+    }
+
+    /// Plays `clip` of `rig` (the rig's rest pose with `None`); the simulation restarts from the
+    /// first pose. `rig` must pose this fur's mesh (it came with it from the same file).
+    pub fn set_clip(&mut self, rig: Rig, clip: Option<usize>) {
+        self.posing = Posing::Rig { rig: Box::new(rig), clip };
+        self.restart_pending = true;
+    }
+
+    /// Changes the clip of the rig set with [`FurStepper::set_clip`]; the simulation restarts
+    /// from its first pose. Does nothing without a rig.
+    pub fn change_clip(&mut self, clip: Option<usize>) {
+        if let Posing::Rig { clip: current, .. } = &mut self.posing {
+            *current = clip;
+            self.restart_pending = true;
+        }
+    }
+
+    /// Back to the rest mesh: no rig poses the base (the simulation restarts from the next pose).
+    pub fn clear_clip(&mut self) {
+        self.posing = Posing::Rest;
+        self.restart_pending = true;
+    }
+
+    /// The rig playing, if any.
+    #[must_use]
+    pub fn rig(&self) -> Option<&Rig> {
+        match &self.posing {
+            Posing::Rig { rig, .. } => Some(rig),
+            _ => None,
+        }
+    }
+
+    /// Plays `scene`'s wind, touch strokes and rigid motion from the next step on.
+    pub fn set_scene(&mut self, scene: Option<Scene>) {
+        self.scene = scene;
+    }
+
+    /// The scene script playing, if any.
+    #[must_use]
+    pub fn scene(&self) -> Option<&Scene> {
+        self.scene.as_ref()
+    }
+
+    /// Whether anything moves the base: a clip, the script's motion or a host pose.
+    #[must_use]
+    pub fn moves(&self) -> bool {
+        match &self.posing {
+            Posing::Rest => self.scene.as_ref().is_some_and(|s| !s.motion.is_empty()),
+            Posing::Rig { clip, .. } => clip.is_some() || self.scene.as_ref().is_some_and(|s| !s.motion.is_empty()),
+            Posing::Host => true,
+        }
+    }
+
+    /// Steps to `time_secs`, with the clip at the same time.
+    ///
+    /// # Errors
+    /// A pose or a script key the simulation refuses (non-finite values).
+    pub fn advance_to(&mut self, time_secs: f64) -> Result<(), SimError> {
+        self.advance_with_clip_at(time_secs, time_secs)
+    }
+
+    /// Steps to `time_secs` with the clip at `clip_time_secs` (a viewer that pauses or speeds up
+    /// the animation keeps its own clock for it).
+    ///
+    /// # Errors
+    /// As [`FurStepper::advance_to`].
+    pub fn advance_with_clip_at(&mut self, time_secs: f64, clip_time_secs: f64) -> Result<(), SimError> {
+        let world_from_model = self.scene.as_ref().and_then(|s| s.motion_at(time_secs)).unwrap_or(Mat4::IDENTITY);
+        self.world_from_model = world_from_model;
+        self.moved = std::mem::take(&mut self.host_posed);
+        // A rig poses once after a change of clip even when nothing plays (back to its rest).
+        let rig_jumps = matches!(self.posing, Posing::Rig { .. }) && self.restart_pending;
+        if self.moves() || rig_jumps {
+            match &self.posing {
+                Posing::Rig { rig, clip } => {
+                    rig.pose(&self.mesh, *clip, clip_time_secs, &mut self.pose);
+                    transform_pose(&mut self.pose, world_from_model);
+                    self.moved = true;
+                }
+                Posing::Rest => {
+                    self.pose.positions.clone_from(&self.mesh.positions);
+                    self.pose.normals.clone_from(&self.mesh.normals);
+                    self.pose.rotations.clear();
+                    self.pose.rotations.resize(self.mesh.vertex_count(), Quat::IDENTITY);
+                    transform_pose(&mut self.pose, world_from_model);
+                    self.moved = true;
+                }
+                // The host set the pose (and the simulation's base) in `set_pose`.
+                Posing::Host => {}
+            }
+            if self.moved && !matches!(self.posing, Posing::Host) {
+                self.simulation.set_base_rotations(&self.pose.positions, &self.pose.rotations)?;
+                if std::mem::take(&mut self.restart_pending) {
+                    self.simulation.restart();
+                }
+            }
+        }
+        if let Some(scene) = &self.scene {
+            scene.apply(time_secs, &mut self.simulation)?;
+        }
+        self.simulation.advance_to(time_secs);
+        Ok(())
+    }
+
+    /// Sets the base's pose from the host's own skinning (world or model space, as the host
+    /// draws the fur): positions, normals and each vertex's rotation from rest. The simulation
+    /// restarts from the first such pose. Call before [`FurStepper::advance_to`].
+    ///
+    /// # Errors
+    /// [`SimError::Size`] or [`SimError::NonFinite`]; the previous pose stays.
+    pub fn set_pose(&mut self, positions: &[Vec3], normals: &[Vec3], rotations: &[Quat]) -> Result<(), SimError> {
+        if normals.len() != positions.len() {
+            return Err(SimError::Size { what: "the pose's normals", expected: positions.len(), got: normals.len() });
+        }
+        self.simulation.set_base_rotations(positions, rotations)?;
+        self.posing = Posing::Host;
+        if std::mem::take(&mut self.restart_pending) {
+            self.simulation.restart();
+        }
+        self.pose.positions.clear();
+        self.pose.positions.extend_from_slice(positions);
+        self.pose.normals.clear();
+        self.pose.normals.extend_from_slice(normals);
+        self.pose.rotations.clear();
+        self.pose.rotations.extend_from_slice(rotations);
+        self.host_posed = true;
+        Ok(())
+    }
+
+    /// The base's pose when it moved in the last step (its normals shade the skin), else `None`.
+    #[must_use]
+    pub fn moved_pose(&self) -> Option<&Pose> {
+        self.moved.then_some(&self.pose)
+    }
+
+    /// The script's rigid transform at the last step (identity without motion): plain meshes
+    /// beside the fur move with it.
+    #[must_use]
+    pub fn world_from_model(&self) -> Mat4 {
+        self.world_from_model
+    }
+
+    /// The simulation.
+    #[must_use]
+    pub fn simulation(&self) -> &Simulation {
+        &self.simulation
+    }
+
+    /// The simulation, to change its parameters, wind or touch.
+    pub fn simulation_mut(&mut self) -> &mut Simulation {
+        &mut self.simulation
+    }
+
+    /// Replaces the simulation (a new structure); the next pose restarts it.
+    ///
+    /// # Errors
+    /// As [`Simulation::new`].
+    pub fn set_structure(&mut self, structure: &FurStructure, params: &SimParams) -> Result<(), SimError> {
+        let bending = self.simulation.cpu_bending();
+        self.simulation = Simulation::new(structure, params)?;
+        self.simulation.set_cpu_bending(bending);
+        self.mesh = structure.mesh.clone();
+        self.restart_pending = true;
+        Ok(())
+    }
+}
+
+/// Moves a pose rigidly by `world_from_model` (rotation and translation; a scale is ignored by
+/// the frames and normals, as the script's motion keys hold none).
+fn transform_pose(pose: &mut Pose, world_from_model: Mat4) {
+    if world_from_model == Mat4::IDENTITY {
+        return;
+    }
+    let (_, turn, _) = world_from_model.to_scale_rotation_translation();
+    for p in &mut pose.positions {
+        *p = world_from_model.transform_point3(*p);
+    }
+    for n in &mut pose.normals {
+        *n = turn * *n;
+    }
+    for q in &mut pose.rotations {
+        *q = (turn * *q).normalize();
+    }
+}

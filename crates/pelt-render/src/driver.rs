@@ -1,0 +1,461 @@
+//! [`FurDriver`]: one fur from its simulation to the host's render pass, the frame every host
+//! (the `pelt` commands, the viewer, the web page, bevy_pelt, the examples) makes the same way.
+//!
+//! A frame is three calls: [`FurDriver::advance_to`] (pose, script, simulation step, queue
+//! writes), [`FurDriver::record`] (the GPU work before the render pass: the GPU simulation's
+//! steps and the silhouette fins) and [`FurDriver::draw`] (into the host's pass).
+
+use std::fmt;
+use std::time::Instant;
+
+use pelt_core::sim::{FurStepper, SimError, SimParams, Simulation};
+use pelt_core::{FurStructure, texture::FurTextures};
+
+use crate::RenderError;
+use crate::fur::{FurStates, GpuFur};
+use crate::lod::FurLevel;
+use crate::object::{FurFrame, FurLook};
+use crate::renderer::{FurDrawSettings, FurRenderer};
+use crate::simulation::GpuSimulation;
+use crate::view::FurView;
+
+/// Where the strands are bent.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SimKernel {
+    /// [`Simulation`] on the CPU (all threads), interpolated there and uploaded every frame.
+    Cpu,
+    /// [`GpuSimulation`], a compute pass writing the buffers the renderer draws; the vertex
+    /// shader interpolates, and only the per-step inputs are uploaded.
+    Gpu,
+}
+
+impl fmt::Display for SimKernel {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(match self {
+            Self::Cpu => "CPU",
+            Self::Gpu => "GPU",
+        })
+    }
+}
+
+/// Which kernel a [`FurDriver`] is to use (`--sim`).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum KernelChoice {
+    /// Whichever is faster here: both are timed on this fur before the first frame.
+    #[default]
+    Auto,
+    /// The CPU kernel.
+    Cpu,
+    /// The GPU kernel.
+    Gpu,
+}
+
+/// Steps per timing run and runs per kernel when choosing ([`KernelChoice::Auto`]).
+const TIMING_STEPS: u32 = 3;
+const TIMING_RUNS: usize = 5;
+
+/// One fur's frame on the GPU: its [`GpuFur`], the kernel that bends it (and with the GPU
+/// kernel its [`GpuSimulation`]) and its per-frame uniform, driven from the host's
+/// [`FurStepper`] (the CPU half: simulation, posing, script).
+///
+/// The stepper stays the host's so that a host without a GPU (tests, a server) or with its CPU
+/// state elsewhere (Bevy's main world) keeps it; the driver decides on each call whether the
+/// stepper's simulation bends the strands (the CPU kernel) or only keeps time and inputs.
+///
+/// Each frame, in order: [`FurDriver::advance_to`] before the host records its encoder (queue
+/// writes only), [`FurDriver::record`] into the host's encoder before its render pass, then
+/// [`FurDriver::draw`] into the pass. A host that never calls `record` still sees the fur move:
+/// with the GPU kernel, steps left unrecorded at the next `advance_to` switch the driver to the
+/// CPU kernel (the reason says so), and the CPU kernel needs no recording (the silhouette fins
+/// do: without [`FurDriver::record_view`], [`FurDrawSettings::silhouette_fins`] draws none).
+#[derive(Debug)]
+pub struct FurDriver {
+    fur: GpuFur,
+    gpu_simulation: Option<GpuSimulation>,
+    kernel: SimKernel,
+    kernel_reason: String,
+    frame: FurFrame,
+    /// The GPU kernel's steps were prepared and not yet recorded.
+    unrecorded: bool,
+}
+
+impl FurDriver {
+    /// The fur grown as `structure`, with `textures`, simulated with `params` on the kernel
+    /// `choice` picks (`Auto` times a few steps of each on this fur first).
+    ///
+    /// # Errors
+    /// The simulation's ([`RenderError::Simulation`]) or the upload's errors.
+    pub fn new(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        renderer: &FurRenderer,
+        structure: &FurStructure,
+        textures: &FurTextures,
+        params: &SimParams,
+        choice: KernelChoice,
+    ) -> Result<Self, RenderError> {
+        let (kernel, kernel_reason) = match choice {
+            KernelChoice::Cpu => (SimKernel::Cpu, "chosen".to_owned()),
+            KernelChoice::Gpu => (SimKernel::Gpu, "chosen".to_owned()),
+            KernelChoice::Auto => {
+                let cpu = cpu_secs_per_step(structure, params, TIMING_STEPS, TIMING_RUNS)?;
+                let gpu = gpu_secs_per_step(device, queue, renderer, structure, params, TIMING_STEPS, TIMING_RUNS)?;
+                let kernel = if gpu < cpu { SimKernel::Gpu } else { SimKernel::Cpu };
+                (kernel, format!("auto: GPU {:.2} ms a step, CPU {:.2} ms", gpu * 1000.0, cpu * 1000.0))
+            }
+        };
+        let mut driver = Self {
+            fur: GpuFur::new(device, queue, renderer, structure, textures, states(kernel))?,
+            gpu_simulation: None,
+            kernel,
+            kernel_reason,
+            frame: FurFrame::default(),
+            unrecorded: false,
+        };
+        driver.use_kernel(device, structure, kernel)?;
+        driver.fur.prepare(queue, &driver.frame);
+        Ok(driver)
+    }
+
+    /// The kernel bending the strands.
+    #[must_use]
+    pub fn kernel(&self) -> SimKernel {
+        self.kernel
+    }
+
+    /// Why that kernel: `chosen`, `auto` with both timings, or a fallback.
+    #[must_use]
+    pub fn kernel_reason(&self) -> &str {
+        &self.kernel_reason
+    }
+
+    /// Switches kernels (`structure` is the fur's current one); the GPU fur is rebuilt with the
+    /// number of states the kernel needs.
+    ///
+    /// # Errors
+    /// As [`FurDriver::new`].
+    pub fn set_kernel(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        renderer: &FurRenderer,
+        structure: &FurStructure,
+        textures: &FurTextures,
+        kernel: SimKernel,
+        reason: &str,
+    ) -> Result<(), RenderError> {
+        self.kernel_reason = reason.to_owned();
+        if kernel == self.kernel {
+            return Ok(());
+        }
+        self.fur = GpuFur::new(device, queue, renderer, structure, textures, states(kernel))?;
+        self.use_kernel(device, structure, kernel)?;
+        self.fur.prepare(queue, &self.frame);
+        Ok(())
+    }
+
+    fn use_kernel(
+        &mut self,
+        device: &wgpu::Device,
+        structure: &FurStructure,
+        kernel: SimKernel,
+    ) -> Result<(), RenderError> {
+        self.kernel = kernel;
+        self.unrecorded = false;
+        self.gpu_simulation = match kernel {
+            SimKernel::Gpu => Some(GpuSimulation::new(device, &self.fur, structure)?),
+            SimKernel::Cpu => None,
+        };
+        Ok(())
+    }
+
+    /// Makes `simulation` bend the strands exactly when the CPU kernel is in use.
+    fn claim(&self, simulation: &mut Simulation) {
+        let cpu = self.kernel == SimKernel::Cpu;
+        if simulation.cpu_bending() != cpu {
+            simulation.set_cpu_bending(cpu);
+            if cpu {
+                // The CPU kept time only: bend from the current inputs (a quasi-static jump).
+                simulation.restart();
+            }
+        }
+    }
+
+    /// Replaces the structure (a new mesh or layer count), keeping the kernel and the textures;
+    /// the host gives its stepper the same structure ([`FurStepper::set_structure`]).
+    ///
+    /// # Errors
+    /// As [`FurDriver::new`].
+    pub fn set_structure(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        renderer: &FurRenderer,
+        structure: &FurStructure,
+    ) -> Result<(), RenderError> {
+        self.fur.set_structure(device, renderer, structure)?;
+        let kernel = self.kernel;
+        self.use_kernel(device, structure, kernel)?;
+        self.fur.prepare(queue, &self.frame);
+        Ok(())
+    }
+
+    /// Replaces the shell and fin textures.
+    ///
+    /// # Errors
+    /// As [`GpuFur::set_textures`].
+    pub fn set_textures(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        renderer: &FurRenderer,
+        textures: &FurTextures,
+    ) -> Result<(), RenderError> {
+        self.fur.set_textures(device, queue, renderer, textures)?;
+        // The root colour and the slice count live in the fur's uniform.
+        self.fur.prepare(queue, &self.frame);
+        Ok(())
+    }
+
+    /// The level of detail from the next frame on.
+    pub fn set_level(&mut self, level: FurLevel) {
+        self.frame.level = level;
+    }
+
+    /// The look (lighting, fading, density) from the next frame on.
+    pub fn set_look(&mut self, look: FurLook) {
+        self.frame.look = look;
+    }
+
+    /// The fur's model transform from the next frame on (the shared array stays in model space).
+    pub fn set_world_from_model(&mut self, world_from_model: glam::Mat4) {
+        self.frame.world_from_model = world_from_model;
+    }
+
+    /// Writes the fur's uniform now, for a frame drawn without an [`FurDriver::advance_to`]
+    /// (paused) after a setter.
+    pub fn prepare(&self, queue: &wgpu::Queue) {
+        self.fur.prepare(queue, &self.frame);
+    }
+
+    /// This frame's uniform as the last [`FurDriver::advance_to`] or setter left it.
+    #[must_use]
+    pub fn frame(&self) -> &FurFrame {
+        &self.frame
+    }
+
+    /// Advances `stepper` to `time_secs` (the clip at the same time): poses the base, plays the
+    /// script, steps the simulation, and writes what the GPU needs (the CPU kernel's
+    /// interpolated positions, or the GPU kernel's per-step inputs; the posed normals; the
+    /// fur's uniform). Queue writes only.
+    ///
+    /// # Errors
+    /// [`RenderError::Simulation`] for a pose or script key the simulation refuses;
+    /// [`RenderError::Count`] for a stepper of another fur; the upload's errors.
+    pub fn advance_to(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        stepper: &mut FurStepper,
+        time_secs: f64,
+    ) -> Result<(), RenderError> {
+        self.advance_with_clip_at(device, queue, stepper, time_secs, time_secs)
+    }
+
+    /// [`FurDriver::advance_to`] with the clip at `clip_time_secs` (a viewer's own clock).
+    ///
+    /// # Errors
+    /// As [`FurDriver::advance_to`].
+    pub fn advance_with_clip_at(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        stepper: &mut FurStepper,
+        time_secs: f64,
+        clip_time_secs: f64,
+    ) -> Result<(), RenderError> {
+        self.fall_back_when_unrecorded();
+        self.claim(stepper.simulation_mut());
+        stepper.advance_with_clip_at(time_secs, clip_time_secs)?;
+        self.upload(device, queue, stepper.simulation(), stepper.moved_pose().map(|pose| &pose.normals[..]))
+    }
+
+    /// Lets `step` change and step `simulation` itself (a test harness replaying recorded
+    /// inputs), then writes what the GPU needs as [`FurDriver::advance_to`] does.
+    ///
+    /// # Errors
+    /// `step`'s error as [`RenderError::Simulation`]; the upload's errors.
+    pub fn step_with(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        simulation: &mut Simulation,
+        step: impl FnOnce(&mut Simulation) -> Result<(), SimError>,
+    ) -> Result<(), RenderError> {
+        self.fall_back_when_unrecorded();
+        self.claim(simulation);
+        step(simulation)?;
+        self.upload(device, queue, simulation, None)
+    }
+
+    /// With the GPU kernel, steps prepared and never recorded mean the host does not record:
+    /// the CPU bends from now on.
+    fn fall_back_when_unrecorded(&mut self) {
+        if self.unrecorded && self.kernel == SimKernel::Gpu {
+            self.gpu_simulation = None;
+            self.kernel = SimKernel::Cpu;
+            self.kernel_reason = "the GPU kernel's steps were never recorded".to_owned();
+            self.unrecorded = false;
+        }
+    }
+
+    fn upload(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        simulation: &Simulation,
+        moved_normals: Option<&[glam::Vec3]>,
+    ) -> Result<(), RenderError> {
+        match &mut self.gpu_simulation {
+            Some(gpu_simulation) => {
+                gpu_simulation.prepare(device, queue, simulation, &self.fur)?;
+                self.unrecorded = gpu_simulation.pending_steps() > 0;
+                self.frame.interpolation = simulation.alpha();
+            }
+            None => {
+                self.fur.set_positions(queue, simulation.positions())?;
+                self.frame.interpolation = 1.0;
+            }
+        }
+        if let Some(normals) = moved_normals {
+            self.fur.set_base_normals(queue, normals)?;
+        }
+        self.fur.prepare(queue, &self.frame);
+        Ok(())
+    }
+
+    /// Records the GPU simulation's pending steps into `encoder` (nothing with the CPU kernel).
+    /// Call once per frame, before [`FurDriver::record_view`] and the render pass.
+    ///
+    /// # Errors
+    /// [`RenderError::Count`] when the GPU simulation and the fur disagree (a bug).
+    pub fn record(&mut self, encoder: &mut wgpu::CommandEncoder) -> Result<(), RenderError> {
+        if let Some(gpu_simulation) = &mut self.gpu_simulation {
+            gpu_simulation.dispatch(encoder, &mut self.fur)?;
+        }
+        self.unrecorded = false;
+        Ok(())
+    }
+
+    /// Records the per-view GPU work into `encoder`: the silhouette pass choosing this view's
+    /// fins (see [`FurRenderer::prepare_fins`]). Once per view and frame, after
+    /// [`FurDriver::record`].
+    pub fn record_view(&self, encoder: &mut wgpu::CommandEncoder, renderer: &FurRenderer, view: &FurView) {
+        renderer.prepare_fins(encoder, view, &self.fur);
+    }
+
+    /// Draws the fur into the host's `pass` (after its opaque geometry).
+    pub fn draw(
+        &self,
+        pass: &mut wgpu::RenderPass<'_>,
+        renderer: &FurRenderer,
+        view: &FurView,
+        settings: &FurDrawSettings,
+    ) {
+        renderer.draw(pass, view, &self.fur, settings);
+    }
+
+    /// The fur's GPU data.
+    #[must_use]
+    pub fn fur(&self) -> &GpuFur {
+        &self.fur
+    }
+}
+
+fn states(kernel: SimKernel) -> FurStates {
+    // The CPU simulation interpolates, so one uploaded state is all the GPU needs; the GPU one
+    // writes two states and the vertex shader interpolates.
+    match kernel {
+        SimKernel::Cpu => FurStates::One,
+        SimKernel::Gpu => FurStates::Two,
+    }
+}
+
+impl From<SimError> for RenderError {
+    fn from(error: SimError) -> Self {
+        Self::Simulation(error)
+    }
+}
+
+/// Median wall seconds per step of the CPU kernel on `structure`, `steps` consecutive steps per
+/// run, on a simulation of its own.
+///
+/// # Errors
+/// [`RenderError::Simulation`] for invalid `params`.
+pub fn cpu_secs_per_step(
+    structure: &FurStructure,
+    params: &SimParams,
+    steps: u32,
+    runs: usize,
+) -> Result<f64, RenderError> {
+    let mut simulation = Simulation::new(structure, params)?;
+    let rate = f64::from(params.rate_hz);
+    let mut step = 1_u32;
+    let mut samples: Vec<f64> = (0..runs.max(1))
+        .map(|_| {
+            let started = Instant::now();
+            for _ in 0..steps {
+                simulation.advance_to(f64::from(step) / rate);
+                step += 1;
+            }
+            started.elapsed().as_secs_f64() / f64::from(steps.max(1))
+        })
+        .collect();
+    Ok(median(&mut samples))
+}
+
+/// Median wall seconds per step of the GPU kernel on `structure`: per run, `steps` steps (each
+/// advanced, prepared and recorded as a frame does) in one submission, then a wait for the GPU,
+/// on a driver of its own (the first run compiles the pipeline on some drivers and is dropped).
+///
+/// # Errors
+/// As [`FurDriver::new`], and a failed wait.
+pub fn gpu_secs_per_step(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    renderer: &FurRenderer,
+    structure: &FurStructure,
+    params: &SimParams,
+    steps: u32,
+    runs: usize,
+) -> Result<f64, RenderError> {
+    let mut driver =
+        FurDriver::new(device, queue, renderer, structure, &FurTextures::blank(), params, KernelChoice::Gpu)?;
+    let mut stepper = FurStepper::new(structure, params)?;
+    let rate = f64::from(params.rate_hz);
+    let mut step = 1_u32;
+    let mut run = |driver: &mut FurDriver| -> Result<f64, RenderError> {
+        let started = Instant::now();
+        let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("sim timing") });
+        // The steps' uniform writes all land before the submission, so every dispatch reads the
+        // last step's inputs: the same work per step, which is what is timed.
+        for _ in 0..steps {
+            driver.advance_to(device, queue, &mut stepper, f64::from(step) / rate)?;
+            step += 1;
+            driver.record(&mut encoder)?;
+        }
+        queue.submit([encoder.finish()]);
+        device
+            .poll(wgpu::PollType::wait_indefinitely())
+            .map_err(|e| RenderError::Gpu { during: "timing the GPU simulation", message: e.to_string() })?;
+        Ok(started.elapsed().as_secs_f64() / f64::from(steps.max(1)))
+    };
+    run(&mut driver)?;
+    let mut samples = (0..runs.max(1)).map(|_| run(&mut driver)).collect::<Result<Vec<f64>, _>>()?;
+    Ok(median(&mut samples))
+}
+
+fn median(samples: &mut [f64]) -> f64 {
+    samples.sort_by(f64::total_cmp);
+    samples[samples.len() / 2]
+}
