@@ -3,7 +3,8 @@
 //! Data flows one way through the modules:
 //! [`mesh`] (import and repair; [`anim`] poses a moving one) -> [`fur`] (the unified shell-and-fin structure) ->
 //! [`texture`] (seeded shell and fin textures) -> [`sim`] (gravity, wind, touch) -> the renderer
-//! in `pelt-render`. [`preset`] holds everything about one fur in one TOML file.
+//! in `pelt-render`. [`preset`] holds everything about one fur in one TOML file; [`stage`] loads
+//! the meshes of one scene (the furred one, its rig, the plain ones) for every host.
 
 #![warn(missing_docs)]
 
@@ -14,10 +15,12 @@ pub mod preset;
 pub mod reference;
 pub mod rng;
 pub mod sim;
+pub mod stage;
 pub mod texture;
 
 pub use fur::{FurParams, FurStructure, GrowthDirection, SeparatedStructure};
 pub use mesh::{ImportOptions, Mesh, MeshError, MeshReport, builtin::Builtin};
 pub use preset::{LodParams, Preset, PresetError, RenderParams};
-pub use sim::{Scene, SimError, SimParams, Simulation};
+pub use sim::{FurStepper, Scene, SimError, SimParams, Simulation};
+pub use stage::{Stage, StageSource};
 pub use texture::{FurTextures, TextureParams};

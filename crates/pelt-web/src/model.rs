@@ -320,7 +320,7 @@ fn load_scene(scene: SceneChoice) -> Result<(Mesh, Option<Mesh>), ModelError> {
     Ok(match scene {
         SceneChoice::Bunny => (Builtin::Bunny.mesh().0, None),
         SceneChoice::TryOn => {
-            let TryOnScene { garment, body } = try_on_scene(&ImportOptions::default())?;
+            let TryOnScene { garment, body, .. } = try_on_scene(&ImportOptions::default())?;
             (garment, Some(body))
         }
     })

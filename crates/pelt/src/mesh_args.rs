@@ -2,9 +2,7 @@
 
 use std::path::PathBuf;
 
-use anyhow::Context as _;
-use pelt_core::anim::Rig;
-use pelt_core::{Builtin, ImportOptions, Mesh, MeshReport};
+use pelt_core::{Builtin, ImportOptions, Stage, StageSource};
 
 /// Which mesh to grow fur on.
 #[derive(Debug, Clone, clap::Args)]
@@ -12,7 +10,7 @@ pub struct MeshArgs {
     /// A mesh file (.obj, .gltf, .glb).
     #[arg(value_name = "MESH", conflicts_with = "builtin")]
     pub mesh: Option<PathBuf>,
-    /// A built-in mesh: box, bunny, sphere, plane, torus.
+    /// A built-in mesh: box, bunny, sphere, plane, torus, or tryon (a furry skirt on a body).
     #[arg(long, value_name = "NAME")]
     pub builtin: Option<String>,
     /// Keep duplicate positions apart instead of welding them (fins need welded adjacency).
@@ -21,26 +19,19 @@ pub struct MeshArgs {
 }
 
 impl MeshArgs {
-    /// Loads the chosen mesh, with the file's rig (skins, animations) when it has one; with
-    /// neither a file nor `--builtin`, `default`.
-    pub fn load_animated(&self, default: Builtin) -> anyhow::Result<(Mesh, MeshReport, Option<Rig>)> {
-        let options = ImportOptions { weld: !self.no_weld, ..ImportOptions::default() };
-        match &self.mesh {
-            Some(path) => Ok(Mesh::load_animated(path, &options)?),
-            None => self.load_builtin(default).map(|(mesh, report)| (mesh, report, None)),
-        }
+    /// Where the furred mesh comes from: the file, `--builtin` (`tryon` included), or `default`.
+    pub fn source(&self, default: Builtin) -> anyhow::Result<StageSource> {
+        Ok(match (&self.mesh, &self.builtin) {
+            (Some(path), _) => StageSource::File(path.clone()),
+            (None, Some(name)) => StageSource::builtin(name)?,
+            (None, None) => StageSource::Builtin(default),
+        })
     }
 
-    fn load_builtin(&self, default: Builtin) -> anyhow::Result<(Mesh, MeshReport)> {
-        match &self.builtin {
-            Some(name) => {
-                let builtin = Builtin::from_name(name).with_context(|| {
-                    let names: Vec<_> = Builtin::ALL.iter().map(|b| b.name()).collect();
-                    format!("unknown built-in mesh {name:?}; choose one of {}", names.join(", "))
-                })?;
-                Ok(builtin.mesh())
-            }
-            None => Ok(default.mesh()),
-        }
+    /// The scene's meshes: the furred one (with its rig, for an animated file), the try-on body
+    /// for `--builtin tryon`, and `plain_files`.
+    pub fn stage(&self, default: Builtin, plain_files: &[PathBuf]) -> anyhow::Result<Stage> {
+        let options = ImportOptions { weld: !self.no_weld, ..ImportOptions::default() };
+        Ok(Stage::load(&self.source(default)?, plain_files, &options)?)
     }
 }

@@ -8,9 +8,8 @@ use std::time::{Duration, Instant};
 use anyhow::{Context as _, bail};
 use glam::{Mat4, Vec3};
 use pelt_core::anim::Rig;
-use pelt_core::mesh::builtin::{TRY_ON_NAME, try_on_scene};
 use pelt_core::sim::{FurStepper, Scene, WindParams};
-use pelt_core::{Builtin, FurStructure, ImportOptions, Mesh, Preset};
+use pelt_core::{Builtin, FurStructure, Mesh, Preset, Stage};
 use pelt_render::{
     Backend, Camera, DEFAULT_BACKGROUND, FurDrawSettings, FurDriver, FurTarget, FurView, Gpu, HEADLESS_FORMAT,
     Headless, Light, PlainMesh, SAMPLE_COUNT, default_sample_count,
@@ -130,7 +129,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         None => Preset::default(),
     };
     let scene = args.script.as_deref().map(Scene::load).transpose()?;
-    let (mesh, plain, rig) = load_meshes(args)?;
+    let Stage { fur_mesh: mesh, rig, plain, .. } = args.mesh.stage(Builtin::Bunny, &args.plain_mesh)?;
     let clip = choose_animation(args, rig.as_ref())?;
     let frames = if frames > 0 {
         frames
@@ -281,25 +280,6 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         headless.target().sample_count,
     );
     Ok(())
-}
-
-/// The furry mesh (with its rig, for an animated file) and the plain ones: `--builtin tryon`
-/// is the garment on the body.
-fn load_meshes(args: &Args) -> anyhow::Result<(Mesh, Vec<Mesh>, Option<Rig>)> {
-    let mut plain = Vec::new();
-    let (mesh, rig) = if args.mesh.mesh.is_none() && args.mesh.builtin.as_deref() == Some(TRY_ON_NAME) {
-        let options = ImportOptions { weld: !args.mesh.no_weld, ..ImportOptions::default() };
-        let scene = try_on_scene(&options)?;
-        plain.push(scene.body);
-        (scene.garment, None)
-    } else {
-        let (mesh, _, rig) = args.mesh.load_animated(Builtin::Bunny)?;
-        (mesh, rig)
-    };
-    for path in &args.plain_mesh {
-        plain.push(Mesh::load(path, &ImportOptions::default())?.0);
-    }
-    Ok((mesh, plain, rig))
 }
 
 /// The animation `--animation` names: by default the first one an animated file has.

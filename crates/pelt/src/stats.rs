@@ -116,7 +116,7 @@ pub struct Savings {
 const PAPER_BOX: (u64, u64, u64) = (5_032, 6_796, 31_492);
 
 pub fn run(args: &Args) -> anyhow::Result<()> {
-    let (mesh, report, rig) = args.mesh.load_animated(Builtin::Box)?;
+    let pelt_core::Stage { fur_mesh: mesh, report, rig, .. } = args.mesh.stage(Builtin::Box, &[])?;
     let mut stats = measure(mesh, report, args.layers, args.fin_faces)?;
     stats.motion = rig.as_ref().map(Motion::of);
     let text = if args.json { serde_json::to_string_pretty(&stats)? + "\n" } else { table(&stats) };

@@ -65,16 +65,9 @@ fn parse_size(text: &str) -> Result<[u32; 2], String> {
 }
 
 pub fn run(args: &Args) -> anyhow::Result<()> {
-    // `--builtin tryon` (as in `pelt render`) is the furry skirt on a body; the app loads it.
-    let (mesh, report, rig) =
-        if args.mesh.mesh.is_none() && args.mesh.builtin.as_deref() == Some(pelt_core::mesh::builtin::TRY_ON_NAME) {
-            let (mesh, report) = pelt_core::Builtin::Plane.mesh();
-            (mesh, report, None)
-        } else {
-            args.mesh.load_animated(pelt_core::Builtin::Bunny)?
-        };
+    let stage = args.mesh.stage(pelt_core::Builtin::Bunny, &[])?;
     // Files and presets are checked before the display is opened, so their errors come first.
-    let mut app = app::App::new(args, mesh, rig, report.source)?;
+    let mut app = app::App::new(args, stage)?;
     let event_loop = winit::event_loop::EventLoop::new()
         .context("opening the display (is DISPLAY or WAYLAND_DISPLAY set? under CI use xvfb-run)")?;
     event_loop.run_app(&mut app).context("running the window's event loop")?;

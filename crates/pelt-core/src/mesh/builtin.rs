@@ -21,6 +21,8 @@ const TRY_ON_BODY_OBJ: &str = include_str!("../../assets/meshes/female_generic.o
 pub struct TryOnScene {
     /// `skirthelper.obj`: an open cloth tube around the hips (MakeHuman, CC0).
     pub garment: Mesh,
+    /// What import did to the garment.
+    pub garment_report: super::MeshReport,
     /// `female_generic.obj`: the body, in the same space (MakeHuman, CC0), with the vertices
     /// that poked through the garment tucked under it ([`super::tuck_under`]).
     pub body: Mesh,
@@ -31,13 +33,14 @@ pub struct TryOnScene {
 /// # Errors
 /// Only if `options` make the shipped meshes unusable (e.g. a weld tolerance that collapses them).
 pub fn try_on_scene(options: &ImportOptions) -> Result<TryOnScene, super::MeshError> {
-    let garment = Mesh::from_obj_str(TRY_ON_GARMENT_OBJ, Path::new("builtin:tryon/skirthelper.obj"), options)?.0;
+    let (garment, garment_report) =
+        Mesh::from_obj_str(TRY_ON_GARMENT_OBJ, Path::new("builtin:tryon/skirthelper.obj"), options)?;
     let mut body = Mesh::from_obj_str(TRY_ON_BODY_OBJ, Path::new("builtin:tryon/female_generic.obj"), options)?.0;
     // The thighs press through the skirt's front; tucked under it they do not show through
     // the fur as pale specks.
     let radius = garment.bounding_sphere().1;
     super::tuck_under(&mut body, &garment, 0.01 * radius, 0.1 * radius);
-    Ok(TryOnScene { garment, body })
+    Ok(TryOnScene { garment, garment_report, body })
 }
 
 /// A mesh Pelt can build without a file.

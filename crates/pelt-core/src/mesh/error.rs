@@ -6,6 +6,14 @@ use std::path::PathBuf;
 #[derive(Debug, thiserror::Error)]
 pub enum MeshError {
     // The cause is part of the message (not a `source`) so it is printed exactly once.
+    /// A built-in mesh name Pelt does not have.
+    #[error("unknown built-in mesh {name:?}; choose one of {choices}")]
+    UnknownBuiltin {
+        /// The name asked for.
+        name: String,
+        /// Every name there is.
+        choices: String,
+    },
     /// The file could not be read.
     #[error("{}: cannot read the file: {error}", file.display())]
     Io {

@@ -9,10 +9,9 @@ use std::path::PathBuf;
 
 use anyhow::{Context as _, bail};
 use glam::{Mat4, Vec3};
-use pelt_core::mesh::builtin::{TRY_ON_NAME, try_on_scene};
 use pelt_core::reference::StrandReference;
 use pelt_core::sim::{FurStepper, SimParams, WindParams};
-use pelt_core::{Builtin, FurStructure, ImportOptions, Mesh, Preset, texture};
+use pelt_core::{Builtin, FurStructure, Mesh, Preset, texture};
 use pelt_render::{
     Backend, Camera, DEFAULT_BACKGROUND, FurDrawSettings, FurDriver, FurLook, FurRenderer, FurTarget, FurView, Gpu,
     HEADLESS_FORMAT, Headless, KernelChoice, Light, PlainMesh, StrandRenderer, StrandRibbons, default_sample_count,
@@ -261,17 +260,9 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
 
 /// The model's name, its furry mesh and any plain ones (the try-on body).
 fn load_meshes(args: &MeshArgs) -> anyhow::Result<(String, Mesh, Vec<Mesh>)> {
-    if args.mesh.is_none() && args.builtin.as_deref() == Some(TRY_ON_NAME) {
-        let scene = try_on_scene(&ImportOptions { weld: !args.no_weld, ..ImportOptions::default() })?;
-        return Ok((TRY_ON_NAME.to_owned(), scene.garment, vec![scene.body]));
-    }
-    let (mesh, _, _) = args.load_animated(Builtin::Bunny)?;
-    let name = match (&args.mesh, &args.builtin) {
-        (Some(path), _) => path.file_stem().map_or_else(|| "mesh".to_owned(), |s| s.to_string_lossy().into_owned()),
-        (None, Some(name)) => name.clone(),
-        (None, None) => Builtin::Bunny.name().to_owned(),
-    };
-    Ok((name, mesh, Vec::new()))
+    let name = args.source(Builtin::Bunny)?.name();
+    let stage = args.stage(Builtin::Bunny, &[])?;
+    Ok((name, stage.fur_mesh, stage.plain))
 }
 
 /// One headless target's renderer, fur, view and plain meshes.

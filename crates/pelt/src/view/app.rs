@@ -5,8 +5,7 @@ use std::path::PathBuf;
 use std::sync::Arc;
 
 use anyhow::Context as _;
-use pelt_core::Mesh;
-use pelt_core::anim::Rig;
+use pelt_core::Stage;
 use winit::application::ApplicationHandler;
 use winit::event::WindowEvent;
 use winit::event_loop::ActiveEventLoop;
@@ -57,8 +56,8 @@ struct Running {
 }
 
 impl App {
-    pub fn new(args: &Args, mesh: Mesh, rig: Option<Rig>, mesh_source: String) -> anyhow::Result<Self> {
-        let model = Model::new(args, mesh, rig, mesh_source)?;
+    pub fn new(args: &Args, stage: Stage) -> anyhow::Result<Self> {
+        let model = Model::new(args, stage)?;
         let screenshot_after = args.screenshot_after.zip(args.out.clone());
         Ok(Self { window_size: args.size, screenshot_after, model, running: None, error: None })
     }

@@ -6,9 +6,8 @@ use std::time::Instant;
 use anyhow::Context as _;
 use glam::Vec3;
 use pelt_core::anim::Rig;
-use pelt_core::mesh::builtin::{TRY_ON_NAME, TryOnScene, try_on_scene};
 use pelt_core::sim::{FurStepper, Scene};
-use pelt_core::{Builtin, FurStructure, FurTextures, Mesh, Preset, PresetError};
+use pelt_core::{Builtin, FurStructure, FurTextures, Mesh, Preset, PresetError, Stage, StageSource};
 
 use super::Args;
 use super::camera::OrbitCamera;
@@ -113,19 +112,21 @@ pub(super) struct TouchDrag {
 }
 
 impl Model {
-    /// The model for `args`, with `mesh` (named `mesh_source`) as the command line's mesh.
-    pub(super) fn new(args: &Args, mesh: Mesh, rig: Option<Rig>, mesh_source: String) -> anyhow::Result<Self> {
+    /// The model for `args`, with `stage` loaded from its mesh arguments.
+    pub(super) fn new(args: &Args, stage: Stage) -> anyhow::Result<Self> {
         let mut mesh_choices: Vec<MeshChoice> = Builtin::ALL.into_iter().map(MeshChoice::Builtin).collect();
         mesh_choices.push(MeshChoice::TryOn);
-        let (choice, file_mesh) = match (&args.mesh.mesh, &args.mesh.builtin) {
-            (Some(path), _) => {
-                let name = path.file_name().map_or(mesh_source, |n| n.to_string_lossy().into_owned());
+        let Stage { fur_mesh: mesh, report, rig, plain } = stage;
+        let choice = match args.mesh.source(Builtin::Bunny)? {
+            StageSource::File(path) => {
+                let name = path.file_name().map_or(report.source, |n| n.to_string_lossy().into_owned());
                 mesh_choices.push(MeshChoice::File(name.clone()));
-                (MeshChoice::File(name), Some(mesh.clone()))
+                MeshChoice::File(name)
             }
-            (None, Some(name)) => (MeshChoice::Builtin(Builtin::from_name(name).unwrap_or(Builtin::Bunny)), None),
-            (None, None) => (MeshChoice::Builtin(Builtin::Bunny), None),
+            StageSource::Builtin(builtin) => MeshChoice::Builtin(builtin),
+            StageSource::TryOn => MeshChoice::TryOn,
         };
+        let file_mesh = matches!(choice, MeshChoice::File(_)).then(|| mesh.clone());
         let (preset, preset_path) = match &args.preset {
             Some(path) => (Preset::load(path)?, path.display().to_string()),
             None => (Preset::default(), "fur.toml".to_owned()),
@@ -160,13 +161,13 @@ impl Model {
         if let Some(rig) = &rig {
             stepper.set_clip(rig.clone(), settings.animation.clip);
         }
-        let mut model = Self {
+        let model = Self {
             settings,
             mesh_choices,
             file_mesh,
             footprint: structure.footprint(),
             structure,
-            body: None,
+            body: plain.into_iter().next(),
             unified_bytes: None,
             no_lod: args.no_lod,
             level: pelt_render::FurLevel::FULL,
@@ -199,10 +200,6 @@ impl Model {
             status: String::new(),
             rig,
         };
-        if args.mesh.mesh.is_none() && args.mesh.builtin.as_deref() == Some(TRY_ON_NAME) {
-            model.settings.mesh = MeshChoice::TryOn;
-            model.apply(Changes { mesh: true, ..Changes::default() })?;
-        }
         Ok(model)
     }
 
@@ -296,9 +293,9 @@ impl Model {
             let mesh = match &self.settings.mesh {
                 MeshChoice::Builtin(builtin) => builtin.mesh().0,
                 MeshChoice::TryOn => {
-                    let TryOnScene { garment, body } = try_on_scene(&pelt_core::ImportOptions::default())?;
-                    self.body = Some(body);
-                    garment
+                    let stage = Stage::load(&StageSource::TryOn, &[], &pelt_core::ImportOptions::default())?;
+                    self.body = stage.plain.into_iter().next();
+                    stage.fur_mesh
                 }
                 MeshChoice::File(_) => self.file_mesh.clone().context("the command-line mesh is gone")?,
             };
@@ -376,8 +373,8 @@ pub(super) fn test_model(args: &[&str]) -> Model {
         args: Args,
     }
     let wrapper = <Wrapper as clap::Parser>::parse_from([&["view"], args].concat());
-    let (mesh, report, rig) = wrapper.args.mesh.load_animated(Builtin::Bunny).unwrap();
-    Model::new(&wrapper.args, mesh, rig, report.source).unwrap()
+    let stage = wrapper.args.mesh.stage(Builtin::Bunny, &[]).unwrap();
+    Model::new(&wrapper.args, stage).unwrap()
 }
 
 #[cfg(test)]
