@@ -8,8 +8,9 @@ use pelt_core::fur::POSITION_BYTES;
 use wgpu::util::DeviceExt as _;
 
 use crate::RenderError;
-use crate::object::{GpuBytes, OBJECT_UNIFORM_BYTES, ObjectShape, ObjectUniform, check_size, uniform_buffer};
-use crate::pipeline::Layouts;
+use crate::object::{GpuBytes, ObjectShape, uniform_buffer};
+use crate::requirements::check_size;
+use crate::shaders::{Layouts, OBJECT_UNIFORM_BYTES, ObjectUniform};
 
 /// Usage of the shared-array buffers: read by the vertex shaders, written by the queue or by a
 /// host's compute pass, and bindable as vertex buffers or copied by hosts that want to.

@@ -110,6 +110,7 @@ mod plain;
 mod renderer;
 mod requirements;
 mod separated;
+mod shaders;
 mod silhouette;
 mod silhouette_cpu;
 mod simulation;
@@ -130,13 +131,15 @@ pub use headless::{HEADLESS_FORMAT, Headless};
 pub use lod::{FurLevel, LodSettings, strand_pixels, strand_pixels_in_view};
 pub use object::{FurFrame, FurLook, GpuBytes, tile_mapping};
 pub use plain::PlainMesh;
-pub use renderer::{FurDrawSettings, FurRenderer, unified_shader_source};
+pub use renderer::{FurDrawSettings, FurRenderer};
 pub use requirements::{check_adapter, required_downlevel_flags, required_features, required_limits};
-pub use separated::{SeparatedFur, SeparatedRenderer, separated_shader_source};
-pub use silhouette::silhouette_shader_source;
+pub use separated::{SeparatedFur, SeparatedRenderer};
+pub use shaders::{
+    separated_shader_source, silhouette_shader_source, simulation_shader_source, strands_shader_source,
+    unified_shader_source, view_lod_shader_source,
+};
 pub use silhouette_cpu::CpuSilhouette;
-pub use simulation::{GpuSimulation, simulation_shader_source};
-pub use strands::{StrandRenderer, StrandRibbons, strands_shader_source};
+pub use simulation::GpuSimulation;
+pub use strands::{StrandRenderer, StrandRibbons};
 pub use targets::{DEFAULT_BACKGROUND, DEPTH_FORMAT, FurTarget, RenderTargets, SAMPLE_COUNT, default_sample_count};
 pub use view::{FurView, Light, LightDirection, ViewData};
-pub use view_lod::view_lod_shader_source;

@@ -12,22 +12,14 @@
 
 use crate::RenderError;
 use crate::fur::GpuFur;
-use crate::pipeline::{Layouts, PassKind, PipelineSource, Transparency, create_pipeline};
+use crate::pipeline::{PassKind, PipelineSource, Transparency, create_pipeline};
 use crate::plain::PlainMesh;
 use crate::requirements::{ErrorScope, check_features_and_limits};
+use crate::shaders::{Layouts, unified_shader_source};
 use crate::silhouette::{FIN_INSTANCE_LAYOUT, SilhouettePipelines};
 use crate::targets::FurTarget;
 use crate::view::FurView;
 use crate::view_lod::{SHELL_DRAW_BYTES, ViewLodPipelines};
-
-pub(crate) const SHADING_WGSL: &str = include_str!("shading.wgsl");
-pub(crate) const UNIFIED_WGSL: &str = include_str!("unified.wgsl");
-
-/// The WGSL module of the unified renderer (the shared shading plus `unified.wgsl`).
-#[must_use]
-pub fn unified_shader_source() -> String {
-    format!("{SHADING_WGSL}\n{UNIFIED_WGSL}")
-}
 
 /// Which parts of a fur a draw records; everything here can change every draw.
 ///

@@ -22,21 +22,14 @@ use wgpu::util::DeviceExt as _;
 
 use crate::RenderError;
 use crate::lod::PreparedLevel;
-use crate::object::{FurFrame, GpuBytes, ObjectShape, check_size, uniform_buffer};
+use crate::object::{FurFrame, GpuBytes, ObjectShape, uniform_buffer};
 use crate::pipeline::{PassKind, PipelineSource, Transparency, create_pipeline};
-use crate::renderer::{FurDrawSettings, FurRenderer, SHADING_WGSL};
-use crate::requirements::ErrorScope;
+use crate::renderer::{FurDrawSettings, FurRenderer};
+use crate::requirements::{ErrorScope, check_size};
+use crate::shaders::separated_shader_source;
 use crate::targets::FurTarget;
 use crate::textures::GpuTextures;
 use crate::view::FurView;
-
-const SEPARATED_WGSL: &str = include_str!("separated.wgsl");
-
-/// The WGSL module of the separated renderer (the shared shading plus `separated.wgsl`).
-#[must_use]
-pub fn separated_shader_source() -> String {
-    format!("{SHADING_WGSL}\n{SEPARATED_WGSL}")
-}
 
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]

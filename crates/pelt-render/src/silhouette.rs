@@ -6,24 +6,14 @@
 //! pass that draws the fur; nothing is read back, nothing blocks.
 
 use crate::RenderError;
-use crate::object::check_size;
-use crate::pipeline::{Layouts, listing_pipelines};
-use crate::renderer::{SHADING_WGSL, UNIFIED_WGSL};
+use crate::pipeline::listing_pipelines;
+use crate::requirements::check_size;
+use crate::shaders::{Layouts, silhouette_shader_source};
 
-pub(crate) const SILHOUETTE_WGSL: &str = include_str!("silhouette.wgsl");
-/// The ordered listing both compute passes share (`scan.wgsl`).
-pub(crate) const SCAN_WGSL: &str = include_str!("scan.wgsl");
 /// One fin instance: the edge and its fade (f32 bits).
 pub(crate) const FIN_INSTANCE_BYTES: u64 = 8;
 /// `wgpu::util::DrawIndexedIndirectArgs`.
 const DRAW_ARGS_BYTES: u64 = 20;
-
-/// The WGSL module of the silhouette pass (the shared shading, `unified.wgsl`, `scan.wgsl` and
-/// `silhouette.wgsl`).
-#[must_use]
-pub fn silhouette_shader_source() -> String {
-    format!("{SHADING_WGSL}\n{UNIFIED_WGSL}\n{SCAN_WGSL}\n{SILHOUETTE_WGSL}")
-}
 
 /// The vertex input of the silhouette fin pipelines: one `(edge, fade bits)` per instance.
 pub(crate) const FIN_INSTANCE_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayout {
@@ -31,24 +21,6 @@ pub(crate) const FIN_INSTANCE_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::
     step_mode: wgpu::VertexStepMode::Instance,
     attributes: &[wgpu::VertexAttribute { format: wgpu::VertexFormat::Uint32x2, offset: 0, shader_location: 0 }],
 };
-
-/// The bind group layout of one fur's fin list (group 3 of the silhouette pass).
-pub(crate) fn fin_list_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
-    let storage = |binding| wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: wgpu::ShaderStages::COMPUTE,
-        ty: wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Storage { read_only: false },
-            has_dynamic_offset: false,
-            min_binding_size: None,
-        },
-        count: None,
-    };
-    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-        label: Some("pelt fin list"),
-        entries: &[storage(0), storage(1)],
-    })
-}
 
 /// The silhouette pass's two pipelines (`silhouette.wgsl`), one pair per renderer.
 #[derive(Debug)]

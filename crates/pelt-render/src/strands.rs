@@ -14,19 +14,11 @@ use pelt_core::reference::StrandReference;
 
 use crate::RenderError;
 use crate::fur::GpuFur;
-use crate::object::check_size;
-use crate::renderer::{FurRenderer, SHADING_WGSL};
-use crate::requirements::ErrorScope;
+use crate::renderer::FurRenderer;
+use crate::requirements::{ErrorScope, check_size};
+use crate::shaders::strands_shader_source;
 use crate::textures::srgb_to_linear;
 use crate::view::FurView;
-
-const STRANDS_WGSL: &str = include_str!("strands.wgsl");
-
-/// The WGSL module of the strand renderer (the shared shading plus `strands.wgsl`).
-#[must_use]
-pub fn strands_shader_source() -> String {
-    format!("{SHADING_WGSL}\n{STRANDS_WGSL}")
-}
 
 /// One ribbon vertex; matches `StrandVertex` in `strands.wgsl`.
 #[repr(C)]

@@ -5,6 +5,7 @@
 use glam::{Mat4, Vec3};
 
 use crate::renderer::FurRenderer;
+use crate::shaders::ViewUniform;
 
 /// Where the key light comes from.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -72,19 +73,6 @@ impl ViewData {
         }
     }
 }
-
-#[repr(C)]
-#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
-struct ViewUniform {
-    clip_from_world: Mat4,
-    camera_position: Vec3,
-    ambient: f32,
-    light_direction: Vec3,
-    _padding_0: f32,
-    light_colour: Vec3,
-    _padding_1: f32,
-}
-const _: () = assert!(size_of::<ViewUniform>() == 112, "matches `View` in shading.wgsl");
 
 /// One view's uniform buffer and bind group (group 0 of every Pelt pipeline). Make one per
 /// camera (or per eye, per shadow view...) and [`FurView::prepare`] it each frame before

@@ -12,41 +12,14 @@
 use std::sync::atomic::{AtomicBool, Ordering};
 
 use crate::RenderError;
-use crate::object::check_size;
-use crate::pipeline::{Layouts, listing_pipelines};
-use crate::renderer::{SHADING_WGSL, UNIFIED_WGSL};
-
-pub(crate) const VIEW_LOD_WGSL: &str = include_str!("view_lod.wgsl");
+use crate::pipeline::listing_pipelines;
+use crate::requirements::check_size;
+use crate::shaders::{Layouts, view_lod_shader_source};
 
 /// Shells one workgroup writes draws for (`cs_view_lod_draws` in `view_lod.wgsl`).
 const WORKGROUP: u32 = 64;
 /// `wgpu::util::DrawIndexedIndirectArgs`.
 pub(crate) const SHELL_DRAW_BYTES: u64 = 20;
-
-/// The WGSL module of the view-angle pass (the shared shading, `unified.wgsl` and
-/// `view_lod.wgsl`).
-#[must_use]
-pub fn view_lod_shader_source() -> String {
-    format!("{SHADING_WGSL}\n{UNIFIED_WGSL}\n{}\n{VIEW_LOD_WGSL}", crate::silhouette::SCAN_WGSL)
-}
-
-/// The bind group layout of one fur's shell list (group 3 of the pass).
-pub(crate) fn shell_list_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
-    let storage = |binding| wgpu::BindGroupLayoutEntry {
-        binding,
-        visibility: wgpu::ShaderStages::COMPUTE,
-        ty: wgpu::BindingType::Buffer {
-            ty: wgpu::BufferBindingType::Storage { read_only: false },
-            has_dynamic_offset: false,
-            min_binding_size: None,
-        },
-        count: None,
-    };
-    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-        label: Some("pelt shell list"),
-        entries: &[storage(0), storage(1), storage(2)],
-    })
-}
 
 /// The pass's three pipelines (each triangle's flag, the list, then the draws), one set per
 /// renderer.
