@@ -7,14 +7,13 @@ use pelt_core::texture::FurTextures;
 
 use crate::RenderError;
 use crate::geometry::UnifiedGeometry;
+use crate::listing::{FinList, ShellList};
 use crate::lod::PreparedLevel;
 use crate::object::{FurFrame, GpuBytes};
 use crate::renderer::FurRenderer;
 use crate::requirements::ErrorScope;
-use crate::silhouette::FinList;
 use crate::silhouette_cpu::CpuSilhouette;
 use crate::textures::GpuTextures;
-use crate::view_lod::ShellList;
 
 /// How many simulation states a [`GpuFur`] keeps on the GPU.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]

@@ -235,12 +235,13 @@ impl UnifiedGeometry {
         pass.draw_indexed(0..3 * triangles, 0, instances);
     }
 
-    /// Draws the fins of `list` (the silhouette pass's edges), through its indirect draw.
-    pub fn draw_fin_list(&self, pass: &mut wgpu::RenderPass<'_>, list: &crate::silhouette::FinList) {
+    /// Draws the fins listed in `instances` (the silhouette pass's edges) through the indirect
+    /// draw `draw`.
+    pub fn draw_fin_list(&self, pass: &mut wgpu::RenderPass<'_>, instances: &wgpu::Buffer, draw: &wgpu::Buffer) {
         if let Some(strip) = &self.fin_indices {
             pass.set_index_buffer(strip.slice(..), wgpu::IndexFormat::Uint32);
-            pass.set_vertex_buffer(0, list.instances.slice(..));
-            pass.draw_indexed_indirect(&list.draw, 0);
+            pass.set_vertex_buffer(0, instances.slice(..));
+            pass.draw_indexed_indirect(draw, 0);
         }
     }
 

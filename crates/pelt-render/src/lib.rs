@@ -103,6 +103,7 @@ mod geometry;
 mod gpu;
 #[cfg(feature = "headless")]
 mod headless;
+mod listing;
 mod lod;
 mod object;
 mod pipeline;
@@ -111,14 +112,12 @@ mod renderer;
 mod requirements;
 mod separated;
 mod shaders;
-mod silhouette;
 mod silhouette_cpu;
 mod simulation;
 mod strands;
 mod targets;
 mod textures;
 mod view;
-mod view_lod;
 
 pub use camera::Camera;
 pub use error::RenderError;

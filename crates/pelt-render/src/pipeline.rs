@@ -1,7 +1,6 @@
 //! Pipeline plumbing shared by the unified and the separated renderer: one function that builds
 //! every fur pipeline for a [`FurTarget`].
 
-use crate::shaders::Layouts;
 use crate::targets::FurTarget;
 
 /// How the fur's transparency is resolved.
@@ -111,36 +110,5 @@ pub(crate) fn create_pipeline(
         }),
         multiview_mask: None,
         cache: None,
-    })
-}
-
-/// The compute pipelines of one per-frame listing pass (the silhouette fins, the view-angle
-/// shells): one module from `source`, the view and unified object in groups 0 and 1, the fur's
-/// list in group 3, one pipeline per entry point in `entry_points`.
-pub(crate) fn listing_pipelines<const N: usize>(
-    device: &wgpu::Device,
-    layouts: &Layouts,
-    (label, source): (&str, String),
-    list_layout: &wgpu::BindGroupLayout,
-    entry_points: [&str; N],
-) -> [wgpu::ComputePipeline; N] {
-    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-        label: Some(label),
-        source: wgpu::ShaderSource::Wgsl(source.into()),
-    });
-    let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-        label: Some(label),
-        bind_group_layouts: &[Some(&layouts.view), Some(&layouts.unified_object), None, Some(list_layout)],
-        immediate_size: 0,
-    });
-    entry_points.map(|entry_point| {
-        device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some(entry_point),
-            layout: Some(&layout),
-            module: &module,
-            entry_point: Some(entry_point),
-            compilation_options: wgpu::PipelineCompilationOptions::default(),
-            cache: None,
-        })
     })
 }
