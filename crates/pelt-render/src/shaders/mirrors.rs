@@ -87,10 +87,21 @@ macro_rules! rust_layout {
 #[cfg(test)]
 pub(crate) use rust_layout;
 
-/// Parses `source` with naga and returns `(members, span)` of struct `name`: each member's
-/// name, offset, size and location (vertex inputs).
+/// One member of a WGSL struct as naga lays it out.
 #[cfg(test)]
-fn wgsl_struct(source: &str, name: &str) -> (Vec<(String, u32, u32, Option<u32>)>, u32) {
+#[derive(Debug)]
+struct WgslMember {
+    name: String,
+    offset: u32,
+    size: u32,
+    /// A vertex input's location.
+    #[expect(dead_code, reason = "read by the vertex input checks")]
+    location: Option<u32>,
+}
+
+/// Parses `source` with naga and returns the members and the size of its struct `name`.
+#[cfg(test)]
+fn wgsl_struct(source: &str, name: &str) -> (Vec<WgslMember>, u32) {
     let module =
         naga::front::wgsl::parse_str(source).unwrap_or_else(|error| panic!("{}", error.emit_to_string(source)));
     let found = module.types.iter().find(|(_, ty)| ty.name.as_deref() == Some(name));
@@ -99,13 +110,14 @@ fn wgsl_struct(source: &str, name: &str) -> (Vec<(String, u32, u32, Option<u32>)
     };
     let members = members
         .iter()
-        .map(|member| {
-            let location = match member.binding {
+        .map(|member| WgslMember {
+            name: member.name.clone().unwrap_or_default(),
+            offset: member.offset,
+            size: module.types[member.ty].inner.size(module.to_ctx()),
+            location: match member.binding {
                 Some(naga::Binding::Location { location, .. }) => Some(location),
                 _ => None,
-            };
-            let size = module.types[member.ty].inner.size(module.to_ctx());
-            (member.name.clone().unwrap_or_default(), member.offset, size, location)
+            },
         })
         .collect();
     (members, *span)
@@ -119,7 +131,7 @@ fn wgsl_struct(source: &str, name: &str) -> (Vec<(String, u32, u32, Option<u32>)
 pub(crate) fn assert_mirrors(source: &str, wgsl: &str, rust: &RustLayout) {
     let (members, span) = wgsl_struct(source, wgsl);
     let name = |field: &str| field.trim_start_matches('_').to_owned();
-    for (member, offset, size, _) in &members {
+    for WgslMember { name: member, offset, size, .. } in &members {
         let field = rust.fields.iter().find(|(field, ..)| name(field) == *member);
         let Some(&(field, rust_offset, rust_size)) = field else {
             panic!("`{wgsl}.{member}` has no field in `{}`", rust.name);
@@ -133,7 +145,7 @@ pub(crate) fn assert_mirrors(source: &str, wgsl: &str, rust: &RustLayout) {
     }
     for (field, offset, _) in &rust.fields {
         assert!(
-            field.starts_with("_padding") || members.iter().any(|(member, ..)| *member == name(field)),
+            field.starts_with("_padding") || members.iter().any(|member| member.name == name(field)),
             "`{}.{field}` (offset {offset}) is in no member of `{wgsl}` and is not padding",
             rust.name
         );
