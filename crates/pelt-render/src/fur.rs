@@ -10,8 +10,8 @@ use crate::geometry::UnifiedGeometry;
 use crate::listing::{FinList, ShellList};
 use crate::lod::PreparedLevel;
 use crate::object::{FurFrame, GpuBytes};
-use crate::renderer::FurRenderer;
 use crate::requirements::ErrorScope;
+use crate::shaders::Layouts;
 use crate::silhouette_cpu::CpuSilhouette;
 use crate::textures::GpuTextures;
 
@@ -28,7 +28,7 @@ pub enum FurStates {
     Two,
 }
 
-/// One fur's GPU data: draw it with [`FurRenderer::draw`] into any pass of the renderer's target,
+/// One fur's GPU data: draw it with [`FurRenderer::draw`](crate::FurRenderer::draw) into any pass of the renderer's target,
 /// as many furs per pass as you like.
 ///
 /// # The shared arrays, for hosts that write them on the GPU
@@ -53,66 +53,53 @@ pub struct GpuFur {
 }
 
 impl GpuFur {
-    /// Uploads `structure` (its rest pose into every state) and `textures` for drawing with
-    /// `renderer`.
-    ///
-    /// # Errors
-    /// [`RenderError::TooLarge`] when the structure exceeds the device's buffer limits,
-    /// [`RenderError::Textures`] for malformed textures, [`RenderError::OutOfMemory`] or
-    /// [`RenderError::Gpu`] where the device reports one.
-    pub fn new(
+    /// [`GpuFur::new`] with the layouts of the renderer it is drawn with.
+    pub(crate) fn upload(
         device: &wgpu::Device,
         queue: &wgpu::Queue,
-        renderer: &FurRenderer,
+        layouts: &Layouts,
         structure: &FurStructure,
         textures: &FurTextures,
         states: FurStates,
     ) -> Result<Self, RenderError> {
         let scope = ErrorScope::push(device);
-        let geometry = geometry(device, renderer, structure, states);
-        let textures = GpuTextures::new(device, queue, renderer.layouts(), textures);
-        let fins = fin_list(device, renderer, structure);
+        let geometry = geometry(device, layouts, structure, states);
+        let textures = GpuTextures::new(device, queue, layouts, textures);
+        let fins = fin_list(device, layouts, structure);
         let shells =
-            shell_list(device, renderer, structure, geometry.as_ref().map_or(0, |g| g.shape.vertices_per_shell()));
+            shell_list(device, layouts, structure, geometry.as_ref().map_or(0, |g| g.shape.vertices_per_shell()));
         scope.pop("uploading the fur")?;
         Ok(Self { geometry: geometry?, textures: textures?, fins: fins?, level: PreparedLevel::new(), shells: shells? })
     }
 
-    /// Replaces the structure (new mesh, layer count or rest pose), keeping the textures and the
-    /// number of states.
-    ///
-    /// # Errors
-    /// As [`GpuFur::new`].
-    pub fn set_structure(
+    /// [`GpuFur::set_structure`] with the renderer's layouts.
+    pub(crate) fn upload_structure(
         &mut self,
         device: &wgpu::Device,
-        renderer: &FurRenderer,
+        layouts: &Layouts,
         structure: &FurStructure,
     ) -> Result<(), RenderError> {
         let states = if self.geometry.state_count() == 1 { FurStates::One } else { FurStates::Two };
         let scope = ErrorScope::push(device);
-        let geometry = geometry(device, renderer, structure, states);
-        let fins = fin_list(device, renderer, structure);
+        let geometry = geometry(device, layouts, structure, states);
+        let fins = fin_list(device, layouts, structure);
         let shells =
-            shell_list(device, renderer, structure, geometry.as_ref().map_or(0, |g| g.shape.vertices_per_shell()));
+            shell_list(device, layouts, structure, geometry.as_ref().map_or(0, |g| g.shape.vertices_per_shell()));
         scope.pop("uploading the fur")?;
         (self.geometry, self.fins, self.shells) = (geometry?, fins?, shells?);
         Ok(())
     }
 
-    /// Replaces the shell and fin textures (any slice count: slices are spread over the layers).
-    ///
-    /// # Errors
-    /// [`RenderError::Textures`] for malformed textures, [`RenderError::OutOfMemory`].
-    pub fn set_textures(
+    /// [`GpuFur::set_textures`] with the renderer's layouts.
+    pub(crate) fn upload_textures(
         &mut self,
         device: &wgpu::Device,
         queue: &wgpu::Queue,
-        renderer: &FurRenderer,
+        layouts: &Layouts,
         textures: &FurTextures,
     ) -> Result<(), RenderError> {
         let scope = ErrorScope::push(device);
-        let textures = GpuTextures::new(device, queue, renderer.layouts(), textures);
+        let textures = GpuTextures::new(device, queue, layouts, textures);
         scope.pop("uploading the fur textures")?;
         self.textures = textures?;
         Ok(())
@@ -201,7 +188,7 @@ impl GpuFur {
         GpuBytes { textures: self.textures.bytes, ..self.geometry.bytes() }
     }
 
-    /// The silhouette decision made on the CPU instead of by [`FurRenderer::prepare_fins`]'s
+    /// The silhouette decision made on the CPU instead of by [`crate::FurRenderer::prepare_fins`]'s
     /// compute pass: decides which fins show for the base vertices `positions` (the first `V`
     /// are used: layer 0 of the shared array as drawn, model space), `frame` (the one given to
     /// [`GpuFur::prepare`]) and the camera at `camera_position_world`, and writes the fins' list
@@ -330,25 +317,25 @@ impl GpuFur {
 
 fn fin_list(
     device: &wgpu::Device,
-    renderer: &FurRenderer,
+    layouts: &Layouts,
     structure: &FurStructure,
 ) -> Result<Option<FinList>, RenderError> {
-    FinList::new(device, renderer.layouts(), structure.mesh.edges.len() as u32, structure.layers)
+    FinList::new(device, layouts, structure.mesh.edges.len() as u32, structure.layers)
 }
 
 fn shell_list(
     device: &wgpu::Device,
-    renderer: &FurRenderer,
+    layouts: &Layouts,
     structure: &FurStructure,
     per_shell: u32,
 ) -> Result<Option<ShellList>, RenderError> {
     let triangles = structure.mesh.triangles.len() as u32;
-    ShellList::new(device, renderer.layouts(), (triangles, per_shell), structure.layers)
+    ShellList::new(device, layouts, (triangles, per_shell), structure.layers)
 }
 
 fn geometry(
     device: &wgpu::Device,
-    renderer: &FurRenderer,
+    layouts: &Layouts,
     structure: &FurStructure,
     states: FurStates,
 ) -> Result<UnifiedGeometry, RenderError> {
@@ -356,12 +343,5 @@ fn geometry(
         FurStates::One => 1,
         FurStates::Two => 2,
     };
-    UnifiedGeometry::new(
-        device,
-        renderer.layouts(),
-        &structure.mesh,
-        structure.layers,
-        &structure.positions,
-        state_count,
-    )
+    UnifiedGeometry::new(device, layouts, &structure.mesh, structure.layers, &structure.positions, state_count)
 }

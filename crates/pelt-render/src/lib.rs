@@ -106,7 +106,6 @@ mod headless;
 mod listing;
 mod lod;
 mod object;
-mod pipeline;
 mod plain;
 mod renderer;
 mod requirements;

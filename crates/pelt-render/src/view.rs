@@ -4,8 +4,7 @@
 
 use glam::{Mat4, Vec3};
 
-use crate::renderer::FurRenderer;
-use crate::shaders::ViewUniform;
+use crate::shaders::{Layouts, ViewUniform};
 
 /// Where the key light comes from.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -84,9 +83,8 @@ pub struct FurView {
 }
 
 impl FurView {
-    /// A view for passes drawn with `renderer` (or a [`crate::SeparatedRenderer`] made from it).
-    #[must_use]
-    pub fn new(device: &wgpu::Device, renderer: &FurRenderer) -> Self {
+    /// [`FurView::new`] with the renderer's layouts.
+    pub(crate) fn create(device: &wgpu::Device, layouts: &Layouts) -> Self {
         let buffer = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("pelt view"),
             size: size_of::<ViewUniform>() as u64,
@@ -95,7 +93,7 @@ impl FurView {
         });
         let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("pelt view"),
-            layout: &renderer.layouts().view,
+            layout: &layouts.view,
             entries: &[wgpu::BindGroupEntry { binding: 0, resource: buffer.as_entire_binding() }],
         });
         Self { buffer, bind_group }

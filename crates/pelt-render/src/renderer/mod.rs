@@ -10,10 +10,14 @@
 //!    with [`FurDrawSettings::silhouette_fins`] only the edges the silhouette pass
 //!    ([`FurRenderer::prepare_fins`]) kept, through an indirect draw; else every edge.
 
+mod objects;
+mod pipeline;
+
+pub(crate) use pipeline::{PassKind, PipelineSource, Transparency, create_pipeline};
+
 use crate::RenderError;
 use crate::fur::GpuFur;
 use crate::listing::{DRAW_ARGS_BYTES, FIN_INSTANCE_LAYOUT, ListingPasses, ShellList};
-use crate::pipeline::{PassKind, PipelineSource, Transparency, create_pipeline};
 use crate::plain::PlainMesh;
 use crate::requirements::{ErrorScope, check_features_and_limits};
 use crate::shaders::{Layouts, unified_shader_source};
