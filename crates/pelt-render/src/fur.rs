@@ -12,7 +12,6 @@ use crate::lod::PreparedLevel;
 use crate::object::{FurFrame, GpuBytes};
 use crate::requirements::ErrorScope;
 use crate::shaders::Layouts;
-use crate::silhouette_cpu::CpuSilhouette;
 use crate::textures::GpuTextures;
 
 /// How many simulation states a [`GpuFur`] keeps on the GPU.
@@ -28,8 +27,8 @@ pub enum FurStates {
     Two,
 }
 
-/// One fur's GPU data: draw it with [`FurRenderer::draw`](crate::FurRenderer::draw) into any pass of the renderer's target,
-/// as many furs per pass as you like.
+/// One fur's GPU data: draw it with [`FurRenderer::draw`](crate::FurRenderer::draw) into any pass
+/// of the renderer's target, as many furs per pass as you like.
 ///
 /// # The shared arrays, for hosts that write them on the GPU
 /// Each state is one buffer of `(L + 1) * V` positions `NV[i * V + j]` (layer `i`, base vertex
@@ -188,42 +187,6 @@ impl GpuFur {
         GpuBytes { textures: self.textures.bytes, ..self.geometry.bytes() }
     }
 
-    /// The silhouette decision made on the CPU instead of by [`crate::FurRenderer::prepare_fins`]'s
-    /// compute pass: decides which fins show for the base vertices `positions` (the first `V`
-    /// are used: layer 0 of the shared array as drawn, model space), `frame` (the one given to
-    /// [`GpuFur::prepare`]) and the camera at `camera_position_world`, and writes the fins' list
-    /// and indirect draw with `queue`. Draw with [`crate::FurDrawSettings::silhouette_fins`] as
-    /// after the compute pass; record no compute pass for this fur and view. Returns the number
-    /// of fins kept (0 for a fur without fins).
-    ///
-    /// # Errors
-    /// [`RenderError::Count`] when `silhouette` was made for a mesh with another edge count, or
-    /// `positions` holds fewer than `V` positions.
-    pub fn prepare_fins_on_cpu(
-        &self,
-        queue: &wgpu::Queue,
-        silhouette: &mut CpuSilhouette,
-        positions: &[Vec3],
-        frame: &FurFrame,
-        camera_position_world: Vec3,
-    ) -> Result<u32, RenderError> {
-        let expected = self.geometry.shape.edge_count as usize;
-        if silhouette.edge_count() != expected {
-            return Err(RenderError::Count {
-                what: "CPU silhouette edges",
-                expected,
-                got: silhouette.edge_count(),
-                rule: "the fur's mesh's edges",
-            });
-        }
-        let Some(list) = &self.fins else {
-            return Ok(0);
-        };
-        let fins = silhouette.decide(positions, frame, camera_position_world)?;
-        list.write(queue, fins, frame.level.shells(self.geometry.shape.layers));
-        Ok(fins.len() as u32)
-    }
-
     /// Bytes of the silhouette pass's fin list (the edges it keeps and their indirect draw) and
     /// of the view-angle pass's shell list (12 bytes a triangle, 20 a layer).
     #[must_use]
@@ -267,10 +230,10 @@ impl GpuFur {
         self.fins.as_ref().map(|list| &list.draw)
     }
 
-    /// The fins the silhouette pass (or [`GpuFur::prepare_fins_on_cpu`]) kept: `(edge, fade as
-    /// f32 bits)` as two little-endian `u32`s per fin, in no particular order, as many as the
-    /// indirect draw's instance count ([`GpuFur::silhouette_draw`]); `COPY_SRC`. For hosts and
-    /// tests that read it back; `None` for a fur without fins.
+    /// The fins the silhouette pass (or the `lab` feature's `GpuFur::prepare_fins_on_cpu`) kept:
+    /// `(edge, fade as f32 bits)` as two little-endian `u32`s per fin, in no particular order, as
+    /// many as the indirect draw's instance count ([`GpuFur::silhouette_draw`]); `COPY_SRC`. For
+    /// hosts and tests that read it back; `None` for a fur without fins.
     #[must_use]
     pub fn silhouette_instances(&self) -> Option<&wgpu::Buffer> {
         self.fins.as_ref().map(|list| &list.instances)

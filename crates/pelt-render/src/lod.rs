@@ -192,6 +192,7 @@ impl PreparedLevel {
     }
 
     /// The layers drawn (as `lod_shell_layer` in `shading.wgsl`), innermost first.
+    #[cfg(any(test, feature = "lab"))]
     pub fn shell_layers(&self, layers: u32) -> impl Iterator<Item = u32> {
         let level = self.get().clamped(layers);
         let shells = level.shells(layers);

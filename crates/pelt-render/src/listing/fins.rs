@@ -94,6 +94,7 @@ impl FinList {
 
     /// Writes a list decided on the CPU (`(edge, fade bits)` per fin, at most `E`) and its
     /// indirect draw of `segments` segments a fin, in place of the compute pass.
+    #[cfg(feature = "lab")]
     pub fn write(&self, queue: &wgpu::Queue, fins: &[[u32; 2]], segments: u32) {
         let fins = &fins[..fins.len().min(self.edge_count as usize)];
         if !fins.is_empty() {

@@ -10,6 +10,7 @@ pub(crate) struct Layouts {
     /// buffers (positions twice, base normals, wedge uvs, topology).
     pub unified_object: wgpu::BindGroupLayout,
     /// Group 1 of the separated structure: the object uniform and the fin vertices.
+    #[cfg(feature = "lab")]
     pub separated_object: wgpu::BindGroupLayout,
     /// Group 2: a fur's textures and the samplers.
     pub textures: wgpu::BindGroupLayout,
@@ -55,6 +56,7 @@ impl Layouts {
             ],
         });
         // The separated fins' vertices, read back by each fin vertex to decide for its whole fin.
+        #[cfg(feature = "lab")]
         let separated_object = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("pelt separated object"),
             entries: &[entry(0, both, uniform), entry(1, vertex, storage)],
@@ -90,6 +92,7 @@ impl Layouts {
         Self {
             view,
             unified_object,
+            #[cfg(feature = "lab")]
             separated_object,
             textures,
             // The fin list: the indirect draw and its instances.

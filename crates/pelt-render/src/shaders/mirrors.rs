@@ -95,7 +95,7 @@ struct WgslMember {
     offset: u32,
     size: u32,
     /// A vertex input's location.
-    #[expect(dead_code, reason = "read by the vertex input checks")]
+    #[cfg_attr(not(feature = "lab"), expect(dead_code, reason = "read by the lab's vertex input checks"))]
     location: Option<u32>,
 }
 
@@ -151,6 +151,35 @@ pub(crate) fn assert_mirrors(source: &str, wgsl: &str, rust: &RustLayout) {
         );
     }
     assert_eq!(rust.size, span as usize, "size of `{}` against `{wgsl}`", rust.name);
+}
+
+/// Asserts that `rust`, read through the vertex `attributes`, mirrors the WGSL vertex input
+/// `wgsl` of `source`: each member's location has an attribute at the offset of the Rust field
+/// of the member's name, and member, field and attribute format have the same size.
+#[cfg(all(test, feature = "lab"))]
+pub(crate) fn assert_vertex_mirrors(source: &str, wgsl: &str, rust: &RustLayout, attributes: &[wgpu::VertexAttribute]) {
+    let (members, _) = wgsl_struct(source, wgsl);
+    assert_eq!(members.len(), rust.fields.len(), "fields of `{}` against `{wgsl}`", rust.name);
+    assert_eq!(attributes.len(), members.len(), "attributes against `{wgsl}`");
+    for WgslMember { name: member, size, location, .. } in &members {
+        let location = location.unwrap_or_else(|| panic!("`{wgsl}.{member}` has no location"));
+        let attribute = attributes
+            .iter()
+            .find(|a| a.shader_location == location)
+            .unwrap_or_else(|| panic!("no attribute at location {location} (`{wgsl}.{member}`)"));
+        let &(_, offset, rust_size) = rust
+            .fields
+            .iter()
+            .find(|(field, ..)| field == member)
+            .unwrap_or_else(|| panic!("`{wgsl}.{member}` has no field in `{}`", rust.name));
+        assert_eq!(attribute.offset, offset as u64, "offset of `{}.{member}` and its attribute", rust.name);
+        assert_eq!(
+            (rust_size as u64, attribute.format.size()),
+            (u64::from(*size), u64::from(*size)),
+            "size of `{}.{member}`, its attribute's format and `{wgsl}.{member}`",
+            rust.name
+        );
+    }
 }
 
 #[cfg(test)]

@@ -10,6 +10,8 @@ mod layouts;
 mod mirrors;
 
 pub(crate) use layouts::Layouts;
+#[cfg(all(test, feature = "lab"))]
+pub(crate) use mirrors::assert_vertex_mirrors;
 pub(crate) use mirrors::{OBJECT_UNIFORM_BYTES, ObjectUniform, ViewUniform};
 #[cfg(test)]
 pub(crate) use mirrors::{RustLayout, assert_mirrors, rust_layout};
@@ -29,8 +31,10 @@ const SIMULATION_WIND_WGSL: &str = include_str!("simulation_wind.wgsl");
 /// One simulation step, one invocation a strand.
 const SIMULATION_WGSL: &str = include_str!("simulation.wgsl");
 /// The separated structure of Lengyel et al. 2001 (the `lab` feature's baseline).
+#[cfg(feature = "lab")]
 const SEPARATED_WGSL: &str = include_str!("separated.wgsl");
 /// The explicit strands as ribbons (the `lab` feature's reference).
+#[cfg(feature = "lab")]
 const STRANDS_WGSL: &str = include_str!("strands.wgsl");
 
 /// The WGSL module of the unified renderer (the shared shading plus `unified.wgsl`).
@@ -61,12 +65,14 @@ pub fn simulation_shader_source() -> String {
 
 /// The WGSL module of the separated renderer (the shared shading plus `separated.wgsl`).
 #[must_use]
+#[cfg(feature = "lab")]
 pub fn separated_shader_source() -> String {
     format!("{SHADING_WGSL}\n{SEPARATED_WGSL}")
 }
 
 /// The WGSL module of the strand renderer (the shared shading plus `strands.wgsl`).
 #[must_use]
+#[cfg(feature = "lab")]
 pub fn strands_shader_source() -> String {
     format!("{SHADING_WGSL}\n{STRANDS_WGSL}")
 }

@@ -227,3 +227,15 @@ impl StrandRibbons {
         self.index_count as usize / 3
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::shaders::{assert_vertex_mirrors, rust_layout};
+
+    #[test]
+    fn ribbon_vertex_mirrors_strand_vertex() {
+        let rust = rust_layout!(RibbonVertex { position, tangent, normal, colour_height, half_width });
+        assert_vertex_mirrors(&strands_shader_source(), "StrandVertex", &rust, &VERTEX_ATTRIBUTES);
+    }
+}
