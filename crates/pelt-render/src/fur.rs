@@ -7,14 +7,12 @@ use pelt_core::texture::FurTextures;
 
 use crate::RenderError;
 use crate::geometry::UnifiedGeometry;
+use crate::listing::{FinList, ShellList};
 use crate::lod::PreparedLevel;
 use crate::object::{FurFrame, GpuBytes};
-use crate::renderer::FurRenderer;
 use crate::requirements::ErrorScope;
-use crate::silhouette::FinList;
-use crate::silhouette_cpu::CpuSilhouette;
+use crate::shaders::Layouts;
 use crate::textures::GpuTextures;
-use crate::view_lod::ShellList;
 
 /// How many simulation states a [`GpuFur`] keeps on the GPU.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -29,8 +27,8 @@ pub enum FurStates {
     Two,
 }
 
-/// One fur's GPU data: draw it with [`FurRenderer::draw`] into any pass of the renderer's target,
-/// as many furs per pass as you like.
+/// One fur's GPU data: draw it with [`FurRenderer::draw`](crate::FurRenderer::draw) into any pass
+/// of the renderer's target, as many furs per pass as you like.
 ///
 /// # The shared arrays, for hosts that write them on the GPU
 /// Each state is one buffer of `(L + 1) * V` positions `NV[i * V + j]` (layer `i`, base vertex
@@ -54,66 +52,53 @@ pub struct GpuFur {
 }
 
 impl GpuFur {
-    /// Uploads `structure` (its rest pose into every state) and `textures` for drawing with
-    /// `renderer`.
-    ///
-    /// # Errors
-    /// [`RenderError::TooLarge`] when the structure exceeds the device's buffer limits,
-    /// [`RenderError::Textures`] for malformed textures, [`RenderError::OutOfMemory`] or
-    /// [`RenderError::Gpu`] where the device reports one.
-    pub fn new(
+    /// [`GpuFur::new`] with the layouts of the renderer it is drawn with.
+    pub(crate) fn upload(
         device: &wgpu::Device,
         queue: &wgpu::Queue,
-        renderer: &FurRenderer,
+        layouts: &Layouts,
         structure: &FurStructure,
         textures: &FurTextures,
         states: FurStates,
     ) -> Result<Self, RenderError> {
         let scope = ErrorScope::push(device);
-        let geometry = geometry(device, renderer, structure, states);
-        let textures = GpuTextures::new(device, queue, renderer.layouts(), textures);
-        let fins = fin_list(device, renderer, structure);
+        let geometry = geometry(device, layouts, structure, states);
+        let textures = GpuTextures::new(device, queue, layouts, textures);
+        let fins = fin_list(device, layouts, structure);
         let shells =
-            shell_list(device, renderer, structure, geometry.as_ref().map_or(0, |g| g.shape.vertices_per_shell()));
+            shell_list(device, layouts, structure, geometry.as_ref().map_or(0, |g| g.shape.vertices_per_shell()));
         scope.pop("uploading the fur")?;
         Ok(Self { geometry: geometry?, textures: textures?, fins: fins?, level: PreparedLevel::new(), shells: shells? })
     }
 
-    /// Replaces the structure (new mesh, layer count or rest pose), keeping the textures and the
-    /// number of states.
-    ///
-    /// # Errors
-    /// As [`GpuFur::new`].
-    pub fn set_structure(
+    /// [`GpuFur::set_structure`] with the renderer's layouts.
+    pub(crate) fn upload_structure(
         &mut self,
         device: &wgpu::Device,
-        renderer: &FurRenderer,
+        layouts: &Layouts,
         structure: &FurStructure,
     ) -> Result<(), RenderError> {
         let states = if self.geometry.state_count() == 1 { FurStates::One } else { FurStates::Two };
         let scope = ErrorScope::push(device);
-        let geometry = geometry(device, renderer, structure, states);
-        let fins = fin_list(device, renderer, structure);
+        let geometry = geometry(device, layouts, structure, states);
+        let fins = fin_list(device, layouts, structure);
         let shells =
-            shell_list(device, renderer, structure, geometry.as_ref().map_or(0, |g| g.shape.vertices_per_shell()));
+            shell_list(device, layouts, structure, geometry.as_ref().map_or(0, |g| g.shape.vertices_per_shell()));
         scope.pop("uploading the fur")?;
         (self.geometry, self.fins, self.shells) = (geometry?, fins?, shells?);
         Ok(())
     }
 
-    /// Replaces the shell and fin textures (any slice count: slices are spread over the layers).
-    ///
-    /// # Errors
-    /// [`RenderError::Textures`] for malformed textures, [`RenderError::OutOfMemory`].
-    pub fn set_textures(
+    /// [`GpuFur::set_textures`] with the renderer's layouts.
+    pub(crate) fn upload_textures(
         &mut self,
         device: &wgpu::Device,
         queue: &wgpu::Queue,
-        renderer: &FurRenderer,
+        layouts: &Layouts,
         textures: &FurTextures,
     ) -> Result<(), RenderError> {
         let scope = ErrorScope::push(device);
-        let textures = GpuTextures::new(device, queue, renderer.layouts(), textures);
+        let textures = GpuTextures::new(device, queue, layouts, textures);
         scope.pop("uploading the fur textures")?;
         self.textures = textures?;
         Ok(())
@@ -202,42 +187,6 @@ impl GpuFur {
         GpuBytes { textures: self.textures.bytes, ..self.geometry.bytes() }
     }
 
-    /// The silhouette decision made on the CPU instead of by [`FurRenderer::prepare_fins`]'s
-    /// compute pass: decides which fins show for the base vertices `positions` (the first `V`
-    /// are used: layer 0 of the shared array as drawn, model space), `frame` (the one given to
-    /// [`GpuFur::prepare`]) and the camera at `camera_position_world`, and writes the fins' list
-    /// and indirect draw with `queue`. Draw with [`crate::FurDrawSettings::silhouette_fins`] as
-    /// after the compute pass; record no compute pass for this fur and view. Returns the number
-    /// of fins kept (0 for a fur without fins).
-    ///
-    /// # Errors
-    /// [`RenderError::Count`] when `silhouette` was made for a mesh with another edge count, or
-    /// `positions` holds fewer than `V` positions.
-    pub fn prepare_fins_on_cpu(
-        &self,
-        queue: &wgpu::Queue,
-        silhouette: &mut CpuSilhouette,
-        positions: &[Vec3],
-        frame: &FurFrame,
-        camera_position_world: Vec3,
-    ) -> Result<u32, RenderError> {
-        let expected = self.geometry.shape.edge_count as usize;
-        if silhouette.edge_count() != expected {
-            return Err(RenderError::Count {
-                what: "CPU silhouette edges",
-                expected,
-                got: silhouette.edge_count(),
-                rule: "the fur's mesh's edges",
-            });
-        }
-        let Some(list) = &self.fins else {
-            return Ok(0);
-        };
-        let fins = silhouette.decide(positions, frame, camera_position_world)?;
-        list.write(queue, fins, frame.level.shells(self.geometry.shape.layers));
-        Ok(fins.len() as u32)
-    }
-
     /// Bytes of the silhouette pass's fin list (the edges it keeps and their indirect draw) and
     /// of the view-angle pass's shell list (12 bytes a triangle, 20 a layer).
     #[must_use]
@@ -281,10 +230,10 @@ impl GpuFur {
         self.fins.as_ref().map(|list| &list.draw)
     }
 
-    /// The fins the silhouette pass (or [`GpuFur::prepare_fins_on_cpu`]) kept: `(edge, fade as
-    /// f32 bits)` as two little-endian `u32`s per fin, in no particular order, as many as the
-    /// indirect draw's instance count ([`GpuFur::silhouette_draw`]); `COPY_SRC`. For hosts and
-    /// tests that read it back; `None` for a fur without fins.
+    /// The fins the silhouette pass (or the `lab` feature's `GpuFur::prepare_fins_on_cpu`) kept:
+    /// `(edge, fade as f32 bits)` as two little-endian `u32`s per fin, in no particular order, as
+    /// many as the indirect draw's instance count ([`GpuFur::silhouette_draw`]); `COPY_SRC`. For
+    /// hosts and tests that read it back; `None` for a fur without fins.
     #[must_use]
     pub fn silhouette_instances(&self) -> Option<&wgpu::Buffer> {
         self.fins.as_ref().map(|list| &list.instances)
@@ -331,25 +280,25 @@ impl GpuFur {
 
 fn fin_list(
     device: &wgpu::Device,
-    renderer: &FurRenderer,
+    layouts: &Layouts,
     structure: &FurStructure,
 ) -> Result<Option<FinList>, RenderError> {
-    FinList::new(device, renderer.layouts(), structure.mesh.edges.len() as u32, structure.layers)
+    FinList::new(device, layouts, structure.mesh.edges.len() as u32, structure.layers)
 }
 
 fn shell_list(
     device: &wgpu::Device,
-    renderer: &FurRenderer,
+    layouts: &Layouts,
     structure: &FurStructure,
     per_shell: u32,
 ) -> Result<Option<ShellList>, RenderError> {
     let triangles = structure.mesh.triangles.len() as u32;
-    ShellList::new(device, renderer.layouts(), (triangles, per_shell), structure.layers)
+    ShellList::new(device, layouts, (triangles, per_shell), structure.layers)
 }
 
 fn geometry(
     device: &wgpu::Device,
-    renderer: &FurRenderer,
+    layouts: &Layouts,
     structure: &FurStructure,
     states: FurStates,
 ) -> Result<UnifiedGeometry, RenderError> {
@@ -357,12 +306,5 @@ fn geometry(
         FurStates::One => 1,
         FurStates::Two => 2,
     };
-    UnifiedGeometry::new(
-        device,
-        renderer.layouts(),
-        &structure.mesh,
-        structure.layers,
-        &structure.positions,
-        state_count,
-    )
+    UnifiedGeometry::new(device, layouts, &structure.mesh, structure.layers, &structure.positions, state_count)
 }

@@ -8,8 +8,9 @@ use pelt_core::fur::POSITION_BYTES;
 use wgpu::util::DeviceExt as _;
 
 use crate::RenderError;
-use crate::object::{GpuBytes, OBJECT_UNIFORM_BYTES, ObjectShape, ObjectUniform, check_size, uniform_buffer};
-use crate::pipeline::Layouts;
+use crate::object::{GpuBytes, ObjectShape, uniform_buffer};
+use crate::requirements::check_size;
+use crate::shaders::{Layouts, OBJECT_UNIFORM_BYTES, ObjectUniform};
 
 /// Usage of the shared-array buffers: read by the vertex shaders, written by the queue or by a
 /// host's compute pass, and bindable as vertex buffers or copied by hosts that want to.
@@ -234,12 +235,13 @@ impl UnifiedGeometry {
         pass.draw_indexed(0..3 * triangles, 0, instances);
     }
 
-    /// Draws the fins of `list` (the silhouette pass's edges), through its indirect draw.
-    pub fn draw_fin_list(&self, pass: &mut wgpu::RenderPass<'_>, list: &crate::silhouette::FinList) {
+    /// Draws the fins listed in `instances` (the silhouette pass's edges) through the indirect
+    /// draw `draw`.
+    pub fn draw_fin_list(&self, pass: &mut wgpu::RenderPass<'_>, instances: &wgpu::Buffer, draw: &wgpu::Buffer) {
         if let Some(strip) = &self.fin_indices {
             pass.set_index_buffer(strip.slice(..), wgpu::IndexFormat::Uint32);
-            pass.set_vertex_buffer(0, list.instances.slice(..));
-            pass.draw_indexed_indirect(&list.draw, 0);
+            pass.set_vertex_buffer(0, instances.slice(..));
+            pass.draw_indexed_indirect(draw, 0);
         }
     }
 

@@ -9,11 +9,9 @@
 //! - [`FurTarget`]: the host's attachments (colour and depth formats, depth comparison, MSAA).
 //!   Reverse-Z hosts use [`FurTarget::reverse_z`] and clear depth to 0.
 //! - [`FurRenderer`]: every pipeline for one target, created once and shared by all furs.
-//!   [`SeparatedRenderer`] adds the separated structure of Lengyel et al. 2001 on the same views
-//!   and textures, for comparisons.
 //! - [`GpuFur`]: one fur's GPU data (shared array in one or two simulation states, topology,
-//!   uvs, base normals, textures, uniform); [`SeparatedFur`] the same for the separated structure;
-//!   [`PlainMesh`] a furless mesh. Each has a model transform.
+//!   uvs, base normals, textures, uniform); [`PlainMesh`] a furless mesh. Each has a model
+//!   transform.
 //! - [`FurView`]: one view's uniform buffer, written from [`ViewData`] (`clip_from_world`, camera
 //!   position, [`Light`]); several views in one submission each have their own.
 //!
@@ -36,6 +34,10 @@
 //!
 //! Nothing in the library path blocks, spawns threads or needs `image`/`pollster`: those are in
 //! the default `headless` feature ([`Gpu`], [`Headless`]), which Pelt's commands and tests use.
+//! The `lab` feature (off by default) adds what Pelt is measured against: the separated structure
+//! of Lengyel et al. 2001 on the same views and textures (`SeparatedRenderer`, `SeparatedFur`),
+//! the explicit strands as ribbons (`StrandRenderer`, `StrandRibbons`) and the silhouette decided
+//! on the CPU (`CpuSilhouette`, `GpuFur::prepare_fins_on_cpu`).
 //!
 //! Shell tile coordinates: meshes with uvs use them (scaled so a tile covers the same model size
 //! as without uvs); meshes without uvs use a triplanar projection of the root positions in model
@@ -104,21 +106,19 @@ mod geometry;
 mod gpu;
 #[cfg(feature = "headless")]
 mod headless;
+#[cfg(feature = "lab")]
+mod lab;
+mod listing;
 mod lod;
 mod object;
-mod pipeline;
 mod plain;
 mod renderer;
 mod requirements;
-mod separated;
-mod silhouette;
-mod silhouette_cpu;
+mod shaders;
 mod simulation;
-mod strands;
 mod targets;
 mod textures;
 mod view;
-mod view_lod;
 
 pub use camera::Camera;
 pub use driver::{FurDriver, KernelChoice, SimKernel, cpu_secs_per_step, gpu_secs_per_step};
@@ -129,16 +129,16 @@ pub use geometry::POSITIONS_USAGE;
 pub use gpu::{Backend, Gpu};
 #[cfg(feature = "headless")]
 pub use headless::{HEADLESS_FORMAT, Headless};
+#[cfg(feature = "lab")]
+pub use lab::{CpuSilhouette, SeparatedFur, SeparatedRenderer, StrandRenderer, StrandRibbons};
 pub use lod::{FurLevel, LodSettings, strand_pixels, strand_pixels_in_view};
 pub use object::{FurFrame, FurLook, GpuBytes, tile_mapping};
 pub use plain::PlainMesh;
-pub use renderer::{FurDrawSettings, FurRenderer, unified_shader_source};
+pub use renderer::{FurDrawSettings, FurRenderer};
 pub use requirements::{check_adapter, required_downlevel_flags, required_features, required_limits};
-pub use separated::{SeparatedFur, SeparatedRenderer, separated_shader_source};
-pub use silhouette::silhouette_shader_source;
-pub use silhouette_cpu::CpuSilhouette;
-pub use simulation::{GpuSimulation, simulation_shader_source};
-pub use strands::{StrandRenderer, StrandRibbons, strands_shader_source};
+#[cfg(feature = "lab")]
+pub use shaders::{separated_shader_source, strands_shader_source};
+pub use shaders::{silhouette_shader_source, simulation_shader_source, unified_shader_source, view_lod_shader_source};
+pub use simulation::GpuSimulation;
 pub use targets::{DEFAULT_BACKGROUND, DEPTH_FORMAT, FurTarget, RenderTargets, SAMPLE_COUNT, default_sample_count};
 pub use view::{FurView, Light, LightDirection, ViewData};
-pub use view_lod::view_lod_shader_source;

@@ -15,7 +15,7 @@
 //! `|n . v|` at the strand's root rises, with the same alpha compensation (the two blends
 //! compose: `1 - (1 - blend) (1 - view weight)`). Triangles where those layers have faded out at
 //! all three corners are not drawn in them: a per-frame compute pass lists the rest
-//! (`view_lod.rs`).
+//! (`listing/shells.rs`).
 
 /// The level a fur is drawn at in one frame.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -192,6 +192,7 @@ impl PreparedLevel {
     }
 
     /// The layers drawn (as `lod_shell_layer` in `shading.wgsl`), innermost first.
+    #[cfg(any(test, feature = "lab"))]
     pub fn shell_layers(&self, layers: u32) -> impl Iterator<Item = u32> {
         let level = self.get().clamped(layers);
         let shells = level.shells(layers);

@@ -2,10 +2,11 @@
 //! model transform, interpolation, fur look), the per-frame data a host gives for it, and the
 //! byte counts objects report.
 
-use glam::{Mat3, Mat4, Vec3, Vec4};
+use glam::{Mat3, Mat4, Vec3};
 use pelt_core::Mesh;
 
 use crate::lod::FurLevel;
+use crate::shaders::{OBJECT_UNIFORM_BYTES, ObjectUniform};
 
 /// How one fur looks, beyond its textures: lighting response, fading and strand density.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -88,43 +89,6 @@ impl GpuBytes {
         self.structure() + self.textures
     }
 }
-
-/// The per-object uniform; matches `Object` in `shading.wgsl`.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
-pub(crate) struct ObjectUniform {
-    world_from_model: Mat4,
-    /// A `mat3x3<f32>` in a uniform: three 16-byte columns.
-    world_normal_from_model: [Vec4; 3],
-    colour: Vec4,
-    vertex_count: u32,
-    layers: u32,
-    triangle_count: u32,
-    edge_count: u32,
-    has_uvs: u32,
-    has_surface: u32,
-    shell_slices: u32,
-    wedge_count: u32,
-    tiles_per_uv: f32,
-    tiles_per_world: f32,
-    world_per_uv: f32,
-    interpolation: f32,
-    fin_fade_cos: f32,
-    shell_fade_cos: f32,
-    root_occlusion: f32,
-    specular: f32,
-    shininess: f32,
-    lod_blend: f32,
-    lod_stride: u32,
-    lod_shells: u32,
-    lod_view: f32,
-    lod_view_start: f32,
-    lod_view_full: f32,
-    _padding_1: u32,
-}
-const _: () = assert!(size_of::<ObjectUniform>() == 224, "matches `Object` in shading.wgsl");
-
-pub(crate) const OBJECT_UNIFORM_BYTES: u64 = size_of::<ObjectUniform>() as u64;
 
 /// The constant part of an object's uniform: what its mesh and textures fix.
 #[derive(Clone, Copy, Debug)]
@@ -232,14 +196,6 @@ pub(crate) fn uniform_buffer(device: &wgpu::Device) -> wgpu::Buffer {
         usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
         mapped_at_creation: false,
     })
-}
-
-/// Fails with [`crate::RenderError::TooLarge`] when `bytes` exceed what one storage binding or
-/// buffer may hold on `device`.
-pub(crate) fn check_size(device: &wgpu::Device, what: &'static str, bytes: u64) -> Result<(), crate::RenderError> {
-    let limits = device.limits();
-    let limit = limits.max_storage_buffer_binding_size.min(limits.max_buffer_size);
-    if bytes > limit { Err(crate::RenderError::TooLarge { what, bytes, limit }) } else { Ok(()) }
 }
 
 #[cfg(test)]

@@ -6,10 +6,11 @@ use pelt_core::Mesh;
 use crate::RenderError;
 use crate::geometry::UnifiedGeometry;
 use crate::object::{FurFrame, GpuBytes};
-use crate::renderer::FurRenderer;
 use crate::requirements::ErrorScope;
+use crate::shaders::Layouts;
 
-/// A furless mesh on the GPU, drawn with [`FurRenderer::draw_plain`] before the furs.
+/// A furless mesh on the GPU, drawn with [`FurRenderer::draw_plain`](crate::FurRenderer::draw_plain)
+/// before the furs.
 #[derive(Debug)]
 pub struct PlainMesh {
     geometry: UnifiedGeometry,
@@ -17,14 +18,15 @@ pub struct PlainMesh {
 }
 
 impl PlainMesh {
-    /// Uploads `mesh`, drawn in linear RGB `colour`.
-    ///
-    /// # Errors
-    /// [`RenderError::TooLarge`] when the mesh exceeds the device's buffer limits,
-    /// [`RenderError::OutOfMemory`] or [`RenderError::Gpu`].
-    pub fn new(device: &wgpu::Device, renderer: &FurRenderer, mesh: &Mesh, colour: Vec3) -> Result<Self, RenderError> {
+    /// [`PlainMesh::new`] with the renderer's layouts.
+    pub(crate) fn upload(
+        device: &wgpu::Device,
+        layouts: &Layouts,
+        mesh: &Mesh,
+        colour: Vec3,
+    ) -> Result<Self, RenderError> {
         let scope = ErrorScope::push(device);
-        let geometry = UnifiedGeometry::new(device, renderer.layouts(), mesh, 0, &mesh.positions, 1);
+        let geometry = UnifiedGeometry::new(device, layouts, mesh, 0, &mesh.positions, 1);
         scope.pop("uploading a plain mesh")?;
         Ok(Self { geometry: geometry?, colour })
     }

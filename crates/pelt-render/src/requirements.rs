@@ -77,6 +77,14 @@ pub(crate) fn check_features_and_limits(features: wgpu::Features, limits: &wgpu:
     Ok(())
 }
 
+/// Fails with [`RenderError::TooLarge`] when `bytes` exceed what one storage binding or
+/// buffer may hold on `device`.
+pub(crate) fn check_size(device: &wgpu::Device, what: &'static str, bytes: u64) -> Result<(), RenderError> {
+    let limits = device.limits();
+    let limit = limits.max_storage_buffer_binding_size.min(limits.max_buffer_size);
+    if bytes > limit { Err(RenderError::TooLarge { what, bytes, limit }) } else { Ok(()) }
+}
+
 /// Catches out-of-memory and validation errors of the GPU calls between `push` and `pop` and
 /// turns them into [`RenderError`]s instead of a panic in wgpu's default handler, without
 /// blocking: native wgpu answers a popped scope at once, so one poll reads it. On the web

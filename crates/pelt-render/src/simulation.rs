@@ -14,17 +14,8 @@ use pelt_core::{FurStructure, rng};
 
 use crate::RenderError;
 use crate::fur::GpuFur;
-use crate::object::check_size;
-use crate::requirements::ErrorScope;
-
-pub(crate) const SIMULATION_WIND_WGSL: &str = include_str!("simulation_wind.wgsl");
-pub(crate) const SIMULATION_WGSL: &str = include_str!("simulation.wgsl");
-
-/// The WGSL module of the GPU simulation (`simulation_wind.wgsl` plus `simulation.wgsl`).
-#[must_use]
-pub fn simulation_shader_source() -> String {
-    format!("{SIMULATION_WIND_WGSL}\n{SIMULATION_WGSL}")
-}
+use crate::requirements::{ErrorScope, check_size};
+use crate::shaders::simulation_shader_source;
 
 /// Strands per workgroup (`@workgroup_size` in `simulation.wgsl`).
 const WORKGROUP: u32 = 64;
@@ -524,5 +515,29 @@ mod tests {
         let small = wgpu::Limits { max_compute_workgroup_size_x: 32, ..limits };
         let error = check_limits(&small).unwrap_err().to_string();
         assert!(error.contains("max_compute_workgroup_size_x = 32"), "{error}");
+    }
+}
+
+#[cfg(test)]
+mod mirror_tests {
+    use super::StepUniform;
+    use crate::shaders::{assert_mirrors, rust_layout, simulation_shader_source};
+
+    /// Member by member as naga lays `Step` out, not only the size.
+    #[test]
+    fn step_uniform_mirrors_step() {
+        let rust = rust_layout!(StepUniform {
+            gravity,
+            wind_direction,
+            wind_shape,
+            travelled_fraction,
+            travelled_xy,
+            travelled_z_seed,
+            jitter_seed_tick,
+            next_tick_counts,
+            touch,
+            grid
+        });
+        assert_mirrors(&simulation_shader_source(), "Step", &rust);
     }
 }

@@ -5,7 +5,7 @@
 use pelt_core::texture::{FurTextures, downsample_rgba8};
 
 use crate::RenderError;
-use crate::pipeline::Layouts;
+use crate::shaders::Layouts;
 
 /// One fur's textures on the GPU with their bind group (group 2 of the fur pipelines).
 #[derive(Debug)]

@@ -4,7 +4,7 @@
 
 use glam::{Mat4, Vec3};
 
-use crate::renderer::FurRenderer;
+use crate::shaders::{Layouts, ViewUniform};
 
 /// Where the key light comes from.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -73,19 +73,6 @@ impl ViewData {
     }
 }
 
-#[repr(C)]
-#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
-struct ViewUniform {
-    clip_from_world: Mat4,
-    camera_position: Vec3,
-    ambient: f32,
-    light_direction: Vec3,
-    _padding_0: f32,
-    light_colour: Vec3,
-    _padding_1: f32,
-}
-const _: () = assert!(size_of::<ViewUniform>() == 112, "matches `View` in shading.wgsl");
-
 /// One view's uniform buffer and bind group (group 0 of every Pelt pipeline). Make one per
 /// camera (or per eye, per shadow view...) and [`FurView::prepare`] it each frame before
 /// submitting the passes that draw with it.
@@ -96,9 +83,8 @@ pub struct FurView {
 }
 
 impl FurView {
-    /// A view for passes drawn with `renderer` (or a [`crate::SeparatedRenderer`] made from it).
-    #[must_use]
-    pub fn new(device: &wgpu::Device, renderer: &FurRenderer) -> Self {
+    /// [`FurView::new`] with the renderer's layouts.
+    pub(crate) fn create(device: &wgpu::Device, layouts: &Layouts) -> Self {
         let buffer = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("pelt view"),
             size: size_of::<ViewUniform>() as u64,
@@ -107,7 +93,7 @@ impl FurView {
         });
         let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("pelt view"),
-            layout: &renderer.layouts().view,
+            layout: &layouts.view,
             entries: &[wgpu::BindGroupEntry { binding: 0, resource: buffer.as_entire_binding() }],
         });
         Self { buffer, bind_group }

@@ -48,14 +48,19 @@ fn every_wgsl_file_is_part_of_a_validated_module() {
         pelt_render::view_lod_shader_source(),
         pelt_render::strands_shader_source(),
     ];
-    let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("src");
+    // Every .wgsl under src/, wherever it lies.
+    let mut dirs = vec![std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("src")];
     let mut checked = 0;
-    for entry in std::fs::read_dir(&dir).expect("src dir") {
-        let path = entry.expect("entry").path();
-        if path.extension().is_some_and(|e| e == "wgsl") {
-            let text = std::fs::read_to_string(&path).expect("read");
-            assert!(sources.iter().any(|s| s.contains(&text)), "{} is in no validated module", path.display());
-            checked += 1;
+    while let Some(dir) = dirs.pop() {
+        for entry in std::fs::read_dir(&dir).expect("src dir") {
+            let path = entry.expect("entry").path();
+            if path.is_dir() {
+                dirs.push(path);
+            } else if path.extension().is_some_and(|e| e == "wgsl") {
+                let text = std::fs::read_to_string(&path).expect("read");
+                assert!(sources.iter().any(|s| s.contains(&text)), "{} is in no validated module", path.display());
+                checked += 1;
+            }
         }
     }
     assert_eq!(

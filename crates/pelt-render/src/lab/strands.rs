@@ -14,19 +14,11 @@ use pelt_core::reference::StrandReference;
 
 use crate::RenderError;
 use crate::fur::GpuFur;
-use crate::object::check_size;
-use crate::renderer::{FurRenderer, SHADING_WGSL};
-use crate::requirements::ErrorScope;
+use crate::renderer::FurRenderer;
+use crate::requirements::{ErrorScope, check_size};
+use crate::shaders::strands_shader_source;
 use crate::textures::srgb_to_linear;
 use crate::view::FurView;
-
-const STRANDS_WGSL: &str = include_str!("strands.wgsl");
-
-/// The WGSL module of the strand renderer (the shared shading plus `strands.wgsl`).
-#[must_use]
-pub fn strands_shader_source() -> String {
-    format!("{SHADING_WGSL}\n{STRANDS_WGSL}")
-}
 
 /// One ribbon vertex; matches `StrandVertex` in `strands.wgsl`.
 #[repr(C)]
@@ -233,5 +225,17 @@ impl StrandRibbons {
     #[must_use]
     pub fn triangle_count(&self) -> usize {
         self.index_count as usize / 3
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::shaders::{assert_vertex_mirrors, rust_layout};
+
+    #[test]
+    fn ribbon_vertex_mirrors_strand_vertex() {
+        let rust = rust_layout!(RibbonVertex { position, tangent, normal, colour_height, half_width });
+        assert_vertex_mirrors(&strands_shader_source(), "StrandVertex", &rust, &VERTEX_ATTRIBUTES);
     }
 }

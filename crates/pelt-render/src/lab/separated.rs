@@ -22,21 +22,13 @@ use wgpu::util::DeviceExt as _;
 
 use crate::RenderError;
 use crate::lod::PreparedLevel;
-use crate::object::{FurFrame, GpuBytes, ObjectShape, check_size, uniform_buffer};
-use crate::pipeline::{PassKind, PipelineSource, Transparency, create_pipeline};
-use crate::renderer::{FurDrawSettings, FurRenderer, SHADING_WGSL};
-use crate::requirements::ErrorScope;
+use crate::object::{FurFrame, GpuBytes, ObjectShape, uniform_buffer};
+use crate::renderer::{FurDrawSettings, FurRenderer, PassKind, PipelineSource, Transparency, create_pipeline};
+use crate::requirements::{ErrorScope, check_size};
+use crate::shaders::separated_shader_source;
 use crate::targets::FurTarget;
 use crate::textures::GpuTextures;
 use crate::view::FurView;
-
-const SEPARATED_WGSL: &str = include_str!("separated.wgsl");
-
-/// The WGSL module of the separated renderer (the shared shading plus `separated.wgsl`).
-#[must_use]
-pub fn separated_shader_source() -> String {
-    format!("{SHADING_WGSL}\n{SEPARATED_WGSL}")
-}
 
 #[repr(C)]
 #[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
@@ -46,6 +38,10 @@ struct Vertex {
     uv: Vec2,
 }
 const _: () = assert!(size_of::<Vertex>() as u64 == SEPARATED_VERTEX_BYTES, "Footprint counts 32-byte vertices");
+
+/// [`Vertex`] as `VertexIn` in `separated.wgsl` reads it.
+const VERTEX_ATTRIBUTES: [wgpu::VertexAttribute; 3] =
+    wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x2];
 
 /// The separated structure's pipelines for the target of a [`FurRenderer`], sharing its views
 /// and layouts.
@@ -76,7 +72,7 @@ impl SeparatedRenderer {
         let vertex_layout = [Some(wgpu::VertexBufferLayout {
             array_stride: SEPARATED_VERTEX_BYTES,
             step_mode: wgpu::VertexStepMode::Vertex,
-            attributes: &wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x2],
+            attributes: &VERTEX_ATTRIBUTES,
         })];
         let build_for = |label: &str, (vertex_entry, fragment_entry), kind, mesh_uvs| {
             let source = PipelineSource {
@@ -289,4 +285,16 @@ fn separated_vertices(fur: &FurStructure, fin_faces: u32) -> (Vec<Vertex>, Vec<V
         }
     }
     (shell, fin)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::shaders::{assert_vertex_mirrors, rust_layout};
+
+    #[test]
+    fn vertex_mirrors_vertex_in() {
+        let rust = rust_layout!(Vertex { position, normal, uv });
+        assert_vertex_mirrors(&separated_shader_source(), "VertexIn", &rust, &VERTEX_ATTRIBUTES);
+    }
 }

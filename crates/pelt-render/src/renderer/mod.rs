@@ -10,24 +10,19 @@
 //!    with [`FurDrawSettings::silhouette_fins`] only the edges the silhouette pass
 //!    ([`FurRenderer::prepare_fins`]) kept, through an indirect draw; else every edge.
 
+mod objects;
+mod pipeline;
+
+pub(crate) use pipeline::{PassKind, PipelineSource, Transparency, create_pipeline};
+
 use crate::RenderError;
 use crate::fur::GpuFur;
-use crate::pipeline::{Layouts, PassKind, PipelineSource, Transparency, create_pipeline};
+use crate::listing::{DRAW_ARGS_BYTES, FIN_INSTANCE_LAYOUT, ListingPasses, ShellList};
 use crate::plain::PlainMesh;
 use crate::requirements::{ErrorScope, check_features_and_limits};
-use crate::silhouette::{FIN_INSTANCE_LAYOUT, SilhouettePipelines};
+use crate::shaders::{Layouts, unified_shader_source};
 use crate::targets::FurTarget;
 use crate::view::FurView;
-use crate::view_lod::{SHELL_DRAW_BYTES, ViewLodPipelines};
-
-pub(crate) const SHADING_WGSL: &str = include_str!("shading.wgsl");
-pub(crate) const UNIFIED_WGSL: &str = include_str!("unified.wgsl");
-
-/// The WGSL module of the unified renderer (the shared shading plus `unified.wgsl`).
-#[must_use]
-pub fn unified_shader_source() -> String {
-    format!("{SHADING_WGSL}\n{UNIFIED_WGSL}")
-}
 
 /// Which parts of a fur a draw records; everything here can change every draw.
 ///
@@ -101,8 +96,8 @@ pub struct FurRenderer {
     fins: [wgpu::RenderPipeline; 2],
     /// Blended, alpha-to-coverage: the silhouette pass's edges.
     silhouette_fins: [wgpu::RenderPipeline; 2],
-    silhouette: SilhouettePipelines,
-    view_lod: ViewLodPipelines,
+    /// The silhouette and view-angle passes.
+    listing: ListingPasses,
 }
 
 impl FurRenderer {
@@ -165,10 +160,9 @@ impl FurRenderer {
             let entries = ("vs_fin_silhouette", "fs_fin");
             build_with("pelt silhouette fins", &fur_layout, entries, PassKind::Fins(t), (&instances, None))
         });
-        let silhouette = SilhouettePipelines::new(device, &layouts);
-        let view_lod = ViewLodPipelines::new(device, &layouts);
+        let listing = ListingPasses::new(device, &layouts);
         scope.pop("building the fur pipelines")?;
-        Ok(Self { target, layouts, wedges, indexed, fins, silhouette_fins, silhouette, view_lod })
+        Ok(Self { target, layouts, wedges, indexed, fins, silhouette_fins, listing })
     }
 
     /// The target description the pipelines were built for.
@@ -210,7 +204,7 @@ impl FurRenderer {
             match fur.fin_list() {
                 Some(list) if settings.silhouette_fins => {
                     pass.set_pipeline(&self.silhouette_fins[which]);
-                    geometry.draw_fin_list(pass, list);
+                    geometry.draw_fin_list(pass, &list.instances, &list.draw);
                 }
                 _ => {
                     pass.set_pipeline(&self.fins[which]);
@@ -231,12 +225,12 @@ impl FurRenderer {
     /// `fur` (until its next [`GpuFur::prepare`]) draw those shells over that list only.
     pub fn prepare_fins(&self, encoder: &mut wgpu::CommandEncoder, view: &FurView, fur: &GpuFur) {
         if let Some(list) = fur.fin_list() {
-            list.record(encoder, &self.silhouette, view.bind_group(), fur.geometry().bind_group());
+            list.record(encoder, &self.listing.silhouette, view.bind_group(), fur.geometry().bind_group());
         }
         if let Some(list) = fur.shell_list()
             && fur.prepared_level().by_view()
         {
-            list.record(encoder, &self.view_lod, view.bind_group(), fur.geometry().bind_group());
+            list.record(encoder, &self.listing.view_lod, view.bind_group(), fur.geometry().bind_group());
         }
     }
 
@@ -266,7 +260,7 @@ fn draw_thinned_shells(
     fur: &GpuFur,
     surface: &SurfacePipelines,
     which: usize,
-    list: &crate::view_lod::ShellList,
+    list: &ShellList,
 ) {
     let geometry = fur.geometry();
     let layers = geometry.shape.layers;
@@ -274,7 +268,7 @@ fn draw_thinned_shells(
         if fur.prepared_level().dropped_shell(layers, shell) {
             pass.set_pipeline(&surface.listed_shells[which]);
             pass.set_index_buffer(list.indices.slice(..), wgpu::IndexFormat::Uint32);
-            pass.draw_indexed_indirect(&list.draws, u64::from(shell) * SHELL_DRAW_BYTES);
+            pass.draw_indexed_indirect(&list.draws, u64::from(shell) * DRAW_ARGS_BYTES);
         } else {
             pass.set_pipeline(&surface.shells[which]);
             geometry.draw_surface(pass, shell..shell + 1);

@@ -9,9 +9,10 @@ use pelt_core::Mesh;
 use pelt_core::mesh::NO_FACE;
 
 use crate::RenderError;
+use crate::fur::GpuFur;
 use crate::object::FurFrame;
 
-/// One fur's topology kept on the CPU for [`crate::GpuFur::prepare_fins_on_cpu`], and the list
+/// One fur's topology kept on the CPU for [`GpuFur::prepare_fins_on_cpu`], and the list
 /// it last wrote. Make it once per mesh (its triangles, edges and the faces beside each edge).
 #[derive(Clone, Debug)]
 pub struct CpuSilhouette {
@@ -98,6 +99,45 @@ impl CpuSilhouette {
             }
         }
         Ok(&self.fins)
+    }
+}
+
+impl GpuFur {
+    /// The silhouette decision made on the CPU instead of by the compute pass of
+    /// [`FurRenderer::prepare_fins`](crate::FurRenderer::prepare_fins): decides which fins show
+    /// for the base vertices `positions` (the first `V` are used: layer 0 of the shared array as
+    /// drawn, model space), `frame` (the one given to [`GpuFur::prepare`]) and the camera at
+    /// `camera_position_world`, and writes the fins' list and indirect draw with `queue`. Draw
+    /// with [`crate::FurDrawSettings::silhouette_fins`] as after the compute pass; record no
+    /// compute pass for this fur and view. Returns the number of fins kept (0 for a fur without
+    /// fins).
+    ///
+    /// # Errors
+    /// [`RenderError::Count`] when `silhouette` was made for a mesh with another edge count, or
+    /// `positions` holds fewer than `V` positions.
+    pub fn prepare_fins_on_cpu(
+        &self,
+        queue: &wgpu::Queue,
+        silhouette: &mut CpuSilhouette,
+        positions: &[Vec3],
+        frame: &FurFrame,
+        camera_position_world: Vec3,
+    ) -> Result<u32, RenderError> {
+        let expected = self.geometry().shape.edge_count as usize;
+        if silhouette.edge_count() != expected {
+            return Err(RenderError::Count {
+                what: "CPU silhouette edges",
+                expected,
+                got: silhouette.edge_count(),
+                rule: "the fur's mesh's edges",
+            });
+        }
+        let Some(list) = self.fin_list() else {
+            return Ok(0);
+        };
+        let fins = silhouette.decide(positions, frame, camera_position_world)?;
+        list.write(queue, fins, frame.level.shells(self.layers()));
+        Ok(fins.len() as u32)
     }
 }
 

@@ -1,0 +1,110 @@
+//! Silhouette fins: the pass decides once per edge per frame which fins show (`silhouette.wgsl`)
+//! and writes them as the instances of an indexed indirect draw, so the fin pass shades only
+//! those edges instead of every edge and every vertex testing its own edge.
+
+use wgpu::util::DrawIndexedIndirectArgs;
+
+use super::{DRAW_ARGS_BYTES, ListingPipelines, check_scan_width, item_groups, list_bind_group};
+use crate::RenderError;
+use crate::requirements::check_size;
+use crate::shaders::Layouts;
+
+/// One fin instance: the edge and its fade (f32 bits).
+const FIN_INSTANCE_BYTES: u64 = 8;
+
+/// The vertex input of the silhouette fin pipelines: one `(edge, fade bits)` per instance.
+pub(crate) const FIN_INSTANCE_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayout {
+    array_stride: FIN_INSTANCE_BYTES,
+    step_mode: wgpu::VertexStepMode::Instance,
+    attributes: &[wgpu::VertexAttribute { format: wgpu::VertexFormat::Uint32x2, offset: 0, shader_location: 0 }],
+};
+
+/// The indirect draw of `fins` fins of `segments` segments each.
+fn fin_draw(segments: u32, fins: u32) -> DrawIndexedIndirectArgs {
+    DrawIndexedIndirectArgs {
+        index_count: 6 * segments,
+        instance_count: fins,
+        first_index: 0,
+        base_vertex: 0,
+        first_instance: 0,
+    }
+}
+
+/// One fur's fins as the silhouette pass leaves them: the indirect draw and its instances.
+#[derive(Debug)]
+pub(crate) struct FinList {
+    /// `DrawIndexedIndirectArgs`: `6L` indices, the instance count the pass counted.
+    pub draw: wgpu::Buffer,
+    /// Up to `E` instances of [`FIN_INSTANCE_LAYOUT`].
+    pub instances: wgpu::Buffer,
+    bind_group: wgpu::BindGroup,
+    edge_count: u32,
+}
+
+impl FinList {
+    /// The list of a fur with `edge_count` edges and `layers` layers; `None` without fins.
+    pub fn new(
+        device: &wgpu::Device,
+        layouts: &Layouts,
+        edge_count: u32,
+        layers: u32,
+    ) -> Result<Option<Self>, RenderError> {
+        if edge_count == 0 || layers == 0 {
+            return Ok(None);
+        }
+        let instance_bytes = u64::from(edge_count) * FIN_INSTANCE_BYTES;
+        check_size(device, "fin instances", instance_bytes)?;
+        check_scan_width(device)?;
+        let draw = wgpu::util::DeviceExt::create_buffer_init(
+            device,
+            &wgpu::util::BufferInitDescriptor {
+                label: Some("pelt fin draw"),
+                contents: fin_draw(layers, 0).as_bytes(),
+                usage: wgpu::BufferUsages::STORAGE
+                    | wgpu::BufferUsages::INDIRECT
+                    | wgpu::BufferUsages::COPY_DST
+                    | wgpu::BufferUsages::COPY_SRC,
+            },
+        );
+        debug_assert_eq!(draw.size(), DRAW_ARGS_BYTES);
+        let instances = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("pelt fin instances"),
+            size: instance_bytes,
+            usage: wgpu::BufferUsages::STORAGE
+                | wgpu::BufferUsages::VERTEX
+                | wgpu::BufferUsages::COPY_DST
+                | wgpu::BufferUsages::COPY_SRC,
+            mapped_at_creation: false,
+        });
+        let bind_group = list_bind_group(device, "pelt fin list", &layouts.fin_list, &[&draw, &instances]);
+        Ok(Some(Self { draw, instances, bind_group, edge_count }))
+    }
+
+    /// Records the silhouette pass: every edge's fade, then one workgroup lists the shown fins
+    /// in edge order and writes the draw's count (both write the instances).
+    pub fn record(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        pipelines: &ListingPipelines<2>,
+        view: &wgpu::BindGroup,
+        object: &wgpu::BindGroup,
+    ) {
+        pipelines.record(encoder, (view, object, &self.bind_group), [item_groups(self.edge_count), (1, 1)]);
+    }
+
+    /// Writes a list decided on the CPU (`(edge, fade bits)` per fin, at most `E`) and its
+    /// indirect draw of `segments` segments a fin, in place of the compute pass.
+    #[cfg(feature = "lab")]
+    pub fn write(&self, queue: &wgpu::Queue, fins: &[[u32; 2]], segments: u32) {
+        let fins = &fins[..fins.len().min(self.edge_count as usize)];
+        if !fins.is_empty() {
+            queue.write_buffer(&self.instances, 0, bytemuck::cast_slice(fins));
+        }
+        queue.write_buffer(&self.draw, 0, fin_draw(segments, fins.len() as u32).as_bytes());
+    }
+
+    /// GPU bytes of the list.
+    pub fn bytes(&self) -> u64 {
+        self.draw.size() + self.instances.size()
+    }
+}

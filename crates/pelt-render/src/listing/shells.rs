@@ -1,0 +1,98 @@
+//! Shells by view angle, the culling half: the pass lists, once per frame and view, the triangles
+//! that still show in the layers the next coarser stride drops (`view_lod.wgsl`), and writes one
+//! indexed indirect draw per shell over that list. The renderer then draws the kept shells over
+//! every triangle and the thinned ones over the list, one shell at a time from the innermost out
+//! (blending needs that order). Facing the eye, most triangles leave the list.
+//!
+//! A fur drawn without the pass (or whose mesh is too large to number every shell's vertices in
+//! one `u32`) draws every triangle in every shell, with the same view-angle fading: the same
+//! picture, without the savings.
+
+use std::sync::atomic::{AtomicBool, Ordering};
+
+use super::{DRAW_ARGS_BYTES, ListingPipelines, check_scan_width, item_groups, list_bind_group};
+use crate::RenderError;
+use crate::requirements::check_size;
+use crate::shaders::Layouts;
+
+/// Shells one workgroup writes draws for (`cs_view_lod_draws` in `view_lod.wgsl`).
+const WORKGROUP: u32 = 64;
+
+/// One fur's shell list as the pass leaves it.
+#[derive(Debug)]
+pub(crate) struct ShellList {
+    /// Indices listed (3 a triangle), one `u32`; `COPY_SRC` for hosts that count.
+    pub listed: wgpu::Buffer,
+    /// The listed triangles' corners or base vertices (the index buffer of the thinned shells).
+    pub indices: wgpu::Buffer,
+    /// One `DrawIndexedIndirectArgs` per shell, [`DRAW_ARGS_BYTES`] apart.
+    pub draws: wgpu::Buffer,
+    bind_group: wgpu::BindGroup,
+    layers: u32,
+    triangle_count: u32,
+    /// Whether the pass was recorded since the fur's last `prepare` (else the list may be from
+    /// another level or view, and the shells are drawn whole).
+    recorded: AtomicBool,
+}
+
+impl ShellList {
+    /// The list of a fur of `triangle_count` triangles, `layers` layers and `per_shell` vertex
+    /// indices a shell (the wedges with uvs, V without); `None` where there is nothing to thin (fewer
+    /// than two layers) or the shells' vertex indices would not fit an `i32` base vertex.
+    pub fn new(
+        device: &wgpu::Device,
+        layouts: &Layouts,
+        (triangle_count, per_shell): (u32, u32),
+        layers: u32,
+    ) -> Result<Option<Self>, RenderError> {
+        let numbered = u64::from(layers) * u64::from(per_shell);
+        if layers < 2 || triangle_count == 0 || numbered > i32::MAX as u64 {
+            return Ok(None);
+        }
+        let index_bytes = u64::from(triangle_count) * 12;
+        check_size(device, "view-angle shell list", index_bytes)?;
+        check_scan_width(device)?;
+        let buffer = |label, size, usage| {
+            device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size,
+                usage: usage | wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC,
+                mapped_at_creation: false,
+            })
+        };
+        let listed = buffer("pelt shell list count", 4, wgpu::BufferUsages::COPY_DST);
+        let indices = buffer("pelt shell list", index_bytes, wgpu::BufferUsages::INDEX);
+        let draws = buffer("pelt shell draws", u64::from(layers) * DRAW_ARGS_BYTES, wgpu::BufferUsages::INDIRECT);
+        let bind_group = list_bind_group(device, "pelt shell list", &layouts.shell_list, &[&listed, &indices, &draws]);
+        Ok(Some(Self { listed, indices, draws, bind_group, layers, triangle_count, recorded: AtomicBool::new(false) }))
+    }
+
+    /// Records the pass: every triangle's flag, then one workgroup lists the triangles in order,
+    /// then the draws are written.
+    pub fn record(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        pipelines: &ListingPipelines<3>,
+        view: &wgpu::BindGroup,
+        object: &wgpu::BindGroup,
+    ) {
+        let groups = [item_groups(self.triangle_count), (1, 1), (self.layers.div_ceil(WORKGROUP), 1)];
+        pipelines.record(encoder, (view, object, &self.bind_group), groups);
+        self.recorded.store(true, Ordering::Relaxed);
+    }
+
+    /// Forgets the last pass (a new level or frame is being prepared).
+    pub fn invalidate(&self) {
+        self.recorded.store(false, Ordering::Relaxed);
+    }
+
+    /// Whether the pass was recorded since the last [`ShellList::invalidate`].
+    pub fn recorded(&self) -> bool {
+        self.recorded.load(Ordering::Relaxed)
+    }
+
+    /// GPU bytes of the list.
+    pub fn bytes(&self) -> u64 {
+        self.listed.size() + self.indices.size() + self.draws.size()
+    }
+}

@@ -1,0 +1,84 @@
+//! The constructors of what a [`FurRenderer`] draws ([`GpuFur`], [`PlainMesh`], [`FurView`]).
+//! Each takes the renderer for its bind group layouts; they live here, with the renderer, because
+//! the renderer sits above the data it draws (the types themselves know only the layouts).
+
+use pelt_core::texture::FurTextures;
+use pelt_core::{FurStructure, Mesh};
+
+use super::FurRenderer;
+use crate::RenderError;
+use crate::fur::{FurStates, GpuFur};
+use crate::plain::PlainMesh;
+use crate::view::FurView;
+
+impl GpuFur {
+    /// Uploads `structure` (its rest pose into every state) and `textures` for drawing with
+    /// `renderer`.
+    ///
+    /// # Errors
+    /// [`RenderError::TooLarge`] when the structure exceeds the device's buffer limits,
+    /// [`RenderError::Textures`] for malformed textures, [`RenderError::OutOfMemory`] or
+    /// [`RenderError::Gpu`] where the device reports one.
+    pub fn new(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        renderer: &FurRenderer,
+        structure: &FurStructure,
+        textures: &FurTextures,
+        states: FurStates,
+    ) -> Result<Self, RenderError> {
+        Self::upload(device, queue, renderer.layouts(), structure, textures, states)
+    }
+
+    /// Replaces the structure (new mesh, layer count or rest pose), keeping the textures and the
+    /// number of states.
+    ///
+    /// # Errors
+    /// As [`GpuFur::new`].
+    pub fn set_structure(
+        &mut self,
+        device: &wgpu::Device,
+        renderer: &FurRenderer,
+        structure: &FurStructure,
+    ) -> Result<(), RenderError> {
+        self.upload_structure(device, renderer.layouts(), structure)
+    }
+
+    /// Replaces the shell and fin textures (any slice count: slices are spread over the layers).
+    ///
+    /// # Errors
+    /// [`RenderError::Textures`] for malformed textures, [`RenderError::OutOfMemory`].
+    pub fn set_textures(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        renderer: &FurRenderer,
+        textures: &FurTextures,
+    ) -> Result<(), RenderError> {
+        self.upload_textures(device, queue, renderer.layouts(), textures)
+    }
+}
+
+impl PlainMesh {
+    /// Uploads `mesh`, drawn in linear RGB `colour`.
+    ///
+    /// # Errors
+    /// [`RenderError::TooLarge`] when the mesh exceeds the device's buffer limits,
+    /// [`RenderError::OutOfMemory`] or [`RenderError::Gpu`].
+    pub fn new(
+        device: &wgpu::Device,
+        renderer: &FurRenderer,
+        mesh: &Mesh,
+        colour: glam::Vec3,
+    ) -> Result<Self, RenderError> {
+        Self::upload(device, renderer.layouts(), mesh, colour)
+    }
+}
+
+impl FurView {
+    /// A view for passes drawn with `renderer` (or a `SeparatedRenderer` made from it).
+    #[must_use]
+    pub fn new(device: &wgpu::Device, renderer: &FurRenderer) -> Self {
+        Self::create(device, renderer.layouts())
+    }
+}

@@ -1,0 +1,141 @@
+//! The bind group layouts every pipeline of one renderer shares (groups 0 to 3 of `shading.wgsl`,
+//! `silhouette.wgsl` and `view_lod.wgsl`), and the samplers the fur textures are read with.
+
+/// The bind group layouts and samplers of one renderer, shared by everything it draws.
+#[derive(Debug, Clone)]
+pub(crate) struct Layouts {
+    /// Group 0: the view uniform.
+    pub view: wgpu::BindGroupLayout,
+    /// Group 1 of the unified structure and plain meshes: the object uniform and the storage
+    /// buffers (positions twice, base normals, wedge uvs, topology).
+    pub unified_object: wgpu::BindGroupLayout,
+    /// Group 1 of the separated structure: the object uniform and the fin vertices.
+    #[cfg(feature = "lab")]
+    pub separated_object: wgpu::BindGroupLayout,
+    /// Group 2: a fur's textures and the samplers.
+    pub textures: wgpu::BindGroupLayout,
+    /// Group 3 of the silhouette pass: a fur's fin list.
+    pub fin_list: wgpu::BindGroupLayout,
+    /// Group 3 of the view-angle pass: a fur's shell list.
+    pub shell_list: wgpu::BindGroupLayout,
+    pub shell_sampler: wgpu::Sampler,
+    pub fin_sampler: wgpu::Sampler,
+}
+
+impl Layouts {
+    pub fn new(device: &wgpu::Device) -> Self {
+        let uniform = wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Uniform,
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        };
+        let storage = wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Storage { read_only: true },
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        };
+        // The silhouette pass (compute) reads the view, the object and its positions too.
+        let both = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT | wgpu::ShaderStages::COMPUTE;
+        let entry = |binding, visibility, ty| wgpu::BindGroupLayoutEntry { binding, visibility, ty, count: None };
+        let view = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("pelt view"),
+            entries: &[entry(0, both, uniform)],
+        });
+        // Storage buffers are read by vertex shaders and the silhouette pass only, so fragment
+        // stages need no storage.
+        let vertex = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::COMPUTE;
+        let unified_object = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("pelt unified object"),
+            entries: &[
+                entry(0, both, uniform),
+                entry(1, vertex, storage),
+                entry(2, vertex, storage),
+                entry(3, vertex, storage),
+                entry(4, vertex, storage),
+                entry(5, vertex, storage),
+            ],
+        });
+        // The separated fins' vertices, read back by each fin vertex to decide for its whole fin.
+        #[cfg(feature = "lab")]
+        let separated_object = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("pelt separated object"),
+            entries: &[entry(0, both, uniform), entry(1, vertex, storage)],
+        });
+        let texture = |view_dimension| wgpu::BindingType::Texture {
+            sample_type: wgpu::TextureSampleType::Float { filterable: true },
+            view_dimension,
+            multisampled: false,
+        };
+        let filtering = wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering);
+        let fragment = wgpu::ShaderStages::FRAGMENT;
+        let textures = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("pelt fur textures"),
+            entries: &[
+                entry(0, fragment, texture(wgpu::TextureViewDimension::D2Array)),
+                entry(1, fragment, texture(wgpu::TextureViewDimension::D2)),
+                entry(2, fragment, filtering),
+                entry(3, fragment, filtering),
+                entry(4, fragment, texture(wgpu::TextureViewDimension::D2)),
+            ],
+        });
+        let sampler = |label, v_mode| {
+            device.create_sampler(&wgpu::SamplerDescriptor {
+                label: Some(label),
+                address_mode_u: wgpu::AddressMode::Repeat,
+                address_mode_v: v_mode,
+                mag_filter: wgpu::FilterMode::Linear,
+                min_filter: wgpu::FilterMode::Linear,
+                mipmap_filter: wgpu::MipmapFilterMode::Linear,
+                ..wgpu::SamplerDescriptor::default()
+            })
+        };
+        Self {
+            view,
+            unified_object,
+            #[cfg(feature = "lab")]
+            separated_object,
+            textures,
+            // The fin list: the indirect draw and its instances.
+            fin_list: list_layout(device, "pelt fin list", 2),
+            // The shell list: the count, the listed indices and one indirect draw per shell.
+            shell_list: list_layout(device, "pelt shell list", 3),
+            shell_sampler: sampler("pelt shell sampler", wgpu::AddressMode::Repeat),
+            // Fin rows run root to tip: clamp so the tips do not bleed into the roots.
+            fin_sampler: sampler("pelt fin sampler", wgpu::AddressMode::ClampToEdge),
+        }
+    }
+
+    /// The layout of pipelines that draw with `object` in group 1, with or without textures.
+    pub fn pipeline_layout(
+        &self,
+        device: &wgpu::Device,
+        label: &str,
+        object: &wgpu::BindGroupLayout,
+        with_textures: bool,
+    ) -> wgpu::PipelineLayout {
+        let with = [Some(&self.view), Some(object), Some(&self.textures)];
+        device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some(label),
+            bind_group_layouts: if with_textures { &with } else { &with[..2] },
+            immediate_size: 0,
+        })
+    }
+}
+
+/// The layout of one fur's list (group 3 of a listing pass): `buffers` storage buffers the
+/// compute stage writes, at bindings `0..buffers`.
+fn list_layout(device: &wgpu::Device, label: &str, buffers: u32) -> wgpu::BindGroupLayout {
+    let entries: Vec<_> = (0..buffers)
+        .map(|binding| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: wgpu::ShaderStages::COMPUTE,
+            ty: wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Storage { read_only: false },
+                has_dynamic_offset: false,
+                min_binding_size: None,
+            },
+            count: None,
+        })
+        .collect();
+    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(label), entries: &entries })
+}

@@ -1,0 +1,78 @@
+//! Every WGSL source of the renderer and what pins the Rust side to it: the bind group layouts
+//! (and samplers) the pipelines share, and the Rust mirrors of the WGSL structs the host side
+//! writes. Nothing here depends on the rest of the crate but the error type, so every other
+//! module may import it.
+//!
+//! A module of WGSL is its files concatenated in order (`shading.wgsl` first): WGSL has no
+//! imports, and one module per pipeline family keeps each `ShaderModule` self-contained.
+
+mod layouts;
+mod mirrors;
+
+pub(crate) use layouts::Layouts;
+#[cfg(all(test, feature = "lab"))]
+pub(crate) use mirrors::assert_vertex_mirrors;
+pub(crate) use mirrors::{OBJECT_UNIFORM_BYTES, ObjectUniform, ViewUniform};
+#[cfg(test)]
+pub(crate) use mirrors::{RustLayout, assert_mirrors, rust_layout};
+
+/// The view, the object uniform, the fur textures and the lighting every fur pipeline shares.
+pub(crate) const SHADING_WGSL: &str = include_str!("shading.wgsl");
+/// The unified structure's vertex and fragment shaders, over the shared vertex array.
+const UNIFIED_WGSL: &str = include_str!("unified.wgsl");
+/// The ordered listing both listing passes share.
+const SCAN_WGSL: &str = include_str!("scan.wgsl");
+/// The silhouette pass: which fins show.
+const SILHOUETTE_WGSL: &str = include_str!("silhouette.wgsl");
+/// The view-angle pass: which triangles the thinned shells still need.
+const VIEW_LOD_WGSL: &str = include_str!("view_lod.wgsl");
+/// The wind's noise, shared by the simulation's step.
+const SIMULATION_WIND_WGSL: &str = include_str!("simulation_wind.wgsl");
+/// One simulation step, one invocation a strand.
+const SIMULATION_WGSL: &str = include_str!("simulation.wgsl");
+/// The separated structure of Lengyel et al. 2001 (the `lab` feature's baseline).
+#[cfg(feature = "lab")]
+const SEPARATED_WGSL: &str = include_str!("separated.wgsl");
+/// The explicit strands as ribbons (the `lab` feature's reference).
+#[cfg(feature = "lab")]
+const STRANDS_WGSL: &str = include_str!("strands.wgsl");
+
+/// The WGSL module of the unified renderer (the shared shading plus `unified.wgsl`).
+#[must_use]
+pub fn unified_shader_source() -> String {
+    format!("{SHADING_WGSL}\n{UNIFIED_WGSL}")
+}
+
+/// The WGSL module of the silhouette pass (the shared shading, `unified.wgsl`, `scan.wgsl` and
+/// `silhouette.wgsl`).
+#[must_use]
+pub fn silhouette_shader_source() -> String {
+    format!("{SHADING_WGSL}\n{UNIFIED_WGSL}\n{SCAN_WGSL}\n{SILHOUETTE_WGSL}")
+}
+
+/// The WGSL module of the view-angle pass (the shared shading, `unified.wgsl`, `scan.wgsl` and
+/// `view_lod.wgsl`).
+#[must_use]
+pub fn view_lod_shader_source() -> String {
+    format!("{SHADING_WGSL}\n{UNIFIED_WGSL}\n{SCAN_WGSL}\n{VIEW_LOD_WGSL}")
+}
+
+/// The WGSL module of the GPU simulation (`simulation_wind.wgsl` plus `simulation.wgsl`).
+#[must_use]
+pub fn simulation_shader_source() -> String {
+    format!("{SIMULATION_WIND_WGSL}\n{SIMULATION_WGSL}")
+}
+
+/// The WGSL module of the separated renderer (the shared shading plus `separated.wgsl`).
+#[must_use]
+#[cfg(feature = "lab")]
+pub fn separated_shader_source() -> String {
+    format!("{SHADING_WGSL}\n{SEPARATED_WGSL}")
+}
+
+/// The WGSL module of the strand renderer (the shared shading plus `strands.wgsl`).
+#[must_use]
+#[cfg(feature = "lab")]
+pub fn strands_shader_source() -> String {
+    format!("{SHADING_WGSL}\n{STRANDS_WGSL}")
+}
