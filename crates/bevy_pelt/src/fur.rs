@@ -18,7 +18,7 @@ use bevy::mesh::{Mesh, Mesh3d};
 use bevy::prelude::{GlobalTransform, Name, Time};
 use bevy::shape::Ray3d;
 use pelt_core::anim::Skin;
-use pelt_core::sim::WindParams;
+use pelt_core::sim::{FurStepper, WindParams};
 use pelt_core::texture::FurTextures;
 use pelt_core::{FurStructure, Simulation};
 
@@ -112,7 +112,8 @@ impl FurTouch {
 pub struct FurState {
     pub(crate) structure: Arc<FurStructure>,
     pub(crate) textures: Arc<FurTextures>,
-    simulation: Simulation,
+    /// The simulation, its base posed from the entity's transform or skeleton each frame.
+    stepper: FurStepper,
     /// Changes whenever the structure or textures do, so the render world re-uploads.
     pub(crate) revision: u64,
     preset: AssetId<FurPreset>,
@@ -128,8 +129,6 @@ pub struct FurState {
     /// The skin when the entity has a `SkinnedMesh`: the base follows Bevy's joints.
     skin: Option<Skin>,
     base: Base,
-    /// Whether the simulation has started from a posed base (it restarts at rest there first).
-    started: bool,
     radius: f32,
 }
 
@@ -137,7 +136,7 @@ impl FurState {
     /// The simulation (its parameters, touch, positions).
     #[must_use]
     pub fn simulation(&self) -> &Simulation {
-        &self.simulation
+        self.stepper.simulation()
     }
 
     /// Takes the simulation's positions to world space: the simulation runs where the fur is in
@@ -227,13 +226,13 @@ fn build(
     let params = preset.preset.fur_params(&mesh);
     let radius = mesh.bounding_sphere().1;
     let structure = FurStructure::new(mesh, &params).map_err(|e| format!("{}: {e}", preset.preset.file().display()))?;
-    let simulation = Simulation::new(&structure, &preset.preset.simulation)
+    let stepper = FurStepper::new(&structure, &preset.preset.simulation)
         .map_err(|e| format!("{}: {e}", preset.preset.file().display()))?;
-    let positions = Arc::new(simulation.positions().to_vec());
+    let positions = Arc::new(stepper.simulation().positions().to_vec());
     Ok(FurState {
         structure: Arc::new(structure),
         textures: Arc::clone(&preset.textures),
-        simulation,
+        stepper,
         revision,
         preset: preset_id,
         mesh: mesh_id,
@@ -243,7 +242,6 @@ fn build(
         centre_world: glam::Vec3::ZERO,
         skin,
         base: Base::default(),
-        started: false,
         radius,
     })
 }
@@ -273,13 +271,15 @@ pub(crate) fn simulate_furs(
             }
         }
         let base = &state.base;
-        if let Err(problem) = state.simulation.set_base_rotations(&base.positions, &base.rotations) {
+        // The first pose restarts the simulation there, at rest, rather than swinging in from
+        // the rest pose.
+        if let Err(problem) = state.stepper.set_pose(&base.positions, &base.normals, &base.rotations) {
             error!("fur on {entity}: {problem}");
             continue;
         }
         state.world_from_simulation = base.world_from_simulation();
         state.centre_world = state.world_from_simulation.transform_point3(box_centre(&base.positions));
-        let mut params = state.simulation.params().clone();
+        let mut params = state.stepper.simulation().params().clone();
         // The preset's gravity direction is the world's (Bevy's +Y is up), and so is the
         // simulation's frame.
         if let Some(preset) = presets.get(fur.preset.id()) {
@@ -291,15 +291,14 @@ pub(crate) fn simulate_furs(
             gust_strength: wind.gust_strength,
             ..params.wind
         };
-        if let Err(problem) = state.simulation.set_params(&params) {
+        if let Err(problem) = state.stepper.simulation_mut().set_params(&params) {
             error!("fur on {entity}: {problem}");
         }
-        state.simulation.advance_to(now);
-        if !std::mem::replace(&mut state.started, true) {
-            // The first pose: start there at rest rather than swinging in from the rest pose.
-            state.simulation.restart();
+        if let Err(problem) = state.stepper.advance_to(now) {
+            error!("fur on {entity}: {problem}");
+            continue;
         }
-        state.positions = Arc::new(state.simulation.positions().to_vec());
+        state.positions = Arc::new(state.stepper.simulation().positions().to_vec());
         state.normals = Arc::new(state.base.normals.clone());
     }
 }
@@ -348,7 +347,7 @@ fn update_touch(touch: &mut FurTouch, furs: &mut FurQuery) {
         (None, None) => {}
         (None, Some(active)) => {
             if let Ok((.., mut state)) = furs.get_mut(active.entity) {
-                state.simulation.touch_end();
+                state.stepper.simulation_mut().touch_end();
             }
             touch.active = None;
         }
@@ -356,7 +355,7 @@ fn update_touch(touch: &mut FurTouch, furs: &mut FurQuery) {
             let point = ray.get_point(active.distance);
             if let Ok((.., mut state)) = furs.get_mut(active.entity) {
                 let point = state.world_from_simulation.inverse().transform_point3(to_pelt(point));
-                if let Err(problem) = state.simulation.touch_drag(point) {
+                if let Err(problem) = state.stepper.simulation_mut().touch_drag(point) {
                     error!("fur touch: {problem}");
                 }
             } else {
@@ -372,7 +371,7 @@ fn update_touch(touch: &mut FurTouch, furs: &mut FurQuery) {
                 && let Ok((.., mut state)) = furs.get_mut(entity)
             {
                 let radius = (radius_fraction * state.radius).max(1e-6);
-                match state.simulation.touch_begin(point, radius) {
+                match state.stepper.simulation_mut().touch_begin(point, radius) {
                     Ok(()) => touch.active = Some(ActiveTouch { entity, distance }),
                     Err(problem) => error!("fur touch: {problem}"),
                 }

@@ -15,9 +15,10 @@ use bevy::render::camera::ExtractedCamera;
 use bevy::render::renderer::{RenderContext, RenderDevice, RenderQueue, ViewQuery};
 use bevy::render::view::{ExtractedView, Msaa, ResolvedCompositingSpace, ViewDepthStencilTexture, ViewTarget};
 use pelt_core::FurStructure;
+use pelt_core::sim::SimParams;
 use pelt_core::texture::FurTextures;
 use pelt_render::{
-    FurDrawSettings, FurFrame, FurRenderer, FurStates, FurTarget, FurView, GpuFur, Light, LightDirection, ViewData,
+    FurDrawSettings, FurDriver, FurRenderer, FurTarget, FurView, KernelChoice, Light, LightDirection, ViewData,
 };
 
 use crate::convert::{to_pelt, to_pelt_mat4};
@@ -129,7 +130,8 @@ pub(crate) struct FurGpu {
 }
 
 struct GpuFurEntry {
-    fur: GpuFur,
+    /// Draws the states the main world's `FurStepper` simulates (the CPU kernel).
+    fur: FurDriver,
     revision: u64,
 }
 
@@ -223,7 +225,9 @@ pub(crate) fn prepare_furs(
             let renderer = &gpu.renderers[&target];
             let stale = gpu.furs.get(&key).is_none_or(|entry| entry.revision != fur.revision);
             if stale {
-                match GpuFur::new(device, queue, renderer, &fur.structure, &fur.textures, FurStates::One) {
+                let params = SimParams::default();
+                match FurDriver::new(device, queue, renderer, &fur.structure, &fur.textures, &params, KernelChoice::Cpu)
+                {
                     Ok(gpu_fur) => {
                         gpu.furs.insert(key, GpuFurEntry { fur: gpu_fur, revision: fur.revision });
                     }
@@ -235,20 +239,14 @@ pub(crate) fn prepare_furs(
                     }
                 }
             }
-            let entry = &gpu.furs[&key];
-            // Before the first simulated frame the normals are the rest ones GpuFur starts with.
-            if !fur.normals.is_empty()
-                && let Err(problem) = entry.fur.set_base_normals(queue, &fur.normals)
-            {
+            let Some(entry) = gpu.furs.get_mut(&key) else { continue };
+            entry.fur.set_world_from_model(fur.world_from_simulation);
+            // Before the first simulated frame the normals are the rest ones the fur starts with.
+            let normals = (!fur.normals.is_empty()).then_some(&fur.normals[..]);
+            if let Err(problem) = entry.fur.show_state(queue, &fur.positions, normals) {
                 error!("Pelt cannot update the fur of {}: {problem}", fur.entity);
                 continue;
             }
-            if let Err(problem) = entry.fur.set_positions(queue, &fur.positions) {
-                error!("Pelt cannot update the fur of {}: {problem}", fur.entity);
-                continue;
-            }
-            let frame = FurFrame { world_from_model: fur.world_from_simulation, ..FurFrame::default() };
-            entry.fur.prepare(queue, &frame);
             seen_furs.insert(key);
         }
     }
@@ -268,7 +266,7 @@ pub(crate) fn draw_furs(
     let Some(entry) = gpu.views.get(&view_entity) else { return };
     let Some(renderer) = gpu.renderers.get(&entry.target) else { return };
     // Farthest first: shells and fins blend over what is behind them.
-    let mut furs: Vec<(&ExtractedFur, &GpuFur)> = extracted
+    let mut furs: Vec<(&ExtractedFur, &FurDriver)> = extracted
         .furs
         .iter()
         .filter_map(|fur| gpu.furs.get(&(fur.entity, entry.target)).map(|e| (fur, &e.fur)))
@@ -309,8 +307,8 @@ pub(crate) fn draw_furs(
         let (position, size) = (viewport.physical_position.as_vec2(), viewport.physical_size.as_vec2());
         pass.set_viewport(position.x, position.y, size.x, size.y, viewport.depth.start, viewport.depth.end);
     }
-    for (fur, gpu_fur) in furs {
+    for (fur, driver) in furs {
         let settings = FurDrawSettings { skin: fur.skin, ..FurDrawSettings::ALL };
-        renderer.draw(&mut pass, &entry.view, gpu_fur, &settings);
+        driver.draw(&mut pass, renderer, &entry.view, &settings);
     }
 }

@@ -298,6 +298,34 @@ impl FurDriver {
         self.upload(device, queue, simulation, None)
     }
 
+    /// Draws a state simulated elsewhere: a host whose [`FurStepper`] lives apart from its GPU
+    /// objects (Bevy's main and render worlds) hands over the stepper's output
+    /// ([`Simulation::positions`], model space) and, when the base moved, its normals. This is
+    /// the CPU kernel's upload: a driver on the GPU kernel switches to the CPU kernel.
+    ///
+    /// # Errors
+    /// [`RenderError::Count`] unless there are `(L + 1) * V` positions and `V` normals.
+    pub fn show_state(
+        &mut self,
+        queue: &wgpu::Queue,
+        positions: &[glam::Vec3],
+        moved_normals: Option<&[glam::Vec3]>,
+    ) -> Result<(), RenderError> {
+        if self.kernel == SimKernel::Gpu {
+            self.gpu_simulation = None;
+            self.kernel = SimKernel::Cpu;
+            self.kernel_reason = "the host hands over states simulated on the CPU".to_owned();
+            self.unrecorded = false;
+        }
+        self.fur.set_positions(queue, positions)?;
+        self.frame.interpolation = 1.0;
+        if let Some(normals) = moved_normals {
+            self.fur.set_base_normals(queue, normals)?;
+        }
+        self.fur.prepare(queue, &self.frame);
+        Ok(())
+    }
+
     /// With the GPU kernel, steps prepared and never recorded mean the host does not record:
     /// the CPU bends from now on.
     fn fall_back_when_unrecorded(&mut self) {

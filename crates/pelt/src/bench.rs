@@ -57,7 +57,7 @@ pub struct Args {
     /// Also time every structure at this frame size (repeat for several), with frames per
     /// second as a game loop without vsync gets them: frames submitted back to back, two in
     /// flight.
-    #[arg(long = "size", value_name = "WIDTHxHEIGHT", value_parser = crate::render::parse_size)]
+    #[arg(long = "size", value_name = "WIDTHxHEIGHT", value_parser = crate::values::parse_size)]
     pub sizes: Vec<(u32, u32)>,
     /// Steps of `--soak` on the CPU kernel.
     #[arg(long, value_name = "N", default_value_t = 1_000_000, requires = "soak")]

@@ -9,6 +9,7 @@ mod render;
 mod sim_kernel;
 mod stats;
 mod textures;
+mod values;
 mod view;
 
 use clap::{Parser, Subcommand};

@@ -58,14 +58,14 @@ pub struct Args {
     #[arg(long, default_value_t = 30.0)]
     fps: f64,
     /// Image size, WIDTHxHEIGHT.
-    #[arg(long, default_value = "1280x720", value_parser = parse_size)]
+    #[arg(long, default_value = "1280x720", value_parser = crate::values::parse_size)]
     size: (u32, u32),
     /// Camera as azimuth,elevation (degrees) and distance (world units) around the meshes'
     /// centre; without it the camera frames the meshes automatically.
-    #[arg(long, value_name = "AZIMUTH,ELEVATION,DISTANCE", value_parser = parse_vec3, allow_hyphen_values = true)]
+    #[arg(long, value_name = "AZIMUTH,ELEVATION,DISTANCE", value_parser = crate::values::parse_vec3, allow_hyphen_values = true)]
     camera: Option<Vec3>,
     /// Wind x,y,z (direction and strength; 0,0,0 for none). Default: the preset's, or a light breeze.
-    #[arg(long, value_name = "X,Y,Z", value_parser = parse_vec3, allow_hyphen_values = true)]
+    #[arg(long, value_name = "X,Y,Z", value_parser = crate::values::parse_vec3, allow_hyphen_values = true)]
     wind: Option<Vec3>,
     /// Graphics backend: vulkan, gl (or metal, dx12); default `WGPU_BACKEND`, else the best there is.
     #[arg(long, default_value = "auto")]
@@ -78,7 +78,7 @@ pub struct Args {
     #[arg(long)]
     alpha_to_coverage: bool,
     /// MSAA samples: 1, 2, 4 or 8. Default: 1 on a CPU rasteriser (lavapipe), 4 on a GPU.
-    #[arg(long, value_name = "N", value_parser = parse_msaa)]
+    #[arg(long, value_name = "N", value_parser = crate::values::parse_msaa)]
     msaa: Option<u32>,
     /// Leave out the fins (shells only).
     #[arg(long)]
@@ -340,48 +340,9 @@ fn save_png(image: &image::RgbaImage, path: &Path) -> anyhow::Result<()> {
     image.save(path).with_context(|| format!("cannot write {}", path.display()))
 }
 
-pub(crate) fn parse_size(text: &str) -> Result<(u32, u32), String> {
-    let parsed = text.split_once(['x', 'X']).and_then(|(w, h)| Some((w.trim().parse().ok()?, h.trim().parse().ok()?)));
-    match parsed {
-        Some((w, h)) if w > 0 && h > 0 => Ok((w, h)),
-        _ => Err(format!("expected WIDTHxHEIGHT with both above 0, e.g. 1280x720, got {text:?}")),
-    }
-}
-
-pub(crate) fn parse_msaa(text: &str) -> Result<u32, String> {
-    match text.trim().parse() {
-        Ok(samples @ (1 | 2 | 4 | 8)) => Ok(samples),
-        _ => Err(format!("expected 1, 2, 4 or 8 samples, got {text:?}")),
-    }
-}
-
-pub(crate) fn parse_vec3(text: &str) -> Result<Vec3, String> {
-    let values: Vec<f32> = text
-        .split(',')
-        .map(|v| v.trim().parse::<f32>())
-        .collect::<Result<_, _>>()
-        .map_err(|e| format!("{text:?}: {e}"))?;
-    match values[..] {
-        [x, y, z] if values.iter().all(|v| v.is_finite()) => Ok(Vec3::new(x, y, z)),
-        _ => Err(format!("expected three numbers x,y,z, got {text:?}")),
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn sizes_and_vectors_parse() {
-        assert_eq!(parse_size("1280x720"), Ok((1280, 720)));
-        assert!(parse_size("0x5").is_err());
-        assert!(parse_size("big").is_err());
-        assert_eq!(parse_msaa("4"), Ok(4));
-        assert!(parse_msaa("3").is_err());
-        assert_eq!(parse_vec3("1,-2, 3.5"), Ok(Vec3::new(1.0, -2.0, 3.5)));
-        assert!(parse_vec3("1,2").is_err());
-        assert!(parse_vec3("1,nan,2").is_err());
-    }
 
     #[test]
     fn outputs_follow_the_extension() {

@@ -51,17 +51,8 @@ pub struct Args {
     #[arg(long)]
     pub no_lod: bool,
     /// Window size in logical pixels, `WIDTHxHEIGHT`.
-    #[arg(long, value_name = "WxH", default_value = "1280x800", value_parser = parse_size)]
-    pub size: [u32; 2],
-}
-
-fn parse_size(text: &str) -> Result<[u32; 2], String> {
-    let (width, height) = text.split_once('x').ok_or_else(|| format!("expected WIDTHxHEIGHT, got {text:?}"))?;
-    let parse = |s: &str| s.trim().parse::<u32>().ok().filter(|v| (64..=16_384).contains(v));
-    match (parse(width), parse(height)) {
-        (Some(w), Some(h)) => Ok([w, h]),
-        _ => Err(format!("each side must be a whole number from 64 to 16384, got {text:?}")),
-    }
+    #[arg(long, value_name = "WxH", default_value = "1280x800", value_parser = crate::values::parse_size)]
+    pub size: (u32, u32),
 }
 
 pub fn run(args: &Args) -> anyhow::Result<()> {
@@ -72,17 +63,4 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         .context("opening the display (is DISPLAY or WAYLAND_DISPLAY set? under CI use xvfb-run)")?;
     event_loop.run_app(&mut app).context("running the window's event loop")?;
     app.finish()
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn window_sizes_parse_and_bad_ones_say_why() {
-        assert_eq!(parse_size("640x480"), Ok([640, 480]));
-        assert!(parse_size("640").unwrap_err().contains("WIDTHxHEIGHT"));
-        assert!(parse_size("0x480").unwrap_err().contains("64 to 16384"));
-        assert!(parse_size("axb").is_err());
-    }
 }

@@ -45,7 +45,7 @@ pub struct Args {
     #[arg(long, default_value = "front,side,back", value_name = "front,side,back")]
     views: String,
     /// Wind x,y,z (direction and strength); calm without it.
-    #[arg(long, value_name = "X,Y,Z", value_parser = crate::render::parse_vec3, allow_hyphen_values = true)]
+    #[arg(long, value_name = "X,Y,Z", value_parser = crate::values::parse_vec3, allow_hyphen_values = true)]
     wind: Option<Vec3>,
     /// Write the results as JSON here.
     #[arg(long, value_name = "FILE")]
@@ -54,14 +54,14 @@ pub struct Args {
     #[arg(long, default_value = "fidelity", value_name = "DIR")]
     out: PathBuf,
     /// Image size, WIDTHxHEIGHT.
-    #[arg(long, default_value = "512x512", value_parser = crate::render::parse_size)]
+    #[arg(long, default_value = "512x512", value_parser = crate::values::parse_size)]
     size: (u32, u32),
     /// The strands are rendered at this many times the size on each axis, then filtered down.
     #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(1..=8))]
     supersample: u32,
     /// MSAA samples of the shells and fins: 1, 2, 4 or 8. Default: 1 on a CPU rasteriser
     /// (lavapipe), 4 on a GPU (as `pelt render`).
-    #[arg(long, value_name = "N", value_parser = crate::render::parse_msaa)]
+    #[arg(long, value_name = "N", value_parser = crate::values::parse_msaa)]
     msaa: Option<u32>,
     /// Graphics backend: vulkan, gl (or metal, dx12); default `WGPU_BACKEND`, else the best there is.
     #[arg(long, default_value = "auto")]

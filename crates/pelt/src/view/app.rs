@@ -59,7 +59,7 @@ impl App {
     pub fn new(args: &Args, stage: Stage) -> anyhow::Result<Self> {
         let model = Model::new(args, stage)?;
         let screenshot_after = args.screenshot_after.zip(args.out.clone());
-        Ok(Self { window_size: args.size, screenshot_after, model, running: None, error: None })
+        Ok(Self { window_size: [args.size.0, args.size.1], screenshot_after, model, running: None, error: None })
     }
 
     /// The error that ended the event loop, if any.
