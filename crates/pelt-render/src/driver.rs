@@ -95,8 +95,8 @@ impl FurDriver {
         choice: KernelChoice,
     ) -> Result<Self, RenderError> {
         let (kernel, kernel_reason) = match choice {
-            KernelChoice::Cpu => (SimKernel::Cpu, "chosen".to_owned()),
-            KernelChoice::Gpu => (SimKernel::Gpu, "chosen".to_owned()),
+            KernelChoice::Cpu => (SimKernel::Cpu, "asked for".to_owned()),
+            KernelChoice::Gpu => (SimKernel::Gpu, "asked for".to_owned()),
             KernelChoice::Auto => {
                 let cpu = cpu_secs_per_step(structure, params, TIMING_STEPS, TIMING_RUNS)?;
                 let gpu = gpu_secs_per_step(device, queue, renderer, structure, params, TIMING_STEPS, TIMING_RUNS)?;
@@ -123,7 +123,7 @@ impl FurDriver {
         self.kernel
     }
 
-    /// Why that kernel: `chosen`, `auto` with both timings, or a fallback.
+    /// Why that kernel: `asked for`, `auto` with both timings, or a fallback.
     #[must_use]
     pub fn kernel_reason(&self) -> &str {
         &self.kernel_reason

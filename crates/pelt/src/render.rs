@@ -274,7 +274,11 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         per_frame(render_time),
         per_frame(simulation_time),
         driver.kernel(),
-        driver.kernel_reason(),
+        match args.sim {
+            SimChoice::Auto => driver.kernel_reason().to_owned(),
+            SimChoice::Cpu => "--sim cpu".to_owned(),
+            SimChoice::Gpu => "--sim gpu".to_owned(),
+        },
         started.elapsed().as_secs_f64(),
         headless.gpu.summary(),
         headless.target().sample_count,

@@ -25,10 +25,10 @@ enum Posing {
 
 /// One fur's simulation with what moves it: the posed base and a scene script.
 ///
-/// Each frame a host calls [`FurStepper::advance_to`] with the frame's time. The stepper poses
-/// the base when anything moves it (a clip, the script's motion, a host pose), restarts the
-/// simulation from the first pose (no fling from the rest pose), applies the script's keys,
-/// then advances the [`Simulation`]. The pose's normals, for shading the skin, are
+/// Each frame a host calls [`FurStepper::advance_to`] with the frame's time. The stepper applies
+/// the script's keys, poses the base when anything moves it (a clip, the script's motion, a host
+/// pose), restarts the simulation from the first pose (no fling from the rest pose), then
+/// advances the [`Simulation`]. The pose's normals, for shading the skin, are
 /// [`FurStepper::moved_pose`].
 #[derive(Debug)]
 pub struct FurStepper {
@@ -132,6 +132,11 @@ impl FurStepper {
     /// # Errors
     /// As [`FurStepper::advance_to`].
     pub fn advance_with_clip_at(&mut self, time_secs: f64, clip_time_secs: f64) -> Result<(), SimError> {
+        // The script's keys first: a restart below computes its states with this step's inputs,
+        // as a GPU kernel replaying the steps does.
+        if let Some(scene) = &self.scene {
+            scene.apply(time_secs, &mut self.simulation)?;
+        }
         let world_from_model = self.scene.as_ref().and_then(|s| s.motion_at(time_secs)).unwrap_or(Mat4::IDENTITY);
         self.world_from_model = world_from_model;
         self.moved = std::mem::take(&mut self.host_posed);
@@ -161,9 +166,6 @@ impl FurStepper {
                     self.simulation.restart();
                 }
             }
-        }
-        if let Some(scene) = &self.scene {
-            scene.apply(time_secs, &mut self.simulation)?;
         }
         self.simulation.advance_to(time_secs);
         Ok(())
