@@ -27,7 +27,7 @@ const MAX_IMAGE_SIDE: u32 = 16_384;
 /// direction map needs colour: red and green map `0..=1` to a flow component `-1..=1`, values
 /// within one 8-bit step of 0.5 counting as 0. Tint reads RGB, an 8- or 16-bit PNG as sRGB
 /// (decoded to linear), vertex colours as linear (glTF's convention). Alpha is ignored. Where a
-/// vertex has several UVs (a seam), it takes the mean of its samples; images wrap.
+/// vertex has several UVs (a seam), it takes the mean of its samples; UVs clamp to the image's edge.
 #[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct GroomParams {
@@ -182,10 +182,11 @@ fn map_values(map: GroomMap, colours: &[Vec4], green_down: bool) -> Vec<f32> {
     }
 }
 
-/// `0..=1` to `-1..=1`, with a dead zone of one 8-bit step around 0.5 (which 8 bits cannot hold).
+/// `0..=1` to `-1..=1`, with a dead zone of one 8-bit step either side of 0.5 (which 8 bits
+/// cannot hold: 127 and 128 both mean no flow).
 fn flow_component(channel: f32) -> f32 {
     let component = (channel * 2.0 - 1.0).clamp(-1.0, 1.0);
-    if component.abs() <= 1.0 / 255.0 { 0.0 } else { component }
+    if component.abs() <= 2.0 / 255.0 { 0.0 } else { component }
 }
 
 fn srgb_to_linear(c: Vec4) -> Vec4 {
@@ -232,15 +233,16 @@ impl MapImage {
         Ok(Self { width, height, texels, has_colour })
     }
 
-    /// Bilinear sample with wrapping at `uv` (`v = 0` is the top row).
+    /// Bilinear sample at `uv` (`v = 0` is the top row), clamped to the edge: a groom map is
+    /// painted for one mesh, not tiled, so its left edge must not bleed into its right.
     fn sample(&self, uv: Vec2) -> Vec4 {
-        let x = uv.x.rem_euclid(1.0) * self.width as f32 - 0.5;
-        let y = uv.y.rem_euclid(1.0) * self.height as f32 - 0.5;
+        let x = uv.x.clamp(0.0, 1.0) * self.width as f32 - 0.5;
+        let y = uv.y.clamp(0.0, 1.0) * self.height as f32 - 0.5;
         let (x0, y0) = (x.floor(), y.floor());
         let (fx, fy) = (x - x0, y - y0);
-        let wrap = |c: f32, n: u32| (c as i64).rem_euclid(i64::from(n)) as usize;
-        let (xa, xb) = (wrap(x0, self.width), wrap(x0 + 1.0, self.width));
-        let (ya, yb) = (wrap(y0, self.height), wrap(y0 + 1.0, self.height));
+        let clamp = |c: f32, n: u32| (c.max(0.0) as usize).min(n as usize - 1);
+        let (xa, xb) = (clamp(x0, self.width), clamp(x0 + 1.0, self.width));
+        let (ya, yb) = (clamp(y0, self.height), clamp(y0 + 1.0, self.height));
         let texel = |x: usize, y: usize| self.texels[y * self.width as usize + x];
         let top = texel(xa, ya).lerp(texel(xb, ya), fx);
         let bottom = texel(xa, yb).lerp(texel(xb, yb), fx);
