@@ -562,3 +562,26 @@ fn groom_maps_know_their_keys_and_sizes() {
     assert!(Groom::default().is_uniform());
     assert!(groom.validate(11, "x").is_err());
 }
+
+#[test]
+fn the_groomed_fox_is_bald_at_the_nose_and_long_on_the_tail() {
+    let assets = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets");
+    let preset = Preset::load(assets.join("presets/fox_groomed.toml")).unwrap();
+    let uniform = Preset::load(assets.join("presets/fox.toml")).unwrap();
+    let (mesh, _) = Mesh::load(&assets.join("meshes/Fox.glb"), &ImportOptions::default()).unwrap();
+    let radius = mesh.bounding_sphere().1;
+    let fur = preset.grow(mesh.clone(), "Fox.glb").unwrap();
+    let nose = (0..mesh.vertex_count()).max_by(|&a, &b| mesh.positions[a].z.total_cmp(&mesh.positions[b].z)).unwrap();
+    let tail = (0..mesh.vertex_count()).min_by(|&a, &b| mesh.positions[a].z.total_cmp(&mesh.positions[b].z)).unwrap();
+    assert_eq!(fur.lengths[nose], 0.0, "the nose tip is bald");
+    assert!(fur.groom.as_ref().unwrap().length.as_ref().unwrap().iter().filter(|f| **f == 0.0).count() >= 4);
+    // The body keeps fox.toml's length; the tail tip grows about twice that.
+    let body_length = uniform.length * radius;
+    let middle =
+        (0..mesh.vertex_count()).min_by(|&a, &b| mesh.positions[a].z.abs().total_cmp(&mesh.positions[b].z.abs()));
+    assert!((fur.lengths[middle.unwrap()] / body_length - 1.0).abs() < 0.02);
+    assert!(fur.lengths[tail] > 1.9 * body_length, "{} vs {body_length}", fur.lengths[tail]);
+    // The nose is a bald patch: its triangles draw no shells.
+    assert!(fur.furred_triangles().len() < fur.mesh.triangles.len());
+    assert!(fur.footprint().faces < uniform.grow(mesh, "Fox.glb").unwrap().footprint().faces);
+}
