@@ -1,7 +1,8 @@
 //! Pelt's core: everything about fur that needs no GPU.
 //!
 //! Data flows one way through the modules:
-//! [`mesh`] (import and repair; [`anim`] poses a moving one) -> [`fur`] (the unified shell-and-fin structure) ->
+//! [`mesh`] (import and repair; [`anim`] poses a moving one) -> [`groom`] (per-vertex maps over
+//! it) -> [`fur`] (the unified shell-and-fin structure) ->
 //! [`texture`] (seeded shell and fin textures) -> [`sim`] (gravity, wind, touch) -> the renderer
 //! in `pelt-render`. [`preset`] holds everything about one fur in one TOML file; [`stage`] loads
 //! the meshes of one scene (the furred one, its rig, the plain ones) for every host.
@@ -10,6 +11,7 @@
 
 pub mod anim;
 pub mod fur;
+pub mod groom;
 pub mod mesh;
 pub mod preset;
 pub mod reference;
@@ -19,6 +21,7 @@ pub mod stage;
 pub mod texture;
 
 pub use fur::{FurParams, FurStructure, GrowthDirection, SeparatedStructure};
+pub use groom::{Groom, GroomError, GroomParams};
 pub use mesh::{ImportOptions, Mesh, MeshError, MeshReport, builtin::Builtin};
 pub use preset::{LodParams, Preset, PresetError, RenderParams};
 pub use sim::{FurStepper, Scene, SimError, SimParams, Simulation};

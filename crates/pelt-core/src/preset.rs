@@ -11,13 +11,15 @@
 //! [colour]             # colours are "#rrggbb" strings (see `texture::ColourParams`)
 //! [simulation]         # `sim::SimParams`; equation = "pelt" | "paper" (`sim::Equation`)
 //! [render]             # how Pelt's commands show it (see `RenderParams`)
+//! [groom]              # per-vertex maps: length, density, direction, clump, tint (`groom::GroomParams`)
 //! ```
 
 use std::path::{Path, PathBuf};
 
 use glam::Vec3;
 
-use crate::fur::{FurLength, FurParams, GrowthDirection, MAX_LAYERS};
+use crate::fur::{FurError, FurLength, FurParams, FurStructure, GrowthDirection, MAX_LAYERS};
+use crate::groom::{Groom, GroomError, GroomParams};
 use crate::mesh::Mesh;
 use crate::sim::{ParamError, SimParams};
 use crate::texture::{
@@ -64,6 +66,14 @@ pub enum PresetError {
         image: PathBuf,
         /// Why it could not be loaded.
         problem: String,
+    },
+    /// The groom the preset names could not be loaded or does not fit the mesh.
+    #[error("{file}: {error}")]
+    Groom {
+        /// The preset file.
+        file: PathBuf,
+        /// What is wrong, naming the groom's file and key.
+        error: GroomError,
     },
     /// The preset could not be written as TOML.
     #[error("cannot write the preset as TOML: {0}")]
@@ -152,6 +162,9 @@ pub struct Preset {
     pub simulation: SimParams,
     /// How Pelt's commands show it.
     pub render: RenderParams,
+    /// Fur that differs over the body; empty (and left out of the TOML) for a uniform coat.
+    #[serde(skip_serializing_if = "GroomParams::is_empty")]
+    pub groom: GroomParams,
     /// The preset file (for messages) and its folder (for relative image paths); not in TOML.
     #[serde(skip)]
     file: PathBuf,
@@ -167,6 +180,7 @@ impl Default for Preset {
             colour: ColourParams::default(),
             simulation: SimParams::default(),
             render: RenderParams::default(),
+            groom: GroomParams::default(),
             file: PathBuf::from("<default preset>"),
         }
     }
@@ -182,6 +196,7 @@ impl PartialEq for Preset {
             && self.colour == other.colour
             && self.simulation == other.simulation
             && self.render == other.render
+            && self.groom == other.groom
     }
 }
 
@@ -201,7 +216,7 @@ impl Preset {
             if !resolved.is_file() {
                 return Err(PresetError::Image {
                     file: preset.file.clone(),
-                    key: key.to_owned(),
+                    key,
                     image: resolved,
                     problem: "no such file".to_owned(),
                 });
@@ -394,17 +409,48 @@ impl Preset {
 
     /// The image paths the preset uses, with their keys (unused ones, e.g. a gradient outside
     /// height mode, are left out).
-    fn image_paths(&self) -> Vec<(&'static str, &Path)> {
+    fn image_paths(&self) -> Vec<(String, &Path)> {
         let mut paths = Vec::new();
         if let Some(pattern) = &self.texture.pattern {
-            paths.push(("texture.pattern", pattern.as_path()));
+            paths.push(("texture.pattern".to_owned(), pattern.as_path()));
         }
         if let (ColourMode::Height, Some(gradient)) = (self.colour.mode, &self.colour.gradient) {
-            paths.push(("colour.gradient", gradient.as_path()));
+            paths.push(("colour.gradient".to_owned(), gradient.as_path()));
         }
         if let (ColourMode::Surface, Some(surface)) = (self.colour.mode, &self.colour.surface) {
-            paths.push(("colour.surface", surface.as_path()));
+            paths.push(("colour.surface".to_owned(), surface.as_path()));
         }
+        paths.extend(self.groom.files());
         paths
+    }
+
+    /// Loads the groom the `[groom]` table names for `mesh` (`None` for a uniform coat); images
+    /// and groom files resolve against the preset's folder, `mesh_name` names the mesh in messages.
+    ///
+    /// # Errors
+    /// [`PresetError::Groom`] naming the preset, the groom's file and key and the problem.
+    pub fn groom(&self, mesh: &Mesh, mesh_name: &str) -> Result<Option<Groom>, PresetError> {
+        self.groom
+            .load(mesh, mesh_name, |path| self.resolve(path))
+            .map_err(|error| PresetError::Groom { file: self.file.clone(), error })
+    }
+
+    /// Grows the preset's fur on `mesh`, groomed: [`Preset::fur_params`] and [`Preset::groom`]
+    /// into [`FurStructure::new_groomed`].
+    ///
+    /// # Errors
+    /// As [`Preset::groom`], and [`PresetError::Invalid`] for values the structure refuses.
+    pub fn grow(&self, mesh: Mesh, mesh_name: &str) -> Result<FurStructure, PresetError> {
+        self.validate()?;
+        let groom = self.groom(&mesh, mesh_name)?;
+        let params = self.fur_params(&mesh);
+        FurStructure::new_groomed(mesh, &params, groom).map_err(|e| {
+            let key = match e {
+                FurError::Layers(_) => "layers",
+                FurError::Length(_) | FurError::LengthMapSize { .. } => "length",
+                FurError::Groom(_) => "groom",
+            };
+            PresetError::Invalid { file: self.file.clone(), key: key.to_owned(), problem: e.to_string() }
+        })
     }
 }

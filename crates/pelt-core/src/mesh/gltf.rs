@@ -8,31 +8,37 @@
 
 use std::path::Path;
 
-use glam::{Mat3, Mat4, Vec2, Vec3};
+use glam::{Mat3, Mat4, Vec2, Vec3, Vec4};
 use gltf::mesh::Mode;
 
-use super::{MeshError, RawMesh};
+use super::{ColourSet, MeshError, RawMesh};
 use crate::anim::{RawRig, Span, read_rig};
+
+/// Vertex colour sets `COLOR_0 ..` read (grooms name them; files rarely have more than two).
+const MAX_COLOUR_SETS: u32 = 8;
 
 /// Deeper node hierarchies than this are treated as broken (and cannot blow the stack).
 const MAX_NODE_DEPTH: usize = 256;
 
-pub(super) fn load(path: &Path) -> Result<RawMesh, MeshError> {
+pub(super) fn load(path: &Path) -> Result<(RawMesh, Vec<ColourSet>), MeshError> {
     let bytes = std::fs::read(path).map_err(|error| MeshError::Io { file: path.to_path_buf(), error })?;
     parse(&bytes, path, path.parent())
 }
 
 /// Parses `.gltf` JSON or `.glb` bytes. External buffers are looked up next to `base`; without
 /// a `base` only embedded (GLB or `data:` URI) buffers can be read.
-pub(super) fn parse(bytes: &[u8], file: &Path, base: Option<&Path>) -> Result<RawMesh, MeshError> {
-    parse_with_rig(bytes, file, base, false).map(|(raw, _)| raw)
+pub(super) fn parse(bytes: &[u8], file: &Path, base: Option<&Path>) -> Result<(RawMesh, Vec<ColourSet>), MeshError> {
+    parse_with_rig(bytes, file, base, false).map(|(raw, colour_sets, _)| (raw, colour_sets))
 }
 
 /// Reads the whole file: [`load`] plus its rig (nodes, skins, morph targets, animations).
-pub(super) fn load_with_rig(path: &Path) -> Result<(RawMesh, Option<RawRig>), MeshError> {
+pub(super) fn load_with_rig(path: &Path) -> Result<Parsed, MeshError> {
     let bytes = std::fs::read(path).map_err(|error| MeshError::Io { file: path.to_path_buf(), error })?;
     parse_with_rig(&bytes, path, path.parent(), true)
 }
+
+/// A file's raw mesh, its vertex colour sets (one colour per raw vertex) and its rig.
+pub(super) type Parsed = (RawMesh, Vec<ColourSet>, Option<RawRig>);
 
 /// [`parse`], with the rig when `with_rig` is set.
 pub(super) fn parse_with_rig(
@@ -40,7 +46,7 @@ pub(super) fn parse_with_rig(
     file: &Path,
     base: Option<&Path>,
     with_rig: bool,
-) -> Result<(RawMesh, Option<RawRig>), MeshError> {
+) -> Result<Parsed, MeshError> {
     // The `gltf` crate's validation indexes unchecked in places (gltf-json 1.4.1 panics on a
     // primitive whose attribute map is emptied, for one); a broken file must stay an error.
     std::panic::catch_unwind(|| parse_unguarded(bytes, file, base, with_rig)).unwrap_or_else(|_| {
@@ -52,12 +58,7 @@ pub(super) fn parse_with_rig(
     })
 }
 
-fn parse_unguarded(
-    bytes: &[u8],
-    file: &Path,
-    base: Option<&Path>,
-    with_rig: bool,
-) -> Result<(RawMesh, Option<RawRig>), MeshError> {
+fn parse_unguarded(bytes: &[u8], file: &Path, base: Option<&Path>, with_rig: bool) -> Result<Parsed, MeshError> {
     let error = |message: String| MeshError::Parse { file: file.to_path_buf(), line: None, message };
     let gltf::Gltf { document, blob } =
         gltf::Gltf::from_slice(bytes).map_err(|e| error(format!("not valid glTF: {e}")))?;
@@ -77,6 +78,7 @@ fn parse_unguarded(
     let mut raw = RawMesh::default();
     let mut normals = Some(Vec::new());
     let mut uvs = Some(Vec::new());
+    let mut colours: Vec<Option<Vec<Vec4>>> = (0..MAX_COLOUR_SETS).map(|_| Some(Vec::new())).collect();
     let mut skipped_primitives = 0;
     let mut spans = Vec::new();
     for (mesh, world_from_local, node, skin) in parts {
@@ -128,6 +130,11 @@ fn parse_unguarded(
             let primitive_uvs =
                 reader.read_tex_coords(0).map(|uv| uv.into_f32().map(Vec2::from_array).collect::<Vec<_>>());
             keep_if_complete(&mut uvs, primitive_uvs, count);
+            for (set, all) in (0..MAX_COLOUR_SETS).zip(&mut colours) {
+                let primitive_colours =
+                    reader.read_colors(set).map(|c| c.into_rgba_f32().map(Vec4::from_array).collect::<Vec<_>>());
+                keep_if_complete(all, primitive_colours, count);
+            }
         }
     }
     if raw.triangles.is_empty() && skipped_primitives > 0 {
@@ -138,8 +145,12 @@ fn parse_unguarded(
     }
     raw.normals = normals;
     raw.uvs = uvs;
+    let colour_sets = (0..MAX_COLOUR_SETS)
+        .zip(colours)
+        .filter_map(|(set, colours)| colours.filter(|c| !c.is_empty()).map(|colours| ColourSet { set, colours }))
+        .collect();
     let rig = if with_rig { read_rig(&document, &buffers, &spans, raw.positions.len()).map_err(error)? } else { None };
-    Ok((raw, rig))
+    Ok((raw, colour_sets, rig))
 }
 
 /// A mesh to import with its world transform, node and skin.

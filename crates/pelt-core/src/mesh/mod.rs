@@ -21,7 +21,7 @@ mod wedges;
 
 use std::path::Path;
 
-use glam::{Mat4, Vec2, Vec3};
+use glam::{Mat4, Vec2, Vec3, Vec4};
 
 use crate::anim::Rig;
 
@@ -45,6 +45,15 @@ pub struct RawMesh {
     pub uvs: Option<Vec<Vec2>>,
     /// Triangles as indices into `positions`.
     pub triangles: Vec<[u32; 3]>,
+}
+
+/// One vertex colour set: glTF's `COLOR_n` attribute, RGBA in `0..=1` (linear, as glTF stores it).
+#[derive(Clone, Debug, PartialEq)]
+pub struct ColourSet {
+    /// `n` of `COLOR_n`.
+    pub set: u32,
+    /// One colour per vertex.
+    pub colours: Vec<Vec4>,
 }
 
 /// How [`Mesh::from_raw`] treats its input.
@@ -84,6 +93,9 @@ pub struct Mesh {
     pub edges: Vec<[u32; 2]>,
     /// The (up to) two triangles next to each edge; [`NO_FACE`] where there is none.
     pub edge_faces: Vec<[u32; 2]>,
+    /// Vertex colour sets read from the file (glTF `COLOR_n`), one colour per vertex each; a
+    /// welded vertex has the mean of the colours welded into it. Grooms can read them.
+    pub colour_sets: Vec<ColourSet>,
 }
 
 impl Mesh {
@@ -100,12 +112,12 @@ impl Mesh {
                 error: std::io::Error::new(std::io::ErrorKind::NotFound, "no such file"),
             });
         }
-        let raw = match extension.as_str() {
-            "obj" => obj::load(path)?,
+        let (raw, colour_sets) = match extension.as_str() {
+            "obj" => (obj::load(path)?, Vec::new()),
             "gltf" | "glb" => gltf::load(path)?,
             _ => return Err(MeshError::UnknownFormat { file: path.to_path_buf(), extension }),
         };
-        Self::from_raw(raw, path, options)
+        Self::repair(raw, &colour_sets, path, options).map(|(mesh, report, _)| (mesh, report))
     }
 
     /// Loads a mesh file like [`Mesh::load`], with its [`Rig`] when it is a glTF file with skins,
@@ -120,8 +132,8 @@ impl Mesh {
         if !matches!(extension.as_str(), "gltf" | "glb") || !path.exists() {
             return Self::load(path, options).map(|(mesh, report)| (mesh, report, None));
         }
-        let (raw, rig) = gltf::load_with_rig(path)?;
-        let (mesh, report, source) = Self::repair(raw, path, options)?;
+        let (raw, colour_sets, rig) = gltf::load_with_rig(path)?;
+        let (mesh, report, source) = Self::repair(raw, &colour_sets, path, options)?;
         Ok((mesh, report, rig.map(|rig| rig.finish(&source))))
     }
 
@@ -134,8 +146,8 @@ impl Mesh {
         name: &Path,
         options: &ImportOptions,
     ) -> Result<(Self, MeshReport, Option<Rig>), MeshError> {
-        let (raw, rig) = gltf::parse_with_rig(bytes, name, None, true)?;
-        let (mesh, report, source) = Self::repair(raw, name, options)?;
+        let (raw, colour_sets, rig) = gltf::parse_with_rig(bytes, name, None, true)?;
+        let (mesh, report, source) = Self::repair(raw, &colour_sets, name, options)?;
         Ok((mesh, report, rig.map(|rig| rig.finish(&source))))
     }
 
@@ -158,8 +170,14 @@ impl Mesh {
         name: &Path,
         options: &ImportOptions,
     ) -> Result<(Self, MeshReport), MeshError> {
-        let raw = gltf::parse(bytes, name, None)?;
-        Self::from_raw(raw, name, options)
+        let (raw, colour_sets) = gltf::parse(bytes, name, None)?;
+        Self::repair(raw, &colour_sets, name, options).map(|(mesh, report, _)| (mesh, report))
+    }
+
+    /// The vertex colours of glTF's `COLOR_n` for `set = n`, one per vertex, if the file had them.
+    #[must_use]
+    pub fn colour_set(&self, set: u32) -> Option<&[Vec4]> {
+        self.colour_sets.iter().find(|c| c.set == set).map(|c| c.colours.as_slice())
     }
 
     /// Number of vertices `V`.

@@ -8,7 +8,7 @@ use glam::Vec3;
 
 use super::topology::sorted_half_edges;
 use super::vertex_cache::{CACHE_SIZE, tipsify_order};
-use super::{ImportOptions, Mesh, MeshError, MeshReport, NormalSource, RawMesh, Topology, bounds};
+use super::{ColourSet, ImportOptions, Mesh, MeshError, MeshReport, NormalSource, RawMesh, Topology, bounds};
 
 impl Mesh {
     /// Validates, welds and repairs a raw mesh.
@@ -17,7 +17,7 @@ impl Mesh {
     /// [`MeshError::IndexOutOfRange`], [`MeshError::NonFinite`] or [`MeshError::NoTriangles`]
     /// (also when every triangle was degenerate).
     pub fn from_raw(raw: RawMesh, file: &Path, options: &ImportOptions) -> Result<(Self, MeshReport), MeshError> {
-        Self::repair(raw, file, options).map(|(mesh, report, _)| (mesh, report))
+        Self::repair(raw, &[], file, options).map(|(mesh, report, _)| (mesh, report))
     }
 
     /// [`Mesh::from_raw`], also returning for each base vertex the raw vertex it was taken from,
@@ -31,13 +31,15 @@ impl Mesh {
         file: &Path,
         options: &ImportOptions,
     ) -> Result<(Self, MeshReport, Vec<u32>), MeshError> {
-        Self::repair(raw, file, options)
+        Self::repair(raw, &[], file, options)
     }
 
     /// [`Mesh::from_raw`], also returning for each kept vertex the raw vertex it was taken from
     /// (so per-vertex data read beside the mesh, like skin weights, follows welding and repair).
+    /// `colour_sets` (one colour per raw vertex each) follow welding too: see [`Mesh::colour_sets`].
     pub(super) fn repair(
         raw: RawMesh,
+        colour_sets: &[ColourSet],
         file: &Path,
         options: &ImportOptions,
     ) -> Result<(Self, MeshReport, Vec<u32>), MeshError> {
@@ -154,6 +156,14 @@ impl Mesh {
             }
             None => (computed, NormalSource::Computed),
         };
+        let colour_sets = colour_sets
+            .iter()
+            .filter(|set| set.colours.len() == input_vertices && set.colours.iter().all(|c| c.is_finite()))
+            .map(|set| ColourSet {
+                set: set.set,
+                colours: welded_mean(&set.colours, &canonical, &new_index, positions.len()),
+            })
+            .collect();
         // After the normals, which sum the faces in order: the order changes no bit of them.
         if options.vertex_cache_order {
             let order = tipsify_order(&triangles, positions.len(), CACHE_SIZE);
@@ -165,8 +175,15 @@ impl Mesh {
 
         let topology = Topology::build(&triangles);
         let boundary_loops = topology.boundary_loops();
-        let mesh =
-            Mesh { positions, normals, corner_uvs, triangles, edges: topology.edges, edge_faces: topology.edge_faces };
+        let mesh = Mesh {
+            positions,
+            normals,
+            corner_uvs,
+            triangles,
+            edges: topology.edges,
+            edge_faces: topology.edge_faces,
+            colour_sets,
+        };
         let report = MeshReport {
             source: file.display().to_string(),
             input_vertices,
@@ -189,6 +206,18 @@ impl Mesh {
         };
         Ok((mesh, report, source))
     }
+}
+
+/// Per kept vertex, the mean of the raw vertices' `values` welded into it.
+fn welded_mean(values: &[glam::Vec4], canonical: &[u32], new_index: &[u32], kept: usize) -> Vec<glam::Vec4> {
+    let mut sums = vec![(glam::Vec4::ZERO, 0u32); kept];
+    for (value, &c) in values.iter().zip(canonical) {
+        if let Some((sum, count)) = sums.get_mut(new_index[c as usize] as usize) {
+            *sum += *value;
+            *count += 1;
+        }
+    }
+    sums.into_iter().map(|(sum, count)| sum / count.max(1) as f32).collect()
 }
 
 /// Which triangles to flip so that every manifold edge is traversed in opposite directions by

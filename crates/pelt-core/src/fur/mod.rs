@@ -7,8 +7,13 @@
 //! `(a, b)` and every `i < L`). Nothing is replicated per layer: the GPU holds this array once,
 //! plus the base triangles and the edge list.
 
+mod footprint;
+
 use glam::{Quat, Vec3};
 
+pub use footprint::{Footprint, SeparatedStructure};
+
+use crate::groom::{Groom, tangent_frames};
 use crate::mesh::Mesh;
 use crate::rng;
 
@@ -39,6 +44,9 @@ pub enum FurError {
         /// Entries in the map.
         got: usize,
     },
+    /// A groom that does not fit the mesh (wrong size, values out of range).
+    #[error("the groom does not fit the mesh: {0}")]
+    Groom(String),
 }
 
 /// How long the fur is.
@@ -126,6 +134,11 @@ pub struct FurStructure {
     pub lengths: Vec<f32>,
     /// The shared vertex array `NV`, `(L + 1) * V` entries, layer-major: `NV[i*V + j]`.
     pub positions: Vec<Vec3>,
+    /// The groom it was grown with (`None`: uniform fur). Its lengths and directions are already
+    /// in `lengths`, `directions` and `positions`; bald regions are what
+    /// [`FurStructure::triangle_has_fur`] and [`FurStructure::edge_has_fins`] say; density,
+    /// clump and tint are the renderer's to apply.
+    pub groom: Option<Groom>,
 }
 
 impl FurStructure {
@@ -135,11 +148,25 @@ impl FurStructure {
     /// [`FurError`] for a layer count outside `1..=MAX_LAYERS`, a negative or non-finite
     /// length, or a length map of the wrong size.
     pub fn new(mesh: Mesh, params: &FurParams) -> Result<Self, FurError> {
+        Self::new_groomed(mesh, params, None)
+    }
+
+    /// Grows the rest pose on `mesh` with a groom (`None`: as [`FurStructure::new`], to the bit).
+    ///
+    /// Vertex `j` grows `params.length` times the groom's length factor. With a direction map,
+    /// its comb is the groom's flow in the vertex's [`crate::groom::TangentFrame`] (in place of
+    /// `params.direction.comb`), leaning by `comb_blend` times the flow's length (at most 1);
+    /// the random tilt applies as before. The groom travels with the structure (`groom`).
+    ///
+    /// # Errors
+    /// As [`FurStructure::new`], and [`FurError::Groom`] for a groom of the wrong size or with
+    /// values out of range.
+    pub fn new_groomed(mesh: Mesh, params: &FurParams, groom: Option<Groom>) -> Result<Self, FurError> {
         if params.layers == 0 || params.layers > MAX_LAYERS {
             return Err(FurError::Layers(params.layers));
         }
         let v = mesh.vertex_count();
-        let lengths = match &params.length {
+        let mut lengths = match &params.length {
             FurLength::Constant(l) => vec![*l; v],
             FurLength::PerVertex(map) if map.len() == v => map.clone(),
             FurLength::PerVertex(map) => return Err(FurError::LengthMapSize { expected: v, got: map.len() }),
@@ -147,8 +174,30 @@ impl FurStructure {
         if let Some(bad) = lengths.iter().find(|l| !l.is_finite() || **l < 0.0) {
             return Err(FurError::Length(*bad));
         }
-        let directions: Vec<Vec3> =
-            mesh.normals.iter().enumerate().map(|(j, n)| params.direction.apply(j, *n)).collect();
+        let groom = groom.filter(|g| !g.is_uniform());
+        if let Some(groom) = &groom {
+            groom.validate(v, "the groom").map_err(|e| FurError::Groom(e.to_string()))?;
+            if let Some(factors) = &groom.length {
+                lengths.iter_mut().zip(factors).for_each(|(l, f)| *l *= f);
+            }
+            if let Some(bad) = lengths.iter().find(|l| !l.is_finite()) {
+                return Err(FurError::Length(*bad));
+            }
+        }
+        let directions: Vec<Vec3> = match groom.as_ref().and_then(|g| g.direction.as_ref()) {
+            None => mesh.normals.iter().enumerate().map(|(j, n)| params.direction.apply(j, *n)).collect(),
+            Some(flows) => {
+                let frames = tangent_frames(&mesh);
+                let base = params.direction;
+                (mesh.normals.iter().zip(&frames).zip(flows).enumerate())
+                    .map(|(j, ((n, frame), flow))| {
+                        let comb = frame.to_surface(*flow);
+                        let comb_blend = base.comb_blend * flow.length().min(1.0);
+                        GrowthDirection { comb, comb_blend, ..base }.apply(j, *n)
+                    })
+                    .collect()
+            }
+        };
         let layers = params.layers;
         let mut positions = Vec::with_capacity((layers as usize + 1) * v);
         for i in 0..=layers {
@@ -157,7 +206,35 @@ impl FurStructure {
                 mesh.positions.iter().zip(&directions).zip(&lengths).map(|((bv, g), l)| *bv + *g * (fraction * l)),
             );
         }
-        Ok(Self { mesh, layers, directions, lengths, positions })
+        Ok(Self { mesh, layers, directions, lengths, positions, groom })
+    }
+
+    /// Whether base triangle `t` gets shell faces: not when all three of its vertices are bald
+    /// (so the fur tapers to nothing across the triangles around a bald patch). Always without
+    /// a groom.
+    #[must_use]
+    pub fn triangle_has_fur(&self, t: usize) -> bool {
+        self.groom.as_ref().is_none_or(|g| !self.mesh.triangles[t].iter().all(|&j| g.is_bald(j as usize)))
+    }
+
+    /// Whether edge `e` gets fin faces: not when both its ends are bald (the fin would have no
+    /// height). Every edge with fins borders a triangle with fur.
+    #[must_use]
+    pub fn edge_has_fins(&self, e: usize) -> bool {
+        self.groom.as_ref().is_none_or(|g| !self.mesh.edges[e].iter().all(|&j| g.is_bald(j as usize)))
+    }
+
+    /// The base triangles with fur ([`FurStructure::triangle_has_fur`]), in mesh order: the
+    /// shells' index list.
+    #[must_use]
+    pub fn furred_triangles(&self) -> Vec<u32> {
+        (0..self.mesh.triangles.len()).filter(|&t| self.triangle_has_fur(t)).map(|t| t as u32).collect()
+    }
+
+    /// The edges with fins ([`FurStructure::edge_has_fins`]), in mesh order.
+    #[must_use]
+    pub fn fin_edges(&self) -> Vec<u32> {
+        (0..self.mesh.edges.len()).filter(|&e| self.edge_has_fins(e)).map(|e| e as u32).collect()
     }
 
     /// `V`, the base vertex count (the stride between layers).
@@ -191,114 +268,11 @@ impl FurStructure {
         [self.index(layer, a), self.index(layer, b), self.index(layer + 1, b), self.index(layer + 1, a)]
     }
 
-    /// Counts and GPU bytes of this unified structure.
+    /// Counts and GPU bytes of this unified structure (faces: those drawn, bald regions left out).
     #[must_use]
     pub fn footprint(&self) -> Footprint {
-        Footprint::unified(&self.mesh, self.layers)
+        Footprint::unified(self)
     }
-}
-
-/// The separated structure of Lengyel et al.: shells plus fins as geometry of their own.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub struct SeparatedStructure {
-    /// Number of shells `L` above the base.
-    pub layers: u32,
-    /// Faces per fin: 2 (one quad, Lengyel) or `N` (the paper compares `N = 30`).
-    pub fin_faces: u32,
-}
-
-impl SeparatedStructure {
-    /// Counts and GPU bytes of this structure on `mesh`.
-    #[must_use]
-    pub fn footprint(&self, mesh: &Mesh) -> Footprint {
-        Footprint::separated(mesh, self.layers, self.fin_faces)
-    }
-}
-
-/// Vertex and face counts and GPU bytes of one structure on one mesh.
-///
-/// The vertex counts follow the paper's Table 2: unified `V(L+1)`; separated `V(L+1) + N*E` with
-/// `N` faces per fin. GPU bytes follow the layouts Pelt draws:
-/// - unified: positions `12 * V(L+1)`; attributes the base normals `12V` plus, when the mesh has
-///   uvs, `8` per wedge (each distinct (vertex, uv) pair, [`crate::mesh::Wedges`]); indices the
-///   base triangles `3F` and the edges `2E` plus each edge's two faces `2E` (for the silhouette
-///   test), and with uvs each wedge's vertex `W` and each corner's wedge `3F`, 4 bytes each;
-/// - separated: every vertex a full vertex (position, normal, uv: 32 bytes), split here into
-///   positions (12) and attributes (20); indices one shell index buffer `3F` reused per layer
-///   with a base-vertex offset, and `3N` per fin.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Serialize)]
-pub struct Footprint {
-    /// Vertices stored (the paper's counting).
-    pub vertices: u64,
-    /// Shell faces (`F * L`, the base is drawn once more as the opaque skin) plus fin faces.
-    pub faces: u64,
-    /// Shell faces, `F * L`.
-    pub shell_faces: u64,
-    /// Fin faces: `2LE` unified, `NE` separated.
-    pub fin_faces: u64,
-    /// GPU bytes of vertex positions.
-    pub position_bytes: u64,
-    /// GPU bytes of other vertex data (normals, uvs).
-    pub attribute_bytes: u64,
-    /// GPU bytes of indices and topology.
-    pub index_bytes: u64,
-}
-
-impl Footprint {
-    fn unified(mesh: &Mesh, layers: u32) -> Self {
-        let (v, f, e, l) = counts(mesh, layers);
-        let vertices = v * (l + 1);
-        // Meshes with uvs: the wedges' uvs, their vertices and each corner's wedge.
-        let (uv_bytes, wedge_indices) = match mesh.wedges() {
-            Some(wedges) => (8 * wedges.vertices.len() as u64, wedges.vertices.len() as u64 + 3 * f),
-            None => (0, 0),
-        };
-        let shell_faces = f * l;
-        let fin_faces = 2 * l * e;
-        Self {
-            vertices,
-            faces: shell_faces + fin_faces,
-            shell_faces,
-            fin_faces,
-            position_bytes: vertices * POSITION_BYTES,
-            attribute_bytes: v * 12 + uv_bytes,
-            index_bytes: (3 * f + 2 * e + 2 * e + wedge_indices) * INDEX_BYTES,
-        }
-    }
-
-    fn separated(mesh: &Mesh, layers: u32, faces_per_fin: u32) -> Self {
-        let (v, f, e, l) = counts(mesh, layers);
-        let n = u64::from(faces_per_fin);
-        let vertices = v * (l + 1) + n * e;
-        let shell_faces = f * l;
-        let fin_faces = n * e;
-        Self {
-            vertices,
-            faces: shell_faces + fin_faces,
-            shell_faces,
-            fin_faces,
-            position_bytes: vertices * POSITION_BYTES,
-            attribute_bytes: vertices * (SEPARATED_VERTEX_BYTES - POSITION_BYTES),
-            index_bytes: (3 * f + 3 * n * e) * INDEX_BYTES,
-        }
-    }
-
-    /// All GPU bytes of the structure.
-    #[must_use]
-    pub fn total_bytes(&self) -> u64 {
-        self.position_bytes + self.attribute_bytes + self.index_bytes
-    }
-
-    /// How much `self` saves against `other`, in percent of `other` (`key` picks the measure).
-    #[must_use]
-    pub fn savings_percent(&self, other: &Self, key: impl Fn(&Self) -> u64) -> f64 {
-        let theirs = key(other) as f64;
-        if theirs == 0.0 { 0.0 } else { 100.0 * (theirs - key(self) as f64) / theirs }
-    }
-}
-
-fn counts(mesh: &Mesh, layers: u32) -> (u64, u64, u64, u64) {
-    (mesh.vertex_count() as u64, mesh.triangles.len() as u64, mesh.edges.len() as u64, u64::from(layers))
 }
 
 #[cfg(test)]
