@@ -18,19 +18,21 @@
 //! # The order a host calls things in
 //! 1. When creating the device: request [`required_features`], [`required_limits`] and check
 //!    [`required_downlevel_flags`] (or [`check_adapter`]).
-//! 2. Once per target description: [`FurRenderer::new`]. Once per fur: [`GpuFur::new`]. Once per
-//!    camera: [`FurView::new`].
-//! 3. Each simulation step: [`GpuFur::push_state`] (or [`GpuFur::set_positions`] each frame, or a
-//!    compute pass writing [`GpuFur::current_positions`]: [`GpuSimulation`] is Pelt's, which
-//!    bends the strands on the GPU from a `pelt_core::Simulation`'s inputs, so nothing is
-//!    uploaded per step but those inputs).
-//! 4. Each frame, before submitting: [`FurView::prepare`] for each view, [`GpuFur::prepare`]
-//!    (model transform, interpolation, look) for each fur.
-//! 5. In the host's encoder, before the render pass: [`FurRenderer::prepare_fins`] for each fur
-//!    and view (the silhouette pass, a compute pass) when drawing with
-//!    [`FurDrawSettings::silhouette_fins`].
-//! 6. In the host's render pass, after its opaque geometry: [`FurRenderer::draw_plain`] for
-//!    plain meshes, then [`FurRenderer::draw`] for each fur (farthest first when blending).
+//! 2. Once per target description: [`FurRenderer::new`]. Once per fur: [`FurDriver::new`] (its
+//!    [`GpuFur`] and the kernel that bends it) and a `pelt_core::sim::FurStepper` (the CPU half:
+//!    simulation, posing, script). Once per camera: [`FurView::new`].
+//! 3. Each frame, before recording: [`FurDriver::advance_to`] for each fur (pose, script,
+//!    simulation step, queue writes) and [`FurView::prepare`] for each view.
+//! 4. In the host's encoder, before the render pass: [`FurDriver::record`] for each fur (the GPU
+//!    kernel's steps), then [`FurDriver::record_view`] for each fur and view (the silhouette
+//!    pass, when drawing with [`FurDrawSettings::silhouette_fins`]).
+//! 5. In the host's render pass, after its opaque geometry: [`FurRenderer::draw_plain`] for
+//!    plain meshes, then [`FurDriver::draw`] for each fur (farthest first when blending).
+//!
+//! Below the driver the pieces stay public for hosts with other needs: [`GpuFur::push_state`]
+//! or [`GpuFur::set_positions`] upload states simulated elsewhere, [`GpuSimulation`] writes
+//! [`GpuFur::current_positions`] in a compute pass, [`GpuFur::prepare`] and
+//! [`FurRenderer::prepare_fins`] / [`FurRenderer::draw`] are what the driver calls.
 //!
 //! Nothing in the library path blocks, spawns threads or needs `image`/`pollster`: those are in
 //! the default `headless` feature ([`Gpu`], [`Headless`]), which Pelt's commands and tests use.
@@ -55,8 +57,9 @@
 //! #     clip_from_world: glam::Mat4,
 //! #     world_from_view: glam::Mat4,
 //! # ) -> Result<(), Box<dyn std::error::Error>> {
-//! use pelt_core::{Builtin, FurStructure, Preset, Simulation};
-//! use pelt_render::{FurDrawSettings, FurFrame, FurRenderer, FurStates, FurTarget, FurView, GpuFur, Light, ViewData};
+//! use pelt_core::sim::FurStepper;
+//! use pelt_core::{Builtin, FurStructure, Preset};
+//! use pelt_render::{FurDrawSettings, FurDriver, FurRenderer, FurTarget, FurView, KernelChoice, Light, ViewData};
 //!
 //! // Once: the pipelines for the host's attachments (here reverse-Z depth), a fur and a view.
 //! let target = FurTarget::new(wgpu::TextureFormat::Bgra8UnormSrgb).reverse_z();
@@ -65,17 +68,18 @@
 //! let preset = Preset::default();
 //! let params = preset.fur_params(&mesh);
 //! let structure = FurStructure::new(mesh, &params)?;
-//! let mut simulation = Simulation::new(&structure, &preset.simulation)?;
-//! let fur = GpuFur::new(device, queue, &renderer, &structure, &preset.generate_textures()?, FurStates::One)?;
+//! let textures = preset.generate_textures()?;
+//! let mut driver =
+//!     FurDriver::new(device, queue, &renderer, &structure, &textures, &preset.simulation, KernelChoice::Cpu)?;
+//! let mut stepper = FurStepper::new(&structure, &preset.simulation)?;
 //! let view = FurView::new(device, &renderer);
 //!
-//! // Each frame: simulate, upload, prepare, then draw into the host's pass.
-//! simulation.advance_to(0.5);
-//! fur.set_positions(queue, simulation.positions())?;
-//! fur.prepare(queue, &FurFrame::default());
+//! // Each frame: step and write, record the GPU work, then draw into the host's pass.
+//! driver.advance_to(device, queue, &mut stepper, 0.5)?;
 //! view.prepare(queue, &ViewData::new(clip_from_world, world_from_view, &Light::default()));
+//! driver.record(encoder)?;
 //! // The silhouette pass (compute) into the host's encoder, before the render pass.
-//! renderer.prepare_fins(encoder, &view, &fur);
+//! driver.record_view(encoder, &renderer, &view);
 //! let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
 //!     color_attachments: &[Some(wgpu::RenderPassColorAttachment {
 //!         view: colour,
@@ -90,7 +94,7 @@
 //!     }),
 //!     ..Default::default()
 //! });
-//! renderer.draw(&mut pass, &view, &fur, &FurDrawSettings::SILHOUETTE);
+//! driver.draw(&mut pass, &renderer, &view, &FurDrawSettings::SILHOUETTE);
 //! # Ok(())
 //! # }
 //! ```
