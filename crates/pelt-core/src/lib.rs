@@ -3,13 +3,15 @@
 //! Data flows one way through the modules:
 //! [`mesh`] (import and repair; [`anim`] poses a moving one) -> [`fur`] (the unified shell-and-fin structure) ->
 //! [`texture`] (seeded shell and fin textures) -> [`sim`] (gravity, wind, touch) -> the renderer
-//! in `pelt-render`. [`preset`] holds everything about one fur in one TOML file.
+//! in `pelt-render`. [`preset`] holds everything about one fur in one TOML file. [`rng`] and
+//! [`param`] (the range error every parameter check returns) sit below them all.
 
 #![warn(missing_docs)]
 
 pub mod anim;
 pub mod fur;
 pub mod mesh;
+pub mod param;
 pub mod preset;
 pub mod reference;
 pub mod rng;

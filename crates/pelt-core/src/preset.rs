@@ -19,7 +19,8 @@ use glam::Vec3;
 
 use crate::fur::{FurLength, FurParams, GrowthDirection, MAX_LAYERS};
 use crate::mesh::Mesh;
-use crate::sim::{ParamError, SimParams};
+use crate::param::ParamError;
+use crate::sim::SimParams;
 use crate::texture::{
     self, ColourMode, ColourParams, FurTextures, ImageRgba8, StrandField, TextureInputs, TextureParams,
 };

@@ -36,6 +36,8 @@ pub mod wind;
 
 use glam::Vec3;
 
+pub use crate::param::ParamError;
+
 pub use bend::{BEND_GAIN, bend_strand, bend_strand_literal, bend_weight};
 pub use dispatch::CpuKernel;
 pub use field::{ForceField, Touch};
@@ -161,16 +163,6 @@ impl Default for TouchParams {
     fn default() -> Self {
         Self { strength: 4.0, release_secs: 0.0 }
     }
-}
-
-/// A parameter outside its allowed range: its preset key and what is allowed.
-#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
-#[error("{key}: {problem}")]
-pub struct ParamError {
-    /// The key as written in a preset, e.g. `simulation.stability`.
-    pub key: String,
-    /// What is wrong and the allowed range.
-    pub problem: String,
 }
 
 /// The largest force magnitude (gravity, wind or touch) the simulation accepts as a parameter.
