@@ -7,6 +7,8 @@
 //! - [`field`]: the per-vertex [`ForceField`] and the touch (patting) overlay.
 //! - [`mod@pick`]: ray picking of the base mesh, so a pointer or a script can touch the fur.
 //! - [`simulation`]: [`Simulation`], fixed steps with linear interpolation between the last two.
+//! - `inputs`: one step's inputs for any kernel, computed once: [`StepInputs`] (shared by every
+//!   strand) and [`StrandInputs`] (per strand).
 //! - [`scene`]: scripted wind and touch strokes ([`Scene`]), reproducible frame by frame.
 //! - [`motion`]: scripted rigid motion of the meshes (`[[motion]]` keys of a [`Scene`]).
 //! - [`inertia`]: the force from the roots' acceleration on a moving body ([`Inertia`]).
@@ -25,6 +27,7 @@ pub mod bend;
 mod dispatch;
 pub mod field;
 pub mod inertia;
+mod inputs;
 mod kernel;
 mod lanes;
 pub mod motion;
@@ -42,13 +45,14 @@ pub use bend::{BEND_GAIN, bend_strand, bend_strand_literal, bend_weight};
 pub use dispatch::CpuKernel;
 pub use field::{ForceField, Touch};
 pub use inertia::Inertia;
+pub use inputs::{StepInputs, StrandInputs};
 pub use kernel::{KernelRest, kernel_rest};
 pub use motion::{Ease, MotionKey};
 pub use pick::{Hit, pick};
 pub use scene::{Scene, SceneError, Stroke, WindKey};
 pub use simulation::{SimError, Simulation};
 pub use soak::{SoakReport, SoakStep, SoakSubject, soak};
-pub use wind::{WindParams, value_noise3};
+pub use wind::{WindParams, WindStep, value_noise3};
 
 /// Simulation parameters; part of a fur preset (`[simulation]` table).
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
