@@ -12,7 +12,7 @@
 //! - [`scene`]: scripted wind and touch strokes ([`Scene`]), reproducible frame by frame.
 //! - [`motion`]: scripted rigid motion of the meshes (`[[motion]]` keys of a [`Scene`]).
 //! - [`inertia`]: the force from the roots' acceleration on a moving body ([`Inertia`]).
-//! - [`mod@soak`]: many steps under extreme, changing inputs for any kernel ([`SoakSubject`]).
+//! - `soak` (with the `lab` feature): many steps under extreme, changing inputs for any kernel.
 //!
 //! `Simulation` bends with a batched kernel (8 strands per AVX2 register, an exact closed form
 //! for straight strands, the running quaternion for curved ones; AVX2 + FMA where the CPU has
@@ -34,6 +34,7 @@ pub mod motion;
 pub mod pick;
 pub mod scene;
 pub mod simulation;
+#[cfg(feature = "lab")]
 pub mod soak;
 pub mod wind;
 
@@ -51,6 +52,7 @@ pub use motion::{Ease, MotionKey};
 pub use pick::{Hit, pick};
 pub use scene::{Scene, SceneError, Stroke, WindKey};
 pub use simulation::{SimError, Simulation};
+#[cfg(feature = "lab")]
 pub use soak::{SoakReport, SoakStep, SoakSubject, soak};
 pub use wind::{WindParams, WindStep, value_noise3};
 

@@ -48,8 +48,8 @@ pub enum SimError {
     /// A touch radius that is not finite and positive.
     #[error("touch radius must be finite and positive, got {0}")]
     TouchRadius(f32),
-    /// Another kernel bending the strands (a GPU pass driven through
-    /// [`SoakSubject`](super::SoakSubject)) failed.
+    /// Another kernel bending the strands (a GPU pass driven through `sim::soak`, a `lab`
+    /// feature) failed.
     #[error("the {kernel} simulation kernel failed: {message}")]
     Kernel {
         /// Which kernel, e.g. `GPU`.
