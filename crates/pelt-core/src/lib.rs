@@ -5,7 +5,8 @@
 //! it) -> [`fur`] (the unified shell-and-fin structure) ->
 //! [`texture`] (seeded shell and fin textures) -> [`sim`] (gravity, wind, touch) -> the renderer
 //! in `pelt-render`. [`preset`] holds everything about one fur in one TOML file; [`stage`] loads
-//! the meshes of one scene (the furred one, its rig, the plain ones) for every host.
+//! the meshes of one scene (the furred one, its rig, the plain ones) for every host. [`rng`] and
+//! [`param`] (the range error every parameter check returns) sit below them all.
 
 #![warn(missing_docs)]
 
@@ -13,6 +14,7 @@ pub mod anim;
 pub mod fur;
 pub mod groom;
 pub mod mesh;
+pub mod param;
 pub mod preset;
 pub mod reference;
 pub mod rng;

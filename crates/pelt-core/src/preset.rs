@@ -21,7 +21,8 @@ use glam::Vec3;
 use crate::fur::{FurError, FurLength, FurParams, FurStructure, GrowthDirection, MAX_LAYERS};
 use crate::groom::{Groom, GroomError, GroomParams};
 use crate::mesh::Mesh;
-use crate::sim::{ParamError, SimParams};
+use crate::param::ParamError;
+use crate::sim::SimParams;
 use crate::texture::{
     self, ColourMode, ColourParams, FurTextures, ImageRgba8, StrandField, TextureInputs, TextureParams,
 };

@@ -142,9 +142,8 @@ impl FurDriver {
         structure: &FurStructure,
         textures: &FurTextures,
         kernel: SimKernel,
-        reason: &str,
     ) -> Result<(), RenderError> {
-        self.kernel_reason = reason.to_owned();
+        self.kernel_reason = "set by the host".to_owned();
         if kernel == self.kernel {
             return Ok(());
         }

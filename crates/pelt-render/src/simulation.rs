@@ -8,9 +8,8 @@
 //! (one compute pass per step into the host's encoder, swapping the fur's states). Nothing is
 //! read back and the shared array never crosses the bus.
 
-use glam::Vec3;
-use pelt_core::sim::{Simulation, kernel_rest};
-use pelt_core::{FurStructure, rng};
+use pelt_core::FurStructure;
+use pelt_core::sim::{Simulation, StepInputs, kernel_rest};
 
 use crate::RenderError;
 use crate::fur::GpuFur;
@@ -25,8 +24,6 @@ const STEP_SLOT_BYTES: u64 = 256;
 const STEP_SLOTS: usize = 2;
 /// Storage buffers the compute stage binds.
 const STORAGE_BUFFERS: u32 = 4;
-/// `wind::random_vector`'s seed salt.
-const JITTER_SALT: u64 = 0x6A69_7474_6572;
 
 /// One step's inputs; the layout of `Step` in `simulation.wgsl`.
 #[repr(C)]
@@ -53,48 +50,29 @@ fn words(value: u64) -> [u32; 2] {
     [value as u32, (value >> 32) as u32]
 }
 
-fn smoothstep(t: f32) -> f32 {
-    t * t * (3.0 - 2.0 * t)
-}
-
-/// The uniform of the step at `time_secs` of `simulation` (gravity, wind, touch), splitting the
-/// wind's f64 arithmetic (how far gusts travelled, the jitter's tick) the way the CPU does it.
-fn step_uniform(simulation: &Simulation, time_secs: f64, counts: [u32; 2], grid_x: u32) -> StepUniform {
-    let params = simulation.params();
-    let gravity = params.gravity_direction.normalize_or_zero() * params.gravity_strength;
-    let wind = &params.wind;
-    let (direction, strength) = match wind.direction.try_normalize() {
-        Some(direction) if wind.strength != 0.0 => (direction, wind.strength),
-        _ => (Vec3::ZERO, 0.0),
-    };
-    let radius = simulation.bounding_radius();
-    let gust_size = f64::from(wind.gust_scale) * f64::from(radius.max(f32::MIN_POSITIVE));
-    let travelled = direction.as_dvec3() * (f64::from(wind.gust_speed) / f64::from(wind.gust_scale) * time_secs);
-    let whole = travelled.floor();
-    let fraction = (travelled - whole).as_vec3();
-    let [x, y, z] = [whole.x, whole.y, whole.z].map(|w| words((w as i64).wrapping_neg() as u64));
-    let seed = words(rng::mix64(wind.seed));
-    let jitter = if wind.jitter > 0.0 { strength * wind.jitter } else { 0.0 };
-    let ticks = time_secs * f64::from(wind.jitter_hz);
-    let tick = ticks.floor();
-    let blend = smoothstep((ticks - tick) as f32);
-    let tick = tick as i64 as u64;
-    let [tick_a, tick_b, jitter_seed] = [tick, tick.wrapping_add(1), wind.seed ^ JITTER_SALT].map(words);
-    let touch = simulation.touch().map_or([0.0; 4], |touch| {
-        let presence = touch.presence(time_secs, params.touch.release_secs);
-        let force = touch.interaction() / touch.radius * params.touch.strength;
-        [force.x, force.y, force.z, presence.max(0.0)]
-    });
+/// The uniform of one step: `inputs` repacked into `Step`'s layout (the gust travel's whole
+/// cells negated, as the shader adds them; 64-bit values as two words).
+fn step_uniform(inputs: &StepInputs, counts: [u32; 2], grid_x: u32) -> StepUniform {
+    let wind = &inputs.wind;
+    let [x, y, z] = wind.gust_travel_cells.map(|cells| words(cells.wrapping_neg() as u64));
+    let seed = words(wind.noise_seed);
+    let [tick_a, tick_b] = wind.jitter_ticks.map(words);
+    let jitter_seed = words(wind.jitter_seed);
     StepUniform {
-        gravity: gravity.extend(0.0).to_array(),
-        wind_direction: direction.extend(strength).to_array(),
-        wind_shape: [wind.gust_strength, jitter, blend, (1.0 / gust_size) as f32],
-        travelled_fraction: fraction.extend(params.equation.gain(simulation.layers())).to_array(),
+        gravity: inputs.gravity.extend(0.0).to_array(),
+        wind_direction: wind.direction.extend(wind.strength).to_array(),
+        wind_shape: [
+            wind.gust_strength,
+            wind.jitter_force.unwrap_or(0.0),
+            wind.jitter_blend,
+            (1.0 / wind.gust_size) as f32,
+        ],
+        travelled_fraction: wind.gust_travel_fraction.extend(inputs.gain).to_array(),
         travelled_xy: [x[0], x[1], y[0], y[1]],
         travelled_z_seed: [z[0], z[1], seed[0], seed[1]],
         jitter_seed_tick: [jitter_seed[0], jitter_seed[1], tick_a[0], tick_a[1]],
         next_tick_counts: [tick_b[0], tick_b[1], counts[0], counts[1]],
-        touch,
+        touch: inputs.touch_force.extend(inputs.touch_presence).to_array(),
         grid: [grid_x, 0, 0, 0],
     }
 }
@@ -339,7 +317,7 @@ impl GpuSimulation {
         self.upload_inputs(queue, simulation);
         let counts = [self.vertex_count, self.layers];
         for &time_secs in &recent[recent.len() - new..] {
-            self.pending.push(step_uniform(simulation, time_secs, counts, self.grid[0]));
+            self.pending.push(step_uniform(&simulation.step_inputs(time_secs), counts, self.grid[0]));
         }
         if self.pending.len() > STEP_SLOTS {
             self.pending.drain(..self.pending.len() - STEP_SLOTS);
@@ -434,34 +412,25 @@ impl GpuSimulation {
 
     /// Writes the per-strand inputs that differ from what the GPU holds.
     fn upload_inputs(&mut self, queue: &wgpu::Queue, simulation: &Simulation) {
-        let stability = simulation.params().stability;
-        let map = simulation.stability_map();
-        let strands: Vec<[f32; 8]> = simulation
-            .roots()
+        let inputs = simulation.strand_inputs();
+        let strands: Vec<[f32; 8]> = inputs
+            .roots
             .iter()
-            .zip(simulation.frames())
+            .zip(inputs.frames)
             .enumerate()
             .map(|(j, (root, frame))| {
-                let s = map.map_or(stability, |m| m[j]);
                 let [x, y, z, w] = frame.to_array();
-                [root.x, root.y, root.z, s, x, y, z, w]
+                [root.x, root.y, root.z, inputs.stability_of(j), x, y, z, w]
             })
             .collect();
         if strands != self.strand_data {
             queue.write_buffer(&self.strands, 0, bytemuck::cast_slice(&strands));
             self.strand_data = strands;
         }
-        let mut forces: Vec<[f32; 8]> = simulation
-            .field()
-            .values()
-            .iter()
-            .zip(simulation.inertial_forces())
-            .map(|(f, i)| [f.x, f.y, f.z, 0.0, i.x, i.y, i.z, 0.0])
-            .collect();
-        if let Some(touch) = simulation.touch() {
-            for &(j, weight) in touch.weights() {
-                forces[j as usize][3] = weight;
-            }
+        let mut forces: Vec<[f32; 8]> =
+            inputs.field.iter().zip(inputs.inertial).map(|(f, i)| [f.x, f.y, f.z, 0.0, i.x, i.y, i.z, 0.0]).collect();
+        for &(j, weight) in inputs.touch_weights {
+            forces[j as usize][3] = weight;
         }
         // Bitwise, so a NaN in the field does not count as a change every step.
         if bytemuck::cast_slice::<_, u32>(&forces) != bytemuck::cast_slice::<_, u32>(&self.force_data) {

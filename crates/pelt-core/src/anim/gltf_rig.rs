@@ -6,25 +6,12 @@ use std::collections::HashMap;
 use glam::{Mat3, Mat4, Quat, Vec3};
 use gltf::animation::util::ReadOutputs;
 
+use crate::mesh::gltf::Span;
+
 use super::{
     Animation, Channel, Influences, Interpolation, MorphSet, PaletteJoint, Property, Rig, RigNode, Sampler,
     SkinSummary, Trs,
 };
-
-/// One primitive's vertices in the raw mesh and where they came from.
-#[derive(Clone, Debug)]
-pub(crate) struct Span {
-    /// The node holding the mesh (none when the file has no scene).
-    pub node: Option<usize>,
-    /// The node's skin.
-    pub skin: Option<usize>,
-    pub mesh: usize,
-    pub primitive: usize,
-    pub first_vertex: u32,
-    pub count: u32,
-    /// The transform the static import applied (identity for a skinned mesh).
-    pub world_from_local: Mat4,
-}
 
 /// Morph targets of one primitive, dense over its raw vertices.
 #[derive(Clone, Debug)]
@@ -37,7 +24,7 @@ struct RawMorphSet {
 
 /// A rig over the raw (unwelded) vertices.
 #[derive(Clone, Debug)]
-pub(crate) struct RawRig {
+pub(super) struct RawRig {
     nodes: Vec<RigNode>,
     order: Vec<usize>,
     skins: Vec<SkinSummary>,
@@ -51,7 +38,7 @@ pub(crate) struct RawRig {
 impl RawRig {
     /// Lines the rig up with the repaired mesh: `source[j]` is the raw vertex base vertex `j`
     /// was taken from.
-    pub(crate) fn finish(self, source: &[u32]) -> Rig {
+    pub(super) fn finish(self, source: &[u32]) -> Rig {
         let influences = source.iter().map(|&i| self.influences[i as usize]).collect();
         let mut morphs = Vec::new();
         for set in self.morphs {
@@ -92,7 +79,7 @@ impl RawRig {
 ///
 /// # Errors
 /// A message for accessors that cannot be read at all.
-pub(crate) fn read_rig(
+pub(super) fn read_rig(
     document: &gltf::Document,
     buffers: &[gltf::buffer::Data],
     spans: &[Span],

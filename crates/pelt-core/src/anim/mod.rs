@@ -18,12 +18,12 @@
 
 mod gltf_rig;
 mod joints;
+mod load;
 pub mod sampler;
 mod skin;
 
 use glam::{Mat3, Mat4, Quat, Vec3};
 
-pub(crate) use gltf_rig::{RawRig, Span, read_rig};
 pub use joints::{Skin, SkinError};
 pub use sampler::{Interpolation, Sampler};
 

@@ -12,44 +12,71 @@ use glam::{Mat3, Mat4, Vec2, Vec3, Vec4};
 use gltf::mesh::Mode;
 
 use super::{ColourSet, MeshError, RawMesh};
-use crate::anim::{RawRig, Span, read_rig};
-
-/// Vertex colour sets `COLOR_0 ..` read (grooms name them; files rarely have more than two).
-const MAX_COLOUR_SETS: u32 = 8;
 
 /// Deeper node hierarchies than this are treated as broken (and cannot blow the stack).
 const MAX_NODE_DEPTH: usize = 256;
 
+/// Vertex colour sets `COLOR_0 ..` read (grooms name them; files rarely have more than two).
+const MAX_COLOUR_SETS: u32 = 8;
+
+/// A file's raw mesh, its vertex colour sets (one colour per raw vertex) and what a further
+/// reader took from the document.
+pub(crate) type Parsed<T> = (RawMesh, Vec<ColourSet>, T);
+
+/// One primitive's vertices in the raw mesh and where in the glTF document they came from, for
+/// readers of the rest of the document (the rig) to line their data up with the mesh.
+#[derive(Clone, Debug)]
+pub(crate) struct Span {
+    /// The node holding the mesh (none when the file has no scene).
+    pub node: Option<usize>,
+    /// The node's skin.
+    pub skin: Option<usize>,
+    pub mesh: usize,
+    pub primitive: usize,
+    pub first_vertex: u32,
+    pub count: u32,
+    /// The transform the static import applied (identity for a skinned mesh).
+    pub world_from_local: Mat4,
+}
+
+/// A further reader of the parsed document: given the document, its buffers, the raw mesh's
+/// spans and vertex count, it returns its own result or a message for the file's parse error.
+pub(crate) trait DocumentReader<T>:
+    FnOnce(&gltf::Document, &[gltf::buffer::Data], &[Span], usize) -> Result<T, String> + std::panic::UnwindSafe
+{
+}
+
+impl<T, F> DocumentReader<T> for F where
+    F: FnOnce(&gltf::Document, &[gltf::buffer::Data], &[Span], usize) -> Result<T, String> + std::panic::UnwindSafe
+{
+}
+
 pub(super) fn load(path: &Path) -> Result<(RawMesh, Vec<ColourSet>), MeshError> {
-    let bytes = std::fs::read(path).map_err(|error| MeshError::Io { file: path.to_path_buf(), error })?;
-    parse(&bytes, path, path.parent())
+    load_with(path, |_, _, _, _| Ok(())).map(|(raw, colour_sets, ())| (raw, colour_sets))
 }
 
 /// Parses `.gltf` JSON or `.glb` bytes. External buffers are looked up next to `base`; without
 /// a `base` only embedded (GLB or `data:` URI) buffers can be read.
 pub(super) fn parse(bytes: &[u8], file: &Path, base: Option<&Path>) -> Result<(RawMesh, Vec<ColourSet>), MeshError> {
-    parse_with_rig(bytes, file, base, false).map(|(raw, colour_sets, _)| (raw, colour_sets))
+    parse_with(bytes, file, base, |_, _, _, _| Ok(())).map(|(raw, colour_sets, ())| (raw, colour_sets))
 }
 
-/// Reads the whole file: [`load`] plus its rig (nodes, skins, morph targets, animations).
-pub(super) fn load_with_rig(path: &Path) -> Result<Parsed, MeshError> {
+/// Reads the whole file: [`load`] plus what `read` takes from the rest of the document.
+pub(crate) fn load_with<T>(path: &Path, read: impl DocumentReader<T>) -> Result<Parsed<T>, MeshError> {
     let bytes = std::fs::read(path).map_err(|error| MeshError::Io { file: path.to_path_buf(), error })?;
-    parse_with_rig(&bytes, path, path.parent(), true)
+    parse_with(&bytes, path, path.parent(), read)
 }
 
-/// A file's raw mesh, its vertex colour sets (one colour per raw vertex) and its rig.
-pub(super) type Parsed = (RawMesh, Vec<ColourSet>, Option<RawRig>);
-
-/// [`parse`], with the rig when `with_rig` is set.
-pub(super) fn parse_with_rig(
+/// [`parse`], plus what `read` takes from the rest of the document.
+pub(crate) fn parse_with<T>(
     bytes: &[u8],
     file: &Path,
     base: Option<&Path>,
-    with_rig: bool,
-) -> Result<Parsed, MeshError> {
+    read: impl DocumentReader<T>,
+) -> Result<Parsed<T>, MeshError> {
     // The `gltf` crate's validation indexes unchecked in places (gltf-json 1.4.1 panics on a
     // primitive whose attribute map is emptied, for one); a broken file must stay an error.
-    std::panic::catch_unwind(|| parse_unguarded(bytes, file, base, with_rig)).unwrap_or_else(|_| {
+    std::panic::catch_unwind(|| parse_unguarded(bytes, file, base, read)).unwrap_or_else(|_| {
         Err(MeshError::Parse {
             file: file.to_path_buf(),
             line: None,
@@ -58,7 +85,12 @@ pub(super) fn parse_with_rig(
     })
 }
 
-fn parse_unguarded(bytes: &[u8], file: &Path, base: Option<&Path>, with_rig: bool) -> Result<Parsed, MeshError> {
+fn parse_unguarded<T>(
+    bytes: &[u8],
+    file: &Path,
+    base: Option<&Path>,
+    read: impl DocumentReader<T>,
+) -> Result<Parsed<T>, MeshError> {
     let error = |message: String| MeshError::Parse { file: file.to_path_buf(), line: None, message };
     let gltf::Gltf { document, blob } =
         gltf::Gltf::from_slice(bytes).map_err(|e| error(format!("not valid glTF: {e}")))?;
@@ -78,9 +110,9 @@ fn parse_unguarded(bytes: &[u8], file: &Path, base: Option<&Path>, with_rig: boo
     let mut raw = RawMesh::default();
     let mut normals = Some(Vec::new());
     let mut uvs = Some(Vec::new());
-    let mut colours: Vec<Option<Vec<Vec4>>> = (0..MAX_COLOUR_SETS).map(|_| Some(Vec::new())).collect();
     let mut skipped_primitives = 0;
     let mut spans = Vec::new();
+    let mut colours: Vec<Option<Vec<Vec4>>> = (0..MAX_COLOUR_SETS).map(|_| Some(Vec::new())).collect();
     for (mesh, world_from_local, node, skin) in parts {
         for primitive in mesh.primitives() {
             let mode = primitive.mode();
@@ -149,8 +181,8 @@ fn parse_unguarded(bytes: &[u8], file: &Path, base: Option<&Path>, with_rig: boo
         .zip(colours)
         .filter_map(|(set, colours)| colours.filter(|c| !c.is_empty()).map(|colours| ColourSet { set, colours }))
         .collect();
-    let rig = if with_rig { read_rig(&document, &buffers, &spans, raw.positions.len()).map_err(error)? } else { None };
-    Ok((raw, colour_sets, rig))
+    let extra = read(&document, &buffers, &spans, raw.positions.len()).map_err(error)?;
+    Ok((raw, colour_sets, extra))
 }
 
 /// A mesh to import with its world transform, node and skin.

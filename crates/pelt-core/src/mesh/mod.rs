@@ -6,11 +6,12 @@
 //!
 //! By job: `error` ([`MeshError`]), the loaders (`obj`, `gltf`, [`builtin`]), `repair`
 //! ([`Mesh::from_raw`], welding, orientation, [`smooth_normals`]), `topology` ([`Topology`],
-//! the edge list) and `report` ([`MeshReport`]).
+//! the edge list) and `report` ([`MeshReport`]). A glTF file's rig is read in `anim`
+//! ([`Mesh::load_animated`]) on top of this module's glTF parse, so meshes never need the rig.
 
 pub mod builtin;
 mod error;
-mod gltf;
+pub(crate) mod gltf;
 mod obj;
 mod repair;
 mod report;
@@ -22,8 +23,6 @@ mod wedges;
 use std::path::Path;
 
 use glam::{Mat4, Vec2, Vec3, Vec4};
-
-use crate::anim::Rig;
 
 pub use error::MeshError;
 pub use repair::smooth_normals;
@@ -118,37 +117,6 @@ impl Mesh {
             _ => return Err(MeshError::UnknownFormat { file: path.to_path_buf(), extension }),
         };
         Self::repair(raw, &colour_sets, path, options).map(|(mesh, report, _)| (mesh, report))
-    }
-
-    /// Loads a mesh file like [`Mesh::load`], with its [`Rig`] when it is a glTF file with skins,
-    /// animations or morph targets (`None` otherwise). The mesh is the static import (the bind
-    /// pose); the rig poses it. Problems with skins and animations the loader could handle are
-    /// lines in [`Rig::report`].
-    ///
-    /// # Errors
-    /// As [`Mesh::load`], and [`MeshError::Parse`] for skin or animation data that cannot be read.
-    pub fn load_animated(path: &Path, options: &ImportOptions) -> Result<(Self, MeshReport, Option<Rig>), MeshError> {
-        let extension = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).unwrap_or_default();
-        if !matches!(extension.as_str(), "gltf" | "glb") || !path.exists() {
-            return Self::load(path, options).map(|(mesh, report)| (mesh, report, None));
-        }
-        let (raw, colour_sets, rig) = gltf::load_with_rig(path)?;
-        let (mesh, report, source) = Self::repair(raw, &colour_sets, path, options)?;
-        Ok((mesh, report, rig.map(|rig| rig.finish(&source))))
-    }
-
-    /// [`Mesh::from_gltf_slice`] with the [`Rig`], as [`Mesh::load_animated`].
-    ///
-    /// # Errors
-    /// As [`Mesh::load_animated`].
-    pub fn from_gltf_slice_animated(
-        bytes: &[u8],
-        name: &Path,
-        options: &ImportOptions,
-    ) -> Result<(Self, MeshReport, Option<Rig>), MeshError> {
-        let (raw, colour_sets, rig) = gltf::parse_with_rig(bytes, name, None, true)?;
-        let (mesh, report, source) = Self::repair(raw, &colour_sets, name, options)?;
-        Ok((mesh, report, rig.map(|rig| rig.finish(&source))))
     }
 
     /// Parses OBJ text held in memory (used for embedded meshes and tests).

@@ -37,7 +37,7 @@ impl Mesh {
     /// [`Mesh::from_raw`], also returning for each kept vertex the raw vertex it was taken from
     /// (so per-vertex data read beside the mesh, like skin weights, follows welding and repair).
     /// `colour_sets` (one colour per raw vertex each) follow welding too: see [`Mesh::colour_sets`].
-    pub(super) fn repair(
+    pub(crate) fn repair(
         raw: RawMesh,
         colour_sets: &[ColourSet],
         file: &Path,

@@ -106,10 +106,20 @@ impl Touch {
     /// `presence`, and `force = interaction / radius * strength`. Vertices outside the radius,
     /// and all of them at zero presence, keep their values exactly.
     pub fn apply(&self, strength: f32, presence: f32, field: &mut [Vec3]) {
+        self.blend(self.force(strength), presence, field);
+    }
+
+    /// The touch's force for the touch parameter `strength`: `interaction / radius * strength`.
+    #[must_use]
+    pub fn force(&self, strength: f32) -> Vec3 {
+        self.interaction() / self.radius * strength
+    }
+
+    /// [`Touch::apply`] with its [`Touch::force`] given.
+    pub fn blend(&self, force: Vec3, presence: f32, field: &mut [Vec3]) {
         if presence <= 0.0 {
             return;
         }
-        let force = self.interaction() / self.radius * strength;
         for &(j, weight) in &self.weights {
             let w = weight * presence;
             let value = &mut field[j as usize];

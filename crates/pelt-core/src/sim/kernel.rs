@@ -40,9 +40,9 @@ pub(crate) type Lanes = [f32; LANES];
 /// A vector per strand of a batch: `[x, y, z]` lanes.
 pub(crate) type VecLanes = [Lanes; 3];
 
-/// Per-strand inputs of one step.
+/// One lane's (strand's) inputs of one step, as the bend reads them.
 #[derive(Clone, Copy, Debug)]
-pub(crate) struct StrandInputs {
+pub(crate) struct LaneInputs {
     pub root: Vec3,
     /// Rotation of the rest frame into the current base frame.
     pub frame: Quat,
@@ -51,7 +51,7 @@ pub(crate) struct StrandInputs {
     pub stability: f32,
 }
 
-impl Default for StrandInputs {
+impl Default for LaneInputs {
     fn default() -> Self {
         Self { root: Vec3::ZERO, frame: Quat::IDENTITY, force: Vec3::ZERO, stability: 1.0 }
     }
@@ -158,7 +158,7 @@ struct Loaded<const W: usize> {
 }
 
 #[inline(always)]
-fn load<const N: usize, const W: usize>(inputs: [&[StrandInputs; LANES]; N]) -> Loaded<W> {
+fn load<const N: usize, const W: usize>(inputs: [&[LaneInputs; LANES]; N]) -> Loaded<W> {
     macro_rules! lane {
         ($($field:tt).+) => {
             F(std::array::from_fn(|i| inputs[i / LANES][i % LANES].$($field).+))
@@ -197,7 +197,7 @@ fn store<const N: usize, const W: usize>(value: V3<W>, parts: &mut [&mut [VecLan
 
 /// Bends one batch of straight strands (see the module docs); `nodes` receives `L + 1` nodes.
 #[inline(always)]
-pub(crate) fn bend_straight(inputs: &[StrandInputs; LANES], gain: f32, rest: BatchRest<'_>, nodes: &mut [VecLanes]) {
+pub(crate) fn bend_straight(inputs: &[LaneInputs; LANES], gain: f32, rest: BatchRest<'_>, nodes: &mut [VecLanes]) {
     const W: usize = LANES;
     let layers = rest.lengths.len();
     debug_assert_eq!(nodes.len(), layers + 1);
@@ -245,7 +245,7 @@ fn put(value: V3<LANES>, out: &mut VecLanes) {
 /// chains for the out-of-order core to overlap); `nodes[n]` receives batch `n`'s `L + 1` nodes.
 #[inline(always)]
 pub(crate) fn bend_general<const N: usize, const W: usize>(
-    inputs: [&[StrandInputs; LANES]; N],
+    inputs: [&[LaneInputs; LANES]; N],
     gain: f32,
     rest: [BatchRest<'_>; N],
     mut nodes: [&mut [VecLanes]; N],
@@ -429,18 +429,18 @@ pub(crate) struct Step<'a> {
 
 impl Step<'_> {
     #[inline(always)]
-    fn inputs(&self, batch: usize) -> [StrandInputs; LANES] {
+    fn inputs(&self, batch: usize) -> [LaneInputs; LANES] {
         std::array::from_fn(|lane| {
             let j = batch * LANES + lane;
             if j < self.vertex_count {
-                StrandInputs {
+                LaneInputs {
                     root: self.roots[j],
                     frame: self.frames[j],
                     force: self.gravity + self.external[j] + self.inertial[j],
                     stability: self.stability_map.map_or(self.stability, |m| m[j]),
                 }
             } else {
-                StrandInputs::default()
+                LaneInputs::default()
             }
         })
     }
@@ -482,7 +482,7 @@ impl Step<'_> {
     }
 
     #[inline(always)]
-    fn bend_one(&self, batch: usize, inputs: &[StrandInputs; LANES], nodes: &mut [VecLanes]) {
+    fn bend_one(&self, batch: usize, inputs: &[LaneInputs; LANES], nodes: &mut [VecLanes]) {
         if self.rest.is_straight[batch] {
             bend_straight(inputs, self.gain, self.rest(batch), nodes);
         } else {
@@ -505,10 +505,10 @@ mod tests {
     fn worst_stretch(off: [f32; LANES], stability: f32, frame: Quat) -> (f64, f64) {
         let directions: [Vec3; LANES] =
             std::array::from_fn(|i| Vec3::new(0.3 + 0.1 * i as f32, 0.8, -0.5 + 0.13 * i as f32).normalize());
-        let inputs: [StrandInputs; LANES] = std::array::from_fn(|i| {
+        let inputs: [LaneInputs; LANES] = std::array::from_fn(|i| {
             let d = frame * directions[i];
             let side = d.any_orthonormal_vector();
-            StrandInputs {
+            LaneInputs {
                 root: Vec3::new(0.01, -0.02, 0.03) * i as f32,
                 frame,
                 force: (-d * off[i].cos() + side * off[i].sin()) * 1.7,

@@ -8,10 +8,12 @@
 //! - [`mod@pick`]: ray picking of the base mesh, so a pointer or a script can touch the fur.
 //! - [`simulation`]: [`Simulation`], fixed steps with linear interpolation between the last two.
 //! - [`stepper`]: [`FurStepper`], one fur driven through time: its base posed, the script played.
+//! - `inputs`: one step's inputs for any kernel, computed once: [`StepInputs`] (shared by every
+//!   strand) and [`StrandInputs`] (per strand).
 //! - [`scene`]: scripted wind and touch strokes ([`Scene`]), reproducible frame by frame.
 //! - [`motion`]: scripted rigid motion of the meshes (`[[motion]]` keys of a [`Scene`]).
 //! - [`inertia`]: the force from the roots' acceleration on a moving body ([`Inertia`]).
-//! - [`mod@soak`]: many steps under extreme, changing inputs for any kernel ([`SoakSubject`]).
+//! - `soak` (with the `lab` feature): many steps under extreme, changing inputs for any kernel.
 //!
 //! `Simulation` bends with a batched kernel (8 strands per AVX2 register, an exact closed form
 //! for straight strands, the running quaternion for curved ones; AVX2 + FMA where the CPU has
@@ -26,30 +28,36 @@ pub mod bend;
 mod dispatch;
 pub mod field;
 pub mod inertia;
+mod inputs;
 mod kernel;
 mod lanes;
 pub mod motion;
 pub mod pick;
 pub mod scene;
 pub mod simulation;
+#[cfg(feature = "lab")]
 pub mod soak;
 pub mod stepper;
 pub mod wind;
 
 use glam::Vec3;
 
+pub use crate::param::ParamError;
+
 pub use bend::{BEND_GAIN, bend_strand, bend_strand_literal, bend_weight};
 pub use dispatch::CpuKernel;
 pub use field::{ForceField, Touch};
 pub use inertia::Inertia;
+pub use inputs::{StepInputs, StrandInputs};
 pub use kernel::{KernelRest, kernel_rest};
 pub use motion::{Ease, MotionKey};
 pub use pick::{Hit, pick};
 pub use scene::{Scene, SceneError, Stroke, WindKey};
 pub use simulation::{SimError, Simulation};
+#[cfg(feature = "lab")]
 pub use soak::{SoakReport, SoakStep, SoakSubject, soak};
 pub use stepper::FurStepper;
-pub use wind::{WindParams, value_noise3};
+pub use wind::{WindParams, WindStep, value_noise3};
 
 /// Simulation parameters; part of a fur preset (`[simulation]` table).
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -164,16 +172,6 @@ impl Default for TouchParams {
     fn default() -> Self {
         Self { strength: 4.0, release_secs: 0.0 }
     }
-}
-
-/// A parameter outside its allowed range: its preset key and what is allowed.
-#[derive(Clone, Debug, PartialEq, Eq, thiserror::Error)]
-#[error("{key}: {problem}")]
-pub struct ParamError {
-    /// The key as written in a preset, e.g. `simulation.stability`.
-    pub key: String,
-    /// What is wrong and the allowed range.
-    pub problem: String,
 }
 
 /// The largest force magnitude (gravity, wind or touch) the simulation accepts as a parameter.

@@ -15,6 +15,7 @@ use rayon::prelude::*;
 use super::dispatch::{self, CpuKernel};
 use super::field::{ForceField, Touch};
 use super::inertia::Inertia;
+use super::inputs::{StepInputs, StrandInputs};
 use super::kernel::{LANES, RestBatches, Step, VecLanes};
 use super::pick::{Hit, pick};
 use super::{ParamError, SimParams, WindParams};
@@ -47,8 +48,8 @@ pub enum SimError {
     /// A touch radius that is not finite and positive.
     #[error("touch radius must be finite and positive, got {0}")]
     TouchRadius(f32),
-    /// Another kernel bending the strands (a GPU pass driven through
-    /// [`SoakSubject`](super::SoakSubject)) failed.
+    /// Another kernel bending the strands (a GPU pass driven through `sim::soak`, a `lab`
+    /// feature) failed.
     #[error("the {kernel} simulation kernel failed: {message}")]
     Kernel {
         /// Which kernel, e.g. `GPU`.
@@ -306,13 +307,39 @@ impl Simulation {
     /// If `out.len()` is not the base vertex count.
     pub fn evaluate_field(&self, time_secs: f64, out: &mut [Vec3]) {
         assert_eq!(out.len(), self.vertex_count, "one force per base vertex");
-        let wind = &self.params.wind;
-        let (field, roots, radius) = (self.field.values(), &self.roots, self.radius);
+        self.external_field_into(&self.step_inputs(time_secs), out);
+    }
+
+    fn external_field_into(&self, inputs: &StepInputs, out: &mut [Vec3]) {
+        let (wind, field, roots) = (&inputs.wind, self.field.values(), &self.roots);
         out.par_iter_mut().enumerate().with_min_len(256).for_each(|(j, force)| {
-            *force = wind.sample(j, roots[j], time_secs, radius) + field[j];
+            *force = wind.force(j, roots[j]) + field[j];
         });
         if let Some(touch) = &self.touch {
-            touch.apply(self.params.touch.strength, touch.presence(time_secs, self.params.touch.release_secs), out);
+            touch.blend(inputs.touch_force, inputs.touch_presence, out);
+        }
+    }
+
+    /// The inputs every strand shares in the step at `time_secs` (gravity, the wind's step, the
+    /// touch, Equation 1's gain), with the parameters and touch as they are now: what the CPU
+    /// kernel bends with, for another kernel to take as they are.
+    #[must_use]
+    pub fn step_inputs(&self, time_secs: f64) -> StepInputs {
+        StepInputs::new(&self.params, self.layers, self.radius, self.touch.as_ref(), time_secs)
+    }
+
+    /// The per-strand inputs as they are now (posed roots and frames, stability, the user field,
+    /// the touch's weights, the inertial force of the newest step).
+    #[must_use]
+    pub fn strand_inputs(&self) -> StrandInputs<'_> {
+        StrandInputs {
+            roots: &self.roots,
+            frames: &self.frames,
+            stability: self.params.stability,
+            stability_map: self.stability_map.as_deref(),
+            field: self.field.values(),
+            touch_weights: self.touch.as_ref().map_or(&[], |touch| touch.weights()),
+            inertial: self.inertia.forces(),
         }
     }
 
@@ -649,23 +676,28 @@ impl Simulation {
             return;
         }
         let started = Instant::now();
+        let inputs = self.step_inputs(time_secs);
         let mut external = std::mem::take(&mut self.external);
-        self.evaluate_field(time_secs, &mut external);
+        self.external_field_into(&inputs, &mut external);
         self.external = external;
+        // Taken out while `strands` borrows the simulation.
+        let mut current = std::mem::take(&mut self.current);
+        let strands = self.strand_inputs();
         let step = Step {
             layers: self.layers as usize,
             vertex_count: self.vertex_count,
-            gain: self.params.equation.gain(self.layers),
-            gravity: self.params.gravity_direction.normalize_or_zero() * self.params.gravity_strength,
-            stability: self.params.stability,
-            stability_map: self.stability_map.as_deref(),
-            roots: &self.roots,
-            frames: &self.frames,
+            gain: inputs.gain,
+            gravity: inputs.gravity,
+            stability: strands.stability,
+            stability_map: strands.stability_map,
+            roots: strands.roots,
+            frames: strands.frames,
             external: &self.external,
-            inertial: self.inertia.forces(),
+            inertial: strands.inertial,
             rest: &self.rest,
         };
-        dispatch::bend_all(self.cpu_kernel, &step, &mut self.current);
+        dispatch::bend_all(self.cpu_kernel, &step, &mut current);
+        self.current = current;
         self.last_step_secs = started.elapsed().as_secs_f64();
     }
 

@@ -77,34 +77,107 @@ impl WindParams {
     }
 
     /// The wind force on `vertex` at `position` and `time_secs`; `radius` is the base mesh's
-    /// bounding radius (the unit of `gust_scale` and `gust_speed`).
+    /// bounding radius (the unit of `gust_scale` and `gust_speed`). For many vertices at one
+    /// time, make the [`WindStep`] once and ask it for each.
     #[must_use]
     pub fn sample(&self, vertex: usize, position: Vec3, time_secs: f64, radius: f32) -> Vec3 {
-        let Some(direction) = self.direction.try_normalize() else { return Vec3::ZERO };
+        WindStep::new(self, time_secs, radius).force(vertex, position)
+    }
+}
+
+/// The wind of one step: everything [`WindParams`] and the time give every vertex alike,
+/// computed once per step. [`WindStep::force`] is the force on one vertex. A kernel without f64
+/// (a GPU's) takes the gust travel as whole cells plus a fraction, so its f32 arithmetic stays
+/// as precise far from the start as near it, and the seeds and jitter ticks as 64-bit integers.
+#[derive(Clone, Copy, Debug, PartialEq)]
+#[non_exhaustive]
+pub struct WindStep {
+    /// The unit direction the wind blows to; zero without wind.
+    pub direction: Vec3,
+    /// The wind's strength; 0 without wind (no strength or no usable direction), and then the
+    /// force is zero everywhere.
+    pub strength: f32,
+    /// How much gusts vary the strength ([`WindParams::gust_strength`]).
+    pub gust_strength: f32,
+    /// World units per gust-noise cell: the gust scale times the bounding radius.
+    pub gust_size: f64,
+    /// How far the gusts have travelled along the wind by this step, in noise cells: the noise
+    /// is read at `position / gust_size - gust_travel`.
+    pub gust_travel: DVec3,
+    /// The whole cells of `gust_travel`: its floor per axis (saturated to `i64`).
+    pub gust_travel_cells: [i64; 3],
+    /// The rest of `gust_travel`, `gust_travel - floor(gust_travel)`, each axis in `[0, 1]`.
+    pub gust_travel_fraction: Vec3,
+    /// The gust noise's seed, mixed once as [`value_noise3`] mixes its seed.
+    pub noise_seed: u64,
+    /// The seed of the jitter's random vectors (the wind's seed, salted).
+    pub jitter_seed: u64,
+    /// The two jitter ticks this step blends between: `floor(time_secs * jitter_hz)` and the
+    /// next.
+    pub jitter_ticks: [u64; 2],
+    /// The second tick's weight in the blend (smoothstepped).
+    pub jitter_blend: f32,
+    /// The jitter's scale, strength times [`WindParams::jitter`]; `None` without jitter.
+    pub jitter_force: Option<f32>,
+}
+
+impl WindStep {
+    /// The wind of `wind` at `time_secs`; `radius` is the base mesh's bounding radius (the unit
+    /// of `gust_scale` and `gust_speed`).
+    #[must_use]
+    pub fn new(wind: &WindParams, time_secs: f64, radius: f32) -> Self {
+        let (direction, strength) = match wind.direction.try_normalize() {
+            Some(direction) if wind.strength != 0.0 => (direction, wind.strength),
+            _ => (Vec3::ZERO, 0.0),
+        };
+        let gust_size = f64::from(wind.gust_scale) * f64::from(radius.max(f32::MIN_POSITIVE));
+        let gust_travel = direction.as_dvec3() * (f64::from(wind.gust_speed) / f64::from(wind.gust_scale) * time_secs);
+        let whole = gust_travel.floor();
+        let ticks = time_secs * f64::from(wind.jitter_hz);
+        let tick = ticks.floor();
+        let jitter_blend = smoothstep((ticks - tick) as f32);
+        let tick = tick as i64 as u64;
+        Self {
+            direction,
+            strength,
+            gust_strength: wind.gust_strength,
+            gust_size,
+            gust_travel,
+            gust_travel_cells: [whole.x as i64, whole.y as i64, whole.z as i64],
+            gust_travel_fraction: (gust_travel - whole).as_vec3(),
+            noise_seed: rng::mix64(wind.seed),
+            jitter_seed: wind.seed ^ JITTER_SALT,
+            jitter_ticks: [tick, tick.wrapping_add(1)],
+            jitter_blend,
+            jitter_force: (wind.jitter > 0.0).then_some(strength * wind.jitter),
+        }
+    }
+
+    /// The wind force on `vertex` at `position`.
+    #[must_use]
+    pub fn force(&self, vertex: usize, position: Vec3) -> Vec3 {
         if self.strength == 0.0 {
             return Vec3::ZERO;
         }
-        let gust_size = f64::from(self.gust_scale) * f64::from(radius.max(f32::MIN_POSITIVE));
-        let travelled = direction.as_dvec3() * (f64::from(self.gust_speed) / f64::from(self.gust_scale) * time_secs);
-        let gust = value_noise3(self.seed, position.as_dvec3() / gust_size - travelled);
-        let mut force = direction * (self.strength * (1.0 + self.gust_strength * gust));
-        if self.jitter > 0.0 {
-            let t = time_secs * f64::from(self.jitter_hz);
-            let tick = t.floor();
-            let blend = smoothstep((t - tick) as f32);
-            let tick = tick as i64 as u64;
-            let a = random_vector(self.seed, vertex as u64, tick);
-            let b = random_vector(self.seed, vertex as u64, tick.wrapping_add(1));
-            force += (a * (1.0 - blend) + b * blend) * (self.strength * self.jitter);
+        let gust = value_noise3_mixed(self.noise_seed, position.as_dvec3() / self.gust_size - self.gust_travel);
+        let mut force = self.direction * (self.strength * (1.0 + self.gust_strength * gust));
+        if let Some(jitter_force) = self.jitter_force {
+            let blend = self.jitter_blend;
+            let a = random_vector(self.jitter_seed, vertex as u64, self.jitter_ticks[0]);
+            let b = random_vector(self.jitter_seed, vertex as u64, self.jitter_ticks[1]);
+            force += (a * (1.0 - blend) + b * blend) * jitter_force;
         }
         force
     }
 }
 
+/// What the jitter's seed is salted with, so its vectors differ from the gusts' noise.
+const JITTER_SALT: u64 = 0x6A69_7474_6572;
+
 /// A seeded random vector in `[-1, 1]^3` for one vertex and tick (21 random bits per axis from
-/// one hash: plenty for a shake, and a third of the hashing).
+/// one hash: plenty for a shake, and a third of the hashing); `seed` is already salted.
 fn random_vector(seed: u64, vertex: u64, tick: u64) -> Vec3 {
-    let bits = rng::hash(seed ^ 0x6A69_7474_6572, vertex, tick, 0);
+    let bits = rng::hash(seed, vertex, tick, 0);
     let axis = |shift: u32| ((bits >> shift) & 0x1F_FFFF) as f32 * (2.0 / 2_097_152.0) - 1.0;
     Vec3::new(axis(0), axis(21), axis(42))
 }
@@ -130,10 +203,14 @@ fn smoothstep(t: f32) -> f32 {
 /// Computed in `f64` so positions far from the origin (long runs advect far) keep their detail.
 #[must_use]
 pub fn value_noise3(seed: u64, point: DVec3) -> f32 {
+    value_noise3_mixed(rng::mix64(seed), point)
+}
+
+/// [`value_noise3`] with its seed already mixed.
+fn value_noise3_mixed(seed: u64, point: DVec3) -> f32 {
     let cell = point.floor();
     let fraction = (point - cell).as_vec3();
     let [x, y, z] = [cell.x as i64, cell.y as i64, cell.z as i64];
-    let seed = rng::mix64(seed);
     let corner = |dx: i64, dy: i64, dz: i64| {
         let bits = corner_bits(seed, x.wrapping_add(dx), y.wrapping_add(dy), z.wrapping_add(dz));
         rng::unit_f32(bits) * 2.0 - 1.0
@@ -175,6 +252,31 @@ mod tests {
             let later = wind.sample(0, Vec3::new(x + 2.0 * 0.75, 0.3, 0.1), 0.75, 1.0);
             assert!(here.distance(later) < 1e-4, "{here} vs {later}");
         }
+    }
+
+    #[test]
+    fn a_step_splits_the_gust_travel_into_whole_cells_and_a_fraction() {
+        let wind = WindParams {
+            strength: 1.0,
+            gust_speed: 3.0,
+            direction: Vec3::new(-1.0, 0.5, 2.0),
+            ..WindParams::default()
+        };
+        for time_secs in [0.0, 0.37, 1e3, 1e7, -2.5] {
+            let step = WindStep::new(&wind, time_secs, 0.8);
+            for axis in 0..3 {
+                let fraction = step.gust_travel_fraction[axis];
+                assert!((0.0..=1.0).contains(&fraction), "{fraction}");
+                let rebuilt = step.gust_travel_cells[axis] as f64 + f64::from(fraction);
+                assert!((rebuilt - step.gust_travel[axis]).abs() < 1e-6, "{rebuilt} vs {}", step.gust_travel[axis]);
+            }
+            assert_eq!(step.jitter_ticks[1], step.jitter_ticks[0].wrapping_add(1));
+            assert_eq!(step.force(3, Vec3::ONE), wind.sample(3, Vec3::ONE, time_secs, 0.8));
+        }
+        let calm = WindStep::new(&WindParams { jitter: 0.0, ..wind.clone() }, 1.0, 1.0);
+        assert_eq!(calm.jitter_force, None);
+        let still = WindStep::new(&WindParams { strength: 0.0, ..wind }, 1.0, 1.0);
+        assert_eq!((still.direction, still.strength, still.gust_travel), (Vec3::ZERO, 0.0, DVec3::ZERO));
     }
 
     #[test]

@@ -5,7 +5,7 @@ use std::path::PathBuf;
 use glam::Vec3;
 
 use super::image::ImageRgba8;
-use crate::sim::ParamError;
+use crate::param::ParamError;
 
 /// An sRGB colour, written `"#rrggbb"` in presets.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]

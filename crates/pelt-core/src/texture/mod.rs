@@ -25,7 +25,7 @@ pub use self::colour::{ColourMode, ColourParams, Rgb, height_table};
 pub use self::image::{ImageRgba8, downsample_rgba8, mip_level_count};
 pub use self::pattern::leopard_pattern;
 pub use self::strands::Strand;
-use crate::sim::ParamError;
+use crate::param::ParamError;
 
 /// Smallest tile edge (texels).
 pub const MIN_TILE_SIZE: u32 = 32;

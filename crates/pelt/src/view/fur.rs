@@ -83,7 +83,7 @@ impl FurScene {
         if kernel == self.driver.kernel() {
             return Ok(());
         }
-        self.driver.set_kernel(&gpu.device, &gpu.queue, &self.renderer, structure, &self.textures, kernel, "panel")?;
+        self.driver.set_kernel(&gpu.device, &gpu.queue, &self.renderer, structure, &self.textures, kernel)?;
         Ok(())
     }
 
