@@ -3,20 +3,20 @@
 //! step uniforms uploaded) and `FurDriver::record` (the dispatch recorded), per step and per
 //! strand. A profiling aid for BENCHMARKS.md: `cargo run --release --example gpu_sim_profile`.
 
+mod profile;
+
 use std::time::Instant;
 
+use pelt_core::Builtin;
 use pelt_core::sim::FurStepper;
-use pelt_core::{Builtin, FurStructure, Preset};
-use pelt_render::{Backend, FurDriver, FurRenderer, FurTarget, Gpu, KernelChoice};
+use pelt_render::{FurDriver, FurRenderer, FurTarget, KernelChoice};
+use profile::Profile;
 
 fn main() -> anyhow::Result<()> {
-    let gpu = Gpu::new(Backend::Auto)?;
-    let (device, queue) = (&gpu.device, &gpu.queue);
+    let profile = Profile::open()?;
+    let (device, queue) = (profile.device(), profile.queue());
     for builtin in [Builtin::Bunny, Builtin::Torus] {
-        let (mesh, _) = builtin.mesh();
-        let mut preset = Preset::default();
-        preset.layers = 32;
-        let fur = FurStructure::new(mesh.clone(), &preset.fur_params(&mesh))?;
+        let (fur, preset) = profile::fur(builtin, 32)?;
         let mut params = preset.simulation.clone();
         // Wind on, as `pelt bench` times the GPU kernel.
         params.wind.strength = 0.5;

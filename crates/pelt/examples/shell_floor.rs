@@ -2,20 +2,15 @@
 //! drawn with a growing number of interpolated components, with and without blending and a
 //! texture sample (`shell_floor.wgsl`), frames interleaved across the variants. A profiling aid
 //! for BENCHMARKS.md: `cargo run --release -p pelt --example shell_floor`
-//! (`SIZES=256x256,1280x720 FRAMES=9 ROUNDS=3 LAYERS=16 VARIANTS=bare,sixteen`).
+//! (`SIZES=256x256,1280x720 FRAMES=9 ROUNDS=3 LAYERS=16 VARIANTS=bare,sixteen MSAA=1`).
 
-use std::time::Instant;
+mod profile;
 
-use glam::Vec3;
-use pelt_core::{Builtin, FurStructure, Preset};
-use pelt_render::{
-    Backend, Camera, DEFAULT_BACKGROUND, FurTarget, Gpu, HEADLESS_FORMAT, RenderTargets, default_sample_count,
+use pelt_render::HEADLESS_FORMAT;
+use profile::{
+    Chosen, Offscreen, Profile, ShellPipeline, Shells, env_frames, env_number, env_sizes, interleaved_rounds,
+    pipeline_layout, shells_shader, storage_entry, uniform_entry,
 };
-use wgpu::util::DeviceExt;
-
-fn env_number(name: &str, default: usize) -> usize {
-    std::env::var(name).ok().and_then(|s| s.parse().ok()).unwrap_or(default)
-}
 
 /// One variant: its name, vertex and fragment entries, whether it blends, and which texture.
 struct Variant {
@@ -73,65 +68,16 @@ fn noise_texture(
 }
 
 fn main() -> anyhow::Result<()> {
-    let gpu = Gpu::new(Backend::Auto)?;
-    let (device, queue) = (&gpu.device, &gpu.queue);
-    let target = FurTarget::new(HEADLESS_FORMAT).with_sample_count(default_sample_count(&gpu.adapter.get_info()));
-    let mesh = Builtin::Bunny.mesh().0;
-    let mut preset = Preset::default();
-    preset.layers = env_number("LAYERS", 16) as u32;
-    let fur = FurStructure::new(mesh.clone(), &preset.fur_params(&mesh))?;
-    let vertex_count = fur.mesh.vertex_count() as u32;
-    let layers = fur.layers;
-
-    let bytes: Vec<u8> = fur.positions.iter().flat_map(|v: &Vec3| v.to_array()).flat_map(f32::to_ne_bytes).collect();
-    let positions = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-        label: Some("positions"),
-        contents: &bytes,
-        usage: wgpu::BufferUsages::STORAGE,
-    });
-    let indices: Vec<u8> = fur.mesh.triangles.iter().flatten().flat_map(|i| i.to_ne_bytes()).collect();
-    let index_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-        label: Some("indices"),
-        contents: &indices,
-        usage: wgpu::BufferUsages::INDEX,
-    });
-    let index_count = 3 * fur.mesh.triangles.len() as u32;
-    let (centre, radius) = fur.mesh.bounding_sphere();
-    let radius = radius + fur.lengths.iter().copied().fold(0.0, f32::max);
-    let uniform = device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("uniforms"),
-        size: 80,
-        usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
-        mapped_at_creation: false,
-    });
-    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-        label: Some("shell floor"),
-        source: wgpu::ShaderSource::Wgsl(include_str!("shell_floor.wgsl").into()),
-    });
-    let stages = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT;
+    let profile = Profile::open()?;
+    let (device, queue) = (profile.device(), profile.queue());
+    let target = profile.target(HEADLESS_FORMAT);
+    let shells = Shells::bunny(device, wgpu::BufferUsages::STORAGE)?;
+    let module = shells_shader(device, "shell floor", include_str!("shell_floor.wgsl"));
     let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
         label: None,
         entries: &[
-            wgpu::BindGroupLayoutEntry {
-                binding: 0,
-                visibility: stages,
-                ty: wgpu::BindingType::Buffer {
-                    ty: wgpu::BufferBindingType::Uniform,
-                    has_dynamic_offset: false,
-                    min_binding_size: None,
-                },
-                count: None,
-            },
-            wgpu::BindGroupLayoutEntry {
-                binding: 1,
-                visibility: wgpu::ShaderStages::VERTEX,
-                ty: wgpu::BindingType::Buffer {
-                    ty: wgpu::BufferBindingType::Storage { read_only: true },
-                    has_dynamic_offset: false,
-                    min_binding_size: None,
-                },
-                count: None,
-            },
+            uniform_entry(0, wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT),
+            storage_entry(1, wgpu::ShaderStages::VERTEX),
             wgpu::BindGroupLayoutEntry {
                 binding: 2,
                 visibility: wgpu::ShaderStages::FRAGMENT,
@@ -171,19 +117,15 @@ fn main() -> anyhow::Result<()> {
                 label: None,
                 layout: &layout,
                 entries: &[
-                    wgpu::BindGroupEntry { binding: 0, resource: uniform.as_entire_binding() },
-                    wgpu::BindGroupEntry { binding: 1, resource: positions.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 0, resource: shells.uniform.as_entire_binding() },
+                    wgpu::BindGroupEntry { binding: 1, resource: shells.positions.as_entire_binding() },
                     wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::TextureView(view) },
                     wgpu::BindGroupEntry { binding: 3, resource: wgpu::BindingResource::Sampler(&sampler) },
                 ],
             })
         })
         .collect();
-    let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-        label: None,
-        bind_group_layouts: &[Some(&layout)],
-        immediate_size: 0,
-    });
+    let pipeline_layout = pipeline_layout(device, &layout);
     let all = [
         Variant { name: "bare opaque", vertex: "vs_bare", fragment: "fs_bare", blend: false, texture: 0 },
         Variant { name: "bare", vertex: "vs_bare", fragment: "fs_bare", blend: true, texture: 0 },
@@ -207,108 +149,37 @@ fn main() -> anyhow::Result<()> {
         },
         Variant { name: "four+tex", vertex: "vs_four", fragment: "fs_four_texture", blend: true, texture: 0 },
     ];
-    let chosen: Option<Vec<String>> =
-        std::env::var("VARIANTS").ok().map(|s| s.split(',').map(|c| c.trim().to_owned()).collect());
-    let variants: Vec<&Variant> =
-        all.iter().filter(|v| chosen.as_ref().is_none_or(|c| c.iter().any(|n| n == v.name))).collect();
+    let chosen = Chosen::from_env("VARIANTS");
+    let variants: Vec<&Variant> = all.iter().filter(|v| chosen.includes(v.name)).collect();
     let pipelines: Vec<wgpu::RenderPipeline> = variants
         .iter()
         .map(|v| {
-            device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
-                label: Some(v.name),
-                layout: Some(&pipeline_layout),
-                vertex: wgpu::VertexState {
-                    module: &module,
-                    entry_point: Some(v.vertex),
-                    compilation_options: Default::default(),
-                    buffers: &[],
-                },
-                primitive: wgpu::PrimitiveState { cull_mode: Some(wgpu::Face::Back), ..Default::default() },
-                depth_stencil: Some(wgpu::DepthStencilState {
-                    format: target.depth_format,
-                    depth_write_enabled: Some(!v.blend),
-                    depth_compare: Some(target.depth_compare),
-                    stencil: Default::default(),
-                    bias: Default::default(),
-                }),
-                multisample: wgpu::MultisampleState { count: target.sample_count, ..Default::default() },
-                fragment: Some(wgpu::FragmentState {
-                    module: &module,
-                    entry_point: Some(v.fragment),
-                    compilation_options: Default::default(),
-                    targets: &[Some(wgpu::ColorTargetState {
-                        format: target.colour_format,
-                        blend: v.blend.then_some(wgpu::BlendState::PREMULTIPLIED_ALPHA_BLENDING),
-                        write_mask: wgpu::ColorWrites::ALL,
-                    })],
-                }),
-                multiview_mask: None,
-                cache: None,
-            })
+            let pipeline = ShellPipeline {
+                layout: &pipeline_layout,
+                module: &module,
+                vertex: v.vertex,
+                fragment: v.fragment,
+                buffers: &[],
+                blend: v.blend,
+            };
+            pipeline.create(device, target, v.name)
         })
         .collect();
+    let names: Vec<&str> = variants.iter().map(|v| v.name).collect();
 
-    let frames = env_number("FRAMES", 9);
-    let rounds = env_number("ROUNDS", 3);
-    let sizes: Vec<(u32, u32)> = std::env::var("SIZES")
-        .unwrap_or_else(|_| "256x256,1280x720".into())
-        .split(',')
-        .filter_map(|size| size.split_once('x'))
-        .filter_map(|(w, h)| Some((w.trim().parse().ok()?, h.trim().parse().ok()?)))
-        .collect();
-    for (width, height) in sizes {
-        let targets = RenderTargets::new(device, target, width, height)?;
-        let output = device.create_texture(&wgpu::TextureDescriptor {
-            label: None,
-            size: wgpu::Extent3d { width, height, depth_or_array_layers: 1 },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format: target.colour_format,
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
-            view_formats: &[],
-        });
-        let output_view = output.create_view(&Default::default());
-        let camera = Camera::framing(centre, radius, 35.0, 20.0, targets.aspect_ratio());
-        let mut data = Vec::new();
-        for c in camera.clip_from_world(targets.aspect_ratio()).to_cols_array() {
-            data.extend_from_slice(&c.to_ne_bytes());
-        }
-        data.extend_from_slice(&vertex_count.to_ne_bytes());
-        data.extend_from_slice(&layers.to_ne_bytes());
-        data.extend_from_slice(&4.0f32.to_ne_bytes());
-        data.extend_from_slice(&0u32.to_ne_bytes());
-        queue.write_buffer(&uniform, 0, &data);
-        for round in 0..rounds {
-            let mut times = vec![Vec::new(); variants.len()];
-            for frame in 0..frames + 1 {
-                for (index, variant_times) in times.iter_mut().enumerate() {
-                    let started = Instant::now();
-                    let mut encoder = device.create_command_encoder(&Default::default());
-                    {
-                        let mut pass = targets.begin_pass(&mut encoder, &output_view, DEFAULT_BACKGROUND);
-                        pass.set_pipeline(&pipelines[index]);
-                        pass.set_bind_group(0, &bind_groups[variants[index].texture], &[]);
-                        pass.set_index_buffer(index_buffer.slice(..), wgpu::IndexFormat::Uint32);
-                        pass.draw_indexed(0..index_count, 0, 0..layers);
-                    }
-                    queue.submit([encoder.finish()]);
-                    device.poll(wgpu::PollType::wait_indefinitely())?;
-                    if frame > 0 {
-                        variant_times.push(started.elapsed().as_secs_f64() * 1000.0);
-                    }
-                }
-            }
-            for (variant, mut times) in variants.iter().zip(times) {
-                times.sort_by(f64::total_cmp);
-                println!(
-                    "{width}x{height} round {round}: {:20} median {:7.2} ms (min {:.2})",
-                    variant.name,
-                    times[times.len() / 2],
-                    times[0]
-                );
-            }
-        }
+    let (frames, rounds) = (env_frames(9), env_number("ROUNDS", 3));
+    for (width, height) in env_sizes(&[(256, 256), (1280, 720)]) {
+        let offscreen = Offscreen::new(device, target, width, height)?;
+        shells.write_uniform(queue, offscreen.aspect_ratio());
+        interleaved_rounds(&format!("{width}x{height}"), rounds, frames, &names, 20, |index| {
+            profile.time_frame(|encoder| {
+                let mut pass = offscreen.begin_pass(encoder);
+                pass.set_pipeline(&pipelines[index]);
+                pass.set_bind_group(0, &bind_groups[variants[index].texture], &[]);
+                shells.draw(&mut pass);
+                Ok(())
+            })
+        })?;
     }
     Ok(())
 }

@@ -1,23 +1,10 @@
 // The shell-floor experiment (`shell_floor.rs`): the bunny's L shells with a growing number of
 // interpolated components and fragment work, to find what a shell triangle and fragment cost on
-// this adapter. Not the product's shader.
+// this adapter. Not the product's shader. Follows `profile/shells.wgsl` (the uniform `u`, the
+// positions and `load3`).
 
-struct Uniforms {
-    clip_from_world: mat4x4<f32>,
-    vertex_count: u32,
-    layers: u32,
-    tiles_per_world: f32,
-    padding: u32,
-}
-
-@group(0) @binding(0) var<uniform> u: Uniforms;
-@group(0) @binding(1) var<storage, read> positions: array<f32>;
 @group(0) @binding(2) var tiles: texture_2d<f32>;
 @group(0) @binding(3) var tiles_sampler: sampler;
-
-fn load3(k: u32) -> vec3<f32> {
-    return vec3<f32>(positions[3u * k], positions[3u * k + 1u], positions[3u * k + 2u]);
-}
 
 fn here(vertex: u32, instance: u32) -> vec3<f32> {
     return load3((instance + 1u) * u.vertex_count + vertex);

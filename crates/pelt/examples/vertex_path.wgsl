@@ -1,19 +1,10 @@
 // The vertex-path experiment (`vertex_path.rs`): the bunny's shells with the same varyings and a
-// near-constant fragment, their positions fetched three ways. Not the product's shader.
+// near-constant fragment, their positions fetched three ways. Not the product's shader. Follows
+// `profile/shells.wgsl` (the uniform `u`, the positions and `load3`).
 
-struct Uniforms {
-    clip_from_world: mat4x4<f32>,
-    vertex_count: u32,
-    layers: u32,
-    tiles_per_world: f32,
-    padding: u32,
-}
-
-@group(0) @binding(0) var<uniform> u: Uniforms;
-// NV as packed xyz triples, and base normals the same way (as the product keeps them).
-@group(0) @binding(1) var<storage, read> positions: array<f32>;
+// Base normals as packed xyz triples (as the product keeps them).
 @group(0) @binding(2) var<storage, read> normals: array<f32>;
-// The same data padded to vec4 (the packed-load variant; more memory).
+// The positions and normals padded to vec4 (the packed-load variant; more memory).
 @group(0) @binding(3) var<storage, read> positions4: array<vec4<f32>>;
 @group(0) @binding(4) var<storage, read> normals4: array<vec4<f32>>;
 
@@ -38,10 +29,6 @@ fn finish(here: vec3<f32>, other: vec3<f32>, root: vec3<f32>, normal: vec3<f32>,
     out.normal = normal;
     out.layer = layer;
     return out;
-}
-
-fn load3(k: u32) -> vec3<f32> {
-    return vec3<f32>(positions[3u * k], positions[3u * k + 1u], positions[3u * k + 2u]);
 }
 
 fn other_layer(layer: u32) -> u32 {
