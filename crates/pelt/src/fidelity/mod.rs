@@ -145,7 +145,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let positions = stepper.simulation().positions();
     let strand_renderer = StrandRenderer::new(&strands.gpu.device, &strand_side.renderer)?;
     let ribbons =
-        StrandRibbons::new(&strands.gpu.device, &reference, &positions, &fur.mesh.normals, &fur.mesh.triangles)?;
+        StrandRibbons::new(&strands.gpu.device, &reference, positions, &fur.mesh.normals, &fur.mesh.triangles)?;
 
     std::fs::create_dir_all(&args.out).with_context(|| format!("cannot create {}", args.out.display()))?;
     let front = preset.render.camera_azimuth_deg.unwrap_or(30.0);
