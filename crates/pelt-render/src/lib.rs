@@ -16,6 +16,8 @@
 //!   [`PlainMesh`] a furless mesh. Each has a model transform.
 //! - [`FurView`]: one view's uniform buffer, written from [`ViewData`] (`clip_from_world`, camera
 //!   position, [`Light`]); several views in one submission each have their own.
+//! - [`Stage`]: the light, exposure and background of Pelt's own pictures, one default that
+//!   `pelt render`, the viewer, the web page and the examples share.
 //!
 //! # The order a host calls things in
 //! 1. When creating the device: request [`required_features`], [`required_limits`] and check
@@ -114,6 +116,7 @@ mod separated;
 mod silhouette;
 mod silhouette_cpu;
 mod simulation;
+mod stage;
 mod strands;
 mod targets;
 mod textures;
@@ -138,6 +141,7 @@ pub use separated::{SeparatedFur, SeparatedRenderer, separated_shader_source};
 pub use silhouette::silhouette_shader_source;
 pub use silhouette_cpu::CpuSilhouette;
 pub use simulation::{GpuSimulation, simulation_shader_source};
+pub use stage::Stage;
 pub use strands::{StrandRenderer, StrandRibbons, strands_shader_source};
 pub use targets::{DEFAULT_BACKGROUND, DEPTH_FORMAT, FurTarget, RenderTargets, SAMPLE_COUNT, default_sample_count};
 pub use view::{FurView, Light, LightDirection, ViewData};
