@@ -1,0 +1,167 @@
+//! One look for every host: the page's frame (its `PageGpu`, drawn through a canvas-format
+//! texture's sRGB view as a browser canvas is) against `pelt render`'s (a `Headless` target of
+//! `HEADLESS_FORMAT`, the preset's own textures, `Stage::default`), same preset, camera and
+//! simulated time, on lavapipe. The fur's mean colour must agree.
+//!
+//! The measurements here read raw bytes and share no code with the renderer: a pixel is the
+//! bunny's when it differs from its image's corner (the background) by more than `DRAWN`.
+
+use glam::Vec3;
+use pelt_core::sim::FurStepper;
+use pelt_core::{FurStructure, Preset};
+use pelt_render::{
+    Backend, FurDrawSettings, FurDriver, FurTarget, FurView, Gpu, HEADLESS_FORMAT, Headless, KernelChoice, Stage,
+    default_sample_count,
+};
+use pelt_web::model::{Model, SceneChoice};
+use pelt_web::page_gpu::{PageGpu, canvas_formats};
+use pelt_web::presets;
+
+const WIDTH_PX: u32 = 240;
+const HEIGHT_PX: u32 = 180;
+/// Frames of simulated time before the picture (the fur settles a little under gravity).
+const FRAMES: u32 = 6;
+const FRAME_SECS: f64 = 1.0 / 30.0;
+/// A channel further than this (of 255) from the background makes a pixel the bunny's.
+const DRAWN: u8 = 12;
+/// Largest difference of the bunny's mean colour between the two hosts, per channel (of 255).
+/// The page's shell tile is a quarter of the texels (256 instead of 512, repeated twice as
+/// often) and it draws with 4x MSAA where `pelt render` draws with 1 on lavapipe: measured
+/// here, these leave the means within 2 of each other.
+const MEAN_BOUND: f64 = 5.0;
+
+/// The GPU: fails, never skips, without an adapter (CI has lavapipe).
+fn gpu() -> Gpu {
+    let backend = std::env::var("PELT_TEST_BACKEND").map_or(Backend::Auto, |name| name.parse().expect("backend"));
+    Gpu::new(backend).unwrap_or_else(|error| panic!("GPU tests need an adapter (CI uses lavapipe): {error}"))
+}
+
+/// The page's default bunny after `FRAMES` frames, drawn as the page draws into its canvas:
+/// a texture of Chromium's canvas format (`bgra8unorm`), through the view the page uses.
+fn page_frame(gpu: &Gpu, preset: &Preset) -> (image::RgbaImage, Model) {
+    let (device, queue) = (&gpu.device, &gpu.queue);
+    let mut model = Model::new(SceneChoice::Bunny, preset.clone(), WIDTH_PX as f32 / HEIGHT_PX as f32).expect("model");
+    let made = presets::web_textures(&model.preset).expect("web textures");
+    let (format, view_format, view_formats) = canvas_formats(wgpu::TextureFormat::Bgra8Unorm);
+    let canvas = device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("canvas"),
+        size: wgpu::Extent3d { width: WIDTH_PX, height: HEIGHT_PX, depth_or_array_layers: 1 },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format,
+        usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+        view_formats: &view_formats,
+    });
+    let mut page = PageGpu::new(device, queue, view_format, &model, &made.textures, made.tile_scale).expect("page");
+    page.resize(device, WIDTH_PX, HEIGHT_PX).expect("size");
+    for _ in 0..FRAMES {
+        page.advance(device, queue, &mut model, FRAME_SECS).expect("advance");
+    }
+    let output = canvas.create_view(&wgpu::TextureViewDescriptor { format: Some(view_format), ..Default::default() });
+    page.render(device, queue, &model, &output).expect("render");
+    let mut image = read_back(gpu, &canvas);
+    if matches!(format, wgpu::TextureFormat::Bgra8Unorm) {
+        for pixel in image.pixels_mut() {
+            pixel.0.swap(0, 2);
+        }
+    }
+    (image, model)
+}
+
+/// The same bunny, preset, camera and time as `pelt render` draws it (`--sim cpu --no-lod`).
+fn render_frame(gpu: Gpu, preset: &Preset, model: &Model) -> image::RgbaImage {
+    let samples = default_sample_count(&gpu.adapter.get_info());
+    let target = FurTarget::new(HEADLESS_FORMAT).with_sample_count(samples);
+    let headless = Headless::with_target(gpu, target, WIDTH_PX, HEIGHT_PX).expect("headless");
+    let (device, queue) = (&headless.gpu.device, &headless.gpu.queue);
+    let renderer = headless.renderer().expect("renderer");
+    let structure =
+        FurStructure::new(model.structure.mesh.clone(), &preset.fur_params(&model.structure.mesh)).expect("structure");
+    let textures = preset.generate_textures().expect("textures");
+    let mut driver =
+        FurDriver::new(device, queue, &renderer, &structure, &textures, &preset.simulation, KernelChoice::Cpu)
+            .expect("driver");
+    let mut stepper = FurStepper::new(&structure, &preset.simulation).expect("stepper");
+    for frame in 1..=FRAMES {
+        driver.advance_to(device, queue, &mut stepper, f64::from(frame) * FRAME_SECS).expect("advance");
+    }
+    let stage = Stage::default();
+    let view = FurView::new(device, &renderer);
+    view.prepare(queue, &stage.view_data(&model.orbit.camera(), headless.aspect_ratio()));
+    headless
+        .render_with(
+            stage.background,
+            |encoder| driver.record_view(encoder, &renderer, &view),
+            |pass| driver.draw(pass, &renderer, &view, &FurDrawSettings::SILHOUETTE),
+        )
+        .expect("frame")
+}
+
+fn read_back(gpu: &Gpu, texture: &wgpu::Texture) -> image::RgbaImage {
+    let (width, height) = (texture.width(), texture.height());
+    let row_bytes = (4 * width).next_multiple_of(wgpu::COPY_BYTES_PER_ROW_ALIGNMENT);
+    let buffer = gpu.device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("readback"),
+        size: u64::from(row_bytes * height),
+        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+        mapped_at_creation: false,
+    });
+    let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor::default());
+    encoder.copy_texture_to_buffer(
+        texture.as_image_copy(),
+        wgpu::TexelCopyBufferInfo {
+            buffer: &buffer,
+            layout: wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(row_bytes), rows_per_image: None },
+        },
+        texture.size(),
+    );
+    gpu.queue.submit([encoder.finish()]);
+    buffer.slice(..).map_async(wgpu::MapMode::Read, |result| result.expect("map"));
+    gpu.device.poll(wgpu::PollType::wait_indefinitely()).expect("poll");
+    let mapped = buffer.slice(..).get_mapped_range().expect("mapped");
+    let pixels =
+        mapped.chunks_exact(row_bytes as usize).flat_map(|row| &row[..(4 * width) as usize]).copied().collect();
+    image::RgbaImage::from_raw(width, height, pixels).expect("image")
+}
+
+/// The background (the top-left corner) and the mean colour of the pixels unlike it, with their count.
+fn bunny_mean(image: &image::RgbaImage) -> ([u8; 3], Vec3, usize) {
+    let background = image.get_pixel(0, 0).0;
+    let background = [background[0], background[1], background[2]];
+    let drawn: Vec<Vec3> = image
+        .pixels()
+        .filter(|p| (0..3).any(|c| p.0[c].abs_diff(background[c]) > DRAWN))
+        .map(|p| Vec3::new(f32::from(p.0[0]), f32::from(p.0[1]), f32::from(p.0[2])))
+        .collect();
+    let mean = drawn.iter().sum::<Vec3>() / drawn.len().max(1) as f32;
+    (background, mean, drawn.len())
+}
+
+#[test]
+fn the_page_shows_the_default_bunny_as_pelt_render_does() {
+    let gpu = gpu();
+    let preset = Preset::default();
+    let (page, model) = page_frame(&gpu, &preset);
+    let render = render_frame(gpu, &preset, &model);
+    let output = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("look");
+    std::fs::create_dir_all(&output).expect("output folder");
+    page.save(output.join("page.png")).expect("page.png");
+    render.save(output.join("render.png")).expect("render.png");
+
+    let (page_background, page_mean, page_count) = bunny_mean(&page);
+    let (render_background, render_mean, render_count) = bunny_mean(&render);
+    let report = format!(
+        "page: background {page_background:?}, bunny mean {page_mean:.1} over {page_count} pixels; \
+         pelt render: background {render_background:?}, bunny mean {render_mean:.1} over {render_count} pixels \
+         (images in {})",
+        output.display()
+    );
+    println!("{report}");
+    let area = (WIDTH_PX * HEIGHT_PX) as usize;
+    assert!(render_count > area / 10 && page_count > area / 10, "the bunny is hardly drawn: {report}");
+    assert!(page_count.abs_diff(render_count) < render_count / 10, "the bunny covers different areas: {report}");
+    assert!(page_background.iter().zip(render_background).all(|(a, b)| a.abs_diff(b) <= 1), "{report}");
+    let difference = (page_mean - render_mean).abs().max_element();
+    assert!(f64::from(difference) <= MEAN_BOUND, "the means differ by {difference:.1} (bound {MEAN_BOUND}): {report}");
+}
