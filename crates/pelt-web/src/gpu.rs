@@ -8,7 +8,7 @@ use std::sync::{Arc, Mutex};
 use pelt_core::FurTextures;
 
 use crate::model::Model;
-use crate::page_gpu::{PageGpu, canvas_formats};
+use crate::page_gpu::{CANVAS_USAGE, PageGpu};
 
 /// What went wrong on the device since the last frame, kept by wgpu's callbacks.
 #[derive(Debug, Default)]
@@ -24,8 +24,6 @@ pub struct CanvasGpu {
     queue: wgpu::Queue,
     surface: wgpu::Surface<'static>,
     config: wgpu::SurfaceConfiguration,
-    /// The sRGB view of the canvas texture the fur is drawn through (shading stays linear).
-    view_format: wgpu::TextureFormat,
     /// False until the canvas has a non-zero size.
     configured: bool,
     page: PageGpu,
@@ -100,10 +98,9 @@ impl CanvasGpu {
         }));
 
         let caps = surface.get_capabilities(&adapter);
-        let preferred = caps.formats.first().copied().ok_or("the canvas offers no texture format")?;
-        let (format, view_format, view_formats) = canvas_formats(preferred);
+        let format = caps.formats.first().copied().ok_or("the canvas offers no texture format")?;
         let config = wgpu::SurfaceConfiguration {
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
+            usage: CANVAS_USAGE,
             format,
             color_space: wgpu::SurfaceColorSpace::Auto,
             width: 1,
@@ -111,10 +108,10 @@ impl CanvasGpu {
             present_mode: wgpu::PresentMode::Fifo,
             desired_maximum_frame_latency: 2,
             alpha_mode: wgpu::CompositeAlphaMode::Opaque,
-            view_formats,
+            view_formats: vec![],
         };
-        let page = PageGpu::new(&device, &queue, view_format, model, textures, tile_scale)?;
-        Ok(Self { device, queue, surface, config, view_format, configured: false, page, trouble, adapter_name })
+        let page = PageGpu::new(&device, &queue, format, model, textures, tile_scale)?;
+        Ok(Self { device, queue, surface, config, configured: false, page, trouble, adapter_name })
     }
 
     /// The message of a lost device, once it is lost (the page then starts a new one).
@@ -177,10 +174,7 @@ impl CanvasGpu {
             }
             _ => return Ok(Err(Skipped::NoFrame)),
         };
-        let output = frame
-            .texture
-            .create_view(&wgpu::TextureViewDescriptor { format: Some(self.view_format), ..Default::default() });
-        self.page.render(&self.device, &self.queue, model, &output)?;
+        self.page.render(&self.device, &self.queue, model, &frame.texture)?;
         self.queue.present(frame);
         Ok(Ok(()))
     }

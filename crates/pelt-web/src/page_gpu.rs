@@ -17,46 +17,51 @@ const BODY_COLOUR: Vec3 = Vec3::new(0.6, 0.45, 0.38);
 /// What the page draws: the fur as `pelt render` draws it (silhouette fins, Pelt's stage).
 pub const PAGE_DRAW: FurDrawSettings = FurDrawSettings::SILHOUETTE;
 
-/// The formats a canvas is configured with and drawn through, from the canvas's preferred
-/// `format`: canvases take only non-sRGB formats, so the fur (shaded in linear light, as
-/// everywhere in Pelt) is drawn through the format's sRGB view, which encodes on write.
-/// Returns `(canvas format, view format, the canvas's extra view formats)`.
+/// The usages a canvas is configured with: the frame is copied into it.
+pub const CANVAS_USAGE: wgpu::TextureUsages =
+    wgpu::TextureUsages::RENDER_ATTACHMENT.union(wgpu::TextureUsages::COPY_DST);
+
+/// The format the page draws in for a canvas of `canvas_format`: its sRGB twin. Canvases take
+/// only non-sRGB formats, and the fur is shaded in linear light, as everywhere in Pelt; the frame
+/// is drawn (and resolved) into a texture of the sRGB format, which encodes on write, and its
+/// bytes are copied into the canvas. (Resolving into an sRGB view of the canvas instead, as
+/// WebGPU allows, stored linear values in Chromium 156 (Dawn on SwiftShader): the page showed
+/// its background at 12/13/15 instead of 60/63/69.)
 #[must_use]
-pub fn canvas_formats(
-    format: wgpu::TextureFormat,
-) -> (wgpu::TextureFormat, wgpu::TextureFormat, Vec<wgpu::TextureFormat>) {
-    let view_format = format.add_srgb_suffix();
-    let view_formats = if view_format == format { vec![] } else { vec![view_format] };
-    (format, view_format, view_formats)
+pub fn frame_format(canvas_format: wgpu::TextureFormat) -> wgpu::TextureFormat {
+    canvas_format.add_srgb_suffix()
 }
 
-/// The page's fur, body and view on one device, for colour views of one format.
+/// The page's fur, body and view on one device, for canvases of one format.
 #[derive(Debug)]
 pub struct PageGpu {
     renderer: FurRenderer,
     driver: FurDriver,
     body: Option<PlainMesh>,
     view: FurView,
-    /// Depth (and MSAA colour) at the view's size; made by [`PageGpu::resize`].
+    /// Depth (and MSAA colour) at the canvas's size; made by [`PageGpu::resize`].
     targets: Option<RenderTargets>,
+    /// The frame in the sRGB format, resolved here and copied into the canvas.
+    frame: Option<wgpu::Texture>,
     stage: Stage,
 }
 
 impl PageGpu {
     /// Uploads `model`'s fur with `textures` (made with a tile `tile_scale` times smaller than the
-    /// preset's) for colour views of `view_format` (4x MSAA).
+    /// preset's) for canvases of `canvas_format` (drawn with 4x MSAA).
     ///
     /// # Errors
     /// The renderer's message (e.g. a structure over the device's limits).
     pub fn new(
         device: &wgpu::Device,
         queue: &wgpu::Queue,
-        view_format: wgpu::TextureFormat,
+        canvas_format: wgpu::TextureFormat,
         model: &Model,
         textures: &FurTextures,
         tile_scale: f32,
     ) -> Result<Self, String> {
-        let renderer = FurRenderer::new(device, FurTarget::new(view_format)).map_err(|e| e.to_string())?;
+        let target = FurTarget::new(frame_format(canvas_format));
+        let renderer = FurRenderer::new(device, target).map_err(|e| e.to_string())?;
         let mut driver = FurDriver::new(
             device,
             queue,
@@ -70,7 +75,7 @@ impl PageGpu {
         driver.set_look(look(tile_scale));
         driver.prepare(queue);
         let view = FurView::new(device, &renderer);
-        let mut gpu = Self { renderer, driver, body: None, view, targets: None, stage: Stage::default() };
+        let mut gpu = Self { renderer, driver, body: None, view, targets: None, frame: None, stage: Stage::default() };
         gpu.set_body(device, queue, model.body.as_ref())?;
         Ok(gpu)
     }
@@ -116,7 +121,7 @@ impl PageGpu {
         Ok(())
     }
 
-    /// Makes the attachments for views of `width_px x height_px` (when the size changed).
+    /// Makes the attachments for a canvas of `width_px x height_px` (when the size changed).
     ///
     /// # Errors
     /// The renderer's message (a zero or over-limit size).
@@ -124,8 +129,18 @@ impl PageGpu {
         if self.targets.as_ref().is_some_and(|t| t.size() == (width_px, height_px)) {
             return Ok(());
         }
-        let targets =
-            RenderTargets::new(device, self.renderer.target(), width_px, height_px).map_err(|e| e.to_string())?;
+        let target = self.renderer.target();
+        let targets = RenderTargets::new(device, target, width_px, height_px).map_err(|e| e.to_string())?;
+        self.frame = Some(device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("pelt web frame"),
+            size: wgpu::Extent3d { width: width_px, height: height_px, depth_or_array_layers: 1 },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: target.colour_format,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+            view_formats: &[],
+        }));
         self.targets = Some(targets);
         Ok(())
     }
@@ -146,31 +161,40 @@ impl PageGpu {
         self.driver.advance_to(device, queue, &mut model.stepper, time_secs).map_err(|e| e.to_string())
     }
 
-    /// Draws `model` from its orbit into `output` (a view of the size last given to
-    /// [`PageGpu::resize`] and of this renderer's format) and submits the frame.
+    /// Draws `model` from its orbit, copies the frame into `canvas` (a texture of the size last
+    /// given to [`PageGpu::resize`], of the canvas format, with [`CANVAS_USAGE`]) and submits.
     ///
     /// # Errors
-    /// A message when [`PageGpu::resize`] was never called, or the driver's.
+    /// A message for a canvas of another size or before [`PageGpu::resize`], or the driver's.
     pub fn render(
         &mut self,
         device: &wgpu::Device,
         queue: &wgpu::Queue,
         model: &Model,
-        output: &wgpu::TextureView,
+        canvas: &wgpu::Texture,
     ) -> Result<(), String> {
-        let Some(targets) = &self.targets else { return Err("the page's view has no size yet".to_owned()) };
+        let (Some(targets), Some(frame)) = (&self.targets, &self.frame) else {
+            return Err("the page's frame has no size yet".to_owned());
+        };
+        if frame.size() != canvas.size() {
+            let (w, h) = (canvas.width(), canvas.height());
+            return Err(format!("the canvas is {w}x{h}, the frame {}x{}", frame.width(), frame.height()));
+        }
+        let output = frame.create_view(&wgpu::TextureViewDescriptor::default());
         let camera = model.orbit.camera();
         self.view.prepare(queue, &self.stage.view_data(&camera, targets.aspect_ratio()));
         let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
         self.driver.record(&mut encoder).map_err(|e| e.to_string())?;
         self.driver.record_view(&mut encoder, &self.renderer, &self.view);
         {
-            let mut pass = targets.begin_pass(&mut encoder, output, self.stage.background);
+            let mut pass = targets.begin_pass(&mut encoder, &output, self.stage.background);
             if let Some(body) = &self.body {
                 self.renderer.draw_plain(&mut pass, &self.view, body);
             }
             self.driver.draw(&mut pass, &self.renderer, &self.view, &PAGE_DRAW);
         }
+        // The encoded bytes as they are: the canvas shows its bytes as sRGB.
+        encoder.copy_texture_to_texture(frame.as_image_copy(), canvas.as_image_copy(), frame.size());
         queue.submit([encoder.finish()]);
         Ok(())
     }
