@@ -21,6 +21,9 @@ const FUR_HEX = '#30c040';
 // SwiftShader draws the fur on the CPU: a small canvas (470 x 400 beside the 250 px panel) keeps
 // a frame near a second on a loaded 2-core machine.
 const VIEWPORT = { width: 720, height: 400, deviceScaleFactor: 1 };
+// pelt render's default bunny from the page's camera on this canvas (crates/pelt-web/tests/look.rs
+// keeps it so): the page must show the same background and fur colour.
+const LOOK = JSON.parse(fs.readFileSync(path.join(here, 'look.json'), 'utf8'));
 
 // WebGPU on SwiftShader, with the compositor on SwiftShader too. Without a GPU, headless Chromium
 // composites in software, which has no shared image for a WebGPU canvas's swap chain ("Could not
@@ -199,11 +202,28 @@ async function bunnyPage() {
     shared = await openPage();
     await waitRunning(shared);
     await hideOverlay(shared);
+    await frames(shared, 6);
+    shared.defaultLook = await shot(shared, 'default-look');
     await setControl(shared, '#colour', FUR_HEX);
     await settled(shared);
   }
   return shared;
 }
+
+test('the default bunny has pelt render\'s background and fur colour (look.json)', async () => {
+  const page = await bunnyPage();
+  const image = page.defaultLook;
+  assert.deepEqual([image.width, image.height], LOOK.canvas_px, 'the canvas is not the one look.json measures');
+  const bg = pixel(image, 0, 0);
+  const drawn = select(image, (p) => differs(p, bg, LOOK.drawn));
+  const meanColour = [0, 1, 2].map((c) => mean(drawn.xs.map((x, i) => pixel(image, x, drawn.ys[i])[c])));
+  const report = `background ${bg}, fur mean ${meanColour.map((v) => v.toFixed(1))} over ${drawn.count} pixels; ` +
+    `pelt render: ${LOOK.background}, ${LOOK.bunny_mean}`;
+  console.log(`look: ${report}`);
+  assert.ok(!differs(bg, LOOK.background, 2), `the background differs: ${report}`);
+  assert.ok(drawn.count > 0.1 * image.width * image.height, `the bunny is hardly drawn: ${report}`);
+  assert.ok(!differs(meanColour, LOOK.bunny_mean, LOOK.mean_bound), `the fur's colour differs: ${report}`);
+});
 
 test('fur is drawn: fur-coloured pixels stand around the bunny beyond its skin', async () => {
   const page = await bunnyPage();

@@ -4,9 +4,7 @@
 use glam::Vec3;
 use pelt_core::sim::{FurStepper, SimParams, WindParams};
 use pelt_core::{Builtin, FurStructure, Preset};
-use pelt_render::{
-    Backend, Camera, DEFAULT_BACKGROUND, FurDrawSettings, FurDriver, FurView, Headless, KernelChoice, Light,
-};
+use pelt_render::{Backend, Camera, FurDrawSettings, FurDriver, FurView, Headless, KernelChoice, Studio};
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let output = std::env::args().nth(1).unwrap_or_else(|| "pelt-headless.png".to_owned());
@@ -23,7 +21,7 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     let simulation = SimParams { wind, ..preset.simulation.clone() };
 
     // A GPU without a window, the pipelines for its target, the fur (simulated on the CPU) and a
-    // view on it.
+    // view on it, lit as every Pelt host lights it.
     let headless = Headless::new(Backend::Auto, 800, 600)?;
     let (device, queue) = (&headless.gpu.device, &headless.gpu.queue);
     let renderer = headless.renderer()?;
@@ -32,15 +30,16 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     stepper.simulation_mut().set_wind(&simulation.wind)?;
     let (centre, radius) = structure.mesh.bounding_sphere();
     let camera = Camera::framing(centre, radius * 1.1, 30.0, 15.0, headless.aspect_ratio());
+    let studio = Studio::default();
     let view = FurView::new(device, &renderer);
-    view.prepare(queue, &camera.view_data(headless.aspect_ratio(), &Light::default()));
+    view.prepare(queue, &studio.view_data(&camera, headless.aspect_ratio()));
 
     // One second at 30 frames a second; the last one is drawn into a pass and read back.
     for frame in 0..=30 {
         driver.advance_to(device, queue, &mut stepper, f64::from(frame) / 30.0)?;
     }
     let image = headless.render_with(
-        DEFAULT_BACKGROUND,
+        studio.background,
         |encoder| driver.record_view(encoder, &renderer, &view),
         |pass| driver.draw(pass, &renderer, &view, &FurDrawSettings::SILHOUETTE),
     )?;

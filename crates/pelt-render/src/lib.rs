@@ -14,6 +14,8 @@
 //!   transform.
 //! - [`FurView`]: one view's uniform buffer, written from [`ViewData`] (`clip_from_world`, camera
 //!   position, [`Light`]); several views in one submission each have their own.
+//! - [`Stage`]: the light, exposure and background of Pelt's own pictures, one default that
+//!   `pelt render`, the viewer, the web page and the examples share.
 //!
 //! # The order a host calls things in
 //! 1. When creating the device: request [`required_features`], [`required_limits`] and check
@@ -120,6 +122,7 @@ mod renderer;
 mod requirements;
 mod shaders;
 mod simulation;
+mod studio;
 mod targets;
 mod textures;
 mod view;
@@ -144,5 +147,6 @@ pub use requirements::{check_adapter, required_downlevel_flags, required_feature
 pub use shaders::{separated_shader_source, strands_shader_source};
 pub use shaders::{silhouette_shader_source, simulation_shader_source, unified_shader_source, view_lod_shader_source};
 pub use simulation::GpuSimulation;
+pub use studio::Studio;
 pub use targets::{DEFAULT_BACKGROUND, DEPTH_FORMAT, FurTarget, RenderTargets, SAMPLE_COUNT, default_sample_count};
 pub use view::{FurView, Light, LightDirection, ViewData};

@@ -1,20 +1,14 @@
-//! The page's GPU: WebGPU on the canvas (opened by the renderer's rules), the fur, the try-on
-//! body and one view, drawn into the canvas each frame. Browser failures (no adapter, a lost
-//! device, a zero-size canvas, a frame the canvas does not give) are messages, never panics.
+//! The page's GPU: WebGPU on the canvas (opened by the renderer's rules), configured for the
+//! page's frame ([`PageGpu`]), which draws into the canvas each frame. Browser failures (no
+//! adapter, a lost device, a zero-size canvas, a frame the canvas does not give) are messages,
+//! never panics.
 
 use std::sync::{Arc, Mutex};
 
-use glam::{Mat4, Vec3};
 use pelt_core::FurTextures;
-use pelt_render::{
-    DEFAULT_BACKGROUND, FurDrawSettings, FurFrame, FurLook, FurRenderer, FurStates, FurTarget, FurView, GpuFur, Light,
-    PlainMesh, RenderTargets,
-};
 
 use crate::model::Model;
-
-/// Colour of the try-on body, linear RGB (the viewer's).
-const BODY_COLOUR: Vec3 = Vec3::new(0.6, 0.45, 0.38);
+use crate::page_gpu::{CANVAS_USAGE, PageGpu};
 
 /// What went wrong on the device since the last frame, kept by wgpu's callbacks.
 #[derive(Debug, Default)]
@@ -30,17 +24,9 @@ pub struct CanvasGpu {
     queue: wgpu::Queue,
     surface: wgpu::Surface<'static>,
     config: wgpu::SurfaceConfiguration,
-    /// The sRGB view of the canvas texture the fur is drawn through (shading stays linear).
-    view_format: wgpu::TextureFormat,
     /// False until the canvas has a non-zero size.
     configured: bool,
-    targets: Option<RenderTargets>,
-    renderer: FurRenderer,
-    fur: GpuFur,
-    body: Option<PlainMesh>,
-    view: FurView,
-    /// The fur's look; the shell tile repeats more often when the web tile is smaller.
-    look: FurLook,
+    page: PageGpu,
     trouble: Arc<Mutex<DeviceTrouble>>,
     /// What the adapter says it is (e.g. SwiftShader), for the page and the figures.
     pub adapter_name: String,
@@ -113,10 +99,8 @@ impl CanvasGpu {
 
         let caps = surface.get_capabilities(&adapter);
         let format = caps.formats.first().copied().ok_or("the canvas offers no texture format")?;
-        // Canvases take non-sRGB formats; the fur is drawn through an sRGB view of them.
-        let view_format = format.add_srgb_suffix();
         let config = wgpu::SurfaceConfiguration {
-            usage: wgpu::TextureUsages::RENDER_ATTACHMENT,
+            usage: CANVAS_USAGE,
             format,
             color_space: wgpu::SurfaceColorSpace::Auto,
             width: 1,
@@ -124,31 +108,10 @@ impl CanvasGpu {
             present_mode: wgpu::PresentMode::Fifo,
             desired_maximum_frame_latency: 2,
             alpha_mode: wgpu::CompositeAlphaMode::Opaque,
-            view_formats: if view_format == format { vec![] } else { vec![view_format] },
+            view_formats: vec![],
         };
-        let renderer = FurRenderer::new(&device, FurTarget::new(view_format)).map_err(|e| e.to_string())?;
-        let fur = GpuFur::new(&device, &queue, &renderer, &model.structure, textures, FurStates::One)
-            .map_err(|e| e.to_string())?;
-        let view = FurView::new(&device, &renderer);
-        let look = FurLook { tiles_per_radius: FurLook::default().tiles_per_radius * tile_scale, ..FurLook::default() };
-        let mut gpu = Self {
-            device,
-            queue,
-            surface,
-            config,
-            view_format,
-            configured: false,
-            targets: None,
-            renderer,
-            fur,
-            body: None,
-            view,
-            look,
-            trouble,
-            adapter_name,
-        };
-        gpu.set_body(model.body.as_ref())?;
-        Ok(gpu)
+        let page = PageGpu::new(&device, &queue, format, model, textures, tile_scale)?;
+        Ok(Self { device, queue, surface, config, configured: false, page, trouble, adapter_name })
     }
 
     /// The message of a lost device, once it is lost (the page then starts a new one).
@@ -167,8 +130,7 @@ impl CanvasGpu {
     /// # Errors
     /// The renderer's message (e.g. a structure over the device's limits).
     pub fn set_structure(&mut self, model: &Model) -> Result<(), String> {
-        self.fur.set_structure(&self.device, &self.renderer, &model.structure).map_err(|e| e.to_string())?;
-        self.set_body(model.body.as_ref())
+        self.page.set_structure(&self.device, &self.queue, model)
     }
 
     /// New textures, made with a tile `tile_scale` times smaller than the preset's.
@@ -176,22 +138,15 @@ impl CanvasGpu {
     /// # Errors
     /// The renderer's message.
     pub fn set_textures(&mut self, textures: &FurTextures, tile_scale: f32) -> Result<(), String> {
-        self.fur.set_textures(&self.device, &self.queue, &self.renderer, textures).map_err(|e| e.to_string())?;
-        self.look.tiles_per_radius = FurLook::default().tiles_per_radius * tile_scale;
-        Ok(())
+        self.page.set_textures(&self.device, &self.queue, textures, tile_scale)
     }
 
-    fn set_body(&mut self, body: Option<&pelt_core::Mesh>) -> Result<(), String> {
-        self.body = match body {
-            Some(mesh) => {
-                let plain =
-                    PlainMesh::new(&self.device, &self.renderer, mesh, BODY_COLOUR).map_err(|e| e.to_string())?;
-                plain.prepare(&self.queue, Mat4::IDENTITY);
-                Some(plain)
-            }
-            None => None,
-        };
-        Ok(())
+    /// Advances the model's fur by `frame_secs` of wall time (see [`PageGpu::advance`]).
+    ///
+    /// # Errors
+    /// The driver's message.
+    pub fn advance(&mut self, model: &mut Model, frame_secs: f64) -> Result<(), String> {
+        self.page.advance(&self.device, &self.queue, model, frame_secs)
     }
 
     /// Draws the model into the canvas at `width_px x height_px` device pixels.
@@ -208,10 +163,7 @@ impl CanvasGpu {
             self.config.width = width_px;
             self.config.height = height_px;
             self.surface.configure(&self.device, &self.config);
-            self.targets = Some(
-                RenderTargets::new(&self.device, self.renderer.target(), width_px, height_px)
-                    .map_err(|e| e.to_string())?,
-            );
+            self.page.resize(&self.device, width_px, height_px)?;
             self.configured = true;
         }
         let frame = match self.surface.get_current_texture() {
@@ -222,23 +174,7 @@ impl CanvasGpu {
             }
             _ => return Ok(Err(Skipped::NoFrame)),
         };
-        let Some(targets) = &self.targets else { return Ok(Err(Skipped::NoFrame)) };
-        self.fur.set_positions(&self.queue, model.sim.positions()).map_err(|e| e.to_string())?;
-        self.fur.prepare(&self.queue, &FurFrame { look: self.look, ..FurFrame::default() });
-        let camera = model.orbit.camera();
-        self.view.prepare(&self.queue, &camera.view_data(targets.aspect_ratio(), &Light::default()));
-        let output = frame
-            .texture
-            .create_view(&wgpu::TextureViewDescriptor { format: Some(self.view_format), ..Default::default() });
-        let mut encoder = self.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
-        {
-            let mut pass = targets.begin_pass(&mut encoder, &output, DEFAULT_BACKGROUND);
-            if let Some(body) = &self.body {
-                self.renderer.draw_plain(&mut pass, &self.view, body);
-            }
-            self.renderer.draw(&mut pass, &self.view, &self.fur, &FurDrawSettings::ALL);
-        }
-        self.queue.submit([encoder.finish()]);
+        self.page.render(&self.device, &self.queue, model, &frame.texture)?;
         self.queue.present(frame);
         Ok(Ok(()))
     }

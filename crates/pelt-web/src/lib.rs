@@ -1,13 +1,15 @@
 //! Pelt in the browser: the bunny and the paper's try-on scene drawn with WebGPU, patted with
 //! pointer events (several at once), with wind, the shipped presets, fur length and colour.
 //!
-//! [`model`] and [`presets`] hold the page's state and touch no browser API (tested natively);
-//! on `wasm32` the GPU side (`gpu`) and the JavaScript interface (`web`, `PeltApp`) build on
-//! them. `web/build.sh` builds the page into `web/dist/`.
+//! [`model`] and [`presets`] hold the page's state and [`page_gpu`] its frame on a GPU device;
+//! none touches a browser API, so they are tested natively (the frame on lavapipe, against
+//! `pelt render`'s look). On `wasm32` the canvas (`gpu`) and the JavaScript interface (`web`,
+//! `PeltApp`) build on them. `web/build.sh` builds the page into `web/dist/`.
 
 #![warn(missing_docs)]
 
 pub mod model;
+pub mod page_gpu;
 pub mod presets;
 
 #[cfg(target_arch = "wasm32")]

@@ -4,9 +4,9 @@
 
 use glam::{Vec2, Vec3};
 use pelt_core::mesh::builtin::{TryOnScene, try_on_scene};
-use pelt_core::sim::Touch;
+use pelt_core::sim::{FurStepper, Touch};
 use pelt_core::texture::Rgb;
-use pelt_core::{Builtin, FurStructure, ImportOptions, Mesh, Preset, Simulation};
+use pelt_core::{Builtin, FurStructure, ImportOptions, Mesh, Preset};
 use pelt_render::Camera;
 
 /// Touch radius as a fraction of the furred mesh's bounding radius (the viewer's default brush).
@@ -123,8 +123,9 @@ pub struct Model {
     pub structure: FurStructure,
     /// The try-on body, drawn plain.
     pub body: Option<Mesh>,
-    /// The simulation of `structure`.
-    pub sim: Simulation,
+    /// The simulation of `structure`, stepped by the page's frame driver (or by
+    /// [`Model::simulate`] without a GPU).
+    pub stepper: FurStepper,
     /// The camera.
     pub orbit: Orbit,
     /// The distance that frames the scene (zoom is bounded around it).
@@ -144,14 +145,14 @@ impl Model {
     pub fn new(scene: SceneChoice, preset: Preset, aspect: f32) -> Result<Self, ModelError> {
         let (mesh, body) = load_scene(scene)?;
         let structure = grow(mesh, &preset)?;
-        let sim = Simulation::new(&structure, &preset.simulation)?;
+        let stepper = FurStepper::new(&structure, &preset.simulation)?;
         let orbit = Orbit { target: Vec3::ZERO, azimuth_deg: 35.0, elevation_deg: 15.0, distance: 1.0 };
         let mut model = Self {
             scene,
             preset,
             structure,
             body,
-            sim,
+            stepper,
             orbit,
             framed_distance: 1.0,
             touches: Vec::new(),
@@ -235,7 +236,7 @@ impl Model {
         let angle = direction_deg.to_radians();
         wind.direction = Vec3::new(angle.cos(), 0.0, angle.sin());
         wind.strength = strength;
-        self.sim.set_wind(&wind)?;
+        self.stepper.simulation_mut().set_wind(&wind)?;
         self.preset.simulation.wind = wind;
         Ok(())
     }
@@ -243,10 +244,10 @@ impl Model {
     fn rebuild(&mut self, preset: Preset) -> Result<(), ModelError> {
         preset.validate()?;
         let structure = grow(self.structure.mesh.clone(), &preset)?;
-        let sim = Simulation::new(&structure, &preset.simulation)?;
+        let stepper = FurStepper::new(&structure, &preset.simulation)?;
         self.preset = preset;
         self.structure = structure;
-        self.sim = sim;
+        self.stepper = stepper;
         self.touches.clear();
         Ok(())
     }
@@ -255,10 +256,11 @@ impl Model {
     /// elsewhere it does nothing (false: the page orbits with it instead).
     pub fn pointer_down(&mut self, pointer_id: i32, pixel: Vec2, size: Vec2) -> bool {
         let (origin, direction) = self.orbit.ray(pixel, size);
-        let Some(hit) = self.sim.pick(&self.structure.mesh.triangles, origin, direction) else { return false };
+        let simulation = self.stepper.simulation();
+        let Some(hit) = simulation.pick(&self.structure.mesh.triangles, origin, direction) else { return false };
         let radius = BRUSH_PER_RADIUS * self.structure.mesh.bounding_sphere().1;
         self.touches.retain(|t| t.pointer_id != pointer_id);
-        let touch = Touch::new(hit.point, radius, self.sim.roots());
+        let touch = Touch::new(hit.point, radius, simulation.roots());
         self.touches.push(PointerTouch { pointer_id, touch, plane_normal: -direction });
         true
     }
@@ -297,21 +299,31 @@ impl Model {
         self.touches.iter().filter(|t| t.touch.released_at_secs.is_none()).count()
     }
 
-    /// Advances the simulation by `frame_secs` of wall time (capped, so a tab coming back from
-    /// the background does not fast-forward).
-    pub fn simulate(&mut self, frame_secs: f64) {
+    /// Moves the page's clock by `frame_secs` of wall time (capped, so a tab coming back from
+    /// the background does not fast-forward) and writes the pointers' touches into the
+    /// simulation's force field: the time the frame driver then advances the stepper to.
+    pub fn tick(&mut self, frame_secs: f64) -> f64 {
         if frame_secs.is_finite() && frame_secs > 0.0 {
             self.clock_secs += frame_secs.min(MAX_FRAME_SECS);
         }
         let params = &self.preset.simulation.touch;
         let (strength, release_secs, now) = (params.strength, params.release_secs, self.clock_secs);
         self.touches.retain(|t| t.touch.presence(now, release_secs) > 0.0);
-        let field = self.sim.field_mut();
+        let field = self.stepper.simulation_mut().field_mut();
         field.fill(Vec3::ZERO);
         for held in &self.touches {
             held.touch.apply(strength, held.touch.presence(now, release_secs), field.values_mut());
         }
-        self.sim.advance_to(self.clock_secs);
+        self.clock_secs
+    }
+
+    /// A frame without a GPU: [`Model::tick`], then the stepper on the CPU.
+    ///
+    /// # Errors
+    /// [`ModelError::Sim`] for a step the simulation refuses.
+    pub fn simulate(&mut self, frame_secs: f64) -> Result<(), ModelError> {
+        let time_secs = self.tick(frame_secs);
+        Ok(self.stepper.advance_to(time_secs)?)
     }
 }
 
@@ -346,7 +358,7 @@ mod tests {
     /// Tip of every strand.
     fn tips(model: &Model) -> Vec<Vec3> {
         let v = model.structure.vertex_count();
-        model.sim.positions()[model.structure.layers as usize * v..].to_vec()
+        model.stepper.simulation().positions()[model.structure.layers as usize * v..].to_vec()
     }
 
     /// The pixel of a base vertex that faces the camera and is the first thing its pixel's ray
@@ -362,7 +374,7 @@ mod tests {
                 let ndc = clip_from_world.project_point3(root);
                 let pixel = Vec2::new((ndc.x + 1.0) * 0.5 * SIZE.x, (1.0 - ndc.y) * 0.5 * SIZE.y);
                 let (origin, direction) = model.orbit.ray(pixel, SIZE);
-                let hit = model.sim.pick(&mesh.triangles, origin, direction)?;
+                let hit = model.stepper.simulation().pick(&mesh.triangles, origin, direction)?;
                 (facing && hit.point.distance(root) < 1e-3 * mesh.bounding_sphere().1).then_some((j, pixel))
             })
             .expect("a visible vertex")
@@ -377,8 +389,8 @@ mod tests {
         assert!(patted.pointer_move(7, pixel + Vec2::new(60.0, 0.0), SIZE));
         assert_eq!(patted.touches_held(), 1);
         for _ in 0..10 {
-            patted.simulate(FRAME_SECS);
-            untouched.simulate(FRAME_SECS);
+            patted.simulate(FRAME_SECS).unwrap();
+            untouched.simulate(FRAME_SECS).unwrap();
         }
         let radius = BRUSH_PER_RADIUS * patted.structure.mesh.bounding_sphere().1;
         let root = patted.structure.mesh.positions[j];
@@ -393,8 +405,8 @@ mod tests {
         patted.pointer_up(7);
         assert_eq!(patted.touches_held(), 0);
         for _ in 0..3 {
-            patted.simulate(FRAME_SECS);
-            untouched.simulate(FRAME_SECS);
+            patted.simulate(FRAME_SECS).unwrap();
+            untouched.simulate(FRAME_SECS).unwrap();
         }
         // The default preset restores at once on release; the fur is exactly the untouched fur.
         assert_eq!(tips(&patted), tips(&untouched));
@@ -422,14 +434,14 @@ mod tests {
         model.pointer_move(2, second_px + Vec2::new(50.0, 0.0), SIZE);
         assert_eq!(model.touches_held(), 2);
         for _ in 0..10 {
-            model.simulate(FRAME_SECS);
-            untouched.simulate(FRAME_SECS);
+            model.simulate(FRAME_SECS).unwrap();
+            untouched.simulate(FRAME_SECS).unwrap();
         }
         let (a, b) = (tips(&model), tips(&untouched));
         for j in [first, second] {
             assert!(a[j].distance(b[j]) > 0.1 * model.structure.lengths[j], "strand {j} was not patted");
         }
-        assert!(a.iter().chain(model.sim.positions()).all(|p| p.is_finite()));
+        assert!(a.iter().chain(model.stepper.simulation().positions()).all(|p| p.is_finite()));
     }
 
     #[test]
@@ -455,8 +467,8 @@ mod tests {
         let mut windy = bunny();
         windy.set_wind(3.0, 90.0).unwrap();
         for _ in 0..20 {
-            calm.simulate(FRAME_SECS);
-            windy.simulate(FRAME_SECS);
+            calm.simulate(FRAME_SECS).unwrap();
+            windy.simulate(FRAME_SECS).unwrap();
         }
         let push: Vec3 = tips(&windy).iter().zip(tips(&calm)).map(|(w, c)| *w - c).sum();
         assert!(push.z > push.x.abs() && push.z > 0.0, "wind toward +Z pushed {push}");
@@ -468,8 +480,8 @@ mod tests {
         assert!(model.body.is_some());
         assert_ne!(model.structure.vertex_count(), bunny_vertices);
         assert_eq!(model.preset.simulation.wind.strength, 2.0, "the wind stays across scenes");
-        model.simulate(FRAME_SECS);
-        assert!(model.sim.positions().iter().all(|p| p.is_finite()));
+        model.simulate(FRAME_SECS).unwrap();
+        assert!(model.stepper.simulation().positions().iter().all(|p| p.is_finite()));
         assert_eq!(SceneChoice::from_name("tryon"), Some(SceneChoice::TryOn));
         assert_eq!(SceneChoice::from_name("cat"), None);
     }
@@ -477,10 +489,10 @@ mod tests {
     #[test]
     fn a_background_tab_does_not_fast_forward_and_zoom_stays_bounded() {
         let mut model = bunny();
-        model.simulate(3600.0);
+        model.simulate(3600.0).unwrap();
         assert!(model.clock_secs <= MAX_FRAME_SECS);
-        model.simulate(f64::NAN);
-        assert!(model.sim.positions().iter().all(|p| p.is_finite()));
+        model.simulate(f64::NAN).unwrap();
+        assert!(model.stepper.simulation().positions().iter().all(|p| p.is_finite()));
         let framed = model.orbit.distance;
         for _ in 0..100 {
             model.zoom(0.5);

@@ -109,7 +109,7 @@ impl PeltApp {
         self.last_frame_ms = Some(now_ms);
         self.css_size = Vec2::new(css_width, css_height);
         let started = Instant::now();
-        self.model.simulate(frame_secs);
+        self.gpu.advance(&mut self.model, frame_secs).map_err(message)?;
         self.sim_ms = smooth(self.sim_ms, started.elapsed().as_secs_f64() * 1e3);
         let drawn = match self.gpu.draw(&self.model, width_px, height_px).map_err(message)? {
             Ok(()) => true,

@@ -11,8 +11,8 @@ use pelt_core::anim::Rig;
 use pelt_core::sim::{FurStepper, Scene, WindParams};
 use pelt_core::{Builtin, FurStructure, Mesh, Preset, Stage};
 use pelt_render::{
-    Backend, Camera, DEFAULT_BACKGROUND, FurDrawSettings, FurDriver, FurTarget, FurView, Gpu, HEADLESS_FORMAT,
-    Headless, Light, PlainMesh, SAMPLE_COUNT, default_sample_count,
+    Backend, Camera, FurDrawSettings, FurDriver, FurTarget, FurView, Gpu, HEADLESS_FORMAT, Headless, PlainMesh,
+    SAMPLE_COUNT, Studio, default_sample_count,
 };
 
 use crate::lod;
@@ -186,8 +186,9 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         mesh.prepare(queue, Mat4::IDENTITY);
     }
     let camera = camera(args, &preset, &fur, &plain, &motion_keys, frames, headless.aspect_ratio());
+    let studio = Studio::default();
     let view = FurView::new(device, &renderer);
-    view.prepare(queue, &camera.view_data(headless.aspect_ratio(), &Light::default()));
+    view.prepare(queue, &studio.view_data(&camera, headless.aspect_ratio()));
     // The camera stays put, so one level serves every frame.
     let level = lod::level(&lod::settings(&preset.render.lod, args.no_lod), &fur, camera.eye, camera.fov_y_rad, height);
     driver.set_level(level);
@@ -235,7 +236,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             }
         }
         let image = headless.render_with(
-            DEFAULT_BACKGROUND,
+            studio.background,
             |encoder| driver.record_view(encoder, &renderer, &view),
             |pass| {
                 for mesh in &plain_meshes {

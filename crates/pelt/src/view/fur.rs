@@ -6,8 +6,8 @@ use pelt_core::sim::{FurStepper, SimParams};
 use pelt_core::texture::FurTextures;
 use pelt_core::{FurStructure, Mesh};
 use pelt_render::{
-    Camera, DEFAULT_BACKGROUND, FurDrawSettings, FurDriver, FurFrame, FurLevel, FurRenderer, FurView, KernelChoice,
-    Light, PlainMesh, SeparatedFur, SeparatedRenderer, SimKernel,
+    Camera, FurDrawSettings, FurDriver, FurFrame, FurLevel, FurRenderer, FurView, KernelChoice, PlainMesh,
+    SeparatedFur, SeparatedRenderer, SimKernel, Studio,
 };
 
 use super::camera::OrbitCamera;
@@ -167,7 +167,8 @@ impl FurScene {
         let (near, far) = camera.near_far();
         let camera =
             Camera { eye: camera.eye(), target: camera.target, up: Vec3::Y, fov_y_rad: camera.fov_y_rad, near, far };
-        self.view.prepare(&gpu.queue, &camera.view_data(viewport.targets.aspect_ratio(), &Light::default()));
+        let studio = Studio::default();
+        self.view.prepare(&gpu.queue, &studio.view_data(&camera, viewport.targets.aspect_ratio()));
         let separated = self.separated.as_ref().filter(|_| separated);
         match separated {
             Some((_, fur)) => fur.prepare(&gpu.queue, &FurFrame { level, ..*self.driver.frame() }),
@@ -178,7 +179,7 @@ impl FurScene {
             }
         }
         {
-            let mut pass = viewport.targets.begin_pass(encoder, &viewport.colour_view, DEFAULT_BACKGROUND);
+            let mut pass = viewport.targets.begin_pass(encoder, &viewport.colour_view, studio.background);
             if let Some(body) = &self.body {
                 self.renderer.draw_plain(&mut pass, &self.view, body);
             }

@@ -1,0 +1,209 @@
+//! The page's frame on a GPU device, apart from the canvas: the fur's [`FurDriver`] (the CPU
+//! kernel: a page has one thread), the try-on body and one view, drawn with Pelt's [`Studio`]
+//! into any colour view. The canvas (`gpu`, on `wasm32`) gives it the canvas's sRGB view each
+//! frame; a native test gives it a texture of the canvas's format and reads it back.
+
+use glam::{Mat4, Vec3};
+use pelt_core::FurTextures;
+use pelt_render::{
+    FurDrawSettings, FurDriver, FurLook, FurRenderer, FurTarget, FurView, KernelChoice, PlainMesh, RenderTargets,
+    Studio,
+};
+
+use crate::model::Model;
+
+/// Colour of the try-on body, linear RGB (the viewer's).
+const BODY_COLOUR: Vec3 = Vec3::new(0.6, 0.45, 0.38);
+
+/// What the page draws: the fur as `pelt render` draws it (silhouette fins, Pelt's studio).
+pub const PAGE_DRAW: FurDrawSettings = FurDrawSettings::SILHOUETTE;
+
+/// The usages a canvas is configured with: the frame is copied into it.
+pub const CANVAS_USAGE: wgpu::TextureUsages =
+    wgpu::TextureUsages::RENDER_ATTACHMENT.union(wgpu::TextureUsages::COPY_DST);
+
+/// The format the page draws in for a canvas of `canvas_format`: its sRGB twin. Canvases take
+/// only non-sRGB formats, and the fur is shaded in linear light, as everywhere in Pelt; the frame
+/// is drawn (and resolved) into a texture of the sRGB format, which encodes on write, and its
+/// bytes are copied into the canvas. (Resolving into an sRGB view of the canvas instead, as
+/// WebGPU allows, stored linear values in Chromium 156 (Dawn on SwiftShader): the page showed
+/// its background at 12/13/15 instead of 60/63/69.)
+#[must_use]
+pub fn frame_format(canvas_format: wgpu::TextureFormat) -> wgpu::TextureFormat {
+    canvas_format.add_srgb_suffix()
+}
+
+/// The page's fur, body and view on one device, for canvases of one format.
+#[derive(Debug)]
+pub struct PageGpu {
+    renderer: FurRenderer,
+    driver: FurDriver,
+    body: Option<PlainMesh>,
+    view: FurView,
+    /// Depth (and MSAA colour) at the canvas's size; made by [`PageGpu::resize`].
+    targets: Option<RenderTargets>,
+    /// The frame in the sRGB format, resolved here and copied into the canvas.
+    frame: Option<wgpu::Texture>,
+    studio: Studio,
+}
+
+impl PageGpu {
+    /// Uploads `model`'s fur with `textures` (made with a tile `tile_scale` times smaller than the
+    /// preset's) for canvases of `canvas_format` (drawn with 4x MSAA).
+    ///
+    /// # Errors
+    /// The renderer's message (e.g. a structure over the device's limits).
+    pub fn new(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        canvas_format: wgpu::TextureFormat,
+        model: &Model,
+        textures: &FurTextures,
+        tile_scale: f32,
+    ) -> Result<Self, String> {
+        let target = FurTarget::new(frame_format(canvas_format));
+        let renderer = FurRenderer::new(device, target).map_err(|e| e.to_string())?;
+        let mut driver = FurDriver::new(
+            device,
+            queue,
+            &renderer,
+            &model.structure,
+            textures,
+            &model.preset.simulation,
+            KernelChoice::Cpu,
+        )
+        .map_err(|e| e.to_string())?;
+        driver.set_look(look(tile_scale));
+        driver.prepare(queue);
+        let view = FurView::new(device, &renderer);
+        let mut gpu =
+            Self { renderer, driver, body: None, view, targets: None, frame: None, studio: Studio::default() };
+        gpu.set_body(device, queue, model.body.as_ref())?;
+        Ok(gpu)
+    }
+
+    /// A new rest pose (scene, length or preset changed): the model's structure and body.
+    ///
+    /// # Errors
+    /// The renderer's message.
+    pub fn set_structure(&mut self, device: &wgpu::Device, queue: &wgpu::Queue, model: &Model) -> Result<(), String> {
+        self.driver.set_structure(device, queue, &self.renderer, &model.structure).map_err(|e| e.to_string())?;
+        self.set_body(device, queue, model.body.as_ref())
+    }
+
+    /// New textures, made with a tile `tile_scale` times smaller than the preset's.
+    ///
+    /// # Errors
+    /// The renderer's message.
+    pub fn set_textures(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        textures: &FurTextures,
+        tile_scale: f32,
+    ) -> Result<(), String> {
+        self.driver.set_look(look(tile_scale));
+        self.driver.set_textures(device, queue, &self.renderer, textures).map_err(|e| e.to_string())
+    }
+
+    fn set_body(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        body: Option<&pelt_core::Mesh>,
+    ) -> Result<(), String> {
+        self.body = match body {
+            Some(mesh) => {
+                let plain = PlainMesh::new(device, &self.renderer, mesh, BODY_COLOUR).map_err(|e| e.to_string())?;
+                plain.prepare(queue, Mat4::IDENTITY);
+                Some(plain)
+            }
+            None => None,
+        };
+        Ok(())
+    }
+
+    /// Makes the attachments for a canvas of `width_px x height_px` (when the size changed).
+    ///
+    /// # Errors
+    /// The renderer's message (a zero or over-limit size).
+    pub fn resize(&mut self, device: &wgpu::Device, width_px: u32, height_px: u32) -> Result<(), String> {
+        if self.targets.as_ref().is_some_and(|t| t.size() == (width_px, height_px)) {
+            return Ok(());
+        }
+        let target = self.renderer.target();
+        let targets = RenderTargets::new(device, target, width_px, height_px).map_err(|e| e.to_string())?;
+        self.frame = Some(device.create_texture(&wgpu::TextureDescriptor {
+            label: Some("pelt web frame"),
+            size: wgpu::Extent3d { width: width_px, height: height_px, depth_or_array_layers: 1 },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format: target.colour_format,
+            usage: wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::COPY_SRC,
+            view_formats: &[],
+        }));
+        self.targets = Some(targets);
+        Ok(())
+    }
+
+    /// Advances the model by `frame_secs` of wall time: its clock and touches
+    /// ([`Model::tick`]), then the fur through the driver (simulation step and upload).
+    ///
+    /// # Errors
+    /// The driver's message.
+    pub fn advance(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        model: &mut Model,
+        frame_secs: f64,
+    ) -> Result<(), String> {
+        let time_secs = model.tick(frame_secs);
+        self.driver.advance_to(device, queue, &mut model.stepper, time_secs).map_err(|e| e.to_string())
+    }
+
+    /// Draws `model` from its orbit, copies the frame into `canvas` (a texture of the size last
+    /// given to [`PageGpu::resize`], of the canvas format, with [`CANVAS_USAGE`]) and submits.
+    ///
+    /// # Errors
+    /// A message for a canvas of another size or before [`PageGpu::resize`], or the driver's.
+    pub fn render(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        model: &Model,
+        canvas: &wgpu::Texture,
+    ) -> Result<(), String> {
+        let (Some(targets), Some(frame)) = (&self.targets, &self.frame) else {
+            return Err("the page's frame has no size yet".to_owned());
+        };
+        if frame.size() != canvas.size() {
+            let (w, h) = (canvas.width(), canvas.height());
+            return Err(format!("the canvas is {w}x{h}, the frame {}x{}", frame.width(), frame.height()));
+        }
+        let output = frame.create_view(&wgpu::TextureViewDescriptor::default());
+        let camera = model.orbit.camera();
+        self.view.prepare(queue, &self.studio.view_data(&camera, targets.aspect_ratio()));
+        let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
+        self.driver.record(&mut encoder).map_err(|e| e.to_string())?;
+        self.driver.record_view(&mut encoder, &self.renderer, &self.view);
+        {
+            let mut pass = targets.begin_pass(&mut encoder, &output, self.studio.background);
+            if let Some(body) = &self.body {
+                self.renderer.draw_plain(&mut pass, &self.view, body);
+            }
+            self.driver.draw(&mut pass, &self.renderer, &self.view, &PAGE_DRAW);
+        }
+        // The encoded bytes as they are: the canvas shows its bytes as sRGB.
+        encoder.copy_texture_to_texture(frame.as_image_copy(), canvas.as_image_copy(), frame.size());
+        queue.submit([encoder.finish()]);
+        Ok(())
+    }
+}
+
+/// Pelt's look, with the shell tile repeated `tile_scale` times more often (the web's tile is
+/// that many times smaller, so the strands keep their size on the mesh).
+fn look(tile_scale: f32) -> FurLook {
+    FurLook { tiles_per_radius: FurLook::default().tiles_per_radius * tile_scale, ..FurLook::default() }
+}
