@@ -9,6 +9,7 @@
 #![warn(missing_docs)]
 
 pub mod anim;
+pub mod export;
 pub mod fur;
 pub mod mesh;
 pub mod preset;
