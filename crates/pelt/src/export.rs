@@ -55,8 +55,9 @@ pub struct Args {
     /// The animation `--time` refers to: its name or index (default: the first).
     #[arg(long, value_name = "NAME|INDEX")]
     animation: Option<String>,
-    /// How the fur's materials treat alpha.
-    #[arg(long, value_enum, default_value_t = Alpha::Blend)]
+    /// How the fur's materials treat alpha. `mask` by default: in three.js it comes closer to
+    /// `pelt render`'s picture than `blend` (web/export-test), and it needs no sorting.
+    #[arg(long, value_enum, default_value_t = Alpha::Mask)]
     alpha: Alpha,
     /// Output: a .glb, or a .gltf (its buffer written beside it as a .bin).
     #[arg(short, long, default_value = "pelt.glb")]
@@ -127,7 +128,12 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     };
     let export = Export::build(&input)?;
     export.write(&args.output)?;
-    let bytes = std::fs::metadata(&args.output).map(|m| m.len()).unwrap_or(0);
+    // A .gltf's buffer is its .bin beside it.
+    let mut files = vec![args.output.clone()];
+    if args.output.extension().is_some_and(|e| e.eq_ignore_ascii_case("gltf")) {
+        files.push(args.output.with_extension("bin"));
+    }
+    let bytes: u64 = files.iter().filter_map(|path| std::fs::metadata(path).ok()).map(|m| m.len()).sum();
     let counts = &export.counts;
     for note in notes {
         println!("note: {note}");
