@@ -11,6 +11,7 @@
 #![warn(missing_docs)]
 
 pub mod anim;
+pub mod export;
 pub mod fur;
 pub mod groom;
 pub mod mesh;

@@ -1,6 +1,7 @@
 //! `pelt`: render, view, measure and author real-time fur.
 
 mod bench;
+mod export;
 mod fidelity;
 mod format;
 mod lod;
@@ -34,6 +35,8 @@ enum Command {
     Textures(textures::Args),
     /// Measure how close shells and fins come to the explicit strands they stand for (SSIM).
     Fidelity(fidelity::Args),
+    /// Write the fur as a standard glTF file (.glb or .gltf) for other viewers and engines.
+    Export(export::Args),
     /// Measure memory, frame time, simulation and texture generation side by side.
     Bench(bench::Args),
 }
@@ -44,6 +47,7 @@ fn main() -> anyhow::Result<()> {
         Command::View(args) => view::run(&args),
         Command::Stats(args) => stats::run(&args),
         Command::Textures(args) => textures::run(&args),
+        Command::Export(args) => export::run(&args),
         Command::Bench(args) => bench::run(&args),
         Command::Fidelity(args) => fidelity::run(&args),
     }

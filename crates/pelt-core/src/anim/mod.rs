@@ -318,6 +318,62 @@ impl Rig {
     }
 }
 
+impl Rig {
+    /// Each base vertex's influences as indices into a glTF skin whose joints are the nodes
+    /// `skin_joints` (what an exported mesh bound to that skin carries as JOINTS_0/WEIGHTS_0).
+    /// `None` when a vertex is moved by a node outside that skin (another skin, or a mesh
+    /// hanging rigidly under an animated node).
+    #[must_use]
+    pub fn influences_in_skin(&self, skin_joints: &[usize]) -> Option<Vec<([u16; 4], [f32; 4])>> {
+        let slot: Vec<Option<u16>> = self
+            .palette
+            .iter()
+            .map(|joint| {
+                let node = joint.node?;
+                skin_joints.iter().position(|&n| n == node).and_then(|k| u16::try_from(k).ok())
+            })
+            .collect();
+        self.influences
+            .iter()
+            .map(|inf| {
+                let mut joints = [0_u16; 4];
+                let mut weights = [0.0_f32; 4];
+                for k in 0..4 {
+                    if inf.weights[k] > 0.0 {
+                        joints[k] = slot[inf.joints[k] as usize]?;
+                        weights[k] = inf.weights[k];
+                    }
+                }
+                Some((joints, weights))
+            })
+            .collect()
+    }
+
+    /// The linear blend skinning matrix of every base vertex in `pose`, which [`Rig::pose`]
+    /// filled (morph targets not included): what takes a point riding on the vertex from the
+    /// bind pose to the pose.
+    #[must_use]
+    pub fn vertex_matrices(&self, pose: &Pose) -> Vec<Mat4> {
+        let joints: Vec<Mat4> = self
+            .palette
+            .iter()
+            .map(|joint| {
+                joint.node.and_then(|n| pose.world.get(n).copied()).unwrap_or(Mat4::IDENTITY) * joint.inverse_bind
+            })
+            .collect();
+        self.influences
+            .iter()
+            .map(|inf| {
+                inf.joints
+                    .iter()
+                    .zip(&inf.weights)
+                    .filter(|(_, w)| **w != 0.0)
+                    .fold(Mat4::ZERO, |sum, (&j, &w)| sum + joints[j as usize] * w)
+            })
+            .collect()
+    }
+}
+
 /// The normal matrix of `m`: the inverse transpose of its upper 3x3 (zero for a singular one).
 fn normal_matrix(m: Mat4) -> Mat3 {
     let linear = Mat3::from_mat4(m);

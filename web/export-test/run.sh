@@ -1,0 +1,26 @@
+#!/usr/bin/env bash
+# Exports fur with `pelt export` (bunny masked and blended, the try-on garment as .gltf + .bin,
+# the Fox at rest and mid-walk), renders the bunny with `pelt render` at the test's camera, and
+# checks the files with the Khronos glTF Validator and three.js in headless Chromium
+# (export.test.mjs). Needs chromium, node and npm (web/test/run.sh installs them) and a Vulkan
+# adapter for `pelt render` (lavapipe in CI). Any failure, validator warnings included, fails it.
+set -euo pipefail
+cd "$(dirname "$0")/../.."
+cargo build -p pelt --locked
+pelt="${CARGO_TARGET_DIR:-target}/debug/pelt"
+out=web/export-test/output
+rm -rf "$out"
+mkdir -p "$out"
+"$pelt" export --builtin bunny -o "$out/bunny.glb"
+"$pelt" export --builtin bunny --alpha blend -o "$out/bunny-blend.glb"
+"$pelt" export --builtin tryon --layers 8 -o "$out/tryon.gltf"
+"$pelt" export assets/meshes/Fox.glb --preset assets/presets/fox.toml -o "$out/fox.glb"
+"$pelt" export assets/meshes/Fox.glb --preset assets/presets/fox.toml --animation Walk --time 0.5 --layers 8 \
+  -o "$out/fox-walk.glb"
+# The picture three.js must match: no wind (the export settles without), every layer; the camera
+# is export.test.mjs's VIEW.
+"$pelt" render --builtin bunny --wind 0,0,0 --no-lod --camera 30,15,24 --size 480x360 -o "$out/bunny-pelt.png"
+
+cd web/export-test
+PUPPETEER_SKIP_DOWNLOAD=1 npm ci --no-fund --no-audit --loglevel=error
+node --test --test-reporter=spec export.test.mjs
