@@ -385,7 +385,7 @@ fn pick(state: &FurState, ray: &Ray3d) -> Option<(glam::Vec3, f32)> {
     let simulation_from_world = state.world_from_simulation.inverse();
     let origin = simulation_from_world.transform_point3(to_pelt(ray.origin));
     let direction = simulation_from_world.transform_vector3(to_pelt(*ray.direction));
-    let hit = state.simulation.pick(&state.structure.mesh.triangles, origin, direction)?;
+    let hit = state.simulation().pick(&state.structure.mesh.triangles, origin, direction)?;
     let world_point = state.world_from_simulation.transform_point3(hit.point);
     Some((hit.point, world_point.distance(to_pelt(ray.origin))))
 }
