@@ -111,8 +111,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         None => Preset::default(),
     };
     let (model, mesh, plain) = load_meshes(&args.mesh)?;
-    let params = preset.fur_params(&mesh);
-    let fur = FurStructure::new(mesh, &params)?;
+    let fur = preset.grow(mesh, &model)?;
     // One strand field: the textures are drawn from it and the reference places it.
     let field = preset.strand_field()?;
     let textures = texture::generate_from(preset.layers, &field);
@@ -145,7 +144,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let positions = stepper.simulation().positions();
     let strand_renderer = StrandRenderer::new(&strands.gpu.device, &strand_side.renderer)?;
     let ribbons =
-        StrandRibbons::new(&strands.gpu.device, &reference, &positions, &fur.mesh.normals, &fur.mesh.triangles)?;
+        StrandRibbons::new(&strands.gpu.device, &reference, positions, &fur.mesh.normals, &fur.mesh.triangles)?;
 
     std::fs::create_dir_all(&args.out).with_context(|| format!("cannot create {}", args.out.display()))?;
     let front = preset.render.camera_azimuth_deg.unwrap_or(30.0);
