@@ -6,7 +6,7 @@ use pelt_core::FurStructure;
 use pelt_core::texture::FurTextures;
 
 use crate::RenderError;
-use crate::geometry::UnifiedGeometry;
+use crate::geometry::{Furred, UnifiedGeometry};
 use crate::listing::{FinList, ShellList};
 use crate::lod::PreparedLevel;
 use crate::object::{FurFrame, GpuBytes};
@@ -62,11 +62,12 @@ impl GpuFur {
         states: FurStates,
     ) -> Result<Self, RenderError> {
         let scope = ErrorScope::push(device);
-        let geometry = geometry(device, layouts, structure, states);
+        let furred = Furred::of(structure);
+        let geometry = geometry(device, layouts, (structure, furred.as_ref()), states);
         let textures = GpuTextures::new(device, queue, layouts, textures);
-        let fins = fin_list(device, layouts, structure);
-        let shells =
-            shell_list(device, layouts, structure, geometry.as_ref().map_or(0, |g| g.shape.vertices_per_shell()));
+        let fins = fin_list(device, layouts, (structure, furred.as_ref()));
+        let per_shell = geometry.as_ref().map_or(0, |g| g.shape.vertices_per_shell());
+        let shells = shell_list(device, layouts, (structure, furred.as_ref()), per_shell);
         scope.pop("uploading the fur")?;
         Ok(Self { geometry: geometry?, textures: textures?, fins: fins?, level: PreparedLevel::new(), shells: shells? })
     }
@@ -80,10 +81,11 @@ impl GpuFur {
     ) -> Result<(), RenderError> {
         let states = if self.geometry.state_count() == 1 { FurStates::One } else { FurStates::Two };
         let scope = ErrorScope::push(device);
-        let geometry = geometry(device, layouts, structure, states);
-        let fins = fin_list(device, layouts, structure);
-        let shells =
-            shell_list(device, layouts, structure, geometry.as_ref().map_or(0, |g| g.shape.vertices_per_shell()));
+        let furred = Furred::of(structure);
+        let geometry = geometry(device, layouts, (structure, furred.as_ref()), states);
+        let fins = fin_list(device, layouts, (structure, furred.as_ref()));
+        let per_shell = geometry.as_ref().map_or(0, |g| g.shape.vertices_per_shell());
+        let shells = shell_list(device, layouts, (structure, furred.as_ref()), per_shell);
         scope.pop("uploading the fur")?;
         (self.geometry, self.fins, self.shells) = (geometry?, fins?, shells?);
         Ok(())
@@ -204,7 +206,9 @@ impl GpuFur {
 
     /// The view-angle pass's list (`COPY_SRC`): as many little-endian `u32`s as
     /// [`GpuFur::view_lod_count`] says, three a triangle, each a triangle corner (meshes with
-    /// uvs: `3 * triangle + k`) or a base vertex (meshes without), in no particular order.
+    /// uvs: `3 * triangle + k`) or a base vertex (meshes without), in no particular order. A
+    /// groomed fur numbers its triangles with the furred ones first (`FurStructure::furred_triangles`
+    /// in order, then the bald ones).
     #[must_use]
     pub fn view_lod_indices(&self) -> Option<&wgpu::Buffer> {
         self.shells.as_ref().map(|list| &list.indices)
@@ -231,7 +235,8 @@ impl GpuFur {
     }
 
     /// The fins the silhouette pass (or the `lab` feature's `GpuFur::prepare_fins_on_cpu`) kept:
-    /// `(edge, fade as f32 bits)` as two little-endian `u32`s per fin, in no particular order, as
+    /// `(edge, fade as f32 bits)` as two little-endian `u32`s per fin (a groomed fur's `edge`
+    /// indexes `FurStructure::fin_edges`), in no particular order, as
     /// many as the indirect draw's instance count ([`GpuFur::silhouette_draw`]); `COPY_SRC`. For
     /// hosts and tests that read it back; `None` for a fur without fins.
     #[must_use]
@@ -281,30 +286,38 @@ impl GpuFur {
 fn fin_list(
     device: &wgpu::Device,
     layouts: &Layouts,
-    structure: &FurStructure,
+    (structure, furred): (&FurStructure, Option<&Furred>),
 ) -> Result<Option<FinList>, RenderError> {
-    FinList::new(device, layouts, structure.mesh.edges.len() as u32, structure.layers)
+    let edges = furred.map_or(structure.mesh.edges.len(), |furred| furred.edges.len());
+    FinList::new(device, layouts, edges as u32, structure.layers)
 }
 
 fn shell_list(
     device: &wgpu::Device,
     layouts: &Layouts,
-    structure: &FurStructure,
+    (structure, furred): (&FurStructure, Option<&Furred>),
     per_shell: u32,
 ) -> Result<Option<ShellList>, RenderError> {
-    let triangles = structure.mesh.triangles.len() as u32;
-    ShellList::new(device, layouts, (triangles, per_shell), structure.layers)
+    let triangles = furred.map_or(structure.mesh.triangles.len(), |furred| furred.triangles.len());
+    ShellList::new(device, layouts, (triangles as u32, per_shell), structure.layers)
 }
 
 fn geometry(
     device: &wgpu::Device,
     layouts: &Layouts,
-    structure: &FurStructure,
+    (structure, furred): (&FurStructure, Option<&Furred>),
     states: FurStates,
 ) -> Result<UnifiedGeometry, RenderError> {
     let state_count = match states {
         FurStates::One => 1,
         FurStates::Two => 2,
     };
-    UnifiedGeometry::new(device, layouts, &structure.mesh, structure.layers, &structure.positions, state_count)
+    UnifiedGeometry::new(
+        device,
+        layouts,
+        (&structure.mesh, furred),
+        structure.layers,
+        &structure.positions,
+        state_count,
+    )
 }

@@ -1,10 +1,15 @@
 //! A mesh in the unified layout on the GPU, shared by [`crate::GpuFur`] (`L` layers) and
 //! [`crate::PlainMesh`] (layer 0 only): the shared vertex array (one or two states), base
 //! normals, wedge uvs and topology as storage buffers, and the object uniform.
+//!
+//! A groomed fur keeps its triangles and edges in the draw order of [`Furred`]: those with fur
+//! (fins) first, so the shells and fins draw a prefix of the topology, the skin all of it, and
+//! the topology keeps its size (`pelt_core::fur::Footprint` counts it).
 
 use glam::{Vec2, Vec3};
-use pelt_core::Mesh;
 use pelt_core::fur::POSITION_BYTES;
+use pelt_core::mesh::NO_FACE;
+use pelt_core::{FurStructure, Mesh};
 use wgpu::util::DeviceExt as _;
 
 use crate::RenderError;
@@ -18,6 +23,63 @@ pub const POSITIONS_USAGE: wgpu::BufferUsages = wgpu::BufferUsages::STORAGE
     .union(wgpu::BufferUsages::VERTEX)
     .union(wgpu::BufferUsages::COPY_DST)
     .union(wgpu::BufferUsages::COPY_SRC);
+
+/// Which base triangles get shells and which edges get fins, each list in mesh order
+/// (`FurStructure::furred_triangles`, `FurStructure::fin_edges`).
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub(crate) struct Furred {
+    pub triangles: Vec<u32>,
+    pub edges: Vec<u32>,
+}
+
+impl Furred {
+    /// What `structure`'s groom leaves furred; `None` (everything, in mesh order) without one.
+    pub fn of(structure: &FurStructure) -> Option<Self> {
+        structure.groom.as_ref()?;
+        Some(Self { triangles: structure.furred_triangles(), edges: structure.fin_edges() })
+    }
+}
+
+/// `first` (ascending, below `count`), then the rest of `0..count` in order: the GPU's order of
+/// a groomed fur's triangles or edges.
+fn furred_first(count: usize, first: &[u32]) -> Vec<u32> {
+    let mut listed = vec![false; count];
+    first.iter().for_each(|&k| listed[k as usize] = true);
+    first.iter().copied().chain((0..count as u32).filter(|&k| !listed[k as usize])).collect()
+}
+
+/// The topology buffer's contents (see `topology` in `unified.wgsl`) with triangles and edges in
+/// the order of `furred` (mesh order without), and the wedges' uvs.
+fn topology(mesh: &Mesh, furred: Option<&Furred>) -> (Vec<u32>, Option<Vec<Vec2>>, u32) {
+    let wedges = mesh.wedges();
+    let Some(furred) = furred else {
+        let mut topology: Vec<u32> = mesh.triangles.iter().flatten().copied().collect();
+        topology.extend(mesh.edges.iter().flatten());
+        topology.extend(mesh.edge_faces.iter().flatten());
+        let Some(wedges) = wedges else { return (topology, None, 0) };
+        let count = wedges.vertices.len() as u32;
+        topology.extend(wedges.vertices);
+        topology.extend(wedges.corners);
+        return (topology, Some(wedges.uvs), count);
+    };
+    let triangles = furred_first(mesh.triangles.len(), &furred.triangles);
+    let edges = furred_first(mesh.edges.len(), &furred.edges);
+    let mut slot_of_triangle = vec![0; triangles.len()];
+    for (slot, &t) in triangles.iter().enumerate() {
+        slot_of_triangle[t as usize] = slot as u32;
+    }
+    let mut topology: Vec<u32> = triangles.iter().flat_map(|&t| mesh.triangles[t as usize]).collect();
+    topology.extend(edges.iter().flat_map(|&e| mesh.edges[e as usize]));
+    topology.extend(edges.iter().flat_map(|&e| {
+        mesh.edge_faces[e as usize].map(|face| if face == NO_FACE { NO_FACE } else { slot_of_triangle[face as usize] })
+    }));
+    let Some(wedges) = wedges else { return (topology, None, 0) };
+    let count = wedges.vertices.len() as u32;
+    topology.extend(wedges.vertices);
+    let corners = &wedges.corners;
+    topology.extend(triangles.iter().flat_map(|&t| corners[3 * t as usize..3 * t as usize + 3].iter().copied()));
+    (topology, Some(wedges.uvs), count)
+}
 
 #[derive(Debug)]
 pub(crate) struct UnifiedGeometry {
@@ -40,16 +102,21 @@ pub(crate) struct UnifiedGeometry {
 }
 
 impl UnifiedGeometry {
-    /// Uploads `mesh` with `positions` (`(L + 1) * V`, layer-major) into every state.
+    /// Uploads `mesh` with `positions` (`(L + 1) * V`, layer-major) into every state; shells
+    /// and fins draw only what `furred` lists (`None`: everything).
     pub fn new(
         device: &wgpu::Device,
         layouts: &Layouts,
-        mesh: &Mesh,
+        (mesh, furred): (&Mesh, Option<&Furred>),
         layers: u32,
         positions: &[Vec3],
         state_count: usize,
     ) -> Result<Self, RenderError> {
         let mut shape = ObjectShape::new(mesh, layers);
+        if let Some(furred) = furred {
+            shape.furred_triangle_count = furred.triangles.len() as u32;
+            shape.fin_edge_count = furred.edges.len() as u32;
+        }
         let expected = (layers as usize + 1) * mesh.vertex_count();
         if positions.len() != expected {
             return Err(RenderError::Count {
@@ -61,18 +128,9 @@ impl UnifiedGeometry {
         }
         let position_bytes = positions.len() as u64 * POSITION_BYTES;
         check_size(device, "shared vertex array", position_bytes)?;
-        let mut topology: Vec<u32> = mesh.triangles.iter().flatten().copied().collect();
-        topology.extend(mesh.edges.iter().flatten());
-        topology.extend(mesh.edge_faces.iter().flatten());
-        let wedge_uvs = match mesh.wedges() {
-            Some(wedges) => {
-                shape.wedge_count = wedges.vertices.len() as u32;
-                topology.extend(wedges.vertices);
-                topology.extend(wedges.corners);
-                wedges.uvs
-            }
-            None => vec![Vec2::ZERO],
-        };
+        let (topology, wedge_uvs, wedge_count) = topology(mesh, furred);
+        shape.wedge_count = wedge_count;
+        let wedge_uvs = wedge_uvs.unwrap_or_else(|| vec![Vec2::ZERO]);
         check_size(device, "mesh topology", topology.len() as u64 * 4)?;
         check_size(device, "mesh uvs", wedge_uvs.len() as u64 * 8)?;
 
@@ -219,9 +277,19 @@ impl UnifiedGeometry {
         &self.bind_groups[self.current]
     }
 
-    /// Draws the base triangles (`instances` = layers), indexed: by wedge with uvs, else by base
-    /// vertex.
-    pub fn draw_surface(&self, pass: &mut wgpu::RenderPass<'_>, instances: std::ops::Range<u32>) {
+    /// Draws every base triangle once: the skin, or a plain mesh.
+    pub fn draw_skin(&self, pass: &mut wgpu::RenderPass<'_>) {
+        self.draw_surface(pass, 0..1, self.shape.triangle_count);
+    }
+
+    /// Draws the furred base triangles in the shells `instances`.
+    pub fn draw_shells(&self, pass: &mut wgpu::RenderPass<'_>, instances: std::ops::Range<u32>) {
+        self.draw_surface(pass, instances, self.shape.furred_triangle_count);
+    }
+
+    /// Draws the first `drawn` base triangles (`instances` = layers), indexed: by wedge with uvs,
+    /// else by base vertex.
+    fn draw_surface(&self, pass: &mut wgpu::RenderPass<'_>, instances: std::ops::Range<u32>, drawn: u32) {
         let shape = &self.shape;
         let triangles = shape.triangle_count;
         // The topology buffer starts with the base triangles and ends with the corners' wedges.
@@ -230,9 +298,12 @@ impl UnifiedGeometry {
         } else {
             0
         };
-        let indices = self.topology.slice(4 * first..4 * (first + 3 * u64::from(triangles)));
+        if drawn == 0 {
+            return;
+        }
+        let indices = self.topology.slice(4 * first..4 * (first + 3 * u64::from(drawn)));
         pass.set_index_buffer(indices, wgpu::IndexFormat::Uint32);
-        pass.draw_indexed(0..3 * triangles, 0, instances);
+        pass.draw_indexed(0..3 * drawn, 0, instances);
     }
 
     /// Draws the fins listed in `instances` (the silhouette pass's edges) through the indirect
@@ -249,7 +320,7 @@ impl UnifiedGeometry {
     pub fn draw_fins(&self, pass: &mut wgpu::RenderPass<'_>, segments: u32) {
         if let Some(strip) = &self.fin_indices {
             pass.set_index_buffer(strip.slice(..), wgpu::IndexFormat::Uint32);
-            pass.draw_indexed(0..6 * segments.min(self.shape.layers), 0, 0..self.shape.edge_count);
+            pass.draw_indexed(0..6 * segments.min(self.shape.layers), 0, 0..self.shape.fin_edge_count);
         }
     }
 }

@@ -97,6 +97,10 @@ pub(crate) struct ObjectShape {
     pub layers: u32,
     pub triangle_count: u32,
     pub edge_count: u32,
+    /// The triangles the shells draw and the edges the fins draw: the first ones of the GPU's
+    /// topology (`geometry.rs` keeps a groomed fur's furred triangles and fin edges first).
+    pub furred_triangle_count: u32,
+    pub fin_edge_count: u32,
     pub has_uvs: bool,
     /// Meshes with uvs on the GPU: the wedges the shells walk (`geometry.rs`); 0 otherwise.
     pub wedge_count: u32,
@@ -113,6 +117,8 @@ impl ObjectShape {
             layers,
             triangle_count: mesh.triangles.len() as u32,
             edge_count: mesh.edges.len() as u32,
+            furred_triangle_count: mesh.triangles.len() as u32,
+            fin_edge_count: mesh.edges.len() as u32,
             has_uvs: mesh.corner_uvs.is_some(),
             wedge_count: 0,
             world_per_uv: world_per_uv(mesh),
@@ -166,7 +172,11 @@ impl ObjectShape {
             lod_view: if level.facing.is_some() { 1.0 } else { 0.0 },
             lod_view_start: level.facing.map_or(0.0, |[start, _]| start),
             lod_view_full: level.facing.map_or(1.0, |[_, full]| full),
+            furred_triangle_count: self.furred_triangle_count,
+            fin_edge_count: self.fin_edge_count,
             _padding_1: 0,
+            _padding_2: 0,
+            _padding_3: 0,
         }
     }
 }

@@ -17,7 +17,7 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use anyhow::Context as _;
-use pelt_core::{FurStructure, Preset};
+use pelt_core::Preset;
 
 use self::models::{MODELS, Model};
 use self::report::{
@@ -243,7 +243,7 @@ fn measure(
     // Everything timed uses the default preset at this layer count.
     let mut preset = Preset::default();
     preset.layers = layers;
-    let fur = FurStructure::new(model.fur.clone(), &preset.fur_params(&model.fur))?;
+    let fur = preset.grow(model.fur.clone(), model.spec.key)?;
     let key = model.spec.key;
     eprintln!("pelt bench:   {key} L={layers}: textures");
     // The median of a few runs: the first one also pays for the thread pool and fresh pages.
@@ -292,7 +292,7 @@ fn measure_anim(model: &Model, layers: u32, plan: Plan<'_>) -> anyhow::Result<An
     };
     let mut preset = Preset::default();
     preset.layers = layers;
-    let fur = FurStructure::new(model.fur.clone(), &preset.fur_params(&model.fur))?;
+    let fur = preset.grow(model.fur.clone(), model.spec.key)?;
     eprintln!("pelt bench:   {} L={layers}: posing ({clip})", model.spec.key);
     anim::measure(&fur, rig, clip, &preset.simulation, plan.sim_budget().drawn_frames)
 }
@@ -302,8 +302,7 @@ fn measure_large_mesh(plan: Plan<'_>, gpu: Result<&render::Bench, &String>) -> a
     let mesh = models::large_mesh()?;
     let mut preset = Preset::default();
     preset.layers = 32;
-    let params = preset.fur_params(&mesh);
-    let fur = FurStructure::new(mesh, &params)?;
+    let fur = preset.grow(mesh, models::LARGE_MESH)?;
     let throughput = sim::throughput(&fur, &preset.simulation, plan.sim_budget())?;
     // The GPU kernel on a mesh big enough to fill a GPU (the bench's models are launch-bound).
     let gpu_sim_node_updates_per_sec = match gpu {

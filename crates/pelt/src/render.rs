@@ -139,8 +139,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         let secs = scene.as_ref().map(Scene::duration_secs).or(clip_secs).unwrap_or(2.0);
         ((secs * args.fps).round() as u32).max(1)
     };
-    let params = preset.fur_params(&mesh);
-    let fur = FurStructure::new(mesh, &params)?;
+    let fur = preset.grow(mesh, &args.mesh.source(Builtin::Bunny)?.name())?;
     let textures = preset.generate_textures()?;
     let mut simulation_params = preset.simulation.clone();
     let wind = match args.wind {

@@ -5,11 +5,13 @@
 
 use std::fmt::Write as _;
 use std::io::Write as _;
+use std::path::PathBuf;
 
 use anyhow::Context as _;
 use pelt_core::anim::Rig;
 use pelt_core::fur::{Footprint, FurLength, MAX_LAYERS};
-use pelt_core::{Builtin, FurParams, FurStructure, GrowthDirection, MeshReport, SeparatedStructure};
+use pelt_core::groom::Groom;
+use pelt_core::{Builtin, FurParams, FurStructure, GrowthDirection, MeshReport, Preset, SeparatedStructure};
 
 use crate::format::thousands;
 use crate::mesh_args::MeshArgs;
@@ -28,6 +30,10 @@ pub struct Args {
     /// Print JSON instead of a table.
     #[arg(long)]
     pub json: bool,
+    /// A preset whose `[groom]` says where fur grows: faces on bald triangles and edges are not
+    /// drawn, so not counted (its other values leave the counts as they are).
+    #[arg(long, value_name = "FILE")]
+    pub preset: Option<PathBuf>,
 }
 
 /// The numbers `pelt stats` reports.
@@ -35,6 +41,9 @@ pub struct Args {
 pub struct Stats {
     pub mesh: MeshReport,
     pub layers: u32,
+    /// The preset whose groom decided the faces drawn.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub groom: Option<String>,
     /// `N`, faces per fin of the second separated structure.
     pub fin_faces: u32,
     /// The JSON names structures as `pelt bench --json` does (`unified`, `separated2`;
@@ -117,7 +126,13 @@ const PAPER_BOX: (u64, u64, u64) = (5_032, 6_796, 31_492);
 
 pub fn run(args: &Args) -> anyhow::Result<()> {
     let pelt_core::Stage { fur_mesh: mesh, report, rig, .. } = args.mesh.stage(Builtin::Box, &[])?;
-    let mut stats = measure(mesh, report, args.layers, args.fin_faces)?;
+    let groom = match &args.preset {
+        Some(path) => Preset::load(path)?.groom(&mesh, &args.mesh.source(Builtin::Box)?.name())?,
+        None => None,
+    };
+    let groomed_by = groom.as_ref().filter(|g| !g.is_uniform()).and(args.preset.as_ref());
+    let mut stats = measure(mesh, report, args.layers, args.fin_faces, groom)?;
+    stats.groom = groomed_by.map(|path| path.display().to_string());
     stats.motion = rig.as_ref().map(Motion::of);
     let text = if args.json { serde_json::to_string_pretty(&stats)? + "\n" } else { table(&stats) };
     write_stdout(&text)
@@ -132,22 +147,31 @@ fn write_stdout(text: &str) -> anyhow::Result<()> {
     }
 }
 
-/// Grows the unified structure on `mesh` and measures both structures.
+/// Grows the unified structure on `mesh` (with `groom`'s bald regions left out) and measures
+/// both structures.
 ///
 /// # Errors
-/// When `layers` is outside `1..=MAX_LAYERS`.
-pub fn measure(mesh: pelt_core::Mesh, report: MeshReport, layers: u32, fin_faces: u32) -> anyhow::Result<Stats> {
+/// When `layers` is outside `1..=MAX_LAYERS`, or the groom does not fit the mesh.
+pub fn measure(
+    mesh: pelt_core::Mesh,
+    report: MeshReport,
+    layers: u32,
+    fin_faces: u32,
+    groom: Option<Groom>,
+) -> anyhow::Result<Stats> {
+    if !(1..=MAX_LAYERS).contains(&layers) {
+        anyhow::bail!("--layers {layers}: choose between 1 and {MAX_LAYERS}");
+    }
     let params = FurParams { layers, length: FurLength::Constant(1.0), direction: GrowthDirection::default() };
-    let fur = FurStructure::new(mesh, &params)
-        .with_context(|| format!("--layers {layers}: choose between 1 and {MAX_LAYERS}"))?;
+    let fur = FurStructure::new_groomed(mesh, &params, groom)?;
     let unified = fur.footprint();
     // The footprint counts what was actually built.
     anyhow::ensure!(
         unified.vertices == fur.positions.len() as u64,
         "unified vertex count disagrees with the structure"
     );
-    let separated_two_face_fins = SeparatedStructure { layers, fin_faces: 2 }.footprint(&fur.mesh);
-    let separated_n_face_fins = SeparatedStructure { layers, fin_faces }.footprint(&fur.mesh);
+    let separated_two_face_fins = SeparatedStructure { layers, fin_faces: 2 }.footprint_of(&fur);
+    let separated_n_face_fins = SeparatedStructure { layers, fin_faces }.footprint_of(&fur);
     let vertices = |f: &Footprint| f.vertices;
     let bytes = |f: &Footprint| f.total_bytes();
     let savings = Savings {
@@ -159,6 +183,7 @@ pub fn measure(mesh: pelt_core::Mesh, report: MeshReport, layers: u32, fin_faces
     Ok(Stats {
         mesh: report,
         layers,
+        groom: None,
         fin_faces,
         unified,
         separated_two_face_fins,
@@ -187,6 +212,9 @@ pub fn table(stats: &Stats) -> String {
         thousands(r.edges as u64),
         stats.layers
     );
+    if let Some(preset) = &stats.groom {
+        let _ = writeln!(out, "groomed by {preset}: faces on bald triangles and edges are not drawn or counted");
+    }
     let _ = writeln!(
         out,
         "{:<26} {:>10} {:>11} {:>11} {:>13} {:>13} {:>13}",
@@ -275,7 +303,7 @@ mod tests {
 
     fn stats_of(builtin: Builtin, layers: u32, fin_faces: u32) -> Stats {
         let (mesh, report) = builtin.mesh();
-        measure(mesh, report, layers, fin_faces).unwrap()
+        measure(mesh, report, layers, fin_faces, None).unwrap()
     }
 
     #[test]
@@ -318,7 +346,7 @@ mod tests {
     fn bad_layer_counts_name_the_flag() {
         for layers in [0, MAX_LAYERS + 1] {
             let (mesh, report) = Builtin::Box.mesh();
-            let message = format!("{:#}", measure(mesh, report, layers, 30).unwrap_err());
+            let message = format!("{:#}", measure(mesh, report, layers, 30, None).unwrap_err());
             assert!(message.contains("--layers"), "{message}");
         }
     }

@@ -77,3 +77,27 @@ fn an_animated_file_lists_its_skins_joints_and_animations() {
     let json: serde_json::Value = serde_json::from_slice(&output.stdout).expect("valid JSON");
     assert!(json.get("motion").is_none());
 }
+
+/// A preset's groom leaves the bald faces out of the counts, for the unified and the separated
+/// structures alike; the vertices and the topology's bytes stay.
+#[test]
+fn a_groomed_preset_counts_only_the_faces_drawn() {
+    let fox = "assets/meshes/Fox.glb";
+    let json = |args: &[&str]| -> serde_json::Value {
+        let output = pelt(args);
+        assert!(output.status.success(), "{}", stderr(&output));
+        serde_json::from_slice(&output.stdout).expect("valid JSON")
+    };
+    let uniform = json(&["stats", fox, "--json"]);
+    let groomed = json(&["stats", fox, "--json", "--preset", "assets/presets/fox_groomed.toml"]);
+    assert!(uniform.get("groom").is_none());
+    assert_eq!(groomed["groom"], "assets/presets/fox_groomed.toml");
+    for structure in ["unified", "separated2", "separated_n"] {
+        let faces = |stats: &serde_json::Value, key: &str| stats[structure][key].as_u64().unwrap();
+        assert!(faces(&groomed, "shell_faces") < faces(&uniform, "shell_faces"), "{structure}");
+        assert!(faces(&groomed, "fin_faces") < faces(&uniform, "fin_faces"), "{structure}");
+    }
+    assert_eq!(groomed["unified"]["index_bytes"], uniform["unified"]["index_bytes"]);
+    let text = stdout(&pelt(&["stats", fox, "--preset", "assets/presets/fox_groomed.toml"]));
+    assert!(text.contains("groomed by assets/presets/fox_groomed.toml"), "{text}");
+}

@@ -5,8 +5,8 @@
 //! path is the cheaper one.
 
 use glam::{Mat3, Vec3};
-use pelt_core::Mesh;
 use pelt_core::mesh::NO_FACE;
+use pelt_core::{FurStructure, Mesh};
 
 use crate::RenderError;
 use crate::fur::GpuFur;
@@ -40,7 +40,20 @@ impl CpuSilhouette {
         }
     }
 
-    /// The mesh's edge count (one possible fin each).
+    /// The topology of `structure`'s base mesh with only the edges that grow fins, in the order
+    /// the GPU keeps them: what a groomed fur needs (as [`CpuSilhouette::new`] without a groom).
+    #[must_use]
+    pub fn of(structure: &FurStructure) -> Self {
+        let mut silhouette = Self::new(&structure.mesh);
+        if structure.groom.is_some() {
+            let fins = structure.fin_edges();
+            silhouette.edges = fins.iter().map(|&e| structure.mesh.edges[e as usize]).collect();
+            silhouette.edge_faces = fins.iter().map(|&e| structure.mesh.edge_faces[e as usize]).collect();
+        }
+        silhouette
+    }
+
+    /// The edges it decides for (one possible fin each).
     #[must_use]
     pub fn edge_count(&self) -> usize {
         self.edges.len()
@@ -113,7 +126,8 @@ impl GpuFur {
     /// fins).
     ///
     /// # Errors
-    /// [`RenderError::Count`] when `silhouette` was made for a mesh with another edge count, or
+    /// [`RenderError::Count`] when `silhouette` was made for a fur with another count of edges
+    /// with fins, or
     /// `positions` holds fewer than `V` positions.
     pub fn prepare_fins_on_cpu(
         &self,
@@ -123,13 +137,13 @@ impl GpuFur {
         frame: &FurFrame,
         camera_position_world: Vec3,
     ) -> Result<u32, RenderError> {
-        let expected = self.geometry().shape.edge_count as usize;
+        let expected = self.geometry().shape.fin_edge_count as usize;
         if silhouette.edge_count() != expected {
             return Err(RenderError::Count {
                 what: "CPU silhouette edges",
                 expected,
                 got: silhouette.edge_count(),
-                rule: "the fur's mesh's edges",
+                rule: "the fur's edges with fins (CpuSilhouette::of)",
             });
         }
         let Some(list) = self.fin_list() else {

@@ -184,7 +184,7 @@ impl FurRenderer {
         pass.set_bind_group(2, fur.textures_bind_group(), &[]);
         if settings.skin {
             pass.set_pipeline(&surface.skin);
-            geometry.draw_surface(pass, 0..1);
+            geometry.draw_skin(pass);
         }
         let layers = geometry.shape.layers;
         if settings.shells && layers > 0 {
@@ -194,7 +194,7 @@ impl FurRenderer {
                 }
                 _ => {
                     pass.set_pipeline(&surface.shells[which]);
-                    geometry.draw_surface(pass, 0..fur.drawn_shells());
+                    geometry.draw_shells(pass, 0..fur.drawn_shells());
                 }
             }
         }
@@ -241,7 +241,7 @@ impl FurRenderer {
         pass.set_bind_group(0, view.bind_group(), &[]);
         pass.set_bind_group(1, geometry.bind_group(), &[]);
         pass.set_pipeline(&self.surface(geometry.shape.has_uvs).plain);
-        geometry.draw_surface(pass, 0..1);
+        geometry.draw_skin(pass);
     }
 
     fn surface(&self, has_uvs: bool) -> &SurfacePipelines {
@@ -271,7 +271,7 @@ fn draw_thinned_shells(
             pass.draw_indexed_indirect(&list.draws, u64::from(shell) * DRAW_ARGS_BYTES);
         } else {
             pass.set_pipeline(&surface.shells[which]);
-            geometry.draw_surface(pass, shell..shell + 1);
+            geometry.draw_shells(pass, shell..shell + 1);
         }
     }
 }

@@ -47,8 +47,12 @@ pub(crate) struct ObjectUniform {
     pub lod_view: f32,
     pub lod_view_start: f32,
     pub lod_view_full: f32,
+    pub furred_triangle_count: u32,
+    pub fin_edge_count: u32,
     /// WGSL rounds the struct up to its 16-byte alignment.
     pub _padding_1: u32,
+    pub _padding_2: u32,
+    pub _padding_3: u32,
 }
 
 pub(crate) const OBJECT_UNIFORM_BYTES: u64 = size_of::<ObjectUniform>() as u64;
@@ -232,7 +236,11 @@ mod tests {
             lod_view,
             lod_view_start,
             lod_view_full,
-            _padding_1
+            furred_triangle_count,
+            fin_edge_count,
+            _padding_1,
+            _padding_2,
+            _padding_3
         });
         assert_mirrors(&unified_shader_source(), "Object", &rust);
     }

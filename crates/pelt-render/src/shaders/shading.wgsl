@@ -64,6 +64,11 @@ struct Object {
     lod_view: f32,
     lod_view_start: f32,
     lod_view_full: f32,
+    // A groomed fur keeps its triangles with fur first and its edges with fins first (bald ones
+    // after them, for the skin and the topology's lookups): the shells draw the first
+    // `furred_triangle_count` triangles and the fins the first `fin_edge_count` edges.
+    furred_triangle_count: u32,
+    fin_edge_count: u32,
 }
 
 // Set per pipeline: shells and fins with alpha-to-coverage output straight colour, blended ones

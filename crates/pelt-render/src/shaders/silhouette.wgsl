@@ -26,7 +26,7 @@ struct FinDraw {
 @compute @workgroup_size(64)
 fn cs_fin_fades(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
     let edge = item_index(id, groups);
-    if edge < object.edge_count {
+    if edge < object.fin_edge_count {
         fin_instances[edge] = vec2<u32>(edge, bitcast<u32>(fin_fade(edge)));
     }
 }
@@ -34,11 +34,11 @@ fn cs_fin_fades(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workg
 @compute @workgroup_size(256)
 fn cs_silhouette(@builtin(local_invocation_index) lane: u32) {
     var listed = 0u;
-    let rounds = (object.edge_count + SCAN_WIDTH - 1u) / SCAN_WIDTH;
+    let rounds = (object.fin_edge_count + SCAN_WIDTH - 1u) / SCAN_WIDTH;
     for (var round = 0u; round < rounds; round++) {
         let edge = round * SCAN_WIDTH + lane;
         var fade = 0.0;
-        if edge < object.edge_count {
+        if edge < object.fin_edge_count {
             fade = bitcast<f32>(fin_instances[edge].y);
         }
         let scan = workgroup_scan(lane, u32(fade > 0.0));

@@ -44,7 +44,7 @@ fn view_lod_shows(triangle: u32) -> bool {
 @compute @workgroup_size(64)
 fn cs_view_lod_flags(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
     let triangle = item_index(id, groups);
-    if triangle < object.triangle_count {
+    if triangle < object.furred_triangle_count {
         listed_indices[3u * triangle] = u32(view_lod_shows(triangle));
     }
 }
@@ -55,10 +55,10 @@ fn cs_view_lod_flags(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_
 @compute @workgroup_size(256)
 fn cs_view_lod_list(@builtin(local_invocation_index) lane: u32) {
     var count = 0u;
-    let rounds = (object.triangle_count + SCAN_WIDTH - 1u) / SCAN_WIDTH;
+    let rounds = (object.furred_triangle_count + SCAN_WIDTH - 1u) / SCAN_WIDTH;
     for (var round = 0u; round < rounds; round++) {
         let triangle = round * SCAN_WIDTH + lane;
-        let shows = triangle < object.triangle_count && listed_indices[3u * triangle] != 0u;
+        let shows = triangle < object.furred_triangle_count && listed_indices[3u * triangle] != 0u;
         let scan = workgroup_scan(lane, u32(shows));
         storageBarrier();
         if shows {

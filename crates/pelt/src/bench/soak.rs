@@ -119,7 +119,7 @@ fn print_report(kernel: &str, report: &SoakReport, secs: f64) {
 pub fn run(steps: u64, gpu_steps: u64) -> anyhow::Result<()> {
     let (mesh, _) = pelt_core::Builtin::Bunny.mesh();
     let preset = Preset::default();
-    let fur = FurStructure::new(mesh.clone(), &preset.fur_params(&mesh))?;
+    let fur = preset.grow(mesh, "bunny")?;
     let progress = |kernel: &'static str, started: Instant| {
         move |done: u64| {
             if done.is_multiple_of(100_000) {

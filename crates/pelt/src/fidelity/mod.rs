@@ -111,8 +111,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         None => Preset::default(),
     };
     let (model, mesh, plain) = load_meshes(&args.mesh)?;
-    let params = preset.fur_params(&mesh);
-    let fur = FurStructure::new(mesh, &params)?;
+    let fur = preset.grow(mesh, &model)?;
     // One strand field: the textures are drawn from it and the reference places it.
     let field = preset.strand_field()?;
     let textures = texture::generate_from(preset.layers, &field);

@@ -149,7 +149,7 @@ impl Model {
             let clip = (!clips.is_empty()).then_some(0);
             settings.animation = AnimationSettings { clips, clip, playing: true, speed: 1.0, time_secs: 0.0 };
         }
-        let structure = grow(mesh, &settings.preset)?;
+        let structure = grow(mesh, &settings.preset, &settings.mesh)?;
         let mut stepper = FurStepper::new(&structure, &settings.preset.simulation)?;
         // The first textures are made before the window opens, so the first frame has them.
         let textures = settings.preset.generate_textures()?;
@@ -299,10 +299,10 @@ impl Model {
                 }
                 MeshChoice::File(_) => self.file_mesh.clone().context("the command-line mesh is gone")?,
             };
-            self.structure = grow(mesh, &self.settings.preset)?;
+            self.structure = grow(mesh, &self.settings.preset, &self.settings.mesh)?;
             self.frame_pending = true;
         } else if changes.structure {
-            self.structure = grow(self.structure.mesh.clone(), &self.settings.preset)?;
+            self.structure = grow(self.structure.mesh.clone(), &self.settings.preset, &self.settings.mesh)?;
         }
         let rebuilt = changes.mesh || changes.structure;
         if changes.animation {
@@ -338,10 +338,9 @@ impl Model {
     }
 }
 
-/// Grows the rest pose of the fur on `mesh`.
-fn grow(mesh: Mesh, preset: &Preset) -> anyhow::Result<FurStructure> {
-    let params = preset.fur_params(&mesh);
-    Ok(FurStructure::new(mesh, &params)?)
+/// Grows the rest pose of the fur on `mesh` (the panel's `choice`), groomed as the preset says.
+fn grow(mesh: Mesh, preset: &Preset, choice: &MeshChoice) -> anyhow::Result<FurStructure> {
+    Ok(preset.grow(mesh, &choice.label())?)
 }
 
 /// Exponential moving average, so the overlay's numbers are readable.
@@ -431,7 +430,7 @@ mod tests {
         let radius = mesh.bounding_sphere().1;
         let mut preset = Preset::default();
         preset.length = 0.25;
-        let fur = grow(mesh, &preset).unwrap();
+        let fur = grow(mesh, &preset, &MeshChoice::Builtin(Builtin::Sphere)).unwrap();
         assert!(fur.lengths.iter().all(|l| (l - 0.25 * radius).abs() < 1e-5));
         assert_eq!(fur.layers, preset.layers);
     }
