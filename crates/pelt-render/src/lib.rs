@@ -14,7 +14,7 @@
 //!   transform.
 //! - [`FurView`]: one view's uniform buffer, written from [`ViewData`] (`clip_from_world`, camera
 //!   position, [`Light`]); several views in one submission each have their own.
-//! - [`Stage`]: the light, exposure and background of Pelt's own pictures, one default that
+//! - [`Studio`]: the light, exposure and background of Pelt's own pictures, one default that
 //!   `pelt render`, the viewer, the web page and the examples share.
 //!
 //! # The order a host calls things in
