@@ -361,6 +361,13 @@ impl FurDriver {
         Ok(())
     }
 
+    /// Whether [`FurDriver::record`] has steps to record: a host that submits the simulation in
+    /// an encoder of its own can skip it on frames between steps.
+    #[must_use]
+    pub fn has_steps_to_record(&self) -> bool {
+        self.unrecorded
+    }
+
     /// Records the GPU simulation's pending steps into `encoder` (nothing with the CPU kernel).
     /// Call once per frame, before [`FurDriver::record_view`] and the render pass.
     ///

@@ -56,9 +56,11 @@ pub fn gpu_cpu_ms_per_drawn_frame(
     let started = Instant::now();
     for frame in 1..=frames {
         driver.advance_to(device, queue, &mut stepper, f64::from(frame) / draw_hz)?;
-        let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("sim") });
-        driver.record(&mut encoder)?;
-        queue.submit([encoder.finish()]);
+        if driver.has_steps_to_record() {
+            let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("sim") });
+            driver.record(&mut encoder)?;
+            queue.submit([encoder.finish()]);
+        }
     }
     let ms = started.elapsed().as_secs_f64() * 1000.0 / f64::from(frames);
     device.poll(wgpu::PollType::wait_indefinitely())?;

@@ -98,10 +98,12 @@ impl FurScene {
         clip_time_secs: f64,
     ) -> anyhow::Result<()> {
         self.driver.advance_with_clip_at(&gpu.device, &gpu.queue, stepper, time_secs, clip_time_secs)?;
-        let mut encoder =
-            gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("simulation") });
-        self.driver.record(&mut encoder)?;
-        gpu.queue.submit([encoder.finish()]);
+        if self.driver.has_steps_to_record() {
+            let mut encoder =
+                gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("simulation") });
+            self.driver.record(&mut encoder)?;
+            gpu.queue.submit([encoder.finish()]);
+        }
         Ok(())
     }
 
