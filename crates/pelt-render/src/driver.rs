@@ -311,29 +311,27 @@ impl FurDriver {
         moved_normals: Option<&[glam::Vec3]>,
     ) -> Result<(), RenderError> {
         if self.kernel == SimKernel::Gpu {
-            self.gpu_simulation = None;
-            self.kernel = SimKernel::Cpu;
-            self.kernel_reason = "the host hands over states simulated on the CPU".to_owned();
-            self.unrecorded = false;
+            self.use_cpu_kernel("the host hands over states simulated on the CPU");
         }
         self.fur.set_positions(queue, positions)?;
         self.frame.interpolation = 1.0;
-        if let Some(normals) = moved_normals {
-            self.fur.set_base_normals(queue, normals)?;
-        }
-        self.fur.prepare(queue, &self.frame);
-        Ok(())
+        self.finish_upload(queue, moved_normals)
     }
 
     /// With the GPU kernel, steps prepared and never recorded mean the host does not record:
     /// the CPU bends from now on.
     fn fall_back_when_unrecorded(&mut self) {
         if self.unrecorded && self.kernel == SimKernel::Gpu {
-            self.gpu_simulation = None;
-            self.kernel = SimKernel::Cpu;
-            self.kernel_reason = "the GPU kernel's steps were never recorded".to_owned();
-            self.unrecorded = false;
+            self.use_cpu_kernel("the GPU kernel's steps were never recorded");
         }
+    }
+
+    /// From now on the stepper's simulation bends the strands (`claim` turns its bending on).
+    fn use_cpu_kernel(&mut self, reason: &str) {
+        self.gpu_simulation = None;
+        self.kernel = SimKernel::Cpu;
+        self.kernel_reason = reason.to_owned();
+        self.unrecorded = false;
     }
 
     fn upload(
@@ -354,6 +352,11 @@ impl FurDriver {
                 self.frame.interpolation = 1.0;
             }
         }
+        self.finish_upload(queue, moved_normals)
+    }
+
+    /// The posed normals (when the base moved) and this frame's uniform.
+    fn finish_upload(&mut self, queue: &wgpu::Queue, moved_normals: Option<&[glam::Vec3]>) -> Result<(), RenderError> {
         if let Some(normals) = moved_normals {
             self.fur.set_base_normals(queue, normals)?;
         }

@@ -174,7 +174,6 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     if let Some(rig) = rig.filter(|_| clip.is_some() || scene.as_ref().is_some_and(|s| !s.motion.is_empty())) {
         stepper.set_clip(rig, clip);
     }
-    let motion_keys = scene.as_ref().map_or(Vec::new(), |s| s.motion.clone());
     stepper.set_scene(scene);
     let moves = stepper.moves();
     let plain_meshes = plain
@@ -184,7 +183,8 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     for mesh in &plain_meshes {
         mesh.prepare(queue, Mat4::IDENTITY);
     }
-    let camera = camera(args, &preset, &fur, &plain, &motion_keys, frames, headless.aspect_ratio());
+    let motion_keys = stepper.scene().map_or(&[][..], |s| &s.motion[..]);
+    let camera = camera(args, &preset, &fur, &plain, motion_keys, frames, headless.aspect_ratio());
     let studio = Studio::default();
     let view = FurView::new(device, &renderer);
     view.prepare(queue, &studio.view_data(&camera, headless.aspect_ratio()));
