@@ -9,9 +9,10 @@
 //! read back and the shared array never crosses the bus.
 
 use pelt_core::FurStructure;
-use pelt_core::sim::{Simulation, StepInputs, kernel_rest};
+use pelt_core::sim::{ContactStep, Simulation, StepInputs, kernel_rest};
 
 use crate::RenderError;
+use crate::contact::{CONTACT_SLOTS, GpuContact};
 use crate::fur::GpuFur;
 use crate::requirements::{ErrorScope, check_size};
 use crate::shaders::simulation_shader_source;
@@ -22,8 +23,9 @@ const WORKGROUP: u32 = 64;
 const STEP_SLOT_BYTES: u64 = 256;
 /// Steps one prepare/dispatch pair can hold: only the last two states are ever kept.
 const STEP_SLOTS: usize = 2;
+const _: () = assert!(STEP_SLOTS == CONTACT_SLOTS);
 /// Storage buffers the compute stage binds.
-const STORAGE_BUFFERS: u32 = 4;
+const STORAGE_BUFFERS: u32 = 5;
 
 /// One step's inputs; the layout of `Step` in `simulation.wgsl`.
 #[repr(C)]
@@ -108,6 +110,10 @@ pub struct GpuSimulation {
     seen_steps: Option<u64>,
     /// Steps prepared and not yet dispatched (at most [`STEP_SLOTS`], in slot order).
     pending: Vec<StepUniform>,
+    /// The contact buffer (`simulation_contact.wgsl`).
+    contact: GpuContact,
+    /// The pending steps' contact, slot by slot.
+    pending_contact: Vec<ContactStep>,
 }
 
 impl GpuSimulation {
@@ -220,6 +226,7 @@ impl GpuSimulation {
                 storage(2, true),
                 storage(3, true),
                 storage(4, false),
+                storage(5, true),
             ],
         });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -254,6 +261,8 @@ impl GpuSimulation {
         );
         let strands = buffer("pelt simulation strands", v.max(1) as u64 * 32, storage_usage);
         let forces = buffer("pelt simulation forces", v.max(1) as u64 * 32, storage_usage);
+        check_size(device, "simulation contact", GpuContact::bytes(v))?;
+        let contact = GpuContact::new(device, structure);
         scope.pop("creating the GPU simulation")?;
         Ok(Self {
             pipeline,
@@ -262,6 +271,8 @@ impl GpuSimulation {
             rest_segments,
             strands,
             forces,
+            contact,
+            pending_contact: Vec::with_capacity(STEP_SLOTS + 2),
             bind_groups: Vec::new(),
             vertex_count: v as u32,
             layers: structure.layers,
@@ -318,12 +329,17 @@ impl GpuSimulation {
         let counts = [self.vertex_count, self.layers];
         for &time_secs in &recent[recent.len() - new..] {
             self.pending.push(step_uniform(&simulation.step_inputs(time_secs), counts, self.grid[0]));
+            self.pending_contact.push(simulation.contact_step(time_secs));
         }
         if self.pending.len() > STEP_SLOTS {
             self.pending.drain(..self.pending.len() - STEP_SLOTS);
+            self.pending_contact.drain(..self.pending_contact.len() - STEP_SLOTS);
         }
-        for (slot, uniform) in self.pending.iter().enumerate() {
+        self.contact.write_strands(queue, &simulation.contact_strands());
+        for (slot, (uniform, contact)) in self.pending.iter_mut().zip(&self.pending_contact).enumerate() {
+            uniform.grid[1] = slot as u32;
             queue.write_buffer(&self.step_uniforms, slot as u64 * STEP_SLOT_BYTES, bytemuck::bytes_of(uniform));
+            self.contact.write_slot(queue, slot, contact);
         }
         Ok(())
     }
@@ -363,6 +379,7 @@ impl GpuSimulation {
             pass.dispatch_workgroups(self.grid[0], self.grid[1], 1);
         }
         self.pending.clear();
+        self.pending_contact.clear();
         Ok(())
     }
 
@@ -399,6 +416,7 @@ impl GpuSimulation {
                 wgpu::BindGroupEntry { binding: 2, resource: self.strands.as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 3, resource: self.forces.as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 4, resource: output.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 5, resource: self.contact.buffer.as_entire_binding() },
             ],
         });
         scope.pop("binding the GPU simulation to the fur")?;

@@ -199,7 +199,7 @@ fn contact_strand(j: u32, v: u32, layers: u32, root: vec3<f32>, frame: vec4<f32>
             u = normalize_or(u + (toward - u) * held, u);
         }
         arc += segment_length;
-        for (var pass = 0u; pass < 3u; pass++) {
+        for (var pass = 0u; pass < 8u; pass++) {
             var moved = false;
             for (var i = 0u; i < near_count; i++) {
                 let c = near[i];

@@ -225,7 +225,7 @@ impl Resolve<'_> {
         planes: &[(Vec3, f32)],
         colliders: impl Iterator<Item = &'c &'c StepCollider> + Clone,
     ) -> Vec3 {
-        for pass in 0..3 {
+        for pass in 0..8 {
             let mut moved = false;
             for c in colliders.clone() {
                 let q = p + u * length;
