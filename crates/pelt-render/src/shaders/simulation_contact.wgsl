@@ -199,7 +199,7 @@ fn contact_strand(j: u32, v: u32, layers: u32, root: vec3<f32>, frame: vec4<f32>
             u = normalize_or(u + (toward - u) * held, u);
         }
         arc += segment_length;
-        for (var pass = 0u; pass < 8u; pass++) {
+        for (var round = 0u; round < 8u; round++) {
             var moved = false;
             for (var i = 0u; i < near_count; i++) {
                 let c = near[i];
@@ -208,7 +208,7 @@ fn contact_strand(j: u32, v: u32, layers: u32, root: vec3<f32>, frame: vec4<f32>
                     continue;
                 }
                 let friction = contact[c + 3u].w;
-                if pass == 0u && friction > 0.0 {
+                if round == 0u && friction > 0.0 {
                     let travel = contact[c + 3u].xyz;
                     let slide = travel - hit.normal * dot(hit.normal, travel);
                     u = normalize_or(u * segment_length + slide * friction, u);
