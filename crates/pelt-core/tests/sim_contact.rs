@@ -549,3 +549,25 @@ fn contact_at_rest_does_not_jitter() {
     assert_eq!(bits(&before), bits(sim.positions()));
     assert_ne!(bits(&before), bits(&fur.positions), "the collider moves the fur");
 }
+
+/// The shipped grasp script parses, and played on the bunny its hand lifts fur off the back and
+/// its ball parts it: the fur moves away from where it is without the script.
+#[test]
+fn the_grasp_script_lifts_and_parts_the_fur() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets/scenes/grasp.toml");
+    let scene = Scene::load(&path).unwrap();
+    assert_eq!((scene.grasps.len(), scene.colliders.len()), (1, 1));
+    let fur = grow(Builtin::Bunny, 8, 0.1);
+    let params = with_skin(true);
+    let mut played = Simulation::new(&fur, &params).unwrap();
+    let mut plain = Simulation::new(&fur, &params).unwrap();
+    let moved_at = |time: f64, played: &mut Simulation, plain: &mut Simulation| {
+        scene.apply(time, played).unwrap();
+        played.advance_to(time);
+        plain.advance_to(time);
+        played.positions().iter().zip(plain.positions()).map(|(a, b)| a.distance(*b)).fold(0.0, f32::max)
+    };
+    let length = fur.lengths[0];
+    assert!(moved_at(2.0, &mut played, &mut plain) > 0.5 * length, "the hand lifts a tuft");
+    assert!(moved_at(5.5, &mut played, &mut plain) > 0.2 * length, "the ball parts the fur");
+}
