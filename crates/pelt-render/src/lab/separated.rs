@@ -196,7 +196,7 @@ impl SeparatedFur {
                 wgpu::BindGroupEntry { binding: 1, resource: fin_vertices.as_entire_binding() },
             ],
         });
-        let textures = GpuTextures::new(device, queue, layouts, textures);
+        let textures = GpuTextures::new(device, queue, layouts, textures, false);
         scope.pop("uploading the separated structure")?;
         let textures = textures?;
         let vertices = (shell.len() + fin.len()) as u64;

@@ -36,13 +36,13 @@ fn vs_separated_skin(in: VertexIn) -> Varyings {
 @vertex
 fn vs_separated_shell_tiles(in: VertexIn, @builtin(instance_index) layer: u32) -> ShellTileVaryings {
     let v = separated_shell(in, layer);
-    return shell_tile_varyings(v, v.fade, separated_lod_blend(v));
+    return shell_tile_varyings(v, v.fade, separated_lod_blend(v), GROOM_NONE);
 }
 
 @vertex
 fn vs_separated_shell_uvs(in: VertexIn, @builtin(instance_index) layer: u32) -> ShellUvVaryings {
     let v = separated_shell(in, layer);
-    return shell_uv_varyings(v, v.fade, separated_lod_blend(v));
+    return shell_uv_varyings(v, v.fade, separated_lod_blend(v), GROOM_NONE);
 }
 
 // Shells by view angle as the unified shells fade them, from the shell vertex itself (these
