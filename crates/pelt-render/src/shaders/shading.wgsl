@@ -428,11 +428,14 @@ fn clump_cells_per_tile() -> f32 {
     return f32(textureDimensions(shell_texture).x) / CLUMP_CELL_TEXELS;
 }
 
-// How far a groom's clump map pulls at `height`: nothing at the roots, the map's value at the
-// tips.
+// How far a groom's clump map pulls at `height`: nothing at the roots, growing to
+// `CLUMP_MAX_PULL` times the map's value at the tips (a full pull would read one texel for a
+// whole cell: flat polygons rather than tufts).
 fn groom_clump_amount(clump: f32, height: f32) -> f32 {
-    return clamp(clump, 0.0, 1.0) * clamp(height, 0.0, 1.0);
+    return CLUMP_MAX_PULL * clamp(clump, 0.0, 1.0) * clamp(height, 0.0, 1.0);
 }
+
+const CLUMP_MAX_PULL: f32 = 0.8;
 
 // Density: whether the strand covering the shell texel at `uv` (tiles) in `slice` survives a
 // density of `density` (its seeded keep value below the density), so 0.5 keeps about half the
