@@ -117,7 +117,7 @@ impl GpuFur {
     /// [`RenderError::Groom`] for a fur without a groom, a density map on textures without keep
     /// values, or a groom that does not fit the mesh.
     pub fn set_groom(&mut self, queue: &wgpu::Queue, groom: &pelt_core::groom::Groom) -> Result<(), RenderError> {
-        if groom.density.is_some() && !self.textures.has_keep {
+        if self.geometry.shape.groomed && groom.density.is_some() && !self.textures.has_keep {
             return Err(RenderError::Groom(
                 "a density map needs the textures uploaded with a groom (set_textures after set_structure)".to_owned(),
             ));

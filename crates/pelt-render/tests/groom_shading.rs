@@ -157,3 +157,39 @@ fn clump_moves_the_strands_where_the_map_says() {
     assert!(left > 0.02, "clump 1 changed the left half by {left} only");
     assert!(right * 10.0 < left, "clump 0 changed the right half by {right} (left {left})");
 }
+
+/// `GpuFur::set_groom` (the painting path: one buffer write) draws what a fur uploaded with that
+/// groom draws, to the byte; a fur without a groom refuses it with an error, never a panic.
+#[test]
+fn set_groom_rewrites_the_shading_in_place() {
+    let rig = Rig::new(SIZE_PX, SIZE_PX);
+    let textures = strand_textures(128, 2, WHITE, WHITE);
+    let plain = plane_fur(2, None);
+    let painted_groom = Groom {
+        density: Some(split(&plain, 0.3, 0.9)),
+        tint: Some(split(&plain, Vec3::new(0.2, 0.9, 0.4), Vec3::ONE)),
+        clump: Some(split(&plain, 0.0, 0.7)),
+        ..Groom::default()
+    };
+    let draw = |fur: &GpuFur| {
+        let look = FurLook { tiles_per_radius: 1.4, ..FurLook::default() };
+        fur.prepare(rig.queue(), &FurFrame { look, ..FurFrame::default() });
+        rig.view.prepare(rig.queue(), &camera().view_data(1.0, &Light::default()));
+        rig.headless.render(Vec3::ZERO, |pass| rig.renderer.draw(pass, &rig.view, fur, &SHELLS)).expect("frame")
+    };
+    let fresh = rig.fur(&plane_fur(2, Some(painted_groom.clone())), &textures);
+    let uniform_density = Groom { density: Some(vec![1.0; plain.mesh.vertex_count()]), ..Groom::default() };
+    let mut painted = rig.fur(&plane_fur(2, Some(uniform_density)), &textures);
+    let before = draw(&painted);
+    painted.set_groom(rig.queue(), &painted_groom).expect("set_groom");
+    let after = draw(&painted);
+    assert_ne!(before, after, "the new groom changed nothing");
+    assert!(draw(&fresh) == after, "set_groom draws otherwise than a fur uploaded with the groom");
+
+    let mut ungroomed = rig.fur(&plain, &textures);
+    let error = ungroomed.set_groom(rig.queue(), &painted_groom).expect_err("no groom to rewrite");
+    assert!(error.to_string().contains("without a groom"), "{error}");
+    let short = Groom { tint: Some(vec![Vec3::ONE; 3]), ..Groom::default() };
+    let error = painted.set_groom(rig.queue(), &short).expect_err("wrong size");
+    assert!(error.to_string().contains("3 values"), "{error}");
+}
