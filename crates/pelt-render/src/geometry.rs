@@ -84,7 +84,7 @@ fn topology(mesh: &Mesh, furred: Option<&Furred>) -> (Vec<u32>, Option<Vec<Vec2>
 
 /// The groom attributes of every vertex of a `vertex_count` mesh (`GroomAttributes` in
 /// `shading.wgsl`); absent maps give the uniform values (tint 1, density 1, clump 0).
-fn groom_attributes(groom: &Groom, vertex_count: usize) -> Vec<[f32; 8]> {
+pub(crate) fn groom_attributes(groom: &Groom, vertex_count: usize) -> Vec<[f32; 8]> {
     (0..vertex_count)
         .map(|j| {
             let tint = groom.tint.as_ref().map_or(Vec3::ONE, |t| t[j]);

@@ -60,7 +60,13 @@ impl Layouts {
         #[cfg(feature = "lab")]
         let separated_object = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("pelt separated object"),
-            entries: &[entry(0, both, uniform), entry(1, vertex, storage)],
+            // A groom's per-vertex attributes and each fin's two base vertices.
+            entries: &[
+                entry(0, both, uniform),
+                entry(1, vertex, storage),
+                entry(2, vertex, storage),
+                entry(3, vertex, storage),
+            ],
         });
         let texture = |view_dimension| wgpu::BindingType::Texture {
             sample_type: wgpu::TextureSampleType::Float { filterable: true },

@@ -154,6 +154,18 @@ struct GroomShade {
 
 const GROOM_NONE = GroomShade(vec3<f32>(1.0), 1.0, 0.0);
 
+// One vertex's entry in a groom attribute buffer (`groom_attributes` in `unified.wgsl` and
+// `separated.wgsl`; written by `geometry.rs`).
+struct GroomAttributes {
+    tint: vec3<f32>,
+    density: f32,
+    clump: f32,
+}
+
+fn groom_shade(g: GroomAttributes) -> GroomShade {
+    return GroomShade(g.tint, g.density, g.clump);
+}
+
 // The lean shell interfaces from the full surface varyings (the unified and separated shells
 // build theirs the same way); `fade` and `lod_blend` are the caller's, computed or carried.
 fn shell_lighting(v: Varyings) -> vec4<f32> {

@@ -21,11 +21,6 @@
 @group(1) @binding(5) var<storage, read> topology: array<u32>;
 // A groomed fur's per-vertex shading terms (V entries; one unused entry without a groom),
 // rewritten in place when a groom is painted (`GpuFur::set_groom`).
-struct GroomAttributes {
-    tint: vec3<f32>,
-    density: f32,
-    clump: f32,
-}
 @group(1) @binding(6) var<storage, read> groom_attributes: array<GroomAttributes>;
 
 // The groom's terms at base vertex `vertex` (the uniform fur's without groom shading).
@@ -34,8 +29,7 @@ fn vertex_groom(vertex: u32) -> GroomShade {
     if object.groom_shading == 0u {
         return GROOM_NONE;
     }
-    let g = groom_attributes[vertex];
-    return GroomShade(g.tint, g.density, g.clump);
+    return groom_shade(groom_attributes[vertex]);
 }
 
 const NO_FACE: u32 = 0xffffffffu;
