@@ -62,10 +62,10 @@ pub struct Args {
     screen_size: Option<u32>,
     /// Bake this many seconds of the fur swaying in the preset's wind (pelt render's light breeze
     /// if it has none) as morph targets with a looping weights animation ("pelt fur motion").
-    #[arg(long, value_name = "SECONDS")]
+    #[arg(long, value_name = "SECONDS", allow_negative_numbers = true)]
     motion: Option<f64>,
     /// Settle the fur at this time (seconds) of the animation instead of the rest pose.
-    #[arg(long, value_name = "T")]
+    #[arg(long, value_name = "T", allow_negative_numbers = true)]
     time: Option<f64>,
     /// The animation `--time` refers to: its name or index (default: the first).
     #[arg(long, value_name = "NAME|INDEX")]
