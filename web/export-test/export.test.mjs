@@ -69,7 +69,7 @@ const exported = () => fs.readdirSync(output).filter((f) => /\.(glb|gltf)$/.test
 test('the glTF Validator finds no error and no warning in any export', async () => {
   const files = exported();
   for (const name of ['bunny.glb', 'bunny-blend.glb', 'tryon.gltf', 'fox.glb', 'fox-walk.glb', 'ball.glb',
-    'bunny-motion.glb']) {
+    'bunny-motion.glb', 'fox-motion.glb']) {
     assert.ok(files.includes(name), `${name} was not exported`);
   }
   for (const file of files) {

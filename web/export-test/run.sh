@@ -21,6 +21,7 @@ mkdir -p "$out"
 # targets.
 "$pelt" export assets/meshes/morph_ball.gltf --layers 8 -o "$out/ball.glb"
 "$pelt" export --builtin bunny --layers 8 --motion 1 -o "$out/bunny-motion.glb"
+"$pelt" export assets/meshes/Fox.glb --preset assets/presets/fox.toml --layers 4 --motion 1 -o "$out/fox-motion.glb"
 # The picture three.js must match: no wind (the export settles without), every layer; the camera
 # is export.test.mjs's VIEW.
 "$pelt" render --builtin bunny --wind 0,0,0 --no-lod --camera 30,15,24 --size 480x360 -o "$out/bunny-pelt.png"

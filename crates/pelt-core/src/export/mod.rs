@@ -1,8 +1,10 @@
 //! Pelt's fur as a standard glTF 2.0 file that any glTF viewer or engine draws without custom
 //! shaders: the shells as one primitive per exported layer (its own slice image, alpha as MASK or
 //! BLEND), the fins as strips on every edge with the fin image, all at one settled pose. A
-//! source glTF is carried over whole (meshes, materials, nodes, skins, animations), and on a
-//! skinned source every fur vertex is bound to its root's joints, so the fur follows the skeleton.
+//! source glTF is carried over whole (meshes, materials, nodes, skins, morph targets,
+//! animations), and on a skinned source every fur vertex is bound to its root's joints, so the
+//! fur follows the skeleton. Morph targets on the fur ([`FurMorphs`]) follow the source's or
+//! loop a baked sway.
 //!
 //! What the renderer computes per fragment and a plain material cannot (Kajiya-Kay lighting, the
 //! view-angle fading of shells and fins) is left to the player's lighting; what depends only on
@@ -88,7 +90,7 @@ pub struct ExportInput<'a> {
     /// The structure: its mesh (bind pose for a skinned source) and layer count.
     pub fur: &'a FurStructure,
     /// The settled shared array `NV`, `(L + 1) * V`, in the mesh's own space (for a skinned mesh,
-    /// the bind pose: see [`bind_space_positions`]).
+    /// the bind pose: see [`bind_space_positions`]; with morph targets, where zero weights put it).
     pub positions: &'a [Vec3],
     /// The fur's textures.
     pub textures: &'a FurTextures,
