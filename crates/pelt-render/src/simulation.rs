@@ -24,6 +24,9 @@ const WORKGROUP: u32 = 64;
 const STEP_SLOT_BYTES: u64 = 256;
 /// Steps one prepare/dispatch pair can hold: only the last two states are ever kept.
 const STEP_SLOTS: usize = 2;
+/// Uniform slots in the ring the steps take in turn: a host recording up to this many steps into
+/// one submission gives each its own inputs (the queue writes all land before it runs).
+const RING_SLOTS: u64 = 64;
 /// Storage buffers the compute stage binds.
 const STORAGE_BUFFERS: u32 = 4;
 
@@ -177,6 +180,8 @@ pub struct GpuSimulation {
     seen_steps: Option<u64>,
     /// Steps prepared and not yet dispatched (at most [`STEP_SLOTS`], in slot order).
     pending: Vec<StepUniform>,
+    /// The ring slot of the first pending step.
+    ring: u64,
     /// Steps the inertial state has seen since it started (up to 2) after the dispatched steps,
     /// and after the pending ones.
     dispatched_history: u8,
@@ -319,7 +324,7 @@ impl GpuSimulation {
         let storage_usage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST;
         let step_uniforms = buffer(
             "pelt simulation steps",
-            STEP_SLOT_BYTES * STEP_SLOTS as u64,
+            STEP_SLOT_BYTES * RING_SLOTS,
             wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
         );
         let rest_segments = wgpu::util::DeviceExt::create_buffer_init(
@@ -355,6 +360,7 @@ impl GpuSimulation {
             touch_uploaded: false,
             seen_steps: None,
             pending: Vec::with_capacity(STEP_SLOTS + 2),
+            ring: 0,
             dispatched_history: 0,
             pending_history: 0,
         })
@@ -433,7 +439,7 @@ impl GpuSimulation {
         let history = if start_over { 0 } else { self.dispatched_history };
         self.pending_history = settle_inertia(&mut self.pending, history);
         for (slot, uniform) in self.pending.iter().enumerate() {
-            queue.write_buffer(&self.step_uniforms, slot as u64 * STEP_SLOT_BYTES, bytemuck::bytes_of(uniform));
+            queue.write_buffer(&self.step_uniforms, self.slot_offset(slot), bytemuck::bytes_of(uniform));
         }
         Ok(())
     }
@@ -465,7 +471,7 @@ impl GpuSimulation {
                 timestamp_writes: None,
             });
             pass.set_pipeline(&self.touch_pipeline);
-            pass.set_bind_group(0, &self.bind_groups[after_next].1, &[0]);
+            pass.set_bind_group(0, &self.bind_groups[after_next].1, &[self.slot_offset(0) as u32]);
             pass.dispatch_workgroups(self.grid[0], self.grid[1], 1);
         }
         for slot in 0..self.pending.len() {
@@ -479,12 +485,18 @@ impl GpuSimulation {
                 timestamp_writes: None,
             });
             pass.set_pipeline(&self.pipeline);
-            pass.set_bind_group(0, bind_group, &[(slot as u64 * STEP_SLOT_BYTES) as u32]);
+            pass.set_bind_group(0, bind_group, &[self.slot_offset(slot) as u32]);
             pass.dispatch_workgroups(self.grid[0], self.grid[1], 1);
         }
+        self.ring = (self.ring + self.pending.len() as u64) % RING_SLOTS;
         self.pending.clear();
         self.dispatched_history = self.pending_history;
         Ok(())
+    }
+
+    /// The byte offset of pending step `slot`'s uniform in the ring.
+    fn slot_offset(&self, slot: usize) -> u64 {
+        (self.ring + slot as u64) % RING_SLOTS * STEP_SLOT_BYTES
     }
 
     /// What the GPU carries from step to step, for tests that compare it with the CPU's
