@@ -216,6 +216,19 @@ impl FurDriver {
         Ok(())
     }
 
+    /// Rewrites the groom's density, clump and tint in place (no new textures or geometry): the
+    /// cheap path for painting them; see [`GpuFur::set_groom`]. Lengths and directions change
+    /// with [`FurDriver::set_structure`].
+    ///
+    /// # Errors
+    /// As [`GpuFur::set_groom`].
+    pub fn set_groom(&mut self, queue: &wgpu::Queue, groom: &pelt_core::groom::Groom) -> Result<(), RenderError> {
+        self.fur.set_groom(queue, groom)?;
+        // Whether the groom shades lives in the fur's uniform.
+        self.fur.prepare(queue, &self.frame);
+        Ok(())
+    }
+
     /// The level of detail from the next frame on.
     pub fn set_level(&mut self, level: FurLevel) {
         self.frame.level = level;
