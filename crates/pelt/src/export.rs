@@ -130,7 +130,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         _ => None,
     };
     let rigged = Rigged { fur: &fur, rig: rig.as_ref(), clip, time_secs, source: gltf_source.as_deref() };
-    let (positions, skin, morphs, notes) = rigged.bind(settled, motion, args.motion)?;
+    let Bound { positions, skin, morphs, notes } = rigged.bind(settled, motion, args.motion)?;
     progress.finish_simulation();
     let look = FurLook::default();
     let plain: Vec<_> = plain.iter().map(|mesh| (mesh, PLAIN_COLOUR)).collect();
@@ -355,7 +355,7 @@ impl Rigged<'_> {
         posed: Vec<Vec3>,
         motion: Option<Vec<Vec<Vec3>>>,
         motion_secs: Option<f64>,
-    ) -> anyhow::Result<(Vec<Vec3>, Option<FurSkin>, Option<FurMorphs>, Vec<String>)> {
+    ) -> anyhow::Result<Bound> {
         let fur = self.fur;
         let mut notes = Vec::new();
         let (positions, matrices, skin) = match (self.rig, self.source) {
@@ -399,7 +399,7 @@ impl Rigged<'_> {
                             weights: rig.nodes()[node].rest_weights.clone(),
                             animation: MorphAnimation::FollowNode(node),
                         };
-                        return Ok((positions, skin, Some(morphs), notes));
+                        return Ok(Bound { positions, skin, morphs: Some(morphs), notes });
                     }
                     None => notes.push(
                         "the fur's roots do not follow the file's morph targets: they hang on several meshes"
@@ -427,8 +427,16 @@ impl Rigged<'_> {
                 period_secs: motion_secs.unwrap_or(1.0) as f32,
             },
         });
-        Ok((positions, skin, morphs, notes))
+        Ok(Bound { positions, skin, morphs, notes })
     }
+}
+
+/// The settled fur as the file holds it: what [`Rigged::bind`] gives.
+struct Bound {
+    positions: Vec<Vec3>,
+    skin: Option<FurSkin>,
+    morphs: Option<FurMorphs>,
+    notes: Vec<String>,
 }
 
 /// The shells `pelt render` draws a fur `pixels` tall on screen with (the preset's
