@@ -256,3 +256,138 @@ pub fn transfer_weights(
     let influences = found.into_iter().map(|f| f.0).collect();
     Ok((body_rig.with_influences(influences), report))
 }
+
+#[cfg(test)]
+mod tests {
+    use std::collections::BTreeMap;
+
+    use super::*;
+    use crate::body::walking_try_on;
+    use crate::mesh::ImportOptions;
+
+    fn points(positions: Vec<Vec3>) -> Mesh {
+        let n = positions.len();
+        Mesh {
+            positions,
+            normals: vec![Vec3::Y; n],
+            corner_uvs: None,
+            triangles: Vec::new(),
+            edges: Vec::new(),
+            edge_faces: Vec::new(),
+            colour_sets: Vec::new(),
+        }
+    }
+
+    /// The oracle: a triangle's corner weights blended by `barycentric`, the four heaviest kept.
+    fn expected(rig: &Rig, corners: [u32; 3], barycentric: [f32; 3]) -> BTreeMap<u32, f32> {
+        let mut sum: BTreeMap<u32, f64> = BTreeMap::new();
+        for (&v, &b) in corners.iter().zip(&barycentric) {
+            let inf = rig.influences()[v as usize];
+            for k in 0..4 {
+                *sum.entry(inf.joints[k]).or_default() += f64::from(inf.weights[k]) * f64::from(b);
+            }
+        }
+        let mut sorted: Vec<(u32, f64)> = sum.into_iter().filter(|e| e.1 > 0.0).collect();
+        sorted.sort_by(|x, y| y.1.total_cmp(&x.1));
+        sorted.truncate(4);
+        let total: f64 = sorted.iter().map(|e| e.1).sum();
+        sorted.into_iter().map(|(j, w)| (j, (w / total) as f32)).collect()
+    }
+
+    fn weights_of(rig: &Rig, v: usize) -> BTreeMap<u32, f32> {
+        let inf = rig.influences()[v];
+        (0..4).filter(|&k| inf.weights[k] > 0.0).map(|k| (inf.joints[k], inf.weights[k])).collect()
+    }
+
+    fn assert_close(got: &BTreeMap<u32, f32>, want: &BTreeMap<u32, f32>, what: &str) {
+        assert_eq!(got.keys().collect::<Vec<_>>(), want.keys().collect::<Vec<_>>(), "{what}: joints");
+        for (j, w) in want {
+            assert!((got[j] - w).abs() < 1e-5, "{what}: joint {j} has {} not {w}", got[j]);
+        }
+    }
+
+    #[test]
+    fn a_point_on_the_body_takes_that_surface_s_weights() {
+        let scene = walking_try_on(&ImportOptions::default()).unwrap();
+        let (body, rig) = (&scene.body, &scene.body_rig);
+        // Every 97th body vertex, and a point inside every 211th triangle.
+        let vertices: Vec<usize> = (0..body.vertex_count()).step_by(97).collect();
+        let triangles: Vec<usize> = (0..body.triangles.len()).step_by(211).collect();
+        let barycentric = [0.2, 0.3, 0.5];
+        let mut positions: Vec<Vec3> = vertices.iter().map(|&v| body.positions[v]).collect();
+        positions.extend(triangles.iter().map(|&t| {
+            let [a, b, c] = body.triangles[t].map(|i| body.positions[i as usize]);
+            a * barycentric[0] + b * barycentric[1] + c * barycentric[2]
+        }));
+        let (garment_rig, report) = transfer_weights(body, rig, &points(positions), 1e-3).unwrap();
+        assert!(report.distance_range.1 < 1e-5, "{report}");
+        for (k, &v) in vertices.iter().enumerate() {
+            assert_close(&weights_of(&garment_rig, k), &weights_of(rig, v), &format!("body vertex {v}"));
+        }
+        for (k, &t) in triangles.iter().enumerate() {
+            let want = expected(rig, body.triangles[t], barycentric);
+            assert_close(&weights_of(&garment_rig, vertices.len() + k), &want, &format!("triangle {t}"));
+        }
+    }
+
+    #[test]
+    fn transferred_weights_sum_to_one_and_do_not_depend_on_threads() {
+        let scene = walking_try_on(&ImportOptions::default()).unwrap();
+        for v in 0..scene.garment.vertex_count() {
+            let total: f32 = scene.garment_rig.influences()[v].weights.iter().sum();
+            assert!((total - 1.0).abs() < 1e-5, "vertex {v}: {total}");
+            assert!(scene.garment_rig.influences()[v].weights.iter().all(|w| (0.0..=1.0).contains(w)));
+        }
+        let run = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new().num_threads(threads).build().unwrap();
+            pool.install(|| {
+                transfer_weights(&scene.body, &scene.body_rig, &scene.garment, 1.0).unwrap().0.influences().to_vec()
+            })
+        };
+        let one = run(1);
+        assert_eq!(one, run(3));
+        assert_eq!(one, scene.garment_rig.influences());
+    }
+
+    #[test]
+    fn a_garment_away_from_the_body_is_a_clear_error() {
+        let scene = walking_try_on(&ImportOptions::default()).unwrap();
+        let mut far = scene.garment.clone();
+        far.transform(glam::Mat4::from_translation(Vec3::new(5.0, 0.0, 0.0)));
+        let error = transfer_weights(&scene.body, &scene.body_rig, &far, 0.2).unwrap_err();
+        let TransferError::TooFar { count, distance, .. } = error else { panic!("{error}") };
+        assert_eq!(count, far.vertex_count());
+        assert!(distance > 4.0);
+        assert!(error.to_string().contains("does not sit on this body"), "{error}");
+        let nan = points(vec![Vec3::NAN]);
+        assert!(matches!(
+            transfer_weights(&scene.body, &scene.body_rig, &nan, 1.0),
+            Err(TransferError::NonFinite { what: "garment", vertex: 0 })
+        ));
+    }
+
+    #[test]
+    fn closest_point_on_a_triangle_matches_a_dense_search() {
+        let (a, b, c) = (Vec3::ZERO, Vec3::X, Vec3::new(0.3, 1.0, 0.0));
+        let mut state = 12_345_u32;
+        let mut next = || {
+            state = state.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+            (state >> 8) as f32 / (1 << 24) as f32 * 4.0 - 2.0
+        };
+        for _ in 0..200 {
+            let p = Vec3::new(next(), next(), next());
+            let w = closest_on_triangle(p, a, b, c);
+            let got = (a * w[0] + b * w[1] + c * w[2]).distance(p);
+            // The oracle: the nearest of a dense barycentric grid over the triangle.
+            let n = 200;
+            let mut best = f32::INFINITY;
+            for i in 0..=n {
+                for j in 0..=n - i {
+                    let (u, v) = (i as f32 / n as f32, j as f32 / n as f32);
+                    best = best.min((a * (1.0 - u - v) + b * u + c * v).distance(p));
+                }
+            }
+            assert!(got <= best + 1e-5 && got >= best - 0.01, "{p}: {got} vs {best}");
+        }
+    }
+}

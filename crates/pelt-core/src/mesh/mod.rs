@@ -216,7 +216,3 @@ fn bounds(positions: &[Vec3]) -> (Vec3, Vec3) {
         .iter()
         .fold((Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)), |(lo, hi), p| (lo.min(*p), hi.max(*p)))
 }
-#[cfg(test)]
-pub(crate) fn tests_bounds(positions: &[Vec3]) -> (Vec3, Vec3) {
-    bounds(positions)
-}
