@@ -138,3 +138,65 @@ fn fit_one(joint: usize, points: &[Vec3]) -> BoneCapsule {
     let fit_error = points.iter().map(|&p| rest.distance(p).abs()).fold(0.0, f32::max);
     BoneCapsule { joint, rest, vertices: points.len(), fit_error }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::body::walking_try_on;
+    use crate::mesh::ImportOptions;
+
+    #[test]
+    fn capsules_follow_the_bones_exactly_as_skinning_moves_rigid_vertices() {
+        let scene = walking_try_on(&ImportOptions::default()).unwrap();
+        let (body, rig, capsules) = (&scene.body, &scene.body_rig, &scene.capsules);
+        assert!(capsules.bones.len() >= 15, "{} capsules", capsules.bones.len());
+        let world = Mat4::from_rotation_y(0.7) * Mat4::from_translation(Vec3::new(1.0, 0.0, -2.0));
+        let mut pose = Pose::default();
+        let mut checked = 0;
+        for k in 0..6 {
+            let t = 0.3 * f64::from(k);
+            rig.pose(body, Some(0), t, &mut pose);
+            let posed = capsules.posed(rig, &pose, world);
+            for (bone, capsule) in capsules.bones.iter().zip(&posed) {
+                // Vertices the joint alone moves keep their distance to its capsule in every pose:
+                // the oracle is the skinned vertex itself, not the capsule's transform.
+                for (v, inf) in rig.influences().iter().enumerate() {
+                    if inf.joints[0] as usize == bone.joint && inf.weights[0] == 1.0 {
+                        let rest = bone.rest.distance(body.positions[v]);
+                        let now = capsule.distance(world.transform_point3(pose.positions[v]));
+                        assert!((rest - now).abs() < 1e-4, "joint {} vertex {v} at {t} s: {rest} vs {now}", bone.joint);
+                        checked += 1;
+                    }
+                }
+            }
+        }
+        assert!(checked > 100, "{checked} rigid vertices checked");
+    }
+
+    #[test]
+    fn each_capsule_hugs_the_vertices_it_was_fitted_to() {
+        let scene = walking_try_on(&ImportOptions::default()).unwrap();
+        let (body, rig) = (&scene.body, &scene.body_rig);
+        for bone in &scene.capsules.bones {
+            let mut gaps: Vec<f32> = rig
+                .influences()
+                .iter()
+                .enumerate()
+                .filter(|(_, inf)| inf.joints[0] as usize == bone.joint && inf.weights[0] >= 0.9)
+                .map(|(v, _)| bone.rest.distance(body.positions[v]).abs())
+                .collect();
+            if gaps.len() < 8 {
+                continue;
+            }
+            gaps.sort_by(f32::total_cmp);
+            let median = gaps[gaps.len() / 2];
+            assert!(
+                median <= 0.5 * bone.rest.radius,
+                "joint {}: median gap {median}, radius {}",
+                bone.joint,
+                bone.rest.radius
+            );
+            assert!(bone.rest.radius.is_finite() && bone.rest.radius > 0.0 && bone.fit_error.is_finite());
+        }
+    }
+}

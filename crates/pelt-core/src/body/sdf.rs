@@ -205,3 +205,110 @@ fn winding_number(mesh: &Mesh, p: Vec3) -> f32 {
         .sum();
     (total / (4.0 * std::f64::consts::PI)) as f32
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::builtin::Builtin;
+
+    /// Inside by ray parity: crossings of a ray in a fixed, unaligned direction (Moller-Trumbore);
+    /// independent of the winding number the bake uses.
+    fn inside_by_parity(mesh: &Mesh, p: Vec3) -> bool {
+        let direction = Vec3::new(0.5377, 0.8031, 0.2566).normalize();
+        let crossings = mesh
+            .triangles
+            .iter()
+            .filter(|t| {
+                let [a, b, c] = t.map(|i| mesh.positions[i as usize]);
+                let (e1, e2) = (b - a, c - a);
+                let q = direction.cross(e2);
+                let det = e1.dot(q);
+                if det.abs() < 1e-12 {
+                    return false;
+                }
+                let s = p - a;
+                let u = s.dot(q) / det;
+                let r = s.cross(e1);
+                let v = direction.dot(r) / det;
+                u >= 0.0 && v >= 0.0 && u + v <= 1.0 && e2.dot(r) / det > 0.0
+            })
+            .count();
+        crossings % 2 == 1
+    }
+
+    fn random_points(n: usize, half: f32) -> Vec<Vec3> {
+        let mut state = 0x9e37_79b9_u32;
+        let mut next = move || {
+            state = state.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+            ((state >> 8) as f32 / (1 << 24) as f32 * 2.0 - 1.0) * half
+        };
+        (0..n).map(|_| Vec3::new(next(), next(), next())).collect()
+    }
+
+    #[test]
+    fn the_bunny_s_field_agrees_with_ray_parity_on_inside_and_outside() {
+        let (bunny, _) = Builtin::Bunny.mesh();
+        let sdf = MeshSdf::bake(&bunny, 24).unwrap();
+        let (lo, hi) = bunny.bounds();
+        let (centre, half) = ((lo + hi) * 0.5, (hi - lo).max_element() * 0.6);
+        let (mut inside, mut checked) = (0, 0);
+        for p in random_points(3000, half).into_iter().map(|p| p + centre) {
+            let d = sdf.distance(p);
+            // Within a cell of the surface the interpolated sign may lag the true one.
+            if d.abs() < 1.5 * sdf.cell() {
+                continue;
+            }
+            let parity = inside_by_parity(&bunny, p);
+            assert_eq!(d < 0.0, parity, "{p}: distance {d}, parity says inside = {parity}");
+            inside += usize::from(parity);
+            checked += 1;
+        }
+        assert!(inside > 100 && checked > 1000, "{inside} inside of {checked}");
+    }
+
+    #[test]
+    fn the_box_s_field_is_the_box_s_distance_and_moves_with_it() {
+        let (cube, _) = Builtin::Box.mesh();
+        let mut sdf = MeshSdf::bake(&cube, 16).unwrap();
+        let exact = |p: Vec3| {
+            let q = p.abs() - Vec3::ONE;
+            q.max(Vec3::ZERO).length() + q.max_element().min(0.0)
+        };
+        for p in random_points(2000, 1.6) {
+            let (d, g) = sdf.distance_gradient(p);
+            assert!((d - exact(p)).abs() <= sdf.cell(), "{p}: {d} vs {}", exact(p));
+            if exact(p).abs() > 2.0 * sdf.cell() && exact(p) > 0.0 {
+                assert!(exact(p + 0.05 * g) > exact(p), "{p}: the gradient {g} points into the box");
+            }
+        }
+        // Beyond the grid: still the distance, to within the padding's error.
+        assert!((sdf.distance(Vec3::new(5.0, 0.0, 0.0)) - 4.0).abs() < sdf.cell());
+        // Moved, turned and doubled: distances double and follow the box.
+        let world = Mat4::from_translation(Vec3::new(3.0, -1.0, 2.0))
+            * Mat4::from_rotation_y(0.6)
+            * Mat4::from_scale(Vec3::splat(2.0));
+        let before: Vec<f32> = random_points(50, 1.5).into_iter().map(|p| sdf.distance(p)).collect();
+        sdf.set_world_from_local(world).unwrap();
+        for (p, d) in random_points(50, 1.5).into_iter().zip(before) {
+            assert!((sdf.distance(world.transform_point3(p)) - 2.0 * d).abs() < 1e-4);
+        }
+    }
+
+    #[test]
+    fn open_meshes_and_bad_transforms_are_refused() {
+        let (plane, _) = Builtin::Plane.mesh();
+        let error = MeshSdf::bake(&plane, 8).unwrap_err();
+        assert!(matches!(error, SdfError::NotClosed { boundary_edges } if boundary_edges > 0), "{error}");
+        assert!(error.to_string().contains("not closed"));
+        let (cube, _) = Builtin::Box.mesh();
+        assert_eq!(MeshSdf::bake(&cube, 1).unwrap_err(), SdfError::Resolution(1));
+        let mut sdf = MeshSdf::bake(&cube, 4).unwrap();
+        assert_eq!(sdf.set_world_from_local(Mat4::from_scale(Vec3::new(1.0, 2.0, 1.0))), Err(SdfError::NotRigid));
+        assert_eq!(
+            sdf.set_world_from_local(Mat4::from_translation(Vec3::NAN)),
+            Err(SdfError::NonFinite("world_from_local"))
+        );
+        assert_eq!(sdf.world_from_local(), Mat4::IDENTITY);
+        assert!(sdf.distance(Vec3::ZERO) < 0.0 && sdf.distance(Vec3::ZERO).is_finite());
+    }
+}
