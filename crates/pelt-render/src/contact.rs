@@ -6,8 +6,8 @@ use pelt_core::FurStructure;
 use pelt_core::sim::contact::{MAX_STEP_COLLIDERS, SKIN_PLANES, skin_planes};
 use pelt_core::sim::{ContactStep, ContactStrands};
 
-/// Step slots (as the simulation's uniform holds).
-pub(crate) const CONTACT_SLOTS: usize = 2;
+/// Step slots: one per slot of the simulation's uniform ring.
+pub(crate) const CONTACT_SLOTS: usize = 64;
 /// vec4s per collider.
 const COLLIDER_WORDS: usize = 5;
 /// The first skin plane, after the slots' headers.

@@ -52,8 +52,8 @@ pub use contact::{
 };
 pub use dispatch::CpuKernel;
 pub use field::{ForceField, Touch};
-pub use inertia::Inertia;
-pub use inputs::{StepInputs, StrandInputs};
+pub use inertia::{Inertia, InertiaStep, SpringStep};
+pub use inputs::{InputVersions, StepInputs, StrandInputs};
 pub use kernel::{KernelRest, kernel_rest};
 pub use motion::{Ease, MotionKey};
 pub use pick::{Hit, pick};

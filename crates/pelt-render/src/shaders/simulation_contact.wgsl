@@ -12,8 +12,8 @@
 
 @group(0) @binding(5) var<storage, read> contact: array<vec4<f32>>;
 
-const CONTACT_SLOTS: u32 = 2u;
-const CONTACT_SKIN: u32 = 4u;
+const CONTACT_SLOTS: u32 = 64u;
+const CONTACT_SKIN: u32 = 2u * CONTACT_SLOTS;
 const SKIN_PLANES: u32 = 8u;
 const CONTACT_COLLIDERS: u32 = 128u;
 const COLLIDER_WORDS: u32 = 5u;
