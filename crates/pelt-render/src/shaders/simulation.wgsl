@@ -181,7 +181,7 @@ fn step_strands(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocati
     } else {
         bend_general(j, v, layers, root, frame, force_direction, scale);
     }
-    contact_strand(j, v, layers, root, strand.frame);
+    contact_strand(j, v, layers, root, frame);
 }
 
 // The fraction of the angle to the force that a node with `remaining` nodes to go turns by.
