@@ -487,8 +487,8 @@ pub fn gpu_secs_per_step(
     let mut run = |driver: &mut FurDriver| -> Result<f64, RenderError> {
         let started = Instant::now();
         let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("sim timing") });
-        // The steps' uniform writes all land before the submission, so every dispatch reads the
-        // last step's inputs: the same work per step, which is what is timed.
+        // Each step takes its own uniform slot of the GPU simulation's ring (up to 64 a
+        // submission), so every dispatch bends with its own step's inputs.
         for _ in 0..steps {
             driver.advance_to(device, queue, &mut stepper, f64::from(step) / rate)?;
             step += 1;
