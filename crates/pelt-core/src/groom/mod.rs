@@ -19,6 +19,7 @@ mod edit;
 mod file;
 mod frame;
 mod source;
+mod strokes;
 
 use std::path::PathBuf;
 
@@ -31,6 +32,7 @@ pub use edit::{DAB_SPACING, GroomEditor, UNDO_DEPTH, rest_point};
 pub use file::{FILE_MAGIC, FILE_VERSION};
 pub use frame::{TangentFrame, tangent_frames};
 pub use source::GroomParams;
+pub use strokes::StrokeList;
 
 /// The largest length factor a groom may hold (images reach 1; groom files may go beyond).
 pub const MAX_LENGTH_FACTOR: f32 = 16.0;
@@ -98,6 +100,14 @@ pub enum GroomError {
         file: PathBuf,
         /// Why.
         error: std::io::Error,
+    },
+    /// A stroke list that cannot be used.
+    #[error("{}: {problem}", file.display())]
+    Strokes {
+        /// The stroke list file.
+        file: PathBuf,
+        /// What is wrong (the stroke and key).
+        problem: String,
     },
     /// A groom file is malformed (magic, version, size, checksum).
     #[error("{}: not a valid groom file: {problem}", file.display())]
