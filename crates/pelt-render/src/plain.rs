@@ -26,7 +26,7 @@ impl PlainMesh {
         colour: Vec3,
     ) -> Result<Self, RenderError> {
         let scope = ErrorScope::push(device);
-        let geometry = UnifiedGeometry::new(device, layouts, (mesh, None), 0, &mesh.positions, 1);
+        let geometry = UnifiedGeometry::new(device, layouts, (mesh, None, None), 0, &mesh.positions, 1);
         scope.pop("uploading a plain mesh")?;
         Ok(Self { geometry: geometry?, colour })
     }
@@ -35,6 +35,15 @@ impl PlainMesh {
     pub fn prepare(&self, queue: &wgpu::Queue, world_from_model: Mat4) {
         let frame = FurFrame { world_from_model, ..FurFrame::default() };
         self.geometry.write_uniform(queue, &self.geometry.shape.uniform(&frame, self.colour, (0, false)));
+    }
+
+    /// Moves the mesh's vertices (a skinned body's pose this frame, in model space).
+    ///
+    /// # Errors
+    /// [`RenderError::Count`] when `positions` or `normals` has another length than the mesh.
+    pub fn set_pose(&self, queue: &wgpu::Queue, positions: &[Vec3], normals: &[Vec3]) -> Result<(), RenderError> {
+        self.geometry.set_positions(queue, positions)?;
+        self.geometry.set_normals(queue, normals)
     }
 
     /// Bytes the mesh holds on the GPU.

@@ -124,7 +124,7 @@ impl Model {
     pub(super) fn new(args: &Args, stage: Stage) -> anyhow::Result<Self> {
         let mut mesh_choices: Vec<MeshChoice> = Builtin::ALL.into_iter().map(MeshChoice::Builtin).collect();
         mesh_choices.push(MeshChoice::TryOn);
-        let Stage { fur_mesh: mesh, report, rig, plain } = stage;
+        let Stage { fur_mesh: mesh, report, rig, plain, .. } = stage;
         let choice = match args.mesh.source(Builtin::Bunny)? {
             StageSource::File(path) => {
                 let name = path.file_name().map_or(report.source, |n| n.to_string_lossy().into_owned());
