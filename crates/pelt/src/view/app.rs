@@ -153,6 +153,11 @@ impl App {
         if requests.save_preset {
             model.save_preset();
         }
+        if requests.undo || requests.redo {
+            if let Err(error) = model.undo_groom(requests.redo) {
+                model.status = format!("{error:#}");
+            }
+        }
         // A bad value from the panel is reported, not fatal: the previous fur stays.
         match model.apply(changes) {
             Ok(true) => {
@@ -162,6 +167,11 @@ impl App {
             Ok(false) => {}
             Err(error) => model.status = format!("{error:#}"),
         }
+        // A length or direction stroke regrew the rest positions: new vertex buffers, same textures.
+        if std::mem::take(&mut model.structure_regrown) {
+            running.fur.set_structure(&running.gpu, &model.structure)?;
+        }
+        model.groom_attributes_changed = false;
         running.fur.set_gpu_simulation(&running.gpu, &model.structure, model.settings.gpu_sim)?;
         if let Some(textures) = model.poll_textures() {
             running.fur.set_textures(&running.gpu, &textures)?;

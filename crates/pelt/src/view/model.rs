@@ -67,6 +67,14 @@ pub(super) struct Model {
     /// Why the kernel in use was chosen (the overlay shows it).
     pub(super) kernel_reason: String,
     pub(super) touch: Option<TouchDrag>,
+    /// The groom being painted (the structure's groom, with its strokes' history).
+    pub(super) groom_editor: pelt_core::groom::GroomEditor,
+    /// A paint stroke is in progress.
+    pub(super) painting: bool,
+    /// A stroke regrew the structure: the GPU's vertex buffers are to be replaced.
+    pub(super) structure_regrown: bool,
+    /// A stroke changed density, clump or tint: the GPU's per-vertex groom is to be updated.
+    pub(super) groom_attributes_changed: bool,
     /// Wind strength W restores after turning the wind off.
     pub(super) wind_strength_on: f32,
     /// Textures made and not yet uploaded.
@@ -161,7 +169,12 @@ impl Model {
         if let Some(rig) = &rig {
             stepper.set_clip(rig.clone(), settings.animation.clip);
         }
+        let groom_editor = super::paint::editor(&structure, &settings.preset)?;
         let model = Self {
+            groom_editor,
+            painting: false,
+            structure_regrown: false,
+            groom_attributes_changed: false,
             settings,
             mesh_choices,
             file_mesh,
@@ -246,7 +259,7 @@ impl Model {
             Ok(preset) => {
                 self.settings.preset = preset;
                 self.status = format!("loaded {}", self.settings.preset_path);
-                Changes { structure: true, textures: true, simulation: true, ..Changes::default() }
+                Changes { structure: true, groom: true, textures: true, simulation: true, ..Changes::default() }
             }
             Err(error) => {
                 self.status = error.to_string();
@@ -255,8 +268,12 @@ impl Model {
         }
     }
 
+    /// Writes the preset, and the painted groom beside it (`<preset>.groom`) when there is one.
     pub(super) fn save_preset(&mut self) {
-        self.status = match self.settings.preset.save(&self.settings.preset_path) {
+        let groom = Some(self.groom_editor.groom()).filter(|g| !g.is_uniform());
+        let saved = self.settings.preset.save_with_groom(&self.settings.preset_path, groom, &self.structure.mesh);
+        self.status = match saved {
+            Ok(()) if groom.is_some() => format!("saved {} with its groom", self.settings.preset_path),
             Ok(()) => format!("saved {}", self.settings.preset_path),
             Err(error) => error.to_string(),
         };
@@ -301,10 +318,19 @@ impl Model {
             };
             self.structure = grow(mesh, &self.settings.preset, &self.settings.mesh)?;
             self.frame_pending = true;
-        } else if changes.structure {
+        } else if changes.groom {
             self.structure = grow(self.structure.mesh.clone(), &self.settings.preset, &self.settings.mesh)?;
+        } else if changes.structure {
+            // A new shape keeps the groom painted so far.
+            self.structure =
+                super::paint::regrow(self.structure.mesh.clone(), &self.settings.preset, &self.groom_editor)?;
         }
-        let rebuilt = changes.mesh || changes.structure;
+        if changes.mesh || changes.groom {
+            self.groom_editor = super::paint::editor(&self.structure, &self.settings.preset)?;
+            self.settings.paint.history = self.groom_editor.history();
+            self.painting = false;
+        }
+        let rebuilt = changes.mesh || changes.structure || changes.groom;
         if changes.animation {
             self.settings.animation.time_secs = 0.0;
             self.stepper.change_clip(self.settings.animation.clip);
