@@ -268,6 +268,9 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     if let Some(bar) = progress {
         bar.finish_and_clear();
     }
+    if let Some(body) = &body {
+        println!("try-on: {}", body.transfer);
+    }
     let per_frame = |total: Duration| total.as_secs_f64() * 1000.0 / f64::from(frames);
     println!(
         "{}: {frames} frame{} of {width}x{height}, {} shell layers on {} triangles (level of detail: {}); mean frame {:.1} ms \
