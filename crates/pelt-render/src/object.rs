@@ -108,6 +108,10 @@ pub(crate) struct ObjectShape {
     pub world_per_uv: f32,
     /// Bounding radius of the base mesh, model units.
     pub radius: f32,
+    /// Whether the fur has a groom (its attribute buffer holds one entry per vertex).
+    pub groomed: bool,
+    /// Whether the groom's density, clump or tint reach the shading.
+    pub groom_shading: bool,
 }
 
 impl ObjectShape {
@@ -123,6 +127,8 @@ impl ObjectShape {
             wedge_count: 0,
             world_per_uv: world_per_uv(mesh),
             radius: mesh.bounding_sphere().1.max(1e-6),
+            groomed: false,
+            groom_shading: false,
         }
     }
 
@@ -174,7 +180,7 @@ impl ObjectShape {
             lod_view_full: level.facing.map_or(1.0, |[_, full]| full),
             furred_triangle_count: self.furred_triangle_count,
             fin_edge_count: self.fin_edge_count,
-            _padding_1: 0,
+            groom_shading: u32::from(self.groom_shading),
             _padding_2: 0,
             _padding_3: 0,
         }

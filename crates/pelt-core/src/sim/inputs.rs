@@ -80,3 +80,21 @@ impl StrandInputs<'_> {
         self.stability_map.map_or(self.stability, |map| map[strand])
     }
 }
+
+/// Counters of the per-strand inputs' changes, from [`Simulation::input_versions`]
+/// (super::Simulation::input_versions): a kernel that keeps the inputs resident uploads one only
+/// when its counter moved. Two simulations never share an `id`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[non_exhaustive]
+pub struct InputVersions {
+    /// Which simulation these count.
+    pub id: u64,
+    /// The posed roots and frames (`set_base`, `set_base_rotations`).
+    pub base: u64,
+    /// The stability map and the stability where none is set.
+    pub stability: u64,
+    /// The user field (every `field_mut`).
+    pub field: u64,
+    /// The touch (every `touch_begin`): its weights are fixed when it begins.
+    pub touch: u64,
+}

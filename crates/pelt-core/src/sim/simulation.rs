@@ -9,13 +9,17 @@ use std::time::Instant;
 #[cfg(target_arch = "wasm32")]
 use web_time::Instant;
 
-use glam::{Quat, Vec3};
+use glam::{Quat, Vec3, Vec4};
 use rayon::prelude::*;
 
+use super::contact::{
+    Collider, ContactStep, ContactStrands, Grasp, GraspParams, MAX_STEP_COLLIDERS, Resolve, SKIN_PLANES, StepCollider,
+    skin_planes,
+};
 use super::dispatch::{self, CpuKernel};
 use super::field::{ForceField, Touch};
-use super::inertia::Inertia;
-use super::inputs::{StepInputs, StrandInputs};
+use super::inertia::{Inertia, InertiaStep};
+use super::inputs::{InputVersions, StepInputs, StrandInputs};
 use super::kernel::{LANES, RestBatches, Step, VecLanes};
 use super::pick::{Hit, pick};
 use super::{ParamError, SimParams, WindParams};
@@ -56,6 +60,18 @@ pub enum SimError {
         kernel: String,
         /// What went wrong.
         message: String,
+    },
+    /// A collider that fails its checks.
+    #[error("collider {index} (id {id}): {key}: {problem}")]
+    Collider {
+        /// Its place in the list given.
+        index: usize,
+        /// Its id.
+        id: u32,
+        /// The bad key.
+        key: String,
+        /// What is wrong with it.
+        problem: String,
     },
     /// A stability map entry out of range.
     #[error("stability map entry {vertex} is {value}: must be between 1e-6 and 1e9")]
@@ -118,7 +134,24 @@ pub struct Simulation {
     cpu_bending: bool,
     /// Times of the last (up to) two steps, oldest first.
     recent_step_times: Vec<f64>,
+    /// What those steps did to the inertial state, oldest first.
+    recent_inertia_steps: Vec<InertiaStep>,
+    /// Counters of the per-strand inputs' changes.
+    versions: InputVersions,
+    /// The roots changed since the last step.
+    roots_moved: bool,
+    /// The touch began on the roots of the newest step.
+    touch_on_step_roots: bool,
+    /// Each strand's skin planes (see `contact::skin`).
+    skin: Vec<[Vec4; SKIN_PLANES]>,
+    /// Colliders the host or a script placed.
+    colliders: Vec<Collider>,
+    /// The grasp holding (or springing back), if any.
+    grasp: Option<Grasp>,
 }
+
+/// Simulations made so far: each one's [`InputVersions::id`].
+static SIMULATIONS: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
 
 impl Simulation {
     /// Sets up the simulation of `fur` and computes the state at time 0.
@@ -172,6 +205,16 @@ impl Simulation {
             steps_taken: 0,
             cpu_bending: true,
             recent_step_times: Vec::with_capacity(3),
+            recent_inertia_steps: Vec::with_capacity(3),
+            versions: InputVersions {
+                id: SIMULATIONS.fetch_add(1, std::sync::atomic::Ordering::Relaxed),
+                ..InputVersions::default()
+            },
+            roots_moved: false,
+            touch_on_step_roots: false,
+            skin: skin_planes(fur),
+            colliders: Vec::new(),
+            grasp: None,
         };
         simulation.jump_to_step(0);
         simulation.update_output();
@@ -194,6 +237,9 @@ impl Simulation {
         if params.rate_hz != self.params.rate_hz {
             // Force a full recompute at the next advance: old step indices mean other times.
             self.step_index = i64::MIN;
+        }
+        if params.stability != self.params.stability {
+            self.versions.stability += 1;
         }
         self.params = params.clone();
         Ok(())
@@ -227,6 +273,7 @@ impl Simulation {
             }
         }
         self.stability_map = map;
+        self.versions.stability += 1;
         Ok(())
     }
 
@@ -242,6 +289,7 @@ impl Simulation {
     /// infinite entries; nothing changes then.
     pub fn set_base(&mut self, positions: &[Vec3], normals: &[Vec3]) -> Result<(), SimError> {
         self.check_base(positions, normals, "the base normals")?;
+        self.moved_base();
         self.roots.copy_from_slice(positions);
         for ((frame, rest), normal) in self.frames.iter_mut().zip(&self.rest_normals).zip(normals) {
             *frame = match (rest.try_normalize(), normal.try_normalize()) {
@@ -263,11 +311,17 @@ impl Simulation {
         if let Some(bad) = rotations.iter().find(|q| q.length_squared() == 0.0) {
             return Err(SimError::NonFinite { what: "the base rotations", value: bad.to_string() });
         }
+        self.moved_base();
         self.roots.copy_from_slice(positions);
         for (frame, rotation) in self.frames.iter_mut().zip(rotations) {
             *frame = rotation.normalize();
         }
         Ok(())
+    }
+
+    fn moved_base(&mut self) {
+        self.versions.base += 1;
+        self.roots_moved = true;
     }
 
     fn check_base(&self, positions: &[Vec3], frames: &[Vec3], what_frames: &'static str) -> Result<(), SimError> {
@@ -291,6 +345,7 @@ impl Simulation {
 
     /// The user force field, to edit; takes effect from the next step.
     pub fn field_mut(&mut self) -> &mut ForceField {
+        self.versions.field += 1;
         &mut self.field
     }
 
@@ -329,7 +384,8 @@ impl Simulation {
     }
 
     /// The per-strand inputs as they are now (posed roots and frames, stability, the user field,
-    /// the touch's weights, the inertial force of the newest step).
+    /// the touch's weights, the inertial force of the newest step: zero while another kernel
+    /// bends, see [`Simulation::set_cpu_bending`]).
     #[must_use]
     pub fn strand_inputs(&self) -> StrandInputs<'_> {
         StrandInputs {
@@ -357,6 +413,8 @@ impl Simulation {
             return Err(SimError::TouchRadius(radius));
         }
         self.touch = Some(Touch::new(point, radius, &self.roots));
+        self.touch_on_step_roots = !self.roots_moved;
+        self.versions.touch += 1;
         Ok(())
     }
 
@@ -408,6 +466,160 @@ impl Simulation {
         self.touch.as_ref()
     }
 
+    /// Whether the touch in progress began on the roots of the newest step (the base did not
+    /// move between that step and the touch): a kernel that keeps each step's roots can weigh
+    /// the touch from them. A host posing the base between steps can begin one on roots no step
+    /// used.
+    #[must_use]
+    pub fn touch_began_on_step_roots(&self) -> bool {
+        self.touch.is_some() && self.touch_on_step_roots
+    }
+
+    /// Replaces the colliders (a host may call it every frame). A collider whose `id` was in the
+    /// last list and that has one key continues the old one's motion from its last key (so the
+    /// step sweeps the path between and friction sees the motion) and keeps its appearance time;
+    /// a new id appears now and grows in.
+    ///
+    /// # Errors
+    /// [`SimError::Collider`] naming the first bad collider and key; nothing changes then.
+    pub fn set_colliders(&mut self, colliders: &[Collider]) -> Result<(), SimError> {
+        for (index, collider) in colliders.iter().enumerate() {
+            collider.validate().map_err(|(key, problem)| SimError::Collider {
+                index,
+                id: collider.id,
+                key,
+                problem,
+            })?;
+        }
+        let now = self.recent_step_times.last().copied().unwrap_or(self.time_secs);
+        let joined = colliders
+            .iter()
+            .map(|collider| {
+                let mut collider = collider.clone();
+                let old = self.colliders.iter().find(|c| c.id == collider.id);
+                match old {
+                    Some(old) if collider.keys.len() == 1 => {
+                        let last = *old.keys.last().expect("validated: one key at least");
+                        if last.time_secs < collider.keys[0].time_secs {
+                            collider.keys.insert(0, last);
+                        }
+                        let step_secs = 1.0 / f64::from(self.params.rate_hz);
+                        collider.appeared_secs = old.appeared_at(f64::MAX, step_secs);
+                        if collider.appeared_at(f64::MAX, step_secs) != collider.appeared_secs {
+                            // It jumped: it grows in again from its new place.
+                            collider.keys.remove(0);
+                            collider.appeared_secs = Some(now.min(collider.keys[0].time_secs));
+                        }
+                    }
+                    None if collider.appeared_secs.is_none() && collider.keys.len() == 1 => {
+                        collider.appeared_secs = Some(now.min(collider.keys[0].time_secs));
+                    }
+                    _ => {}
+                }
+                collider
+            })
+            .collect();
+        self.colliders = joined;
+        Ok(())
+    }
+
+    /// The colliders in use.
+    #[must_use]
+    pub fn colliders(&self) -> &[Collider] {
+        &self.colliders
+    }
+
+    /// Closes a hand at `point` at `time_secs` (simulation time): the strands rooted within `radius` are gathered toward the grip
+    /// (moved by [`Simulation::grasp_move`]); a ball of `hand_radius` (0: none) about the grip
+    /// pushes the strands it does not hold. Replaces a grasp in progress.
+    ///
+    /// # Errors
+    /// [`SimError::NonFinite`] for a non-finite point; [`SimError::TouchRadius`] for a radius
+    /// that is not finite and positive or a hand radius that is negative; [`SimError::Params`]
+    /// for bad `params`.
+    pub fn grasp_begin(
+        &mut self,
+        point: Vec3,
+        radius: f32,
+        hand_radius: f32,
+        params: GraspParams,
+        time_secs: f64,
+    ) -> Result<(), SimError> {
+        if !point.is_finite() {
+            return Err(SimError::NonFinite { what: "the grasp point", value: point.to_string() });
+        }
+        if !(radius.is_finite() && radius > 0.0) {
+            return Err(SimError::TouchRadius(radius));
+        }
+        if !(hand_radius.is_finite() && hand_radius >= 0.0) {
+            return Err(SimError::TouchRadius(hand_radius));
+        }
+        params.validate().map_err(|(key, problem)| ParamError { key: format!("grasp.{key}"), problem })?;
+        if !time_secs.is_finite() {
+            return Err(SimError::NonFinite { what: "the grasp time", value: time_secs.to_string() });
+        }
+        self.grasp = Some(Grasp::new(point, radius, hand_radius, time_secs, params, &self.roots));
+        Ok(())
+    }
+
+    /// Moves the grip of the grasp in progress to `point`. Does nothing without one.
+    ///
+    /// # Errors
+    /// [`SimError::NonFinite`] for a non-finite point.
+    pub fn grasp_move(&mut self, point: Vec3) -> Result<(), SimError> {
+        if !point.is_finite() {
+            return Err(SimError::NonFinite { what: "the grip point", value: point.to_string() });
+        }
+        if let Some(grasp) = self.grasp.as_mut().filter(|g| g.released_at_secs.is_none()) {
+            grasp.grip = point;
+        }
+        Ok(())
+    }
+
+    /// Opens the hand at `time_secs`: the held strands spring back and settle.
+    pub fn grasp_end(&mut self, time_secs: f64) {
+        if let Some(grasp) = self.grasp.as_mut().filter(|g| g.released_at_secs.is_none()) {
+            grasp.released_at_secs = Some(time_secs);
+        }
+    }
+
+    /// The grasp holding or springing back, if any.
+    #[must_use]
+    pub fn grasp(&self) -> Option<&Grasp> {
+        self.grasp.as_ref()
+    }
+
+    /// What every strand shares in the contact of the step at `time_secs`: the skin switch, the
+    /// colliders there (sampled along their paths within the step, grown since they appeared,
+    /// the grasp's hand last), the grip and its presence. Read by every kernel.
+    #[must_use]
+    pub fn contact_step(&self, time_secs: f64) -> ContactStep {
+        let step_secs = 1.0 / f64::from(self.params.rate_hz);
+        let mut colliders = Vec::new();
+        for collider in &self.colliders {
+            collider.push_step(time_secs, step_secs, self.radius, &mut colliders);
+        }
+        let mut step = ContactStep { skin: self.params.contact.skin, ..ContactStep::default() };
+        if let Some(grasp) = &self.grasp {
+            if grasp.hand_radius > 0.0 && grasp.released_at_secs.is_none() {
+                let mut hand = StepCollider::ball(grasp.grip, grasp.hand_radius);
+                hand.grasp_hand = true;
+                colliders.insert(0, hand);
+            }
+            step.grip = grasp.grip;
+            step.grip_presence = grasp.presence(time_secs);
+        }
+        colliders.truncate(MAX_STEP_COLLIDERS);
+        step.colliders = colliders;
+        step
+    }
+
+    /// The per-strand contact inputs: skin planes and the grasp's weights.
+    #[must_use]
+    pub fn contact_strands(&self) -> ContactStrands<'_> {
+        ContactStrands { skin: &self.skin, grasp_weights: self.grasp.as_ref().map_or(&[], |g| g.weights()) }
+    }
+
     /// The nearest hit of a ray with the base mesh at its current root positions.
     #[must_use]
     pub fn pick(&self, triangles: &[[u32; 3]], ray_origin: Vec3, ray_direction: Vec3) -> Option<Hit> {
@@ -441,6 +653,9 @@ impl Simulation {
             self.alpha = 1.0;
         }
         self.drop_faded_touch();
+        if self.grasp.as_ref().is_some_and(|g| g.settled(self.time_secs)) {
+            self.grasp = None;
+        }
         if self.cpu_bending {
             self.update_output();
         }
@@ -578,12 +793,16 @@ impl Simulation {
     /// keeps the time, the steps ([`Simulation::recent_step_times`]), the touch and every input,
     /// but bends nothing and leaves [`Simulation::positions`] and
     /// [`Simulation::external_field`] as they were: for a host whose strands are bent by another
-    /// kernel (`pelt_render::GpuSimulation`) from this simulation's inputs. Either way the next
-    /// `advance_to` recomputes both states, so switching never mixes kernels in one pair.
+    /// kernel (`pelt_render::GpuSimulation`) from this simulation's inputs. Off, the inertia's
+    /// steps are only decided ([`Simulation::recent_inertia_steps`]) and
+    /// [`Simulation::inertial_forces`] stays zero: the kernel that bends keeps the forces.
+    /// Either way the next `advance_to` recomputes both states and the motion so far is
+    /// forgotten, so switching never mixes kernels in one pair.
     pub fn set_cpu_bending(&mut self, on: bool) {
         if on != self.cpu_bending {
             self.cpu_bending = on;
             self.step_index = i64::MIN;
+            self.inertia.reset();
         }
     }
 
@@ -600,6 +819,20 @@ impl Simulation {
     #[must_use]
     pub fn recent_step_times(&self) -> &[f64] {
         &self.recent_step_times
+    }
+
+    /// What each of [`Simulation::recent_step_times`]' steps did to the inertial state (one
+    /// entry per step, oldest first): with the CPU's bending off the simulation only decides
+    /// them, and the kernel that bends applies them to every strand.
+    #[must_use]
+    pub fn recent_inertia_steps(&self) -> &[InertiaStep] {
+        &self.recent_inertia_steps
+    }
+
+    /// Counters of the per-strand inputs' changes (roots, stability, field, touch).
+    #[must_use]
+    pub fn input_versions(&self) -> InputVersions {
+        self.versions
     }
 
     /// Each strand's rotation from its rest frame into the current base frame (identity until
@@ -669,9 +902,19 @@ impl Simulation {
         if self.recent_step_times.len() > 2 {
             self.recent_step_times.remove(0);
         }
-        // The inertia is state carried from step to step: it advances whichever kernel bends.
+        // The inertia is state carried from step to step. Its step is decided here whichever
+        // kernel bends; the kernel that bends applies it to every strand.
         let (inertia, damping) = (self.params.inertia, self.params.damping);
-        self.inertia.update(&self.roots, time_secs, inertia, damping, self.radius);
+        let roots_moved = std::mem::take(&mut self.roots_moved);
+        let inertia_step = if self.cpu_bending {
+            self.inertia.update(&self.roots, time_secs, inertia, damping, self.radius)
+        } else {
+            self.inertia.advance(&self.roots, roots_moved, time_secs, inertia, damping, self.radius)
+        };
+        self.recent_inertia_steps.push(inertia_step);
+        if self.recent_inertia_steps.len() > 2 {
+            self.recent_inertia_steps.remove(0);
+        }
         if !self.cpu_bending {
             return;
         }
@@ -697,6 +940,17 @@ impl Simulation {
             rest: &self.rest,
         };
         dispatch::bend_all(self.cpu_kernel, &step, &mut current);
+        let contact = self.contact_step(time_secs);
+        Resolve {
+            step: &contact,
+            strands: self.contact_strands(),
+            roots: strands.roots,
+            frames: strands.frames,
+            rest: &self.rest,
+            layers: self.layers as usize,
+            vertex_count: self.vertex_count,
+        }
+        .apply(&mut current);
         self.current = current;
         self.last_step_secs = started.elapsed().as_secs_f64();
     }

@@ -49,8 +49,8 @@ pub(crate) struct ObjectUniform {
     pub lod_view_full: f32,
     pub furred_triangle_count: u32,
     pub fin_edge_count: u32,
+    pub groom_shading: u32,
     /// WGSL rounds the struct up to its 16-byte alignment.
-    pub _padding_1: u32,
     pub _padding_2: u32,
     pub _padding_3: u32,
 }
@@ -238,7 +238,7 @@ mod tests {
             lod_view_full,
             furred_triangle_count,
             fin_edge_count,
-            _padding_1,
+            groom_shading,
             _padding_2,
             _padding_3
         });

@@ -19,6 +19,18 @@
 // Triangles (3F), then edges (2E), then the two faces beside each edge (2E); with uvs, then each
 // wedge's base vertex (W) and each triangle corner's wedge (3F, the shells' index buffer).
 @group(1) @binding(5) var<storage, read> topology: array<u32>;
+// A groomed fur's per-vertex shading terms (V entries; one unused entry without a groom),
+// rewritten in place when a groom is painted (`GpuFur::set_groom`).
+@group(1) @binding(6) var<storage, read> groom_attributes: array<GroomAttributes>;
+
+// The groom's terms at base vertex `vertex` (the uniform fur's without groom shading).
+fn vertex_groom(vertex: u32) -> GroomShade {
+    // A uniform branch: ungroomed furs read nothing.
+    if object.groom_shading == 0u {
+        return GROOM_NONE;
+    }
+    return groom_shade(groom_attributes[vertex]);
+}
 
 const NO_FACE: u32 = 0xffffffffu;
 
@@ -157,12 +169,12 @@ fn vs_shell_indexed_listed(@builtin(vertex_index) index: u32) -> ShellTileVaryin
 fn shell_wedge(wedge: u32, shell: u32) -> ShellUvVaryings {
     let vertex = wedge_vertex(wedge);
     let v = surface_varyings(vertex, wedge, lod_shell_layer(shell));
-    return shell_uv_varyings(v, shell_fade(v.normal, v.world_position), lod_shell_blend(vertex, v.normal));
+    return shell_uv_varyings(v, shell_fade(v.normal, v.world_position), lod_shell_blend(vertex, v.normal), vertex_groom(vertex));
 }
 
 fn shell_vertex(vertex: u32, shell: u32) -> ShellTileVaryings {
     let v = surface_varyings(vertex, 0u, lod_shell_layer(shell));
-    return shell_tile_varyings(v, shell_fade(v.normal, v.world_position), lod_shell_blend(vertex, v.normal));
+    return shell_tile_varyings(v, shell_fade(v.normal, v.world_position), lod_shell_blend(vertex, v.normal), vertex_groom(vertex));
 }
 
 // The level of detail's blend at base vertex `vertex` (world normal `normal`): the view angle
@@ -254,6 +266,9 @@ fn fin_varyings(index: u32, edge: u32, fade: f32) -> FinVaryings {
         }
     }
     out.uvs = vec4<f32>(offset + along, layer_height(layer), surface_uv);
+    let groom = vertex_groom(vertex);
+    out.tint_density = vec4<f32>(groom.tint, groom.density);
+    out.clump = groom.clump;
     return out;
 }
 
