@@ -256,7 +256,10 @@ fn the_try_on_body_walks_and_the_skirt_goes_with_it() {
     let still = pelt(&[&args[..], &["--animation", "none", "-o", "still"]].concat(), &dir);
     assert!(still.status.success(), "{}", text(&still));
     let moved = |folder: &str| {
-        differing_fraction(&png(&dir, &format!("{folder}/frame_0001.png")), &png(&dir, &format!("{folder}/frame_0002.png")))
+        differing_fraction(
+            &png(&dir, &format!("{folder}/frame_0001.png")),
+            &png(&dir, &format!("{folder}/frame_0002.png")),
+        )
     };
     let (walk, rest) = (moved("walk"), moved("still"));
     assert!(walk > 0.02 && walk > 4.0 * rest, "walking changes {walk} of the image, standing still {rest}");

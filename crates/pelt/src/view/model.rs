@@ -174,6 +174,9 @@ impl Model {
             Some(body) if choice_is_try_on => rig.take().map(|rig| (rig, body, Pose::default())),
             _ => None,
         };
+        if let (Some((_, body, _)), Some(mesh)) = (&walking, plain.first()) {
+            stepper.set_body(Some((mesh.clone(), body.rig.clone(), body.capsules.clone())));
+        }
         let model = Self {
             settings,
             mesh_choices,
@@ -355,6 +358,13 @@ impl Model {
                 }
                 _ => self.stepper.clear_clip(),
             }
+            let body = match (&self.walking, &self.body, &self.settings.mesh) {
+                (Some((_, body, _)), Some(mesh), MeshChoice::TryOn) => {
+                    Some((mesh.clone(), body.rig.clone(), body.capsules.clone()))
+                }
+                _ => None,
+            };
+            self.stepper.set_body(body);
             self.touch = None;
         } else if changes.simulation {
             self.stepper.simulation_mut().set_params(&self.settings.preset.simulation)?;
