@@ -179,6 +179,9 @@ impl App {
         if let Some((time_secs, clip_secs)) = model.simulate(frame_secs) {
             let started = std::time::Instant::now();
             running.fur.advance(&running.gpu, &mut model.stepper, time_secs, clip_secs)?;
+            if let Some((positions, normals, world_from_model)) = model.pose_body(clip_secs) {
+                running.fur.pose_body(&running.gpu, positions, normals, world_from_model)?;
+            }
             model.took(started.elapsed().as_secs_f64());
         }
         if requests.screenshot {
