@@ -175,6 +175,10 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         stepper.set_clip(rig, clip);
     }
     stepper.set_scene(scene);
+    // The walking try-on's body pushes the skirt's fur out of its legs.
+    if let (Some(body), Some(mesh)) = (&body, plain.first()) {
+        stepper.set_body(Some((mesh.clone(), body.rig.clone(), body.capsules.clone())));
+    }
     let moves = stepper.moves();
     let plain_meshes = plain
         .iter()
@@ -267,6 +271,9 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     drop(gif);
     if let Some(bar) = progress {
         bar.finish_and_clear();
+    }
+    if let Some(body) = &body {
+        println!("try-on: {}", body.transfer);
     }
     let per_frame = |total: Duration| total.as_secs_f64() * 1000.0 / f64::from(frames);
     println!(
