@@ -1,7 +1,8 @@
 //! Pelt's core: everything about fur that needs no GPU.
 //!
 //! Data flows one way through the modules:
-//! [`mesh`] (import and repair; [`anim`] poses a moving one) -> [`groom`] (per-vertex maps over
+//! [`mesh`] (import and repair; [`anim`] poses a moving one; [`body`] skins a garment to a body
+//! and gives the fur the body's surface) -> [`groom`] (per-vertex maps over
 //! it) -> [`fur`] (the unified shell-and-fin structure) ->
 //! [`texture`] (seeded shell and fin textures) -> [`sim`] (gravity, wind, touch) -> the renderer
 //! in `pelt-render`. [`preset`] holds everything about one fur in one TOML file; [`stage`] loads
@@ -11,6 +12,7 @@
 #![warn(missing_docs)]
 
 pub mod anim;
+pub mod body;
 pub mod export;
 pub mod fur;
 pub mod groom;

@@ -259,6 +259,32 @@ impl Preset {
         std::fs::write(path, text).map_err(|source| PresetError::Io { file: path.to_path_buf(), source })
     }
 
+    /// Writes the preset to `path` with `groom` (painted on `mesh`) as a per-vertex groom file
+    /// beside it, `<stem>.groom`, which the `[groom]` table then names alone (the file holds every
+    /// map, those first read from images included). A uniform groom (or `None`) clears the table.
+    /// The groom file is written first, through a temporary file and a rename.
+    ///
+    /// # Errors
+    /// [`PresetError::Groom`] naming the groom file, else as [`Preset::save`].
+    pub fn save_with_groom(
+        &mut self,
+        path: impl AsRef<Path>,
+        groom: Option<&Groom>,
+        mesh: &Mesh,
+    ) -> Result<(), PresetError> {
+        let path = path.as_ref();
+        self.groom = GroomParams::default();
+        if let Some(groom) = groom.filter(|g| !g.is_uniform()) {
+            let stem = path.file_stem().map_or_else(|| "fur".into(), |s| s.to_string_lossy().into_owned());
+            let name = PathBuf::from(format!("{stem}.groom"));
+            groom
+                .save(&path.with_file_name(&name), mesh)
+                .map_err(|error| PresetError::Groom { file: path.to_path_buf(), error })?;
+            self.groom.file = Some(name);
+        }
+        self.save(path)
+    }
+
     /// The file this preset was read from (or a placeholder name).
     #[must_use]
     pub fn file(&self) -> &Path {

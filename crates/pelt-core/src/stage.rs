@@ -1,11 +1,13 @@
 //! [`Stage`]: the meshes one fur scene is made of, loaded in one place for every command and
 //! host: the mesh the fur grows on (a file, a built-in, or the try-on garment), its rig when the
-//! file moves, and the plain meshes drawn beside it (the try-on body, `--plain-mesh` files).
+//! file moves, and the plain meshes drawn beside it (the try-on body, `--plain-mesh` files); the
+//! try-on body walks, with its own rig and colliders ([`StageBody`]).
 
 use std::path::{Path, PathBuf};
 
-use crate::anim::Rig;
-use crate::mesh::builtin::{Builtin, TRY_ON_NAME, try_on_scene};
+use crate::anim::{Pose, Rig};
+use crate::body::{BodyCapsules, BodyError, Capsule, TransferReport, walking_try_on};
+use crate::mesh::builtin::{Builtin, TRY_ON_NAME};
 use crate::mesh::{ImportOptions, Mesh, MeshError, MeshReport};
 
 /// Where the furred mesh comes from.
@@ -15,7 +17,8 @@ pub enum StageSource {
     File(PathBuf),
     /// A built-in mesh.
     Builtin(Builtin),
-    /// The paper's virtual try-on: the fur grows on the garment, the body is drawn plain.
+    /// The paper's virtual try-on: the fur grows on a skirt skinned to a walking body
+    /// ([`walking_try_on`]), the body is drawn plain.
     TryOn,
 }
 
@@ -59,6 +62,36 @@ pub struct Stage {
     pub rig: Option<Rig>,
     /// Meshes drawn without fur: the try-on body, then the extra files in order.
     pub plain: Vec<Mesh>,
+    /// What moves `plain[0]` with the fur's rig: the try-on body.
+    pub body: Option<StageBody>,
+}
+
+/// A plain mesh skinned to the same skeleton and clips as the fur's rig (the walking try-on
+/// body): the host poses it at the fur's clip time.
+#[derive(Clone, Debug)]
+pub struct StageBody {
+    /// The body's rig (its clips are the fur rig's, in the same order).
+    pub rig: Rig,
+    /// The body as one capsule per bone, for the fur to collide with.
+    pub capsules: BodyCapsules,
+    /// How the garment took the body's weights.
+    pub transfer: TransferReport,
+}
+
+impl StageBody {
+    /// Poses `body` (the stage's `plain[0]`) with `clip` at `clip_time_secs` into `pose`, and
+    /// returns the body's capsules there, placed by `world_from_model`.
+    pub fn pose(
+        &self,
+        body: &Mesh,
+        clip: Option<usize>,
+        clip_time_secs: f64,
+        world_from_model: glam::Mat4,
+        pose: &mut Pose,
+    ) -> Vec<Capsule> {
+        self.rig.pose(body, clip, clip_time_secs, pose);
+        self.capsules.posed(&self.rig, pose, world_from_model)
+    }
 }
 
 impl Stage {
@@ -70,15 +103,24 @@ impl Stage {
         let mut stage = match source {
             StageSource::File(path) => {
                 let (fur_mesh, report, rig) = Mesh::load_animated(path, options)?;
-                Self { fur_mesh, report, rig, plain: Vec::new() }
+                Self { fur_mesh, report, rig, plain: Vec::new(), body: None }
             }
             StageSource::Builtin(builtin) => {
                 let (fur_mesh, report) = builtin.mesh();
-                Self { fur_mesh, report, rig: None, plain: Vec::new() }
+                Self { fur_mesh, report, rig: None, plain: Vec::new(), body: None }
             }
             StageSource::TryOn => {
-                let scene = try_on_scene(options)?;
-                Self { fur_mesh: scene.garment, report: scene.garment_report, rig: None, plain: vec![scene.body] }
+                let scene = walking_try_on(options).map_err(|e| match e {
+                    BodyError::Mesh(e) => e,
+                    other => MeshError::Parse { file: TRY_ON_NAME.into(), line: None, message: other.to_string() },
+                })?;
+                Self {
+                    fur_mesh: scene.garment,
+                    report: scene.garment_report,
+                    rig: Some(scene.garment_rig),
+                    plain: vec![scene.body],
+                    body: Some(StageBody { rig: scene.body_rig, capsules: scene.capsules, transfer: scene.transfer }),
+                }
             }
         };
         for path in plain_files {

@@ -585,3 +585,33 @@ fn the_groomed_fox_is_bald_at_the_nose_and_long_on_the_tail() {
     assert!(fur.furred_triangles().len() < fur.mesh.triangles.len());
     assert!(fur.footprint().faces < uniform.grow(mesh, "Fox.glb").unwrap().footprint().faces);
 }
+
+/// A flow map (direction) from a float vertex colour set with a NaN in it, and an image larger
+/// than any map may be: each a clear error naming the key and the file, never a panic.
+#[test]
+fn a_nan_in_a_flow_map_and_an_oversized_image_are_clear_errors() {
+    let gltf = coloured_tetrahedron(|k, _| if k < 3 { [f32::NAN, 0.5, 0.0, 1.0] } else { [0.5, 0.5, 0.0, 1.0] });
+    let name = Path::new("nan.gltf");
+    let preset = Preset::from_toml_str("[groom]\ndirection = \"COLOR_0\"\n", "fur.toml").unwrap();
+    match Mesh::from_gltf_slice(&gltf, name, &ImportOptions::default()) {
+        // The import may refuse the NaN itself, naming the file.
+        Err(error) => assert!(error.to_string().contains("nan.gltf"), "{error}"),
+        Ok((mesh, _)) => {
+            let message = preset.groom(&mesh, "nan.gltf").unwrap_err().to_string();
+            assert!(
+                message.contains("groom.direction") && message.contains("nan.gltf") && message.contains("finite"),
+                "{message}"
+            );
+        }
+    }
+
+    let folder = scratch("oversized");
+    // One texel wide, one texel too tall: cheap to write, refused before it is decoded whole.
+    image::GrayImage::new(1, 16_385).save(folder.join("tall.png")).unwrap();
+    let preset = Preset::from_toml_str("[groom]\ndensity = \"tall.png\"\n", folder.join("fur.toml")).unwrap();
+    let message = preset.groom(&plane(), "plane.glb").unwrap_err().to_string();
+    assert!(
+        message.contains("groom.density") && message.contains("tall.png") && message.contains("16385"),
+        "{message}"
+    );
+}

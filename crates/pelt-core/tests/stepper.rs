@@ -112,7 +112,13 @@ fn a_host_pose_moves_the_roots_and_bad_poses_are_errors() {
 fn the_stage_loads_files_built_ins_and_the_try_on_and_names_unknown_built_ins() {
     let tryon = Stage::load(&StageSource::TryOn, &[], &ImportOptions::default()).expect("try-on");
     assert_eq!(tryon.plain.len(), 1, "the body is drawn plain");
-    assert!(tryon.rig.is_none());
+    // The skirt follows the body's walk: its own rig, the body's clip, and the body's rig beside it.
+    let rig = tryon.rig.as_ref().expect("the try-on skirt is skinned");
+    assert_eq!(rig.vertex_count(), tryon.fur_mesh.vertex_count());
+    let body = tryon.body.as_ref().expect("the try-on body walks");
+    assert_eq!(body.rig.vertex_count(), tryon.plain[0].vertex_count());
+    assert_eq!(rig.animations(), body.rig.animations());
+    assert!(!rig.animations().is_empty());
     let bunny = Stage::load(&StageSource::builtin("bunny").expect("bunny"), &[], &ImportOptions::default());
     assert!(bunny.expect("bunny").plain.is_empty());
     let error = StageSource::builtin("dragon").unwrap_err().to_string();

@@ -104,6 +104,7 @@
 #![warn(missing_docs)]
 
 mod camera;
+mod contact;
 mod driver;
 mod error;
 mod fur;

@@ -37,6 +37,15 @@ impl PlainMesh {
         self.geometry.write_uniform(queue, &self.geometry.shape.uniform(&frame, self.colour, (0, false)));
     }
 
+    /// Moves the mesh's vertices (a skinned body's pose this frame, in model space).
+    ///
+    /// # Errors
+    /// [`RenderError::Count`] when `positions` or `normals` has another length than the mesh.
+    pub fn set_pose(&self, queue: &wgpu::Queue, positions: &[Vec3], normals: &[Vec3]) -> Result<(), RenderError> {
+        self.geometry.set_positions(queue, positions)?;
+        self.geometry.set_normals(queue, normals)
+    }
+
     /// Bytes the mesh holds on the GPU.
     #[must_use]
     pub fn gpu_bytes(&self) -> GpuBytes {

@@ -11,9 +11,10 @@
 //! begins). Nothing is read back and the shared array never crosses the bus.
 
 use pelt_core::FurStructure;
-use pelt_core::sim::{InertiaStep, InputVersions, Simulation, StepInputs, kernel_rest};
+use pelt_core::sim::{ContactStep, InertiaStep, InputVersions, Simulation, StepInputs, kernel_rest};
 
 use crate::RenderError;
+use crate::contact::{CONTACT_SLOTS, GpuContact};
 use crate::fur::GpuFur;
 use crate::requirements::{ErrorScope, check_size};
 use crate::shaders::simulation_shader_source;
@@ -27,8 +28,10 @@ const STEP_SLOTS: usize = 2;
 /// Uniform slots in the ring the steps take in turn: a host recording up to this many steps into
 /// one submission gives each its own inputs (the queue writes all land before it runs).
 const RING_SLOTS: u64 = 64;
+// Each ring slot has its own contact slot, for the same reason.
+const _: () = assert!(RING_SLOTS == CONTACT_SLOTS as u64);
 /// Storage buffers the compute stage binds.
-const STORAGE_BUFFERS: u32 = 4;
+const STORAGE_BUFFERS: u32 = 5;
 
 /// One step's inputs; the layout of `Step` in `simulation.wgsl`.
 #[repr(C)]
@@ -186,6 +189,10 @@ pub struct GpuSimulation {
     /// and after the pending ones.
     dispatched_history: u8,
     pending_history: u8,
+    /// The contact buffer (`simulation_contact.wgsl`).
+    contact: GpuContact,
+    /// The pending steps' contact, slot by slot.
+    pending_contact: Vec<ContactStep>,
 }
 
 impl GpuSimulation {
@@ -299,6 +306,7 @@ impl GpuSimulation {
                 storage(2, true),
                 storage(3, false),
                 storage(4, false),
+                storage(5, true),
             ],
         });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -342,6 +350,8 @@ impl GpuSimulation {
             v.max(1) as u64 * STATE_BYTES,
             storage_usage | wgpu::BufferUsages::COPY_SRC,
         );
+        check_size(device, "simulation contact", GpuContact::bytes(v))?;
+        let contact = GpuContact::new(device, structure);
         scope.pop("creating the GPU simulation")?;
         Ok(Self {
             pipeline,
@@ -351,6 +361,8 @@ impl GpuSimulation {
             rest_segments,
             strands,
             state,
+            contact,
+            pending_contact: Vec::with_capacity(STEP_SLOTS + 2),
             bind_groups: Vec::new(),
             vertex_count: v as u32,
             layers: structure.layers,
@@ -417,6 +429,7 @@ impl GpuSimulation {
         let mut start_over = unseen > recent.len() as u64;
         if start_over {
             self.pending.clear();
+            self.pending_contact.clear();
         }
         for (&time_secs, &inertia) in
             recent[recent.len() - new..].iter().zip(&inertia_steps[inertia_steps.len() - new..])
@@ -431,15 +444,21 @@ impl GpuSimulation {
             if let Some(uniform) = self.pending.last_mut() {
                 uniform.inertia_kind[1] = u32::from(self.touch_uploaded);
             }
+            self.pending_contact.push(simulation.contact_step(time_secs));
         }
         if self.pending.len() > STEP_SLOTS {
             self.pending.drain(..self.pending.len() - STEP_SLOTS);
+            self.pending_contact.drain(..self.pending_contact.len() - STEP_SLOTS);
             start_over = true;
         }
         let history = if start_over { 0 } else { self.dispatched_history };
         self.pending_history = settle_inertia(&mut self.pending, history);
-        for (slot, uniform) in self.pending.iter().enumerate() {
-            queue.write_buffer(&self.step_uniforms, self.slot_offset(slot), bytemuck::bytes_of(uniform));
+        self.contact.write_strands(queue, &simulation.contact_strands());
+        for slot in 0..self.pending.len() {
+            let ring_slot = (self.ring + slot as u64) % RING_SLOTS;
+            self.pending[slot].grid[1] = ring_slot as u32;
+            queue.write_buffer(&self.step_uniforms, self.slot_offset(slot), bytemuck::bytes_of(&self.pending[slot]));
+            self.contact.write_slot(queue, ring_slot as usize, &self.pending_contact[slot]);
         }
         Ok(())
     }
@@ -491,6 +510,7 @@ impl GpuSimulation {
         self.ring = (self.ring + self.pending.len() as u64) % RING_SLOTS;
         self.pending.clear();
         self.dispatched_history = self.pending_history;
+        self.pending_contact.clear();
         Ok(())
     }
 
@@ -540,6 +560,7 @@ impl GpuSimulation {
                 wgpu::BindGroupEntry { binding: 2, resource: self.strands.as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 3, resource: self.state.as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 4, resource: output.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 5, resource: self.contact.buffer.as_entire_binding() },
             ],
         });
         scope.pop("binding the GPU simulation to the fur")?;

@@ -21,7 +21,7 @@ fn separated_module_validates() {
 #[test]
 fn simulation_module_validates() {
     validate(
-        "simulation_wind.wgsl + simulation.wgsl + simulation_inputs.wgsl",
+        "simulation_wind.wgsl + simulation.wgsl + simulation_inputs.wgsl + simulation_contact.wgsl",
         &pelt_render::simulation_shader_source(),
     );
 }
@@ -67,8 +67,8 @@ fn every_wgsl_file_is_part_of_a_validated_module() {
         }
     }
     assert_eq!(
-        checked, 10,
-        "shading, unified, separated, scan, silhouette, view_lod, simulation_wind, simulation, simulation_inputs \
-         and strands"
+        checked, 11,
+        "shading, unified, separated, scan, silhouette, view_lod, simulation_wind, simulation, simulation_inputs, \
+         simulation_contact and strands"
     );
 }

@@ -50,6 +50,12 @@ pub struct Args {
     /// 1e-5 of its strand's length.
     #[arg(long)]
     pub soak: bool,
+    /// Time the models with this preset (its look, textures, simulation and groom; the layer
+    /// counts stay the table's) instead of the default one, e.g. a groomed Fox against the
+    /// uniform coat: `--model fox --preset assets/presets/fox_groomed.toml`. Its groom must fit
+    /// every model timed.
+    #[arg(long, value_name = "FILE")]
+    pub preset: Option<PathBuf>,
     /// Leave out the level-of-detail measurements (the frame-time table always draws every
     /// shell).
     #[arg(long)]
@@ -79,6 +85,17 @@ struct Plan<'a> {
     no_lod: bool,
     /// `--size`: frame sizes timed besides the two standard ones.
     extra_sizes: &'a [(u32, u32)],
+    /// `--preset`: the preset timed in place of the default one.
+    preset: Option<&'a Preset>,
+}
+
+impl Plan<'_> {
+    /// The preset timed at `layers`: `--preset`'s, else the default.
+    fn preset(self, layers: u32) -> Preset {
+        let mut preset = self.preset.cloned().unwrap_or_default();
+        preset.layers = layers;
+        preset
+    }
 }
 
 impl Plan<'_> {
@@ -133,7 +150,8 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             MODELS.iter().map(|m| m.key).collect::<Vec<_>>().join(", ")
         );
     }
-    let plan = Plan { quick: args.quick, no_lod: args.no_lod, extra_sizes: &args.sizes };
+    let preset = args.preset.as_deref().map(Preset::load).transpose()?;
+    let plan = Plan { quick: args.quick, no_lod: args.no_lod, extra_sizes: &args.sizes, preset: preset.as_ref() };
     let meshes_dir = models::meshes_dir(args.meshes.as_deref());
 
     // One GPU for the whole run; without one the frame times are null with the reason.
@@ -240,9 +258,8 @@ fn measure(
         );
     }
 
-    // Everything timed uses the default preset at this layer count.
-    let mut preset = Preset::default();
-    preset.layers = layers;
+    // Everything timed uses the default preset (or `--preset`'s) at this layer count.
+    let preset = plan.preset(layers);
     let fur = preset.grow(model.fur.clone(), model.spec.key)?;
     let key = model.spec.key;
     eprintln!("pelt bench:   {key} L={layers}: textures");
@@ -290,8 +307,7 @@ fn measure_anim(model: &Model, layers: u32, plan: Plan<'_>) -> anyhow::Result<An
     let (Some(rig), Some(clip)) = (&model.rig, model.spec.animation) else {
         return Ok(AnimFigures { anim_unavailable_reason: Some(NOT_ANIMATED.to_owned()), ..AnimFigures::default() });
     };
-    let mut preset = Preset::default();
-    preset.layers = layers;
+    let preset = plan.preset(layers);
     let fur = preset.grow(model.fur.clone(), model.spec.key)?;
     eprintln!("pelt bench:   {} L={layers}: posing ({clip})", model.spec.key);
     anim::measure(&fur, rig, clip, &preset.simulation, plan.sim_budget().drawn_frames)

@@ -7,7 +7,7 @@ use std::time::{Duration, Instant};
 
 use anyhow::{Context as _, bail};
 use glam::{Mat4, Vec3};
-use pelt_core::anim::Rig;
+use pelt_core::anim::{Pose, Rig};
 use pelt_core::sim::{FurStepper, Scene, WindParams};
 use pelt_core::{Builtin, FurStructure, Mesh, Preset, Stage};
 use pelt_render::{
@@ -24,7 +24,7 @@ pub const PLAIN_COLOUR: Vec3 = Vec3::new(0.62, 0.46, 0.38);
 
 /// Wind of the default render (no `--wind`, and the preset has none): a light breeze from the
 /// camera's left.
-const LIGHT_WIND: Vec3 = Vec3::new(0.35, 0.0, 0.1);
+pub const LIGHT_WIND: Vec3 = Vec3::new(0.35, 0.0, 0.1);
 
 /// Arguments of `pelt render`.
 #[derive(Debug, clap::Args)]
@@ -129,7 +129,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         None => Preset::default(),
     };
     let scene = args.script.as_deref().map(Scene::load).transpose()?;
-    let Stage { fur_mesh: mesh, rig, plain, .. } = args.mesh.stage(Builtin::Bunny, &args.plain_mesh)?;
+    let Stage { fur_mesh: mesh, rig, plain, body, .. } = args.mesh.stage(Builtin::Bunny, &args.plain_mesh)?;
     let clip = choose_animation(args, rig.as_ref())?;
     let frames = if frames > 0 {
         frames
@@ -175,6 +175,10 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         stepper.set_clip(rig, clip);
     }
     stepper.set_scene(scene);
+    // The walking try-on's body pushes the skirt's fur out of its legs.
+    if let (Some(body), Some(mesh)) = (&body, plain.first()) {
+        stepper.set_body(Some((mesh.clone(), body.rig.clone(), body.capsules.clone())));
+    }
     let moves = stepper.moves();
     let plain_meshes = plain
         .iter()
@@ -218,12 +222,18 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         _ => None,
     };
     let (mut render_time, mut simulation_time) = (Duration::ZERO, Duration::ZERO);
+    let mut body_pose = Pose::default();
     for frame in 0..frames {
         let time_secs = f64::from(frame) / args.fps;
         let sim_started = Instant::now();
         driver.advance_to(device, queue, &mut stepper, time_secs)?;
         simulation_time += sim_started.elapsed();
         let render_started = Instant::now();
+        // The walking try-on body takes the fur's clip at the same time.
+        if let (Some(body), Some(body_mesh), Some(plain_mesh)) = (&body, plain.first(), plain_meshes.first()) {
+            body.rig.pose(body_mesh, clip, time_secs, &mut body_pose);
+            plain_mesh.set_pose(queue, &body_pose.positions, &body_pose.normals)?;
+        }
         // The simulation's GPU steps in a submission of their own: the frame's closures below
         // only read the driver.
         let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("simulation") });
@@ -261,6 +271,9 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     drop(gif);
     if let Some(bar) = progress {
         bar.finish_and_clear();
+    }
+    if let Some(body) = &body {
+        println!("try-on: {}", body.transfer);
     }
     let per_frame = |total: Duration| total.as_secs_f64() * 1000.0 / f64::from(frames);
     println!(

@@ -8,6 +8,7 @@ mod capture;
 mod fur;
 mod gpu;
 mod model;
+mod paint;
 mod panel;
 mod shell_share;
 mod ui;

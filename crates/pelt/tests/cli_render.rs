@@ -247,6 +247,25 @@ fn the_fox_walks_and_unknown_animations_list_the_real_ones() {
 }
 
 #[test]
+fn the_try_on_body_walks_and_the_skirt_goes_with_it() {
+    let dir = temp_dir("tryon-walk");
+    // Half a second apart: a quarter of the walk cycle, the legs in another place.
+    let args = ["render", "--builtin", "tryon", "--fps", "2", "--frames", "2", "--size", "96x128"];
+    let walking = pelt(&[&args[..], &["-o", "walk"]].concat(), &dir);
+    assert!(walking.status.success(), "{}", text(&walking));
+    let still = pelt(&[&args[..], &["--animation", "none", "-o", "still"]].concat(), &dir);
+    assert!(still.status.success(), "{}", text(&still));
+    let moved = |folder: &str| {
+        differing_fraction(
+            &png(&dir, &format!("{folder}/frame_0001.png")),
+            &png(&dir, &format!("{folder}/frame_0002.png")),
+        )
+    };
+    let (walk, rest) = (moved("walk"), moved("still"));
+    assert!(walk > 0.02 && walk > 4.0 * rest, "walking changes {walk} of the image, standing still {rest}");
+}
+
+#[test]
 fn the_catwalk_script_moves_the_body_and_the_skirt_together() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
     let script = root.join("assets/scenes/catwalk.toml");

@@ -184,6 +184,14 @@ pub struct Pose {
     world: Vec<Mat4>,
 }
 
+impl Pose {
+    /// The morph target weights of `node`'s mesh in this pose (empty for a node without them).
+    #[must_use]
+    pub fn morph_weights(&self, node: usize) -> &[f32] {
+        self.weights.get(node).map_or(&[], Vec::as_slice)
+    }
+}
+
 impl Rig {
     /// The nodes of the hierarchy.
     #[must_use]
@@ -207,6 +215,29 @@ impl Rig {
     #[must_use]
     pub fn morph_target_count(&self) -> usize {
         self.morphs.iter().map(|m| m.targets.len()).sum()
+    }
+
+    /// The morph targets as whole-mesh position deltas (in the mesh's space, per target one per
+    /// base vertex) and the node whose weights drive them; `None` without morph targets, or when
+    /// they hang on more than one node or their primitives disagree on the target count (a single
+    /// set of weights cannot drive them).
+    #[must_use]
+    pub fn morph_position_deltas(&self) -> Option<(usize, Vec<Vec<Vec3>>)> {
+        let first = self.morphs.first()?;
+        if self.morphs.iter().any(|m| m.node != first.node || m.targets.len() != first.targets.len()) {
+            return None;
+        }
+        let mut targets = vec![vec![Vec3::ZERO; self.influences.len()]; first.targets.len()];
+        for set in &self.morphs {
+            for (deltas, target) in targets.iter_mut().zip(&set.targets) {
+                for &(v, dp, _) in target {
+                    if let Some(d) = deltas.get_mut(v as usize) {
+                        *d += dp;
+                    }
+                }
+            }
+        }
+        Some((first.node, targets))
     }
 
     /// What was wrong with the file's skins and animations and how it was handled, one line each.
@@ -371,6 +402,66 @@ impl Rig {
                     .fold(Mat4::ZERO, |sum, (&j, &w)| sum + joints[j as usize] * w)
             })
             .collect()
+    }
+}
+
+impl Rig {
+    /// Palette joints: the matrices [`Rig::joint_matrices`] returns, one per joint.
+    #[must_use]
+    pub fn joint_count(&self) -> usize {
+        self.palette.len()
+    }
+
+    /// The node a palette joint follows (`None` for a joint fixed at the identity).
+    #[must_use]
+    pub fn joint_node(&self, joint: usize) -> Option<usize> {
+        self.palette.get(joint).and_then(|j| j.node)
+    }
+
+    /// Every palette joint's skinning matrix `world(joint) * inverse_bind` in `pose`, which
+    /// [`Rig::pose`] filled: what takes a point that follows the joint from the bind pose to the pose.
+    #[must_use]
+    pub fn joint_matrices(&self, pose: &Pose) -> Vec<Mat4> {
+        self.palette
+            .iter()
+            .map(|joint| {
+                joint.node.and_then(|n| pose.world.get(n).copied()).unwrap_or(Mat4::IDENTITY) * joint.inverse_bind
+            })
+            .collect()
+    }
+
+    /// Turns the rig's whole world by `turn` (over every root node) and rebinds `mesh` (the
+    /// mesh this rig was read with) to the turned rest pose: its positions and normals become
+    /// that pose and every inverse bind matrix follows, so poses come out as before, turned, and
+    /// the rest pose is the mesh itself. Exact when every joint's rest skinning matrix is the
+    /// same (a bind pose that is the rest pose up to one transform, as a Z-up export's).
+    pub(crate) fn rebind_at_rest(&mut self, mesh: &mut Mesh, turn: Mat4) {
+        let mut pose = Pose::default();
+        self.pose(mesh, None, 0.0, &mut pose);
+        let rest = self.joint_matrices(&pose).first().copied().unwrap_or(Mat4::IDENTITY);
+        for node in self.nodes.iter_mut().filter(|n| n.parent.is_none()) {
+            let turned = turn * node.rest_matrix.unwrap_or_else(|| node.rest.matrix());
+            let (scale, rotation, translation) = turned.to_scale_rotation_translation();
+            node.rest = Trs { translation, rotation, scale };
+            node.rest_matrix = node.rest_matrix.map(|_| turned);
+        }
+        let bind_from_old = turn * rest;
+        mesh.transform(bind_from_old);
+        let old_from_bind = bind_from_old.inverse();
+        for joint in &mut self.palette {
+            joint.inverse_bind *= old_from_bind;
+        }
+    }
+
+    /// Each base vertex's joints and weights (palette indices; up to four, summing to 1).
+    pub(crate) fn influences(&self) -> &[Influences] {
+        &self.influences
+    }
+
+    /// This rig's skeleton and clips driving another mesh, whose vertices take `influences`
+    /// (one per vertex). Morph targets belong to the old mesh's vertices and are left out.
+    pub(crate) fn with_influences(&self, influences: Vec<Influences>) -> Self {
+        Self { influences, morphs: Vec::new(), ..self.clone() }
     }
 }
 

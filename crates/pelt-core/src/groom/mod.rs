@@ -12,10 +12,14 @@
 //! Sources are named in the preset's `[groom]` table ([`GroomParams`], `source`): images through
 //! the mesh's UVs, glTF vertex colour sets, or a per-vertex groom file (`file`, its format in
 //! `file.rs`). [`crate::fur::FurStructure::new_groomed`] grows the structure a groom describes.
+//! [`GroomEditor`] paints a groom with [`Brush`]es (`brush.rs`, `edit.rs`).
 
+mod brush;
+mod edit;
 mod file;
 mod frame;
 mod source;
+mod strokes;
 
 use std::path::PathBuf;
 
@@ -23,9 +27,12 @@ use glam::{Vec2, Vec3};
 
 use crate::mesh::Mesh;
 
+pub use brush::{Axis, Brush, BrushKind, Falloff, LENGTH_STEP};
+pub use edit::{DAB_SPACING, GroomEditor, UNDO_DEPTH, rest_point};
 pub use file::{FILE_MAGIC, FILE_VERSION};
 pub use frame::{TangentFrame, tangent_frames};
 pub use source::GroomParams;
+pub use strokes::StrokeList;
 
 /// The largest length factor a groom may hold (images reach 1; groom files may go beyond).
 pub const MAX_LENGTH_FACTOR: f32 = 16.0;
@@ -93,6 +100,14 @@ pub enum GroomError {
         file: PathBuf,
         /// Why.
         error: std::io::Error,
+    },
+    /// A stroke list that cannot be used.
+    #[error("{}: {problem}", file.display())]
+    Strokes {
+        /// The stroke list file.
+        file: PathBuf,
+        /// What is wrong (the stroke and key).
+        problem: String,
     },
     /// A groom file is malformed (magic, version, size, checksum).
     #[error("{}: not a valid groom file: {problem}", file.display())]
@@ -246,6 +261,17 @@ impl Groom {
             }
             GroomMap::Clump => self.clump = Some(values),
             GroomMap::Tint => self.tint = Some(values.chunks_exact(3).map(|c| Vec3::new(c[0], c[1], c[2])).collect()),
+        }
+    }
+
+    /// Removes `map` (back to the preset's uniform value).
+    pub fn clear(&mut self, map: GroomMap) {
+        match map {
+            GroomMap::Length => self.length = None,
+            GroomMap::Density => self.density = None,
+            GroomMap::Direction => self.direction = None,
+            GroomMap::Clump => self.clump = None,
+            GroomMap::Tint => self.tint = None,
         }
     }
 

@@ -13,8 +13,8 @@ const BUNNY_OBJ: &str = include_str!("../../assets/meshes/bunny.obj");
 
 /// The `--builtin` name of the paper's virtual try-on scene ([`try_on_scene`]).
 pub const TRY_ON_NAME: &str = "tryon";
-const TRY_ON_GARMENT_OBJ: &str = include_str!("../../assets/meshes/skirthelper.obj");
-const TRY_ON_BODY_OBJ: &str = include_str!("../../assets/meshes/female_generic.obj");
+pub(crate) const TRY_ON_GARMENT_OBJ: &str = include_str!("../../assets/meshes/skirthelper.obj");
+pub(crate) const TRY_ON_BODY_OBJ: &str = include_str!("../../assets/meshes/female_generic.obj");
 
 /// The paper's virtual try-on: a garment to grow fur on, worn by a body drawn plain.
 #[derive(Clone, Debug)]

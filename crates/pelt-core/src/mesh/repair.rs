@@ -158,7 +158,8 @@ impl Mesh {
         };
         let colour_sets = colour_sets
             .iter()
-            .filter(|set| set.colours.len() == input_vertices && set.colours.iter().all(|c| c.is_finite()))
+            // Non-finite colours are kept: a groom reading the set says which vertex and key.
+            .filter(|set| set.colours.len() == input_vertices)
             .map(|set| ColourSet {
                 set: set.set,
                 colours: welded_mean(&set.colours, &canonical, &new_index, positions.len()),

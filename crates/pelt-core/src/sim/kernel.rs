@@ -336,6 +336,11 @@ impl RestBatches {
         rest
     }
 
+    /// Segment `k`'s rest length in lane `lane` of batch `b`.
+    pub fn length(&self, b: usize, lane: usize, k: usize) -> f32 {
+        self.lengths[b * (self.lengths.len() / self.is_straight.len().max(1)) + k][lane]
+    }
+
     /// The share of batches the straight form bends.
     pub fn straight_share(&self) -> f32 {
         if self.is_straight.is_empty() {

@@ -13,6 +13,7 @@
 //! - [`scene`]: scripted wind and touch strokes ([`Scene`]), reproducible frame by frame.
 //! - [`motion`]: scripted rigid motion of the meshes (`[[motion]]` keys of a [`Scene`]).
 //! - [`inertia`]: the force from the roots' acceleration on a moving body ([`Inertia`]).
+//! - [`contact`]: the skin, colliders and the grasp, applied after the bend.
 //! - `soak` (with the `lab` feature): many steps under extreme, changing inputs for any kernel.
 //!
 //! `Simulation` bends with a batched kernel (8 strands per AVX2 register, an exact closed form
@@ -25,6 +26,7 @@
 //! deterministic, parallel over strands, and cheap to jump to any time.
 
 pub mod bend;
+pub mod contact;
 mod dispatch;
 pub mod field;
 pub mod inertia;
@@ -45,6 +47,9 @@ use glam::Vec3;
 pub use crate::param::ParamError;
 
 pub use bend::{BEND_GAIN, bend_strand, bend_strand_literal, bend_weight};
+pub use contact::{
+    Collider, ColliderKey, ContactParams, ContactStep, ContactStrands, Grasp, GraspParams, Shape, StepCollider,
+};
 pub use dispatch::CpuKernel;
 pub use field::{ForceField, Touch};
 pub use inertia::{Inertia, InertiaStep, SpringStep};
@@ -89,6 +94,8 @@ pub struct SimParams {
     /// Damping ratio of the fur's swing after the body's motion changes: below 1 it swings past
     /// and settles, 1 or more it settles without swinging. Default 0.3.
     pub damping: f32,
+    /// Contact with the skin (`[simulation.contact]`); off by default.
+    pub contact: ContactParams,
 }
 
 impl Default for SimParams {
@@ -104,6 +111,7 @@ impl Default for SimParams {
             touch: TouchParams::default(),
             inertia: 0.05,
             damping: 0.3,
+            contact: ContactParams::default(),
         }
     }
 }

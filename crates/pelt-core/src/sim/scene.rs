@@ -22,6 +22,21 @@
 //! translation = [0.0, 0.0, 0.0]
 //! rotation_deg = [0.0, 0.0, 0.0]
 //! ease = "in_out"
+//!
+//! [[collider]]                     # a collider on keyframed poses (see `sim::contact`)
+//! shape = { kind = "sphere", radius = 0.5 }   # or capsule (radius, half_length), box
+//!                                  # (half_extents), plane (local +Y up)
+//! friction = 0.3                   # optional (default 0.3), 0..=1
+//! appear_secs = 0.25               # optional: grows in over this after its first key
+//! keys = [{ time_secs = 0.0, position = [0.0, 5.0, 2.0], rotation_deg = [0.0, 0.0, 0.0] }]
+//!
+//! [[grasp]]                        # a hand closes at path[0], moves along the path, lets go
+//! start_secs = 1.0
+//! end_secs = 3.0
+//! radius = 0.5                     # strands rooted within this are gathered
+//! hand_radius = 0.2                # optional (default 0): a ball at the grip pushing the rest
+//! path = [[0.0, 5.2, 2.6], [0.0, 6.0, 2.6]]
+//! close_secs = 0.3                 # optional, and spring_hz (2) and damping (0.35) likewise
 //! ```
 //!
 //! Stroke points are world positions, on or near the base surface, which keeps a script
@@ -36,9 +51,10 @@
 
 use std::path::{Path, PathBuf};
 
-use glam::{Mat4, Vec3};
+use glam::{EulerRot, Mat4, Quat, Vec3};
 
 use super::MAX_FORCE;
+use super::contact::{Collider, ColliderKey, GraspParams, Shape};
 use super::motion::{self, MotionKey};
 use super::simulation::{SimError, Simulation};
 
@@ -72,6 +88,9 @@ pub enum SceneError {
         problem: String,
     },
 }
+
+/// Ids of a script's colliders (`[[collider]]` `i` is this plus `i`), apart from a host's.
+pub const SCENE_COLLIDER_IDS: u32 = 0x5c00_0000;
 
 /// One wind keyframe.
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -130,6 +149,124 @@ impl Stroke {
     }
 }
 
+/// One pose of a scripted collider.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneColliderKey {
+    /// When (seconds of scene time).
+    pub time_secs: f64,
+    /// The collider's centre.
+    pub position: Vec3,
+    /// Turns about X, Y and Z in degrees (applied Y, X, Z, as `[[motion]]`).
+    #[serde(default)]
+    pub rotation_deg: Vec3,
+}
+
+/// A scripted collider (`[[collider]]`).
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneCollider {
+    /// Its shape.
+    pub shape: Shape,
+    /// See [`Collider::friction`] (default 0.3).
+    #[serde(default = "default_friction")]
+    pub friction: f32,
+    /// See [`Collider::appear_secs`] (default 0.25).
+    #[serde(default = "default_appear_secs")]
+    pub appear_secs: f32,
+    /// Poses, sorted by time.
+    pub keys: Vec<SceneColliderKey>,
+}
+
+fn default_friction() -> f32 {
+    0.3
+}
+
+fn default_appear_secs() -> f32 {
+    0.25
+}
+
+impl SceneCollider {
+    /// The collider it describes, with `id`.
+    #[must_use]
+    pub fn collider(&self, id: u32) -> Collider {
+        let keys = self
+            .keys
+            .iter()
+            .map(|k| {
+                let r = k.rotation_deg * (std::f32::consts::PI / 180.0);
+                ColliderKey {
+                    time_secs: k.time_secs,
+                    position: k.position,
+                    rotation: Quat::from_euler(EulerRot::YXZ, r.y, r.x, r.z),
+                }
+            })
+            .collect();
+        Collider {
+            id,
+            shape: self.shape,
+            keys,
+            friction: self.friction,
+            appear_secs: self.appear_secs,
+            appeared_secs: None,
+        }
+    }
+}
+
+/// A scripted grasp (`[[grasp]]`): the hand closes at `path[0]` at `start_secs`, the grip moves
+/// along `path` until `end_secs`, then lets go.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneGrasp {
+    /// When the hand closes.
+    pub start_secs: f64,
+    /// When it lets go.
+    pub end_secs: f64,
+    /// Strands rooted within this distance of `path[0]` are gathered.
+    pub radius: f32,
+    /// A ball about the grip that pushes the strands it does not hold (default 0: none).
+    #[serde(default)]
+    pub hand_radius: f32,
+    /// World points of the grip, at one segment per equal share of the hold.
+    pub path: Vec<Vec3>,
+    /// See [`GraspParams::close_secs`].
+    #[serde(default = "default_close_secs")]
+    pub close_secs: f32,
+    /// See [`GraspParams::spring_hz`].
+    #[serde(default = "default_spring_hz")]
+    pub spring_hz: f32,
+    /// See [`GraspParams::damping`].
+    #[serde(default = "default_grasp_damping")]
+    pub damping: f32,
+}
+
+fn default_close_secs() -> f32 {
+    GraspParams::default().close_secs
+}
+
+fn default_spring_hz() -> f32 {
+    GraspParams::default().spring_hz
+}
+
+fn default_grasp_damping() -> f32 {
+    GraspParams::default().damping
+}
+
+impl SceneGrasp {
+    /// Its closing and spring-back.
+    #[must_use]
+    pub fn params(&self) -> GraspParams {
+        GraspParams { close_secs: self.close_secs, spring_hz: self.spring_hz, damping: self.damping }
+    }
+
+    /// The grip at `time_secs` (clamped to the hold).
+    #[must_use]
+    pub fn grip_at(&self, time_secs: f64) -> Vec3 {
+        Stroke { start_secs: self.start_secs, end_secs: self.end_secs, radius: self.radius, path: self.path.clone() }
+            .point_at(time_secs)
+    }
+}
+
 /// A parsed, validated scene script.
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -146,6 +283,12 @@ pub struct Scene {
     /// Rigid motion keyframes of the meshes, sorted by time.
     #[serde(default)]
     pub motion: Vec<MotionKey>,
+    /// Colliders on keyframed poses.
+    #[serde(default, rename = "collider")]
+    pub colliders: Vec<SceneCollider>,
+    /// Grasps.
+    #[serde(default, rename = "grasp")]
+    pub grasps: Vec<SceneGrasp>,
 }
 
 impl Scene {
@@ -221,6 +364,32 @@ impl Scene {
                 return Err((format!("stroke[{i}].path[{k}]"), "must be finite".into()));
             }
         }
+        for (i, collider) in self.colliders.iter().enumerate() {
+            if collider.keys.iter().any(|k| !k.rotation_deg.is_finite()) {
+                let k = collider.keys.iter().position(|k| !k.rotation_deg.is_finite()).unwrap_or(0);
+                return Err((format!("collider[{i}].keys[{k}].rotation_deg"), "must be finite".into()));
+            }
+            collider
+                .collider(i as u32)
+                .validate()
+                .map_err(|(key, problem)| (format!("collider[{i}].{key}"), problem))?;
+        }
+        for (i, grasp) in self.grasps.iter().enumerate() {
+            finite_time(format!("grasp[{i}].start_secs"), grasp.start_secs)?;
+            finite_time(format!("grasp[{i}].end_secs"), grasp.end_secs)?;
+            if grasp.end_secs <= grasp.start_secs {
+                return Err((format!("grasp[{i}].end_secs"), "must be later than start_secs".into()));
+            }
+            range(format!("grasp[{i}].radius"), grasp.radius, f32::MIN_POSITIVE, f32::MAX)?;
+            range(format!("grasp[{i}].hand_radius"), grasp.hand_radius, 0.0, f32::MAX)?;
+            if grasp.path.is_empty() {
+                return Err((format!("grasp[{i}].path"), "needs at least one point".into()));
+            }
+            if let Some(k) = grasp.path.iter().position(|p| !p.is_finite()) {
+                return Err((format!("grasp[{i}].path[{k}]"), "must be finite".into()));
+            }
+            grasp.params().validate().map_err(|(key, problem)| (format!("grasp[{i}].{key}"), problem))?;
+        }
         Ok(())
     }
 
@@ -230,7 +399,9 @@ impl Scene {
         self.duration_secs.unwrap_or_else(|| {
             let wind = self.wind.last().map_or(0.0, |k| k.time_secs);
             let motion = self.motion.last().map_or(0.0, |k| k.time_secs);
-            self.strokes.iter().map(|s| s.end_secs).fold(wind.max(motion), f64::max)
+            let keys = self.colliders.iter().filter_map(|c| c.keys.last()).map(|k| k.time_secs);
+            let grasps = self.grasps.iter().map(|g| g.end_secs);
+            self.strokes.iter().map(|s| s.end_secs).chain(keys).chain(grasps).fold(wind.max(motion), f64::max)
         })
     }
 
@@ -299,6 +470,33 @@ impl Scene {
                     sim.touch_end();
                 }
             }
+        }
+        if !self.colliders.is_empty() {
+            let colliders: Vec<Collider> =
+                self.colliders.iter().enumerate().map(|(i, c)| c.collider(SCENE_COLLIDER_IDS + i as u32)).collect();
+            if sim.colliders() != colliders.as_slice() {
+                sim.set_colliders(&colliders)?;
+            }
+        }
+        self.apply_grasps(time_secs, sim)
+    }
+
+    /// Closes, moves and opens the grasps for `time_secs`, as if every earlier frame was played:
+    /// the latest grasp begun by then holds, or springs back from its release.
+    fn apply_grasps(&self, time_secs: f64, sim: &mut Simulation) -> Result<(), SimError> {
+        let Some(grasp) = self.grasps.iter().rev().find(|g| g.start_secs <= time_secs) else { return Ok(()) };
+        let ours = sim.grasp().is_some_and(|g| {
+            g.point == grasp.path[0] && g.radius == grasp.radius && g.closed_at_secs == grasp.start_secs
+        });
+        if !ours {
+            if time_secs >= grasp.end_secs + f64::from(grasp.params().settle_secs()) {
+                return Ok(());
+            }
+            sim.grasp_begin(grasp.path[0], grasp.radius, grasp.hand_radius, grasp.params(), grasp.start_secs)?;
+        }
+        sim.grasp_move(grasp.grip_at(time_secs))?;
+        if time_secs >= grasp.end_secs {
+            sim.grasp_end(grasp.end_secs);
         }
         Ok(())
     }

@@ -9,9 +9,13 @@ use std::time::Instant;
 #[cfg(target_arch = "wasm32")]
 use web_time::Instant;
 
-use glam::{Quat, Vec3};
+use glam::{Quat, Vec3, Vec4};
 use rayon::prelude::*;
 
+use super::contact::{
+    Collider, ContactStep, ContactStrands, Grasp, GraspParams, MAX_STEP_COLLIDERS, Resolve, SKIN_PLANES, StepCollider,
+    skin_planes,
+};
 use super::dispatch::{self, CpuKernel};
 use super::field::{ForceField, Touch};
 use super::inertia::{Inertia, InertiaStep};
@@ -56,6 +60,18 @@ pub enum SimError {
         kernel: String,
         /// What went wrong.
         message: String,
+    },
+    /// A collider that fails its checks.
+    #[error("collider {index} (id {id}): {key}: {problem}")]
+    Collider {
+        /// Its place in the list given.
+        index: usize,
+        /// Its id.
+        id: u32,
+        /// The bad key.
+        key: String,
+        /// What is wrong with it.
+        problem: String,
     },
     /// A stability map entry out of range.
     #[error("stability map entry {vertex} is {value}: must be between 1e-6 and 1e9")]
@@ -126,6 +142,12 @@ pub struct Simulation {
     roots_moved: bool,
     /// The touch began on the roots of the newest step.
     touch_on_step_roots: bool,
+    /// Each strand's skin planes (see `contact::skin`).
+    skin: Vec<[Vec4; SKIN_PLANES]>,
+    /// Colliders the host or a script placed.
+    colliders: Vec<Collider>,
+    /// The grasp holding (or springing back), if any.
+    grasp: Option<Grasp>,
 }
 
 /// Simulations made so far: each one's [`InputVersions::id`].
@@ -190,6 +212,9 @@ impl Simulation {
             },
             roots_moved: false,
             touch_on_step_roots: false,
+            skin: skin_planes(fur),
+            colliders: Vec::new(),
+            grasp: None,
         };
         simulation.jump_to_step(0);
         simulation.update_output();
@@ -450,6 +475,151 @@ impl Simulation {
         self.touch.is_some() && self.touch_on_step_roots
     }
 
+    /// Replaces the colliders (a host may call it every frame). A collider whose `id` was in the
+    /// last list and that has one key continues the old one's motion from its last key (so the
+    /// step sweeps the path between and friction sees the motion) and keeps its appearance time;
+    /// a new id appears now and grows in.
+    ///
+    /// # Errors
+    /// [`SimError::Collider`] naming the first bad collider and key; nothing changes then.
+    pub fn set_colliders(&mut self, colliders: &[Collider]) -> Result<(), SimError> {
+        for (index, collider) in colliders.iter().enumerate() {
+            collider.validate().map_err(|(key, problem)| SimError::Collider {
+                index,
+                id: collider.id,
+                key,
+                problem,
+            })?;
+        }
+        let now = self.recent_step_times.last().copied().unwrap_or(self.time_secs);
+        let joined = colliders
+            .iter()
+            .map(|collider| {
+                let mut collider = collider.clone();
+                let old = self.colliders.iter().find(|c| c.id == collider.id);
+                match old {
+                    Some(old) if collider.keys.len() == 1 => {
+                        let last = *old.keys.last().expect("validated: one key at least");
+                        if last.time_secs < collider.keys[0].time_secs {
+                            collider.keys.insert(0, last);
+                        }
+                        let step_secs = 1.0 / f64::from(self.params.rate_hz);
+                        collider.appeared_secs = old.appeared_at(f64::MAX, step_secs);
+                        if collider.appeared_at(f64::MAX, step_secs) != collider.appeared_secs {
+                            // It jumped: it grows in again from its new place.
+                            collider.keys.remove(0);
+                            collider.appeared_secs = Some(now.min(collider.keys[0].time_secs));
+                        }
+                    }
+                    None if collider.appeared_secs.is_none() && collider.keys.len() == 1 => {
+                        collider.appeared_secs = Some(now.min(collider.keys[0].time_secs));
+                    }
+                    _ => {}
+                }
+                collider
+            })
+            .collect();
+        self.colliders = joined;
+        Ok(())
+    }
+
+    /// The colliders in use.
+    #[must_use]
+    pub fn colliders(&self) -> &[Collider] {
+        &self.colliders
+    }
+
+    /// Closes a hand at `point` at `time_secs` (simulation time): the strands rooted within `radius` are gathered toward the grip
+    /// (moved by [`Simulation::grasp_move`]); a ball of `hand_radius` (0: none) about the grip
+    /// pushes the strands it does not hold. Replaces a grasp in progress.
+    ///
+    /// # Errors
+    /// [`SimError::NonFinite`] for a non-finite point; [`SimError::TouchRadius`] for a radius
+    /// that is not finite and positive or a hand radius that is negative; [`SimError::Params`]
+    /// for bad `params`.
+    pub fn grasp_begin(
+        &mut self,
+        point: Vec3,
+        radius: f32,
+        hand_radius: f32,
+        params: GraspParams,
+        time_secs: f64,
+    ) -> Result<(), SimError> {
+        if !point.is_finite() {
+            return Err(SimError::NonFinite { what: "the grasp point", value: point.to_string() });
+        }
+        if !(radius.is_finite() && radius > 0.0) {
+            return Err(SimError::TouchRadius(radius));
+        }
+        if !(hand_radius.is_finite() && hand_radius >= 0.0) {
+            return Err(SimError::TouchRadius(hand_radius));
+        }
+        params.validate().map_err(|(key, problem)| ParamError { key: format!("grasp.{key}"), problem })?;
+        if !time_secs.is_finite() {
+            return Err(SimError::NonFinite { what: "the grasp time", value: time_secs.to_string() });
+        }
+        self.grasp = Some(Grasp::new(point, radius, hand_radius, time_secs, params, &self.roots));
+        Ok(())
+    }
+
+    /// Moves the grip of the grasp in progress to `point`. Does nothing without one.
+    ///
+    /// # Errors
+    /// [`SimError::NonFinite`] for a non-finite point.
+    pub fn grasp_move(&mut self, point: Vec3) -> Result<(), SimError> {
+        if !point.is_finite() {
+            return Err(SimError::NonFinite { what: "the grip point", value: point.to_string() });
+        }
+        if let Some(grasp) = self.grasp.as_mut().filter(|g| g.released_at_secs.is_none()) {
+            grasp.grip = point;
+        }
+        Ok(())
+    }
+
+    /// Opens the hand at `time_secs`: the held strands spring back and settle.
+    pub fn grasp_end(&mut self, time_secs: f64) {
+        if let Some(grasp) = self.grasp.as_mut().filter(|g| g.released_at_secs.is_none()) {
+            grasp.released_at_secs = Some(time_secs);
+        }
+    }
+
+    /// The grasp holding or springing back, if any.
+    #[must_use]
+    pub fn grasp(&self) -> Option<&Grasp> {
+        self.grasp.as_ref()
+    }
+
+    /// What every strand shares in the contact of the step at `time_secs`: the skin switch, the
+    /// colliders there (sampled along their paths within the step, grown since they appeared,
+    /// the grasp's hand last), the grip and its presence. Read by every kernel.
+    #[must_use]
+    pub fn contact_step(&self, time_secs: f64) -> ContactStep {
+        let step_secs = 1.0 / f64::from(self.params.rate_hz);
+        let mut colliders = Vec::new();
+        for collider in &self.colliders {
+            collider.push_step(time_secs, step_secs, self.radius, &mut colliders);
+        }
+        let mut step = ContactStep { skin: self.params.contact.skin, ..ContactStep::default() };
+        if let Some(grasp) = &self.grasp {
+            if grasp.hand_radius > 0.0 && grasp.released_at_secs.is_none() {
+                let mut hand = StepCollider::ball(grasp.grip, grasp.hand_radius);
+                hand.grasp_hand = true;
+                colliders.insert(0, hand);
+            }
+            step.grip = grasp.grip;
+            step.grip_presence = grasp.presence(time_secs);
+        }
+        colliders.truncate(MAX_STEP_COLLIDERS);
+        step.colliders = colliders;
+        step
+    }
+
+    /// The per-strand contact inputs: skin planes and the grasp's weights.
+    #[must_use]
+    pub fn contact_strands(&self) -> ContactStrands<'_> {
+        ContactStrands { skin: &self.skin, grasp_weights: self.grasp.as_ref().map_or(&[], |g| g.weights()) }
+    }
+
     /// The nearest hit of a ray with the base mesh at its current root positions.
     #[must_use]
     pub fn pick(&self, triangles: &[[u32; 3]], ray_origin: Vec3, ray_direction: Vec3) -> Option<Hit> {
@@ -483,6 +653,9 @@ impl Simulation {
             self.alpha = 1.0;
         }
         self.drop_faded_touch();
+        if self.grasp.as_ref().is_some_and(|g| g.settled(self.time_secs)) {
+            self.grasp = None;
+        }
         if self.cpu_bending {
             self.update_output();
         }
@@ -767,6 +940,17 @@ impl Simulation {
             rest: &self.rest,
         };
         dispatch::bend_all(self.cpu_kernel, &step, &mut current);
+        let contact = self.contact_step(time_secs);
+        Resolve {
+            step: &contact,
+            strands: self.contact_strands(),
+            roots: strands.roots,
+            frames: strands.frames,
+            rest: &self.rest,
+            layers: self.layers as usize,
+            vertex_count: self.vertex_count,
+        }
+        .apply(&mut current);
         self.current = current;
         self.last_step_secs = started.elapsed().as_secs_f64();
     }

@@ -5,9 +5,11 @@
 use glam::{Mat4, Quat, Vec3};
 
 use super::SimParams;
+use super::contact::{Collider, Shape};
 use super::scene::Scene;
 use super::simulation::{SimError, Simulation};
 use crate::anim::{Pose, Rig};
+use crate::body::{BodyCapsules, Capsule};
 use crate::fur::FurStructure;
 use crate::mesh::Mesh;
 
@@ -45,6 +47,21 @@ pub struct FurStepper {
     restart_pending: bool,
     /// The host set a pose since the last step.
     host_posed: bool,
+    /// A body the fur collides with, posed with the clip.
+    body: Option<BodyColliders>,
+}
+
+/// Ids of the colliders a [`FurStepper`]'s body gives the simulation (capsule `k` is this plus
+/// `k`), apart from a host's and a script's.
+pub const BODY_COLLIDER_IDS: u32 = 0xb0d0_0000;
+
+/// A skinned body beside the fur (the walking try-on's): its capsules collide with the fur.
+#[derive(Clone, Debug)]
+struct BodyColliders {
+    mesh: Mesh,
+    rig: Rig,
+    capsules: BodyCapsules,
+    pose: Pose,
 }
 
 impl FurStepper {
@@ -63,7 +80,15 @@ impl FurStepper {
             moved: false,
             restart_pending: true,
             host_posed: false,
+            body: None,
         })
+    }
+
+    /// Makes `mesh` (skinned by `rig`, whose clips are the fur rig's) collide with the fur: every
+    /// step its [`BodyCapsules`] are posed with the fur's clip and the script's motion and handed
+    /// to the simulation as capsule colliders, beside any the script places. `None` removes it.
+    pub fn set_body(&mut self, body: Option<(Mesh, Rig, BodyCapsules)>) {
+        self.body = body.map(|(mesh, rig, capsules)| BodyColliders { mesh, rig, capsules, pose: Pose::default() });
     }
 
     /// Plays `clip` of `rig` (the rig's rest pose with `None`); the simulation restarts from the
@@ -160,6 +185,19 @@ impl FurStepper {
                 // The host set the pose (and the simulation's base) in `set_pose`.
                 Posing::Host => {}
             }
+            if let (Some(body), Posing::Rig { clip, .. }) = (&mut self.body, &self.posing) {
+                body.rig.pose(&body.mesh, *clip, clip_time_secs, &mut body.pose);
+                let capsules = body.capsules.posed(&body.rig, &body.pose, world_from_model);
+                let mut colliders: Vec<Collider> = self
+                    .simulation
+                    .colliders()
+                    .iter()
+                    .filter(|c| c.id.wrapping_sub(BODY_COLLIDER_IDS) >= capsules.len() as u32)
+                    .cloned()
+                    .collect();
+                colliders.extend(capsules.iter().enumerate().map(|(k, c)| capsule_collider(k, c, time_secs)));
+                self.simulation.set_colliders(&colliders)?;
+            }
             if self.moved && !matches!(self.posing, Posing::Host) {
                 self.simulation.set_base_rotations(&self.pose.positions, &self.pose.rotations)?;
                 if std::mem::take(&mut self.restart_pending) {
@@ -250,4 +288,12 @@ fn transform_pose(pose: &mut Pose, world_from_model: Mat4) {
     for q in &mut pose.rotations {
         *q = (turn * *q).normalize();
     }
+}
+
+/// A body capsule as the simulation's collider, standing at `time_secs`.
+fn capsule_collider(k: usize, capsule: &Capsule, time_secs: f64) -> Collider {
+    let axis = capsule.b - capsule.a;
+    let rotation = axis.try_normalize().map_or(Quat::IDENTITY, |d| Quat::from_rotation_arc(Vec3::Y, d));
+    let shape = Shape::Capsule { radius: capsule.radius, half_length: 0.5 * axis.length() };
+    Collider::at(BODY_COLLIDER_IDS + k as u32, shape, time_secs, 0.5 * (capsule.a + capsule.b), rotation)
 }

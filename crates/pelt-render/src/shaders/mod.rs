@@ -32,6 +32,8 @@ const SIMULATION_WIND_WGSL: &str = include_str!("simulation_wind.wgsl");
 const SIMULATION_WGSL: &str = include_str!("simulation.wgsl");
 /// The step's per-strand inputs the GPU keeps and computes (inertia, the touch's weights).
 const SIMULATION_INPUTS_WGSL: &str = include_str!("simulation_inputs.wgsl");
+/// Contact after the bend (skin, colliders, grasp), called by the simulation's step.
+const SIMULATION_CONTACT_WGSL: &str = include_str!("simulation_contact.wgsl");
 /// The separated structure of Lengyel et al. 2001 (the `lab` feature's baseline).
 #[cfg(feature = "lab")]
 const SEPARATED_WGSL: &str = include_str!("separated.wgsl");
@@ -60,10 +62,10 @@ pub fn view_lod_shader_source() -> String {
 }
 
 /// The WGSL module of the GPU simulation (`simulation_wind.wgsl`, `simulation.wgsl` and
-/// `simulation_inputs.wgsl`).
+/// `simulation_inputs.wgsl` and `simulation_contact.wgsl`).
 #[must_use]
 pub fn simulation_shader_source() -> String {
-    format!("{SIMULATION_WIND_WGSL}\n{SIMULATION_WGSL}\n{SIMULATION_INPUTS_WGSL}")
+    format!("{SIMULATION_WIND_WGSL}\n{SIMULATION_WGSL}\n{SIMULATION_INPUTS_WGSL}\n{SIMULATION_CONTACT_WGSL}")
 }
 
 /// The WGSL module of the separated renderer (the shared shading plus `separated.wgsl`).

@@ -27,7 +27,7 @@ struct Step {
     next_tick_counts: vec4<u32>,
     // xyz: the touch force; w: its presence (0: no touch).
     touch: vec4<f32>,
-    // x: workgroups per row of the dispatch grid.
+    // x: workgroups per row of the dispatch grid; y: the step's slot (its contact data).
     grid: vec4<u32>,
     // xyz: the touch's centre; w: its radius (read by the `weigh_touch` pass).
     touch_centre: vec4<f32>,
@@ -181,6 +181,7 @@ fn step_strands(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocati
     } else {
         bend_general(j, v, layers, root, frame, force_direction, scale);
     }
+    contact_strand(j, v, layers, root, strand.frame);
 }
 
 // The fraction of the angle to the force that a node with `remaining` nodes to go turns by.

@@ -153,6 +153,11 @@ impl App {
         if requests.save_preset {
             model.save_preset();
         }
+        if requests.undo || requests.redo {
+            if let Err(error) = model.undo_groom(requests.redo) {
+                model.status = format!("{error:#}");
+            }
+        }
         // A bad value from the panel is reported, not fatal: the previous fur stays.
         match model.apply(changes) {
             Ok(true) => {
@@ -162,6 +167,11 @@ impl App {
             Ok(false) => {}
             Err(error) => model.status = format!("{error:#}"),
         }
+        // A length or direction stroke regrew the rest positions: new vertex buffers, same textures.
+        if std::mem::take(&mut model.structure_regrown) {
+            running.fur.set_structure(&running.gpu, &model.structure)?;
+        }
+        model.groom_attributes_changed = false;
         running.fur.set_gpu_simulation(&running.gpu, &model.structure, model.settings.gpu_sim)?;
         if let Some(textures) = model.poll_textures() {
             running.fur.set_textures(&running.gpu, &textures)?;
@@ -169,6 +179,9 @@ impl App {
         if let Some((time_secs, clip_secs)) = model.simulate(frame_secs) {
             let started = std::time::Instant::now();
             running.fur.advance(&running.gpu, &mut model.stepper, time_secs, clip_secs)?;
+            if let Some((positions, normals, world_from_model)) = model.pose_body(clip_secs) {
+                running.fur.pose_body(&running.gpu, positions, normals, world_from_model)?;
+            }
             model.took(started.elapsed().as_secs_f64());
         }
         if requests.screenshot {

@@ -127,6 +127,21 @@ impl FurScene {
         Ok(())
     }
 
+    /// Moves the body (the walking try-on's) to this frame's pose and place.
+    pub fn pose_body(
+        &self,
+        gpu: &pelt_render::Gpu,
+        positions: &[Vec3],
+        normals: &[Vec3],
+        world_from_model: Mat4,
+    ) -> anyhow::Result<()> {
+        if let Some(body) = &self.body {
+            body.set_pose(&gpu.queue, positions, normals)?;
+            body.prepare(&gpu.queue, world_from_model);
+        }
+        Ok(())
+    }
+
     /// Builds the separated structure if it is to be drawn and is not there yet.
     pub fn prepare_separated(&mut self, gpu: &pelt_render::Gpu, structure: &FurStructure) -> anyhow::Result<()> {
         if self.separated.is_none() {

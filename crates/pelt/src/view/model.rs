@@ -5,8 +5,9 @@ use std::time::Instant;
 
 use anyhow::Context as _;
 use glam::Vec3;
-use pelt_core::anim::Rig;
+use pelt_core::anim::{Pose, Rig};
 use pelt_core::sim::{FurStepper, Scene};
+use pelt_core::stage::StageBody;
 use pelt_core::{Builtin, FurStructure, FurTextures, Mesh, Preset, PresetError, Stage, StageSource};
 
 use super::Args;
@@ -67,6 +68,14 @@ pub(super) struct Model {
     /// Why the kernel in use was chosen (the overlay shows it).
     pub(super) kernel_reason: String,
     pub(super) touch: Option<TouchDrag>,
+    /// The groom being painted (the structure's groom, with its strokes' history).
+    pub(super) groom_editor: pelt_core::groom::GroomEditor,
+    /// A paint stroke is in progress.
+    pub(super) painting: bool,
+    /// A stroke regrew the structure: the GPU's vertex buffers are to be replaced.
+    pub(super) structure_regrown: bool,
+    /// A stroke changed density, clump or tint: the GPU's per-vertex groom is to be updated.
+    pub(super) groom_attributes_changed: bool,
     /// Wind strength W restores after turning the wind off.
     pub(super) wind_strength_on: f32,
     /// Textures made and not yet uploaded.
@@ -85,6 +94,21 @@ pub(super) struct Model {
     /// The command line's file's rig, when it moves (the stepper plays it while that file's
     /// mesh is shown).
     pub(super) rig: Option<Rig>,
+    /// While the try-on is shown: the skirt's rig and the walking body's, with the body's pose.
+    pub(super) walking: Option<(Rig, StageBody, Pose)>,
+}
+
+/// The panel's clips for `rig`: the first one playing.
+fn animation_settings(rig: Option<&Rig>) -> AnimationSettings {
+    let Some(rig) = rig else { return AnimationSettings::default() };
+    let clips: Vec<(String, f32)> = rig
+        .animations()
+        .iter()
+        .enumerate()
+        .map(|(k, a)| (a.name.clone().unwrap_or_else(|| format!("animation {k}")), a.duration_secs()))
+        .collect();
+    let clip = (!clips.is_empty()).then_some(0);
+    AnimationSettings { clips, clip, playing: true, speed: 1.0, time_secs: 0.0 }
 }
 
 /// Wall-clock time, or exactly `FIXED_FRAME_SECS` per frame for repeatable runs.
@@ -116,7 +140,7 @@ impl Model {
     pub(super) fn new(args: &Args, stage: Stage) -> anyhow::Result<Self> {
         let mut mesh_choices: Vec<MeshChoice> = Builtin::ALL.into_iter().map(MeshChoice::Builtin).collect();
         mesh_choices.push(MeshChoice::TryOn);
-        let Stage { fur_mesh: mesh, report, rig, plain } = stage;
+        let Stage { fur_mesh: mesh, report, mut rig, plain, body } = stage;
         let choice = match args.mesh.source(Builtin::Bunny)? {
             StageSource::File(path) => {
                 let name = path.file_name().map_or(report.source, |n| n.to_string_lossy().into_owned());
@@ -127,6 +151,7 @@ impl Model {
             StageSource::TryOn => MeshChoice::TryOn,
         };
         let file_mesh = matches!(choice, MeshChoice::File(_)).then(|| mesh.clone());
+        let choice_is_try_on = choice == MeshChoice::TryOn;
         let (preset, preset_path) = match &args.preset {
             Some(path) => (Preset::load(path)?, path.display().to_string()),
             None => (Preset::default(), "fur.toml".to_owned()),
@@ -139,16 +164,7 @@ impl Model {
         };
         let mut settings = Settings::new(choice, preset, preset_path);
         settings.overlay = !args.no_overlay;
-        if let Some(rig) = &rig {
-            let clips: Vec<(String, f32)> = rig
-                .animations()
-                .iter()
-                .enumerate()
-                .map(|(k, a)| (a.name.clone().unwrap_or_else(|| format!("animation {k}")), a.duration_secs()))
-                .collect();
-            let clip = (!clips.is_empty()).then_some(0);
-            settings.animation = AnimationSettings { clips, clip, playing: true, speed: 1.0, time_secs: 0.0 };
-        }
+        settings.animation = animation_settings(rig.as_ref());
         let structure = grow(mesh, &settings.preset, &settings.mesh)?;
         let mut stepper = FurStepper::new(&structure, &settings.preset.simulation)?;
         // The first textures are made before the window opens, so the first frame has them.
@@ -161,7 +177,20 @@ impl Model {
         if let Some(rig) = &rig {
             stepper.set_clip(rig.clone(), settings.animation.clip);
         }
+        let groom_editor = super::paint::editor(&structure, &settings.preset)?;
+        // The try-on's rig is the skirt's, kept with the body (not as the file's).
+        let walking = match body {
+            Some(body) if choice_is_try_on => rig.take().map(|rig| (rig, body, Pose::default())),
+            _ => None,
+        };
+        if let (Some((_, body, _)), Some(mesh)) = (&walking, plain.first()) {
+            stepper.set_body(Some((mesh.clone(), body.rig.clone(), body.capsules.clone())));
+        }
         let model = Self {
+            groom_editor,
+            painting: false,
+            structure_regrown: false,
+            groom_attributes_changed: false,
             settings,
             mesh_choices,
             file_mesh,
@@ -199,6 +228,7 @@ impl Model {
             panel_hidden: false,
             status: String::new(),
             rig,
+            walking,
         };
         Ok(model)
     }
@@ -246,7 +276,7 @@ impl Model {
             Ok(preset) => {
                 self.settings.preset = preset;
                 self.status = format!("loaded {}", self.settings.preset_path);
-                Changes { structure: true, textures: true, simulation: true, ..Changes::default() }
+                Changes { structure: true, groom: true, textures: true, simulation: true, ..Changes::default() }
             }
             Err(error) => {
                 self.status = error.to_string();
@@ -255,8 +285,12 @@ impl Model {
         }
     }
 
+    /// Writes the preset, and the painted groom beside it (`<preset>.groom`) when there is one.
     pub(super) fn save_preset(&mut self) {
-        self.status = match self.settings.preset.save(&self.settings.preset_path) {
+        let groom = Some(self.groom_editor.groom()).filter(|g| !g.is_uniform());
+        let saved = self.settings.preset.save_with_groom(&self.settings.preset_path, groom, &self.structure.mesh);
+        self.status = match saved {
+            Ok(()) if groom.is_some() => format!("saved {} with its groom", self.settings.preset_path),
             Ok(()) => format!("saved {}", self.settings.preset_path),
             Err(error) => error.to_string(),
         };
@@ -270,7 +304,11 @@ impl Model {
         }
         self.sim_clock_secs += frame_secs;
         let animation = &mut self.settings.animation;
-        let duration = match (&self.rig, animation.clip) {
+        let rig = match self.settings.mesh {
+            MeshChoice::TryOn => self.walking.as_ref().map(|w| &w.0),
+            _ => self.rig.as_ref(),
+        };
+        let duration = match (rig, animation.clip) {
             (Some(rig), Some(k)) => rig.animations()[k].duration_secs(),
             _ => 0.0,
         };
@@ -279,6 +317,14 @@ impl Model {
         }
         animation.time_secs = animation.time_secs.clamp(0.0, duration);
         Some((self.sim_clock_secs, f64::from(animation.time_secs)))
+    }
+
+    /// Poses the walking try-on body with the skirt's clip at `clip_secs`: its positions and
+    /// normals, and where the script's motion puts it; `None` without one.
+    pub(super) fn pose_body(&mut self, clip_secs: f64) -> Option<(&[Vec3], &[Vec3], glam::Mat4)> {
+        let (Some((_, body, pose)), Some(mesh)) = (&mut self.walking, &self.body) else { return None };
+        body.rig.pose(mesh, self.settings.animation.clip, clip_secs, pose);
+        Some((&pose.positions, &pose.normals, self.stepper.world_from_model()))
     }
 
     /// Smooths the measured cost of one step into the overlay's figure.
@@ -290,21 +336,40 @@ impl Model {
     pub(super) fn apply(&mut self, changes: Changes) -> anyhow::Result<bool> {
         if changes.mesh {
             self.body = None;
+            self.walking = None;
             let mesh = match &self.settings.mesh {
                 MeshChoice::Builtin(builtin) => builtin.mesh().0,
                 MeshChoice::TryOn => {
                     let stage = Stage::load(&StageSource::TryOn, &[], &pelt_core::ImportOptions::default())?;
                     self.body = stage.plain.into_iter().next();
+                    self.walking = stage.rig.zip(stage.body).map(|(rig, body)| (rig, body, Pose::default()));
                     stage.fur_mesh
                 }
                 MeshChoice::File(_) => self.file_mesh.clone().context("the command-line mesh is gone")?,
             };
             self.structure = grow(mesh, &self.settings.preset, &self.settings.mesh)?;
             self.frame_pending = true;
-        } else if changes.structure {
+        } else if changes.groom {
             self.structure = grow(self.structure.mesh.clone(), &self.settings.preset, &self.settings.mesh)?;
+        } else if changes.structure {
+            // A new shape keeps the groom painted so far.
+            self.structure =
+                super::paint::regrow(self.structure.mesh.clone(), &self.settings.preset, &self.groom_editor)?;
         }
-        let rebuilt = changes.mesh || changes.structure;
+        if changes.mesh || changes.groom {
+            self.groom_editor = super::paint::editor(&self.structure, &self.settings.preset)?;
+            self.settings.paint.history = self.groom_editor.history();
+            self.painting = false;
+        }
+        if changes.mesh {
+            let rig = match self.settings.mesh {
+                MeshChoice::TryOn => self.walking.as_ref().map(|w| &w.0),
+                MeshChoice::File(_) => self.rig.as_ref(),
+                MeshChoice::Builtin(_) => None,
+            };
+            self.settings.animation = animation_settings(rig);
+        }
+        let rebuilt = changes.mesh || changes.structure || changes.groom;
         if changes.animation {
             self.settings.animation.time_secs = 0.0;
             self.stepper.change_clip(self.settings.animation.clip);
@@ -313,10 +378,19 @@ impl Model {
             self.footprint = self.structure.footprint();
             self.stepper.set_structure(&self.structure, &self.settings.preset.simulation)?;
             // The file's clip poses only the file's mesh.
-            match (&self.rig, &self.settings.mesh) {
-                (Some(rig), MeshChoice::File(_)) => self.stepper.set_clip(rig.clone(), self.settings.animation.clip),
+            match (&self.rig, &self.walking, &self.settings.mesh) {
+                (Some(rig), _, MeshChoice::File(_)) | (_, Some((rig, ..)), MeshChoice::TryOn) => {
+                    self.stepper.set_clip(rig.clone(), self.settings.animation.clip);
+                }
                 _ => self.stepper.clear_clip(),
             }
+            let body = match (&self.walking, &self.body, &self.settings.mesh) {
+                (Some((_, body, _)), Some(mesh), MeshChoice::TryOn) => {
+                    Some((mesh.clone(), body.rig.clone(), body.capsules.clone()))
+                }
+                _ => None,
+            };
+            self.stepper.set_body(body);
             self.touch = None;
         } else if changes.simulation {
             self.stepper.simulation_mut().set_params(&self.settings.preset.simulation)?;

@@ -12,6 +12,7 @@ pub const SHORTCUTS: &[(&str, &str)] = &[
     ("U", "unified or separated structure"),
     ("W", "wind on or off"),
     ("[ / ]", "smaller / larger brush"),
+    ("Ctrl+Z / Ctrl+Shift+Z", "undo / redo a groom stroke"),
     ("H", "hide or show the panel"),
     ("O", "overlay on or off"),
     ("Ctrl+S", "save the preset"),
@@ -21,7 +22,7 @@ pub const SHORTCUTS: &[(&str, &str)] = &[
 
 /// The mouse, shown under the shortcuts.
 pub const MOUSE: &[(&str, &str)] = &[
-    ("left-drag on fur", "pat the fur (release restores it)"),
+    ("left-drag on fur", "pat the fur (release restores it), or paint the groom"),
     ("left-drag off fur, right-drag", "orbit"),
     ("middle-drag, Shift+drag", "pan"),
     ("wheel", "zoom"),
@@ -80,6 +81,8 @@ pub struct Settings {
     pub preset_path: String,
     /// The animated file's clips and what plays.
     pub animation: AnimationSettings,
+    /// Groom painting.
+    pub paint: super::paint::PaintSettings,
 }
 
 /// The animation controls: which clip, playing or not, speed and the timeline.
@@ -107,6 +110,7 @@ impl Settings {
             overlay: true,
             preset_path,
             animation: AnimationSettings::default(),
+            paint: super::paint::PaintSettings::default(),
         }
     }
 }
@@ -124,6 +128,8 @@ pub struct Changes {
     pub animation: bool,
     /// The CPU/GPU simulation toggle.
     pub kernel: bool,
+    /// The groom is the preset's again (a preset was loaded): painting starts over from it.
+    pub groom: bool,
 }
 
 impl Changes {
@@ -134,6 +140,7 @@ impl Changes {
         self.textures |= other.textures;
         self.simulation |= other.simulation;
         self.kernel |= other.kernel;
+        self.groom |= other.groom;
     }
 }
 
@@ -144,6 +151,9 @@ pub struct Requests {
     pub screenshot: bool,
     pub save_preset: bool,
     pub load_preset: bool,
+    /// Undo or redo a groom stroke.
+    pub undo: bool,
+    pub redo: bool,
 }
 
 impl Requests {
@@ -152,6 +162,8 @@ impl Requests {
         self.screenshot |= other.screenshot;
         self.save_preset |= other.save_preset;
         self.load_preset |= other.load_preset;
+        self.undo |= other.undo;
+        self.redo |= other.redo;
     }
 }
 
@@ -237,6 +249,11 @@ pub fn show(
                 }
             });
             changes.structure |= ui.add(egui::DragValue::new(&mut direction.seed).prefix("direction seed ")).changed();
+        });
+        section(ui, "Groom", false, |ui| {
+            let painted = super::paint::section_ui(ui, &mut settings.paint, &mut settings.brush_per_radius);
+            requests.undo |= painted.undo;
+            requests.redo |= painted.redo;
         });
         section(ui, "Strands", true, |ui| {
             let texture = &mut preset.texture;

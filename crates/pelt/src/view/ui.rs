@@ -17,6 +17,8 @@ impl Model {
         outcome.1.frame |= shortcuts.frame;
         outcome.1.screenshot |= shortcuts.screenshot;
         outcome.1.save_preset |= shortcuts.save_preset;
+        outcome.1.undo |= shortcuts.undo;
+        outcome.1.redo |= shortcuts.redo;
         if !self.panel_hidden {
             egui::Panel::right("settings").resizable(true).default_size(320.0).min_size(260.0).show(ui, |ui| {
                 let (changes, requests) = panel::show(ui, &mut self.settings, &self.mesh_choices, &self.status);
@@ -80,6 +82,8 @@ impl Model {
             if input.consume_key(none, egui::Key::H) {
                 self.panel_hidden = !self.panel_hidden;
             }
+            outcome.redo = input.consume_key(command | egui::Modifiers::SHIFT, egui::Key::Z);
+            outcome.undo = input.consume_key(command, egui::Key::Z);
             outcome.screenshot = input.consume_key(command, egui::Key::P);
             outcome.save_preset = input.consume_key(command, egui::Key::S);
             self.quit |= input.consume_key(command, egui::Key::Q);
@@ -94,6 +98,8 @@ struct ShortcutOutcome {
     screenshot: bool,
     save_preset: bool,
     simulation: bool,
+    undo: bool,
+    redo: bool,
 }
 
 impl Model {
@@ -125,14 +131,25 @@ impl Model {
             .filter(|_| self.touch.is_none() && !modifiers.alt && !modifiers.shift)
             .and_then(|ray| self.stepper.simulation().pick(&self.structure.mesh.triangles, ray.origin, ray.direction));
 
-        if response.drag_started_by(egui::PointerButton::Primary)
+        let paint = self.settings.paint.on;
+        if paint && (self.painting || (response.drag_started_by(egui::PointerButton::Primary) && hover_hit.is_some())) {
+            if (primary || response.drag_started_by(egui::PointerButton::Primary))
+                && let Some(ray) = ray
+            {
+                self.paint_ray(ray.origin, ray.direction)?;
+            } else {
+                self.paint_end();
+            }
+        } else if response.drag_started_by(egui::PointerButton::Primary)
             && let Some(hit) = hover_hit
         {
             self.stepper.simulation_mut().touch_begin(hit.point, brush_radius)?;
             let plane_normal = (self.camera.target - self.camera.eye()).normalize_or(Vec3::NEG_Z);
             self.touch = Some(TouchDrag { hit: hit.point, plane_normal });
         }
-        if let Some(touch) = self.touch {
+        if self.painting {
+            // The stroke holds the pointer: no orbit while painting.
+        } else if let Some(touch) = self.touch {
             if primary && let Some(ray) = ray {
                 let along = ray.direction.dot(touch.plane_normal);
                 if along.abs() > 1e-6 {
@@ -306,6 +323,9 @@ mod tests {
         let brush = model.settings.brush_per_radius;
         press(&mut model, egui::Key::CloseBracket, none);
         assert!(model.settings.brush_per_radius > brush);
+        assert!(press(&mut model, egui::Key::Z, egui::Modifiers::COMMAND).1.undo);
+        let redo = press(&mut model, egui::Key::Z, egui::Modifiers::COMMAND | egui::Modifiers::SHIFT).1;
+        assert!(redo.redo && !redo.undo);
         press(&mut model, egui::Key::H, none);
         assert!(model.panel_hidden);
         // Plain keys do nothing while they type into a text field; here none is focused.

@@ -1,0 +1,277 @@
+//! Contact: the fur against its own skin ([`skin`]), colliders a host or a script places
+//! ([`Collider`]) and a grasping hand ([`Grasp`]).
+//!
+//! Contact runs after the bend, on its result, per strand, root first: segment `k` keeps the
+//! direction the bend gave it (turned toward the grip for held strands), is turned by the least
+//! angle that puts its end outside every collider and above every skin plane (the plane tangent
+//! to the collider at the end's closest point, or where that cannot be reached, at the segment's
+//! start's), and the strand beyond moves with it. Each segment keeps its rest length exactly (a
+//! unit direction times the length), roots never move, and the skin is enforced last, so no
+//! force or collider pushes a node below it. A strand that touches nothing is left as the bend
+//! made it, bit for bit.
+//!
+//! - Friction: a node touching a moving collider is first carried `friction` times the
+//!   collider's motion over the step along its surface.
+//! - At rest: the result is a function of the step's inputs, so still inputs give the same
+//!   nodes every step: no jitter.
+//! - No tunnelling: a collider's path within the step is sampled at most one thickness (a
+//!   sphere's or capsule's radius, a box's smallest half extent) apart, up to
+//!   [`SWEEP_RADII_PER_STEP`] thicknesses per step, and the fur is pushed out of every sample:
+//!   nothing the collider passed over in the step is left inside its path.
+//! - No fling: a collider grows in over [`Collider::appear_secs`] after it appears (or jumps
+//!   faster than the sweep), so fur it appears in is pushed out over a few steps.
+//!
+//! [`ContactStep`] (what every strand shares) and [`ContactStrands`] (per strand) are the inputs
+//! every kernel reads, as [`StepInputs`](super::StepInputs) and [`StrandInputs`](super::StrandInputs).
+
+mod collider;
+mod grasp;
+pub mod skin;
+
+use glam::{Quat, Vec3, Vec4};
+use rayon::prelude::*;
+
+pub use collider::{Collider, ColliderKey, SWEEP_RADII_PER_STEP, Shape, StepCollider};
+pub use grasp::{Grasp, GraspParams};
+pub use skin::{SKIN_PLANES, skin_planes};
+
+use super::kernel::{LANES, RestBatches, VecLanes};
+
+/// Most collider samples one step holds (after the sweep); more are dropped, last first.
+pub const MAX_STEP_COLLIDERS: usize = 128;
+
+/// Contact parameters; the `[simulation.contact]` table of a preset.
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct ContactParams {
+    /// Keep every node above the skin the fur grows from. Default false.
+    pub skin: bool,
+}
+
+/// What every strand shares in one step's contact, from
+/// [`Simulation::contact_step`](super::Simulation::contact_step).
+#[derive(Clone, Debug, Default, PartialEq)]
+#[non_exhaustive]
+pub struct ContactStep {
+    /// Whether the skin planes apply.
+    pub skin: bool,
+    /// The colliders as the step reads them (the grasp's hand included), at most
+    /// [`MAX_STEP_COLLIDERS`].
+    pub colliders: Vec<StepCollider>,
+    /// Where the grip is.
+    pub grip: Vec3,
+    /// How far held strands turn toward the grip (see [`Grasp::presence`]); 0 without a grasp.
+    pub grip_presence: f32,
+}
+
+impl ContactStep {
+    /// Whether anything would touch the fur.
+    #[must_use]
+    pub fn is_active(&self) -> bool {
+        self.skin || !self.colliders.is_empty() || self.grip_presence != 0.0
+    }
+}
+
+/// Per-strand contact inputs, from [`Simulation::contact_strands`](super::Simulation::contact_strands).
+#[derive(Clone, Copy, Debug)]
+#[non_exhaustive]
+pub struct ContactStrands<'a> {
+    /// Each strand's skin planes `(n, h)`, in its rest frame: the node `x` keeps
+    /// `(frame * n) . (x - root) >= -h`.
+    pub skin: &'a [[Vec4; SKIN_PLANES]],
+    /// How far each strand is held by the grasp (empty without one).
+    pub grasp_weights: &'a [f32],
+}
+
+/// Everything the CPU pass reads.
+pub(crate) struct Resolve<'a> {
+    pub step: &'a ContactStep,
+    pub strands: ContactStrands<'a>,
+    pub roots: &'a [Vec3],
+    pub frames: &'a [Quat],
+    pub rest: &'a RestBatches,
+    pub layers: usize,
+    pub vertex_count: usize,
+}
+
+/// A little beyond a surface, relative to the segment's length, so rounding leaves nodes outside.
+const MARGIN: f32 = 1e-5;
+
+impl Resolve<'_> {
+    /// Applies contact to every strand of `nodes` (batch-major, `L + 1` nodes per batch).
+    pub fn apply(&self, nodes: &mut [VecLanes]) {
+        if !self.step.is_active() {
+            return;
+        }
+        let count = self.layers + 1;
+        nodes.par_chunks_mut(count).enumerate().with_min_len(8).for_each(|(b, batch)| self.batch(b, batch));
+    }
+
+    fn batch(&self, b: usize, batch: &mut [VecLanes]) {
+        let lanes = LANES.min(self.vertex_count - b * LANES);
+        // A collider can reach a strand when its bound comes within the strand's length of the
+        // root (every node, moved or not, lies within that); the GPU kernel tests the same.
+        let reach: [f32; LANES] =
+            std::array::from_fn(|lane| (0..self.layers).map(|k| self.rest.length(b, lane, k)).sum::<f32>());
+        let roots = &self.roots[b * LANES..b * LANES + lanes];
+        let (lo, hi) =
+            roots.iter().fold((Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)), |(l, h), r| (l.min(*r), h.max(*r)));
+        let batch_reach = reach[..lanes].iter().copied().fold(0.0, f32::max);
+        let near: Vec<&StepCollider> = self
+            .step
+            .colliders
+            .iter()
+            .filter(|c| {
+                let gap = (lo - c.centre).max(c.centre - hi).max(Vec3::ZERO);
+                gap.length() <= c.bound + batch_reach
+            })
+            .collect();
+        let mut strand = Vec::with_capacity(batch.len());
+        let mut reaching = Vec::with_capacity(near.len());
+        for lane in 0..lanes {
+            let j = b * LANES + lane;
+            let held = self.strands.grasp_weights.get(j).copied().unwrap_or(0.0) * self.step.grip_presence;
+            reaching.clear();
+            // Strands the grasp holds pass through its hand.
+            reaching.extend(near.iter().copied().filter(|c| {
+                !(c.grasp_hand && held != 0.0) && self.roots[j].distance(c.centre) <= c.bound + reach[lane]
+            }));
+            if !self.step.skin && reaching.is_empty() && held == 0.0 {
+                continue;
+            }
+            strand.clear();
+            strand.extend(batch.iter().map(|n| Vec3::new(n[0][lane], n[1][lane], n[2][lane])));
+            if self.solve_strand(j, b, lane, held, &reaching, &mut strand) {
+                for (node, p) in batch.iter_mut().zip(&strand) {
+                    node[0][lane] = p.x;
+                    node[1][lane] = p.y;
+                    node[2][lane] = p.z;
+                }
+            }
+        }
+    }
+
+    /// Solves one strand in place; false when nothing touched it (left as it was).
+    fn solve_strand(
+        &self,
+        j: usize,
+        b: usize,
+        lane: usize,
+        held: f32,
+        near: &[&StepCollider],
+        nodes: &mut [Vec3],
+    ) -> bool {
+        let root = self.roots[j];
+        let frame = self.frames[j];
+        let mut planes = [(Vec3::ZERO, 0.0_f32); SKIN_PLANES];
+        let mut plane_count = 0;
+        if self.step.skin {
+            for plane in &self.strands.skin[j] {
+                let n = plane.truncate();
+                if n != Vec3::ZERO {
+                    planes[plane_count] = (frame * n, plane.w);
+                    plane_count += 1;
+                }
+            }
+        }
+        let planes = &planes[..plane_count];
+        let colliders = near.iter();
+        let touches = held != 0.0
+            || nodes[1..].iter().any(|&x| {
+                planes.iter().any(|(n, h)| n.dot(x - root) < -h) || colliders.clone().any(|c| c.closest(x).2 < 0.0)
+            });
+        if !touches {
+            return false;
+        }
+        let grip = self.step.grip - root;
+        let grip_distance = grip.length();
+        let grip_direction = grip.try_normalize();
+        let mut arc = 0.0;
+        let mut previous_bent = nodes[0];
+        for k in 0..self.layers {
+            let length = self.rest.length(b, lane, k);
+            let bent = nodes[k + 1];
+            let p = nodes[k];
+            if length <= 0.0 {
+                nodes[k + 1] = p;
+                previous_bent = bent;
+                continue;
+            }
+            let mut u = (bent - previous_bent).try_normalize().unwrap_or(Vec3::Y);
+            previous_bent = bent;
+            if held != 0.0
+                && let Some(toward) = grip_direction
+            {
+                // Up to the grip the strand runs to it; the rest sticks out of the hand.
+                if arc < grip_distance {
+                    u = (u + (toward - u) * held).try_normalize().unwrap_or(u);
+                }
+            }
+            arc += length;
+            let u = self.constrain(p, u, length, root, planes, colliders.clone());
+            nodes[k + 1] = p + u * length;
+        }
+        true
+    }
+
+    /// The direction nearest `u` whose segment from `p` ends outside every collider and above
+    /// every skin plane (skin last).
+    fn constrain<'c>(
+        &self,
+        p: Vec3,
+        mut u: Vec3,
+        length: f32,
+        root: Vec3,
+        planes: &[(Vec3, f32)],
+        colliders: impl Iterator<Item = &'c &'c StepCollider> + Clone,
+    ) -> Vec3 {
+        for pass in 0..8 {
+            let mut moved = false;
+            for c in colliders.clone() {
+                let q = p + u * length;
+                let (s, n, distance) = c.closest(q);
+                if distance >= 0.0 {
+                    continue;
+                }
+                if pass == 0 && c.friction > 0.0 {
+                    let slide = c.travel - n * n.dot(c.travel);
+                    u = (u * length + slide * c.friction).try_normalize().unwrap_or(u);
+                }
+                let mut floor = n.dot(s - p) / length;
+                let mut normal = n;
+                if floor > 1.0 - MARGIN {
+                    // The tangent plane at the end's closest point is out of reach: take the one
+                    // at the segment's start, which it is above when the start is outside.
+                    let (s, n, _) = c.closest(p);
+                    floor = n.dot(s - p) / length;
+                    normal = n;
+                }
+                u = turn_above(u, normal, floor + MARGIN);
+                moved = true;
+            }
+            for &(n, h) in planes {
+                let floor = (-h - n.dot(p - root)) / length;
+                if n.dot(u) < floor {
+                    u = turn_above(u, n, floor + MARGIN);
+                    moved = true;
+                }
+            }
+            if !moved {
+                break;
+            }
+        }
+        u
+    }
+}
+
+/// The unit direction nearest unit `u` with `n . result >= floor` (`n` unit): `u` itself when it
+/// already is, else on the cone `n . result = floor` in the plane of `u` and `n`.
+fn turn_above(u: Vec3, n: Vec3, floor: f32) -> Vec3 {
+    let floor = floor.clamp(-1.0, 1.0);
+    let along = n.dot(u);
+    if along >= floor {
+        return u;
+    }
+    let side = (u - n * along).try_normalize().unwrap_or_else(|| n.any_orthonormal_vector());
+    (n * floor + side * (1.0 - floor * floor).max(0.0).sqrt()).normalize()
+}

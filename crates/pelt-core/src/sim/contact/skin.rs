@@ -1,0 +1,184 @@
+//! The fur's own skin as a few planes per strand.
+//!
+//! Each strand keeps up to [`SKIN_PLANES`] half-spaces, in its rest frame relative to its root,
+//! that every node must stay in: the root's tangent plane, and the planes of the faces within the
+//! strand's reach that rise above it (a crease, the far wall of a fold, the base of an ear),
+//! the most restrictive first. Outside the skin, locally, is the root's upper half-space where
+//! the surface is convex (the surface falls away below the tangent plane) and the intersection
+//! with the rising faces' half-spaces where it is concave, so the intersection of these
+//! half-spaces lies outside the surface within the strand's reach. The planes turn and move with
+//! the strand's posed frame and root, so they follow skinning and rigid motion with no per-step
+//! mesh query, and a node is tested with a dot product per plane: the same small per-strand
+//! input for the CPU and the GPU kernel. Planes are relaxed where the rest strand itself would
+//! cross them, so the rest pose is never moved.
+
+use std::collections::HashMap;
+
+use glam::{Vec3, Vec4};
+
+use crate::fur::FurStructure;
+
+/// Half-spaces per strand.
+pub const SKIN_PLANES: usize = 8;
+
+/// An unused plane: `0 . x >= -1` holds everywhere.
+const NO_PLANE: Vec4 = Vec4::new(0.0, 0.0, 0.0, 1.0);
+
+/// The skin planes of every strand of `fur`: `(n, h)` in the strand's rest frame, the node `x`
+/// must satisfy `n . (x - root) >= -h`.
+#[must_use]
+pub fn skin_planes(fur: &FurStructure) -> Vec<[Vec4; SKIN_PLANES]> {
+    let v = fur.vertex_count();
+    let layers = fur.layers as usize;
+    let positions = &fur.positions;
+    let mesh = &fur.mesh;
+    let reach: Vec<f32> = (0..v)
+        .map(|j| (0..layers).map(|k| positions[(k + 1) * v + j].distance(positions[k * v + j])).sum::<f32>())
+        .collect();
+    let cell = reach.iter().copied().fold(0.0_f32, f32::max).max(1e-6);
+    let grid = Grid::new(&mesh.positions, &mesh.triangles, cell);
+    let mut stamp = vec![u32::MAX; mesh.triangles.len()];
+    let mut candidates: Vec<Vec4> = Vec::new();
+    let mut rising: Vec<[Vec3; 3]> = Vec::new();
+    (0..v)
+        .map(|j| {
+            let root = positions[j];
+            let nodes: Vec<Vec3> = (1..=layers).map(|k| positions[k * v + j] - root).collect();
+            let normal = mesh.normals[j].try_normalize().or_else(|| nodes.last().and_then(|t| t.try_normalize()));
+            let mut planes = [NO_PLANE; SKIN_PLANES];
+            let Some(n0) = normal else { return planes };
+            // Relaxed so the rest strand satisfies the plane.
+            let relax = |n: Vec3, h: f32| nodes.iter().map(|x| -n.dot(*x)).fold(h, f32::max);
+            planes[0] = n0.extend(relax(n0, 0.0));
+            let r = reach[j] * 1.05;
+            if r <= 0.0 {
+                return planes;
+            }
+            // The faces within reach that rise above the tangent plane, and the planes of those
+            // with the root on their upper side: cover the rising faces greedily, each plane
+            // taken for the most faces that lie on or below it.
+            rising.clear();
+            grid.near(root, r, |t| {
+                if stamp[t as usize] == j as u32 {
+                    return;
+                }
+                stamp[t as usize] = j as u32;
+                let corners = mesh.triangles[t as usize].map(|i| mesh.positions[i as usize]);
+                let [a, b, c] = corners;
+                if distance_to_triangle(root, a, b, c) > r {
+                    return;
+                }
+                let rise = corners.iter().map(|y| n0.dot(*y - root)).fold(f32::MIN, f32::max);
+                if rise > 1e-6 * r {
+                    rising.push(corners);
+                }
+            });
+            candidates.clear();
+            for [a, b, c] in &rising {
+                let Some(nf) = (*b - *a).cross(*c - *a).try_normalize() else { continue };
+                let d = nf.dot(root - *a);
+                if d >= -1e-6 * r {
+                    let h = relax(nf, d.max(0.0));
+                    // A plane the rest strand crosses covers nothing it was taken for.
+                    if h <= d.max(0.0) + 1e-4 * r {
+                        candidates.push(nf.extend(h));
+                    }
+                }
+            }
+            let covers = |plane: Vec4, corners: &[Vec3; 3]| {
+                corners.iter().all(|y| plane.truncate().dot(*y - root) <= -plane.w + 1e-5 * r)
+            };
+            let mut uncovered: Vec<bool> = rising.iter().map(|t| !covers(planes[0], t)).collect();
+            for slot in planes.iter_mut().skip(1) {
+                let best = candidates
+                    .iter()
+                    .map(|&plane| {
+                        let count = rising.iter().zip(&uncovered).filter(|(t, u)| **u && covers(plane, t)).count();
+                        (count, plane)
+                    })
+                    .max_by_key(|(count, _)| *count);
+                let Some((count, plane)) = best.filter(|(count, _)| *count > 0) else { break };
+                let _ = count;
+                *slot = plane;
+                for (t, u) in rising.iter().zip(uncovered.iter_mut()) {
+                    if *u && covers(plane, t) {
+                        *u = false;
+                    }
+                }
+            }
+            planes
+        })
+        .collect()
+}
+
+/// Triangles binned by the cells their boxes cover.
+struct Grid {
+    cell: f32,
+    bins: HashMap<[i32; 3], Vec<u32>>,
+}
+
+impl Grid {
+    fn new(points: &[Vec3], triangles: &[[u32; 3]], cell: f32) -> Self {
+        let mut bins: HashMap<[i32; 3], Vec<u32>> = HashMap::new();
+        let key = |p: Vec3| (p / cell).floor().as_ivec3().to_array();
+        for (t, tri) in triangles.iter().enumerate() {
+            let [a, b, c] = tri.map(|i| points[i as usize]);
+            let (lo, hi) = (key(a.min(b).min(c)), key(a.max(b).max(c)));
+            for x in lo[0]..=hi[0] {
+                for y in lo[1]..=hi[1] {
+                    for z in lo[2]..=hi[2] {
+                        bins.entry([x, y, z]).or_default().push(t as u32);
+                    }
+                }
+            }
+        }
+        Self { cell, bins }
+    }
+
+    fn near(&self, p: Vec3, r: f32, mut visit: impl FnMut(u32)) {
+        let key = |p: Vec3| (p / self.cell).floor().as_ivec3().to_array();
+        let (lo, hi) = (key(p - Vec3::splat(r)), key(p + Vec3::splat(r)));
+        for x in lo[0]..=hi[0] {
+            for y in lo[1]..=hi[1] {
+                for z in lo[2]..=hi[2] {
+                    for &t in self.bins.get(&[x, y, z]).map_or(&[][..], Vec::as_slice) {
+                        visit(t);
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// Distance from `p` to the triangle `abc` (Ericson, Real-Time Collision Detection 5.1.5).
+fn distance_to_triangle(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> f32 {
+    let (ab, ac, ap) = (b - a, c - a, p - a);
+    let (d1, d2) = (ab.dot(ap), ac.dot(ap));
+    if d1 <= 0.0 && d2 <= 0.0 {
+        return p.distance(a);
+    }
+    let bp = p - b;
+    let (d3, d4) = (ab.dot(bp), ac.dot(bp));
+    if d3 >= 0.0 && d4 <= d3 {
+        return p.distance(b);
+    }
+    let vc = d1 * d4 - d3 * d2;
+    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
+        return p.distance(a + ab * (d1 / (d1 - d3)));
+    }
+    let cp = p - c;
+    let (d5, d6) = (ab.dot(cp), ac.dot(cp));
+    if d6 >= 0.0 && d5 <= d6 {
+        return p.distance(c);
+    }
+    let vb = d5 * d2 - d1 * d6;
+    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
+        return p.distance(a + ac * (d2 / (d2 - d6)));
+    }
+    let va = d3 * d6 - d5 * d4;
+    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
+        return p.distance(b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6))));
+    }
+    let denominator = 1.0 / (va + vb + vc);
+    p.distance(a + ab * (vb * denominator) + ac * (vc * denominator))
+}

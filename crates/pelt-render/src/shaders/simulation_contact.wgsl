@@ -1,0 +1,241 @@
+// Contact after the bend (`pelt_core::sim::contact`): the skin planes, the colliders and the
+// grasp, per strand, root first, on the nodes `step_strands` just wrote. Appended to
+// `simulation.wgsl`; `step_strands` calls `contact_strand` last.
+//
+// `contact` layout, in vec4s (V strands, `grid.y` the step's slot):
+//   [2 s], [2 s + 1] for slot s < CONTACT_SLOTS: (collider count, skin on, grip presence, -),
+//     (grip xyz, -);
+//   from CONTACT_SKIN: SKIN_PLANES planes per strand (n xyz in the rest frame, h);
+//   then ceil(V / 4) vec4s of grasp weights, 4 strands each;
+//   then per slot CONTACT_COLLIDERS colliders of 5 vec4s: (centre, radius),
+//     (half extents, kind as bits), rotation, (travel, friction), (bound, grasp hand, -, -).
+
+@group(0) @binding(5) var<storage, read> contact: array<vec4<f32>>;
+
+const CONTACT_SLOTS: u32 = 64u;
+const CONTACT_SKIN: u32 = 2u * CONTACT_SLOTS;
+const SKIN_PLANES: u32 = 8u;
+const CONTACT_COLLIDERS: u32 = 128u;
+const COLLIDER_WORDS: u32 = 5u;
+const NEAR_COLLIDERS: u32 = 32u;
+const CONTACT_MARGIN: f32 = 1e-5;
+
+struct Closest {
+    surface: vec3<f32>,
+    normal: vec3<f32>,
+    distance: f32,
+}
+
+fn read_node(j: u32, v: u32, k: u32) -> vec3<f32> {
+    let index = (k * v + j) * 3u;
+    return vec3<f32>(positions[index], positions[index + 1u], positions[index + 2u]);
+}
+
+fn conjugate(q: vec4<f32>) -> vec4<f32> {
+    return vec4<f32>(-q.xyz, q.w);
+}
+
+fn around_ball(x: vec3<f32>, core: vec3<f32>, radius: f32, fallback: vec3<f32>) -> Closest {
+    let d = x - core;
+    let l = length(d);
+    var normal = fallback;
+    if l > 0.0 {
+        normal = d / l;
+    }
+    return Closest(core + normal * radius, normal, l - radius);
+}
+
+// `StepCollider::closest`: the closest surface point, outward normal, signed distance.
+fn collider_closest(c: u32, x: vec3<f32>) -> Closest {
+    let centre = contact[c].xyz;
+    let radius = contact[c].w;
+    let half = contact[c + 1u].xyz;
+    let kind = bitcast<u32>(contact[c + 1u].w);
+    let turn = contact[c + 2u];
+    let up = rotate(turn, vec3<f32>(0.0, 1.0, 0.0));
+    if kind == 0u {
+        return around_ball(x, centre, radius, up);
+    }
+    if kind == 1u {
+        let t = clamp(dot(up, x - centre), -half.y, half.y);
+        return around_ball(x, centre + up * t, radius, up);
+    }
+    if kind == 2u {
+        let local = rotate(conjugate(turn), x - centre);
+        let q = abs(local) - half;
+        if max(max(q.x, q.y), q.z) > 0.0 {
+            let clamped = clamp(local, -half, half);
+            let out = local - clamped;
+            let l = length(out);
+            return Closest(centre + rotate(turn, clamped), rotate(turn, out / l), l);
+        }
+        var axis = 2u;
+        if q.x >= q.y && q.x >= q.z {
+            axis = 0u;
+        } else if q.y >= q.z {
+            axis = 1u;
+        }
+        let sign = select(1.0, -1.0, local[axis] < 0.0);
+        var surface = local;
+        surface[axis] = sign * half[axis];
+        var normal = vec3<f32>(0.0);
+        normal[axis] = sign;
+        return Closest(centre + rotate(turn, surface), rotate(turn, normal), q[axis]);
+    }
+    let distance = dot(up, x - centre);
+    return Closest(x - up * distance, up, distance);
+}
+
+// Any unit vector perpendicular to unit `n` (`glam::Vec3::any_orthonormal_vector`).
+fn any_orthonormal(n: vec3<f32>) -> vec3<f32> {
+    let sign = select(-1.0, 1.0, n.z >= 0.0);
+    let a = -1.0 / (sign + n.z);
+    let b = n.x * n.y * a;
+    return vec3<f32>(b, sign + n.y * n.y * a, -n.y);
+}
+
+fn normalize_or(x: vec3<f32>, fallback: vec3<f32>) -> vec3<f32> {
+    let l = length(x);
+    if l > 0.0 && is_finite(l) {
+        return x / l;
+    }
+    return fallback;
+}
+
+// `contact::turn_above`: the unit direction nearest `u` with `n . result >= floor`.
+fn turn_above(u: vec3<f32>, n: vec3<f32>, floor_in: f32) -> vec3<f32> {
+    let floor = clamp(floor_in, -1.0, 1.0);
+    let along = dot(n, u);
+    if along >= floor {
+        return u;
+    }
+    let side = normalize_or(u - n * along, any_orthonormal(n));
+    return normalize(n * floor + side * sqrt(max(1.0 - floor * floor, 0.0)));
+}
+
+fn strand_grasp_weight(j: u32, v: u32) -> f32 {
+    let at = CONTACT_SKIN + SKIN_PLANES * v + j / 4u;
+    return contact[at][j % 4u];
+}
+
+fn contact_strand(j: u32, v: u32, layers: u32, root: vec3<f32>, frame: vec4<f32>) {
+    let slot = inputs.grid.y;
+    let header = contact[2u * slot];
+    let count = bitcast<u32>(header.x);
+    let skin = header.y > 0.0;
+    let presence = header.z;
+    if count == 0u && !skin && presence == 0.0 {
+        return;
+    }
+    let grip = contact[2u * slot + 1u].xyz;
+    let held = strand_grasp_weight(j, v) * presence;
+
+    var planes: array<vec4<f32>, 8>;
+    var plane_count = 0u;
+    if skin {
+        for (var p = 0u; p < SKIN_PLANES; p++) {
+            let plane = contact[CONTACT_SKIN + j * SKIN_PLANES + p];
+            if any(plane.xyz != vec3<f32>(0.0)) {
+                planes[plane_count] = vec4<f32>(rotate(frame, plane.xyz), plane.w);
+                plane_count += 1u;
+            }
+        }
+    }
+    // Colliders that can reach the strand (its nodes lie within its length of the root).
+    var strand_length = 0.0;
+    for (var k = 0u; k < layers; k++) {
+        strand_length += rest_segments[k * v + j].w;
+    }
+    let first = CONTACT_SKIN + SKIN_PLANES * v + (v + 3u) / 4u + slot * CONTACT_COLLIDERS * COLLIDER_WORDS;
+    var near: array<u32, 32>;
+    var near_count = 0u;
+    for (var i = 0u; i < count && near_count < NEAR_COLLIDERS; i++) {
+        let c = first + i * COLLIDER_WORDS;
+        let bound = contact[c + 4u];
+        if bound.y > 0.0 && held != 0.0 {
+            continue;
+        }
+        if distance(root, contact[c].xyz) <= bound.x + strand_length {
+            near[near_count] = c;
+            near_count += 1u;
+        }
+    }
+    // Whether anything touches the strand; if not, it stays as the bend made it.
+    var touches = held != 0.0;
+    for (var k = 1u; k <= layers && !touches; k++) {
+        let x = read_node(j, v, k);
+        for (var p = 0u; p < plane_count; p++) {
+            if dot(planes[p].xyz, x - root) < -planes[p].w {
+                touches = true;
+            }
+        }
+        for (var i = 0u; i < near_count; i++) {
+            if collider_closest(near[i], x).distance < 0.0 {
+                touches = true;
+            }
+        }
+    }
+    if !touches {
+        return;
+    }
+    let to_grip = grip - root;
+    let grip_distance = length(to_grip);
+    let has_grip = grip_distance > 0.0;
+    let toward = to_grip / select(1.0, grip_distance, has_grip);
+    var arc = 0.0;
+    var previous_bent = root;
+    var p = root;
+    for (var k = 0u; k < layers; k++) {
+        let segment_length = rest_segments[k * v + j].w;
+        let bent = read_node(j, v, k + 1u);
+        if segment_length <= 0.0 {
+            previous_bent = bent;
+            write_node(j, v, k + 1u, p);
+            continue;
+        }
+        var u = normalize_or(bent - previous_bent, vec3<f32>(0.0, 1.0, 0.0));
+        previous_bent = bent;
+        if held != 0.0 && has_grip && arc < grip_distance {
+            u = normalize_or(u + (toward - u) * held, u);
+        }
+        arc += segment_length;
+        for (var round = 0u; round < 8u; round++) {
+            var moved = false;
+            for (var i = 0u; i < near_count; i++) {
+                let c = near[i];
+                let hit = collider_closest(c, p + u * segment_length);
+                if hit.distance >= 0.0 {
+                    continue;
+                }
+                let friction = contact[c + 3u].w;
+                if round == 0u && friction > 0.0 {
+                    let travel = contact[c + 3u].xyz;
+                    let slide = travel - hit.normal * dot(hit.normal, travel);
+                    u = normalize_or(u * segment_length + slide * friction, u);
+                }
+                var floor = dot(hit.normal, hit.surface - p) / segment_length;
+                var normal = hit.normal;
+                if floor > 1.0 - CONTACT_MARGIN {
+                    let start = collider_closest(c, p);
+                    floor = dot(start.normal, start.surface - p) / segment_length;
+                    normal = start.normal;
+                }
+                u = turn_above(u, normal, floor + CONTACT_MARGIN);
+                moved = true;
+            }
+            for (var q = 0u; q < plane_count; q++) {
+                let n = planes[q].xyz;
+                let floor = (-planes[q].w - dot(n, p - root)) / segment_length;
+                if dot(n, u) < floor {
+                    u = turn_above(u, n, floor + CONTACT_MARGIN);
+                    moved = true;
+                }
+            }
+            if !moved {
+                break;
+            }
+        }
+        p = p + u * segment_length;
+        write_node(j, v, k + 1u, p);
+    }
+}
