@@ -153,10 +153,10 @@ impl App {
         if requests.save_preset {
             model.save_preset();
         }
-        if requests.undo || requests.redo {
-            if let Err(error) = model.undo_groom(requests.redo) {
-                model.status = format!("{error:#}");
-            }
+        if (requests.undo || requests.redo)
+            && let Err(error) = model.undo_groom(requests.redo)
+        {
+            model.status = format!("{error:#}");
         }
         // A bad value from the panel is reported, not fatal: the previous fur stays.
         match model.apply(changes) {
