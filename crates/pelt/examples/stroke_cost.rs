@@ -1,7 +1,8 @@
 //! What one groom brush dab costs while painting, as the viewer pays it: the dab itself (the
-//! editor), regrowing the rest positions, the simulation restarted on them, and the GPU's new
-//! vertex buffers (`FurDriver::set_structure`, submitted and waited for), on the bunny and the
-//! Fox; and, for comparison, the textures a dab does not rebuild. For BENCHMARKS.md:
+//! editor), regrowing the rest positions, the simulation restarted on them, and the GPU upload
+//! (length and comb: new vertex buffers, `FurDriver::set_structure`; tint: the per-vertex groom
+//! rewritten, `FurDriver::set_groom`; submitted and waited for), on the bunny and the Fox; and,
+//! for comparison, the textures a dab does not rebuild. For BENCHMARKS.md:
 //! `cargo run --release -p pelt --example stroke_cost` (`DABS=40` dabs per row).
 
 mod profile;
@@ -9,7 +10,8 @@ mod profile;
 use std::path::Path;
 use std::time::Instant;
 
-use pelt_core::groom::{Brush, BrushKind, GroomEditor};
+use glam::Vec3;
+use pelt_core::groom::{Brush, BrushKind, Groom, GroomEditor};
 use pelt_core::sim::FurStepper;
 use pelt_core::{Builtin, FurStructure, ImportOptions, Mesh, Preset};
 use pelt_render::{FurDriver, FurRenderer, HEADLESS_FORMAT, KernelChoice};
@@ -35,11 +37,13 @@ fn main() -> anyhow::Result<()> {
         let params = preset.fur_params(&mesh);
         let radius = mesh.bounding_sphere().1;
         for kind in [BrushKind::Grow, BrushKind::Comb, BrushKind::Tint] {
-            let mut structure = FurStructure::new(mesh.clone(), &params)?;
+            // Groomed from the start (a white tint), as a fur being painted is.
+            let groom = Groom { tint: Some(vec![Vec3::ONE; mesh.vertex_count()]), ..Groom::default() };
+            let mut structure = FurStructure::new_groomed(mesh.clone(), &params, Some(groom.clone()))?;
             let mut stepper = FurStepper::new(&structure, &preset.simulation)?;
             let mut driver =
                 FurDriver::new(device, queue, &renderer, &structure, &textures, &preset.simulation, KernelChoice::Cpu)?;
-            let mut editor = GroomEditor::new(&mesh, None, preset.direction.comb)?;
+            let mut editor = GroomEditor::new(&mesh, Some(groom), preset.direction.comb)?;
             let brush = Brush { kind, radius: 0.1 * radius, strength: 0.3, ..Brush::default() };
             // A stroke across the model's vertices, one dab per vertex visited.
             let mut times = [0.0f64; 4];
@@ -62,9 +66,11 @@ fn main() -> anyhow::Result<()> {
                 let t3 = Instant::now();
                 if reshaped {
                     driver.set_structure(device, queue, &renderer, &structure)?;
-                    queue.submit([]);
-                    device.poll(wgpu::PollType::wait_indefinitely())?;
+                } else {
+                    driver.set_groom(queue, editor.groom())?;
                 }
+                queue.submit([]);
+                device.poll(wgpu::PollType::wait_indefinitely())?;
                 let t4 = Instant::now();
                 for (time, (a, b)) in times.iter_mut().zip([(t0, t1), (t1, t2), (t2, t3), (t3, t4)]) {
                     *time += (b - a).as_secs_f64() * 1e3 / dabs as f64;

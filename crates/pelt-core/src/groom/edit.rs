@@ -35,10 +35,13 @@ struct Stroke {
     last: Option<Vec3>,
 }
 
+/// One map a stroke touched: its values before and after (`None`: absent).
+type MapChange = (GroomMap, Option<Vec<f32>>, Option<Vec<f32>>);
+
 /// One stroke's change: each map it touched, before and after.
 #[derive(Clone, Debug)]
 struct Edit {
-    maps: Vec<(GroomMap, Option<Vec<f32>>, Option<Vec<f32>>)>,
+    maps: Vec<MapChange>,
 }
 
 impl GroomEditor {

@@ -153,10 +153,10 @@ impl App {
         if requests.save_preset {
             model.save_preset();
         }
-        if requests.undo || requests.redo {
-            if let Err(error) = model.undo_groom(requests.redo) {
-                model.status = format!("{error:#}");
-            }
+        if (requests.undo || requests.redo)
+            && let Err(error) = model.undo_groom(requests.redo)
+        {
+            model.status = format!("{error:#}");
         }
         // A bad value from the panel is reported, not fatal: the previous fur stays.
         match model.apply(changes) {
@@ -171,7 +171,9 @@ impl App {
         if std::mem::take(&mut model.structure_regrown) {
             running.fur.set_structure(&running.gpu, &model.structure)?;
         }
-        model.groom_attributes_changed = false;
+        if std::mem::take(&mut model.groom_attributes_changed) {
+            running.fur.set_groom(&running.gpu, &model.structure)?;
+        }
         running.fur.set_gpu_simulation(&running.gpu, &model.structure, model.settings.gpu_sim)?;
         if let Some(textures) = model.poll_textures() {
             running.fur.set_textures(&running.gpu, &textures)?;

@@ -72,6 +72,18 @@ impl FurScene {
         Ok(())
     }
 
+    /// Rewrites the painted density, clump and tint in place; a fur first uploaded without a
+    /// groom (or textures without keep values) is uploaded groomed once, textures as they are.
+    pub fn set_groom(&mut self, gpu: &pelt_render::Gpu, structure: &FurStructure) -> anyhow::Result<()> {
+        let Some(groom) = &structure.groom else { return self.set_structure(gpu, structure) };
+        if self.driver.set_groom(&gpu.queue, groom).is_err() {
+            self.set_structure(gpu, structure)?;
+            self.driver.set_textures(&gpu.device, &gpu.queue, &self.renderer, &self.textures)?;
+            self.driver.set_groom(&gpu.queue, groom)?;
+        }
+        Ok(())
+    }
+
     /// Simulates on the GPU (two states and a compute pass) or not (one state, uploaded).
     pub fn set_gpu_simulation(
         &mut self,

@@ -1,7 +1,7 @@
 //! Groom painting: the panel's brush section, and the model's strokes on the rest surface under
 //! the pointer's posed hit, with undo and redo. Length and direction strokes regrow the fur's
-//! rest positions (the GPU's vertex buffers, never the textures); the other maps travel with the
-//! structure's groom.
+//! rest positions (the GPU's vertex buffers, never the textures); density, clump and tint
+//! rewrite the GPU's per-vertex groom in place (`FurDriver::set_groom`).
 
 use glam::Vec3;
 use pelt_core::groom::{Axis, Brush, BrushKind, Falloff, GroomEditor, GroomMap, rest_point};
