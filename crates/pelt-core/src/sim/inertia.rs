@@ -44,6 +44,8 @@ pub struct Inertia {
     last_dt: f32,
     force: Vec<Vec3>,
     force_velocity: Vec<Vec3>,
+    /// Per strand, the mass on the spring relative to a dry strand's (empty: all 1).
+    masses: Vec<f32>,
     resets: u64,
 }
 
@@ -58,6 +60,7 @@ impl Inertia {
             last_dt: 0.0,
             force: vec![Vec3::ZERO; strands],
             force_velocity: vec![Vec3::ZERO; strands],
+            masses: Vec::new(),
             resets: 0,
         }
     }
@@ -68,6 +71,16 @@ impl Inertia {
         self.last_time_secs = None;
         self.force.fill(Vec3::ZERO);
         self.force_velocity.fill(Vec3::ZERO);
+    }
+
+    /// Each strand's mass relative to a dry one (`None`: all 1): a heavier strand swings at
+    /// `1 / sqrt(mass)` of the natural frequency. Values below 1 count as 1.
+    ///
+    /// # Panics
+    /// If `masses` has not one entry per strand.
+    pub fn set_masses(&mut self, masses: Option<Vec<f32>>) {
+        self.masses = masses.unwrap_or_default();
+        assert!(self.masses.is_empty() || self.masses.len() == self.force.len(), "one mass per strand");
     }
 
     /// The inertial force per strand for the newest step.
@@ -121,15 +134,24 @@ impl Inertia {
         // a = 2 ((r - r1) / dt - (r1 - r2) / dt_before) / (dt + dt_before).
         let scale = -inertia * 2.0 / (radius * (dt + dt_before));
         let damp = 1.0 / (1.0 + 2.0 * damping * omega * dt);
+        let masses = &self.masses;
         self.previous_roots
             .par_iter_mut()
             .zip(self.force.par_iter_mut())
             .zip(self.force_velocity.par_iter_mut())
             .zip(roots.par_iter())
+            .enumerate()
             .with_min_len(STRANDS_PER_TASK)
-            .for_each(|(((previous, force), velocity), root)| {
+            .for_each(|(j, (((previous, force), velocity), root))| {
                 let acceleration = (*root - previous[0]) / dt - (previous[0] - previous[1]) / dt_before;
                 let target = (acceleration * scale).clamp_length_max(MAX_INERTIAL_FORCE);
+                let mass = masses.get(j).copied().unwrap_or(1.0);
+                let (omega, damp) = if mass > 1.0 {
+                    let omega = omega / mass.sqrt();
+                    (omega, 1.0 / (1.0 + 2.0 * damping * omega * dt))
+                } else {
+                    (omega, damp)
+                };
                 *velocity = (*velocity + (target - *force) * (omega * omega * dt)) * damp;
                 *force += *velocity * dt;
                 *previous = [*root, previous[0]];

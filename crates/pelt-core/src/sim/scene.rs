@@ -22,6 +22,17 @@
 //! translation = [0.0, 0.0, 0.0]
 //! rotation_deg = [0.0, 0.0, 0.0]
 //! ease = "in_out"
+//!
+//! [[rain]]                         # a shower, see `wet::RainKey`
+//! start_secs = 0.0
+//! end_secs = 4.0
+//! direction = [0.0, -1.0, 0.0]
+//! rate = 0.4                       # wetness per second facing the rain, 0..=100
+//!
+//! [[water]]                        # water level keys, see `wet::WaterKey`
+//! time_secs = 0.0
+//! point = [0.0, -1.0, 0.0]
+//! normal = [0.0, 1.0, 0.0]
 //! ```
 //!
 //! Stroke points are world positions, on or near the base surface, which keeps a script
@@ -41,6 +52,7 @@ use glam::{Mat4, Vec3};
 use super::MAX_FORCE;
 use super::motion::{self, MotionKey};
 use super::simulation::{SimError, Simulation};
+use crate::wet::{self, RainKey, WaterKey, WetSources};
 
 /// Errors from reading a scene; each names the file and, where it can, the key.
 #[derive(Debug, thiserror::Error)]
@@ -146,6 +158,12 @@ pub struct Scene {
     /// Rigid motion keyframes of the meshes, sorted by time.
     #[serde(default)]
     pub motion: Vec<MotionKey>,
+    /// Showers.
+    #[serde(default)]
+    pub rain: Vec<RainKey>,
+    /// Water level keyframes, sorted by time.
+    #[serde(default)]
+    pub water: Vec<WaterKey>,
 }
 
 impl Scene {
@@ -207,6 +225,7 @@ impl Scene {
             range(format!("wind[{i}].jitter"), key.jitter, 0.0, 1.0)?;
         }
         motion::validate(&self.motion)?;
+        wet::validate(&self.rain, &self.water)?;
         for (i, stroke) in self.strokes.iter().enumerate() {
             finite_time(format!("stroke[{i}].start_secs"), stroke.start_secs)?;
             finite_time(format!("stroke[{i}].end_secs"), stroke.end_secs)?;
@@ -230,7 +249,9 @@ impl Scene {
         self.duration_secs.unwrap_or_else(|| {
             let wind = self.wind.last().map_or(0.0, |k| k.time_secs);
             let motion = self.motion.last().map_or(0.0, |k| k.time_secs);
-            self.strokes.iter().map(|s| s.end_secs).fold(wind.max(motion), f64::max)
+            let water = self.water.last().map_or(0.0, |k| k.time_secs);
+            let rain = self.rain.iter().map(|r| r.end_secs).fold(0.0, f64::max);
+            self.strokes.iter().map(|s| s.end_secs).fold(wind.max(motion).max(water).max(rain), f64::max)
         })
     }
 
@@ -262,6 +283,12 @@ impl Scene {
     #[must_use]
     pub fn motion_at(&self, time_secs: f64) -> Option<Mat4> {
         motion::motion_at(&self.motion, time_secs)
+    }
+
+    /// What wets the fur: the scene's rain and water keys.
+    #[must_use]
+    pub fn wet_sources(&self) -> WetSources<'_> {
+        WetSources { rain: &self.rain, water: &self.water }
     }
 
     /// The stroke active at `time_secs` (the last one listed, where several overlap).

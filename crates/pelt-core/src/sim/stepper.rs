@@ -10,6 +10,7 @@ use super::simulation::{SimError, Simulation};
 use crate::anim::{Pose, Rig};
 use crate::fur::FurStructure;
 use crate::mesh::Mesh;
+use crate::wet::{WetParams, Wetness};
 
 /// Where the base's pose comes from each step.
 #[derive(Debug, Default)]
@@ -45,6 +46,11 @@ pub struct FurStepper {
     restart_pending: bool,
     /// The host set a pose since the last step.
     host_posed: bool,
+    /// A wetness per base vertex (rain, water, sponge, drying) and what it does.
+    wetness: Wetness,
+    wet: WetParams,
+    /// The normals the wetness was last advanced with (the posed base's, world space).
+    wet_normals: Vec<Vec3>,
 }
 
 impl FurStepper {
@@ -63,6 +69,9 @@ impl FurStepper {
             moved: false,
             restart_pending: true,
             host_posed: false,
+            wetness: Wetness::new(structure.mesh.vertex_count(), 0.0),
+            wet: WetParams::default(),
+            wet_normals: Vec::new(),
         })
     }
 
@@ -167,8 +176,69 @@ impl FurStepper {
                 }
             }
         }
+        self.advance_wetness(time_secs)?;
         self.simulation.advance_to(time_secs);
         Ok(())
+    }
+
+    /// Advances the wetness to `time_secs` on the posed base and hands it to the simulation.
+    fn advance_wetness(&mut self, time_secs: f64) -> Result<(), SimError> {
+        let sources = self.scene.as_ref().map(Scene::wet_sources).unwrap_or_default();
+        if !sources.is_empty() || !self.wetness.is_dry() {
+            let simulation = &self.simulation;
+            self.wet_normals.clear();
+            self.wet_normals.extend(simulation.frames().iter().zip(&self.mesh.normals).map(|(q, n)| *q * *n));
+            self.wetness.advance_to(
+                time_secs,
+                simulation.params().rate_hz,
+                sources,
+                &self.wet,
+                simulation.roots(),
+                &self.wet_normals,
+                simulation.bounding_radius(),
+            );
+        }
+        let wet = (!self.wetness.is_dry()).then(|| self.wetness.values());
+        if wet.is_some() || self.simulation.wetness().is_some() {
+            self.simulation.set_wetness(wet, &self.wet)?;
+        }
+        Ok(())
+    }
+
+    /// What wetness does (the preset's `[wet]`); its `wetness` becomes every vertex's wetness
+    /// now and after a jump back in time.
+    ///
+    /// # Errors
+    /// [`SimError::Params`] for values out of range (keys `wet.*`).
+    pub fn set_wet(&mut self, params: &WetParams) -> Result<(), SimError> {
+        params.validate()?;
+        self.wet = params.clone();
+        self.wetness.set_uniform(params.wetness);
+        Ok(())
+    }
+
+    /// What wetness does, as [`FurStepper::set_wet`] left it.
+    #[must_use]
+    pub fn wet(&self) -> &WetParams {
+        &self.wet
+    }
+
+    /// The wetness per base vertex, as the last step left it.
+    #[must_use]
+    pub fn wetness(&self) -> &Wetness {
+        &self.wetness
+    }
+
+    /// The wetness, for a host's sponge ([`Wetness::sponge`] at the simulation's
+    /// [`roots`](Simulation::roots)) or a uniform setting; the next step takes it up.
+    pub fn wetness_mut(&mut self) -> &mut Wetness {
+        &mut self.wetness
+    }
+
+    /// Presses a sponge at `centre` (the posed base's space): the wetness within `radius` moves
+    /// toward `amount` (0 dries, 1 soaks) with a smooth falloff.
+    pub fn sponge(&mut self, centre: Vec3, radius: f32, amount: f32) {
+        self.wetness.sponge(self.simulation.roots(), centre, radius, amount);
     }
 
     /// Sets the base's pose from the host's own skinning (world or model space, as the host
@@ -229,6 +299,7 @@ impl FurStepper {
         self.simulation = Simulation::new(structure, params)?;
         self.simulation.set_cpu_bending(bending);
         self.mesh = structure.mesh.clone();
+        self.wetness = Wetness::new(self.mesh.vertex_count(), self.wet.wetness);
         self.restart_pending = true;
         Ok(())
     }
