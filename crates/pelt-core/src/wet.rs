@@ -4,10 +4,10 @@
 //! ```toml
 //! [wet]
 //! wetness = 0.0          # the coat's wetness at time 0, 0..=1
-//! clump_size = 0.12      # clump cells, in shell tiles
+//! clump_size = 0.03      # clump cells, in shell tiles
 //! clump_strength = 0.6   # how far soaked strands gather toward their clump's centre, 0..=1
 //! darkening = 0.5        # albedo times 1 - darkening * wetness
-//! shine = 1.5            # highlight strength and exponent times 1 + shine * wetness
+//! shine = 0.6            # highlight strength times 1 + shine * wetness (exponent 1 + 2 shine w)
 //! added_weight = 1.0     # gravity on a strand times 1 + added_weight * wetness
 //! softening = 0.3        # stability times 1 - softening * wetness
 //! drying_per_sec = 0.05  # wetness lost per second
@@ -28,13 +28,14 @@ use crate::param::ParamError;
 pub struct WetParams {
     /// The whole coat's wetness at time 0 (`pelt render --wetness` sets it), `0..=1`. Default 0.
     pub wetness: f32,
-    /// Clump cell size in shell tiles, `0.02..=1`. Default 0.12.
+    /// Clump cell size in shell tiles, `0.005..=1`. Default 0.03 (a few dozen strands a clump).
     pub clump_size: f32,
     /// How far a soaked strand's tip gathers toward its clump's centre, `0..=0.95`. Default 0.6.
     pub clump_strength: f32,
     /// Albedo times `1 - darkening * wetness`, `0..=1`. Default 0.5.
     pub darkening: f32,
-    /// Highlight strength and exponent times `1 + shine * wetness`, `0..=8`. Default 1.5.
+    /// Highlight strength times `1 + shine * wetness`, its exponent times `1 + 2 * shine * wetness`,
+    /// `0..=8`. Default 0.6.
     pub shine: f32,
     /// Gravity on a strand times `1 + added_weight * wetness`, `0..=10`. Default 1.
     pub added_weight: f32,
@@ -51,10 +52,10 @@ impl Default for WetParams {
     fn default() -> Self {
         Self {
             wetness: 0.0,
-            clump_size: 0.12,
+            clump_size: 0.03,
             clump_strength: 0.6,
             darkening: 0.5,
-            shine: 1.5,
+            shine: 0.6,
             added_weight: 1.0,
             softening: 0.3,
             drying_per_sec: 0.05,
@@ -77,7 +78,7 @@ impl WetParams {
     pub fn validate(&self) -> Result<(), ParamError> {
         let checks = [
             ("wetness", self.wetness, 0.0, 1.0),
-            ("clump_size", self.clump_size, 0.02, 1.0),
+            ("clump_size", self.clump_size, 0.005, 1.0),
             ("clump_strength", self.clump_strength, 0.0, 0.95),
             ("darkening", self.darkening, 0.0, 1.0),
             ("shine", self.shine, 0.0, 8.0),

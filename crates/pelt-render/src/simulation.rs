@@ -9,7 +9,7 @@
 //! read back and the shared array never crosses the bus.
 
 use pelt_core::FurStructure;
-use pelt_core::sim::{Simulation, StepInputs, kernel_rest};
+use pelt_core::sim::{Simulation, StepInputs, StrandInputs, kernel_rest};
 
 use crate::RenderError;
 use crate::fur::GpuFur;
@@ -23,7 +23,7 @@ const STEP_SLOT_BYTES: u64 = 256;
 /// Steps one prepare/dispatch pair can hold: only the last two states are ever kept.
 const STEP_SLOTS: usize = 2;
 /// Storage buffers the compute stage binds.
-const STORAGE_BUFFERS: u32 = 4;
+const STORAGE_BUFFERS: u32 = 5;
 
 /// One step's inputs; the layout of `Step` in `simulation.wgsl`.
 #[repr(C)]
@@ -96,6 +96,7 @@ pub struct GpuSimulation {
     rest_segments: wgpu::Buffer,
     strands: wgpu::Buffer,
     forces: wgpu::Buffer,
+    wet: WetInputs,
     /// One bind group per shared-array buffer written so far (a fur has one or two).
     bind_groups: Vec<(wgpu::Buffer, wgpu::BindGroup)>,
     vertex_count: u32,
@@ -220,6 +221,7 @@ impl GpuSimulation {
                 storage(2, true),
                 storage(3, true),
                 storage(4, false),
+                storage(5, true),
             ],
         });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -254,6 +256,7 @@ impl GpuSimulation {
         );
         let strands = buffer("pelt simulation strands", v.max(1) as u64 * 32, storage_usage);
         let forces = buffer("pelt simulation forces", v.max(1) as u64 * 32, storage_usage);
+        let wet = WetInputs::new(device, v);
         scope.pop("creating the GPU simulation")?;
         Ok(Self {
             pipeline,
@@ -262,6 +265,7 @@ impl GpuSimulation {
             rest_segments,
             strands,
             forces,
+            wet,
             bind_groups: Vec::new(),
             vertex_count: v as u32,
             layers: structure.layers,
@@ -399,6 +403,7 @@ impl GpuSimulation {
                 wgpu::BindGroupEntry { binding: 2, resource: self.strands.as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 3, resource: self.forces.as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 4, resource: output.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 5, resource: self.wet.gravity_scales.as_entire_binding() },
             ],
         });
         scope.pop("binding the GPU simulation to the fur")?;
@@ -436,6 +441,42 @@ impl GpuSimulation {
         if bytemuck::cast_slice::<_, u32>(&forces) != bytemuck::cast_slice::<_, u32>(&self.force_data) {
             queue.write_buffer(&self.forces, 0, bytemuck::cast_slice(&forces));
             self.force_data = forces;
+        }
+        self.wet.upload(queue, &inputs);
+    }
+}
+
+/// Wet strands' extra weight: gravity's factor per strand (binding 5), kept apart from the other
+/// per-strand inputs. A wet strand's lower stability rides in the strands buffer
+/// ([`StrandInputs::stability_of`]).
+#[derive(Debug)]
+struct WetInputs {
+    gravity_scales: wgpu::Buffer,
+    /// What the buffer holds; empty while it holds all ones.
+    uploaded: Vec<f32>,
+}
+
+impl WetInputs {
+    fn new(device: &wgpu::Device, strands: usize) -> Self {
+        let gravity_scales = wgpu::util::DeviceExt::create_buffer_init(
+            device,
+            &wgpu::util::BufferInitDescriptor {
+                label: Some("pelt simulation wet gravity"),
+                contents: bytemuck::cast_slice(&vec![1.0_f32; strands.max(1)]),
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            },
+        );
+        Self { gravity_scales, uploaded: Vec::new() }
+    }
+
+    fn upload(&mut self, queue: &wgpu::Queue, inputs: &StrandInputs<'_>) {
+        if inputs.wetness.is_none() && self.uploaded.is_empty() {
+            return;
+        }
+        let scales: Vec<f32> = (0..inputs.roots.len()).map(|j| inputs.gravity_scale_of(j)).collect();
+        if scales != self.uploaded {
+            queue.write_buffer(&self.gravity_scales, 0, bytemuck::cast_slice(&scales));
+            self.uploaded = if inputs.wetness.is_none() { Vec::new() } else { scales };
         }
     }
 }

@@ -69,6 +69,15 @@ struct Object {
     // `furred_triangle_count` triangles and the fins the first `fin_edge_count` edges.
     furred_triangle_count: u32,
     fin_edge_count: u32,
+    // Wet fur (`wet.wgsl`): albedo times 1 - wet_darkening * w, the highlight times
+    // 1 + wet_shine * w (its exponent 1 + 2 * wet_shine * w), clump cells of clump_size tiles
+    // gathering by up to clump_strength; wet_any is 1 when some vertex is wet (else the wetness
+    // is never read).
+    wet_darkening: f32,
+    wet_shine: f32,
+    clump_size: f32,
+    clump_strength: f32,
+    wet_any: u32,
 }
 
 // Set per pipeline: shells and fins with alpha-to-coverage output straight colour, blended ones
@@ -108,6 +117,8 @@ struct Varyings {
     // Shells without mesh uvs: the base normal in model space, which picks the axis-aligned
     // projection of the tiles (fixed to the model, so it moves with it).
     @location(10) tile_normal: vec3<f32>,
+    // The strand's wetness (0 dry, 1 soaked).
+    @location(11) wetness: f32,
 }
 
 // What a shell fragment reads and nothing more, packed four to a location: software
@@ -121,8 +132,8 @@ struct ShellTileVaryings {
     // `hair_terms` at the vertex.
     @location(0) @interpolate(perspective, centroid) lighting: vec4<f32>,
     // The opacity from the view angle (`shell_fade`), how far the layers the next coarser stride
-    // drops have faded here (`lod_vertex_blend`), and the layer.
-    @location(1) @interpolate(perspective, centroid) fade_blend_layer: vec3<f32>,
+    // drops have faded here (`lod_vertex_blend`), the layer, and the wetness.
+    @location(1) @interpolate(perspective, centroid) fade_blend_layer_wet: vec4<f32>,
     // The root in tiles, model space, and the base normal picking its projection.
     @location(2) @interpolate(perspective, centroid) tile_position: vec3<f32>,
     @location(3) @interpolate(perspective, centroid) tile_normal: vec3<f32>,
@@ -131,7 +142,7 @@ struct ShellTileVaryings {
 struct ShellUvVaryings {
     @builtin(position) clip_position: vec4<f32>,
     @location(0) @interpolate(perspective, centroid) lighting: vec4<f32>,
-    @location(1) @interpolate(perspective, centroid) fade_blend_layer: vec3<f32>,
+    @location(1) @interpolate(perspective, centroid) fade_blend_layer_wet: vec4<f32>,
     // The mesh uv in tiles (xy) and at the strand's root (zw, surface colour mode).
     @location(2) @interpolate(perspective, centroid) uvs: vec4<f32>,
 }
@@ -143,13 +154,13 @@ fn shell_lighting(v: Varyings) -> vec4<f32> {
 }
 
 fn shell_tile_varyings(v: Varyings, fade: f32, lod_blend: f32) -> ShellTileVaryings {
-    let fade_blend_layer = vec3<f32>(fade, lod_blend, f32(v.layer));
-    return ShellTileVaryings(v.clip_position, shell_lighting(v), fade_blend_layer, v.tile_position, v.tile_normal);
+    let fade_blend_layer_wet = vec4<f32>(fade, lod_blend, f32(v.layer), v.wetness);
+    return ShellTileVaryings(v.clip_position, shell_lighting(v), fade_blend_layer_wet, v.tile_position, v.tile_normal);
 }
 
 fn shell_uv_varyings(v: Varyings, fade: f32, lod_blend: f32) -> ShellUvVaryings {
-    let fade_blend_layer = vec3<f32>(fade, lod_blend, f32(v.layer));
-    return ShellUvVaryings(v.clip_position, shell_lighting(v), fade_blend_layer, vec4<f32>(v.uv, v.surface_uv));
+    let fade_blend_layer_wet = vec4<f32>(fade, lod_blend, f32(v.layer), v.wetness);
+    return ShellUvVaryings(v.clip_position, shell_lighting(v), fade_blend_layer_wet, vec4<f32>(v.uv, v.surface_uv));
 }
 
 // The layer a shell fragment carries: interpolated from three equal corners, so within rounding.
@@ -168,6 +179,8 @@ struct FinVaryings {
     // Along the edge in tiles, the height (0 at the roots, 1 at the tips), and the mesh uv at
     // this end of the edge (surface colour mode).
     @location(1) @interpolate(perspective, centroid) uvs: vec4<f32>,
+    // The strand's wetness (0 without `object.wet_any`).
+    @location(2) @interpolate(perspective, centroid) wetness: f32,
 }
 
 // Set per pipeline where every mesh it draws has uvs (1) or none has (2), so the shaders drop
@@ -350,10 +363,15 @@ fn tile_texel(tile_position: vec3<f32>, tile_normal: vec3<f32>, layer: u32) -> v
     // the largest part of a shell fragment's cost on software rasterisers (a blend of all three
     // cost three). The tiles are strand dots, so the seams where the projection changes do not
     // show (SSIM test in tests/lean.rs).
+    return sample_shell(tile_uv(tile_position, tile_normal), shell_slice(layer));
+}
+
+// The tile uv of a mesh without uvs: `tile_position` projected along the axis `tile_normal`
+// faces most.
+fn tile_uv(tile_position: vec3<f32>, tile_normal: vec3<f32>) -> vec2<f32> {
     let p = tile_position;
     let axis = tile_axis(tile_normal);
-    let uv = select(select(p.xy, p.zx, axis == 1u), p.yz, axis == 0u);
-    return sample_shell(uv, shell_slice(layer));
+    return select(select(p.xy, p.zx, axis == 1u), p.yz, axis == 0u);
 }
 
 // Surface colour mode: the mesh's texture at the strand's root tints the strand's brightness.
@@ -388,26 +406,47 @@ fn fs_skin(in: Varyings) -> @location(0) vec4<f32> {
     return vec4<f32>(colour, 1.0);
 }
 
-// A shell fragment from its texel: fading, level of detail and hair lighting.
-fn shell_colour(texel: vec4<f32>, surface_uv: vec2<f32>, lighting: vec4<f32>, fade_blend_layer: vec3<f32>) -> vec4<f32> {
-    let layer = varying_layer(fade_blend_layer.z);
-    let alpha = lod_alpha(texel.a * fade_blend_layer.x, layer, fade_blend_layer.y);
+// A shell fragment from its texel: fading, level of detail and hair lighting (wet where the
+// fur is: the branch is on the object uniform, so a dry fur runs the dry code alone).
+fn shell_colour(texel: vec4<f32>, surface_uv: vec2<f32>, lighting: vec4<f32>, fade_blend_layer_wet: vec4<f32>) -> vec4<f32> {
+    let layer = varying_layer(fade_blend_layer_wet.z);
+    let alpha = lod_alpha(texel.a * fade_blend_layer_wet.x, layer, fade_blend_layer_wet.y);
     let albedo = texel.rgb * surface_tint(surface_uv);
+    if object.wet_any != 0u {
+        return fur_output(wet_hair_colour(albedo, lighting, layer_height(layer), fade_blend_layer_wet.w), alpha);
+    }
     return fur_output(hair_colour(albedo, lighting, layer_height(layer)), alpha);
 }
 
 // Shells of meshes without uvs (`vs_shell_indexed`, `vs_separated_shell_tiles`).
 @fragment
 fn fs_shell_tiles(in: ShellTileVaryings) -> @location(0) vec4<f32> {
-    let texel = tile_texel(in.tile_position, in.tile_normal, varying_layer(in.fade_blend_layer.z));
-    return shell_colour(texel, vec2<f32>(0.0), in.lighting, in.fade_blend_layer);
+    let layer = varying_layer(in.fade_blend_layer_wet.z);
+    var texel: vec4<f32>;
+    if object.wet_any != 0u {
+        let uv = tile_uv(in.tile_position, in.tile_normal);
+        let clumped = clump_uv(uv, layer_height(layer), in.fade_blend_layer_wet.w);
+        texel = sample_shell(clumped.xy, shell_slice(layer));
+        texel.a *= clumped.z;
+    } else {
+        texel = tile_texel(in.tile_position, in.tile_normal, layer);
+    }
+    return shell_colour(texel, vec2<f32>(0.0), in.lighting, in.fade_blend_layer_wet);
 }
 
 // Shells of meshes with uvs (`vs_shell_wedges`, `vs_separated_shell_uvs`).
 @fragment
 fn fs_shell_uvs(in: ShellUvVaryings) -> @location(0) vec4<f32> {
-    let texel = sample_shell(in.uvs.xy, shell_slice(varying_layer(in.fade_blend_layer.z)));
-    return shell_colour(texel, in.uvs.zw, in.lighting, in.fade_blend_layer);
+    let layer = varying_layer(in.fade_blend_layer_wet.z);
+    var texel: vec4<f32>;
+    if object.wet_any != 0u {
+        let clumped = clump_uv(in.uvs.xy, layer_height(layer), in.fade_blend_layer_wet.w);
+        texel = sample_shell(clumped.xy, shell_slice(layer));
+        texel.a *= clumped.z;
+    } else {
+        texel = sample_shell(in.uvs.xy, shell_slice(layer));
+    }
+    return shell_colour(texel, in.uvs.zw, in.lighting, in.fade_blend_layer_wet);
 }
 
 // Seen from the side the roots are less hidden than from above: fins light and occlude their
@@ -420,12 +459,23 @@ fn fin_lighting_height(height: f32) -> f32 {
 fn fs_fin(in: FinVaryings) -> @location(0) vec4<f32> {
     let height = in.uvs.y;
     // Fin texture rows run from the tips (v = 0) to the roots (v = 1).
-    let texel = textureSample(fin_texture, fin_sampler, vec2<f32>(in.uvs.x, 1.0 - height));
+    var texel: vec4<f32>;
+    if object.wet_any != 0u {
+        // The shells' clumps seen from the side: strands along the edge gather the same way.
+        let clumped = clump_along(in.uvs.x, height, in.wetness);
+        texel = textureSample(fin_texture, fin_sampler, vec2<f32>(clumped.x, 1.0 - height));
+        texel.a *= clumped.y;
+    } else {
+        texel = textureSample(fin_texture, fin_sampler, vec2<f32>(in.uvs.x, 1.0 - height));
+    }
     // Several fins overlap along a silhouette; thinning them keeps the fringe from reading as a
     // solid band, most of all at the roots where the shells already cover.
     let alpha = texel.a * in.lighting_fade.w * mix(0.15, 0.6, height);
     let albedo = texel.rgb * surface_tint(in.uvs.zw);
     let lit_height = fin_lighting_height(height);
     let lighting = vec4<f32>(in.lighting_fade.xyz, occlusion(lit_height));
+    if object.wet_any != 0u {
+        return fur_output(wet_hair_colour(albedo, lighting, lit_height, in.wetness), alpha);
+    }
     return fur_output(hair_colour(albedo, lighting, lit_height), alpha);
 }

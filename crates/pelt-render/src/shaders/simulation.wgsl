@@ -53,6 +53,8 @@ struct StrandForces {
 @group(0) @binding(3) var<storage, read> forces: array<StrandForces>;
 // The shared vertex array: NV[i * V + j] as packed xyz.
 @group(0) @binding(4) var<storage, read_write> positions: array<f32>;
+// Per strand, gravity's factor: 1 + added_weight * wetness (1 when dry).
+@group(0) @binding(5) var<storage, read> wet_gravity: array<f32>;
 
 const PARALLEL_SINE: f32 = 1e-7;
 const WORKGROUP: u32 = 64u;
@@ -160,7 +162,7 @@ fn step_strands(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocati
     if touch_weight > 0.0 {
         field_force = field_force * (1.0 - touch_weight) + inputs.touch.xyz * touch_weight;
     }
-    let force = inputs.gravity.xyz + field_force + strand_forces.inertial.xyz;
+    let force = inputs.gravity.xyz * wet_gravity[j] + field_force + strand_forces.inertial.xyz;
 
     // `bend::split_force`: unit direction and magnitude without overflow; a non-finite force
     // has neither.

@@ -19,6 +19,16 @@
 // Triangles (3F), then edges (2E), then the two faces beside each edge (2E); with uvs, then each
 // wedge's base vertex (W) and each triangle corner's wedge (3F, the shells' index buffer).
 @group(1) @binding(5) var<storage, read> topology: array<u32>;
+// A wetness per base vertex, read only when `object.wet_any` is set.
+@group(1) @binding(6) var<storage, read> wetness: array<f32>;
+
+// Base vertex `vertex`'s wetness; 0 for a dry fur (a uniform branch, no fetch).
+fn vertex_wetness(vertex: u32) -> f32 {
+    if object.wet_any == 0u {
+        return 0.0;
+    }
+    return wetness[vertex];
+}
 
 const NO_FACE: u32 = 0xffffffffu;
 
@@ -106,6 +116,7 @@ fn surface_varyings(vertex: u32, wedge: u32, layer: u32) -> Varyings {
         out.surface_uv = vec2<f32>(0.0);
         out.uv = vec2<f32>(0.0);
     }
+    out.wetness = vertex_wetness(vertex);
     out.layer = layer;
     out.slice = shell_slice(layer);
     out.height = layer_height(layer);
@@ -254,6 +265,7 @@ fn fin_varyings(index: u32, edge: u32, fade: f32) -> FinVaryings {
         }
     }
     out.uvs = vec4<f32>(offset + along, layer_height(layer), surface_uv);
+    out.wetness = vertex_wetness(vertex);
     return out;
 }
 
