@@ -187,6 +187,26 @@ mod tests {
     }
 
     #[test]
+    fn a_heavier_strand_swings_slower() {
+        // The time the force first passes 90% of a steady target: sqrt(4) = 2 times later at
+        // four times the mass (damping ratio 1: no overshoot to confuse the count).
+        let rise = |mass: f32| {
+            let mut state = Inertia::new(1);
+            state.set_masses(Some(vec![mass]));
+            (0..600)
+                .find(|&n| {
+                    let t = f64::from(n) / 120.0;
+                    state.update(&[Vec3::new((t * t) as f32, 0.0, 0.0)], t, 0.5, 1.0, 1.0);
+                    state.forces()[0].x < -0.9
+                })
+                .expect("rises")
+        };
+        let (dry, wet) = (rise(1.0), rise(4.0));
+        let ratio = wet as f32 / dry as f32;
+        assert!((1.8..=2.2).contains(&ratio), "dry {dry} steps, wet {wet}: {ratio}");
+    }
+
+    #[test]
     fn a_teleport_and_a_time_jump_start_over() {
         let mut state = Inertia::new(2);
         let at = |x: f32| [Vec3::new(x, 0.0, 0.0), Vec3::new(x, 1.0, 0.0)];
