@@ -232,6 +232,17 @@ impl WetSources<'_> {
     }
 }
 
+/// The posed base the wetness is advanced on, in the scene's (world) space.
+#[derive(Clone, Copy, Debug)]
+pub struct WetSurface<'a> {
+    /// Base vertex positions.
+    pub positions: &'a [Vec3],
+    /// Unit base normals.
+    pub normals: &'a [Vec3],
+    /// The base's bounding radius (the unit of the wicking band).
+    pub radius: f32,
+}
+
 /// The most ticks a jump replays; a longer jump starts this many ticks before its target.
 const MAX_REPLAY_TICKS: i64 = 36_000;
 
@@ -269,6 +280,15 @@ impl Wetness {
         *self = Self::new(self.values.len(), wetness);
     }
 
+    /// Sets the wetness a replay starts from (time 0 and every jump back), clamped to `0..=1`;
+    /// the values change only when nothing has been advanced yet.
+    pub fn set_initial(&mut self, wetness: f32) {
+        self.initial = if wetness.is_finite() { wetness.clamp(0.0, 1.0) } else { 0.0 };
+        if self.tick.is_none() {
+            self.values.fill(self.initial);
+        }
+    }
+
     /// A sponge pressed at `centre` (world units, the space of `positions`): within `radius`,
     /// each vertex's wetness moves toward `amount` (0 dries, 1 soaks) by a smooth falloff
     /// (full at the centre). Non-finite or non-positive input changes nothing.
@@ -288,18 +308,16 @@ impl Wetness {
 
     /// Advances to `time_secs` in ticks of `1 / rate_hz` seconds: every tick, drying, then each
     /// active shower (`rate * max(0, n . -direction)`), then the water (1 below the plane, down
-    /// to 0 over the wicking band above it, never lowering). `positions` and `normals` are the
-    /// posed base in the scene's (world) space, `radius` the base's bounding radius.
+    /// to 0 over the wicking band above it, never lowering), on `surface`.
     pub fn advance_to(
         &mut self,
         time_secs: f64,
         rate_hz: f32,
         sources: WetSources<'_>,
         params: &WetParams,
-        positions: &[Vec3],
-        normals: &[Vec3],
-        radius: f32,
+        surface: WetSurface<'_>,
     ) {
+        let WetSurface { positions, normals, radius } = surface;
         if !time_secs.is_finite() {
             return;
         }
@@ -356,6 +374,10 @@ impl Wetness {
 mod tests {
     use super::*;
 
+    fn surface<'a>(positions: &'a [Vec3], normals: &'a [Vec3]) -> WetSurface<'a> {
+        WetSurface { positions, normals, radius: 1.0 }
+    }
+
     #[test]
     fn rain_wets_what_faces_it_and_drying_returns_to_exactly_zero() {
         let rain = [RainKey { start_secs: 0.0, end_secs: 1.0, direction: Vec3::NEG_Y, rate: 0.5 }];
@@ -364,12 +386,12 @@ mod tests {
         let normals = [Vec3::Y, Vec3::NEG_Y, Vec3::X];
         let mut wet = Wetness::new(3, 0.0);
         let sources = WetSources { rain: &rain, water: &[] };
-        wet.advance_to(1.0, 30.0, sources, &params, &positions, &normals, 1.0);
+        wet.advance_to(1.0, 30.0, sources, &params, surface(&positions, &normals));
         let w = wet.values();
         assert!(w[0] > 0.35 && w[0] < 0.45, "facing the rain: {}", w[0]);
         assert_eq!(w[1], 0.0, "facing away stays dry");
         assert_eq!(w[2], 0.0, "side-on stays dry");
-        wet.advance_to(10.0, 30.0, sources, &params, &positions, &normals, 1.0);
+        wet.advance_to(10.0, 30.0, sources, &params, surface(&positions, &normals));
         assert!(wet.is_dry(), "dried back to exactly 0: {:?}", wet.values());
     }
 
@@ -379,7 +401,7 @@ mod tests {
         let params = WetParams { wicking: 0.5, ..WetParams::default() };
         let positions = [Vec3::new(0.0, -1.0, 0.0), Vec3::new(0.0, 0.25, 0.0), Vec3::new(0.0, 2.0, 0.0)];
         let mut wet = Wetness::new(3, 0.0);
-        wet.advance_to(0.0, 30.0, WetSources { rain: &[], water: &water }, &params, &positions, &[Vec3::Y; 3], 1.0);
+        wet.advance_to(0.0, 30.0, WetSources { rain: &[], water: &water }, &params, surface(&positions, &[Vec3::Y; 3]));
         assert_eq!(wet.values(), &[1.0, 0.5, 0.0]);
     }
 
@@ -395,11 +417,11 @@ mod tests {
         let params = WetParams::default();
         let mut stepped = Wetness::new(8, 0.0);
         for frame in 0..=90 {
-            stepped.advance_to(f64::from(frame) / 24.0, 30.0, sources, &params, &positions, &normals, 1.0);
+            stepped.advance_to(f64::from(frame) / 24.0, 30.0, sources, &params, surface(&positions, &normals));
         }
         let mut jumped = Wetness::new(8, 0.0);
-        jumped.advance_to(1.0, 30.0, sources, &params, &positions, &normals, 1.0);
-        jumped.advance_to(90.0 / 24.0, 30.0, sources, &params, &positions, &normals, 1.0);
+        jumped.advance_to(1.0, 30.0, sources, &params, surface(&positions, &normals));
+        jumped.advance_to(90.0 / 24.0, 30.0, sources, &params, surface(&positions, &normals));
         assert_eq!(stepped.values(), jumped.values());
     }
 

@@ -13,6 +13,7 @@ mod shell_share;
 mod ui;
 mod ui_layer;
 mod viewport;
+mod wet;
 
 use std::path::PathBuf;
 

@@ -143,7 +143,7 @@ impl Stroke {
 }
 
 /// A parsed, validated scene script.
-#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Scene {
     /// Length of the scene; default the last keyframe or stroke end.

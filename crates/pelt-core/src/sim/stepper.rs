@@ -10,7 +10,7 @@ use super::simulation::{SimError, Simulation};
 use crate::anim::{Pose, Rig};
 use crate::fur::FurStructure;
 use crate::mesh::Mesh;
-use crate::wet::{WetParams, Wetness};
+use crate::wet::{WetParams, WetSurface, Wetness};
 
 /// Where the base's pose comes from each step.
 #[derive(Debug, Default)]
@@ -193,9 +193,11 @@ impl FurStepper {
                 simulation.params().rate_hz,
                 sources,
                 &self.wet,
-                simulation.roots(),
-                &self.wet_normals,
-                simulation.bounding_radius(),
+                WetSurface {
+                    positions: simulation.roots(),
+                    normals: &self.wet_normals,
+                    radius: simulation.bounding_radius(),
+                },
             );
         }
         let wet = (!self.wetness.is_dry()).then(|| self.wetness.values());
@@ -205,15 +207,15 @@ impl FurStepper {
         Ok(())
     }
 
-    /// What wetness does (the preset's `[wet]`); its `wetness` becomes every vertex's wetness
-    /// now and after a jump back in time.
+    /// What wetness does (the preset's `[wet]`); its `wetness` is every vertex's wetness at
+    /// time 0 (and after a jump back in time, which replays from there).
     ///
     /// # Errors
     /// [`SimError::Params`] for values out of range (keys `wet.*`).
     pub fn set_wet(&mut self, params: &WetParams) -> Result<(), SimError> {
         params.validate()?;
         self.wet = params.clone();
-        self.wetness.set_uniform(params.wetness);
+        self.wetness.set_initial(params.wetness);
         Ok(())
     }
 

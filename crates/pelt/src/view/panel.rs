@@ -3,6 +3,8 @@
 use pelt_core::texture::{ColourMode, Rgb, Style};
 use pelt_core::{Builtin, Preset};
 
+use super::wet::{WetChanges, WetControls, wet_ui};
+
 /// The keyboard shortcuts, shown in the panel (and in the README).
 pub const SHORTCUTS: &[(&str, &str)] = &[
     ("F", "frame the fur"),
@@ -80,6 +82,8 @@ pub struct Settings {
     pub preset_path: String,
     /// The animated file's clips and what plays.
     pub animation: AnimationSettings,
+    /// Rain, water, the sponge and the coat's wetness.
+    pub wet: WetControls,
 }
 
 /// The animation controls: which clip, playing or not, speed and the timeline.
@@ -107,6 +111,7 @@ impl Settings {
             overlay: true,
             preset_path,
             animation: AnimationSettings::default(),
+            wet: WetControls::default(),
         }
     }
 }
@@ -124,6 +129,8 @@ pub struct Changes {
     pub animation: bool,
     /// The CPU/GPU simulation toggle.
     pub kernel: bool,
+    /// Wetness, rain, water or `[wet]`.
+    pub wet: WetChanges,
 }
 
 impl Changes {
@@ -134,6 +141,7 @@ impl Changes {
         self.textures |= other.textures;
         self.simulation |= other.simulation;
         self.kernel |= other.kernel;
+        self.wet.merge(other.wet);
     }
 }
 
@@ -317,6 +325,7 @@ pub fn show(
             }
             changes.simulation |= *sim != before;
         });
+        section(ui, "Wet", true, |ui| changes.wet.merge(wet_ui(ui, &mut settings.wet, &mut settings.preset.wet)));
         section(ui, "Drawing", true, |ui| {
             let draw = &mut settings.draw;
             ui.horizontal(|ui| {

@@ -19,6 +19,7 @@ impl Model {
         outcome.1.save_preset |= shortcuts.save_preset;
         if !self.panel_hidden {
             egui::Panel::right("settings").resizable(true).default_size(320.0).min_size(260.0).show(ui, |ui| {
+                self.show_wetness();
                 let (changes, requests) = panel::show(ui, &mut self.settings, &self.mesh_choices, &self.status);
                 outcome.0.merge(changes);
                 outcome.1.merge(requests);
@@ -125,7 +126,11 @@ impl Model {
             .filter(|_| self.touch.is_none() && !modifiers.alt && !modifiers.shift)
             .and_then(|ray| self.stepper.simulation().pick(&self.structure.mesh.triangles, ray.origin, ray.direction));
 
-        if response.drag_started_by(egui::PointerButton::Primary)
+        let sponging = self.settings.wet.sponge && primary && !modifiers.alt && hover_hit.is_some();
+        if sponging && let Some(hit) = hover_hit {
+            // The sponge wets (Ctrl: dries) under the brush while the button is held.
+            self.stepper.sponge(hit.point, brush_radius, if modifiers.ctrl { 0.0 } else { 1.0 });
+        } else if response.drag_started_by(egui::PointerButton::Primary)
             && let Some(hit) = hover_hit
         {
             self.stepper.simulation_mut().touch_begin(hit.point, brush_radius)?;
@@ -145,7 +150,7 @@ impl Model {
             }
         } else if response.dragged_by(egui::PointerButton::Middle) || (primary && modifiers.shift) {
             self.camera.pan(drag, size.y);
-        } else if response.dragged_by(egui::PointerButton::Secondary) || primary {
+        } else if response.dragged_by(egui::PointerButton::Secondary) || (primary && !sponging) {
             self.camera.orbit(drag);
         }
         if response.hovered() {
