@@ -1,7 +1,8 @@
 // Checks the files `run.sh` exports (in output/): the Khronos glTF Validator finds no error and
 // no warning in any; three.js (its own GLTFLoader, in the system's headless Chromium on
 // SwiftShader's WebGL) draws the bunny's fur as `pelt render` does at the same camera, within a
-// stated mean colour difference over the fur's pixels; the Fox's fur follows its walk.
+// stated mean colour difference over the fur's pixels; the Fox's fur follows its walk; the
+// ball's fur follows its morph targets; the --motion export's fur sways.
 // The pixel checks share no code with Pelt: they read the two images only.
 //
 //   node --test export.test.mjs        (after run.sh has written output/)
@@ -67,7 +68,8 @@ const exported = () => fs.readdirSync(output).filter((f) => /\.(glb|gltf)$/.test
 
 test('the glTF Validator finds no error and no warning in any export', async () => {
   const files = exported();
-  for (const name of ['bunny.glb', 'bunny-blend.glb', 'tryon.gltf', 'fox.glb', 'fox-walk.glb']) {
+  for (const name of ['bunny.glb', 'bunny-blend.glb', 'tryon.gltf', 'fox.glb', 'fox-walk.glb', 'ball.glb',
+    'bunny-motion.glb', 'fox-motion.glb']) {
     assert.ok(files.includes(name), `${name} was not exported`);
   }
   for (const file of files) {
@@ -143,4 +145,54 @@ test("three.js moves the Fox's fur with its walk", async () => {
   console.log(`fox.glb: ${furA} fur pixels at the legs, ${changed} changed between 0.1 s and 0.45 s of Walk`);
   assert.ok(furA > 200, 'the fur is drawn at the legs');
   assert.ok(changed > 0.2 * furA, 'the fur at the legs moves with the walk');
+});
+
+/** Rows of `pixels` (top first) holding anything but the background: [first, last]. */
+function rows(pixels) {
+  const { width, height } = VIEW;
+  let first = height;
+  let last = -1;
+  for (let y = 0; y < height; y++) {
+    for (let x = 0; x < width; x++) {
+      if (!isBackground(pixels, 4 * (y * width + x))) {
+        first = Math.min(first, y);
+        last = y;
+        break;
+      }
+    }
+  }
+  return [first, last];
+}
+
+test("three.js moves the ball's fur with its morph targets", async () => {
+  // The ball itself hidden: only the fur is drawn. At 1 s of Breathe the "stretch" target is
+  // full on (the ball 1.4 times as tall); fur left at the rest would not grow with it.
+  const options = { azimuth: 0, elevation: 0, distance: 9, clip: 'Breathe', hide: ['ball'] };
+  const rest = rows(await draw('ball.glb', { ...options, time: 0, save: 'ball-0-three.png' }));
+  const stretched = rows(await draw('ball.glb', { ...options, time: 1, save: 'ball-1-three.png' }));
+  const [h0, h1] = [rest[1] - rest[0], stretched[1] - stretched[0]];
+  console.log(`ball.glb: the fur ${h0} px tall at rest, ${h1} px stretched`);
+  assert.ok(h0 > 50, 'the fur is drawn');
+  // Fur of length f on a unit ball: (2 * 1.4 + 2f) / (2 + 2f), 1.2 or more for f below 1.
+  assert.ok(h1 > 1.15 * h0, `the fur grows with the ball: ${h0} -> ${h1} px`);
+});
+
+test("three.js sways the --motion export's fur", async () => {
+  const options = { ...VIEW, clip: 'pelt fur motion' };
+  const a = await draw('bunny-motion.glb', { ...options, time: 0, save: 'bunny-motion-0-three.png' });
+  const again = await draw('bunny-motion.glb', { ...options, time: 0, save: 'bunny-motion-0b-three.png' });
+  const b = await draw('bunny-motion.glb', { ...options, time: 0.5, save: 'bunny-motion-0.5-three.png' });
+  let fur = 0;
+  let changed = 0;
+  let unchanged = true;
+  for (let k = 0; k < a.length; k += 4) {
+    if (isBackground(a, k) && isBackground(b, k)) continue;
+    fur++;
+    if ([0, 1, 2].some((c) => Math.abs(a[k + c] - b[k + c]) > 24)) changed++;
+    if ([0, 1, 2].some((c) => a[k + c] !== again[k + c])) unchanged = false;
+  }
+  console.log(`bunny-motion.glb: ${changed} of ${fur} fur pixels changed between 0 s and 0.5 s of the loop`);
+  assert.ok(unchanged, 'the same time draws the same picture');
+  assert.ok(fur > 0.1 * VIEW.width * VIEW.height, 'the fur is drawn');
+  assert.ok(changed > 0.02 * fur, 'the fur moves between two times of the loop');
 });

@@ -4,8 +4,8 @@
 //! ```toml
 //! [wet]
 //! wetness = 0.0          # the coat's wetness at time 0, 0..=1
-//! clump_size = 0.03      # clump cells, in shell tiles
-//! clump_strength = 0.6   # how far soaked strands gather toward their clump's centre, 0..=1
+//! clump_size = 12.0      # clump cells, in shell texels
+//! clump_strength = 0.8   # how strongly a soaked coat clumps, 0..=1
 //! darkening = 0.5        # albedo times 1 - darkening * wetness
 //! shine = 0.6            # highlight strength times 1 + shine * wetness (exponent 1 + 2 shine w)
 //! added_weight = 1.0     # gravity on a strand times 1 + added_weight * wetness
@@ -28,9 +28,11 @@ use crate::param::ParamError;
 pub struct WetParams {
     /// The whole coat's wetness at time 0 (`pelt render --wetness` sets it), `0..=1`. Default 0.
     pub wetness: f32,
-    /// Clump cell size in shell tiles, `0.005..=1`. Default 0.03 (a few dozen strands a clump).
+    /// Clump cells, in shell texels (a groom's clump map uses the same cells), `2..=128`.
+    /// Default 12.
     pub clump_size: f32,
-    /// How far a soaked strand's tip gathers toward its clump's centre, `0..=0.95`. Default 0.6.
+    /// How strongly a soaked coat clumps, `0..=1`: the clump amount a soaked strand adds to its
+    /// groom's. Default 0.8.
     pub clump_strength: f32,
     /// Albedo times `1 - darkening * wetness`, `0..=1`. Default 0.5.
     pub darkening: f32,
@@ -52,8 +54,8 @@ impl Default for WetParams {
     fn default() -> Self {
         Self {
             wetness: 0.0,
-            clump_size: 0.03,
-            clump_strength: 0.6,
+            clump_size: 12.0,
+            clump_strength: 0.8,
             darkening: 0.5,
             shine: 0.6,
             added_weight: 1.0,
@@ -78,8 +80,8 @@ impl WetParams {
     pub fn validate(&self) -> Result<(), ParamError> {
         let checks = [
             ("wetness", self.wetness, 0.0, 1.0),
-            ("clump_size", self.clump_size, 0.005, 1.0),
-            ("clump_strength", self.clump_strength, 0.0, 0.95),
+            ("clump_size", self.clump_size, 2.0, 128.0),
+            ("clump_strength", self.clump_strength, 0.0, 1.0),
             ("darkening", self.darkening, 0.0, 1.0),
             ("shine", self.shine, 0.0, 8.0),
             ("added_weight", self.added_weight, 0.0, 10.0),

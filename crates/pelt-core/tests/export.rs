@@ -69,6 +69,7 @@ fn a_builtin_export_reads_back_with_the_structures_counts() {
             source: None,
             plain: &[],
             extras: serde_json::json!({ "preset": "default" }),
+            morphs: None,
         };
         let export = Export::build(&input).expect("export");
         let glb = export.glb();
@@ -131,6 +132,7 @@ fn a_skinned_export_keeps_the_skin_and_binds_every_fur_vertex() {
         source: Some(&path),
         plain: &[],
         extras: serde_json::json!({}),
+        morphs: None,
     };
     let glb = Export::build(&input).expect("export").glb();
     let (document, primitives) = read_fur(&glb);
@@ -172,6 +174,7 @@ fn a_failed_write_leaves_no_file() {
         source: None,
         plain: &[],
         extras: serde_json::json!({}),
+        morphs: None,
     };
     let export = Export::build(&input).expect("export");
     let folder = std::env::temp_dir().join(format!("pelt-export-test-{}", std::process::id()));

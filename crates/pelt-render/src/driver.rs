@@ -216,6 +216,19 @@ impl FurDriver {
         Ok(())
     }
 
+    /// Rewrites the groom's density, clump and tint in place (no new textures or geometry): the
+    /// cheap path for painting them; see [`GpuFur::set_groom`]. Lengths and directions change
+    /// with [`FurDriver::set_structure`].
+    ///
+    /// # Errors
+    /// As [`GpuFur::set_groom`].
+    pub fn set_groom(&mut self, queue: &wgpu::Queue, groom: &pelt_core::groom::Groom) -> Result<(), RenderError> {
+        self.fur.set_groom(queue, groom)?;
+        // Whether the groom shades lives in the fur's uniform.
+        self.fur.prepare(queue, &self.frame);
+        Ok(())
+    }
+
     /// The level of detail from the next frame on.
     pub fn set_level(&mut self, level: FurLevel) {
         self.frame.level = level;
@@ -488,8 +501,8 @@ pub fn gpu_secs_per_step(
     let mut run = |driver: &mut FurDriver| -> Result<f64, RenderError> {
         let started = Instant::now();
         let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("sim timing") });
-        // The steps' uniform writes all land before the submission, so every dispatch reads the
-        // last step's inputs: the same work per step, which is what is timed.
+        // Each step takes its own uniform slot of the GPU simulation's ring (up to 64 a
+        // submission), so every dispatch bends with its own step's inputs.
         for _ in 0..steps {
             driver.advance_to(device, queue, &mut stepper, f64::from(step) / rate)?;
             step += 1;

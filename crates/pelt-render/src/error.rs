@@ -103,6 +103,9 @@ pub enum RenderError {
     /// The fur textures are malformed.
     #[error("invalid fur textures: {0}")]
     Textures(String),
+    /// A groom that does not fit the fur, or a fur uploaded without one.
+    #[error("groom: {0}")]
+    Groom(String),
     /// A target of a size the device cannot hold.
     #[error("the target is {width}x{height}; both sides must be between 1 and {limit}")]
     TargetSize {

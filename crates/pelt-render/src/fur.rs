@@ -64,7 +64,7 @@ impl GpuFur {
         let scope = ErrorScope::push(device);
         let furred = Furred::of(structure);
         let geometry = geometry(device, layouts, (structure, furred.as_ref()), states);
-        let textures = GpuTextures::new(device, queue, layouts, textures);
+        let textures = GpuTextures::new(device, queue, layouts, textures, structure.groom.is_some());
         let fins = fin_list(device, layouts, (structure, furred.as_ref()));
         let per_shell = geometry.as_ref().map_or(0, |g| g.shape.vertices_per_shell());
         let shells = shell_list(device, layouts, (structure, furred.as_ref()), per_shell);
@@ -100,10 +100,37 @@ impl GpuFur {
         textures: &FurTextures,
     ) -> Result<(), RenderError> {
         let scope = ErrorScope::push(device);
-        let textures = GpuTextures::new(device, queue, layouts, textures);
+        let textures = GpuTextures::new(device, queue, layouts, textures, self.geometry.shape.groomed);
         scope.pop("uploading the fur textures")?;
         self.textures = textures?;
         Ok(())
+    }
+
+    /// Rewrites the groom's density, clump and tint (one small buffer write, no new textures or
+    /// geometry): the cheap path for painting them. The fur must have been grown with a groom
+    /// (any map; `set_structure` with a groomed structure first), and for density its textures
+    /// uploaded while it had one (`new` or `set_textures`), which brings the strands' keep
+    /// values. Lengths and directions shape the shared array: they change with
+    /// [`GpuFur::set_structure`]. Takes effect at the next [`GpuFur::prepare`].
+    ///
+    /// # Errors
+    /// [`RenderError::Groom`] for a fur without a groom, a density map on textures without keep
+    /// values, or a groom that does not fit the mesh.
+    pub fn set_groom(&mut self, queue: &wgpu::Queue, groom: &pelt_core::groom::Groom) -> Result<(), RenderError> {
+        if self.geometry.shape.groomed && groom.density.is_some() && !self.textures.has_keep {
+            return Err(RenderError::Groom(
+                "a density map needs the textures uploaded with a groom (set_textures after set_structure)".to_owned(),
+            ));
+        }
+        self.geometry.set_groom(queue, groom)
+    }
+
+    /// Bytes the groom adds on the GPU: the per-vertex attributes (32 a vertex) and the strands'
+    /// keep values (one byte a shell texel). 0 without a groom.
+    #[must_use]
+    pub fn groom_bytes(&self) -> u64 {
+        let keep = if self.textures.has_keep { self.textures.keep_bytes } else { 0 };
+        self.geometry.groom_bytes() + keep
     }
 
     /// Writes this frame's model transform, interpolation and look (takes effect at the next
@@ -324,7 +351,7 @@ fn geometry(
     UnifiedGeometry::new(
         device,
         layouts,
-        (&structure.mesh, furred),
+        (&structure.mesh, furred, structure.groom.as_ref()),
         structure.layers,
         &structure.positions,
         state_count,

@@ -8,6 +8,7 @@
 
 use glam::{Vec2, Vec3};
 use pelt_core::fur::POSITION_BYTES;
+use pelt_core::groom::Groom;
 use pelt_core::mesh::NO_FACE;
 use pelt_core::{FurStructure, Mesh};
 use wgpu::util::DeviceExt as _;
@@ -81,6 +82,24 @@ fn topology(mesh: &Mesh, furred: Option<&Furred>) -> (Vec<u32>, Option<Vec<Vec2>
     (topology, Some(wedges.uvs), count)
 }
 
+/// The groom attributes of every vertex of a `vertex_count` mesh (`GroomAttributes` in
+/// `shading.wgsl`); absent maps give the uniform values (tint 1, density 1, clump 0).
+pub(crate) fn groom_attributes(groom: &Groom, vertex_count: usize) -> Vec<[f32; 8]> {
+    (0..vertex_count)
+        .map(|j| {
+            let tint = groom.tint.as_ref().map_or(Vec3::ONE, |t| t[j]);
+            let density = groom.density.as_ref().map_or(1.0, |d| d[j]);
+            let clump = groom.clump.as_ref().map_or(0.0, |c| c[j]);
+            [tint.x, tint.y, tint.z, density, clump, 0.0, 0.0, 0.0]
+        })
+        .collect()
+}
+
+/// Whether `groom` changes the shading (density, clump or tint).
+pub(crate) fn shades(groom: &Groom) -> bool {
+    groom.density.is_some() || groom.clump.is_some() || groom.tint.is_some()
+}
+
 #[derive(Debug)]
 pub(crate) struct UnifiedGeometry {
     pub shape: ObjectShape,
@@ -99,6 +118,8 @@ pub(crate) struct UnifiedGeometry {
     /// The fin strip of one edge (`6L` indices into `2(L + 1)` strip vertices), shared by all
     /// edges: indexed, each strip vertex is shaded once however many triangles use it.
     fin_indices: Option<wgpu::Buffer>,
+    /// Each vertex's groom attributes (`V` entries for a groomed fur, else one unused entry).
+    groom: wgpu::Buffer,
     /// `bind_groups[c]` reads `states[c]` as current and the other state as previous.
     bind_groups: Vec<wgpu::BindGroup>,
     bytes: GpuBytes,
@@ -106,11 +127,11 @@ pub(crate) struct UnifiedGeometry {
 
 impl UnifiedGeometry {
     /// Uploads `mesh` with `positions` (`(L + 1) * V`, layer-major) into every state; shells
-    /// and fins draw only what `furred` lists (`None`: everything).
+    /// and fins draw only what `furred` lists (`None`: everything) and shade with `groom`.
     pub fn new(
         device: &wgpu::Device,
         layouts: &Layouts,
-        (mesh, furred): (&Mesh, Option<&Furred>),
+        (mesh, furred, groom): (&Mesh, Option<&Furred>, Option<&Groom>),
         layers: u32,
         positions: &[Vec3],
         state_count: usize,
@@ -167,6 +188,17 @@ impl UnifiedGeometry {
             .collect();
         let fin_indices =
             (layers > 0).then(|| buffer("pelt fin strip", bytemuck::cast_slice(&strip), wgpu::BufferUsages::INDEX));
+        let attributes = match groom {
+            Some(groom) => groom_attributes(groom, mesh.vertex_count()),
+            None => vec![[0.0; 8]],
+        };
+        shape.groomed = groom.is_some();
+        shape.groom_shading = groom.is_some_and(shades);
+        let groom_buffer = buffer(
+            "pelt groom attributes",
+            bytemuck::cast_slice(&attributes),
+            wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+        );
         let uniform = uniform_buffer(device);
         let bind_groups = (0..states.len())
             .map(|current| {
@@ -181,7 +213,8 @@ impl UnifiedGeometry {
                         wgpu::BindGroupEntry { binding: 3, resource: normals.as_entire_binding() },
                         wgpu::BindGroupEntry { binding: 4, resource: uvs.as_entire_binding() },
                         wgpu::BindGroupEntry { binding: 5, resource: topology_buffer.as_entire_binding() },
-                        wgpu::BindGroupEntry { binding: 6, resource: wetness.as_entire_binding() },
+                        wgpu::BindGroupEntry { binding: 6, resource: groom_buffer.as_entire_binding() },
+                        wgpu::BindGroupEntry { binding: 7, resource: wetness.as_entire_binding() },
                     ],
                 })
             })
@@ -202,9 +235,30 @@ impl UnifiedGeometry {
             wetness,
             topology: topology_buffer,
             fin_indices,
+            groom: groom_buffer,
             bind_groups,
             bytes,
         })
+    }
+
+    /// Bytes of the groom attributes (0 without a groom).
+    pub fn groom_bytes(&self) -> u64 {
+        if self.shape.groomed { self.groom.size() } else { 0 }
+    }
+
+    /// Rewrites the groom attributes from `groom` (density, clump, tint; lengths and directions
+    /// live in the shared array). No allocation on the GPU: the buffer was made for the groom.
+    pub fn set_groom(&mut self, queue: &wgpu::Queue, groom: &Groom) -> Result<(), RenderError> {
+        let vertices = self.shape.vertex_count as usize;
+        if !self.shape.groomed {
+            return Err(RenderError::Groom(
+                "the fur was uploaded without a groom; grow it with one (set_structure) first".to_owned(),
+            ));
+        }
+        groom.validate(vertices, "the groom").map_err(|e| RenderError::Groom(e.to_string()))?;
+        queue.write_buffer(&self.groom, 0, bytemuck::cast_slice(&groom_attributes(groom, vertices)));
+        self.shape.groom_shading = shades(groom);
+        Ok(())
     }
 
     pub fn bytes(&self) -> GpuBytes {

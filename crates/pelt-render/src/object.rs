@@ -27,11 +27,13 @@ pub struct FurLook {
     pub tiles_per_radius: f32,
     /// Wet albedo is `1 - wet_darkening * wetness` of the dry one (`[wet] darkening`).
     pub wet_darkening: f32,
-    /// The wet highlight grows by `1 + wet_shine * wetness`, its exponent by `1 + 2 wet_shine wetness` (`[wet] shine`).
+    /// The wet highlight grows by `1 + wet_shine * w`, its exponent by `1 + 2 * wet_shine * w`
+    /// (`[wet] shine`).
     pub wet_shine: f32,
-    /// Clump cells, in shell tiles (`[wet] clump_size`).
+    /// Clump cells, in shell texels, for wet fur and a groom's clump map alike
+    /// (`[wet] clump_size`).
     pub clump_size: f32,
-    /// How far a soaked strand's tip gathers toward its clump's centre (`[wet] clump_strength`).
+    /// How strongly a soaked strand clumps, 0..1 (`[wet] clump_strength`).
     pub clump_strength: f32,
 }
 
@@ -60,8 +62,8 @@ impl Default for FurLook {
             tiles_per_radius: 0.4,
             wet_darkening: 0.5,
             wet_shine: 0.6,
-            clump_size: 0.03,
-            clump_strength: 0.6,
+            clump_size: 12.0,
+            clump_strength: 0.8,
         }
     }
 }
@@ -143,6 +145,10 @@ pub(crate) struct ObjectShape {
     pub world_per_uv: f32,
     /// Bounding radius of the base mesh, model units.
     pub radius: f32,
+    /// Whether the fur has a groom (its attribute buffer holds one entry per vertex).
+    pub groomed: bool,
+    /// Whether the groom's density, clump or tint reach the shading.
+    pub groom_shading: bool,
 }
 
 impl ObjectShape {
@@ -158,6 +164,8 @@ impl ObjectShape {
             wedge_count: 0,
             world_per_uv: world_per_uv(mesh),
             radius: mesh.bounding_sphere().1.max(1e-6),
+            groomed: false,
+            groom_shading: false,
         }
     }
 
@@ -209,12 +217,12 @@ impl ObjectShape {
             lod_view_full: level.facing.map_or(1.0, |[_, full]| full),
             furred_triangle_count: self.furred_triangle_count,
             fin_edge_count: self.fin_edge_count,
+            groom_shading: u32::from(self.groom_shading),
             wet_darkening: look.wet_darkening,
             wet_shine: look.wet_shine,
-            clump_size: look.clump_size.max(1e-3),
-            clump_strength: look.clump_strength.clamp(0.0, 0.95),
+            wet_clump: look.clump_strength.clamp(0.0, 1.0),
+            clump_cell_texels: look.clump_size.clamp(2.0, 128.0),
             wet_any: u32::from(frame.wet),
-            _padding_1: 0,
             _padding_2: 0,
         }
     }

@@ -26,7 +26,7 @@ impl PlainMesh {
         colour: Vec3,
     ) -> Result<Self, RenderError> {
         let scope = ErrorScope::push(device);
-        let geometry = UnifiedGeometry::new(device, layouts, (mesh, None), 0, &mesh.positions, 1);
+        let geometry = UnifiedGeometry::new(device, layouts, (mesh, None, None), 0, &mesh.positions, 1);
         scope.pop("uploading a plain mesh")?;
         Ok(Self { geometry: geometry?, colour })
     }

@@ -4,12 +4,14 @@
 //! The CPU `Simulation` stays the controller (time, fixed steps, touch, field, parameters, posed
 //! roots), with its own bending turned off ([`Simulation::set_cpu_bending`]); after each
 //! `advance_to` the host calls [`GpuSimulation::prepare`] (small queue writes: one uniform slot
-//! per step, and the per-strand inputs only when they changed) and [`GpuSimulation::dispatch`]
-//! (one compute pass per step into the host's encoder, swapping the fur's states). Nothing is
-//! read back and the shared array never crosses the bus.
+//! per step, and a per-strand input only when its [`InputVersions`] counter moved) and
+//! [`GpuSimulation::dispatch`] (one compute pass per step into the host's encoder, swapping the
+//! fur's states). What changes every step per strand is computed here: the inertial force
+//! (from the simulation's [`InertiaStep`]s and the roots) and the touch's weights (when a touch
+//! begins). Nothing is read back and the shared array never crosses the bus.
 
 use pelt_core::FurStructure;
-use pelt_core::sim::{Simulation, StepInputs, StrandInputs, kernel_rest};
+use pelt_core::sim::{InertiaStep, InputVersions, Simulation, StepInputs, StrandInputs, kernel_rest};
 
 use crate::RenderError;
 use crate::fur::GpuFur;
@@ -22,6 +24,9 @@ const WORKGROUP: u32 = 64;
 const STEP_SLOT_BYTES: u64 = 256;
 /// Steps one prepare/dispatch pair can hold: only the last two states are ever kept.
 const STEP_SLOTS: usize = 2;
+/// Uniform slots in the ring the steps take in turn: a host recording up to this many steps into
+/// one submission gives each its own inputs (the queue writes all land before it runs).
+const RING_SLOTS: u64 = 64;
 /// Storage buffers the compute stage binds.
 const STORAGE_BUFFERS: u32 = 5;
 
@@ -39,7 +44,22 @@ struct StepUniform {
     next_tick_counts: [u32; 4],
     touch: [f32; 4],
     grid: [u32; 4],
+    touch_centre: [f32; 4],
+    inertia: [f32; 4],
+    inertia_damp: [f32; 4],
+    inertia_kind: [u32; 4],
 }
+
+/// `InertiaStep`'s kinds as `simulation_inputs.wgsl` numbers them.
+const INERTIA_START: u32 = 0;
+const INERTIA_SHIFT: u32 = 1;
+const INERTIA_SHIFT_ZERO: u32 = 2;
+const INERTIA_SPRING: u32 = 3;
+
+/// Bytes per strand of the resident inputs (root and stability, frame, field) and of the state
+/// the GPU carries (last two roots and the touch weight, force, its rate of change).
+const STRAND_BYTES: u64 = 3 * 16;
+const STATE_BYTES: u64 = 4 * 16;
 
 // A slot holds one step, in the 16-byte units WGSL lays `Step` out in.
 const _: () =
@@ -51,8 +71,15 @@ fn words(value: u64) -> [u32; 2] {
 }
 
 /// The uniform of one step: `inputs` repacked into `Step`'s layout (the gust travel's whole
-/// cells negated, as the shader adds them; 64-bit values as two words).
-fn step_uniform(inputs: &StepInputs, counts: [u32; 2], grid_x: u32) -> StepUniform {
+/// cells negated, as the shader adds them; 64-bit values as two words), with the inertia's step
+/// and the touch's centre and radius.
+fn step_uniform(
+    inputs: &StepInputs,
+    inertia: InertiaStep,
+    touch_centre: [f32; 4],
+    counts: [u32; 2],
+    grid_x: u32,
+) -> StepUniform {
     let wind = &inputs.wind;
     let [x, y, z] = wind.gust_travel_cells.map(|cells| words(cells.wrapping_neg() as u64));
     let seed = words(wind.noise_seed);
@@ -74,13 +101,52 @@ fn step_uniform(inputs: &StepInputs, counts: [u32; 2], grid_x: u32) -> StepUnifo
         next_tick_counts: [tick_b[0], tick_b[1], counts[0], counts[1]],
         touch: inputs.touch_force.extend(inputs.touch_presence).to_array(),
         grid: [grid_x, 0, 0, 0],
+        touch_centre,
+        inertia: match inertia {
+            InertiaStep::Spring(spring) => [spring.dt, spring.dt_before, spring.scale, spring.stiffness_dt],
+            _ => [0.0; 4],
+        },
+        inertia_damp: match inertia {
+            InertiaStep::Spring(spring) => [spring.damp, 0.0, 0.0, 0.0],
+            _ => [0.0; 4],
+        },
+        inertia_kind: [
+            match inertia {
+                InertiaStep::Start => INERTIA_START,
+                InertiaStep::Shift { zero: false } => INERTIA_SHIFT,
+                InertiaStep::Shift { zero: true } => INERTIA_SHIFT_ZERO,
+                InertiaStep::Spring(_) => INERTIA_SPRING,
+            },
+            0,
+            0,
+            0,
+        ],
     }
+}
+
+/// Makes a run of steps' inertia kinds one the GPU's state can follow, from `history` (how
+/// many steps the state has seen since it started, up to 2: 0 when it never started or missed
+/// steps): the first step after a gap starts over, a spring needs two steps of history.
+/// Returns the history after the run.
+fn settle_inertia(pending: &mut [StepUniform], mut history: u8) -> u8 {
+    for uniform in pending {
+        let kind = &mut uniform.inertia_kind[0];
+        if history == 0 {
+            *kind = INERTIA_START;
+        } else if *kind == INERTIA_SPRING && history < 2 {
+            *kind = INERTIA_SHIFT;
+        }
+        history = if *kind == INERTIA_START { 1 } else { (history + 1).min(2) };
+    }
+    history
 }
 
 /// A fur's simulation on the GPU: bends every strand exactly as `pelt_core::sim` defines it
 /// (Equation 1 as Pelt implements it, gravity, the wind with the same noise and seeds, the user
-/// field and the touch over it, the inertial force, posed roots and frames) in a compute pass, one invocation per
-/// strand, writing the new state into [`GpuFur::current_positions`] after
+/// field and the touch over it, the inertial force, posed roots and frames) in a compute pass,
+/// one invocation per strand, which also steps each strand's inertial force; a touch's weights
+/// come from a small pass when it begins. Each step writes the new state into
+/// [`GpuFur::current_positions`] after
 /// [`GpuFur::swap_states`]; the fur's vertex shader interpolates between its two states.
 ///
 /// Per frame: `simulation.advance_to(t)`, then [`GpuSimulation::prepare`] and
@@ -91,24 +157,36 @@ fn step_uniform(inputs: &StepInputs, counts: [u32; 2], grid_x: u32) -> StepUnifo
 #[derive(Debug)]
 pub struct GpuSimulation {
     pipeline: wgpu::ComputePipeline,
+    touch_pipeline: wgpu::ComputePipeline,
     layout: wgpu::BindGroupLayout,
     step_uniforms: wgpu::Buffer,
     rest_segments: wgpu::Buffer,
     strands: wgpu::Buffer,
-    forces: wgpu::Buffer,
+    state: wgpu::Buffer,
     wet: WetInputs,
     /// One bind group per shared-array buffer written so far (a fur has one or two).
     bind_groups: Vec<(wgpu::Buffer, wgpu::BindGroup)>,
     vertex_count: u32,
     layers: u32,
     grid: [u32; 2],
-    /// What `strands` and `forces` hold, so unchanged inputs are not uploaded again.
-    strand_data: Vec<[f32; 8]>,
-    force_data: Vec<[f32; 8]>,
+    /// The input versions `strands` holds (`None`: nothing uploaded yet), and the stability
+    /// where no map is set that its roots section was written with.
+    uploaded: Option<(InputVersions, f32)>,
+    /// A touch began on the last step's roots: the `weigh_touch` pass runs before the next step.
+    weigh_touch: bool,
+    /// The touch's weights are the CPU's, uploaded beside the field (it began on roots no step
+    /// used), not the `weigh_touch` pass's.
+    touch_uploaded: bool,
     /// `Simulation::steps_taken` at the last prepare (`None`: replay the last two steps).
     seen_steps: Option<u64>,
     /// Steps prepared and not yet dispatched (at most [`STEP_SLOTS`], in slot order).
     pending: Vec<StepUniform>,
+    /// The ring slot of the first pending step.
+    ring: u64,
+    /// Steps the inertial state has seen since it started (up to 2) after the dispatched steps,
+    /// and after the pending ones.
+    dispatched_history: u8,
+    pending_history: u8,
 }
 
 impl GpuSimulation {
@@ -187,7 +265,8 @@ impl GpuSimulation {
             rest.push([0.0; 4]);
         }
         check_size(device, "simulation rest segments", rest.len() as u64 * 16)?;
-        check_size(device, "simulation strands and forces", v.max(1) as u64 * 32)?;
+        check_size(device, "simulation strand inputs", v.max(1) as u64 * STRAND_BYTES)?;
+        check_size(device, "simulation strand state", v.max(1) as u64 * STATE_BYTES)?;
 
         let scope = ErrorScope::push(device);
         let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
@@ -219,7 +298,7 @@ impl GpuSimulation {
                 },
                 storage(1, true),
                 storage(2, true),
-                storage(3, true),
+                storage(3, false),
                 storage(4, false),
                 storage(5, true),
             ],
@@ -229,21 +308,25 @@ impl GpuSimulation {
             bind_group_layouts: &[Some(&layout)],
             immediate_size: 0,
         });
-        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some("pelt simulation"),
-            layout: Some(&pipeline_layout),
-            module: &module,
-            entry_point: Some("step_strands"),
-            compilation_options: wgpu::PipelineCompilationOptions::default(),
-            cache: None,
-        });
+        let compute_pipeline = |entry_point| {
+            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some(entry_point),
+                layout: Some(&pipeline_layout),
+                module: &module,
+                entry_point: Some(entry_point),
+                compilation_options: wgpu::PipelineCompilationOptions::default(),
+                cache: None,
+            })
+        };
+        let pipeline = compute_pipeline("step_strands");
+        let touch_pipeline = compute_pipeline("weigh_touch");
         let buffer = |label, size: u64, usage| {
             device.create_buffer(&wgpu::BufferDescriptor { label: Some(label), size, usage, mapped_at_creation: false })
         };
         let storage_usage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST;
         let step_uniforms = buffer(
             "pelt simulation steps",
-            STEP_SLOT_BYTES * STEP_SLOTS as u64,
+            STEP_SLOT_BYTES * RING_SLOTS,
             wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
         );
         let rest_segments = wgpu::util::DeviceExt::create_buffer_init(
@@ -254,36 +337,46 @@ impl GpuSimulation {
                 usage: wgpu::BufferUsages::STORAGE,
             },
         );
-        let strands = buffer("pelt simulation strands", v.max(1) as u64 * 32, storage_usage);
-        let forces = buffer("pelt simulation forces", v.max(1) as u64 * 32, storage_usage);
+        let strands = buffer("pelt simulation strands", v.max(1) as u64 * STRAND_BYTES, storage_usage);
+        // Read back by tests comparing it with the CPU's inputs.
+        let state = buffer(
+            "pelt simulation strand state",
+            v.max(1) as u64 * STATE_BYTES,
+            storage_usage | wgpu::BufferUsages::COPY_SRC,
+        );
         let wet = WetInputs::new(device, v);
         scope.pop("creating the GPU simulation")?;
         Ok(Self {
             pipeline,
+            touch_pipeline,
             layout,
             step_uniforms,
             rest_segments,
             strands,
-            forces,
+            state,
             wet,
             bind_groups: Vec::new(),
             vertex_count: v as u32,
             layers: structure.layers,
             grid,
-            strand_data: Vec::new(),
-            force_data: Vec::new(),
+            uploaded: None,
+            weigh_touch: false,
+            touch_uploaded: false,
             seen_steps: None,
             pending: Vec::with_capacity(STEP_SLOTS + 2),
+            ring: 0,
+            dispatched_history: 0,
+            pending_history: 0,
         })
     }
 
     /// Takes the steps `simulation` ran since the last call (all of its last two the first
-    /// time): writes their uniforms and, when they changed, the per-strand inputs (roots,
-    /// frames, stability, field, touch weights, inertial forces). Queue writes only; call
+    /// time): writes their uniforms (each with its own inertia step) and, when they changed, the
+    /// resident per-strand inputs (roots, frames, stability, field). Queue writes only; call
     /// [`GpuSimulation::dispatch`] before the next submission. Steps not dispatched yet are kept
-    /// (the last two). The per-strand inputs are the simulation's now: when it took two steps
-    /// at once (a catch-up), the older one is bent with the newer one's inertial force (the CPU
-    /// keeps no older one); everything else of a step is its own.
+    /// (the last two). The resident inputs are the simulation's now: when it took two steps at
+    /// once (a catch-up) after its base moved, both are bent from the newer roots. Steps this
+    /// never saw (more than two between calls) start the inertial force over from rest.
     ///
     /// # Errors
     /// [`RenderError::Count`] when `simulation` or `fur` is not the shape this was made for;
@@ -310,24 +403,47 @@ impl GpuSimulation {
         }
         let taken = simulation.steps_taken();
         let recent = simulation.recent_step_times();
-        let new = match self.seen_steps {
-            None => recent.len(),
-            Some(seen) => usize::try_from(taken.saturating_sub(seen)).unwrap_or(usize::MAX).min(recent.len()),
+        let unseen = match self.seen_steps {
+            None => u64::MAX,
+            Some(seen) => taken.saturating_sub(seen),
         };
+        let new = usize::try_from(unseen).unwrap_or(usize::MAX).min(recent.len());
         self.seen_steps = Some(taken);
         if new == 0 {
             return Ok(());
         }
         self.upload_inputs(queue, simulation);
+        let touch_centre =
+            simulation.touch().map_or([0.0, 0.0, 0.0, 1.0], |touch| touch.point.extend(touch.radius).to_array());
         let counts = [self.vertex_count, self.layers];
-        for &time_secs in &recent[recent.len() - new..] {
-            self.pending.push(step_uniform(&simulation.step_inputs(time_secs), counts, self.grid[0]));
+        let inertia_steps = simulation.recent_inertia_steps();
+        // Steps the GPU never saw (or pending steps dropped below): its inertial state starts over.
+        let mut start_over = unseen > recent.len() as u64;
+        if start_over {
+            self.pending.clear();
+        }
+        for (&time_secs, &inertia) in
+            recent[recent.len() - new..].iter().zip(&inertia_steps[inertia_steps.len() - new..])
+        {
+            self.pending.push(step_uniform(
+                &simulation.step_inputs(time_secs),
+                inertia,
+                touch_centre,
+                counts,
+                self.grid[0],
+            ));
+            if let Some(uniform) = self.pending.last_mut() {
+                uniform.inertia_kind[1] = u32::from(self.touch_uploaded);
+            }
         }
         if self.pending.len() > STEP_SLOTS {
             self.pending.drain(..self.pending.len() - STEP_SLOTS);
+            start_over = true;
         }
+        let history = if start_over { 0 } else { self.dispatched_history };
+        self.pending_history = settle_inertia(&mut self.pending, history);
         for (slot, uniform) in self.pending.iter().enumerate() {
-            queue.write_buffer(&self.step_uniforms, slot as u64 * STEP_SLOT_BYTES, bytemuck::bytes_of(uniform));
+            queue.write_buffer(&self.step_uniforms, self.slot_offset(slot), bytemuck::bytes_of(uniform));
         }
         Ok(())
     }
@@ -352,6 +468,16 @@ impl GpuSimulation {
                 rule: "call GpuSimulation::prepare with the same fur first",
             });
         };
+        if std::mem::take(&mut self.weigh_touch) && self.vertex_count > 0 {
+            // The touch's roots are those of the last step: the state that is current now.
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("pelt simulation touch weights"),
+                timestamp_writes: None,
+            });
+            pass.set_pipeline(&self.touch_pipeline);
+            pass.set_bind_group(0, &self.bind_groups[after_next].1, &[self.slot_offset(0) as u32]);
+            pass.dispatch_workgroups(self.grid[0], self.grid[1], 1);
+        }
         for slot in 0..self.pending.len() {
             fur.swap_states();
             let bind_group = &self.bind_groups[if slot % 2 == 0 { next } else { after_next }].1;
@@ -363,11 +489,26 @@ impl GpuSimulation {
                 timestamp_writes: None,
             });
             pass.set_pipeline(&self.pipeline);
-            pass.set_bind_group(0, bind_group, &[(slot as u64 * STEP_SLOT_BYTES) as u32]);
+            pass.set_bind_group(0, bind_group, &[self.slot_offset(slot) as u32]);
             pass.dispatch_workgroups(self.grid[0], self.grid[1], 1);
         }
+        self.ring = (self.ring + self.pending.len() as u64) % RING_SLOTS;
         self.pending.clear();
+        self.dispatched_history = self.pending_history;
         Ok(())
+    }
+
+    /// The byte offset of pending step `slot`'s uniform in the ring.
+    fn slot_offset(&self, slot: usize) -> u64 {
+        (self.ring + slot as u64) % RING_SLOTS * STEP_SLOT_BYTES
+    }
+
+    /// What the GPU carries from step to step, for tests that compare it with the CPU's
+    /// inputs: `4 V` `vec4<f32>` in sections of `V`: the root at the last step (xyz) and the
+    /// touch's weight (w), the root the step before, the inertial force, its rate of change.
+    #[must_use]
+    pub fn strand_state(&self) -> &wgpu::Buffer {
+        &self.state
     }
 
     /// Steps prepared and not yet dispatched (0, 1 or 2).
@@ -401,9 +542,9 @@ impl GpuSimulation {
                 },
                 wgpu::BindGroupEntry { binding: 1, resource: self.rest_segments.as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 2, resource: self.strands.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 3, resource: self.forces.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 3, resource: self.state.as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 4, resource: output.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 5, resource: self.wet.gravity_scales.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 5, resource: self.wet.buffer.as_entire_binding() },
             ],
         });
         scope.pop("binding the GPU simulation to the fur")?;
@@ -415,67 +556,80 @@ impl GpuSimulation {
         Ok(())
     }
 
-    /// Writes the per-strand inputs that differ from what the GPU holds.
+    /// Writes the resident per-strand inputs whose version moved since they were written, and
+    /// marks a new touch for the `weigh_touch` pass.
     fn upload_inputs(&mut self, queue: &wgpu::Queue, simulation: &Simulation) {
+        let versions = simulation.input_versions();
         let inputs = simulation.strand_inputs();
-        let strands: Vec<[f32; 8]> = inputs
-            .roots
-            .iter()
-            .zip(inputs.frames)
-            .enumerate()
-            .map(|(j, (root, frame))| {
-                let [x, y, z, w] = frame.to_array();
-                [root.x, root.y, root.z, inputs.stability_of(j), x, y, z, w]
-            })
-            .collect();
-        if strands != self.strand_data {
-            queue.write_buffer(&self.strands, 0, bytemuck::cast_slice(&strands));
-            self.strand_data = strands;
+        let v = self.vertex_count as u64;
+        let old = self.uploaded.filter(|(old, _)| old.id == versions.id);
+        let changed =
+            |version: fn(&InputVersions) -> u64| old.is_none_or(|(old, _)| version(&old) != version(&versions));
+        let stability_changed = old.is_none_or(|(_, stability)| {
+            inputs.stability_map.is_none() && stability.to_bits() != inputs.stability.to_bits()
+        });
+        if changed(|x| x.base) || changed(|x| x.stability) || stability_changed {
+            let roots: Vec<[f32; 4]> = inputs
+                .roots
+                .iter()
+                .enumerate()
+                .map(|(j, root)| root.extend(inputs.stability_of(j)).to_array())
+                .collect();
+            queue.write_buffer(&self.strands, 0, bytemuck::cast_slice(&roots));
         }
-        let mut forces: Vec<[f32; 8]> =
-            inputs.field.iter().zip(inputs.inertial).map(|(f, i)| [f.x, f.y, f.z, 0.0, i.x, i.y, i.z, 0.0]).collect();
-        for &(j, weight) in inputs.touch_weights {
-            forces[j as usize][3] = weight;
+        if changed(|x| x.base) {
+            let frames: Vec<[f32; 4]> = inputs.frames.iter().map(|frame| frame.to_array()).collect();
+            queue.write_buffer(&self.strands, v * 16, bytemuck::cast_slice(&frames));
         }
-        // Bitwise, so a NaN in the field does not count as a change every step.
-        if bytemuck::cast_slice::<_, u32>(&forces) != bytemuck::cast_slice::<_, u32>(&self.force_data) {
-            queue.write_buffer(&self.forces, 0, bytemuck::cast_slice(&forces));
-            self.force_data = forces;
+        let new_touch = changed(|x| x.touch) && simulation.touch().is_some();
+        let touch_uploaded = if new_touch { !simulation.touch_began_on_step_roots() } else { self.touch_uploaded };
+        self.weigh_touch |= new_touch && !touch_uploaded;
+        if changed(|x| x.field) || (new_touch && (touch_uploaded || self.touch_uploaded)) {
+            // The field, with the touch's weights in w when they are the CPU's.
+            let mut field: Vec<[f32; 4]> = inputs.field.iter().map(|force| force.extend(0.0).to_array()).collect();
+            if touch_uploaded {
+                for &(j, weight) in inputs.touch_weights {
+                    field[j as usize][3] = weight;
+                }
+            }
+            queue.write_buffer(&self.strands, 2 * v * 16, bytemuck::cast_slice(&field));
         }
+        self.touch_uploaded = touch_uploaded;
+        self.uploaded = Some((versions, inputs.stability));
         self.wet.upload(queue, &inputs);
     }
 }
 
-/// Wet strands' extra weight: gravity's factor per strand (binding 5), kept apart from the other
-/// per-strand inputs. A wet strand's lower stability rides in the strands buffer
-/// ([`StrandInputs::stability_of`]).
+/// Wet strands' extra weight, kept apart from the other per-strand inputs (binding 5): per
+/// strand, gravity's factor and the mass on the inertial spring, both `1 + added_weight * w`. A
+/// wet strand's lower stability rides in the strands buffer ([`StrandInputs::stability_of`]).
 #[derive(Debug)]
 struct WetInputs {
-    gravity_scales: wgpu::Buffer,
+    buffer: wgpu::Buffer,
     /// What the buffer holds; empty while it holds all ones.
-    uploaded: Vec<f32>,
+    uploaded: Vec<[f32; 2]>,
 }
 
 impl WetInputs {
     fn new(device: &wgpu::Device, strands: usize) -> Self {
-        let gravity_scales = wgpu::util::DeviceExt::create_buffer_init(
+        let buffer = wgpu::util::DeviceExt::create_buffer_init(
             device,
             &wgpu::util::BufferInitDescriptor {
-                label: Some("pelt simulation wet gravity"),
-                contents: bytemuck::cast_slice(&vec![1.0_f32; strands.max(1)]),
+                label: Some("pelt simulation wet strands"),
+                contents: bytemuck::cast_slice(&vec![[1.0_f32; 2]; strands.max(1)]),
                 usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
             },
         );
-        Self { gravity_scales, uploaded: Vec::new() }
+        Self { buffer, uploaded: Vec::new() }
     }
 
     fn upload(&mut self, queue: &wgpu::Queue, inputs: &StrandInputs<'_>) {
         if inputs.wetness.is_none() && self.uploaded.is_empty() {
             return;
         }
-        let scales: Vec<f32> = (0..inputs.roots.len()).map(|j| inputs.gravity_scale_of(j)).collect();
+        let scales: Vec<[f32; 2]> = (0..inputs.roots.len()).map(|j| [inputs.gravity_scale_of(j); 2]).collect();
         if scales != self.uploaded {
-            queue.write_buffer(&self.gravity_scales, 0, bytemuck::cast_slice(&scales));
+            queue.write_buffer(&self.buffer, 0, bytemuck::cast_slice(&scales));
             self.uploaded = if inputs.wetness.is_none() { Vec::new() } else { scales };
         }
     }
@@ -546,7 +700,11 @@ mod mirror_tests {
             jitter_seed_tick,
             next_tick_counts,
             touch,
-            grid
+            grid,
+            touch_centre,
+            inertia,
+            inertia_damp,
+            inertia_kind
         });
         assert_mirrors(&simulation_shader_source(), "Step", &rust);
     }

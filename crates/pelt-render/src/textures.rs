@@ -15,8 +15,12 @@ pub(crate) struct GpuTextures {
     pub has_surface: bool,
     /// Alpha-weighted mean strand colour of the root slice, linear RGB.
     pub root_colour: glam::Vec3,
-    /// Bytes of all three textures with their mipmaps.
+    /// Bytes of all textures with their mipmaps.
     pub bytes: u64,
+    /// Whether the strands' keep values are on the GPU (a groomed fur's density reads them).
+    pub has_keep: bool,
+    /// Bytes of the keep values (the 1-byte stand-in without them).
+    pub keep_bytes: u64,
 }
 
 impl GpuTextures {
@@ -25,8 +29,16 @@ impl GpuTextures {
         queue: &wgpu::Queue,
         layouts: &Layouts,
         textures: &FurTextures,
+        with_keep: bool,
     ) -> Result<Self, RenderError> {
         validate(textures)?;
+        let keep_bytes = textures.size as usize * textures.size as usize * textures.layers as usize;
+        if with_keep && textures.strand_keep.len() != keep_bytes {
+            return Err(RenderError::Textures(format!(
+                "strand keep values have {} bytes, expected {keep_bytes} (one per shell texel)",
+                textures.strand_keep.len()
+            )));
+        }
         let limits = device.limits();
         let side = textures.size.max(textures.fin_width).max(textures.fin_height);
         let surface_side = textures.surface.as_ref().map_or(1, |s| s.width.max(s.height));
@@ -65,6 +77,10 @@ impl GpuTextures {
         };
         let surface = upload(device, queue, "pelt surface colour", surface_size, vec![surface_pixels])
             .create_view(&wgpu::TextureViewDescriptor::default());
+        // Without a groom a 1x1 stand-in that keeps every strand.
+        let (keep_size, keep_layers, keep_texels): (u32, u32, &[u8]) =
+            if with_keep { (textures.size, textures.layers, &textures.strand_keep) } else { (1, 1, &[0]) };
+        let keep = upload_keep(device, queue, (keep_size, keep_layers), keep_texels);
         let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("pelt fur textures"),
             layout: &layouts.textures,
@@ -74,17 +90,21 @@ impl GpuTextures {
                 wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::Sampler(&layouts.shell_sampler) },
                 wgpu::BindGroupEntry { binding: 3, resource: wgpu::BindingResource::Sampler(&layouts.fin_sampler) },
                 wgpu::BindGroupEntry { binding: 4, resource: wgpu::BindingResource::TextureView(&surface) },
+                wgpu::BindGroupEntry { binding: 5, resource: wgpu::BindingResource::TextureView(&keep) },
             ],
         });
         let bytes = mipmapped_bytes(textures.size, textures.size) * u64::from(textures.layers)
             + mipmapped_bytes(textures.fin_width, textures.fin_height)
-            + mipmapped_bytes(surface_size.0, surface_size.1);
+            + mipmapped_bytes(surface_size.0, surface_size.1)
+            + u64::from(keep_size * keep_size * keep_layers);
         Ok(Self {
             bind_group,
             shell_slices: textures.layers,
             has_surface: textures.surface.is_some(),
             root_colour: root_colour(textures, slice_bytes),
             bytes,
+            has_keep: with_keep,
+            keep_bytes: u64::from(keep_size * keep_size * keep_layers),
         })
     }
 }
@@ -170,6 +190,41 @@ fn upload(
     texture
 }
 
+/// The strands' keep values: an R8 array texture, one layer per slice, no mipmaps (the shader
+/// fetches texels, never filters them).
+fn upload_keep(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    (size, layers): (u32, u32),
+    texels: &[u8],
+) -> wgpu::TextureView {
+    let texture = device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("pelt strand keep values"),
+        size: wgpu::Extent3d { width: size, height: size, depth_or_array_layers: layers },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format: wgpu::TextureFormat::R8Unorm,
+        usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+        view_formats: &[],
+    });
+    queue.write_texture(
+        wgpu::TexelCopyTextureInfo {
+            texture: &texture,
+            mip_level: 0,
+            origin: wgpu::Origin3d::ZERO,
+            aspect: wgpu::TextureAspect::All,
+        },
+        texels,
+        wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(size), rows_per_image: Some(size) },
+        wgpu::Extent3d { width: size, height: size, depth_or_array_layers: layers },
+    );
+    texture.create_view(&wgpu::TextureViewDescriptor {
+        dimension: Some(wgpu::TextureViewDimension::D2Array),
+        ..wgpu::TextureViewDescriptor::default()
+    })
+}
+
 pub(crate) fn srgb_to_linear(value: f32) -> f32 {
     if value <= 0.04045 { value / 12.92 } else { ((value + 0.055) / 1.055).powf(2.4) }
 }
@@ -204,10 +259,11 @@ mod tests {
             fin_width: 2,
             fin_height: 2,
             fin: vec![0; 16],
+            strand_keep: vec![0; 16],
             surface: None,
         };
         assert!(matches!(validate(&textures), Err(RenderError::Textures(_))));
-        let textures = FurTextures { shell: vec![0; 4 * 4 * 4 * 2], ..textures };
+        let textures = FurTextures { shell: vec![0; 4 * 4 * 4 * 2], strand_keep: vec![0; 32], ..textures };
         assert!(validate(&textures).is_ok());
         let surface = pelt_core::texture::ImageRgba8 { width: 2, height: 2, pixels: vec![0; 12] };
         assert!(validate(&FurTextures { surface: Some(surface), ..textures }).is_err());

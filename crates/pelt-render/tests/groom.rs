@@ -8,7 +8,7 @@ use common::{Rig, load_asset, out_dir, pixel_difference, strand_textures};
 use glam::{Vec3, Vec4Swizzles as _};
 use pelt_core::sim::pick;
 use pelt_core::{FurStructure, Preset};
-use pelt_render::{Camera, FurDrawSettings};
+use pelt_render::{Camera, DEFAULT_BACKGROUND, FurDrawSettings, FurFrame, Light, SeparatedFur, SeparatedRenderer};
 
 const SIZE_PX: u32 = 192;
 /// Red roots, green tips: fur drawn over the root-coloured skin shows.
@@ -87,6 +87,39 @@ fn bald_triangles_draw_no_fur_pixels() {
         mask.len(),
         dir.display()
     );
+}
+
+/// The separated baseline grows the same groom: its bald triangles draw no shells and its bald
+/// edges no fins either (`bald_triangles_draw_no_fur_pixels` on `SeparatedFur`), while the
+/// rest of the face keeps its fur.
+#[test]
+fn separated_baseline_is_groomed_too() {
+    let fur = groomed_fox();
+    let camera = face_camera(&fur);
+    let mask = bald_pixels(&fur, &camera, 2);
+    let rig = Rig::new(SIZE_PX, SIZE_PX);
+    let separated_renderer = SeparatedRenderer::new(rig.device(), &rig.renderer).expect("separated renderer");
+    let textures = strand_textures(64, fur.layers, ROOT, TIP);
+    let separated = SeparatedFur::new(rig.device(), rig.queue(), &rig.renderer, &fur, &textures, 8).expect("separated");
+    separated.prepare(rig.queue(), &FurFrame::default());
+    rig.view.prepare(rig.queue(), &camera.view_data(1.0, &Light::default()));
+    let draw = |settings: &FurDrawSettings| {
+        rig.headless
+            .render(DEFAULT_BACKGROUND, |pass| separated_renderer.draw(pass, &rig.view, &separated, settings))
+            .expect("frame")
+    };
+    let (skin, whole) = (draw(&FurDrawSettings::SKIN), draw(&FurDrawSettings::ALL));
+    let dir = out_dir();
+    whole.save(dir.join("groomed-fox-face-separated.png")).expect("save");
+    let furred = mask.iter().filter(|&&(x, y)| pixel_difference(skin.get_pixel(x, y), whole.get_pixel(x, y)) > 8);
+    let furred = furred.count();
+    assert!(furred * 100 <= mask.len(), "{furred} of the {} bald pixels show separated fur", mask.len());
+    let furred_pixels = (0..SIZE_PX * SIZE_PX)
+        .filter(|k| {
+            pixel_difference(skin.get_pixel(k % SIZE_PX, k / SIZE_PX), whole.get_pixel(k % SIZE_PX, k / SIZE_PX)) > 8
+        })
+        .count();
+    assert!(furred_pixels > 1000, "the separated fur shows elsewhere ({furred_pixels} pixels)");
 }
 
 /// The structure's bytes on the GPU are still the footprint's with a groom (the topology is

@@ -20,7 +20,10 @@ fn separated_module_validates() {
 
 #[test]
 fn simulation_module_validates() {
-    validate("simulation_wind.wgsl + simulation.wgsl", &pelt_render::simulation_shader_source());
+    validate(
+        "simulation_wind.wgsl + simulation.wgsl + simulation_inputs.wgsl",
+        &pelt_render::simulation_shader_source(),
+    );
 }
 
 #[test]
@@ -64,7 +67,8 @@ fn every_wgsl_file_is_part_of_a_validated_module() {
         }
     }
     assert_eq!(
-        checked, 9,
-        "shading, unified, separated, scan, silhouette, view_lod, simulation_wind, simulation and strands"
+        checked, 10,
+        "shading, unified, separated, scan, silhouette, view_lod, simulation_wind, simulation, simulation_inputs \
+         and strands"
     );
 }

@@ -175,7 +175,7 @@ fn agreement(backend: Backend) {
             assert!(difference <= 1e-4, "{backend}: after the jump the previous state is {difference} off");
         }
         if step == 270 {
-            assert!(control.inertial_forces().iter().any(|f| f.length() > 0.01), "the sway gives an inertial force");
+            assert!(cpu.inertial_forces().iter().any(|f| f.length() > 0.01), "the sway gives an inertial force");
         }
         worst = worst.max(difference);
         moved = moved.max(worst_relative_difference(&structure, &current, &structure.positions));

@@ -6,9 +6,10 @@ use std::time::Instant;
 
 use anyhow::{Context as _, bail};
 use glam::Vec3;
-use pelt_core::anim::{Pose, Rig};
+use pelt_core::anim::{Pose, Property, Rig};
 use pelt_core::export::{
-    AlphaMode, Export, ExportInput, FurSkin, bind_space_positions, exported_layers, source_skin_joints,
+    AlphaMode, Export, ExportInput, FurMorphs, FurSkin, MorphAnimation, bind_space_positions, carried_up,
+    exported_layers, source_skin_joints,
 };
 use pelt_core::sim::{FurStepper, WindParams};
 use pelt_core::{Builtin, FurStructure, Preset, Stage, StageSource};
@@ -16,12 +17,18 @@ use pelt_render::{FurLook, tile_mapping};
 use serde_json::json;
 
 use crate::mesh_args::MeshArgs;
-use crate::render::PLAIN_COLOUR;
+use crate::render::{LIGHT_WIND, PLAIN_COLOUR};
 
 /// How long the fur settles under gravity before it is written (seconds of simulated time).
 const SETTLE_SECS: f64 = 1.5;
 /// Frame rate the simulation is driven at while a clip plays to `--time`.
 const DRIVE_FPS: f64 = 30.0;
+/// How long the wind blows before `--motion` samples it (the lean it starts with is not looped).
+const MOTION_WARM_SECS: f64 = 1.0;
+/// Sampled frames (morph targets) per second of `--motion`, and at most: each frame is a copy of
+/// every fur position in the file.
+const MOTION_FPS: f64 = 4.0;
+const MOTION_MAX_FRAMES: u32 = 24;
 
 /// The `--alpha` choices.
 #[derive(Clone, Copy, Debug, clap::ValueEnum)]
@@ -47,10 +54,18 @@ pub struct Args {
     #[arg(long, value_name = "P")]
     preset: Option<PathBuf>,
     /// Shells to write (spread evenly up to the tips); default every layer of the preset.
-    #[arg(long, value_name = "N")]
+    #[arg(long, value_name = "N", conflicts_with = "screen_size")]
     layers: Option<u32>,
+    /// Shells for a fur this many pixels tall on screen: the level `pelt render` draws it at
+    /// there (the preset's `[render.lod]`), in place of `--layers`.
+    #[arg(long, value_name = "PIXELS")]
+    screen_size: Option<u32>,
+    /// Bake this many seconds of the fur swaying in the preset's wind (pelt render's light breeze
+    /// if it has none) as morph targets with a looping weights animation ("pelt fur motion").
+    #[arg(long, value_name = "SECONDS", allow_negative_numbers = true)]
+    motion: Option<f64>,
     /// Settle the fur at this time (seconds) of the animation instead of the rest pose.
-    #[arg(long, value_name = "T")]
+    #[arg(long, value_name = "T", allow_negative_numbers = true)]
     time: Option<f64>,
     /// The animation `--time` refers to: its name or index (default: the first).
     #[arg(long, value_name = "NAME|INDEX")]
@@ -75,6 +90,14 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     {
         bail!("--time must be a number of seconds, 0 or more, got {time}");
     }
+    if let Some(motion) = args.motion
+        && !(motion.is_finite() && motion > 0.0 && motion <= 60.0)
+    {
+        bail!("--motion must be a number of seconds above 0 and at most 60, got {motion}");
+    }
+    if args.screen_size == Some(0) {
+        bail!("--screen-size must be at least 1 pixel, got 0");
+    }
     let preset = match &args.preset {
         Some(path) => Preset::load(path)?,
         None => Preset::default(),
@@ -84,18 +107,31 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let clip = choose_clip(args, rig.as_ref())?;
     let params = preset.fur_params(&mesh);
     let fur = FurStructure::new(mesh, &params)?;
-    let shells = args.layers.unwrap_or(fur.layers);
+    let shells = match args.screen_size {
+        Some(pixels) => shells_at_screen_size(&preset, &fur, pixels),
+        None => args.layers.unwrap_or(fur.layers),
+    };
     if shells > fur.layers {
         bail!("--layers {shells}: the preset has only {} layers", fur.layers);
     }
     let textures = preset.generate_textures()?;
 
-    let (positions, time_secs) = settle(&fur, &preset, rig.as_ref(), clip, args.time)?;
+    let motion_frames = args.motion.map(|secs| ((secs * MOTION_FPS).round() as u32).clamp(2, MOTION_MAX_FRAMES));
+    let progress = Progress::new(settle_frames(args.time) + motion_frames.map_or(0, |n| motion_steps(args, n)));
+    let mut stepper = settle(&fur, &preset, rig.as_ref(), clip, args.time, &progress)?;
+    let time_secs = if clip.is_some() { args.time.unwrap_or(0.0) } else { 0.0 };
+    let settled = stepper.simulation().positions().to_vec();
+    let motion = match (args.motion, motion_frames) {
+        (Some(secs), Some(frames)) => Some(sway(&mut stepper, &preset, time_secs, secs, frames, &progress)?),
+        _ => None,
+    };
     let gltf_source = match &source {
         StageSource::File(path) if is_gltf(path) => Some(path.clone()),
         _ => None,
     };
-    let (positions, skin, notes) = bind(&fur, positions, rig.as_ref(), clip, time_secs, gltf_source.as_deref())?;
+    let rigged = Rigged { fur: &fur, rig: rig.as_ref(), clip, time_secs, source: gltf_source.as_deref() };
+    let (positions, skin, morphs, notes) = rigged.bind(settled, motion, args.motion)?;
+    progress.finish_simulation();
     let look = FurLook::default();
     let plain: Vec<_> = plain.iter().map(|mesh| (mesh, PLAIN_COLOUR)).collect();
     let layers_written = exported_layers(fur.layers, shells);
@@ -109,6 +145,8 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         "time_secs": time_secs,
         "animation": clip.and_then(|k| rig.as_ref().and_then(|r| r.animations()[k].name.clone())),
         "alpha": format!("{:?}", args.alpha).to_ascii_lowercase(),
+        "motion_secs": args.motion,
+        "motion_frames": motion_frames,
     });
     let input = ExportInput {
         fur: &fur,
@@ -125,9 +163,11 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         source: gltf_source.as_deref(),
         plain: &plain,
         extras,
+        morphs,
     };
     let export = Export::build(&input)?;
     export.write(&args.output)?;
+    progress.done();
     // A .gltf's buffer is its .bin beside it.
     let mut files = vec![args.output.clone()];
     if args.output.extension().is_some_and(|e| e.eq_ignore_ascii_case("gltf")) {
@@ -138,8 +178,12 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     for note in notes {
         println!("note: {note}");
     }
+    let motion_text = match (args.motion, motion_frames) {
+        (Some(secs), Some(frames)) => format!(", {secs} s of motion in {frames} morph targets"),
+        _ => String::new(),
+    };
     println!(
-        "{}: {:.2} MB, {} shells of {} vertices and {} triangles, fins of {} vertices and {} triangles, {}; {:.2} s",
+        "{}: {:.2} MB, {} shells of {} vertices and {} triangles, fins of {} vertices and {} triangles, {}{motion_text}; {:.2} s",
         args.output.display(),
         bytes as f64 / 1e6,
         counts.shell_layers.len(),
@@ -211,15 +255,28 @@ fn choose_clip(args: &Args, rig: Option<&Rig>) -> anyhow::Result<Option<usize>> 
     Ok(clip)
 }
 
+/// Simulation frames of the settling (and of the clip up to `--time`).
+fn settle_frames(time: Option<f64>) -> u64 {
+    let settle = (SETTLE_SECS * DRIVE_FPS).round() as u64 + 1;
+    settle + time.map_or(0, |t| (t * DRIVE_FPS).ceil() as u64)
+}
+
+/// Simulation frames of `--motion`: the warm-up and the sampled seconds.
+fn motion_steps(args: &Args, frames: u32) -> u64 {
+    let secs = args.motion.unwrap_or(0.0);
+    ((MOTION_WARM_SECS + secs) * DRIVE_FPS).ceil() as u64 + u64::from(frames)
+}
+
 /// Settles the fur under gravity (no wind): at the rest pose, or in the clip's first pose and
-/// then through the clip to `time`. The shared array at the end, posed, and the clip time.
+/// then through the clip to `time`. The stepper at the end (posed at the clip time).
 fn settle(
     fur: &FurStructure,
     preset: &Preset,
     rig: Option<&Rig>,
     clip: Option<usize>,
     time: Option<f64>,
-) -> anyhow::Result<(Vec<Vec3>, f64)> {
+    progress: &Progress,
+) -> anyhow::Result<FurStepper> {
     let mut params = preset.simulation.clone();
     params.wind = WindParams { strength: 0.0, ..params.wind };
     let mut stepper = FurStepper::new(fur, &params)?;
@@ -229,6 +286,7 @@ fn settle(
     let settle_frames = (SETTLE_SECS * DRIVE_FPS).round() as u32;
     for frame in 0..=settle_frames {
         stepper.advance_with_clip_at(f64::from(frame) / DRIVE_FPS, 0.0)?;
+        progress.step();
     }
     let clip_secs = if clip.is_some() { time.unwrap_or(0.0) } else { 0.0 };
     if clip_secs > 0.0 {
@@ -236,36 +294,177 @@ fn settle(
         for frame in 1..=frames {
             let t = (f64::from(frame) / DRIVE_FPS).min(clip_secs);
             stepper.advance_with_clip_at(SETTLE_SECS + t, t)?;
+            progress.step();
         }
     }
-    Ok((stepper.simulation().positions().to_vec(), clip_secs))
+    Ok(stepper)
 }
 
-/// The shared array in the mesh's own space (the bind pose of a skinned glTF), the skin the fur
-/// is bound to, and notes on what could not follow.
-fn bind(
-    fur: &FurStructure,
-    posed: Vec<Vec3>,
-    rig: Option<&Rig>,
+/// The settled fur swaying in the preset's wind (`pelt render`'s light breeze if it has none),
+/// the pose held at `clip_secs`: after a warm-up, `frames` shared arrays (posed) sampled evenly
+/// over `secs`.
+fn sway(
+    stepper: &mut FurStepper,
+    preset: &Preset,
+    clip_secs: f64,
+    secs: f64,
+    frames: u32,
+    progress: &Progress,
+) -> anyhow::Result<Vec<Vec<Vec3>>> {
+    let mut wind = preset.simulation.wind.clone();
+    if wind.strength <= 0.0 {
+        wind = WindParams { direction: LIGHT_WIND.normalize(), strength: LIGHT_WIND.length(), ..wind };
+    }
+    stepper.simulation_mut().set_wind(&wind)?;
+    let start = SETTLE_SECS + clip_secs;
+    let mut now = 0.0;
+    let mut advance = |to: f64, stepper: &mut FurStepper| -> anyhow::Result<()> {
+        while now < to - 1e-9 {
+            now = (now + 1.0 / DRIVE_FPS).min(to);
+            stepper.advance_with_clip_at(start + now, clip_secs)?;
+            progress.step();
+        }
+        Ok(())
+    };
+    let mut sampled = Vec::with_capacity(frames as usize);
+    for k in 0..frames {
+        advance(MOTION_WARM_SECS + secs * f64::from(k) / f64::from(frames), stepper)?;
+        sampled.push(stepper.simulation().positions().to_vec());
+        progress.step();
+    }
+    Ok(sampled)
+}
+
+/// The fur and how its file moves, for binding the settled arrays to it.
+struct Rigged<'a> {
+    fur: &'a FurStructure,
+    rig: Option<&'a Rig>,
     clip: Option<usize>,
     time_secs: f64,
-    source: Option<&Path>,
-) -> anyhow::Result<(Vec<Vec3>, Option<FurSkin>, Vec<String>)> {
-    let (Some(rig), Some(source)) = (rig, source) else { return Ok((posed, None, Vec::new())) };
-    let mut pose = Pose::default();
-    rig.pose(&fur.mesh, clip, time_secs, &mut pose);
-    let positions = bind_space_positions(&posed, &fur.positions, &rig.vertex_matrices(&pose));
-    let skins = source_skin_joints(source)?;
-    let skin = skins
-        .iter()
-        .enumerate()
-        .find_map(|(s, joints)| rig.influences_in_skin(joints).map(|influences| FurSkin { skin: s, influences }));
-    let mut notes = Vec::new();
-    if skin.is_none() && !rig.animations().is_empty() {
-        notes.push("the fur does not follow the file's animations: its mesh is not bound to a single skin".to_owned());
+    /// The glTF file the mesh came from.
+    source: Option<&'a Path>,
+}
+
+impl Rigged<'_> {
+    /// The settled shared array in the mesh's own space (the bind pose of a skinned glTF, the
+    /// morph targets' rest), the skin it is bound to, its morph targets (the source's, carried
+    /// up every strand, or the sampled `motion` frames as deltas from it), and notes on what
+    /// could not follow.
+    fn bind(
+        &self,
+        posed: Vec<Vec3>,
+        motion: Option<Vec<Vec<Vec3>>>,
+        motion_secs: Option<f64>,
+    ) -> anyhow::Result<(Vec<Vec3>, Option<FurSkin>, Option<FurMorphs>, Vec<String>)> {
+        let fur = self.fur;
+        let mut notes = Vec::new();
+        let (positions, matrices, skin) = match (self.rig, self.source) {
+            (Some(rig), Some(source)) => {
+                let mut pose = Pose::default();
+                rig.pose(&fur.mesh, self.clip, self.time_secs, &mut pose);
+                let matrices = rig.vertex_matrices(&pose);
+                let mut positions = bind_space_positions(&posed, &fur.positions, &matrices);
+                let skins = source_skin_joints(source)?;
+                let skin = skins.iter().enumerate().find_map(|(s, joints)| {
+                    rig.influences_in_skin(joints).map(|influences| FurSkin { skin: s, influences })
+                });
+                // Channels on morph weights alone move the fur through its targets, not a skin.
+                let moves_nodes =
+                    rig.animations().iter().flat_map(|a| &a.channels).any(|c| c.property != Property::Weights);
+                if skin.is_none() && moves_nodes {
+                    notes.push(
+                        "the fur does not follow the file's animations: its mesh is not bound to a single skin"
+                            .to_owned(),
+                    );
+                }
+                match rig.morph_position_deltas() {
+                    _ if rig.morph_target_count() == 0 => {}
+                    Some(_) if motion.is_some() => notes.push(
+                        "the fur's roots do not follow the file's morph targets: --motion uses the fur's".to_owned(),
+                    ),
+                    Some((node, deltas)) => {
+                        // The roots sit where the pose's weights put them; the file's targets
+                        // start from the rest, so that displacement comes off every strand.
+                        let weights = pose.morph_weights(node);
+                        let v = fur.vertex_count();
+                        for (j, offset) in (0..v).map(|j| {
+                            (j, deltas.iter().zip(weights).map(|(d, w)| d[j] * *w).fold(Vec3::ZERO, |a, b| a + b))
+                        }) {
+                            for layer in 0..=fur.layers as usize {
+                                positions[layer * v + j] -= offset;
+                            }
+                        }
+                        let morphs = FurMorphs {
+                            targets: deltas.iter().map(|d| carried_up(d, fur.layers)).collect(),
+                            weights: rig.nodes()[node].rest_weights.clone(),
+                            animation: MorphAnimation::FollowNode(node),
+                        };
+                        return Ok((positions, skin, Some(morphs), notes));
+                    }
+                    None => notes.push(
+                        "the fur's roots do not follow the file's morph targets: they hang on several meshes"
+                            .to_owned(),
+                    ),
+                }
+                (positions, Some(matrices), skin)
+            }
+            _ => (posed, None, None),
+        };
+        let morphs = motion.map(|frames| FurMorphs {
+            targets: frames
+                .iter()
+                .map(|frame| {
+                    let frame = match &matrices {
+                        Some(matrices) => bind_space_positions(frame, &fur.positions, matrices),
+                        None => frame.clone(),
+                    };
+                    frame.iter().zip(&positions).map(|(a, b)| *a - *b).collect()
+                })
+                .collect(),
+            weights: Vec::new(),
+            animation: MorphAnimation::Loop {
+                name: "pelt fur motion".to_owned(),
+                period_secs: motion_secs.unwrap_or(1.0) as f32,
+            },
+        });
+        Ok((positions, skin, morphs, notes))
     }
-    if rig.morph_target_count() > 0 {
-        notes.push("the fur's roots do not follow the file's morph targets".to_owned());
+}
+
+/// The shells `pelt render` draws a fur `pixels` tall on screen with (the preset's
+/// `[render.lod]`): its strands span `length / (2 * (radius + length))` of that height.
+fn shells_at_screen_size(preset: &Preset, fur: &FurStructure, pixels: u32) -> u32 {
+    let length = fur.lengths.iter().copied().fold(0.0, f32::max);
+    let (_, radius) = fur.mesh.bounding_sphere();
+    let strand_pixels = length * pixels as f32 / (2.0 * (radius + length)).max(1e-6);
+    crate::lod::settings(&preset.render.lod, false).level(fur.layers, strand_pixels).shells(fur.layers)
+}
+
+/// A bar on stderr over the export's simulation frames, drawn only on a terminal.
+struct Progress(indicatif::ProgressBar);
+
+impl Progress {
+    fn new(steps: u64) -> Self {
+        let bar = indicatif::ProgressBar::with_draw_target(Some(steps), indicatif::ProgressDrawTarget::stderr());
+        bar.set_style(
+            indicatif::ProgressStyle::with_template(
+                "{msg:12} {bar:40} {pos}/{len} frames, {elapsed} elapsed, eta {eta}",
+            )
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+        );
+        bar.set_message("simulating");
+        Self(bar)
     }
-    Ok((positions, skin, notes))
+
+    fn step(&self) {
+        self.0.inc(1);
+    }
+
+    fn finish_simulation(&self) {
+        self.0.set_message("writing");
+    }
+
+    fn done(&self) {
+        self.0.finish_and_clear();
+    }
 }

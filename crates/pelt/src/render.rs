@@ -24,7 +24,7 @@ pub const PLAIN_COLOUR: Vec3 = Vec3::new(0.62, 0.46, 0.38);
 
 /// Wind of the default render (no `--wind`, and the preset has none): a light breeze from the
 /// camera's left.
-const LIGHT_WIND: Vec3 = Vec3::new(0.35, 0.0, 0.1);
+pub const LIGHT_WIND: Vec3 = Vec3::new(0.35, 0.0, 0.1);
 
 /// Arguments of `pelt render`.
 #[derive(Debug, clap::Args)]

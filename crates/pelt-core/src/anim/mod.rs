@@ -184,6 +184,14 @@ pub struct Pose {
     world: Vec<Mat4>,
 }
 
+impl Pose {
+    /// The morph target weights of `node`'s mesh in this pose (empty for a node without them).
+    #[must_use]
+    pub fn morph_weights(&self, node: usize) -> &[f32] {
+        self.weights.get(node).map_or(&[], Vec::as_slice)
+    }
+}
+
 impl Rig {
     /// The nodes of the hierarchy.
     #[must_use]
@@ -207,6 +215,29 @@ impl Rig {
     #[must_use]
     pub fn morph_target_count(&self) -> usize {
         self.morphs.iter().map(|m| m.targets.len()).sum()
+    }
+
+    /// The morph targets as whole-mesh position deltas (in the mesh's space, per target one per
+    /// base vertex) and the node whose weights drive them; `None` without morph targets, or when
+    /// they hang on more than one node or their primitives disagree on the target count (a single
+    /// set of weights cannot drive them).
+    #[must_use]
+    pub fn morph_position_deltas(&self) -> Option<(usize, Vec<Vec<Vec3>>)> {
+        let first = self.morphs.first()?;
+        if self.morphs.iter().any(|m| m.node != first.node || m.targets.len() != first.targets.len()) {
+            return None;
+        }
+        let mut targets = vec![vec![Vec3::ZERO; self.influences.len()]; first.targets.len()];
+        for set in &self.morphs {
+            for (deltas, target) in targets.iter_mut().zip(&set.targets) {
+                for &(v, dp, _) in target {
+                    if let Some(d) = deltas.get_mut(v as usize) {
+                        *d += dp;
+                    }
+                }
+            }
+        }
+        Some((first.node, targets))
     }
 
     /// What was wrong with the file's skins and animations and how it was handled, one line each.

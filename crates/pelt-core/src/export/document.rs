@@ -145,6 +145,20 @@ impl Document {
         self.accessor(&bytes, ARRAY_BUFFER, accessor)
     }
 
+    /// A SCALAR float accessor of animation keys (a buffer view with no target), with its bounds
+    /// where asked (a sampler's input needs them).
+    pub fn animation_floats(&mut self, values: &[f32], bounds: bool) -> usize {
+        let bytes: Vec<u8> = values.iter().flat_map(|v| v.to_le_bytes()).collect();
+        let view = self.view(&bytes, None);
+        let mut accessor =
+            json!({ "bufferView": view, "componentType": FLOAT, "count": values.len(), "type": "SCALAR" });
+        if bounds {
+            accessor["min"] = json!([values.iter().copied().fold(f32::INFINITY, f32::min)]);
+            accessor["max"] = json!([values.iter().copied().fold(f32::NEG_INFINITY, f32::max)]);
+        }
+        self.push("accessors", accessor)
+    }
+
     /// A VEC2 float accessor.
     pub fn vec2(&mut self, values: &[Vec2]) -> usize {
         let bytes: Vec<u8> = values.iter().flat_map(|v| v.to_array()).flat_map(f32::to_le_bytes).collect();

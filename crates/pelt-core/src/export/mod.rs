@@ -1,8 +1,10 @@
 //! Pelt's fur as a standard glTF 2.0 file that any glTF viewer or engine draws without custom
 //! shaders: the shells as one primitive per exported layer (its own slice image, alpha as MASK or
 //! BLEND), the fins as strips on every edge with the fin image, all at one settled pose. A
-//! source glTF is carried over whole (meshes, materials, nodes, skins, animations), and on a
-//! skinned source every fur vertex is bound to its root's joints, so the fur follows the skeleton.
+//! source glTF is carried over whole (meshes, materials, nodes, skins, morph targets,
+//! animations), and on a skinned source every fur vertex is bound to its root's joints, so the
+//! fur follows the skeleton. Morph targets on the fur ([`FurMorphs`]) follow the source's or
+//! loop a baked sway.
 //!
 //! What the renderer computes per fragment and a plain material cannot (Kajiya-Kay lighting, the
 //! view-angle fading of shells and fins) is left to the player's lighting; what depends only on
@@ -12,6 +14,7 @@
 mod document;
 mod geometry;
 mod images;
+mod morph;
 
 use std::path::{Path, PathBuf};
 
@@ -20,6 +23,7 @@ use serde_json::{Value, json};
 
 use self::document::{CLAMP_TO_EDGE, Document, REPEAT};
 use self::geometry::{fins, shell_wedges, srgb_to_linear, surface_colours};
+pub use self::morph::{FurMorphs, MorphAnimation, carried_up};
 use crate::fur::FurStructure;
 use crate::mesh::Mesh;
 use crate::reference::TileMapping;
@@ -86,7 +90,7 @@ pub struct ExportInput<'a> {
     /// The structure: its mesh (bind pose for a skinned source) and layer count.
     pub fur: &'a FurStructure,
     /// The settled shared array `NV`, `(L + 1) * V`, in the mesh's own space (for a skinned mesh,
-    /// the bind pose: see [`bind_space_positions`]).
+    /// the bind pose: see [`bind_space_positions`]; with morph targets, where zero weights put it).
     pub positions: &'a [Vec3],
     /// The fur's textures.
     pub textures: &'a FurTextures,
@@ -107,6 +111,8 @@ pub struct ExportInput<'a> {
     pub plain: &'a [(&'a Mesh, Vec3)],
     /// Written as `asset.extras.pelt`: the preset, Pelt's version, how it was made.
     pub extras: Value,
+    /// Morph targets on every fur primitive (the source's, or a wind loop) and what drives them.
+    pub morphs: Option<FurMorphs>,
 }
 
 /// What the export holds of the fur, for reports and checks.
@@ -196,6 +202,9 @@ impl Export {
         {
             return Err(ExportError::Input(format!("{} skin influences for {v} vertices", skin.influences.len())));
         }
+        if let Some(morphs) = &input.morphs {
+            morphs.check(input.positions.len())?;
+        }
         let mut document = match input.source {
             Some(path) => Document::from_source(path)?,
             None => Document::new(),
@@ -208,12 +217,19 @@ impl Export {
         if input.source.is_none() {
             primitives.insert(0, builder.skin()?);
         }
-        let mesh = document.push("meshes", json!({ "name": "pelt fur", "primitives": primitives }));
+        let mut mesh = json!({ "name": "pelt fur", "primitives": primitives });
+        if let Some(morphs) = input.morphs.as_ref().filter(|m| !m.weights.is_empty()) {
+            mesh["weights"] = json!(morphs.weights);
+        }
+        let mesh = document.push("meshes", mesh);
         let mut node = json!({ "name": "pelt fur", "mesh": mesh });
         if let Some(skin) = &input.skin {
             node["skin"] = json!(skin.skin);
         }
-        document.add_root_node(node);
+        let fur_node = document.add_root_node(node);
+        if let Some(morphs) = &input.morphs {
+            morphs.animate(&mut document, fur_node);
+        }
         for (k, (mesh, colour)) in input.plain.iter().enumerate() {
             let primitive = plain_primitive(&mut document, mesh, *colour, k);
             let mesh = document.push("meshes", json!({ "name": format!("plain {k}"), "primitives": [primitive] }));
@@ -300,6 +316,14 @@ impl Builder<'_, '_> {
         }
     }
 
+    /// The morph targets of a primitive whose vertices are the shared array's `nodes` (every
+    /// primitive of a mesh carries the same targets).
+    fn morph_targets(&mut self, nodes: &[usize], primitive: &mut Value) {
+        if let Some(morphs) = &self.input.morphs {
+            primitive["targets"] = morphs.primitive_targets(self.document, nodes);
+        }
+    }
+
     /// The surface colour mode's tint at each uv, as COLOR_0.
     fn tint(&mut self, uvs: Option<&Vec<glam::Vec2>>, attributes: &mut Value) {
         if let (Some(surface), Some(uvs)) = (&self.input.textures.surface, uvs) {
@@ -353,7 +377,10 @@ impl Builder<'_, '_> {
             let positions: Vec<Vec3> = wedges.vertices.iter().map(|&j| input.positions[base + j as usize]).collect();
             let mut attributes = shared.clone();
             attributes["POSITION"] = json!(self.document.vec3(&positions, true));
-            primitives.push(json!({ "attributes": attributes, "indices": indices, "material": material }));
+            let mut primitive = json!({ "attributes": attributes, "indices": indices, "material": material });
+            let nodes: Vec<usize> = wedges.vertices.iter().map(|&j| base + j as usize).collect();
+            self.morph_targets(&nodes, &mut primitive);
+            primitives.push(primitive);
         }
         Ok(primitives)
     }
@@ -383,7 +410,10 @@ impl Builder<'_, '_> {
         let png = images::fin_png(input.textures, input.root_occlusion)?;
         let texture = self.document.png_texture(&png, sampler, "pelt fins");
         let material = self.material("pelt fins".to_owned(), texture, 1.0);
-        let primitive = json!({ "attributes": attributes, "indices": indices, "material": material });
+        let mut primitive = json!({ "attributes": attributes, "indices": indices, "material": material });
+        let nodes: Vec<usize> =
+            fins.vertices.iter().zip(&fins.layers).map(|(&j, &i)| i as usize * v + j as usize).collect();
+        self.morph_targets(&nodes, &mut primitive);
         Ok((primitive, (fins.vertices.len(), fins.triangles.len())))
     }
 
@@ -423,7 +453,10 @@ impl Builder<'_, '_> {
         self.skin_attributes(&roots, &mut attributes);
         let indices = self.document.indices(&triangles, roots.len());
         let material = self.document.push("materials", material);
-        Ok(json!({ "attributes": attributes, "indices": indices, "material": material }))
+        let mut primitive = json!({ "attributes": attributes, "indices": indices, "material": material });
+        let nodes: Vec<usize> = roots.iter().map(|&j| j as usize).collect();
+        self.morph_targets(&nodes, &mut primitive);
+        Ok(primitive)
     }
 }
 

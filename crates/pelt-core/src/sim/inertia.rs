@@ -65,22 +65,23 @@ impl Inertia {
         }
     }
 
-    /// Forgets the motion: no force until two more steps have been seen.
-    pub fn reset(&mut self) {
-        self.history = 0;
-        self.last_time_secs = None;
-        self.force.fill(Vec3::ZERO);
-        self.force_velocity.fill(Vec3::ZERO);
-    }
-
     /// Each strand's mass relative to a dry one (`None`: all 1): a heavier strand swings at
-    /// `1 / sqrt(mass)` of the natural frequency. Values below 1 count as 1.
+    /// `1 / sqrt(mass)` of the natural frequency ([`SpringStep::heavier`]). Values up to 1 count
+    /// as 1.
     ///
     /// # Panics
     /// If `masses` has not one entry per strand.
     pub fn set_masses(&mut self, masses: Option<Vec<f32>>) {
         self.masses = masses.unwrap_or_default();
         assert!(self.masses.is_empty() || self.masses.len() == self.force.len(), "one mass per strand");
+    }
+
+    /// Forgets the motion: no force until two more steps have been seen.
+    pub fn reset(&mut self) {
+        self.history = 0;
+        self.last_time_secs = None;
+        self.force.fill(Vec3::ZERO);
+        self.force_velocity.fill(Vec3::ZERO);
     }
 
     /// The inertial force per strand for the newest step.
@@ -98,73 +99,177 @@ impl Inertia {
 
     /// Takes the roots of the step at `time_secs` and updates the forces. `inertia` scales the
     /// force, `damping` is the spring's damping ratio and `radius` the body's bounding radius.
-    pub fn update(&mut self, roots: &[Vec3], time_secs: f64, inertia: f32, damping: f32, radius: f32) {
+    pub fn update(&mut self, roots: &[Vec3], time_secs: f64, inertia: f32, damping: f32, radius: f32) -> InertiaStep {
         assert_eq!(roots.len(), self.force.len(), "one root per strand");
+        let step = self.decide(roots, true, time_secs, inertia, damping, radius);
+        self.apply(step, roots);
+        step
+    }
+
+    /// The step at `time_secs` decided as [`Inertia::update`] decides it, for another kernel
+    /// (a GPU pass) to apply to every strand; the forces here stay as they were. Only the roots
+    /// are kept, for the teleport check: `roots_moved` says whether they changed since the last
+    /// step (when not, no root can have teleported and none is read).
+    pub fn advance(
+        &mut self,
+        roots: &[Vec3],
+        roots_moved: bool,
+        time_secs: f64,
+        inertia: f32,
+        damping: f32,
+        radius: f32,
+    ) -> InertiaStep {
+        assert_eq!(roots.len(), self.force.len(), "one root per strand");
+        let step = self.decide(roots, roots_moved, time_secs, inertia, damping, radius);
+        if step == InertiaStep::Start || roots_moved {
+            for (p, r) in self.previous_roots.iter_mut().zip(roots) {
+                *p = [*r, *r];
+            }
+        }
+        step
+    }
+
+    /// What the step at `time_secs` does to every strand (the per-strand work is
+    /// [`Inertia::apply`]'s).
+    fn decide(
+        &mut self,
+        roots: &[Vec3],
+        roots_moved: bool,
+        time_secs: f64,
+        inertia: f32,
+        damping: f32,
+        radius: f32,
+    ) -> InertiaStep {
         let dt = self.last_time_secs.map(|last| time_secs - last);
         self.last_time_secs = Some(time_secs);
         let Some(dt) = dt.filter(|&dt| dt > 0.0 && dt <= MAX_STEP_GAP_SECS) else {
             if self.history > 0 {
                 self.resets += 1;
             }
-            self.start_from(roots);
-            return;
+            self.history = 1;
+            return InertiaStep::Start;
         };
         let teleport = TELEPORT_RADII_PER_STEP * radius;
-        if self.history > 0 && roots.iter().zip(&self.previous_roots).any(|(r, p)| r.distance(p[0]) > teleport) {
+        if self.history > 0
+            && roots_moved
+            && roots.iter().zip(&self.previous_roots).any(|(r, p)| r.distance(p[0]) > teleport)
+        {
             self.resets += 1;
-            self.start_from(roots);
-            return;
+            self.history = 1;
+            return InertiaStep::Start;
         }
         let (dt, dt_before) = (dt as f32, self.last_dt);
         self.last_dt = dt;
         if self.history < 2 || inertia == 0.0 {
             self.history = (self.history + 1).min(2);
-            if inertia == 0.0 {
-                self.force.fill(Vec3::ZERO);
-                self.force_velocity.fill(Vec3::ZERO);
-            }
-            for (p, r) in self.previous_roots.iter_mut().zip(roots) {
-                *p = [*r, p[0]];
-            }
-            return;
+            return InertiaStep::Shift { zero: inertia == 0.0 };
         }
         // The spring is stepped semi-implicitly (damping implicit) and its frequency kept below
         // the step rate, so it is stable at any rate and damping.
         let omega = (std::f32::consts::TAU * INERTIA_FREQUENCY_HZ).min(1.0 / dt);
-        // a = 2 ((r - r1) / dt - (r1 - r2) / dt_before) / (dt + dt_before).
-        let scale = -inertia * 2.0 / (radius * (dt + dt_before));
-        let damp = 1.0 / (1.0 + 2.0 * damping * omega * dt);
-        let masses = &self.masses;
-        self.previous_roots
-            .par_iter_mut()
-            .zip(self.force.par_iter_mut())
-            .zip(self.force_velocity.par_iter_mut())
-            .zip(roots.par_iter())
-            .enumerate()
-            .with_min_len(STRANDS_PER_TASK)
-            .for_each(|(j, (((previous, force), velocity), root))| {
-                let acceleration = (*root - previous[0]) / dt - (previous[0] - previous[1]) / dt_before;
-                let target = (acceleration * scale).clamp_length_max(MAX_INERTIAL_FORCE);
-                let mass = masses.get(j).copied().unwrap_or(1.0);
-                let (omega, damp) = if mass > 1.0 {
-                    let omega = omega / mass.sqrt();
-                    (omega, 1.0 / (1.0 + 2.0 * damping * omega * dt))
-                } else {
-                    (omega, damp)
-                };
-                *velocity = (*velocity + (target - *force) * (omega * omega * dt)) * damp;
-                *force += *velocity * dt;
-                *previous = [*root, previous[0]];
-            });
+        InertiaStep::Spring(SpringStep {
+            dt,
+            dt_before,
+            // a = 2 ((r - r1) / dt - (r1 - r2) / dt_before) / (dt + dt_before).
+            scale: -inertia * 2.0 / (radius * (dt + dt_before)),
+            stiffness_dt: omega * omega * dt,
+            damp: 1.0 / (1.0 + 2.0 * damping * omega * dt),
+        })
     }
 
-    fn start_from(&mut self, roots: &[Vec3]) {
-        self.force.fill(Vec3::ZERO);
-        self.force_velocity.fill(Vec3::ZERO);
-        for (p, r) in self.previous_roots.iter_mut().zip(roots) {
-            *p = [*r, *r];
+    /// Applies `step` to every strand at `roots`.
+    fn apply(&mut self, step: InertiaStep, roots: &[Vec3]) {
+        match step {
+            InertiaStep::Start => {
+                self.force.fill(Vec3::ZERO);
+                self.force_velocity.fill(Vec3::ZERO);
+                for (p, r) in self.previous_roots.iter_mut().zip(roots) {
+                    *p = [*r, *r];
+                }
+            }
+            InertiaStep::Shift { zero } => {
+                if zero {
+                    self.force.fill(Vec3::ZERO);
+                    self.force_velocity.fill(Vec3::ZERO);
+                }
+                for (p, r) in self.previous_roots.iter_mut().zip(roots) {
+                    *p = [*r, p[0]];
+                }
+            }
+            InertiaStep::Spring(spring) => {
+                let masses = &self.masses;
+                self.previous_roots
+                    .par_iter_mut()
+                    .zip(self.force.par_iter_mut())
+                    .zip(self.force_velocity.par_iter_mut())
+                    .zip(roots.par_iter())
+                    .enumerate()
+                    .with_min_len(STRANDS_PER_TASK)
+                    .for_each(|(j, (((previous, force), velocity), root))| {
+                        let spring = match masses.get(j) {
+                            Some(&mass) if mass > 1.0 => spring.heavier(mass),
+                            _ => spring,
+                        };
+                        *force = spring.force(*previous, *root, force, velocity);
+                        *previous = [*root, previous[0]];
+                    });
+            }
         }
-        self.history = 1;
+    }
+}
+
+/// What one step does to every strand's inertial state: decided once per step from its time,
+/// the history and the teleport check ([`Inertia::update`], [`Inertia::advance`]), then applied
+/// to each strand by [`SpringStep::force`] or its GPU twin.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum InertiaStep {
+    /// Start over from rest: no force, no velocity, both earlier roots set to this step's.
+    Start,
+    /// Too little history (or no inertia): the roots move down the history; with `zero` the
+    /// force and its velocity become zero, else they stay.
+    Shift {
+        /// Inertia is off: the force and its velocity become zero.
+        zero: bool,
+    },
+    /// The damped spring toward `target = -inertia * a / radius`.
+    Spring(SpringStep),
+}
+
+/// The shared numbers of one spring step.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SpringStep {
+    /// Seconds since the last step.
+    pub dt: f32,
+    /// Seconds between the two steps before.
+    pub dt_before: f32,
+    /// `-inertia * 2 / (radius * (dt + dt_before))`: the acceleration's factor.
+    pub scale: f32,
+    /// `omega^2 * dt` with `omega` the spring's angular frequency.
+    pub stiffness_dt: f32,
+    /// The implicit damping's factor `1 / (1 + 2 * damping * omega * dt)`.
+    pub damp: f32,
+}
+
+impl SpringStep {
+    /// The same step for a strand `mass` times heavier on the same spring: `omega` over
+    /// `sqrt(mass)` (the GPU kernel does the same arithmetic).
+    #[must_use]
+    pub fn heavier(self, mass: f32) -> Self {
+        Self {
+            stiffness_dt: self.stiffness_dt / mass,
+            damp: 1.0 / (1.0 + (1.0 / self.damp - 1.0) / mass.sqrt()),
+            ..self
+        }
+    }
+
+    /// One strand's new force from its earlier roots `[n - 1, n - 2]`, its root now, and its
+    /// force and velocity (the velocity is updated in place).
+    #[must_use]
+    pub fn force(&self, previous: [Vec3; 2], root: Vec3, force: &Vec3, velocity: &mut Vec3) -> Vec3 {
+        let acceleration = (root - previous[0]) / self.dt - (previous[0] - previous[1]) / self.dt_before;
+        let target = (acceleration * self.scale).clamp_length_max(MAX_INERTIAL_FORCE);
+        *velocity = (*velocity + (target - *force) * self.stiffness_dt) * self.damp;
+        *force + *velocity * self.dt
     }
 }
 

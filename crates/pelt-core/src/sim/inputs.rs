@@ -102,3 +102,21 @@ impl StrandInputs<'_> {
         self.wetness.map_or(1.0, |wetness| 1.0 + self.wet_weight * wetness[strand])
     }
 }
+
+/// Counters of the per-strand inputs' changes, from [`Simulation::input_versions`]
+/// (super::Simulation::input_versions): a kernel that keeps the inputs resident uploads one only
+/// when its counter moved. Two simulations never share an `id`.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+#[non_exhaustive]
+pub struct InputVersions {
+    /// Which simulation these count.
+    pub id: u64,
+    /// The posed roots and frames (`set_base`, `set_base_rotations`).
+    pub base: u64,
+    /// The stability map and the stability where none is set.
+    pub stability: u64,
+    /// The user field (every `field_mut`).
+    pub field: u64,
+    /// The touch (every `touch_begin`): its weights are fixed when it begins.
+    pub touch: u64,
+}

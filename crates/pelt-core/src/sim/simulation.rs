@@ -14,8 +14,8 @@ use rayon::prelude::*;
 
 use super::dispatch::{self, CpuKernel};
 use super::field::{ForceField, Touch};
-use super::inertia::Inertia;
-use super::inputs::{StepInputs, StrandInputs};
+use super::inertia::{Inertia, InertiaStep};
+use super::inputs::{InputVersions, StepInputs, StrandInputs};
 use super::kernel::{LANES, RestBatches, Step, VecLanes};
 use super::pick::{Hit, pick};
 use super::{ParamError, SimParams, WindParams};
@@ -123,7 +123,18 @@ pub struct Simulation {
     cpu_bending: bool,
     /// Times of the last (up to) two steps, oldest first.
     recent_step_times: Vec<f64>,
+    /// What those steps did to the inertial state, oldest first.
+    recent_inertia_steps: Vec<InertiaStep>,
+    /// Counters of the per-strand inputs' changes.
+    versions: InputVersions,
+    /// The roots changed since the last step.
+    roots_moved: bool,
+    /// The touch began on the roots of the newest step.
+    touch_on_step_roots: bool,
 }
+
+/// Simulations made so far: each one's [`InputVersions::id`].
+static SIMULATIONS: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
 
 impl Simulation {
     /// Sets up the simulation of `fur` and computes the state at time 0.
@@ -180,6 +191,13 @@ impl Simulation {
             steps_taken: 0,
             cpu_bending: true,
             recent_step_times: Vec::with_capacity(3),
+            recent_inertia_steps: Vec::with_capacity(3),
+            versions: InputVersions {
+                id: SIMULATIONS.fetch_add(1, std::sync::atomic::Ordering::Relaxed),
+                ..InputVersions::default()
+            },
+            roots_moved: false,
+            touch_on_step_roots: false,
         };
         simulation.jump_to_step(0);
         simulation.update_output();
@@ -202,6 +220,9 @@ impl Simulation {
         if params.rate_hz != self.params.rate_hz {
             // Force a full recompute at the next advance: old step indices mean other times.
             self.step_index = i64::MIN;
+        }
+        if params.stability != self.params.stability {
+            self.versions.stability += 1;
         }
         self.params = params.clone();
         Ok(())
@@ -235,6 +256,7 @@ impl Simulation {
             }
         }
         self.stability_map = map;
+        self.versions.stability += 1;
         Ok(())
     }
 
@@ -250,6 +272,7 @@ impl Simulation {
     /// infinite entries; nothing changes then.
     pub fn set_base(&mut self, positions: &[Vec3], normals: &[Vec3]) -> Result<(), SimError> {
         self.check_base(positions, normals, "the base normals")?;
+        self.moved_base();
         self.roots.copy_from_slice(positions);
         for ((frame, rest), normal) in self.frames.iter_mut().zip(&self.rest_normals).zip(normals) {
             *frame = match (rest.try_normalize(), normal.try_normalize()) {
@@ -271,11 +294,17 @@ impl Simulation {
         if let Some(bad) = rotations.iter().find(|q| q.length_squared() == 0.0) {
             return Err(SimError::NonFinite { what: "the base rotations", value: bad.to_string() });
         }
+        self.moved_base();
         self.roots.copy_from_slice(positions);
         for (frame, rotation) in self.frames.iter_mut().zip(rotations) {
             *frame = rotation.normalize();
         }
         Ok(())
+    }
+
+    fn moved_base(&mut self) {
+        self.versions.base += 1;
+        self.roots_moved = true;
     }
 
     fn check_base(&self, positions: &[Vec3], frames: &[Vec3], what_frames: &'static str) -> Result<(), SimError> {
@@ -299,6 +328,7 @@ impl Simulation {
 
     /// The user force field, to edit; takes effect from the next step.
     pub fn field_mut(&mut self) -> &mut ForceField {
+        self.versions.field += 1;
         &mut self.field
     }
 
@@ -337,7 +367,8 @@ impl Simulation {
     }
 
     /// The per-strand inputs as they are now (posed roots and frames, stability, the user field,
-    /// the touch's weights, the inertial force of the newest step).
+    /// the touch's weights, the inertial force of the newest step: zero while another kernel
+    /// bends, see [`Simulation::set_cpu_bending`]).
     #[must_use]
     pub fn strand_inputs(&self) -> StrandInputs<'_> {
         StrandInputs {
@@ -378,6 +409,16 @@ impl Simulation {
                 .into());
             }
         }
+        let same = match (wetness, &self.wetness) {
+            (Some(values), Some(kept)) => values == &kept[..],
+            (None, None) => true,
+            _ => false,
+        };
+        if same && self.wet_weight == params.added_weight && self.wet_softening == params.softening {
+            return Ok(());
+        }
+        // The stabilities a GPU kernel keeps resident change with the wetness.
+        self.versions.stability += 1;
         match (wetness, &mut self.wetness) {
             (Some(values), Some(kept)) => kept.copy_from_slice(values),
             (values, kept) => *kept = values.map(<[f32]>::to_vec),
@@ -410,6 +451,8 @@ impl Simulation {
             return Err(SimError::TouchRadius(radius));
         }
         self.touch = Some(Touch::new(point, radius, &self.roots));
+        self.touch_on_step_roots = !self.roots_moved;
+        self.versions.touch += 1;
         Ok(())
     }
 
@@ -459,6 +502,15 @@ impl Simulation {
     #[must_use]
     pub fn touch(&self) -> Option<&Touch> {
         self.touch.as_ref()
+    }
+
+    /// Whether the touch in progress began on the roots of the newest step (the base did not
+    /// move between that step and the touch): a kernel that keeps each step's roots can weigh
+    /// the touch from them. A host posing the base between steps can begin one on roots no step
+    /// used.
+    #[must_use]
+    pub fn touch_began_on_step_roots(&self) -> bool {
+        self.touch.is_some() && self.touch_on_step_roots
     }
 
     /// The nearest hit of a ray with the base mesh at its current root positions.
@@ -631,12 +683,16 @@ impl Simulation {
     /// keeps the time, the steps ([`Simulation::recent_step_times`]), the touch and every input,
     /// but bends nothing and leaves [`Simulation::positions`] and
     /// [`Simulation::external_field`] as they were: for a host whose strands are bent by another
-    /// kernel (`pelt_render::GpuSimulation`) from this simulation's inputs. Either way the next
-    /// `advance_to` recomputes both states, so switching never mixes kernels in one pair.
+    /// kernel (`pelt_render::GpuSimulation`) from this simulation's inputs. Off, the inertia's
+    /// steps are only decided ([`Simulation::recent_inertia_steps`]) and
+    /// [`Simulation::inertial_forces`] stays zero: the kernel that bends keeps the forces.
+    /// Either way the next `advance_to` recomputes both states and the motion so far is
+    /// forgotten, so switching never mixes kernels in one pair.
     pub fn set_cpu_bending(&mut self, on: bool) {
         if on != self.cpu_bending {
             self.cpu_bending = on;
             self.step_index = i64::MIN;
+            self.inertia.reset();
         }
     }
 
@@ -653,6 +709,20 @@ impl Simulation {
     #[must_use]
     pub fn recent_step_times(&self) -> &[f64] {
         &self.recent_step_times
+    }
+
+    /// What each of [`Simulation::recent_step_times`]' steps did to the inertial state (one
+    /// entry per step, oldest first): with the CPU's bending off the simulation only decides
+    /// them, and the kernel that bends applies them to every strand.
+    #[must_use]
+    pub fn recent_inertia_steps(&self) -> &[InertiaStep] {
+        &self.recent_inertia_steps
+    }
+
+    /// Counters of the per-strand inputs' changes (roots, stability, field, touch).
+    #[must_use]
+    pub fn input_versions(&self) -> InputVersions {
+        self.versions
     }
 
     /// Each strand's rotation from its rest frame into the current base frame (identity until
@@ -722,9 +792,19 @@ impl Simulation {
         if self.recent_step_times.len() > 2 {
             self.recent_step_times.remove(0);
         }
-        // The inertia is state carried from step to step: it advances whichever kernel bends.
+        // The inertia is state carried from step to step. Its step is decided here whichever
+        // kernel bends; the kernel that bends applies it to every strand.
         let (inertia, damping) = (self.params.inertia, self.params.damping);
-        self.inertia.update(&self.roots, time_secs, inertia, damping, self.radius);
+        let roots_moved = std::mem::take(&mut self.roots_moved);
+        let inertia_step = if self.cpu_bending {
+            self.inertia.update(&self.roots, time_secs, inertia, damping, self.radius)
+        } else {
+            self.inertia.advance(&self.roots, roots_moved, time_secs, inertia, damping, self.radius)
+        };
+        self.recent_inertia_steps.push(inertia_step);
+        if self.recent_inertia_steps.len() > 2 {
+            self.recent_inertia_steps.remove(0);
+        }
         if !self.cpu_bending {
             return;
         }

@@ -171,6 +171,8 @@ impl FurStepper {
             }
             if self.moved && !matches!(self.posing, Posing::Host) {
                 self.simulation.set_base_rotations(&self.pose.positions, &self.pose.rotations)?;
+                // The wetness on the new pose, before a restart computes its states with it.
+                self.advance_wetness(time_secs)?;
                 if std::mem::take(&mut self.restart_pending) {
                     self.simulation.restart();
                 }

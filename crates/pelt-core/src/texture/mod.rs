@@ -52,6 +52,11 @@ pub struct FurTextures {
     pub fin_height: u32,
     /// RGBA8, `fin_width * fin_height * 4` bytes.
     pub fin: Vec<u8>,
+    /// One byte per shell texel, slice-major like [`Self::shell`] (`layers * size * size`): the
+    /// seeded keep value (`0..=254`) of the strand covering the texel most. A groom's density
+    /// keeps a texel where `(value + 0.5) / 256 < density`, so 0.5 keeps about half the strands,
+    /// each whole, without new textures. Uploaded for groomed furs only.
+    pub strand_keep: Vec<u8>,
     /// Surface colour mode only: the base mesh's colour texture. Shell and fin RGB then hold a
     /// grey per-strand brightness; the renderer multiplies it by this image sampled with the
     /// mesh's corner UVs. `None` in the other modes (the RGB is the final strand colour).
@@ -63,7 +68,16 @@ impl FurTextures {
     /// simulated or measured but never looked at.
     #[must_use]
     pub fn blank() -> Self {
-        Self { size: 4, layers: 1, shell: vec![0; 64], fin_width: 4, fin_height: 4, fin: vec![0; 64], surface: None }
+        Self {
+            size: 4,
+            layers: 1,
+            shell: vec![0; 64],
+            fin_width: 4,
+            fin_height: 4,
+            fin: vec![0; 64],
+            strand_keep: vec![0; 16],
+            surface: None,
+        }
     }
 }
 
@@ -75,6 +89,7 @@ impl std::fmt::Debug for FurTextures {
             .field("layers", &self.layers)
             .field("shell_bytes", &self.shell.len())
             .field("fin_size", &(self.fin_width, self.fin_height))
+            .field("strand_keep_bytes", &self.strand_keep.len())
             .field("surface", &self.surface)
             .finish()
     }
@@ -432,12 +447,15 @@ pub fn generate_from(layers: u32, field: &StrandField) -> FurTextures {
     let size = params.size;
     let slice_bytes = size as usize * size as usize * 4;
     let mut shell = vec![0u8; slice_bytes * layers as usize];
-    shell.par_chunks_mut(slice_bytes).enumerate().for_each(|(k, slice)| {
-        let t = (k + 1) as f32 / layers as f32;
-        strands::draw_slice(params, strands, t, &colour_at, slice);
-    });
+    let mut strand_keep = vec![0u8; slice_bytes / 4 * layers as usize];
+    shell.par_chunks_mut(slice_bytes).zip(strand_keep.par_chunks_mut(slice_bytes / 4)).enumerate().for_each(
+        |(k, (slice, keep))| {
+            let t = (k + 1) as f32 / layers as f32;
+            strands::draw_slice(params, strands, (t, k as u64), &colour_at, (slice, keep));
+        },
+    );
     let fin_height = (size / 2).max(MIN_TILE_SIZE);
     let mut fin = vec![0u8; size as usize * fin_height as usize * 4];
     strands::draw_fin(params, strands, fin_height, &colour_at, &mut fin);
-    FurTextures { size, layers, shell, fin_width: size, fin_height, fin, surface: field.surface.clone() }
+    FurTextures { size, layers, shell, fin_width: size, fin_height, fin, strand_keep, surface: field.surface.clone() }
 }

@@ -26,6 +26,8 @@ const SALT_LEAN: u64 = 0x6c65_616e;
 const SALT_CURL: u64 = 0x6375_726c;
 const SALT_LOOK: u64 = 0x6c6f_6f6b;
 const SALT_CLUMP: u64 = 0x636c_756d;
+const SALT_KEEP: u64 = 0x6b65_6570;
+const SALT_EMPTY: u64 = 0x656d_7074;
 
 /// One strand of the seeded field: where it roots in the tile and how it moves through the
 /// layers (texel units). The shell slices and the fin are drawn from these, and the explicit
@@ -46,6 +48,9 @@ pub struct Strand {
     pub(super) brightness: f32,
     /// The pattern's colour at the root (white without a tinting pattern).
     pub(super) tint: Vec3,
+    /// The strand's seeded value for a groom's density (`0..=254`): the shader keeps the strand
+    /// where `(keep + 0.5) / 256` is below the density.
+    pub(super) keep: u8,
 }
 
 impl Strand {
@@ -177,6 +182,7 @@ fn grow_strand(
         length: length.max(0.05),
         brightness: 1.0 - brightness_variation * unit_f32(mix64(look_bits ^ 1)),
         tint,
+        keep: keep_byte(hash(seed, x, y, SALT_KEEP)),
     }
 }
 
@@ -229,6 +235,14 @@ struct Texel {
     transmission: f32,
     weight: f32,
     colour: Vec3,
+    /// The largest coverage one strand gives the texel, and that strand's keep value.
+    best: f32,
+    keep: u8,
+}
+
+/// A uniform byte in `0..=254` from seed bits (255 would never pass a density of 1).
+fn keep_byte(bits: u64) -> u8 {
+    (unit_f32(bits) * 255.0).min(254.0) as u8
 }
 
 fn resolve(texels: &[Texel], out: &mut [u8]) {
@@ -245,8 +259,16 @@ fn resolve(texels: &[Texel], out: &mut [u8]) {
 }
 
 /// Rasterises the cross-sections of every strand alive at height `t` into one `size x size`
-/// RGBA8 slice.
-pub(super) fn draw_slice(params: &TextureParams, strands: &[Strand], t: f32, colour: ColourAt<'_>, out: &mut [u8]) {
+/// RGBA8 slice, and into `keep` (`size x size` bytes) the keep value of the strand covering each
+/// texel most; empty texels get a seeded value of their own, so a minified fetch that lands on
+/// one thins by the density too.
+pub(super) fn draw_slice(
+    params: &TextureParams,
+    strands: &[Strand],
+    (t, slice): (f32, u64),
+    colour: ColourAt<'_>,
+    (out, keep): (&mut [u8], &mut [u8]),
+) {
     let size = params.size as usize;
     let mask = size as i64 - 1;
     let mut texels = vec![Texel { transmission: 1.0, ..Texel::default() }; size * size];
@@ -273,11 +295,18 @@ pub(super) fn draw_slice(params: &TextureParams, strands: &[Strand], t: f32, col
                     texel.transmission *= 1.0 - a;
                     texel.weight += a;
                     texel.colour += rgb * a;
+                    if a > texel.best {
+                        texel.best = a;
+                        texel.keep = strand.keep;
+                    }
                 }
             }
         }
     }
     resolve(&texels, out);
+    for (k, (texel, value)) in texels.iter().zip(keep.iter_mut()).enumerate() {
+        *value = if texel.best > 0.0 { texel.keep } else { keep_byte(hash(params.seed, k as u64, slice, SALT_EMPTY)) };
+    }
 }
 
 /// The fin: a side view of the strands rooted in a thin band of the tile, `u` along the tile's

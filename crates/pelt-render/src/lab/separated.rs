@@ -127,8 +127,9 @@ impl SeparatedRenderer {
         }
         if settings.shells {
             pass.set_pipeline(&self.shells[usize::from(fur.shape.has_uvs)][which]);
+            let furred = 3 * fur.shape.furred_triangle_count;
             for layer in fur.level.shell_layers(fur.shape.layers) {
-                pass.draw_indexed(0..fur.index_count, (layer * fur.shape.vertex_count) as i32, layer..layer + 1);
+                pass.draw_indexed(0..furred, (layer * fur.shape.vertex_count) as i32, layer..layer + 1);
             }
         }
         if settings.fins {
@@ -171,10 +172,25 @@ impl SeparatedFur {
         textures: &FurTextures,
         fin_faces: u32,
     ) -> Result<Self, RenderError> {
-        let (shell, fin) = separated_vertices(structure, fin_faces);
+        // A groom's bald triangles get no shells and its bald edges no fins, as in the unified
+        // structure: the index buffer holds the furred triangles first (the shells draw those),
+        // then the bald ones (the skin draws them all).
+        let fin_edges = structure.fin_edges();
+        let (shell, fin) = separated_vertices(structure, &fin_edges, fin_faces);
         check_size(device, "separated shells", shell.len() as u64 * SEPARATED_VERTEX_BYTES)?;
         check_size(device, "separated fins", fin.len() as u64 * SEPARATED_VERTEX_BYTES)?;
-        let indices: Vec<u32> = structure.mesh.triangles.iter().flatten().copied().collect();
+        let furred = structure.furred_triangles();
+        let mut is_furred = vec![false; structure.mesh.triangles.len()];
+        furred.iter().for_each(|&t| is_furred[t as usize] = true);
+        let order = furred.iter().copied().chain((0..is_furred.len() as u32).filter(|&t| !is_furred[t as usize]));
+        let indices: Vec<u32> = order.flat_map(|t| structure.mesh.triangles[t as usize]).collect();
+        let groom = structure.groom.as_ref();
+        let attributes = groom
+            .map_or_else(|| vec![[0.0; 8]], |g| crate::geometry::groom_attributes(g, structure.mesh.vertex_count()));
+        let mut ends: Vec<u32> = fin_edges.iter().flat_map(|&e| structure.mesh.edges[e as usize]).collect();
+        if ends.is_empty() {
+            ends = vec![0, 0];
+        }
         let scope = ErrorScope::push(device);
         let buffer = |label, contents: &[u8], usage| {
             device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents, usage })
@@ -188,15 +204,20 @@ impl SeparatedFur {
         let fin_vertices = buffer("pelt separated fins", fin_bytes, fin_usage);
         let uniform = uniform_buffer(device);
         let layouts = renderer.layouts();
+        let groom_buffer =
+            buffer("pelt separated groom attributes", bytemuck::cast_slice(&attributes), wgpu::BufferUsages::STORAGE);
+        let ends_buffer = buffer("pelt separated fin ends", bytemuck::cast_slice(&ends), wgpu::BufferUsages::STORAGE);
         let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("pelt separated object"),
             layout: &layouts.separated_object,
             entries: &[
                 wgpu::BindGroupEntry { binding: 0, resource: uniform.as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 1, resource: fin_vertices.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 2, resource: groom_buffer.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 3, resource: ends_buffer.as_entire_binding() },
             ],
         });
-        let textures = GpuTextures::new(device, queue, layouts, textures);
+        let textures = GpuTextures::new(device, queue, layouts, textures, groom.is_some());
         scope.pop("uploading the separated structure")?;
         let textures = textures?;
         let vertices = (shell.len() + fin.len()) as u64;
@@ -206,8 +227,15 @@ impl SeparatedFur {
             indices: indices.len() as u64 * 4,
             textures: textures.bytes,
         };
+        let mut shape = ObjectShape::new(&structure.mesh, structure.layers);
+        // The fin fade finds a fin's vertices from the fins' count.
+        shape.edge_count = fin_edges.len() as u32;
+        shape.furred_triangle_count = furred.len() as u32;
+        shape.fin_edge_count = fin_edges.len() as u32;
+        shape.groomed = groom.is_some();
+        shape.groom_shading = groom.is_some_and(crate::geometry::shades);
         Ok(Self {
-            shape: ObjectShape::new(&structure.mesh, structure.layers),
+            shape,
             uniform,
             bind_group,
             textures,
@@ -241,8 +269,8 @@ impl SeparatedFur {
     }
 }
 
-/// The shell vertices (`(L + 1) * V`, layer 0 the skin) and the fin triangle list.
-fn separated_vertices(fur: &FurStructure, fin_faces: u32) -> (Vec<Vertex>, Vec<Vertex>) {
+/// The shell vertices (`(L + 1) * V`, layer 0 the skin) and the fins of `fin_edges`.
+fn separated_vertices(fur: &FurStructure, fin_edges: &[u32], fin_faces: u32) -> (Vec<Vertex>, Vec<Vertex>) {
     let mesh = &fur.mesh;
     let v = mesh.vertex_count();
     let world_per_uv = crate::object::world_per_uv(mesh);
@@ -265,8 +293,8 @@ fn separated_vertices(fur: &FurStructure, fin_faces: u32) -> (Vec<Vertex>, Vec<V
         }
     }
     let quads_per_fin = fin_faces.max(2).div_ceil(2);
-    let mut fin = Vec::with_capacity(mesh.edges.len() * 6 * quads_per_fin as usize);
-    for &[a, b] in &mesh.edges {
+    let mut fin = Vec::with_capacity(fin_edges.len() * 6 * quads_per_fin as usize);
+    for &[a, b] in fin_edges.iter().map(|&e| &mesh.edges[e as usize]) {
         let (a, b) = (a as usize, b as usize);
         let root = |j: usize| fur.positions[j];
         let tip = |j: usize| fur.positions[fur.index(fur.layers, j as u32) as usize];

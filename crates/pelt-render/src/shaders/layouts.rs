@@ -7,7 +7,7 @@ pub(crate) struct Layouts {
     /// Group 0: the view uniform.
     pub view: wgpu::BindGroupLayout,
     /// Group 1 of the unified structure and plain meshes: the object uniform and the storage
-    /// buffers (positions twice, base normals, wedge uvs, topology, wetness).
+    /// buffers (positions twice, base normals, wedge uvs, topology, groom attributes, wetness).
     pub unified_object: wgpu::BindGroupLayout,
     /// Group 1 of the separated structure: the object uniform and the fin vertices.
     #[cfg(feature = "lab")]
@@ -54,13 +54,20 @@ impl Layouts {
                 entry(4, vertex, storage),
                 entry(5, vertex, storage),
                 entry(6, vertex, storage),
+                entry(7, vertex, storage),
             ],
         });
         // The separated fins' vertices, read back by each fin vertex to decide for its whole fin.
         #[cfg(feature = "lab")]
         let separated_object = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("pelt separated object"),
-            entries: &[entry(0, both, uniform), entry(1, vertex, storage)],
+            // A groom's per-vertex attributes and each fin's two base vertices.
+            entries: &[
+                entry(0, both, uniform),
+                entry(1, vertex, storage),
+                entry(2, vertex, storage),
+                entry(3, vertex, storage),
+            ],
         });
         let texture = |view_dimension| wgpu::BindingType::Texture {
             sample_type: wgpu::TextureSampleType::Float { filterable: true },
@@ -77,6 +84,8 @@ impl Layouts {
                 entry(2, fragment, filtering),
                 entry(3, fragment, filtering),
                 entry(4, fragment, texture(wgpu::TextureViewDimension::D2)),
+                // The strands' keep values (a groom's density), fetched by texel.
+                entry(5, fragment, texture(wgpu::TextureViewDimension::D2Array)),
             ],
         });
         let sampler = |label, v_mode| {

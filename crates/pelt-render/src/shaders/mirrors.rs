@@ -49,13 +49,13 @@ pub(crate) struct ObjectUniform {
     pub lod_view_full: f32,
     pub furred_triangle_count: u32,
     pub fin_edge_count: u32,
+    pub groom_shading: u32,
     pub wet_darkening: f32,
     pub wet_shine: f32,
-    pub clump_size: f32,
-    pub clump_strength: f32,
+    pub wet_clump: f32,
+    pub clump_cell_texels: f32,
     pub wet_any: u32,
     /// WGSL rounds the struct up to its 16-byte alignment.
-    pub _padding_1: u32,
     pub _padding_2: u32,
 }
 
@@ -242,12 +242,12 @@ mod tests {
             lod_view_full,
             furred_triangle_count,
             fin_edge_count,
+            groom_shading,
             wet_darkening,
             wet_shine,
-            clump_size,
-            clump_strength,
+            wet_clump,
+            clump_cell_texels,
             wet_any,
-            _padding_1,
             _padding_2
         });
         assert_mirrors(&unified_shader_source(), "Object", &rust);

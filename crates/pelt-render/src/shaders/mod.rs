@@ -32,6 +32,8 @@ const VIEW_LOD_WGSL: &str = include_str!("view_lod.wgsl");
 const SIMULATION_WIND_WGSL: &str = include_str!("simulation_wind.wgsl");
 /// One simulation step, one invocation a strand.
 const SIMULATION_WGSL: &str = include_str!("simulation.wgsl");
+/// The step's per-strand inputs the GPU keeps and computes (inertia, the touch's weights).
+const SIMULATION_INPUTS_WGSL: &str = include_str!("simulation_inputs.wgsl");
 /// The separated structure of Lengyel et al. 2001 (the `lab` feature's baseline).
 #[cfg(feature = "lab")]
 const SEPARATED_WGSL: &str = include_str!("separated.wgsl");
@@ -59,10 +61,11 @@ pub fn view_lod_shader_source() -> String {
     format!("{SHADING_WGSL}\n{WET_WGSL}\n{UNIFIED_WGSL}\n{SCAN_WGSL}\n{VIEW_LOD_WGSL}")
 }
 
-/// The WGSL module of the GPU simulation (`simulation_wind.wgsl` plus `simulation.wgsl`).
+/// The WGSL module of the GPU simulation (`simulation_wind.wgsl`, `simulation.wgsl` and
+/// `simulation_inputs.wgsl`).
 #[must_use]
 pub fn simulation_shader_source() -> String {
-    format!("{SIMULATION_WIND_WGSL}\n{SIMULATION_WGSL}")
+    format!("{SIMULATION_WIND_WGSL}\n{SIMULATION_WGSL}\n{SIMULATION_INPUTS_WGSL}")
 }
 
 /// The WGSL module of the separated renderer (the shared shading plus `separated.wgsl`).

@@ -1,6 +1,20 @@
 // The separated structure of Lengyel et al. 2001: shells and fins as their own static vertex
 // buffers (position, normal, uv: 32 bytes a vertex, model space). Appended to `shading.wgsl`;
-// group 1 holds the object uniform and the fin vertices again as storage (`vs_separated_fin`).
+// group 1 holds the object uniform, the fin vertices again as storage (`vs_separated_fin`), and
+// a groom's per-vertex attributes with the base vertices at each fin's ends.
+
+// A groomed fur's shading terms per base vertex (V entries; one unused entry without a groom).
+@group(1) @binding(2) var<storage, read> groom_attributes: array<GroomAttributes>;
+// The base vertices at the ends of fin `f`: entries 2f and 2f + 1.
+@group(1) @binding(3) var<storage, read> fin_ends: array<u32>;
+
+fn separated_groom(vertex: u32) -> GroomShade {
+    // A uniform branch: ungroomed furs read nothing.
+    if object.groom_shading == 0u {
+        return GROOM_NONE;
+    }
+    return groom_shade(groom_attributes[vertex]);
+}
 
 struct VertexIn {
     @location(0) position: vec3<f32>,
@@ -34,15 +48,20 @@ fn vs_separated_skin(in: VertexIn) -> Varyings {
 // Meshes without uvs and with them pass on what `fs_shell_tiles` and `fs_shell_uvs` read, as
 // the unified shells do.
 @vertex
-fn vs_separated_shell_tiles(in: VertexIn, @builtin(instance_index) layer: u32) -> ShellTileVaryings {
+fn vs_separated_shell_tiles(in: VertexIn, @builtin(instance_index) layer: u32, @builtin(vertex_index) index: u32) -> ShellTileVaryings {
     let v = separated_shell(in, layer);
-    return shell_tile_varyings(v, v.fade, separated_lod_blend(v));
+    return shell_tile_varyings(v, v.fade, separated_lod_blend(v), separated_shell_groom(index));
 }
 
 @vertex
-fn vs_separated_shell_uvs(in: VertexIn, @builtin(instance_index) layer: u32) -> ShellUvVaryings {
+fn vs_separated_shell_uvs(in: VertexIn, @builtin(instance_index) layer: u32, @builtin(vertex_index) index: u32) -> ShellUvVaryings {
     let v = separated_shell(in, layer);
-    return shell_uv_varyings(v, v.fade, separated_lod_blend(v));
+    return shell_uv_varyings(v, v.fade, separated_lod_blend(v), separated_shell_groom(index));
+}
+
+// Each layer is drawn with base vertex `layer * V`, so the base vertex is the index modulo V.
+fn separated_shell_groom(index: u32) -> GroomShade {
+    return separated_groom(index % max(object.vertex_count, 1u));
 }
 
 // Shells by view angle as the unified shells fade them, from the shell vertex itself (these
@@ -90,8 +109,35 @@ fn separated_fin_fade(index: u32, normal: vec3<f32>) -> f32 {
     return smoothstep(1.0 - object.fin_fade_cos, 1.0, abs(dot(normal, to_camera)));
 }
 
+// `Varyings` and the groom's terms (a fin vertex's end of the edge).
+struct SeparatedFinVaryings {
+    @builtin(position) clip_position: vec4<f32>,
+    @location(0) world_position: vec3<f32>,
+    @location(1) normal: vec3<f32>,
+    @location(2) uv: vec2<f32>,
+    @location(3) height: f32,
+    @location(4) fade: f32,
+    @location(5) surface_uv: vec2<f32>,
+    @location(6) tint_density: vec4<f32>,
+    @location(7) clump: f32,
+}
+
 @vertex
-fn vs_separated_fin(in: VertexIn, @builtin(vertex_index) index: u32) -> Varyings {
+fn vs_separated_fin(in: VertexIn, @builtin(vertex_index) index: u32) -> SeparatedFinVaryings {
+    let v = separated_fin(in, index);
+    var out = SeparatedFinVaryings(v.clip_position, v.world_position, v.normal, v.uv, v.height, v.fade, v.surface_uv, vec4<f32>(1.0), 0.0);
+    if object.groom_shading != 0u && v.fade > 0.0 {
+        let per_fin = max((arrayLength(&fin_vertex_floats) / 8u) / max(object.edge_count, 1u), 1u);
+        // Side b of the edge sits at u > 0.
+        let side = select(0u, 1u, in.uv.x > 0.0);
+        let groom = separated_groom(fin_ends[2u * (index / per_fin) + side]);
+        out.tint_density = vec4<f32>(groom.tint, groom.density);
+        out.clump = groom.clump;
+    }
+    return out;
+}
+
+fn separated_fin(in: VertexIn, index: u32) -> Varyings {
     var out: Varyings;
     out.normal = world_from_model_normal(in.normal);
     // Lengyel's fade: a fin shows where it faces the viewer, i.e. stands on a silhouette edge.
@@ -120,16 +166,30 @@ fn vs_separated_fin(in: VertexIn, @builtin(vertex_index) index: u32) -> Varyings
 // Fins store no strand direction: it is the direction of growing height across the fin, from the
 // screen-space derivatives of position and uv.
 @fragment
-fn fs_separated_fin(in: Varyings) -> @location(0) vec4<f32> {
+fn fs_separated_fin(in: SeparatedFinVaryings) -> @location(0) vec4<f32> {
     let dp_dx = dpdx(in.world_position);
     let dp_dy = dpdy(in.world_position);
     let duv_dx = dpdx(in.uv);
     let duv_dy = dpdy(in.uv);
     let determinant = duv_dx.x * duv_dy.y - duv_dy.x * duv_dx.y;
     let up = (duv_dx.x * dp_dy - duv_dy.x * dp_dx) * sign(determinant);
-    let texel = textureSample(fin_texture, fin_sampler, vec2<f32>(in.uv.x, 1.0 - in.uv.y));
+    let fin_uv = vec2<f32>(in.uv.x, 1.0 - in.uv.y);
+    var texel: vec4<f32>;
+    var groom_alpha = 1.0;
+    var groom_tint = vec3<f32>(1.0);
+    // A uniform branch: the unified fins' groom shading (`fs_fin`).
+    if object.groom_shading != 0u {
+        let cells = clump_cells_per_tile();
+        let along = clump_uv(vec2<f32>(fin_uv.x, 0.5 / cells), cells, groom_clump_amount(in.clump, in.height)).x;
+        texel = textureSampleGrad(fin_texture, fin_sampler, vec2<f32>(along, fin_uv.y), dpdx(fin_uv), dpdy(fin_uv));
+        groom_alpha = clamp(in.tint_density.a, 0.0, 1.0);
+        groom_tint = in.tint_density.rgb;
+    } else {
+        texel = textureSample(fin_texture, fin_sampler, fin_uv);
+    }
     let normal = normalize(in.normal);
     let tangent = safe_normalize(up, normal);
-    let colour = hair_lighting(texel.rgb * surface_tint(in.surface_uv), tangent, tangent, in.world_position, in.height);
-    return fur_output(colour, texel.a * in.fade);
+    let albedo = texel.rgb * surface_tint(in.surface_uv) * groom_tint;
+    let colour = hair_lighting(albedo, tangent, tangent, in.world_position, in.height);
+    return fur_output(colour, texel.a * in.fade * groom_alpha);
 }

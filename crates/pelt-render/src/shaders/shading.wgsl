@@ -69,14 +69,16 @@ struct Object {
     // `furred_triangle_count` triangles and the fins the first `fin_edge_count` edges.
     furred_triangle_count: u32,
     fin_edge_count: u32,
+    // 1 when a groom's density, clump or tint reach the shading (0: none of their code runs).
+    groom_shading: u32,
     // Wet fur (`wet.wgsl`): albedo times 1 - wet_darkening * w, the highlight times
-    // 1 + wet_shine * w (its exponent 1 + 2 * wet_shine * w), clump cells of clump_size tiles
-    // gathering by up to clump_strength; wet_any is 1 when some vertex is wet (else the wetness
-    // is never read).
+    // 1 + wet_shine * w (its exponent 1 + 2 * wet_shine * w), a clump amount of wet_clump * w
+    // added to the groom's, in cells of clump_cell_texels shell texels (a groom's too); wet_any
+    // is 1 when some vertex is wet (else the wetness is never read).
     wet_darkening: f32,
     wet_shine: f32,
-    clump_size: f32,
-    clump_strength: f32,
+    wet_clump: f32,
+    clump_cell_texels: f32,
     wet_any: u32,
 }
 
@@ -89,6 +91,9 @@ override ALPHA_TO_COVERAGE: bool = false;
 @group(2) @binding(0) var shell_texture: texture_2d_array<f32>;
 @group(2) @binding(1) var fin_texture: texture_2d<f32>;
 @group(2) @binding(2) var shell_sampler: sampler;
+// Each shell texel's strand keep value (`FurTextures::strand_keep`, R8, no mipmaps); a 1x1
+// stand-in that keeps everything for furs without a groom.
+@group(2) @binding(5) var strand_keep: texture_2d_array<f32>;
 @group(2) @binding(3) var fin_sampler: sampler;
 // The mesh's colour texture (surface colour mode), else 1x1 white.
 @group(2) @binding(4) var surface_texture: texture_2d<f32>;
@@ -117,8 +122,6 @@ struct Varyings {
     // Shells without mesh uvs: the base normal in model space, which picks the axis-aligned
     // projection of the tiles (fixed to the model, so it moves with it).
     @location(10) tile_normal: vec3<f32>,
-    // The strand's wetness (0 dry, 1 soaked).
-    @location(11) wetness: f32,
 }
 
 // What a shell fragment reads and nothing more, packed four to a location: software
@@ -132,19 +135,46 @@ struct ShellTileVaryings {
     // `hair_terms` at the vertex.
     @location(0) @interpolate(perspective, centroid) lighting: vec4<f32>,
     // The opacity from the view angle (`shell_fade`), how far the layers the next coarser stride
-    // drops have faded here (`lod_vertex_blend`), the layer, and the wetness.
-    @location(1) @interpolate(perspective, centroid) fade_blend_layer_wet: vec4<f32>,
+    // drops have faded here (`lod_vertex_blend`), the layer, and the groom's clump.
+    @location(1) @interpolate(perspective, centroid) fade_blend_layer: vec4<f32>,
     // The root in tiles, model space, and the base normal picking its projection.
     @location(2) @interpolate(perspective, centroid) tile_position: vec3<f32>,
     @location(3) @interpolate(perspective, centroid) tile_normal: vec3<f32>,
+    // The groom's tint (rgb) and density (`GroomShade`).
+    @location(4) @interpolate(perspective, centroid) tint_density: vec4<f32>,
 }
 
 struct ShellUvVaryings {
     @builtin(position) clip_position: vec4<f32>,
     @location(0) @interpolate(perspective, centroid) lighting: vec4<f32>,
-    @location(1) @interpolate(perspective, centroid) fade_blend_layer_wet: vec4<f32>,
+    @location(1) @interpolate(perspective, centroid) fade_blend_layer: vec4<f32>,
     // The mesh uv in tiles (xy) and at the strand's root (zw, surface colour mode).
     @location(2) @interpolate(perspective, centroid) uvs: vec4<f32>,
+    @location(3) @interpolate(perspective, centroid) tint_density: vec4<f32>,
+}
+
+// A groom's shading terms at a strand's root (`GroomAttributes` of its base vertex): the
+// uniform fur's are `GROOM_NONE`.
+struct GroomShade {
+    tint: vec3<f32>,
+    density: f32,
+    clump: f32,
+    // The strand's wetness (`wet_groom`), read by the vertex only.
+    wetness: f32,
+}
+
+const GROOM_NONE = GroomShade(vec3<f32>(1.0), 1.0, 0.0, 0.0);
+
+// One vertex's entry in a groom attribute buffer (`groom_attributes` in `unified.wgsl` and
+// `separated.wgsl`; written by `geometry.rs`).
+struct GroomAttributes {
+    tint: vec3<f32>,
+    density: f32,
+    clump: f32,
+}
+
+fn groom_shade(g: GroomAttributes) -> GroomShade {
+    return GroomShade(g.tint, g.density, g.clump, 0.0);
 }
 
 // The lean shell interfaces from the full surface varyings (the unified and separated shells
@@ -153,14 +183,18 @@ fn shell_lighting(v: Varyings) -> vec4<f32> {
     return hair_terms(v.tangent, v.normal, v.world_position, layer_height(v.layer));
 }
 
-fn shell_tile_varyings(v: Varyings, fade: f32, lod_blend: f32) -> ShellTileVaryings {
-    let fade_blend_layer_wet = vec4<f32>(fade, lod_blend, f32(v.layer), v.wetness);
-    return ShellTileVaryings(v.clip_position, shell_lighting(v), fade_blend_layer_wet, v.tile_position, v.tile_normal);
+fn shell_tile_varyings(v: Varyings, fade: f32, lod_blend: f32, groom: GroomShade) -> ShellTileVaryings {
+    let fade_blend_layer = vec4<f32>(fade, lod_blend, f32(v.layer), groom.clump);
+    let tint_density = vec4<f32>(groom.tint, groom.density);
+    let lighting = wet_terms(shell_lighting(v), groom.wetness);
+    return ShellTileVaryings(v.clip_position, lighting, fade_blend_layer, v.tile_position, v.tile_normal, tint_density);
 }
 
-fn shell_uv_varyings(v: Varyings, fade: f32, lod_blend: f32) -> ShellUvVaryings {
-    let fade_blend_layer_wet = vec4<f32>(fade, lod_blend, f32(v.layer), v.wetness);
-    return ShellUvVaryings(v.clip_position, shell_lighting(v), fade_blend_layer_wet, vec4<f32>(v.uv, v.surface_uv));
+fn shell_uv_varyings(v: Varyings, fade: f32, lod_blend: f32, groom: GroomShade) -> ShellUvVaryings {
+    let fade_blend_layer = vec4<f32>(fade, lod_blend, f32(v.layer), groom.clump);
+    let tint_density = vec4<f32>(groom.tint, groom.density);
+    let lighting = wet_terms(shell_lighting(v), groom.wetness);
+    return ShellUvVaryings(v.clip_position, lighting, fade_blend_layer, vec4<f32>(v.uv, v.surface_uv), tint_density);
 }
 
 // The layer a shell fragment carries: interpolated from three equal corners, so within rounding.
@@ -179,8 +213,9 @@ struct FinVaryings {
     // Along the edge in tiles, the height (0 at the roots, 1 at the tips), and the mesh uv at
     // this end of the edge (surface colour mode).
     @location(1) @interpolate(perspective, centroid) uvs: vec4<f32>,
-    // The strand's wetness (0 without `object.wet_any`).
-    @location(2) @interpolate(perspective, centroid) wetness: f32,
+    // The groom's tint and density, and its clump (`GroomShade`).
+    @location(2) @interpolate(perspective, centroid) tint_density: vec4<f32>,
+    @location(3) @interpolate(perspective, centroid) clump: f32,
 }
 
 // Set per pipeline where every mesh it draws has uvs (1) or none has (2), so the shaders drop
@@ -357,21 +392,115 @@ fn tile_axis(n: vec3<f32>) -> u32 {
     return select(2u, 1u, a.y >= a.z);
 }
 
-// The shell texel of a mesh without uvs at `tile_position` (the root in tiles, model space).
-fn tile_texel(tile_position: vec3<f32>, tile_normal: vec3<f32>, layer: u32) -> vec4<f32> {
-    // The one axis-aligned projection the surface faces most: one texture fetch a fragment,
-    // the largest part of a shell fragment's cost on software rasterisers (a blend of all three
-    // cost three). The tiles are strand dots, so the seams where the projection changes do not
-    // show (SSIM test in tests/lean.rs).
-    return sample_shell(tile_uv(tile_position, tile_normal), shell_slice(layer));
-}
-
-// The tile uv of a mesh without uvs: `tile_position` projected along the axis `tile_normal`
-// faces most.
+// The shell uv (in tiles) of a mesh without uvs at `tile_position` (the root in tiles, model
+// space): the one axis-aligned projection the surface faces most, so one texture fetch a
+// fragment, the largest part of a shell fragment's cost on software rasterisers (a blend of all
+// three cost three). The tiles are strand dots, so the seams where the projection changes do not
+// show (SSIM test in tests/lean.rs).
 fn tile_uv(tile_position: vec3<f32>, tile_normal: vec3<f32>) -> vec2<f32> {
     let p = tile_position;
     let axis = tile_axis(tile_normal);
     return select(select(p.xy, p.zx, axis == 1u), p.yz, axis == 0u);
+}
+
+// Clumping: strands gather toward the centres of clump cells, a jittered grid of
+// `cells_per_tile` cells along each side of a tile. `uv` is in tiles, `amount` (0..1) how far
+// toward its cell's centre the sampling moves: 0 leaves `uv` as it is, 1 reads the centre
+// alone. The texture is sampled closer to the centre than the fragment lies, so the strands near
+// a centre spread over its cell and the fur parts into tufts, more toward the tips when
+// `amount` grows with the height. Used by a groom's clump map (`groom_clump_amount`); wet fur
+// can drive it with its wetness.
+fn clump_uv(uv: vec2<f32>, cells_per_tile: f32, amount: f32) -> vec2<f32> {
+    let a = clamp(amount, 0.0, 1.0);
+    let p = uv * cells_per_tile;
+    let cell = floor(p);
+    var centre = cell + 0.5;
+    var best = 1e30;
+    for (var dy = -1; dy <= 1; dy++) {
+        for (var dx = -1; dx <= 1; dx++) {
+            let c = cell + vec2<f32>(f32(dx), f32(dy));
+            let candidate = c + clump_jitter(c);
+            let to_candidate = candidate - p;
+            let d = dot(to_candidate, to_candidate);
+            if d < best {
+                best = d;
+                centre = candidate;
+            }
+        }
+    }
+    return mix(p, centre, a) / cells_per_tile;
+}
+
+// A clump cell's centre within it (0.15..0.85 on each axis), seeded by the cell.
+fn clump_jitter(cell: vec2<f32>) -> vec2<f32> {
+    let c = vec2<u32>(bitcast<u32>(i32(cell.x)), bitcast<u32>(i32(cell.y)));
+    let bits = groom_hash(c.x * 0x8da6b343u ^ groom_hash(c.y ^ 0x68e31da4u));
+    let unit = vec2<f32>(f32(bits & 0xffffu), f32(bits >> 16u)) / 65536.0;
+    return 0.15 + 0.7 * unit;
+}
+
+fn groom_hash(x: u32) -> u32 {
+    var h = x * 0x9e3779b9u;
+    h = (h ^ (h >> 16u)) * 0x85ebca6bu;
+    h = (h ^ (h >> 13u)) * 0xc2b2ae35u;
+    return h ^ (h >> 16u);
+}
+
+// Clump cells are `object.clump_cell_texels` shell texels wide (`FurLook::clump_size`, 12 by
+// default; the textures' own clumps are 10).
+fn clump_cells_per_tile() -> f32 {
+    return f32(textureDimensions(shell_texture).x) / object.clump_cell_texels;
+}
+
+// How far a groom's clump map pulls at `height`: nothing at the roots, growing to
+// `CLUMP_MAX_PULL` times the map's value at the tips (a full pull would read one texel for a
+// whole cell: flat polygons rather than tufts).
+fn groom_clump_amount(clump: f32, height: f32) -> f32 {
+    return CLUMP_MAX_PULL * clamp(clump, 0.0, 1.0) * clamp(height, 0.0, 1.0);
+}
+
+const CLUMP_MAX_PULL: f32 = 0.8;
+
+// Density: whether the strand covering the shell texel at `uv` (tiles) in `slice` survives a
+// density of `density` (its seeded keep value below the density), so 0.5 keeps about half the
+// strands, each whole, without new textures.
+fn strand_kept(uv: vec2<f32>, slice: i32, density: f32) -> bool {
+    let size = textureDimensions(strand_keep);
+    let texel = vec2<i32>(floor(fract(uv) * vec2<f32>(size)));
+    let layer = min(slice, i32(textureNumLayers(strand_keep)) - 1);
+    let clamped = clamp(texel, vec2<i32>(0), vec2<i32>(size) - 1);
+    let keep = textureLoad(strand_keep, clamped, layer, 0).r;
+    return (round(keep * 255.0) + 0.5) / 256.0 < density;
+}
+
+// A groomed shell fragment's texel at `uv` (tiles): clumped, thinned by the density. The
+// gradients are the unclumped uv's, so the cells' borders pick no other mip level.
+fn groomed_shell_texel(uv: vec2<f32>, slice: i32, groom: GroomShade, height: f32) -> vec4<f32> {
+    let dx = dpdx(uv) * SHELL_GRAD_SCALE;
+    let dy = dpdy(uv) * SHELL_GRAD_SCALE;
+    let sampled = clump_uv(uv, clump_cells_per_tile(), groom_clump_amount(groom.clump, height));
+    var texel = textureSampleGrad(shell_texture, shell_sampler, sampled, slice, dx, dy);
+    if !strand_kept(sampled, slice, groom.density) {
+        texel.a = 0.0;
+    }
+    // A uniform branch: only wet fur parts between its clumps.
+    if object.wet_any != 0u {
+        texel.a *= clump_parting(uv, clump_cells_per_tile(), groom.clump, height);
+    }
+    return texel;
+}
+
+// `SHELL_LOD_BIAS` as a scale on the gradients (2^bias).
+const SHELL_GRAD_SCALE: f32 = 0.70710678;
+
+// The groom's terms a shell fragment carries.
+fn shell_groom(fade_blend_layer: vec4<f32>, tint_density: vec4<f32>) -> GroomShade {
+    return GroomShade(tint_density.rgb, tint_density.a, fade_blend_layer.w, 0.0);
+}
+
+// The shell texel of a mesh without uvs at `tile_position` (the root in tiles, model space).
+fn tile_texel(tile_position: vec3<f32>, tile_normal: vec3<f32>, layer: u32) -> vec4<f32> {
+    return sample_shell(tile_uv(tile_position, tile_normal), shell_slice(layer));
 }
 
 // Surface colour mode: the mesh's texture at the strand's root tints the strand's brightness.
@@ -406,14 +535,13 @@ fn fs_skin(in: Varyings) -> @location(0) vec4<f32> {
     return vec4<f32>(colour, 1.0);
 }
 
-// A shell fragment from its texel: fading, level of detail and hair lighting (wet where the
-// fur is: the branch is on the object uniform, so a dry fur runs the dry code alone).
-fn shell_colour(texel: vec4<f32>, surface_uv: vec2<f32>, lighting: vec4<f32>, fade_blend_layer_wet: vec4<f32>) -> vec4<f32> {
-    let layer = varying_layer(fade_blend_layer_wet.z);
-    let alpha = lod_alpha(texel.a * fade_blend_layer_wet.x, layer, fade_blend_layer_wet.y);
-    let albedo = texel.rgb * surface_tint(surface_uv);
-    if object.wet_any != 0u {
-        return fur_output(wet_hair_colour(albedo, lighting, layer_height(layer), fade_blend_layer_wet.w), alpha);
+// A shell fragment from its texel: fading, level of detail, the groom's tint and hair lighting.
+fn shell_colour(texel: vec4<f32>, surface_uv: vec2<f32>, lighting: vec4<f32>, fade_blend_layer: vec4<f32>, tint: vec3<f32>) -> vec4<f32> {
+    let layer = varying_layer(fade_blend_layer.z);
+    let alpha = lod_alpha(texel.a * fade_blend_layer.x, layer, fade_blend_layer.y);
+    var albedo = texel.rgb * surface_tint(surface_uv);
+    if clump_shading() {
+        albedo *= tint;
     }
     return fur_output(hair_colour(albedo, lighting, layer_height(layer)), alpha);
 }
@@ -421,32 +549,39 @@ fn shell_colour(texel: vec4<f32>, surface_uv: vec2<f32>, lighting: vec4<f32>, fa
 // Shells of meshes without uvs (`vs_shell_indexed`, `vs_separated_shell_tiles`).
 @fragment
 fn fs_shell_tiles(in: ShellTileVaryings) -> @location(0) vec4<f32> {
-    let layer = varying_layer(in.fade_blend_layer_wet.z);
+    let layer = varying_layer(in.fade_blend_layer.z);
     var texel: vec4<f32>;
-    if object.wet_any != 0u {
+    // A uniform branch: ungroomed dry furs fetch as they always have.
+    if clump_shading() {
         let uv = tile_uv(in.tile_position, in.tile_normal);
-        let clumped = clump_uv(uv, layer_height(layer), in.fade_blend_layer_wet.w);
-        texel = sample_shell(clumped.xy, shell_slice(layer));
-        texel.a *= clumped.z;
+        let groom = shell_groom(in.fade_blend_layer, in.tint_density);
+        if object.groom_shading != 0u {
+            texel = groomed_shell_texel(uv, shell_slice(layer), groom, layer_height(layer));
+        } else {
+            texel = wet_shell_texel(uv, shell_slice(layer), groom.clump, layer_height(layer));
+        }
     } else {
         texel = tile_texel(in.tile_position, in.tile_normal, layer);
     }
-    return shell_colour(texel, vec2<f32>(0.0), in.lighting, in.fade_blend_layer_wet);
+    return shell_colour(texel, vec2<f32>(0.0), in.lighting, in.fade_blend_layer, in.tint_density.rgb);
 }
 
 // Shells of meshes with uvs (`vs_shell_wedges`, `vs_separated_shell_uvs`).
 @fragment
 fn fs_shell_uvs(in: ShellUvVaryings) -> @location(0) vec4<f32> {
-    let layer = varying_layer(in.fade_blend_layer_wet.z);
+    let layer = varying_layer(in.fade_blend_layer.z);
     var texel: vec4<f32>;
-    if object.wet_any != 0u {
-        let clumped = clump_uv(in.uvs.xy, layer_height(layer), in.fade_blend_layer_wet.w);
-        texel = sample_shell(clumped.xy, shell_slice(layer));
-        texel.a *= clumped.z;
+    if clump_shading() {
+        let groom = shell_groom(in.fade_blend_layer, in.tint_density);
+        if object.groom_shading != 0u {
+            texel = groomed_shell_texel(in.uvs.xy, shell_slice(layer), groom, layer_height(layer));
+        } else {
+            texel = wet_shell_texel(in.uvs.xy, shell_slice(layer), groom.clump, layer_height(layer));
+        }
     } else {
         texel = sample_shell(in.uvs.xy, shell_slice(layer));
     }
-    return shell_colour(texel, in.uvs.zw, in.lighting, in.fade_blend_layer_wet);
+    return shell_colour(texel, in.uvs.zw, in.lighting, in.fade_blend_layer, in.tint_density.rgb);
 }
 
 // Seen from the side the roots are less hidden than from above: fins light and occlude their
@@ -459,23 +594,38 @@ fn fin_lighting_height(height: f32) -> f32 {
 fn fs_fin(in: FinVaryings) -> @location(0) vec4<f32> {
     let height = in.uvs.y;
     // Fin texture rows run from the tips (v = 0) to the roots (v = 1).
+    let fin_uv = vec2<f32>(in.uvs.x, 1.0 - height);
     var texel: vec4<f32>;
-    if object.wet_any != 0u {
-        // The shells' clumps seen from the side: strands along the edge gather the same way.
-        let clumped = clump_along(in.uvs.x, height, in.wetness);
-        texel = textureSample(fin_texture, fin_sampler, vec2<f32>(clumped.x, 1.0 - height));
-        texel.a *= clumped.y;
+    var groom_alpha = 1.0;
+    var groom_tint = vec3<f32>(1.0);
+    // A uniform branch, as in the shells.
+    if clump_shading() {
+        // The fin is the side view of a band of strands: clumps gather along the edge, and a
+        // thinner coat is a fainter fringe (the density scales its opacity).
+        let dx = dpdx(fin_uv);
+        let dy = dpdy(fin_uv);
+        let cells = clump_cells_per_tile();
+        let amount = groom_clump_amount(in.clump, height);
+        let along = clump_uv(vec2<f32>(fin_uv.x, 0.5 / cells), cells, amount).x;
+        if object.groom_shading != 0u {
+            texel = textureSampleGrad(fin_texture, fin_sampler, vec2<f32>(along, fin_uv.y), dx, dy);
+        } else {
+            // Wet only: where nothing clumps, the dry fin's very fetch.
+            texel = textureSample(fin_texture, fin_sampler, vec2<f32>(select(fin_uv.x, along, amount > 0.0), fin_uv.y));
+        }
+        groom_alpha = clamp(in.tint_density.a, 0.0, 1.0);
+        if object.wet_any != 0u {
+            groom_alpha *= clump_parting(vec2<f32>(fin_uv.x, 0.5 / cells), cells, in.clump, height);
+        }
+        groom_tint = in.tint_density.rgb;
     } else {
-        texel = textureSample(fin_texture, fin_sampler, vec2<f32>(in.uvs.x, 1.0 - height));
+        texel = textureSample(fin_texture, fin_sampler, fin_uv);
     }
     // Several fins overlap along a silhouette; thinning them keeps the fringe from reading as a
     // solid band, most of all at the roots where the shells already cover.
-    let alpha = texel.a * in.lighting_fade.w * mix(0.15, 0.6, height);
-    let albedo = texel.rgb * surface_tint(in.uvs.zw);
+    let alpha = texel.a * in.lighting_fade.w * mix(0.15, 0.6, height) * groom_alpha;
+    let albedo = texel.rgb * surface_tint(in.uvs.zw) * groom_tint;
     let lit_height = fin_lighting_height(height);
     let lighting = vec4<f32>(in.lighting_fade.xyz, occlusion(lit_height));
-    if object.wet_any != 0u {
-        return fur_output(wet_hair_colour(albedo, lighting, lit_height, in.wetness), alpha);
-    }
     return fur_output(hair_colour(albedo, lighting, lit_height), alpha);
 }

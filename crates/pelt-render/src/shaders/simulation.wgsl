@@ -2,7 +2,8 @@
 // (gravity + wind + the user field with the touch blended over it + inertia), then the bend of Equation 1 as
 // `pelt_core::sim::bend` defines it, in the CPU kernel's two forms (the exact straight form,
 // the running quaternion for curved strands, O(L) both), written layer-major into the
-// shared vertex array the renderer draws from. Appended to `simulation_wind.wgsl`.
+// shared vertex array the renderer draws from. Appended to `simulation_wind.wgsl`; the
+// per-strand inputs (`strands`, `strand_state`) are `simulation_inputs.wgsl`'s.
 
 // One step's inputs (a 256-byte slot of a uniform buffer, chosen by dynamic offset).
 struct Step {
@@ -28,12 +29,15 @@ struct Step {
     touch: vec4<f32>,
     // x: workgroups per row of the dispatch grid.
     grid: vec4<u32>,
-}
-
-// Per strand: root and stability, then the rotation of its rest frame (quaternion xyzw).
-struct Strand {
-    root_stability: vec4<f32>,
-    frame: vec4<f32>,
+    // xyz: the touch's centre; w: its radius (read by the `weigh_touch` pass).
+    touch_centre: vec4<f32>,
+    // The inertia's spring step (`SpringStep`): x dt, y dt before, z scale, w omega^2 dt.
+    inertia: vec4<f32>,
+    // x: the spring's damping factor.
+    inertia_damp: vec4<f32>,
+    // x: the `InertiaStep` kind (`INERTIA_*`); y: 1 where the touch's weights are the CPU's
+    // (in the field's w), 0 where the `weigh_touch` pass's.
+    inertia_kind: vec4<u32>,
 }
 
 @group(0) @binding(0) var<uniform> inputs: Step;
@@ -42,19 +46,11 @@ struct Strand {
 // direction (xyz) and w = 1 where the CPU bends it by the straight form (`sim::straight_directions`),
 // 0 where by the running quaternion, so both kernels bend every strand the same way.
 @group(0) @binding(1) var<storage, read> rest_segments: array<vec4<f32>>;
-@group(0) @binding(2) var<storage, read> strands: array<Strand>;
-// Per strand: the user field (xyz) and the touch's falloff weight (w, 0 outside it); the
-// inertial force of this step (from the roots' motion, computed on the CPU).
-struct StrandForces {
-    field_touch: vec4<f32>,
-    inertial: vec4<f32>,
-}
-
-@group(0) @binding(3) var<storage, read> forces: array<StrandForces>;
 // The shared vertex array: NV[i * V + j] as packed xyz.
 @group(0) @binding(4) var<storage, read_write> positions: array<f32>;
-// Per strand, gravity's factor: 1 + added_weight * wetness (1 when dry).
-@group(0) @binding(5) var<storage, read> wet_gravity: array<f32>;
+// Per strand, a wet strand's weight: x gravity's factor, y the mass on the inertial spring (both
+// 1 + added_weight * wetness; 1 when dry).
+@group(0) @binding(5) var<storage, read> wet_strands: array<vec2<f32>>;
 
 const PARALLEL_SINE: f32 = 1e-7;
 const WORKGROUP: u32 = 64u;
@@ -150,19 +146,19 @@ fn step_strands(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocati
     if j >= v {
         return;
     }
-    let strand = strands[j];
-    let root = strand.root_stability.xyz;
-    let stability = strand.root_stability.w;
+    let root_stability = strand_root(j);
+    let root = root_stability.xyz;
+    let stability = root_stability.w;
+    let frame = strand_frame(j, v);
+    let inertial = inertial_force(j, v, root);
 
     // The external field (wind + user field) with the touch over it (`evaluate_field`), then gravity.
-    let strand_forces = forces[j];
-    let field = strand_forces.field_touch;
-    var field_force = wind(j, root) + field.xyz;
-    let touch_weight = field.w * inputs.touch.w;
-    if touch_weight > 0.0 {
-        field_force = field_force * (1.0 - touch_weight) + inputs.touch.xyz * touch_weight;
+    var field_force = wind(j, root) + user_field(j, v);
+    let touch = touch_weight(j, v) * inputs.touch.w;
+    if touch > 0.0 {
+        field_force = field_force * (1.0 - touch) + inputs.touch.xyz * touch;
     }
-    let force = inputs.gravity.xyz * wet_gravity[j] + field_force + strand_forces.inertial.xyz;
+    let force = inputs.gravity.xyz * wet_strands[j].x + field_force + inertial;
 
     // `bend::split_force`: unit direction and magnitude without overflow; a non-finite force
     // has neither.
@@ -184,9 +180,9 @@ fn step_strands(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocati
     positions[j * 3u + 2u] = root.z;
     let straight = rest_segments[layers * v + j];
     if straight.w > 0.0 {
-        bend_straight(j, v, layers, root, strand.frame, straight.xyz, force_direction, scale);
+        bend_straight(j, v, layers, root, frame, straight.xyz, force_direction, scale);
     } else {
-        bend_general(j, v, layers, root, strand.frame, force_direction, scale);
+        bend_general(j, v, layers, root, frame, force_direction, scale);
     }
 }
 

@@ -19,15 +19,25 @@
 // Triangles (3F), then edges (2E), then the two faces beside each edge (2E); with uvs, then each
 // wedge's base vertex (W) and each triangle corner's wedge (3F, the shells' index buffer).
 @group(1) @binding(5) var<storage, read> topology: array<u32>;
-// A wetness per base vertex, read only when `object.wet_any` is set.
-@group(1) @binding(6) var<storage, read> wetness: array<f32>;
+// A groomed fur's per-vertex shading terms (V entries; one unused entry without a groom),
+// rewritten in place when a groom is painted (`GpuFur::set_groom`).
+@group(1) @binding(6) var<storage, read> groom_attributes: array<GroomAttributes>;
 
-// Base vertex `vertex`'s wetness; 0 for a dry fur (a uniform branch, no fetch).
-fn vertex_wetness(vertex: u32) -> f32 {
-    if object.wet_any == 0u {
-        return 0.0;
+// A wetness per base vertex, read only while `object.wet_any` is set.
+@group(1) @binding(7) var<storage, read> wetness: array<f32>;
+
+// The groom's terms at base vertex `vertex` (the uniform fur's without groom shading), wet
+// where the fur is.
+fn vertex_groom(vertex: u32) -> GroomShade {
+    var groom = GROOM_NONE;
+    // Uniform branches: ungroomed dry furs read nothing.
+    if object.groom_shading != 0u {
+        groom = groom_shade(groom_attributes[vertex]);
     }
-    return wetness[vertex];
+    if object.wet_any != 0u {
+        groom = wet_groom(groom, wetness[vertex]);
+    }
+    return groom;
 }
 
 const NO_FACE: u32 = 0xffffffffu;
@@ -116,7 +126,6 @@ fn surface_varyings(vertex: u32, wedge: u32, layer: u32) -> Varyings {
         out.surface_uv = vec2<f32>(0.0);
         out.uv = vec2<f32>(0.0);
     }
-    out.wetness = vertex_wetness(vertex);
     out.layer = layer;
     out.slice = shell_slice(layer);
     out.height = layer_height(layer);
@@ -168,12 +177,12 @@ fn vs_shell_indexed_listed(@builtin(vertex_index) index: u32) -> ShellTileVaryin
 fn shell_wedge(wedge: u32, shell: u32) -> ShellUvVaryings {
     let vertex = wedge_vertex(wedge);
     let v = surface_varyings(vertex, wedge, lod_shell_layer(shell));
-    return shell_uv_varyings(v, shell_fade(v.normal, v.world_position), lod_shell_blend(vertex, v.normal));
+    return shell_uv_varyings(v, shell_fade(v.normal, v.world_position), lod_shell_blend(vertex, v.normal), vertex_groom(vertex));
 }
 
 fn shell_vertex(vertex: u32, shell: u32) -> ShellTileVaryings {
     let v = surface_varyings(vertex, 0u, lod_shell_layer(shell));
-    return shell_tile_varyings(v, shell_fade(v.normal, v.world_position), lod_shell_blend(vertex, v.normal));
+    return shell_tile_varyings(v, shell_fade(v.normal, v.world_position), lod_shell_blend(vertex, v.normal), vertex_groom(vertex));
 }
 
 // The level of detail's blend at base vertex `vertex` (world normal `normal`): the view angle
@@ -251,7 +260,8 @@ fn fin_varyings(index: u32, edge: u32, fade: f32) -> FinVaryings {
     let tangent = strand_tangent(layer, vertex, here, normal);
     // The occlusion (`w`) is the fragment's, from the interpolated height.
     let terms = hair_terms(tangent, normal, position, 0.0);
-    out.lighting_fade = vec4<f32>(terms.xyz, fade);
+    let groom = vertex_groom(vertex);
+    out.lighting_fade = vec4<f32>(wet_terms(terms, groom.wetness).xyz, fade);
     let offset = f32(hash(edge) & 0xffffu) / 65536.0;
     let along = f32(side) * distance(model_vertex(0u, a), model_vertex(0u, b)) * object.tiles_per_world;
     // The surface uv of this end of the edge, from its corner in the first face.
@@ -265,7 +275,8 @@ fn fin_varyings(index: u32, edge: u32, fade: f32) -> FinVaryings {
         }
     }
     out.uvs = vec4<f32>(offset + along, layer_height(layer), surface_uv);
-    out.wetness = vertex_wetness(vertex);
+    out.tint_density = vec4<f32>(groom.tint, groom.density);
+    out.clump = groom.clump;
     return out;
 }
 

@@ -28,6 +28,9 @@ fn unit(x: u32, y: u32, salt: u32) -> f32 {
 /// Shell slices with round strands that taper and lean, plus a matching fin texture.
 pub fn strand_textures(size: u32, layers: u32, root: [u8; 3], tip: [u8; 3]) -> FurTextures {
     let mut shell = vec![0_u8; (size * size * layers * 4) as usize];
+    // Each texel's keep value for a groom's density: its strand's, or its own where empty.
+    let mut strand_keep: Vec<u8> =
+        (0..size * size * layers).map(|k| (unit(k, 0, 6) * 255.0).min(254.0) as u8).collect();
     let mut fin_columns = Vec::new();
     for y in 0..size {
         for x in 0..size {
@@ -61,6 +64,7 @@ pub fn strand_textures(size: u32, layers: u32, root: [u8; 3], tip: [u8; 3]) -> F
                         let a = (alpha * 255.0) as u8;
                         if a > shell[k4 + 3] {
                             shell[k4..k4 + 4].copy_from_slice(&[colour(0), colour(1), colour(2), a]);
+                            strand_keep[k4 / 4] = (unit(x, y, 5) * 255.0).min(254.0) as u8;
                         }
                     }
                 }
@@ -85,7 +89,7 @@ pub fn strand_textures(size: u32, layers: u32, root: [u8; 3], tip: [u8; 3]) -> F
             }
         }
     }
-    FurTextures { size, layers, shell, fin_width, fin_height, fin, surface: None }
+    FurTextures { size, layers, shell, fin_width, fin_height, fin, strand_keep, surface: None }
 }
 
 pub const BROWN_ROOT: [u8; 3] = [70, 45, 28];

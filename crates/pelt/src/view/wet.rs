@@ -57,16 +57,17 @@ pub fn wet_ui(ui: &mut egui::Ui, controls: &mut WetControls, wet: &mut WetParams
     changes.sources |= ui.add(egui::Slider::new(&mut controls.rain_rate, 0.0..=3.0).text("rain (per s)")).changed();
     ui.horizontal(|ui| {
         changes.sources |= ui.checkbox(&mut controls.water, "water").changed();
-        changes.sources |=
-            ui.add_enabled(controls.water, egui::Slider::new(&mut controls.water_level, 0.0..=1.0).text("level")).changed();
+        changes.sources |= ui
+            .add_enabled(controls.water, egui::Slider::new(&mut controls.water_level, 0.0..=1.0).text("level"))
+            .changed();
     });
     ui.checkbox(&mut controls.sponge, "sponge: left-drag wets (Ctrl dries)");
     let before = wet.clone();
     ui.add(egui::Slider::new(&mut wet.drying_per_sec, 0.0..=2.0).text("drying (per s)"));
     ui.add(egui::Slider::new(&mut wet.darkening, 0.0..=1.0).text("darkening"));
     ui.add(egui::Slider::new(&mut wet.shine, 0.0..=4.0).text("shine"));
-    ui.add(egui::Slider::new(&mut wet.clump_strength, 0.0..=0.95).text("clumping"));
-    ui.add(egui::Slider::new(&mut wet.clump_size, 0.005..=0.2).logarithmic(true).text("clump size (tiles)"));
+    ui.add(egui::Slider::new(&mut wet.clump_strength, 0.0..=1.0).text("clumping"));
+    ui.add(egui::Slider::new(&mut wet.clump_size, 2.0..=128.0).logarithmic(true).text("clump size (texels)"));
     ui.add(egui::Slider::new(&mut wet.added_weight, 0.0..=5.0).text("added weight"));
     ui.add(egui::Slider::new(&mut wet.softening, 0.0..=0.9).text("softening"));
     ui.add(egui::Slider::new(&mut wet.wicking, 0.0..=1.0).text("wicking band"));
