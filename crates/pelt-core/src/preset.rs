@@ -12,6 +12,7 @@
 //! [simulation]         # `sim::SimParams`; equation = "pelt" | "paper" (`sim::Equation`)
 //! [render]             # how Pelt's commands show it (see `RenderParams`)
 //! [groom]              # per-vertex maps: length, density, direction, clump, tint (`groom::GroomParams`)
+//! [wet]                # what wetness does: clumps, darkening, shine, weight, drying (`wet::WetParams`)
 //! ```
 
 use std::path::{Path, PathBuf};
@@ -26,6 +27,7 @@ use crate::sim::SimParams;
 use crate::texture::{
     self, ColourMode, ColourParams, FurTextures, ImageRgba8, StrandField, TextureInputs, TextureParams,
 };
+use crate::wet::WetParams;
 
 /// Why a preset could not be read, checked or used. Every message starts with the file.
 #[derive(Debug, thiserror::Error)]
@@ -166,6 +168,10 @@ pub struct Preset {
     /// Fur that differs over the body; empty (and left out of the TOML) for a uniform coat.
     #[serde(skip_serializing_if = "GroomParams::is_empty")]
     pub groom: GroomParams,
+    /// What wetness does to the fur, and its wetness at time 0; left out of the TOML at its
+    /// defaults.
+    #[serde(skip_serializing_if = "WetParams::is_default")]
+    pub wet: WetParams,
     /// The preset file (for messages) and its folder (for relative image paths); not in TOML.
     #[serde(skip)]
     file: PathBuf,
@@ -182,6 +188,7 @@ impl Default for Preset {
             simulation: SimParams::default(),
             render: RenderParams::default(),
             groom: GroomParams::default(),
+            wet: WetParams::default(),
             file: PathBuf::from("<default preset>"),
         }
     }
@@ -198,6 +205,7 @@ impl PartialEq for Preset {
             && self.simulation == other.simulation
             && self.render == other.render
             && self.groom == other.groom
+            && self.wet == other.wet
     }
 }
 
@@ -356,6 +364,7 @@ impl Preset {
         )?;
         self.texture.validate().map_err(invalid)?;
         self.colour.validate().map_err(invalid)?;
+        self.wet.validate().map_err(invalid)?;
         self.simulation.validate().map_err(invalid)
     }
 

@@ -234,7 +234,8 @@ impl FurDriver {
         self.frame.level = level;
     }
 
-    /// The look (lighting, fading, density) from the next frame on.
+    /// The look (lighting, fading, density) from the next frame on; its wet terms follow the
+    /// stepper's `[wet]` at each [`FurDriver::advance_to`].
     pub fn set_look(&mut self, look: FurLook) {
         self.frame.look = look;
     }
@@ -289,7 +290,20 @@ impl FurDriver {
         self.fall_back_when_unrecorded();
         self.claim(stepper.simulation_mut());
         stepper.advance_with_clip_at(time_secs, clip_time_secs)?;
+        self.show_wetness(queue, stepper)?;
         self.upload(device, queue, stepper.simulation(), stepper.moved_pose().map(|pose| &pose.normals[..]))
+    }
+
+    /// The stepper's wetness and what it does to the look (`[wet]`), for the coming frame: the
+    /// values uploaded while any vertex is wet, the shaders' wet paths off when none is.
+    fn show_wetness(&mut self, queue: &wgpu::Queue, stepper: &FurStepper) -> Result<(), RenderError> {
+        let wetness = stepper.wetness();
+        self.frame.wet = !wetness.is_dry();
+        self.frame.look = self.frame.look.with_wet(stepper.wet());
+        if self.frame.wet {
+            self.fur.set_wetness(queue, wetness.values())?;
+        }
+        Ok(())
     }
 
     /// Lets `step` change and step `simulation` itself (a test harness replaying recorded

@@ -202,6 +202,15 @@ impl GpuFur {
         self.geometry.set_normals(queue, normals)
     }
 
+    /// Replaces the wetness per base vertex (`V` values in `0..=1`; they start at 0). The
+    /// shaders read it only for a [`FurFrame`] with `wet` set.
+    ///
+    /// # Errors
+    /// [`RenderError::Count`] unless there are exactly `V` values.
+    pub fn set_wetness(&self, queue: &wgpu::Queue, wetness: &[f32]) -> Result<(), RenderError> {
+        self.geometry.set_wetness(queue, wetness)
+    }
+
     /// The base normals' buffer; see the layout in [`GpuFur`].
     #[must_use]
     pub fn base_normals(&self) -> &wgpu::Buffer {

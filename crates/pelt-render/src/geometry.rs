@@ -108,6 +108,9 @@ pub(crate) struct UnifiedGeometry {
     states: Vec<wgpu::Buffer>,
     current: usize,
     normals: wgpu::Buffer,
+    /// A wetness per base vertex (`V` `f32`, zero until set): per-frame state like the
+    /// silhouette list, so not counted in [`GpuBytes`].
+    wetness: wgpu::Buffer,
     /// Triangles (3F), edges (2E), edge faces (2E), and for meshes with uvs the wedges' base
     /// vertices (W) and the corners' wedges (3F); also the index buffer of the base triangles (by
     /// vertex, or by wedge with uvs).
@@ -166,6 +169,11 @@ impl UnifiedGeometry {
             bytemuck::cast_slice(&mesh.normals),
             wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
         );
+        let wetness = buffer(
+            "pelt wetness",
+            bytemuck::cast_slice(&vec![0.0_f32; mesh.vertex_count().max(1)]),
+            wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+        );
         let uvs = buffer("pelt wedge uvs", bytemuck::cast_slice(&wedge_uvs), wgpu::BufferUsages::STORAGE);
         let topology_buffer = buffer(
             "pelt topology",
@@ -206,6 +214,7 @@ impl UnifiedGeometry {
                         wgpu::BindGroupEntry { binding: 4, resource: uvs.as_entire_binding() },
                         wgpu::BindGroupEntry { binding: 5, resource: topology_buffer.as_entire_binding() },
                         wgpu::BindGroupEntry { binding: 6, resource: groom_buffer.as_entire_binding() },
+                        wgpu::BindGroupEntry { binding: 7, resource: wetness.as_entire_binding() },
                     ],
                 })
             })
@@ -223,6 +232,7 @@ impl UnifiedGeometry {
             states,
             current: 0,
             normals,
+            wetness,
             topology: topology_buffer,
             fin_indices,
             groom: groom_buffer,
@@ -324,6 +334,15 @@ impl UnifiedGeometry {
             return Err(RenderError::Count { what: "base normals", expected, got: normals.len(), rule: "V" });
         }
         queue.write_buffer(&self.normals, 0, bytemuck::cast_slice(normals));
+        Ok(())
+    }
+
+    pub fn set_wetness(&self, queue: &wgpu::Queue, wetness: &[f32]) -> Result<(), RenderError> {
+        let expected = self.shape.vertex_count as usize;
+        if wetness.len() != expected {
+            return Err(RenderError::Count { what: "wetness values", expected, got: wetness.len(), rule: "V" });
+        }
+        queue.write_buffer(&self.wetness, 0, bytemuck::cast_slice(wetness));
         Ok(())
     }
 

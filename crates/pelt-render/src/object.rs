@@ -25,6 +25,30 @@ pub struct FurLook {
     /// relative to the mesh whatever its size. (A larger tile holds more, finer strands: the
     /// texture's resolution sets how fine the fur is, as in the paper's "resizing".)
     pub tiles_per_radius: f32,
+    /// Wet albedo is `1 - wet_darkening * wetness` of the dry one (`[wet] darkening`).
+    pub wet_darkening: f32,
+    /// The wet highlight grows by `1 + wet_shine * w`, its exponent by `1 + 2 * wet_shine * w`
+    /// (`[wet] shine`).
+    pub wet_shine: f32,
+    /// Clump cells, in shell texels, for wet fur and a groom's clump map alike
+    /// (`[wet] clump_size`).
+    pub clump_size: f32,
+    /// How strongly a soaked strand clumps, 0..1 (`[wet] clump_strength`).
+    pub clump_strength: f32,
+}
+
+impl FurLook {
+    /// This look with `wet`'s darkening, shine and clumps.
+    #[must_use]
+    pub fn with_wet(self, wet: &pelt_core::wet::WetParams) -> Self {
+        Self {
+            wet_darkening: wet.darkening,
+            wet_shine: wet.shine,
+            clump_size: wet.clump_size,
+            clump_strength: wet.clump_strength,
+            ..self
+        }
+    }
 }
 
 impl Default for FurLook {
@@ -36,6 +60,10 @@ impl Default for FurLook {
             fin_fade_cos: 0.1,
             shell_fade_cos: 0.25,
             tiles_per_radius: 0.4,
+            wet_darkening: 0.5,
+            wet_shine: 0.6,
+            clump_size: 12.0,
+            clump_strength: 0.8,
         }
     }
 }
@@ -52,11 +80,20 @@ pub struct FurFrame {
     pub look: FurLook,
     /// Level of detail: which shells and fin segments to draw ([`FurLevel::FULL`]: all).
     pub level: FurLevel,
+    /// Whether any vertex of the fur is wet ([`crate::GpuFur::set_wetness`]): only then do the
+    /// shaders read the wetness (a dry fur draws the bytes of one that never was wet).
+    pub wet: bool,
 }
 
 impl Default for FurFrame {
     fn default() -> Self {
-        Self { world_from_model: Mat4::IDENTITY, interpolation: 1.0, look: FurLook::default(), level: FurLevel::FULL }
+        Self {
+            world_from_model: Mat4::IDENTITY,
+            interpolation: 1.0,
+            look: FurLook::default(),
+            level: FurLevel::FULL,
+            wet: false,
+        }
     }
 }
 
@@ -181,8 +218,12 @@ impl ObjectShape {
             furred_triangle_count: self.furred_triangle_count,
             fin_edge_count: self.fin_edge_count,
             groom_shading: u32::from(self.groom_shading),
+            wet_darkening: look.wet_darkening,
+            wet_shine: look.wet_shine,
+            wet_clump: look.clump_strength.clamp(0.0, 1.0),
+            clump_cell_texels: look.clump_size.clamp(2.0, 128.0),
+            wet_any: u32::from(frame.wet),
             _padding_2: 0,
-            _padding_3: 0,
         }
     }
 }

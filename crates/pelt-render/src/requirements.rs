@@ -4,8 +4,8 @@
 use crate::RenderError;
 
 /// Storage buffers the unified vertex shaders read: two position states, base normals, wedge
-/// uvs and topology.
-const STORAGE_BUFFERS_PER_STAGE: u32 = 5;
+/// uvs, topology, groom attributes and wetness.
+const STORAGE_BUFFERS_PER_STAGE: u32 = 7;
 /// View, object and textures; the silhouette pass's fin list is group 3.
 const BIND_GROUPS: u32 = 4;
 /// The varyings of `shading.wgsl`.

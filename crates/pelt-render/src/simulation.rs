@@ -11,7 +11,7 @@
 //! begins). Nothing is read back and the shared array never crosses the bus.
 
 use pelt_core::FurStructure;
-use pelt_core::sim::{ContactStep, InertiaStep, InputVersions, Simulation, StepInputs, kernel_rest};
+use pelt_core::sim::{ContactStep, InertiaStep, InputVersions, Simulation, StepInputs, StrandInputs, kernel_rest};
 
 use crate::RenderError;
 use crate::contact::{CONTACT_SLOTS, GpuContact};
@@ -31,7 +31,7 @@ const RING_SLOTS: u64 = 64;
 // Each ring slot has its own contact slot, for the same reason.
 const _: () = assert!(RING_SLOTS == CONTACT_SLOTS as u64);
 /// Storage buffers the compute stage binds.
-const STORAGE_BUFFERS: u32 = 5;
+const STORAGE_BUFFERS: u32 = 6;
 
 /// One step's inputs; the layout of `Step` in `simulation.wgsl`.
 #[repr(C)]
@@ -166,6 +166,7 @@ pub struct GpuSimulation {
     rest_segments: wgpu::Buffer,
     strands: wgpu::Buffer,
     state: wgpu::Buffer,
+    wet: WetInputs,
     /// One bind group per shared-array buffer written so far (a fur has one or two).
     bind_groups: Vec<(wgpu::Buffer, wgpu::BindGroup)>,
     vertex_count: u32,
@@ -307,6 +308,7 @@ impl GpuSimulation {
                 storage(3, false),
                 storage(4, false),
                 storage(5, true),
+                storage(6, true),
             ],
         });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -352,6 +354,7 @@ impl GpuSimulation {
         );
         check_size(device, "simulation contact", GpuContact::bytes(v))?;
         let contact = GpuContact::new(device, structure);
+        let wet = WetInputs::new(device, v);
         scope.pop("creating the GPU simulation")?;
         Ok(Self {
             pipeline,
@@ -363,6 +366,7 @@ impl GpuSimulation {
             state,
             contact,
             pending_contact: Vec::with_capacity(STEP_SLOTS + 2),
+            wet,
             bind_groups: Vec::new(),
             vertex_count: v as u32,
             layers: structure.layers,
@@ -561,6 +565,7 @@ impl GpuSimulation {
                 wgpu::BindGroupEntry { binding: 3, resource: self.state.as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 4, resource: output.as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 5, resource: self.contact.buffer.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 6, resource: self.wet.buffer.as_entire_binding() },
             ],
         });
         scope.pop("binding the GPU simulation to the fur")?;
@@ -612,6 +617,42 @@ impl GpuSimulation {
         }
         self.touch_uploaded = touch_uploaded;
         self.uploaded = Some((versions, inputs.stability));
+        self.wet.upload(queue, &inputs);
+    }
+}
+
+/// Wet strands' extra weight, kept apart from the other per-strand inputs (binding 5): per
+/// strand, gravity's factor and the mass on the inertial spring, both `1 + added_weight * w`. A
+/// wet strand's lower stability rides in the strands buffer ([`StrandInputs::stability_of`]).
+#[derive(Debug)]
+struct WetInputs {
+    buffer: wgpu::Buffer,
+    /// What the buffer holds; empty while it holds all ones.
+    uploaded: Vec<[f32; 2]>,
+}
+
+impl WetInputs {
+    fn new(device: &wgpu::Device, strands: usize) -> Self {
+        let buffer = wgpu::util::DeviceExt::create_buffer_init(
+            device,
+            &wgpu::util::BufferInitDescriptor {
+                label: Some("pelt simulation wet strands"),
+                contents: bytemuck::cast_slice(&vec![[1.0_f32; 2]; strands.max(1)]),
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            },
+        );
+        Self { buffer, uploaded: Vec::new() }
+    }
+
+    fn upload(&mut self, queue: &wgpu::Queue, inputs: &StrandInputs<'_>) {
+        if inputs.wetness.is_none() && self.uploaded.is_empty() {
+            return;
+        }
+        let scales: Vec<[f32; 2]> = (0..inputs.roots.len()).map(|j| [inputs.gravity_scale_of(j); 2]).collect();
+        if scales != self.uploaded {
+            queue.write_buffer(&self.buffer, 0, bytemuck::cast_slice(&scales));
+            self.uploaded = if inputs.wetness.is_none() { Vec::new() } else { scales };
+        }
     }
 }
 

@@ -87,9 +87,23 @@ pub struct Args {
     /// `[render.lod]` is on by default).
     #[arg(long)]
     no_lod: bool,
+    /// A uniformly wet coat, 0 (dry) to 1 (soaked), held (no drying): the preset's `[wet]`
+    /// says what wetness does. A script's `[[rain]]` and `[[water]]` add to it.
+    #[arg(long, value_name = "W", value_parser = crate::values::parse_wetness)]
+    wetness: Option<f32>,
     /// Output: a .png (one frame), a .gif (animated) or a folder (numbered PNGs).
     #[arg(short, long, default_value = "pelt.png")]
     output: PathBuf,
+}
+
+/// The preset's `[wet]`, with `--wetness` as the whole coat's wetness, held.
+pub fn wet_params(preset: &Preset, wetness: Option<f32>) -> pelt_core::wet::WetParams {
+    let mut wet = preset.wet.clone();
+    if let Some(w) = wetness {
+        wet.wetness = w;
+        wet.drying_per_sec = 0.0;
+    }
+    wet
 }
 
 /// Where frames go.
@@ -170,6 +184,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     // The wind is set after the state at time 0 is made, as a host changing it live would.
     let mut stepper = FurStepper::new(&fur, &preset.simulation)?;
     stepper.simulation_mut().set_wind(&simulation_params.wind)?;
+    stepper.set_wet(&wet_params(&preset, args.wetness))?;
     // A rig poses the base only while it plays a clip or the script moves it.
     if let Some(rig) = rig.filter(|_| clip.is_some() || scene.as_ref().is_some_and(|s| !s.motion.is_empty())) {
         stepper.set_clip(rig, clip);

@@ -20,6 +20,14 @@ pub fn parse_msaa(text: &str) -> Result<u32, String> {
     }
 }
 
+/// A wetness, `0..=1` (0 dry, 1 soaked).
+pub fn parse_wetness(text: &str) -> Result<f32, String> {
+    match text.trim().parse::<f32>() {
+        Ok(w) if (0.0..=1.0).contains(&w) => Ok(w),
+        _ => Err(format!("expected a wetness from 0 (dry) to 1 (soaked), got {text:?}")),
+    }
+}
+
 pub fn parse_vec3(text: &str) -> Result<Vec3, String> {
     let values: Vec<f32> = text
         .split(',')

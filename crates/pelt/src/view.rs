@@ -14,6 +14,7 @@ mod shell_share;
 mod ui;
 mod ui_layer;
 mod viewport;
+mod wet;
 
 use std::path::PathBuf;
 

@@ -44,6 +44,8 @@ pub struct Inertia {
     last_dt: f32,
     force: Vec<Vec3>,
     force_velocity: Vec<Vec3>,
+    /// Per strand, the mass on the spring relative to a dry strand's (empty: all 1).
+    masses: Vec<f32>,
     resets: u64,
 }
 
@@ -58,8 +60,20 @@ impl Inertia {
             last_dt: 0.0,
             force: vec![Vec3::ZERO; strands],
             force_velocity: vec![Vec3::ZERO; strands],
+            masses: Vec::new(),
             resets: 0,
         }
+    }
+
+    /// Each strand's mass relative to a dry one (`None`: all 1): a heavier strand swings at
+    /// `1 / sqrt(mass)` of the natural frequency ([`SpringStep::heavier`]). Values up to 1 count
+    /// as 1.
+    ///
+    /// # Panics
+    /// If `masses` has not one entry per strand.
+    pub fn set_masses(&mut self, masses: Option<Vec<f32>>) {
+        self.masses = masses.unwrap_or_default();
+        assert!(self.masses.is_empty() || self.masses.len() == self.force.len(), "one mass per strand");
     }
 
     /// Forgets the motion: no force until two more steps have been seen.
@@ -183,13 +197,19 @@ impl Inertia {
                 }
             }
             InertiaStep::Spring(spring) => {
+                let masses = &self.masses;
                 self.previous_roots
                     .par_iter_mut()
                     .zip(self.force.par_iter_mut())
                     .zip(self.force_velocity.par_iter_mut())
                     .zip(roots.par_iter())
+                    .enumerate()
                     .with_min_len(STRANDS_PER_TASK)
-                    .for_each(|(((previous, force), velocity), root)| {
+                    .for_each(|(j, (((previous, force), velocity), root))| {
+                        let spring = match masses.get(j) {
+                            Some(&mass) if mass > 1.0 => spring.heavier(mass),
+                            _ => spring,
+                        };
                         *force = spring.force(*previous, *root, force, velocity);
                         *previous = [*root, previous[0]];
                     });
@@ -231,6 +251,17 @@ pub struct SpringStep {
 }
 
 impl SpringStep {
+    /// The same step for a strand `mass` times heavier on the same spring: `omega` over
+    /// `sqrt(mass)` (the GPU kernel does the same arithmetic).
+    #[must_use]
+    pub fn heavier(self, mass: f32) -> Self {
+        Self {
+            stiffness_dt: self.stiffness_dt / mass,
+            damp: 1.0 / (1.0 + (1.0 / self.damp - 1.0) / mass.sqrt()),
+            ..self
+        }
+    }
+
     /// One strand's new force from its earlier roots `[n - 1, n - 2]`, its root now, and its
     /// force and velocity (the velocity is updated in place).
     #[must_use]
@@ -258,6 +289,26 @@ mod tests {
         }
         let f = state.forces()[0];
         assert!((f.x + 1.0).abs() < 1e-2 && f.y == 0.0 && f.z == 0.0, "{f}");
+    }
+
+    #[test]
+    fn a_heavier_strand_swings_slower() {
+        // The time the force first passes 90% of a steady target: sqrt(4) = 2 times later at
+        // four times the mass (damping ratio 1: no overshoot to confuse the count).
+        let rise = |mass: f32| {
+            let mut state = Inertia::new(1);
+            state.set_masses(Some(vec![mass]));
+            (0..600)
+                .find(|&n| {
+                    let t = f64::from(n) / 120.0;
+                    state.update(&[Vec3::new((t * t) as f32, 0.0, 0.0)], t, 0.5, 1.0, 1.0);
+                    state.forces()[0].x < -0.9
+                })
+                .expect("rises")
+        };
+        let (dry, wet) = (rise(1.0), rise(4.0));
+        let ratio = wet as f32 / dry as f32;
+        assert!((1.8..=2.2).contains(&ratio), "dry {dry} steps, wet {wet}: {ratio}");
     }
 
     #[test]

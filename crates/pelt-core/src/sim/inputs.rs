@@ -1,7 +1,7 @@
 //! The inputs of one simulation step, computed in one place for every kernel that bends the
 //! strands: [`StepInputs`] (what every strand shares: gravity, the wind's step, the touch,
 //! Equation 1's gain) and [`StrandInputs`] (one entry per strand: posed roots and frames,
-//! stability, the user field, the touch's weights, the inertial force). The CPU kernel reads them
+//! stability, the user field, the touch's weights, the inertial force, wetness). The CPU kernel reads them
 //! here; a GPU kernel packs them into its buffers as they are.
 
 use glam::{Quat, Vec3};
@@ -9,6 +9,8 @@ use glam::{Quat, Vec3};
 use super::SimParams;
 use super::field::Touch;
 use super::wind::WindStep;
+#[cfg(doc)]
+use crate::wet::WetParams;
 
 /// What every strand shares in the step at [`StepInputs::time_secs`], from
 /// [`Simulation::step_inputs`](super::Simulation::step_inputs).
@@ -68,16 +70,36 @@ pub struct StrandInputs<'a> {
     pub touch_weights: &'a [(u32, f32)],
     /// The inertial force from the roots' acceleration at the newest step.
     pub inertial: &'a [Vec3],
+    /// Each strand's wetness in `[0, 1]`, if any strand is wet.
+    pub wetness: Option<&'a [f32]>,
+    /// Gravity's factor per unit of wetness ([`WetParams::added_weight`]).
+    pub wet_weight: f32,
+    /// Stability's loss per unit of wetness ([`WetParams::softening`]).
+    pub wet_softening: f32,
 }
 
 impl StrandInputs<'_> {
-    /// Strand `strand`'s stability: the map's entry, or [`StrandInputs::stability`].
+    /// Strand `strand`'s stability: the map's entry, or [`StrandInputs::stability`], times
+    /// `1 - softening * wetness` when wet.
     ///
     /// # Panics
     /// If `strand` is not a strand of the simulation and a map is set.
     #[must_use]
     pub fn stability_of(&self, strand: usize) -> f32 {
-        self.stability_map.map_or(self.stability, |map| map[strand])
+        let stability = self.stability_map.map_or(self.stability, |map| map[strand]);
+        match self.wetness {
+            Some(wetness) => stability * (1.0 - self.wet_softening * wetness[strand]),
+            None => stability,
+        }
+    }
+
+    /// Gravity's factor on strand `strand`: `1 + added_weight * wetness` (exactly 1 when dry).
+    ///
+    /// # Panics
+    /// If `strand` is not a strand of the simulation and wetness is set.
+    #[must_use]
+    pub fn gravity_scale_of(&self, strand: usize) -> f32 {
+        self.wetness.map_or(1.0, |wetness| 1.0 + self.wet_weight * wetness[strand])
     }
 }
 

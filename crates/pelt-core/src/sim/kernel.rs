@@ -429,6 +429,8 @@ pub(crate) struct Step<'a> {
     pub external: &'a [Vec3],
     /// The inertial force from the roots' acceleration, one per strand.
     pub inertial: &'a [Vec3],
+    /// Every strand's wetness, gravity's factor and stability's loss per unit of it.
+    pub wetness: Option<(&'a [f32], f32, f32)>,
     pub rest: &'a RestBatches,
 }
 
@@ -438,11 +440,19 @@ impl Step<'_> {
         std::array::from_fn(|lane| {
             let j = batch * LANES + lane;
             if j < self.vertex_count {
+                let stability = self.stability_map.map_or(self.stability, |m| m[j]);
+                let (gravity, stability) = match self.wetness {
+                    // A wet strand is heavier and limper (the same arithmetic as `StrandInputs`).
+                    Some((wetness, weight, softening)) => {
+                        (self.gravity * (1.0 + weight * wetness[j]), stability * (1.0 - softening * wetness[j]))
+                    }
+                    None => (self.gravity, stability),
+                };
                 LaneInputs {
                     root: self.roots[j],
                     frame: self.frames[j],
-                    force: self.gravity + self.external[j] + self.inertial[j],
-                    stability: self.stability_map.map_or(self.stability, |m| m[j]),
+                    force: gravity + self.external[j] + self.inertial[j],
+                    stability,
                 }
             } else {
                 LaneInputs::default()

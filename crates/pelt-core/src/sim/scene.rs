@@ -37,6 +37,17 @@
 //! hand_radius = 0.2                # optional (default 0): a ball at the grip pushing the rest
 //! path = [[0.0, 5.2, 2.6], [0.0, 6.0, 2.6]]
 //! close_secs = 0.3                 # optional, and spring_hz (2) and damping (0.35) likewise
+//!
+//! [[rain]]                         # a shower, see `wet::RainKey`
+//! start_secs = 0.0
+//! end_secs = 4.0
+//! direction = [0.0, -1.0, 0.0]
+//! rate = 0.4                       # wetness per second facing the rain, 0..=100
+//!
+//! [[water]]                        # water level keys, see `wet::WaterKey`
+//! time_secs = 0.0
+//! point = [0.0, -1.0, 0.0]
+//! normal = [0.0, 1.0, 0.0]
 //! ```
 //!
 //! Stroke points are world positions, on or near the base surface, which keeps a script
@@ -57,6 +68,7 @@ use super::MAX_FORCE;
 use super::contact::{Collider, ColliderKey, GraspParams, Shape};
 use super::motion::{self, MotionKey};
 use super::simulation::{SimError, Simulation};
+use crate::wet::{self, RainKey, WaterKey, WetSources};
 
 /// Errors from reading a scene; each names the file and, where it can, the key.
 #[derive(Debug, thiserror::Error)]
@@ -268,7 +280,7 @@ impl SceneGrasp {
 }
 
 /// A parsed, validated scene script.
-#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Scene {
     /// Length of the scene; default the last keyframe or stroke end.
@@ -289,6 +301,12 @@ pub struct Scene {
     /// Grasps.
     #[serde(default, rename = "grasp")]
     pub grasps: Vec<SceneGrasp>,
+    /// Showers.
+    #[serde(default)]
+    pub rain: Vec<RainKey>,
+    /// Water level keyframes, sorted by time.
+    #[serde(default)]
+    pub water: Vec<WaterKey>,
 }
 
 impl Scene {
@@ -350,6 +368,7 @@ impl Scene {
             range(format!("wind[{i}].jitter"), key.jitter, 0.0, 1.0)?;
         }
         motion::validate(&self.motion)?;
+        wet::validate(&self.rain, &self.water)?;
         for (i, stroke) in self.strokes.iter().enumerate() {
             finite_time(format!("stroke[{i}].start_secs"), stroke.start_secs)?;
             finite_time(format!("stroke[{i}].end_secs"), stroke.end_secs)?;
@@ -399,9 +418,16 @@ impl Scene {
         self.duration_secs.unwrap_or_else(|| {
             let wind = self.wind.last().map_or(0.0, |k| k.time_secs);
             let motion = self.motion.last().map_or(0.0, |k| k.time_secs);
+            let water = self.water.last().map_or(0.0, |k| k.time_secs);
+            let rain = self.rain.iter().map(|r| r.end_secs).fold(0.0, f64::max);
             let keys = self.colliders.iter().filter_map(|c| c.keys.last()).map(|k| k.time_secs);
             let grasps = self.grasps.iter().map(|g| g.end_secs);
-            self.strokes.iter().map(|s| s.end_secs).chain(keys).chain(grasps).fold(wind.max(motion), f64::max)
+            self.strokes
+                .iter()
+                .map(|s| s.end_secs)
+                .chain(keys)
+                .chain(grasps)
+                .fold(wind.max(motion).max(water).max(rain), f64::max)
         })
     }
 
@@ -433,6 +459,12 @@ impl Scene {
     #[must_use]
     pub fn motion_at(&self, time_secs: f64) -> Option<Mat4> {
         motion::motion_at(&self.motion, time_secs)
+    }
+
+    /// What wets the fur: the scene's rain and water keys.
+    #[must_use]
+    pub fn wet_sources(&self) -> WetSources<'_> {
+        WetSources { rain: &self.rain, water: &self.water }
     }
 
     /// The stroke active at `time_secs` (the last one listed, where several overlap).

@@ -112,6 +112,11 @@ pub struct Simulation {
     /// Rotation of each strand's rest frame into the current base frame (from `set_base`).
     frames: Vec<Quat>,
     stability_map: Option<Vec<f32>>,
+    /// Each strand's wetness, with gravity's factor and stability's loss per unit of it; `None`
+    /// while the fur is dry.
+    wetness: Option<Vec<f32>>,
+    wet_weight: f32,
+    wet_softening: f32,
     /// Bounding radius of the base at rest: the unit of wind gust sizes and speeds.
     radius: f32,
     field: ForceField,
@@ -190,6 +195,9 @@ impl Simulation {
             roots,
             frames: vec![Quat::IDENTITY; v],
             stability_map: None,
+            wetness: None,
+            wet_weight: 0.0,
+            wet_softening: 0.0,
             radius,
             field: ForceField::new(v),
             touch: None,
@@ -396,7 +404,62 @@ impl Simulation {
             field: self.field.values(),
             touch_weights: self.touch.as_ref().map_or(&[], |touch| touch.weights()),
             inertial: self.inertia.forces(),
+            wetness: self.wetness.as_deref(),
+            wet_weight: self.wet_weight,
+            wet_softening: self.wet_softening,
         }
+    }
+
+    /// Each strand's wetness in `[0, 1]` (`None`, or all zero: dry, the bytes of a fur that was
+    /// never wet), from the next step on: a wet strand's gravity is `1 + params.added_weight * w`
+    /// times stronger, its stability `1 - params.softening * w` times lower, and its swing after
+    /// the body's motion slower (the inertial spring's frequency over `sqrt(1 + added_weight * w)`,
+    /// a heavier mass on the same spring).
+    ///
+    /// # Errors
+    /// [`SimError::Size`] unless there is one value per strand; [`SimError::Params`] for a value
+    /// outside `[0, 1]` or parameters out of range.
+    pub fn set_wetness(&mut self, wetness: Option<&[f32]>, params: &crate::wet::WetParams) -> Result<(), SimError> {
+        params.validate()?;
+        let wetness = wetness.filter(|w| w.iter().any(|&x| x != 0.0));
+        if let Some(values) = wetness {
+            if values.len() != self.vertex_count {
+                return Err(SimError::Size { what: "the wetness", expected: self.vertex_count, got: values.len() });
+            }
+            if let Some(bad) = values.iter().find(|w| !(0.0..=1.0).contains(*w)) {
+                return Err(ParamError {
+                    key: "wetness".into(),
+                    problem: format!("must be between 0 and 1, got {bad}"),
+                }
+                .into());
+            }
+        }
+        let same = match (wetness, &self.wetness) {
+            (Some(values), Some(kept)) => values == &kept[..],
+            (None, None) => true,
+            _ => false,
+        };
+        if same && self.wet_weight == params.added_weight && self.wet_softening == params.softening {
+            return Ok(());
+        }
+        // The stabilities a GPU kernel keeps resident change with the wetness.
+        self.versions.stability += 1;
+        match (wetness, &mut self.wetness) {
+            (Some(values), Some(kept)) => kept.copy_from_slice(values),
+            (values, kept) => *kept = values.map(<[f32]>::to_vec),
+        }
+        self.wet_weight = params.added_weight;
+        self.wet_softening = params.softening;
+        let masses: Option<Vec<f32>> =
+            self.wetness.as_ref().map(|w| w.iter().map(|&x| params.gravity_scale(x)).collect());
+        self.inertia.set_masses(masses);
+        Ok(())
+    }
+
+    /// Each strand's wetness, if any is wet.
+    #[must_use]
+    pub fn wetness(&self) -> Option<&[f32]> {
+        self.wetness.as_deref()
     }
 
     /// Begins a touch at `point` (on or near the base surface; see [`Simulation::pick`]) with
@@ -937,6 +1000,7 @@ impl Simulation {
             frames: strands.frames,
             external: &self.external,
             inertial: strands.inertial,
+            wetness: strands.wetness.map(|w| (w, strands.wet_weight, strands.wet_softening)),
             rest: &self.rest,
         };
         dispatch::bend_all(self.cpu_kernel, &step, &mut current);

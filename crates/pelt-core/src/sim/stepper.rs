@@ -12,6 +12,7 @@ use crate::anim::{Pose, Rig};
 use crate::body::{BodyCapsules, Capsule};
 use crate::fur::FurStructure;
 use crate::mesh::Mesh;
+use crate::wet::{WetParams, WetSurface, Wetness};
 
 /// Where the base's pose comes from each step.
 #[derive(Debug, Default)]
@@ -49,6 +50,11 @@ pub struct FurStepper {
     host_posed: bool,
     /// A body the fur collides with, posed with the clip.
     body: Option<BodyColliders>,
+    /// A wetness per base vertex (rain, water, sponge, drying) and what it does.
+    wetness: Wetness,
+    wet: WetParams,
+    /// The normals the wetness was last advanced with (the posed base's, world space).
+    wet_normals: Vec<Vec3>,
 }
 
 /// Ids of the colliders a [`FurStepper`]'s body gives the simulation (capsule `k` is this plus
@@ -81,6 +87,9 @@ impl FurStepper {
             restart_pending: true,
             host_posed: false,
             body: None,
+            wetness: Wetness::new(structure.mesh.vertex_count(), 0.0),
+            wet: WetParams::default(),
+            wet_normals: Vec::new(),
         })
     }
 
@@ -200,13 +209,78 @@ impl FurStepper {
             }
             if self.moved && !matches!(self.posing, Posing::Host) {
                 self.simulation.set_base_rotations(&self.pose.positions, &self.pose.rotations)?;
+                // The wetness on the new pose, before a restart computes its states with it.
+                self.advance_wetness(time_secs)?;
                 if std::mem::take(&mut self.restart_pending) {
                     self.simulation.restart();
                 }
             }
         }
+        self.advance_wetness(time_secs)?;
         self.simulation.advance_to(time_secs);
         Ok(())
+    }
+
+    /// Advances the wetness to `time_secs` on the posed base and hands it to the simulation.
+    fn advance_wetness(&mut self, time_secs: f64) -> Result<(), SimError> {
+        let sources = self.scene.as_ref().map(Scene::wet_sources).unwrap_or_default();
+        if !sources.is_empty() || !self.wetness.is_dry() {
+            let simulation = &self.simulation;
+            self.wet_normals.clear();
+            self.wet_normals.extend(simulation.frames().iter().zip(&self.mesh.normals).map(|(q, n)| *q * *n));
+            self.wetness.advance_to(
+                time_secs,
+                simulation.params().rate_hz,
+                sources,
+                &self.wet,
+                WetSurface {
+                    positions: simulation.roots(),
+                    normals: &self.wet_normals,
+                    radius: simulation.bounding_radius(),
+                },
+            );
+        }
+        let wet = (!self.wetness.is_dry()).then(|| self.wetness.values());
+        if wet.is_some() || self.simulation.wetness().is_some() {
+            self.simulation.set_wetness(wet, &self.wet)?;
+        }
+        Ok(())
+    }
+
+    /// What wetness does (the preset's `[wet]`); its `wetness` is every vertex's wetness at
+    /// time 0 (and after a jump back in time, which replays from there).
+    ///
+    /// # Errors
+    /// [`SimError::Params`] for values out of range (keys `wet.*`).
+    pub fn set_wet(&mut self, params: &WetParams) -> Result<(), SimError> {
+        params.validate()?;
+        self.wet = params.clone();
+        self.wetness.set_initial(params.wetness);
+        Ok(())
+    }
+
+    /// What wetness does, as [`FurStepper::set_wet`] left it.
+    #[must_use]
+    pub fn wet(&self) -> &WetParams {
+        &self.wet
+    }
+
+    /// The wetness per base vertex, as the last step left it.
+    #[must_use]
+    pub fn wetness(&self) -> &Wetness {
+        &self.wetness
+    }
+
+    /// The wetness, for a host's sponge ([`Wetness::sponge`] at the simulation's
+    /// [`roots`](Simulation::roots)) or a uniform setting; the next step takes it up.
+    pub fn wetness_mut(&mut self) -> &mut Wetness {
+        &mut self.wetness
+    }
+
+    /// Presses a sponge at `centre` (the posed base's space): the wetness within `radius` moves
+    /// toward `amount` (0 dries, 1 soaks) with a smooth falloff.
+    pub fn sponge(&mut self, centre: Vec3, radius: f32, amount: f32) {
+        self.wetness.sponge(self.simulation.roots(), centre, radius, amount);
     }
 
     /// Sets the base's pose from the host's own skinning (world or model space, as the host
@@ -267,6 +341,7 @@ impl FurStepper {
         self.simulation = Simulation::new(structure, params)?;
         self.simulation.set_cpu_bending(bending);
         self.mesh = structure.mesh.clone();
+        self.wetness = Wetness::new(self.mesh.vertex_count(), self.wet.wetness);
         self.restart_pending = true;
         Ok(())
     }

@@ -7,7 +7,7 @@ pub(crate) struct Layouts {
     /// Group 0: the view uniform.
     pub view: wgpu::BindGroupLayout,
     /// Group 1 of the unified structure and plain meshes: the object uniform and the storage
-    /// buffers (positions twice, base normals, wedge uvs, topology, groom attributes).
+    /// buffers (positions twice, base normals, wedge uvs, topology, groom attributes, wetness).
     pub unified_object: wgpu::BindGroupLayout,
     /// Group 1 of the separated structure: the object uniform and the fin vertices.
     #[cfg(feature = "lab")]
@@ -54,6 +54,7 @@ impl Layouts {
                 entry(4, vertex, storage),
                 entry(5, vertex, storage),
                 entry(6, vertex, storage),
+                entry(7, vertex, storage),
             ],
         });
         // The separated fins' vertices, read back by each fin vertex to decide for its whole fin.

@@ -50,9 +50,13 @@ pub(crate) struct ObjectUniform {
     pub furred_triangle_count: u32,
     pub fin_edge_count: u32,
     pub groom_shading: u32,
+    pub wet_darkening: f32,
+    pub wet_shine: f32,
+    pub wet_clump: f32,
+    pub clump_cell_texels: f32,
+    pub wet_any: u32,
     /// WGSL rounds the struct up to its 16-byte alignment.
     pub _padding_2: u32,
-    pub _padding_3: u32,
 }
 
 pub(crate) const OBJECT_UNIFORM_BYTES: u64 = size_of::<ObjectUniform>() as u64;
@@ -239,8 +243,12 @@ mod tests {
             furred_triangle_count,
             fin_edge_count,
             groom_shading,
-            _padding_2,
-            _padding_3
+            wet_darkening,
+            wet_shine,
+            wet_clump,
+            clump_cell_texels,
+            wet_any,
+            _padding_2
         });
         assert_mirrors(&unified_shader_source(), "Object", &rust);
     }

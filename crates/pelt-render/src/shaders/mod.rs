@@ -18,6 +18,8 @@ pub(crate) use mirrors::{RustLayout, assert_mirrors, rust_layout};
 
 /// The view, the object uniform, the fur textures and the lighting every fur pipeline shares.
 pub(crate) const SHADING_WGSL: &str = include_str!("shading.wgsl");
+/// The wet look and the clumps, appended to the shading wherever it goes.
+const WET_WGSL: &str = include_str!("wet.wgsl");
 /// The unified structure's vertex and fragment shaders, over the shared vertex array.
 const UNIFIED_WGSL: &str = include_str!("unified.wgsl");
 /// The ordered listing both listing passes share.
@@ -44,21 +46,21 @@ const STRANDS_WGSL: &str = include_str!("strands.wgsl");
 /// The WGSL module of the unified renderer (the shared shading plus `unified.wgsl`).
 #[must_use]
 pub fn unified_shader_source() -> String {
-    format!("{SHADING_WGSL}\n{UNIFIED_WGSL}")
+    format!("{SHADING_WGSL}\n{WET_WGSL}\n{UNIFIED_WGSL}")
 }
 
 /// The WGSL module of the silhouette pass (the shared shading, `unified.wgsl`, `scan.wgsl` and
 /// `silhouette.wgsl`).
 #[must_use]
 pub fn silhouette_shader_source() -> String {
-    format!("{SHADING_WGSL}\n{UNIFIED_WGSL}\n{SCAN_WGSL}\n{SILHOUETTE_WGSL}")
+    format!("{SHADING_WGSL}\n{WET_WGSL}\n{UNIFIED_WGSL}\n{SCAN_WGSL}\n{SILHOUETTE_WGSL}")
 }
 
 /// The WGSL module of the view-angle pass (the shared shading, `unified.wgsl`, `scan.wgsl` and
 /// `view_lod.wgsl`).
 #[must_use]
 pub fn view_lod_shader_source() -> String {
-    format!("{SHADING_WGSL}\n{UNIFIED_WGSL}\n{SCAN_WGSL}\n{VIEW_LOD_WGSL}")
+    format!("{SHADING_WGSL}\n{WET_WGSL}\n{UNIFIED_WGSL}\n{SCAN_WGSL}\n{VIEW_LOD_WGSL}")
 }
 
 /// The WGSL module of the GPU simulation (`simulation_wind.wgsl`, `simulation.wgsl` and
@@ -72,12 +74,12 @@ pub fn simulation_shader_source() -> String {
 #[must_use]
 #[cfg(feature = "lab")]
 pub fn separated_shader_source() -> String {
-    format!("{SHADING_WGSL}\n{SEPARATED_WGSL}")
+    format!("{SHADING_WGSL}\n{WET_WGSL}\n{SEPARATED_WGSL}")
 }
 
 /// The WGSL module of the strand renderer (the shared shading plus `strands.wgsl`).
 #[must_use]
 #[cfg(feature = "lab")]
 pub fn strands_shader_source() -> String {
-    format!("{SHADING_WGSL}\n{STRANDS_WGSL}")
+    format!("{SHADING_WGSL}\n{WET_WGSL}\n{STRANDS_WGSL}")
 }

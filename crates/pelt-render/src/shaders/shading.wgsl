@@ -71,6 +71,15 @@ struct Object {
     fin_edge_count: u32,
     // 1 when a groom's density, clump or tint reach the shading (0: none of their code runs).
     groom_shading: u32,
+    // Wet fur (`wet.wgsl`): albedo times 1 - wet_darkening * w, the highlight times
+    // 1 + wet_shine * w (its exponent 1 + 2 * wet_shine * w), a clump amount of wet_clump * w
+    // added to the groom's, in cells of clump_cell_texels shell texels (a groom's too); wet_any
+    // is 1 when some vertex is wet (else the wetness is never read).
+    wet_darkening: f32,
+    wet_shine: f32,
+    wet_clump: f32,
+    clump_cell_texels: f32,
+    wet_any: u32,
 }
 
 // Set per pipeline: shells and fins with alpha-to-coverage output straight colour, blended ones
@@ -150,9 +159,11 @@ struct GroomShade {
     tint: vec3<f32>,
     density: f32,
     clump: f32,
+    // The strand's wetness (`wet_groom`), read by the vertex only.
+    wetness: f32,
 }
 
-const GROOM_NONE = GroomShade(vec3<f32>(1.0), 1.0, 0.0);
+const GROOM_NONE = GroomShade(vec3<f32>(1.0), 1.0, 0.0, 0.0);
 
 // One vertex's entry in a groom attribute buffer (`groom_attributes` in `unified.wgsl` and
 // `separated.wgsl`; written by `geometry.rs`).
@@ -163,7 +174,7 @@ struct GroomAttributes {
 }
 
 fn groom_shade(g: GroomAttributes) -> GroomShade {
-    return GroomShade(g.tint, g.density, g.clump);
+    return GroomShade(g.tint, g.density, g.clump, 0.0);
 }
 
 // The lean shell interfaces from the full surface varyings (the unified and separated shells
@@ -175,13 +186,15 @@ fn shell_lighting(v: Varyings) -> vec4<f32> {
 fn shell_tile_varyings(v: Varyings, fade: f32, lod_blend: f32, groom: GroomShade) -> ShellTileVaryings {
     let fade_blend_layer = vec4<f32>(fade, lod_blend, f32(v.layer), groom.clump);
     let tint_density = vec4<f32>(groom.tint, groom.density);
-    return ShellTileVaryings(v.clip_position, shell_lighting(v), fade_blend_layer, v.tile_position, v.tile_normal, tint_density);
+    let lighting = wet_terms(shell_lighting(v), groom.wetness);
+    return ShellTileVaryings(v.clip_position, lighting, fade_blend_layer, v.tile_position, v.tile_normal, tint_density);
 }
 
 fn shell_uv_varyings(v: Varyings, fade: f32, lod_blend: f32, groom: GroomShade) -> ShellUvVaryings {
     let fade_blend_layer = vec4<f32>(fade, lod_blend, f32(v.layer), groom.clump);
     let tint_density = vec4<f32>(groom.tint, groom.density);
-    return ShellUvVaryings(v.clip_position, shell_lighting(v), fade_blend_layer, vec4<f32>(v.uv, v.surface_uv), tint_density);
+    let lighting = wet_terms(shell_lighting(v), groom.wetness);
+    return ShellUvVaryings(v.clip_position, lighting, fade_blend_layer, vec4<f32>(v.uv, v.surface_uv), tint_density);
 }
 
 // The layer a shell fragment carries: interpolated from three equal corners, so within rounding.
@@ -433,11 +446,10 @@ fn groom_hash(x: u32) -> u32 {
     return h ^ (h >> 16u);
 }
 
-// Clump cells are this many shell texels wide (the textures' own clumps are 10 by default).
-const CLUMP_CELL_TEXELS: f32 = 12.0;
-
+// Clump cells are `object.clump_cell_texels` shell texels wide (`FurLook::clump_size`, 12 by
+// default; the textures' own clumps are 10).
 fn clump_cells_per_tile() -> f32 {
-    return f32(textureDimensions(shell_texture).x) / CLUMP_CELL_TEXELS;
+    return f32(textureDimensions(shell_texture).x) / object.clump_cell_texels;
 }
 
 // How far a groom's clump map pulls at `height`: nothing at the roots, growing to
@@ -471,6 +483,10 @@ fn groomed_shell_texel(uv: vec2<f32>, slice: i32, groom: GroomShade, height: f32
     if !strand_kept(sampled, slice, groom.density) {
         texel.a = 0.0;
     }
+    // A uniform branch: only wet fur parts between its clumps.
+    if object.wet_any != 0u {
+        texel.a *= clump_parting(uv, clump_cells_per_tile(), groom.clump, height);
+    }
     return texel;
 }
 
@@ -479,7 +495,7 @@ const SHELL_GRAD_SCALE: f32 = 0.70710678;
 
 // The groom's terms a shell fragment carries.
 fn shell_groom(fade_blend_layer: vec4<f32>, tint_density: vec4<f32>) -> GroomShade {
-    return GroomShade(tint_density.rgb, tint_density.a, fade_blend_layer.w);
+    return GroomShade(tint_density.rgb, tint_density.a, fade_blend_layer.w, 0.0);
 }
 
 // The shell texel of a mesh without uvs at `tile_position` (the root in tiles, model space).
@@ -524,7 +540,7 @@ fn shell_colour(texel: vec4<f32>, surface_uv: vec2<f32>, lighting: vec4<f32>, fa
     let layer = varying_layer(fade_blend_layer.z);
     let alpha = lod_alpha(texel.a * fade_blend_layer.x, layer, fade_blend_layer.y);
     var albedo = texel.rgb * surface_tint(surface_uv);
-    if object.groom_shading != 0u {
+    if clump_shading() {
         albedo *= tint;
     }
     return fur_output(hair_colour(albedo, lighting, layer_height(layer)), alpha);
@@ -535,11 +551,15 @@ fn shell_colour(texel: vec4<f32>, surface_uv: vec2<f32>, lighting: vec4<f32>, fa
 fn fs_shell_tiles(in: ShellTileVaryings) -> @location(0) vec4<f32> {
     let layer = varying_layer(in.fade_blend_layer.z);
     var texel: vec4<f32>;
-    // A uniform branch: ungroomed furs fetch as they always have.
-    if object.groom_shading != 0u {
+    // A uniform branch: ungroomed dry furs fetch as they always have.
+    if clump_shading() {
         let uv = tile_uv(in.tile_position, in.tile_normal);
         let groom = shell_groom(in.fade_blend_layer, in.tint_density);
-        texel = groomed_shell_texel(uv, shell_slice(layer), groom, layer_height(layer));
+        if object.groom_shading != 0u {
+            texel = groomed_shell_texel(uv, shell_slice(layer), groom, layer_height(layer));
+        } else {
+            texel = wet_shell_texel(uv, shell_slice(layer), groom.clump, layer_height(layer));
+        }
     } else {
         texel = tile_texel(in.tile_position, in.tile_normal, layer);
     }
@@ -551,9 +571,13 @@ fn fs_shell_tiles(in: ShellTileVaryings) -> @location(0) vec4<f32> {
 fn fs_shell_uvs(in: ShellUvVaryings) -> @location(0) vec4<f32> {
     let layer = varying_layer(in.fade_blend_layer.z);
     var texel: vec4<f32>;
-    if object.groom_shading != 0u {
+    if clump_shading() {
         let groom = shell_groom(in.fade_blend_layer, in.tint_density);
-        texel = groomed_shell_texel(in.uvs.xy, shell_slice(layer), groom, layer_height(layer));
+        if object.groom_shading != 0u {
+            texel = groomed_shell_texel(in.uvs.xy, shell_slice(layer), groom, layer_height(layer));
+        } else {
+            texel = wet_shell_texel(in.uvs.xy, shell_slice(layer), groom.clump, layer_height(layer));
+        }
     } else {
         texel = sample_shell(in.uvs.xy, shell_slice(layer));
     }
@@ -575,15 +599,24 @@ fn fs_fin(in: FinVaryings) -> @location(0) vec4<f32> {
     var groom_alpha = 1.0;
     var groom_tint = vec3<f32>(1.0);
     // A uniform branch, as in the shells.
-    if object.groom_shading != 0u {
+    if clump_shading() {
         // The fin is the side view of a band of strands: clumps gather along the edge, and a
         // thinner coat is a fainter fringe (the density scales its opacity).
         let dx = dpdx(fin_uv);
         let dy = dpdy(fin_uv);
         let cells = clump_cells_per_tile();
-        let along = clump_uv(vec2<f32>(fin_uv.x, 0.5 / cells), cells, groom_clump_amount(in.clump, height)).x;
-        texel = textureSampleGrad(fin_texture, fin_sampler, vec2<f32>(along, fin_uv.y), dx, dy);
+        let amount = groom_clump_amount(in.clump, height);
+        let along = clump_uv(vec2<f32>(fin_uv.x, 0.5 / cells), cells, amount).x;
+        if object.groom_shading != 0u {
+            texel = textureSampleGrad(fin_texture, fin_sampler, vec2<f32>(along, fin_uv.y), dx, dy);
+        } else {
+            // Wet only: where nothing clumps, the dry fin's very fetch.
+            texel = textureSample(fin_texture, fin_sampler, vec2<f32>(select(fin_uv.x, along, amount > 0.0), fin_uv.y));
+        }
         groom_alpha = clamp(in.tint_density.a, 0.0, 1.0);
+        if object.wet_any != 0u {
+            groom_alpha *= clump_parting(vec2<f32>(fin_uv.x, 0.5 / cells), cells, in.clump, height);
+        }
         groom_tint = in.tint_density.rgb;
     } else {
         texel = textureSample(fin_texture, fin_sampler, fin_uv);

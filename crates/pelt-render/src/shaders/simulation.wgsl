@@ -48,6 +48,9 @@ struct Step {
 @group(0) @binding(1) var<storage, read> rest_segments: array<vec4<f32>>;
 // The shared vertex array: NV[i * V + j] as packed xyz.
 @group(0) @binding(4) var<storage, read_write> positions: array<f32>;
+// Per strand, a wet strand's weight: x gravity's factor, y the mass on the inertial spring (both
+// 1 + added_weight * wetness; 1 when dry).
+@group(0) @binding(6) var<storage, read> wet_strands: array<vec2<f32>>;
 
 const PARALLEL_SINE: f32 = 1e-7;
 const WORKGROUP: u32 = 64u;
@@ -155,7 +158,7 @@ fn step_strands(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocati
     if touch > 0.0 {
         field_force = field_force * (1.0 - touch) + inputs.touch.xyz * touch;
     }
-    let force = inputs.gravity.xyz + field_force + inertial;
+    let force = inputs.gravity.xyz * wet_strands[j].x + field_force + inertial;
 
     // `bend::split_force`: unit direction and magnitude without overflow; a non-finite force
     // has neither.

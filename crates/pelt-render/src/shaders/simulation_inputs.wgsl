@@ -74,7 +74,15 @@ fn inertial_force(j: u32, v: u32, root: vec3<f32>) -> vec3<f32> {
     if length_squared > MAX_INERTIAL_FORCE * MAX_INERTIAL_FORCE {
         pull = MAX_INERTIAL_FORCE * (pull / sqrt(length_squared));
     }
-    let velocity = (strand_state[3u * v + j].xyz + (pull - force) * inputs.inertia.w) * inputs.inertia_damp.x;
+    // A wet strand is heavier on the same spring (`SpringStep::heavier`).
+    let mass = wet_strands[j].y;
+    var stiffness_dt = inputs.inertia.w;
+    var damp = inputs.inertia_damp.x;
+    if mass > 1.0 {
+        stiffness_dt = stiffness_dt / mass;
+        damp = 1.0 / (1.0 + (1.0 / damp - 1.0) / sqrt(mass));
+    }
+    let velocity = (strand_state[3u * v + j].xyz + (pull - force) * stiffness_dt) * damp;
     let new_force = force + velocity * dt;
     strand_state[2u * v + j] = vec4<f32>(new_force, 0.0);
     strand_state[3u * v + j] = vec4<f32>(velocity, 0.0);

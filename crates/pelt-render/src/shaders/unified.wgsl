@@ -23,13 +23,21 @@
 // rewritten in place when a groom is painted (`GpuFur::set_groom`).
 @group(1) @binding(6) var<storage, read> groom_attributes: array<GroomAttributes>;
 
-// The groom's terms at base vertex `vertex` (the uniform fur's without groom shading).
+// A wetness per base vertex, read only while `object.wet_any` is set.
+@group(1) @binding(7) var<storage, read> wetness: array<f32>;
+
+// The groom's terms at base vertex `vertex` (the uniform fur's without groom shading), wet
+// where the fur is.
 fn vertex_groom(vertex: u32) -> GroomShade {
-    // A uniform branch: ungroomed furs read nothing.
-    if object.groom_shading == 0u {
-        return GROOM_NONE;
+    var groom = GROOM_NONE;
+    // Uniform branches: ungroomed dry furs read nothing.
+    if object.groom_shading != 0u {
+        groom = groom_shade(groom_attributes[vertex]);
     }
-    return groom_shade(groom_attributes[vertex]);
+    if object.wet_any != 0u {
+        groom = wet_groom(groom, wetness[vertex]);
+    }
+    return groom;
 }
 
 const NO_FACE: u32 = 0xffffffffu;
@@ -252,7 +260,8 @@ fn fin_varyings(index: u32, edge: u32, fade: f32) -> FinVaryings {
     let tangent = strand_tangent(layer, vertex, here, normal);
     // The occlusion (`w`) is the fragment's, from the interpolated height.
     let terms = hair_terms(tangent, normal, position, 0.0);
-    out.lighting_fade = vec4<f32>(terms.xyz, fade);
+    let groom = vertex_groom(vertex);
+    out.lighting_fade = vec4<f32>(wet_terms(terms, groom.wetness).xyz, fade);
     let offset = f32(hash(edge) & 0xffffu) / 65536.0;
     let along = f32(side) * distance(model_vertex(0u, a), model_vertex(0u, b)) * object.tiles_per_world;
     // The surface uv of this end of the edge, from its corner in the first face.
@@ -266,7 +275,6 @@ fn fin_varyings(index: u32, edge: u32, fade: f32) -> FinVaryings {
         }
     }
     out.uvs = vec4<f32>(offset + along, layer_height(layer), surface_uv);
-    let groom = vertex_groom(vertex);
     out.tint_density = vec4<f32>(groom.tint, groom.density);
     out.clump = groom.clump;
     return out;

@@ -54,6 +54,8 @@ pub(super) struct Model {
     /// The simulation with its posing (the file's clip) and script (`--script`: wind, touch
     /// strokes and motion, played on the simulation clock).
     pub(super) stepper: FurStepper,
+    /// The command line's script, which the panel's rain and water are added to.
+    pub(super) script: Option<Scene>,
     /// Simulation time: advances only while the simulation runs.
     pub(super) sim_clock_secs: f64,
     /// Smoothed cost of one `advance_to`.
@@ -173,7 +175,8 @@ impl Model {
             Some(path) => Some(Scene::load(path)?),
             None => None,
         };
-        stepper.set_scene(scene);
+        stepper.set_wet(&settings.preset.wet)?;
+        stepper.set_scene(scene.clone());
         if let Some(rig) = &rig {
             stepper.set_clip(rig.clone(), settings.animation.clip);
         }
@@ -209,6 +212,7 @@ impl Model {
             clock: Clock { fixed: args.screenshot_after.is_some(), last: Instant::now() },
             frame_time_secs: 0.0,
             stepper,
+            script: scene,
             sim_clock_secs: 0.0,
             sim_time_secs: 0.0,
             shown_times_secs: [0.0; 2],
@@ -398,6 +402,9 @@ impl Model {
         if changes.kernel {
             self.kernel_reason = "panel".to_owned();
         }
+        if rebuilt || changes.wet.any() {
+            self.apply_wet(changes.wet)?;
+        }
         if changes.textures {
             self.textures_stale = true;
         }
@@ -406,6 +413,28 @@ impl Model {
 }
 
 impl Model {
+    /// The panel's wet changes: `[wet]`, the coat set to one wetness, the scene's rain and water.
+    fn apply_wet(&mut self, changes: super::wet::WetChanges) -> anyhow::Result<()> {
+        let wet = &self.settings.preset.wet;
+        self.stepper.set_wet(wet)?;
+        if changes.uniform {
+            self.stepper.wetness_mut().set_uniform(wet.wetness);
+        }
+        let positions = &self.structure.mesh.positions;
+        let heights = positions.iter().fold([f32::MAX, f32::MIN], |[lo, hi], p| [lo.min(p.y), hi.max(p.y)]);
+        let scene = super::wet::scene_with_sources(self.script.as_ref(), &self.settings.wet, heights);
+        self.stepper.set_scene(scene);
+        Ok(())
+    }
+
+    /// The coat's mean and largest wetness, for the panel.
+    pub(super) fn show_wetness(&mut self) {
+        let values = self.stepper.wetness().values();
+        let largest = values.iter().copied().fold(0.0, f32::max);
+        let mean = values.iter().sum::<f32>() / values.len().max(1) as f32;
+        self.settings.wet.shown = [mean, largest];
+    }
+
     /// The kernel the panel's toggle selects.
     pub(super) fn kernel(&self) -> SimKernel {
         if self.settings.gpu_sim { SimKernel::Gpu } else { SimKernel::Cpu }

@@ -3,6 +3,8 @@
 use pelt_core::texture::{ColourMode, Rgb, Style};
 use pelt_core::{Builtin, Preset};
 
+use super::wet::{WetChanges, WetControls, wet_ui};
+
 /// The keyboard shortcuts, shown in the panel (and in the README).
 pub const SHORTCUTS: &[(&str, &str)] = &[
     ("F", "frame the fur"),
@@ -83,6 +85,8 @@ pub struct Settings {
     pub animation: AnimationSettings,
     /// Groom painting.
     pub paint: super::paint::PaintSettings,
+    /// Rain, water, the sponge and the coat's wetness.
+    pub wet: WetControls,
 }
 
 /// The animation controls: which clip, playing or not, speed and the timeline.
@@ -111,6 +115,7 @@ impl Settings {
             preset_path,
             animation: AnimationSettings::default(),
             paint: super::paint::PaintSettings::default(),
+            wet: WetControls::default(),
         }
     }
 }
@@ -130,6 +135,8 @@ pub struct Changes {
     pub kernel: bool,
     /// The groom is the preset's again (a preset was loaded): painting starts over from it.
     pub groom: bool,
+    /// Wetness, rain, water or `[wet]`.
+    pub wet: WetChanges,
 }
 
 impl Changes {
@@ -141,6 +148,7 @@ impl Changes {
         self.simulation |= other.simulation;
         self.kernel |= other.kernel;
         self.groom |= other.groom;
+        self.wet.merge(other.wet);
     }
 }
 
@@ -334,6 +342,7 @@ pub fn show(
             }
             changes.simulation |= *sim != before;
         });
+        section(ui, "Wet", true, |ui| changes.wet.merge(wet_ui(ui, &mut settings.wet, &mut settings.preset.wet)));
         section(ui, "Drawing", true, |ui| {
             let draw = &mut settings.draw;
             ui.horizontal(|ui| {

@@ -21,6 +21,7 @@ impl Model {
         outcome.1.redo |= shortcuts.redo;
         if !self.panel_hidden {
             egui::Panel::right("settings").resizable(true).default_size(320.0).min_size(260.0).show(ui, |ui| {
+                self.show_wetness();
                 let (changes, requests) = panel::show(ui, &mut self.settings, &self.mesh_choices, &self.status);
                 outcome.0.merge(changes);
                 outcome.1.merge(requests);
@@ -132,6 +133,7 @@ impl Model {
             .and_then(|ray| self.stepper.simulation().pick(&self.structure.mesh.triangles, ray.origin, ray.direction));
 
         let paint = self.settings.paint.on;
+        let sponging = !paint && self.settings.wet.sponge && primary && !modifiers.alt && hover_hit.is_some();
         if paint && (self.painting || (response.drag_started_by(egui::PointerButton::Primary) && hover_hit.is_some())) {
             if (primary || response.drag_started_by(egui::PointerButton::Primary))
                 && let Some(ray) = ray
@@ -140,6 +142,9 @@ impl Model {
             } else {
                 self.paint_end();
             }
+        } else if sponging && let Some(hit) = hover_hit {
+            // The sponge wets (Ctrl: dries) under the brush while the button is held.
+            self.stepper.sponge(hit.point, brush_radius, if modifiers.ctrl { 0.0 } else { 1.0 });
         } else if response.drag_started_by(egui::PointerButton::Primary)
             && let Some(hit) = hover_hit
         {
@@ -162,7 +167,7 @@ impl Model {
             }
         } else if response.dragged_by(egui::PointerButton::Middle) || (primary && modifiers.shift) {
             self.camera.pan(drag, size.y);
-        } else if response.dragged_by(egui::PointerButton::Secondary) || primary {
+        } else if response.dragged_by(egui::PointerButton::Secondary) || (primary && !sponging) {
             self.camera.orbit(drag);
         }
         if response.hovered() {

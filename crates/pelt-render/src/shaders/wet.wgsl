@@ -1,0 +1,85 @@
+// Wet fur, appended to `shading.wgsl`: a strand's wetness (0 dry, 1 soaked) darkens its tint,
+// raises its Kajiya-Kay highlight term (sharper and stronger) and adds to its clump amount, all
+// per vertex; the fragments clump through the groom's `clump_uv` and part between clumps
+// (`clump_parting`). Every term here is the dry one at wetness 0, and the callers run it only
+// while `object.wet_any` is set.
+
+// Whether the shells and fins take the groomed path (clumps, tint, density): a groom's terms or
+// a wet coat. Uniform.
+fn clump_shading() -> bool {
+    return object.groom_shading != 0u || object.wet_any != 0u;
+}
+
+// A strand's groom terms with its wetness `w`: the tint darkened, the clump amount raised.
+fn wet_groom(groom: GroomShade, wetness: f32) -> GroomShade {
+    let w = clamp(wetness, 0.0, 1.0);
+    let tint = groom.tint * (1.0 - object.wet_darkening * w);
+    let clump = min(groom.clump + object.wet_clump * w, 1.0);
+    return GroomShade(tint, groom.density, clump, w);
+}
+
+// The Kajiya-Kay terms (`hair_terms`) of a strand of wetness `w`: the highlight term
+// sin^2 raised so that `hair_colour`'s pow(., shininess / 2) gives a lobe 1 + 2 shine w times
+// sharper and 1 + shine w times stronger: pow(x, k) * pow(s, 2 / shininess) to the
+// shininess / 2 is x^(k shininess / 2) * s. The terms themselves at w = 0.
+fn wet_terms(terms: vec4<f32>, wetness: f32) -> vec4<f32> {
+    if object.wet_any == 0u || wetness <= 0.0 {
+        return terms;
+    }
+    let shine = 1.0 + object.wet_shine * clamp(wetness, 0.0, 1.0);
+    let sharper = 2.0 * shine - 1.0;
+    let raised = pow(max(terms.y, 0.0), sharper) * pow(shine, 2.0 / max(object.shininess, 1e-3));
+    return vec4<f32>(terms.x, raised, terms.z, terms.w);
+}
+
+// A wet, ungroomed shell fragment's texel at `uv` (tiles): clumped as a groom's clump map
+// clumps, parted between clumps. Where nothing clumps (a dry strand of a wet coat) it is the
+// dry fragment's very fetch, so dry parts of a wet coat keep their bytes.
+fn wet_shell_texel(uv: vec2<f32>, slice: i32, clump: f32, height: f32) -> vec4<f32> {
+    let cells = clump_cells_per_tile();
+    let amount = groom_clump_amount(clump, height);
+    var texel = sample_shell(select(uv, clump_uv(uv, cells, amount), amount > 0.0), slice);
+    texel.a *= clump_parting(uv, cells, clump, height);
+    return texel;
+}
+
+// How much of a clumped fragment at `uv` (tiles) still shows strands: wet strands gather toward
+// their cell's centre (the nearest jittered centre of `clump_uv`'s cells), so a fragment shows
+// the strand rooted at `centre + (p - centre) / (1 - a)`, and where that root lies in another
+// clump's cell no strand reaches it: the parting, down to the skin. `a` grows with the clump
+// amount and the height (the roots part a little, so the skin shows along the partings); the
+// edge is soft and as wide as the gathering, so coverage returns to 1 as the clump goes to 0.
+fn clump_parting(uv: vec2<f32>, cells_per_tile: f32, clump: f32, height: f32) -> f32 {
+    let a = CLUMP_PARTING * clamp(clump, 0.0, 1.0) * mix(0.35, 1.0, clamp(height, 0.0, 1.0));
+    if a <= 0.0 {
+        return 1.0;
+    }
+    let p = uv * cells_per_tile;
+    let cell = floor(p);
+    var centres: array<vec2<f32>, 9>;
+    var nearest = 0u;
+    var nearest_d2 = 3.4e38;
+    for (var k = 0u; k < 9u; k++) {
+        let c = cell + vec2<f32>(f32(k % 3u) - 1.0, f32(k / 3u) - 1.0);
+        let centre = c + clump_jitter(c);
+        centres[k] = centre;
+        let d2 = dot(p - centre, p - centre);
+        if d2 < nearest_d2 {
+            nearest_d2 = d2;
+            nearest = k;
+        }
+    }
+    let centre = centres[nearest];
+    let source = centre + (p - centre) / (1.0 - a);
+    let own = distance(source, centre);
+    var margin = 3.4e38;
+    for (var k = 0u; k < 9u; k++) {
+        if k != nearest {
+            margin = min(margin, distance(source, centres[k]) - own);
+        }
+    }
+    return clamp(margin / (0.25 * a), 0.0, 1.0);
+}
+
+// The most a soaked strand's clump gathers (in cell units, at the tips).
+const CLUMP_PARTING: f32 = 0.6;
