@@ -9,7 +9,7 @@ use std::path::Path;
 use glam::Vec3;
 use pelt_core::ImportOptions;
 use pelt_core::groom::Groom;
-use pelt_core::mesh::builtin::try_on_scene;
+use pelt_core::{Stage, StageSource};
 
 /// The length factor of the body between the trims.
 const BODY: f32 = 0.25;
@@ -27,7 +27,8 @@ fn trim(t: f32) -> f32 {
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
-    let garment = try_on_scene(&ImportOptions::default())?.garment;
+    // The skirt as `--builtin tryon` stages it (fitted to the body), which the groom must match.
+    let garment = Stage::load(&StageSource::TryOn, &[], &ImportOptions::default())?.fur_mesh;
     let (low, high) = garment.positions.iter().fold((f32::MAX, f32::MIN), |(l, h), p| (l.min(p.y), h.max(p.y)));
     let trims: Vec<f32> = garment.positions.iter().map(|p| trim((p.y - low) / (high - low))).collect();
     let groom = Groom {
