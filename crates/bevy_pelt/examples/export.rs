@@ -62,7 +62,7 @@ fn main() {
 /// written to `assets/EXPORTED`.
 fn export_fox(assets: &Path, preset: &str) -> Result<(), Box<dyn std::error::Error>> {
     let source = assets.join(FOX);
-    let preset = Preset::load(&assets.join(preset))?;
+    let preset = Preset::load(assets.join(preset))?;
     let stage = Stage::load(&StageSource::File(source.clone()), &[], &ImportOptions::default())?;
     let rig = stage.rig.ok_or("the Fox has no rig")?;
     let fur = FurStructure::new(stage.fur_mesh.clone(), &preset.fur_params(&stage.fur_mesh))?;
@@ -130,6 +130,8 @@ fn setup(mut commands: Commands, mut graphs: ResMut<Assets<AnimationGraph>>, ass
 }
 
 /// Once a scene is in, its animation player walks; the left Fox's skinned meshes grow fur.
+// A Bevy system takes each resource and query it touches as an argument.
+#[allow(clippy::too_many_arguments)]
 fn play_walk(
     ready: On<WorldInstanceReady>,
     mut commands: Commands,
