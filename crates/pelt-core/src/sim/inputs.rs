@@ -103,7 +103,7 @@ impl StrandInputs<'_> {
     }
 }
 
-/// Counters of the per-strand inputs' changes, from [`Simulation::input_versions`]
+/// Counters of the per-strand inputs' changes, from [`Simulation::input_versions`](super::Simulation::input_versions)
 /// (super::Simulation::input_versions): a kernel that keeps the inputs resident uploads one only
 /// when its counter moved. Two simulations never share an `id`.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
