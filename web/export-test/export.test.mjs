@@ -68,8 +68,8 @@ const exported = () => fs.readdirSync(output).filter((f) => /\.(glb|gltf)$/.test
 
 test('the glTF Validator finds no error and no warning in any export', async () => {
   const files = exported();
-  for (const name of ['bunny.glb', 'bunny-blend.glb', 'tryon.gltf', 'fox.glb', 'fox-walk.glb', 'ball.glb',
-    'bunny-motion.glb', 'fox-motion.glb']) {
+  for (const name of ['bunny.glb', 'bunny-blend.glb', 'tryon.gltf', 'fox.glb', 'fox-walk.glb', 'fox-groomed.glb',
+    'ball.glb', 'bunny-motion.glb', 'fox-motion.glb']) {
     assert.ok(files.includes(name), `${name} was not exported`);
   }
   for (const file of files) {

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Exports fur with `pelt export` (bunny masked and blended, the try-on garment as .gltf + .bin,
-# the Fox at rest and mid-walk, a morph-target ball, the bunny with --motion), renders the bunny with `pelt render` at the test's camera, and
+# the Fox at rest, mid-walk and groomed, a morph-target ball, the bunny with --motion), renders the bunny with `pelt render` at the test's camera, and
 # checks the files with the Khronos glTF Validator and three.js in headless Chromium
 # (export.test.mjs). Needs chromium, node and npm (web/test/run.sh installs them) and a Vulkan
 # adapter for `pelt render` (lavapipe in CI). Any failure, validator warnings included, fails it.
@@ -20,6 +20,7 @@ mkdir -p "$out"
 # A mesh with morph targets (its fur's roots follow them), and fur swaying in the wind as morph
 # targets.
 "$pelt" export assets/meshes/morph_ball.gltf --layers 8 -o "$out/ball.glb"
+"$pelt" export assets/meshes/Fox.glb --preset assets/presets/fox_groomed.toml --layers 8 -o "$out/fox-groomed.glb"
 "$pelt" export --builtin bunny --layers 8 --motion 1 -o "$out/bunny-motion.glb"
 "$pelt" export assets/meshes/Fox.glb --preset assets/presets/fox.toml --layers 4 --motion 1 -o "$out/fox-motion.glb"
 # The picture three.js must match: no wind (the export settles without), every layer; the camera

@@ -7,6 +7,7 @@ use std::path::{Path, PathBuf};
 
 use glam::Vec3;
 use pelt_core::export::{AlphaMode, Export, ExportInput, FurSkin, exported_layers, source_skin_joints};
+use pelt_core::groom::Groom;
 use pelt_core::reference::TileMapping;
 use pelt_core::{Builtin, FurStructure, FurTextures, ImportOptions, Mesh, Preset, Stage, StageSource};
 
@@ -197,4 +198,43 @@ fn a_failed_write_leaves_no_file() {
 
     let bad = ExportInput { shells: 3, ..input };
     assert!(Export::build(&bad).is_err(), "more shells than layers");
+}
+
+#[test]
+fn a_groomed_export_has_no_fur_on_its_bald_faces() {
+    let (mesh, _) = Builtin::Box.mesh();
+    let preset = small_preset(4);
+    // Bald where the base vertex lies above the cube's middle: the top face and the upper sides.
+    let bald: Vec<bool> = mesh.positions.iter().map(|p| p.y > 0.0).collect();
+    let groom = Groom { length: Some(bald.iter().map(|&b| if b { 0.0 } else { 1.0 }).collect()), ..Groom::default() };
+    let fur = FurStructure::new_groomed(mesh.clone(), &preset.fur_params(&mesh), Some(groom)).expect("fur");
+    // The oracle counts the faces from the mesh and the bald flags alone.
+    let furred_triangles = mesh.triangles.iter().filter(|t| !t.iter().all(|&j| bald[j as usize])).count();
+    let fin_edges = mesh.edges.iter().filter(|e| !e.iter().all(|&j| bald[j as usize])).count();
+    assert!(furred_triangles > 0 && furred_triangles < mesh.triangles.len(), "the groom bares some faces only");
+    let textures = textures(&preset);
+    let input = ExportInput {
+        fur: &fur,
+        positions: &fur.positions,
+        textures: &textures,
+        mapping: MAPPING,
+        root_occlusion: 0.3,
+        shells: 4,
+        alpha: AlphaMode::Mask,
+        skin: None,
+        source: None,
+        plain: &[],
+        extras: serde_json::json!({}),
+        morphs: None,
+    };
+    let glb = Export::build(&input).expect("export").glb();
+    let (_, primitives) = read_fur(&glb);
+    let layers = exported_layers(fur.layers, 4);
+    assert_eq!(primitives[0].1, mesh.triangles.len(), "the skin keeps every triangle");
+    for (_, triangles, name, _) in &primitives[1..=layers.len()] {
+        assert_eq!(*triangles, furred_triangles, "{name}: only the furred triangles");
+    }
+    let (_, fin_triangles, name, _) = &primitives[layers.len() + 1];
+    assert_eq!(name, "pelt fins");
+    assert_eq!(*fin_triangles, 2 * fin_edges * layers.len(), "fins on the furred edges only");
 }

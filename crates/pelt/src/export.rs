@@ -105,8 +105,8 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let source = args.mesh.source(Builtin::Bunny)?;
     let Stage { fur_mesh: mesh, rig, plain, .. } = args.mesh.stage(Builtin::Bunny, &[])?;
     let clip = choose_clip(args, rig.as_ref())?;
-    let params = preset.fur_params(&mesh);
-    let fur = FurStructure::new(mesh, &params)?;
+    // The preset's groom too: lengths, directions, and no fur on its bald faces.
+    let fur = preset.grow(mesh, &source.name())?;
     let shells = match args.screen_size {
         Some(pixels) => shells_at_screen_size(&preset, &fur, pixels),
         None => args.layers.unwrap_or(fur.layers),

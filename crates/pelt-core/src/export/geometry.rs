@@ -24,19 +24,30 @@ pub(super) struct ShellWedges {
 
 /// The renderer's tile coordinates: mesh uvs scaled, or without uvs the axis-aligned projection of
 /// the root that the triangle faces most (the shader picks it per fragment from the interpolated
-/// normal, so away from narrow bands it is the same).
-pub(super) fn shell_wedges(mesh: &Mesh, mapping: TileMapping) -> ShellWedges {
+/// normal, so away from narrow bands it is the same). Only the triangles with fur (a groom's bald
+/// ones have none, as in the renderer).
+pub(super) fn shell_wedges(fur: &FurStructure, mapping: TileMapping) -> ShellWedges {
+    let mesh = &fur.mesh;
     if let Some(wedges) = mesh.wedges() {
         return ShellWedges {
             vertices: wedges.vertices,
             tile_uvs: wedges.uvs.iter().map(|uv| *uv * mapping.tiles_per_uv).collect(),
             mesh_uvs: Some(wedges.uvs),
-            triangles: wedges.corners.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect(),
+            triangles: wedges
+                .corners
+                .chunks_exact(3)
+                .enumerate()
+                .filter(|&(t, _)| fur.triangle_has_fur(t))
+                .map(|(_, c)| [c[0], c[1], c[2]])
+                .collect(),
         };
     }
     let mut numbered = std::collections::HashMap::with_capacity(2 * mesh.vertex_count());
     let mut out = ShellWedges::default();
-    for triangle in &mesh.triangles {
+    for (t, triangle) in mesh.triangles.iter().enumerate() {
+        if !fur.triangle_has_fur(t) {
+            continue;
+        }
         let [a, b, c] = triangle.map(|j| mesh.positions[j as usize]);
         let axis = tile_axis((b - a).cross(c - a));
         out.triangles.push(triangle.map(|vertex| {
@@ -87,12 +98,16 @@ pub(super) struct Fins {
     pub triangles: Vec<[u32; 3]>,
 }
 
-/// Fins on every edge through `nodes` (layer 0, then the exported layers, ascending).
+/// Fins on every edge with fins (a groom's bald edges have none) through `nodes` (layer 0, then
+/// the exported layers, ascending).
 pub(super) fn fins(fur: &FurStructure, nodes: &[u32], mapping: TileMapping) -> Fins {
     let mesh = &fur.mesh;
     let mut out = Fins { mesh_uvs: mesh.corner_uvs.as_ref().map(|_| Vec::new()), ..Fins::default() };
     let top = fur.layers as f32;
     for (edge, &[a, b]) in mesh.edges.iter().enumerate() {
+        if !fur.edge_has_fins(edge) {
+            continue;
+        }
         let (pa, pb) = (mesh.positions[a as usize], mesh.positions[b as usize]);
         let offset = f32::from((hash(edge as u32) & 0xffff) as u16) / 65536.0;
         let along = pa.distance(pb) * mapping.tiles_per_world;

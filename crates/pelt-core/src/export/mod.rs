@@ -235,7 +235,7 @@ impl Export {
             let mesh = document.push("meshes", json!({ "name": format!("plain {k}"), "primitives": [primitive] }));
             document.add_root_node(json!({ "name": format!("plain {k}"), "mesh": mesh }));
         }
-        let wedges = shell_wedges(&fur.mesh, input.mapping);
+        let wedges = shell_wedges(fur, input.mapping);
         let counts = FurCounts {
             shell_layers: exported_layers(fur.layers, input.shells),
             shell_vertices: wedges.vertices.len(),
@@ -354,7 +354,7 @@ impl Builder<'_, '_> {
         let input = self.input;
         let fur = input.fur;
         let v = fur.vertex_count();
-        let wedges = shell_wedges(&fur.mesh, input.mapping);
+        let wedges = shell_wedges(fur, input.mapping);
         let mut shared = json!({});
         shared["TEXCOORD_0"] = json!(self.document.vec2(&wedges.tile_uvs));
         let normals: Vec<Vec3> = wedges.vertices.iter().map(|&j| unit(fur.mesh.normals[j as usize])).collect();
