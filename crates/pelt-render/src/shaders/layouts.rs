@@ -53,8 +53,10 @@ impl Layouts {
                 entry(3, vertex, storage),
                 entry(4, vertex, storage),
                 entry(5, vertex, storage),
-                entry(6, vertex, storage),
-                entry(7, vertex, storage),
+                // A groom's attributes and the wetness: vertex shaders only, so the listing
+                // passes stay within WebGPU's 8 storage buffers per compute stage.
+                entry(6, wgpu::ShaderStages::VERTEX, storage),
+                entry(7, wgpu::ShaderStages::VERTEX, storage),
             ],
         });
         // The separated fins' vertices, read back by each fin vertex to decide for its whole fin.

@@ -434,7 +434,7 @@ fn clump_uv(uv: vec2<f32>, cells_per_tile: f32, amount: f32) -> vec2<f32> {
 // A clump cell's centre within it (0.15..0.85 on each axis), seeded by the cell.
 fn clump_jitter(cell: vec2<f32>) -> vec2<f32> {
     let c = vec2<u32>(bitcast<u32>(i32(cell.x)), bitcast<u32>(i32(cell.y)));
-    let bits = groom_hash(c.x * 0x8da6b343u ^ groom_hash(c.y ^ 0x68e31da4u));
+    let bits = groom_hash((c.x * 0x8da6b343u) ^ groom_hash(c.y ^ 0x68e31da4u));
     let unit = vec2<f32>(f32(bits & 0xffffu), f32(bits >> 16u)) / 65536.0;
     return 0.15 + 0.7 * unit;
 }
