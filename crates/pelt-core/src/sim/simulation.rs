@@ -13,8 +13,8 @@ use glam::{Quat, Vec3, Vec4};
 use rayon::prelude::*;
 
 use super::contact::{
-    Collider, ContactStep, ContactStrands, Grasp, GraspParams, MAX_STEP_COLLIDERS, Resolve, SKIN_PLANES, StepCollider,
-    skin_planes,
+    Collider, ContactStep, ContactStrands, Grasp, GraspParams, MAX_STEP_COLLIDERS, Resolve, SKIN_PLANES, SkinSurface,
+    StepCollider, skin_planes, skin_surface,
 };
 use super::dispatch::{self, CpuKernel};
 use super::field::{ForceField, Touch};
@@ -149,6 +149,8 @@ pub struct Simulation {
     touch_on_step_roots: bool,
     /// Each strand's skin planes (see `contact::skin`).
     skin: Vec<[Vec4; SKIN_PLANES]>,
+    /// The skin triangles where the planes do not suffice (see `contact::surface`).
+    surface: SkinSurface,
     /// Colliders the host or a script placed.
     colliders: Vec<Collider>,
     /// The grasp holding (or springing back), if any.
@@ -184,6 +186,7 @@ impl Simulation {
         debug_assert!(centre.is_finite());
         let nodes = v * (layers + 1);
         let batch_nodes = batches * (layers + 1);
+        let skin = skin_planes(fur);
         let mut simulation = Self {
             params: params.clone(),
             layers: fur.layers,
@@ -220,7 +223,8 @@ impl Simulation {
             },
             roots_moved: false,
             touch_on_step_roots: false,
-            skin: skin_planes(fur),
+            surface: skin_surface(fur, &skin),
+            skin,
             colliders: Vec::new(),
             grasp: None,
         };
@@ -680,7 +684,12 @@ impl Simulation {
     /// The per-strand contact inputs: skin planes and the grasp's weights.
     #[must_use]
     pub fn contact_strands(&self) -> ContactStrands<'_> {
-        ContactStrands { skin: &self.skin, grasp_weights: self.grasp.as_ref().map_or(&[], |g| g.weights()) }
+        ContactStrands {
+            skin: &self.skin,
+            grasp_weights: self.grasp.as_ref().map_or(&[], |g| g.weights()),
+            surface: &self.surface,
+            rest_roots: &self.rest_roots,
+        }
     }
 
     /// The nearest hit of a ray with the base mesh at its current root positions.

@@ -8,7 +8,11 @@
 //   from CONTACT_SKIN: SKIN_PLANES planes per strand (n xyz in the rest frame, h);
 //   then ceil(V / 4) vec4s of grasp weights, 4 strands each;
 //   then per slot CONTACT_COLLIDERS colliders of 5 vec4s: (centre, radius),
-//     (half extents, kind as bits), rotation, (travel, friction), (bound, grasp hand, -, -).
+//     (half extents, kind as bits), rotation, (travel, friction), (bound, grasp hand, -, -);
+//   then the skin's triangles (`contact::surface`), from `surface_first`: per strand (rest root,
+//     first << 6 | count as bits), the lists (each entry its triangle's first vec4 from
+//     `surface_first`), the triangles of 10 vec4s (a, b, c, face normal, edge ab, bc, ca and
+//     corner a, b, c pseudonormals).
 
 @group(0) @binding(5) var<storage, read> contact: array<vec4<f32>>;
 
@@ -113,6 +117,89 @@ fn turn_above(u: vec3<f32>, n: vec3<f32>, floor_in: f32) -> vec3<f32> {
     return normalize(n * floor + side * sqrt(max(1.0 - floor * floor, 0.0)));
 }
 
+fn surface_first(v: u32) -> u32 {
+    return CONTACT_SKIN + SKIN_PLANES * v + (v + 3u) / 4u + CONTACT_SLOTS * CONTACT_COLLIDERS * COLLIDER_WORDS;
+}
+
+// One strand's skin triangles, posed with its root and frame.
+struct Surface {
+    first: u32,
+    count: u32,
+    rest_root: vec3<f32>,
+    root: vec3<f32>,
+    frame: vec4<f32>,
+}
+
+fn list_entry(base: u32, i: u32) -> u32 {
+    return bitcast<u32>(contact[base + i / 4u][i % 4u]);
+}
+
+// `surface::closest_feature`: the closest point of triangle abc to p and its feature's word.
+fn closest_feature(p: vec3<f32>, a: vec3<f32>, b: vec3<f32>, c: vec3<f32>) -> vec4<f32> {
+    let ab = b - a;
+    let ac = c - a;
+    let ap = p - a;
+    let d1 = dot(ab, ap);
+    let d2 = dot(ac, ap);
+    if d1 <= 0.0 && d2 <= 0.0 {
+        return vec4<f32>(a, 7.0);
+    }
+    let bp = p - b;
+    let d3 = dot(ab, bp);
+    let d4 = dot(ac, bp);
+    if d3 >= 0.0 && d4 <= d3 {
+        return vec4<f32>(b, 8.0);
+    }
+    let vc = d1 * d4 - d3 * d2;
+    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
+        return vec4<f32>(a + ab * (d1 / (d1 - d3)), 4.0);
+    }
+    let cp = p - c;
+    let d5 = dot(ab, cp);
+    let d6 = dot(ac, cp);
+    if d6 >= 0.0 && d5 <= d6 {
+        return vec4<f32>(c, 9.0);
+    }
+    let vb = d5 * d2 - d1 * d6;
+    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
+        return vec4<f32>(a + ac * (d2 / (d2 - d6)), 6.0);
+    }
+    let va = d3 * d6 - d5 * d4;
+    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
+        return vec4<f32>(b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6))), 5.0);
+    }
+    let denominator = 1.0 / (va + vb + vc);
+    return vec4<f32>(a + ab * (vb * denominator) + ac * (vc * denominator), 3.0);
+}
+
+// `SkinSurface::closest_posed`: the closest point, pseudonormal and signed distance of the
+// strand's triangles to world point x (distance +inf without triangles).
+fn surface_closest(s: Surface, x: vec3<f32>, v: u32) -> Closest {
+    var best = Closest(x, vec3<f32>(0.0, 1.0, 0.0), 3.4e38);
+    if s.count == 0u {
+        return best;
+    }
+    let origin = surface_first(v);
+    let local = s.rest_root + rotate(conjugate(s.frame), x - s.root);
+    var best_d2 = 3.4e38;
+    var found = false;
+    for (var i = 0u; i < s.count; i++) {
+        let t = origin + list_entry(origin + v + s.first / 4u, s.first % 4u + i);
+        let hit = closest_feature(local, contact[t].xyz, contact[t + 1u].xyz, contact[t + 2u].xyz);
+        let gap = local - hit.xyz;
+        let d2 = dot(gap, gap);
+        if !found || d2 < best_d2 {
+            found = true;
+            best_d2 = d2;
+            best.surface = hit.xyz;
+            best.normal = contact[t + u32(hit.w)].xyz;
+        }
+    }
+    let distance = sqrt(best_d2);
+    let signed = select(distance, -distance, dot(best.normal, local - best.surface) < 0.0);
+    return Closest(s.root + rotate(s.frame, best.surface - s.rest_root), rotate(s.frame, best.normal), signed);
+}
+
 fn strand_grasp_weight(j: u32, v: u32) -> f32 {
     let at = CONTACT_SKIN + SKIN_PLANES * v + j / 4u;
     return contact[at][j % 4u];
@@ -160,6 +247,12 @@ fn contact_strand(j: u32, v: u32, layers: u32, root: vec3<f32>, frame: vec4<f32>
             near_count += 1u;
         }
     }
+    var surface = Surface(0u, 0u, vec3<f32>(0.0), root, frame);
+    if skin {
+        let header = contact[surface_first(v) + j];
+        let packed = bitcast<u32>(header.w);
+        surface = Surface(packed >> 6u, packed & 63u, header.xyz, root, frame);
+    }
     // Whether anything touches the strand; if not, it stays as the bend made it.
     var touches = held != 0.0;
     for (var k = 1u; k <= layers && !touches; k++) {
@@ -173,6 +266,9 @@ fn contact_strand(j: u32, v: u32, layers: u32, root: vec3<f32>, frame: vec4<f32>
             if collider_closest(near[i], x).distance < 0.0 {
                 touches = true;
             }
+        }
+        if surface_closest(surface, x, v).distance < 0.0 {
+            touches = true;
         }
     }
     if !touches {
@@ -230,6 +326,18 @@ fn contact_strand(j: u32, v: u32, layers: u32, root: vec3<f32>, frame: vec4<f32>
                     u = turn_above(u, n, floor + CONTACT_MARGIN);
                     moved = true;
                 }
+            }
+            let below = surface_closest(surface, p + u * segment_length, v);
+            if below.distance < 0.0 {
+                var floor = dot(below.normal, below.surface - p) / segment_length;
+                var normal = below.normal;
+                if floor > 1.0 - CONTACT_MARGIN {
+                    let start = surface_closest(surface, p, v);
+                    floor = dot(start.normal, start.surface - p) / segment_length;
+                    normal = start.normal;
+                }
+                u = turn_above(u, normal, floor + CONTACT_MARGIN);
+                moved = true;
             }
             if !moved {
                 break;

@@ -27,6 +27,7 @@
 mod collider;
 mod grasp;
 pub mod skin;
+pub mod surface;
 
 use glam::{Quat, Vec3, Vec4};
 use rayon::prelude::*;
@@ -34,6 +35,7 @@ use rayon::prelude::*;
 pub use collider::{Collider, ColliderKey, SWEEP_RADII_PER_STEP, Shape, StepCollider};
 pub use grasp::{Grasp, GraspParams};
 pub use skin::{SKIN_PLANES, skin_planes};
+pub use surface::{SURFACE_WORDS, SkinSurface, skin_surface};
 
 use super::kernel::{LANES, RestBatches, VecLanes};
 
@@ -81,6 +83,10 @@ pub struct ContactStrands<'a> {
     pub skin: &'a [[Vec4; SKIN_PLANES]],
     /// How far each strand is held by the grasp (empty without one).
     pub grasp_weights: &'a [f32],
+    /// The skin triangles strands test where their planes do not suffice, in the rest mesh's space.
+    pub surface: &'a SkinSurface,
+    /// Each strand's root in the rest mesh (where its node is taken to test `surface`).
+    pub rest_roots: &'a [Vec3],
 }
 
 /// Everything the CPU pass reads.
@@ -175,10 +181,20 @@ impl Resolve<'_> {
             }
         }
         let planes = &planes[..plane_count];
+        let surface = Surface {
+            j,
+            root,
+            frame,
+            rest_root: self.strands.rest_roots.get(j).copied().unwrap_or(root),
+            on: self.step.skin && !self.strands.surface.strand(j).is_empty(),
+            triangles: self.strands.surface,
+        };
         let colliders = near.iter();
         let touches = held != 0.0
             || nodes[1..].iter().any(|&x| {
-                planes.iter().any(|(n, h)| n.dot(x - root) < -h) || colliders.clone().any(|c| c.closest(x).2 < 0.0)
+                planes.iter().any(|(n, h)| n.dot(x - root) < -h)
+                    || colliders.clone().any(|c| c.closest(x).2 < 0.0)
+                    || surface.closest(x).is_some_and(|(_, _, d)| d < 0.0)
             });
         if !touches {
             return false;
@@ -208,14 +224,15 @@ impl Resolve<'_> {
                 }
             }
             arc += length;
-            let u = self.constrain(p, u, length, root, planes, colliders.clone());
+            let u = self.constrain(p, u, length, root, planes, &surface, colliders.clone());
             nodes[k + 1] = p + u * length;
         }
         true
     }
 
-    /// The direction nearest `u` whose segment from `p` ends outside every collider and above
-    /// every skin plane (skin last).
+    /// The direction nearest `u` whose segment from `p` ends outside every collider, above
+    /// every skin plane and in front of the skin's triangles (skin last).
+    #[allow(clippy::too_many_arguments)]
     fn constrain<'c>(
         &self,
         p: Vec3,
@@ -223,6 +240,7 @@ impl Resolve<'_> {
         length: f32,
         root: Vec3,
         planes: &[(Vec3, f32)],
+        surface: &Surface<'_>,
         colliders: impl Iterator<Item = &'c &'c StepCollider> + Clone,
     ) -> Vec3 {
         for pass in 0..8 {
@@ -256,11 +274,46 @@ impl Resolve<'_> {
                     moved = true;
                 }
             }
+            if let Some((s, n, distance)) = surface.closest(p + u * length)
+                && distance < 0.0
+            {
+                let mut floor = n.dot(s - p) / length;
+                let mut normal = n;
+                if floor > 1.0 - MARGIN
+                    && let Some((s, n, _)) = surface.closest(p)
+                {
+                    floor = n.dot(s - p) / length;
+                    normal = n;
+                }
+                u = turn_above(u, normal, floor + MARGIN);
+                moved = true;
+            }
             if !moved {
                 break;
             }
         }
         u
+    }
+}
+
+/// One strand's skin triangles, posed with its root and frame.
+struct Surface<'a> {
+    j: usize,
+    root: Vec3,
+    frame: Quat,
+    rest_root: Vec3,
+    on: bool,
+    triangles: &'a SkinSurface,
+}
+
+impl Surface<'_> {
+    /// The closest point, pseudonormal and signed distance of the strand's triangles to world
+    /// point `x`; `None` where the strand has none or the skin is off.
+    fn closest(&self, x: Vec3) -> Option<(Vec3, Vec3, f32)> {
+        if !self.on {
+            return None;
+        }
+        self.triangles.closest_posed(self.j, x, self.root, self.frame, self.rest_root)
     }
 }
 

@@ -112,13 +112,13 @@ pub fn skin_planes(fur: &FurStructure) -> Vec<[Vec4; SKIN_PLANES]> {
 }
 
 /// Triangles binned by the cells their boxes cover.
-struct Grid {
+pub(super) struct Grid {
     cell: f32,
     bins: HashMap<[i32; 3], Vec<u32>>,
 }
 
 impl Grid {
-    fn new(points: &[Vec3], triangles: &[[u32; 3]], cell: f32) -> Self {
+    pub(super) fn new(points: &[Vec3], triangles: &[[u32; 3]], cell: f32) -> Self {
         let mut bins: HashMap<[i32; 3], Vec<u32>> = HashMap::new();
         let key = |p: Vec3| (p / cell).floor().as_ivec3().to_array();
         for (t, tri) in triangles.iter().enumerate() {
@@ -135,7 +135,7 @@ impl Grid {
         Self { cell, bins }
     }
 
-    fn near(&self, p: Vec3, r: f32, mut visit: impl FnMut(u32)) {
+    pub(super) fn near(&self, p: Vec3, r: f32, mut visit: impl FnMut(u32)) {
         let key = |p: Vec3| (p / self.cell).floor().as_ivec3().to_array();
         let (lo, hi) = (key(p - Vec3::splat(r)), key(p + Vec3::splat(r)));
         for x in lo[0]..=hi[0] {
@@ -151,7 +151,7 @@ impl Grid {
 }
 
 /// Distance from `p` to the triangle `abc` (Ericson, Real-Time Collision Detection 5.1.5).
-fn distance_to_triangle(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> f32 {
+pub(super) fn distance_to_triangle(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> f32 {
     let (ab, ac, ap) = (b - a, c - a, p - a);
     let (d1, d2) = (ab.dot(ap), ac.dot(ap));
     if d1 <= 0.0 && d2 <= 0.0 {
