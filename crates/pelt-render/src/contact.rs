@@ -84,7 +84,7 @@ impl GpuContact {
             }
             w
         }));
-        words.extend(surface.triangles.iter().flat_map(|t| t.map(glam::Vec4::to_array)));
+        words.extend(surface.triangles.iter().flat_map(|t| t.map(|w| w.to_array())));
         let buffer = wgpu::util::DeviceExt::create_buffer_init(
             device,
             &wgpu::util::BufferInitDescriptor {

@@ -23,6 +23,8 @@ const CONTACT_COLLIDERS: u32 = 128u;
 const COLLIDER_WORDS: u32 = 5u;
 const NEAR_COLLIDERS: u32 = 32u;
 const CONTACT_MARGIN: f32 = 1e-5;
+const CONTACT_SIDE_BIAS: f32 = 0.01;
+const CONTACT_FRICTION_DEPTH: f32 = 0.25;
 
 struct Closest {
     surface: vec3<f32>,
@@ -107,13 +109,14 @@ fn normalize_or(x: vec3<f32>, fallback: vec3<f32>) -> vec3<f32> {
 }
 
 // `contact::turn_above`: the unit direction nearest `u` with `n . result >= floor`.
-fn turn_above(u: vec3<f32>, n: vec3<f32>, floor_in: f32) -> vec3<f32> {
+// A little of `hint` picks the side where `u` points against `n` (`CONTACT_SIDE_BIAS`).
+fn turn_above(u: vec3<f32>, n: vec3<f32>, floor_in: f32, hint: vec3<f32>) -> vec3<f32> {
     let floor = clamp(floor_in, -1.0, 1.0);
     let along = dot(n, u);
     if along >= floor {
         return u;
     }
-    let side = normalize_or(u - n * along, any_orthonormal(n));
+    let side = normalize_or((u - n * along) + (hint - n * dot(n, hint)) * CONTACT_SIDE_BIAS, any_orthonormal(n));
     return normalize(n * floor + side * sqrt(max(1.0 - floor * floor, 0.0)));
 }
 
@@ -281,6 +284,9 @@ fn contact_strand(j: u32, v: u32, layers: u32, root: vec3<f32>, frame: vec4<f32>
     var arc = 0.0;
     var previous_bent = root;
     var p = root;
+    // `Resolve::solve_strand`'s hint: the way the segment before went.
+    let across = rotate(frame, vec3<f32>(1.0, 0.0, 0.0));
+    var hint = across;
     for (var k = 0u; k < layers; k++) {
         let segment_length = rest_segments[k * v + j].w;
         let bent = read_node(j, v, k + 1u);
@@ -291,8 +297,9 @@ fn contact_strand(j: u32, v: u32, layers: u32, root: vec3<f32>, frame: vec4<f32>
         }
         var u = normalize_or(bent - previous_bent, vec3<f32>(0.0, 1.0, 0.0));
         previous_bent = bent;
-        if held != 0.0 && has_grip && arc < grip_distance {
-            u = normalize_or(u + (toward - u) * held, u);
+        let before_grip = clamp((grip_distance - arc) / segment_length, 0.0, 1.0);
+        if held != 0.0 && has_grip && before_grip > 0.0 {
+            u = normalize_or(u + (toward - u) * (held * before_grip), u);
         }
         arc += segment_length;
         for (var round = 0u; round < 8u; round++) {
@@ -307,7 +314,8 @@ fn contact_strand(j: u32, v: u32, layers: u32, root: vec3<f32>, frame: vec4<f32>
                 if round == 0u && friction > 0.0 {
                     let travel = contact[c + 3u].xyz;
                     let slide = travel - hit.normal * dot(hit.normal, travel);
-                    u = normalize_or(u * segment_length + slide * friction, u);
+                    let depth = min(-hit.distance / (CONTACT_FRICTION_DEPTH * segment_length), 1.0);
+                    u = normalize_or(u * segment_length + slide * (friction * depth), u);
                 }
                 var floor = dot(hit.normal, hit.surface - p) / segment_length;
                 var normal = hit.normal;
@@ -316,14 +324,14 @@ fn contact_strand(j: u32, v: u32, layers: u32, root: vec3<f32>, frame: vec4<f32>
                     floor = dot(start.normal, start.surface - p) / segment_length;
                     normal = start.normal;
                 }
-                u = turn_above(u, normal, floor + CONTACT_MARGIN);
+                u = turn_above(u, normal, floor + CONTACT_MARGIN, hint);
                 moved = true;
             }
             for (var q = 0u; q < plane_count; q++) {
                 let n = planes[q].xyz;
                 let floor = (-planes[q].w - dot(n, p - root)) / segment_length;
                 if dot(n, u) < floor {
-                    u = turn_above(u, n, floor + CONTACT_MARGIN);
+                    u = turn_above(u, n, floor + CONTACT_MARGIN, hint);
                     moved = true;
                 }
             }
@@ -336,13 +344,14 @@ fn contact_strand(j: u32, v: u32, layers: u32, root: vec3<f32>, frame: vec4<f32>
                     floor = dot(start.normal, start.surface - p) / segment_length;
                     normal = start.normal;
                 }
-                u = turn_above(u, normal, floor + CONTACT_MARGIN);
+                u = turn_above(u, normal, floor + CONTACT_MARGIN, hint);
                 moved = true;
             }
             if !moved {
                 break;
             }
         }
+        hint = u + across * 0.5;
         p = p + u * segment_length;
         write_node(j, v, k + 1u, p);
     }

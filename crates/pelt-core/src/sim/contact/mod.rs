@@ -10,8 +10,9 @@
 //! force or collider pushes a node below it. A strand that touches nothing is left as the bend
 //! made it, bit for bit.
 //!
-//! - Friction: a node touching a moving collider is first carried `friction` times the
-//!   collider's motion over the step along its surface.
+//! - Friction: a node inside a moving collider is first carried up to `friction` times the
+//!   collider's motion over the step along its surface (all of it from a quarter segment in,
+//!   less nearer the surface, so the response has no jump there).
 //! - At rest: the result is a function of the step's inputs, so still inputs give the same
 //!   nodes every step: no jitter.
 //! - No tunnelling: a collider's path within the step is sampled at most one thickness (a
@@ -102,6 +103,12 @@ pub(crate) struct Resolve<'a> {
 
 /// A little beyond a surface, relative to the segment's length, so rounding leaves nodes outside.
 const MARGIN: f32 = 1e-5;
+
+/// How deep, relative to the segment's length, a node's end takes a collider's full friction.
+const FRICTION_DEPTH: f32 = 0.25;
+
+/// How much a turn's hint weighs against the side `u` already leans to (see `turn_above`).
+const SIDE_BIAS: f32 = 0.01;
 
 impl Resolve<'_> {
     /// Applies contact to every strand of `nodes` (batch-major, `L + 1` nodes per batch).
@@ -204,6 +211,10 @@ impl Resolve<'_> {
         let grip_direction = grip.try_normalize();
         let mut arc = 0.0;
         let mut previous_bent = nodes[0];
+        // Which way a segment turns where every way is as near (see `turn_above`): the way the
+        // segment before went, and the strand's own X axis where that points into the surface.
+        let across = frame * Vec3::X;
+        let mut hint = across;
         for k in 0..self.layers {
             let length = self.rest.length(b, lane, k);
             let bent = nodes[k + 1];
@@ -218,13 +229,16 @@ impl Resolve<'_> {
             if held != 0.0
                 && let Some(toward) = grip_direction
             {
-                // Up to the grip the strand runs to it; the rest sticks out of the hand.
-                if arc < grip_distance {
-                    u = (u + (toward - u) * held).try_normalize().unwrap_or(u);
+                // Up to the grip the strand runs to it; the rest sticks out of the hand. The
+                // segment the grip falls in turns in part, so no rounding of `arc` flips it.
+                let before_grip = ((grip_distance - arc) / length).clamp(0.0, 1.0);
+                if before_grip > 0.0 {
+                    u = (u + (toward - u) * (held * before_grip)).try_normalize().unwrap_or(u);
                 }
             }
             arc += length;
-            let u = self.constrain(p, u, length, root, planes, &surface, colliders.clone());
+            let u = self.constrain(p, u, length, root, planes, &surface, hint, colliders.clone());
+            hint = u + across * 0.5;
             nodes[k + 1] = p + u * length;
         }
         true
@@ -241,6 +255,7 @@ impl Resolve<'_> {
         root: Vec3,
         planes: &[(Vec3, f32)],
         surface: &Surface<'_>,
+        hint: Vec3,
         colliders: impl Iterator<Item = &'c &'c StepCollider> + Clone,
     ) -> Vec3 {
         for pass in 0..8 {
@@ -252,8 +267,11 @@ impl Resolve<'_> {
                     continue;
                 }
                 if pass == 0 && c.friction > 0.0 {
+                    // Full friction from FRICTION_DEPTH in, none at the surface: no jump where
+                    // a node's end crosses it.
                     let slide = c.travel - n * n.dot(c.travel);
-                    u = (u * length + slide * c.friction).try_normalize().unwrap_or(u);
+                    let depth = (-distance / (FRICTION_DEPTH * length)).min(1.0);
+                    u = (u * length + slide * (c.friction * depth)).try_normalize().unwrap_or(u);
                 }
                 let mut floor = n.dot(s - p) / length;
                 let mut normal = n;
@@ -264,13 +282,13 @@ impl Resolve<'_> {
                     floor = n.dot(s - p) / length;
                     normal = n;
                 }
-                u = turn_above(u, normal, floor + MARGIN);
+                u = turn_above(u, normal, floor + MARGIN, hint);
                 moved = true;
             }
             for &(n, h) in planes {
                 let floor = (-h - n.dot(p - root)) / length;
                 if n.dot(u) < floor {
-                    u = turn_above(u, n, floor + MARGIN);
+                    u = turn_above(u, n, floor + MARGIN, hint);
                     moved = true;
                 }
             }
@@ -285,7 +303,7 @@ impl Resolve<'_> {
                     floor = n.dot(s - p) / length;
                     normal = n;
                 }
-                u = turn_above(u, normal, floor + MARGIN);
+                u = turn_above(u, normal, floor + MARGIN, hint);
                 moved = true;
             }
             if !moved {
@@ -319,12 +337,18 @@ impl Surface<'_> {
 
 /// The unit direction nearest unit `u` with `n . result >= floor` (`n` unit): `u` itself when it
 /// already is, else on the cone `n . result = floor` in the plane of `u` and `n`.
-fn turn_above(u: Vec3, n: Vec3, floor: f32) -> Vec3 {
+///
+/// Where `u` points (nearly) against `n`, every side is (nearly) as near and the least turn's
+/// side would follow `u`'s last bits; a little of `hint` decides it there, so kernels that
+/// round differently turn the same way.
+fn turn_above(u: Vec3, n: Vec3, floor: f32, hint: Vec3) -> Vec3 {
     let floor = floor.clamp(-1.0, 1.0);
     let along = n.dot(u);
     if along >= floor {
         return u;
     }
-    let side = (u - n * along).try_normalize().unwrap_or_else(|| n.any_orthonormal_vector());
+    let side = ((u - n * along) + (hint - n * n.dot(hint)) * SIDE_BIAS)
+        .try_normalize()
+        .unwrap_or_else(|| n.any_orthonormal_vector());
     (n * floor + side * (1.0 - floor * floor).max(0.0).sqrt()).normalize()
 }
