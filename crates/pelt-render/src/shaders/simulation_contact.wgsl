@@ -12,7 +12,8 @@
 //   then the skin's triangles (`contact::surface`), from `surface_first`: per strand (rest root,
 //     first << 6 | count as bits), the lists (each entry its triangle's first vec4 from
 //     `surface_first`), the triangles of 10 vec4s (a, b, c, face normal, edge ab, bc, ca and
-//     corner a, b, c pseudonormals).
+//     corner a, b, c pseudonormals; a bounding ball's centre in a, b, c's w, its radius in the
+//     face normal's).
 
 @group(0) @binding(5) var<storage, read> contact: array<vec4<f32>>;
 
@@ -25,6 +26,7 @@ const NEAR_COLLIDERS: u32 = 32u;
 const CONTACT_MARGIN: f32 = 1e-5;
 const CONTACT_SIDE_BIAS: f32 = 0.01;
 const CONTACT_FRICTION_DEPTH: f32 = 0.25;
+const CONTACT_SKIP_SLACK: f32 = 1.001;
 
 struct Closest {
     surface: vec3<f32>,
@@ -188,6 +190,10 @@ fn surface_closest(s: Surface, x: vec3<f32>, v: u32) -> Closest {
     var found = false;
     for (var i = 0u; i < s.count; i++) {
         let t = origin + list_entry(origin + v + s.first / 4u, s.first % 4u + i);
+        let ball = length(local - vec3<f32>(contact[t].w, contact[t + 1u].w, contact[t + 2u].w)) - contact[t + 3u].w;
+        if found && ball > 0.0 && ball * ball >= best_d2 {
+            continue;
+        }
         let hit = closest_feature(local, contact[t].xyz, contact[t + 1u].xyz, contact[t + 2u].xyz);
         let gap = local - hit.xyz;
         let d2 = dot(gap, gap);
@@ -201,6 +207,28 @@ fn surface_closest(s: Surface, x: vec3<f32>, v: u32) -> Closest {
     let distance = sqrt(best_d2);
     let signed = select(distance, -distance, dot(best.normal, local - best.surface) < 0.0);
     return Closest(s.root + rotate(s.frame, best.surface - s.rest_root), rotate(s.frame, best.normal), signed);
+}
+
+// `contact::clearance`: how far x is from touching a skin plane, a collider or the skin's
+// triangles (negative: touching).
+fn clearance(
+    x: vec3<f32>,
+    root: vec3<f32>,
+    planes: ptr<function, array<vec4<f32>, 8>>,
+    plane_count: u32,
+    near: ptr<function, array<u32, 32>>,
+    near_count: u32,
+    surface: Surface,
+    v: u32,
+) -> f32 {
+    var least = 3.4e38;
+    for (var p = 0u; p < plane_count; p++) {
+        least = min(least, dot((*planes)[p].xyz, x - root) + (*planes)[p].w);
+    }
+    for (var i = 0u; i < near_count; i++) {
+        least = min(least, collider_closest((*near)[i], x).distance);
+    }
+    return min(least, surface_closest(surface, x, v).distance);
 }
 
 fn strand_grasp_weight(j: u32, v: u32) -> f32 {
@@ -257,22 +285,16 @@ fn contact_strand(j: u32, v: u32, layers: u32, root: vec3<f32>, frame: vec4<f32>
         surface = Surface(packed >> 6u, packed & 63u, header.xyz, root, frame);
     }
     // Whether anything touches the strand; if not, it stays as the bend made it.
+    // `Resolve::solve_strand`: after one `clearance` away the nodes within it need no test.
     var touches = held != 0.0;
-    for (var k = 1u; k <= layers && !touches; k++) {
-        let x = read_node(j, v, k);
-        for (var p = 0u; p < plane_count; p++) {
-            if dot(planes[p].xyz, x - root) < -planes[p].w {
-                touches = true;
-            }
+    var budget = 0.0;
+    for (var k = 0u; k < layers && !touches; k++) {
+        budget -= rest_segments[k * v + j].w * CONTACT_SKIP_SLACK;
+        if budget > 0.0 {
+            continue;
         }
-        for (var i = 0u; i < near_count; i++) {
-            if collider_closest(near[i], x).distance < 0.0 {
-                touches = true;
-            }
-        }
-        if surface_closest(surface, x, v).distance < 0.0 {
-            touches = true;
-        }
+        budget = clearance(read_node(j, v, k + 1u), root, &planes, plane_count, &near, near_count, surface, v);
+        touches = budget < 0.0;
     }
     if !touches {
         return;
@@ -287,6 +309,7 @@ fn contact_strand(j: u32, v: u32, layers: u32, root: vec3<f32>, frame: vec4<f32>
     // `Resolve::solve_strand`'s hint: the way the segment before went.
     let across = rotate(frame, vec3<f32>(1.0, 0.0, 0.0));
     var hint = across;
+    var walk_budget = 0.0;
     for (var k = 0u; k < layers; k++) {
         let segment_length = rest_segments[k * v + j].w;
         let bent = read_node(j, v, k + 1u);
@@ -302,7 +325,13 @@ fn contact_strand(j: u32, v: u32, layers: u32, root: vec3<f32>, frame: vec4<f32>
             u = normalize_or(u + (toward - u) * (held * before_grip), u);
         }
         arc += segment_length;
-        for (var round = 0u; round < 8u; round++) {
+        // Where the start is clear by more than the segment, no end can touch anything.
+        let step = segment_length * CONTACT_SKIP_SLACK;
+        if walk_budget <= step {
+            walk_budget = clearance(p, root, &planes, plane_count, &near, near_count, surface, v);
+        }
+        walk_budget -= step;
+        for (var round = 0u; round < 8u && walk_budget <= 0.0; round++) {
             var moved = false;
             for (var i = 0u; i < near_count; i++) {
                 let c = near[i];

@@ -104,6 +104,9 @@ pub(crate) struct Resolve<'a> {
 /// A little beyond a surface, relative to the segment's length, so rounding leaves nodes outside.
 const MARGIN: f32 = 1e-5;
 
+/// A little more than a segment's length is taken off a clearance per segment, for rounding.
+const SKIP_SLACK: f32 = 1.001;
+
 /// How deep, relative to the segment's length, a node's end takes a collider's full friction.
 const FRICTION_DEPTH: f32 = 0.25;
 
@@ -197,15 +200,26 @@ impl Resolve<'_> {
             triangles: self.strands.surface,
         };
         let colliders = near.iter();
-        let touches = held != 0.0
-            || nodes[1..].iter().any(|&x| {
-                planes.iter().any(|(n, h)| n.dot(x - root) < -h)
-                    || colliders.clone().any(|c| c.closest(x).2 < 0.0)
-                    || surface.closest(x).is_some_and(|(_, _, d)| d < 0.0)
-            });
+        let clearance = |x: Vec3| clearance(x, root, planes, &surface, colliders.clone());
+        // A node is at most a segment's length nearer anything than the node before, so after
+        // one `clearance` away the nodes within it need no test.
+        let mut touches = held != 0.0;
+        let mut budget = 0.0_f32;
+        for k in 0..self.layers {
+            if touches {
+                break;
+            }
+            budget -= self.rest.length(b, lane, k) * SKIP_SLACK;
+            if budget > 0.0 {
+                continue;
+            }
+            budget = clearance(nodes[k + 1]);
+            touches = budget < 0.0;
+        }
         if !touches {
             return false;
         }
+        let mut budget = 0.0_f32;
         let grip = self.step.grip - root;
         let grip_distance = grip.length();
         let grip_direction = grip.try_normalize();
@@ -237,7 +251,17 @@ impl Resolve<'_> {
                 }
             }
             arc += length;
-            let u = self.constrain(p, u, length, root, planes, &surface, hint, colliders.clone());
+            // Where the start is clear by more than the segment, no end can touch anything.
+            let step = length * SKIP_SLACK;
+            if budget <= step {
+                budget = clearance(p);
+            }
+            budget -= step;
+            let u = if budget > 0.0 {
+                u
+            } else {
+                self.constrain(p, u, length, root, planes, &surface, hint, colliders.clone())
+            };
             hint = u + across * 0.5;
             nodes[k + 1] = p + u * length;
         }
@@ -312,6 +336,29 @@ impl Resolve<'_> {
         }
         u
     }
+}
+
+/// How far `x` is from touching anything: the least of its heights above the skin planes, its
+/// distances outside the colliders and in front of the skin's triangles (negative: touching).
+/// Each moves by at most as much as `x` does.
+fn clearance<'c>(
+    x: Vec3,
+    root: Vec3,
+    planes: &[(Vec3, f32)],
+    surface: &Surface<'_>,
+    colliders: impl Iterator<Item = &'c &'c StepCollider>,
+) -> f32 {
+    let mut least = f32::MAX;
+    for &(n, h) in planes {
+        least = least.min(n.dot(x - root) + h);
+    }
+    for c in colliders {
+        least = least.min(c.closest(x).2);
+    }
+    if let Some((_, _, d)) = surface.closest(x) {
+        least = least.min(d);
+    }
+    least
 }
 
 /// One strand's skin triangles, posed with its root and frame.
