@@ -28,6 +28,16 @@ const NO_PLANE: Vec4 = Vec4::new(0.0, 0.0, 0.0, 1.0);
 /// must satisfy `n . (x - root) >= -h`.
 #[must_use]
 pub fn skin_planes(fur: &FurStructure) -> Vec<[Vec4; SKIN_PLANES]> {
+    skin_planes_of(fur, 0..fur.vertex_count()).1
+}
+
+/// The skin planes of `strands` alone (those a groom dab reshaped), with the size of the grid
+/// cell they were found in: the longest strand's reach. Equal to [`skin_planes`]'s for the same
+/// cell (the cell orders the faces a tie between planes is decided by).
+pub(crate) fn skin_planes_of(
+    fur: &FurStructure,
+    strands: impl Iterator<Item = usize>,
+) -> (f32, Vec<[Vec4; SKIN_PLANES]>) {
     let v = fur.vertex_count();
     let layers = fur.layers as usize;
     let positions = &fur.positions;
@@ -40,7 +50,7 @@ pub fn skin_planes(fur: &FurStructure) -> Vec<[Vec4; SKIN_PLANES]> {
     let mut stamp = vec![u32::MAX; mesh.triangles.len()];
     let mut candidates: Vec<Vec4> = Vec::new();
     let mut rising: Vec<[Vec3; 3]> = Vec::new();
-    (0..v)
+    let planes = strands
         .map(|j| {
             let root = positions[j];
             let nodes: Vec<Vec3> = (1..=layers).map(|k| positions[k * v + j] - root).collect();
@@ -108,7 +118,8 @@ pub fn skin_planes(fur: &FurStructure) -> Vec<[Vec4; SKIN_PLANES]> {
             }
             planes
         })
-        .collect()
+        .collect();
+    (cell, planes)
 }
 
 /// Triangles binned by the cells their boxes cover.
