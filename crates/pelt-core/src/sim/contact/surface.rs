@@ -14,7 +14,7 @@ use std::collections::HashMap;
 
 use glam::{Quat, Vec3, Vec4};
 
-use super::skin::{Grid, SKIN_PLANES, distance_to_triangle};
+use super::skin::{Grid, SKIN_PLANES, distance_to_triangle, grid_cell};
 use crate::fur::FurStructure;
 
 /// Words per stored triangle: its corners `a`, `b`, `c`, its face normal, the pseudonormals of
@@ -124,8 +124,7 @@ pub fn skin_surface(fur: &FurStructure, planes: &[[Vec4; SKIN_PLANES]]) -> SkinS
     let reach: Vec<f32> = (0..v)
         .map(|j| (0..layers).map(|k| positions[(k + 1) * v + j].distance(positions[k * v + j])).sum::<f32>())
         .collect();
-    let cell = reach.iter().copied().fold(0.0_f32, f32::max).max(1e-6);
-    let grid = Grid::new(points, &mesh.triangles, cell);
+    let grid = Grid::new(points, &mesh.triangles, grid_cell(points, &reach));
     let words = triangle_words(points, &mesh.triangles);
     let mut corner_triangles: Vec<Vec<u32>> = vec![Vec::new(); points.len()];
     for (t, tri) in mesh.triangles.iter().enumerate() {
