@@ -10,7 +10,7 @@ use pelt_core::wet::{WetSources, WetSurface};
 use crate::model::ModelError;
 
 /// The finger's radius, as a fraction of the furred mesh's bounding radius.
-const FINGER_PER_RADIUS: f32 = 0.06;
+const FINGER_PER_RADIUS: f32 = 0.1;
 /// Half the finger's straight part (its tip at the skin, the rest toward the eye), same unit.
 const FINGER_HALF_LENGTH_PER_RADIUS: f32 = 0.3;
 /// Strands rooted within this of the grip are grasped, same unit.
