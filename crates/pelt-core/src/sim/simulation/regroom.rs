@@ -4,6 +4,7 @@
 
 use super::{SimError, Simulation, skin_planes_of, skin_surface};
 use crate::fur::FurStructure;
+use crate::sim::contact::surface::skin_surface_of;
 
 impl Simulation {
     /// Takes `fur`'s rest shape for `strands` (the base vertices whose length or direction a
@@ -37,12 +38,12 @@ impl Simulation {
             for (&j, planes) in strands.iter().zip(planes) {
                 self.skin[j as usize] = planes;
             }
+            self.surface = skin_surface_of(&self.surface, fur, &self.skin, strands);
         } else {
             // The longest strand changed: the grid, and so every strand's tie order, with it.
             (self.skin_cell, self.skin) = skin_planes_of(fur, 0..v);
+            self.surface = skin_surface(fur, &self.skin);
         }
-        // Which strands need triangles depends on their planes and reach; rebuilt whole, as new.
-        self.surface = skin_surface(fur, &self.skin);
         self.restart();
         Ok(())
     }
