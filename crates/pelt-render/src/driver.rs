@@ -298,10 +298,25 @@ impl FurDriver {
     /// values uploaded while any vertex is wet, the shaders' wet paths off when none is.
     fn show_wetness(&mut self, queue: &wgpu::Queue, stepper: &FurStepper) -> Result<(), RenderError> {
         let wetness = stepper.wetness();
-        self.frame.wet = !wetness.is_dry();
-        self.frame.look = self.frame.look.with_wet(stepper.wet());
-        if self.frame.wet {
-            self.fur.set_wetness(queue, wetness.values())?;
+        self.show_wet(queue, (!wetness.is_dry()).then(|| wetness.values()), stepper.wet())
+    }
+
+    /// Shows a wetness simulated elsewhere (a host whose [`FurStepper`] lives apart, as for
+    /// [`FurDriver::show_state`]): `wetness` per base vertex in `0..=1` (`None` when dry, which
+    /// draws the dry bytes) and what it does to the look (`wet`, the preset's `[wet]`).
+    ///
+    /// # Errors
+    /// [`RenderError::Count`] unless there are `V` values.
+    pub fn show_wet(
+        &mut self,
+        queue: &wgpu::Queue,
+        wetness: Option<&[f32]>,
+        wet: &pelt_core::wet::WetParams,
+    ) -> Result<(), RenderError> {
+        self.frame.wet = wetness.is_some();
+        self.frame.look = self.frame.look.with_wet(wet);
+        if let Some(values) = wetness {
+            self.fur.set_wetness(queue, values)?;
         }
         Ok(())
     }

@@ -29,6 +29,16 @@ const NO_PLANE: Vec4 = Vec4::new(0.0, 0.0, 0.0, 1.0);
 /// must satisfy `n . (x - root) >= -h`.
 #[must_use]
 pub fn skin_planes(fur: &FurStructure) -> Vec<[Vec4; SKIN_PLANES]> {
+    skin_planes_of(fur, 0..fur.vertex_count()).1
+}
+
+/// The skin planes of `strands` alone (those a groom dab reshaped), with the size of the grid
+/// cell they were found in: the longest strand's reach. Equal to [`skin_planes`]'s for the same
+/// cell (the cell orders the faces a tie between planes is decided by).
+pub(crate) fn skin_planes_of(
+    fur: &FurStructure,
+    strands: impl Iterator<Item = usize>,
+) -> (f32, Vec<[Vec4; SKIN_PLANES]>) {
     let v = fur.vertex_count();
     let layers = fur.layers as usize;
     let positions = &fur.positions;
@@ -36,12 +46,17 @@ pub fn skin_planes(fur: &FurStructure) -> Vec<[Vec4; SKIN_PLANES]> {
     let reach: Vec<f32> = (0..v)
         .map(|j| (0..layers).map(|k| positions[(k + 1) * v + j].distance(positions[k * v + j])).sum::<f32>())
         .collect();
-    let cell = reach.iter().copied().fold(0.0_f32, f32::max).max(1e-6);
+    // Cells no smaller than a 32nd of the mesh: short or bald fur must not bin each triangle
+    // into millions of cells.
+    let (lo, hi) = mesh.positions.iter().fold((Vec3::MAX, Vec3::MIN), |(l, h), p| (l.min(*p), h.max(*p)));
+    let extent = (hi - lo).max_element();
+    let floor = if extent.is_finite() && extent > 0.0 { extent / 32.0 } else { 1.0 };
+    let cell = reach.iter().copied().fold(0.0_f32, f32::max).max(floor);
     let grid = Grid::new(&mesh.positions, &mesh.triangles, cell);
     let mut stamp = vec![u32::MAX; mesh.triangles.len()];
     let mut candidates: Vec<Vec4> = Vec::new();
     let mut rising: Vec<[Vec3; 3]> = Vec::new();
-    (0..v)
+    let planes = strands
         .map(|j| {
             let root = positions[j];
             let nodes: Vec<Vec3> = (1..=layers).map(|k| positions[k * v + j] - root).collect();
@@ -109,7 +124,8 @@ pub fn skin_planes(fur: &FurStructure) -> Vec<[Vec4; SKIN_PLANES]> {
             }
             planes
         })
-        .collect()
+        .collect();
+    (cell, planes)
 }
 
 /// Triangles binned by the cells their boxes cover.
@@ -182,4 +198,22 @@ pub(super) fn distance_to_triangle(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> f32 {
     }
     let denominator = 1.0 / (va + vb + vc);
     p.distance(a + ab * (vb * denominator) + ac * (vc * denominator))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fur::{FurLength, FurParams, GrowthDirection};
+    use crate::mesh::builtin::Builtin;
+
+    /// A bald coat (every strand of length 0) gets its planes at once: the triangle grid's cells
+    /// do not shrink with the fur.
+    #[test]
+    fn a_bald_coat_has_planes_without_a_huge_grid() {
+        let (mesh, _) = Builtin::Sphere.mesh();
+        let params = FurParams { layers: 8, length: FurLength::Constant(0.0), direction: GrowthDirection::default() };
+        let fur = FurStructure::new(mesh, &params).unwrap();
+        let planes = skin_planes(&fur);
+        assert_eq!(planes.len(), fur.vertex_count());
+    }
 }
