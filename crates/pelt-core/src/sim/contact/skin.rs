@@ -10,7 +10,8 @@
 //! the strand's posed frame and root, so they follow skinning and rigid motion with no per-step
 //! mesh query, and a node is tested with a dot product per plane: the same small per-strand
 //! input for the CPU and the GPU kernel. Planes are relaxed where the rest strand itself would
-//! cross them, so the rest pose is never moved.
+//! cross them, so the rest pose is never moved. Where the intersection of the planes still
+//! reaches below the surface (saddles, creases), [`surface`](super::surface) keeps triangles.
 
 use std::collections::HashMap;
 
