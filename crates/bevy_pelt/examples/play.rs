@@ -1,6 +1,6 @@
 //! The bunny's fur with things that touch it, in Bevy: a ball (`FurCollider`) rolls back and
-//! forth through the fur on its flank, a sponge (`FurSponge`) presses on its back, and a hand
-//! (`FurGrasp`) grabs a tuft on its rump, pulls it up and sways it, then lets go, on a loop.
+//! forth through the fur on its flank, a sponge (`FurSponge`) presses on its rump, and a hand
+//! (`FurGrasp`) grabs a tuft on its flank, pulls it up and sways it, then lets go, on a loop.
 //!
 //! `cargo run --release -p bevy_pelt --example play [--ignore-rust-version] -- [PRESET] [--screenshot PNG]`
 //! (PRESET is relative to the repository's `assets/`, default `presets/wet.toml`, which dries in
@@ -42,13 +42,13 @@ fn main() {
 #[derive(Component)]
 struct Ball;
 
-/// The hand, closing over the rump at `surface`.
+/// The hand, closing over the flank at `surface`.
 #[derive(Component)]
 struct Hand {
     surface: Vec3,
 }
 
-/// The sponge, pressing on the back at `surface`.
+/// The sponge, pressing on the rump at `surface`.
 #[derive(Component)]
 struct Sponge {
     surface: Vec3,
@@ -102,22 +102,22 @@ fn setup(
         FurCollider::sphere(BALL_RADIUS),
         Transform::default(),
     ));
-    // The sponge on the bunny's back, a flat yellow block where it presses.
-    let back = top_near(0.1, 0.0);
+    // The sponge on the bunny's rump, a flat yellow block where it presses.
+    let rump_top = top_near(0.45, 0.0);
     commands.spawn((
-        Sponge { surface: back },
+        Sponge { surface: rump_top },
         Mesh3d(meshes.add(Cuboid::new(0.3, 0.06, 0.3))),
         MeshMaterial3d(materials.add(Color::srgb(0.95, 0.85, 0.2))),
         FurSponge::new(0.4),
-        Transform::from_translation(back + Vec3::Y * 0.03),
+        Transform::from_translation(rump_top + Vec3::Y * 0.03),
     ));
-    let rump = top_near(0.5, 0.2);
+    let flank = top_near(0.3, 0.3);
     commands.spawn((
-        Hand { surface: rump },
+        Hand { surface: flank },
         Mesh3d(meshes.add(Sphere::new(0.04))),
         MeshMaterial3d(materials.add(Color::srgb(0.2, 0.4, 0.9))),
         FurGrasp { hand_radius: 0.04, ..FurGrasp::new(0.2) },
-        Transform::from_translation(rump + Vec3::Y * 0.05),
+        Transform::from_translation(flank + Vec3::Y * 0.05),
     ));
     info!("right-drag orbits, wheel zooms; S presses or lifts the sponge");
 }
@@ -141,7 +141,7 @@ fn sponge_key(keys: Res<ButtonInput<KeyCode>>, mut sponges: Query<(&Sponge, &mut
     }
 }
 
-/// Every six seconds the hand closes in the fur on the rump, pulls the tuft up and sways it for
+/// Every six seconds the hand closes in the fur on the flank, pulls the tuft up and sways it for
 /// four seconds, then opens and lets it spring back.
 fn move_hand(time: Res<Time>, mut hands: Query<(&Hand, &mut FurGrasp, &mut Transform)>) {
     let t = time.elapsed_secs() % 6.0;
@@ -149,6 +149,6 @@ fn move_hand(time: Res<Time>, mut hands: Query<(&Hand, &mut FurGrasp, &mut Trans
         grasp.closed = (0.5..4.5).contains(&t);
         let pull = if grasp.closed { (t - 0.5).min(1.0) } else { 0.0 };
         let sway = Vec3::new(0.12 * (t * 2.0).sin(), 0.0, 0.0) * pull;
-        transform.translation = hand.surface + Vec3::Y * (0.05 + 0.2 * pull) + sway;
+        transform.translation = hand.surface + Vec3::Y * (0.05 + 0.1 * pull) + sway;
     }
 }
