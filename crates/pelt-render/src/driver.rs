@@ -508,9 +508,27 @@ pub fn gpu_secs_per_step(
     steps: u32,
     runs: usize,
 ) -> Result<f64, RenderError> {
+    let mut stepper = FurStepper::new(structure, params)?;
+    gpu_secs_per_step_of(device, queue, renderer, structure, params, &mut stepper, steps, runs)
+}
+
+/// [`gpu_secs_per_step`] with the host's own `stepper` (colliders placed, a body set, a script).
+///
+/// # Errors
+/// As [`gpu_secs_per_step`].
+#[allow(clippy::too_many_arguments)]
+pub fn gpu_secs_per_step_of(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    renderer: &FurRenderer,
+    structure: &FurStructure,
+    params: &SimParams,
+    stepper: &mut FurStepper,
+    steps: u32,
+    runs: usize,
+) -> Result<f64, RenderError> {
     let mut driver =
         FurDriver::new(device, queue, renderer, structure, &FurTextures::blank(), params, KernelChoice::Gpu)?;
-    let mut stepper = FurStepper::new(structure, params)?;
     let rate = f64::from(params.rate_hz);
     let mut step = 1_u32;
     let mut run = |driver: &mut FurDriver| -> Result<f64, RenderError> {
@@ -519,7 +537,7 @@ pub fn gpu_secs_per_step(
         // Each step takes its own uniform slot of the GPU simulation's ring (up to 64 a
         // submission), so every dispatch bends with its own step's inputs.
         for _ in 0..steps {
-            driver.advance_to(device, queue, &mut stepper, f64::from(step) / rate)?;
+            driver.advance_to(device, queue, stepper, f64::from(step) / rate)?;
             step += 1;
             driver.record(&mut encoder)?;
         }
