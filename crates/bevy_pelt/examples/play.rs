@@ -1,14 +1,13 @@
 //! The bunny's fur with things that touch it, in Bevy: a ball (`FurCollider`) rolls back and
-//! forth through the fur, a sponge (`FurSponge`) presses on its back, and a hand (`FurGrasp`)
-//! grabs a tuft when you hold G and pulls it along with the cursor... or, without a person, on a
-//! loop.
+//! forth through the fur on its flank, a sponge (`FurSponge`) presses on its rump, and a hand
+//! (`FurGrasp`) grabs a tuft on its flank, pulls it up and sways it, then lets go, on a loop.
 //!
 //! `cargo run --release -p bevy_pelt --example play [--ignore-rust-version] -- [PRESET] [--screenshot PNG]`
 //! (PRESET is relative to the repository's `assets/`, default `presets/wet.toml`, which dries in
 //! a few seconds).
 //!
-//! Right-drag orbits, the wheel zooms. S presses the sponge or lifts it, G closes the hand while
-//! held. `--screenshot PNG` saves a frame and exits.
+//! Right-drag orbits, the wheel zooms. S presses the sponge or lifts it. `--screenshot PNG` saves
+//! a frame and exits.
 
 mod common;
 
@@ -31,7 +30,7 @@ fn main() {
                     focus: Vec3::new(0.0, 0.7, 0.0),
                 },
                 sun_lux: 8000.0,
-                screenshot_frame: 100,
+                screenshot_frame: 40,
             },
         ))
         .insert_resource(Args::from_env("presets/wet.toml"))
@@ -43,8 +42,17 @@ fn main() {
 #[derive(Component)]
 struct Ball;
 
+/// The hand, closing over the flank at `surface`.
 #[derive(Component)]
-struct Hand;
+struct Hand {
+    surface: Vec3,
+}
+
+/// The sponge, pressing on the rump at `surface`.
+#[derive(Component)]
+struct Sponge {
+    surface: Vec3,
+}
 
 /// The ball's radius.
 const BALL_RADIUS: f32 = 0.22;
@@ -65,6 +73,17 @@ fn setup(
     mesh.insert_attribute(Mesh::ATTRIBUTE_NORMAL, bunny.normals.iter().map(|n| n.to_array()).collect::<Vec<_>>());
     mesh.insert_indices(bevy::mesh::Indices::U32(bunny.triangles.iter().flatten().copied().collect()));
     let scale = 1.0 / radius;
+    let world = |p: Vec3| (p - Vec3::new(centre.x, lowest, centre.z)) * scale;
+    // The highest point of the bunny within 0.15 of (x, z): where the sponge and hand go.
+    let top_near = |x: f32, z: f32| {
+        bunny
+            .positions
+            .iter()
+            .map(|p| world(Vec3::from_array(p.to_array())))
+            .filter(|p| (p.x - x).abs() < 0.15 && (p.z - z).abs() < 0.15)
+            .max_by(|a, b| a.y.total_cmp(&b.y))
+            .unwrap_or(Vec3::new(x, 1.0, z))
+    };
     commands.spawn((
         Name::new("bunny"),
         Mesh3d(meshes.add(mesh)),
@@ -83,21 +102,24 @@ fn setup(
         FurCollider::sphere(BALL_RADIUS),
         Transform::default(),
     ));
-    // The sponge on the bunny's back, a flat yellow block where it presses.
+    // The sponge on the bunny's rump, a flat yellow block where it presses.
+    let rump_top = top_near(0.45, 0.0);
     commands.spawn((
-        Mesh3d(meshes.add(Cuboid::new(0.3, 0.08, 0.3))),
+        Sponge { surface: rump_top },
+        Mesh3d(meshes.add(Cuboid::new(0.3, 0.06, 0.3))),
         MeshMaterial3d(materials.add(Color::srgb(0.95, 0.85, 0.2))),
-        FurSponge::new(0.35),
-        Transform::from_xyz(-0.25, 1.05, 0.0),
+        FurSponge::new(0.4),
+        Transform::from_translation(rump_top + Vec3::Y * 0.03),
     ));
+    let flank = top_near(0.3, 0.3);
     commands.spawn((
-        Hand,
-        Mesh3d(meshes.add(Sphere::new(0.05))),
+        Hand { surface: flank },
+        Mesh3d(meshes.add(Sphere::new(0.04))),
         MeshMaterial3d(materials.add(Color::srgb(0.2, 0.4, 0.9))),
-        FurGrasp { hand_radius: 0.05, ..FurGrasp::new(0.25) },
-        Transform::from_xyz(0.0, 1.2, 0.3),
+        FurGrasp { hand_radius: 0.04, ..FurGrasp::new(0.2) },
+        Transform::from_translation(flank + Vec3::Y * 0.05),
     ));
-    info!("right-drag orbits, wheel zooms; S presses or lifts the sponge, hold G to grab a tuft");
+    info!("right-drag orbits, wheel zooms; S presses or lifts the sponge");
 }
 
 /// The ball rolls to and fro across the bunny's flank, half buried in the fur.
@@ -108,27 +130,25 @@ fn roll_ball(time: Res<Time>, mut balls: Query<&mut Transform, With<Ball>>) {
     }
 }
 
-fn sponge_key(keys: Res<ButtonInput<KeyCode>>, mut sponges: Query<(&mut FurSponge, &mut Transform)>) {
+fn sponge_key(keys: Res<ButtonInput<KeyCode>>, mut sponges: Query<(&Sponge, &mut FurSponge, &mut Transform)>) {
     if keys.just_pressed(KeyCode::KeyS) {
-        for (mut sponge, mut transform) in &mut sponges {
+        for (place, mut sponge, mut transform) in &mut sponges {
             sponge.pressing = !sponge.pressing;
             // Lifted, it hovers above the fur.
-            transform.translation.y = if sponge.pressing { 1.05 } else { 1.35 };
+            let lift = if sponge.pressing { 0.03 } else { 0.3 };
+            transform.translation = place.surface + Vec3::Y * lift;
         }
     }
 }
 
-/// Holding G closes the hand over the bunny's back and it sways, pulling a tuft; without G it
-/// hovers where the tuft is (open).
-fn move_hand(
-    time: Res<Time>,
-    keys: Res<ButtonInput<KeyCode>>,
-    mut hands: Query<(&mut FurGrasp, &mut Transform), With<Hand>>,
-) {
-    let t = time.elapsed_secs();
-    for (mut grasp, mut transform) in &mut hands {
-        grasp.closed = keys.pressed(KeyCode::KeyG) || (t % 6.0) > 1.0;
-        let sway = if grasp.closed { 0.15 * (t * 1.5).sin() } else { 0.0 };
-        transform.translation = Vec3::new(0.35 + sway, 1.05, 0.25);
+/// Every six seconds the hand closes in the fur on the flank, pulls the tuft up and sways it for
+/// four seconds, then opens and lets it spring back.
+fn move_hand(time: Res<Time>, mut hands: Query<(&Hand, &mut FurGrasp, &mut Transform)>) {
+    let t = time.elapsed_secs() % 6.0;
+    for (hand, mut grasp, mut transform) in &mut hands {
+        grasp.closed = (0.5..4.5).contains(&t);
+        let pull = if grasp.closed { (t - 0.5).min(1.0) } else { 0.0 };
+        let sway = Vec3::new(0.12 * (t * 2.0).sin(), 0.0, 0.0) * pull;
+        transform.translation = hand.surface + Vec3::Y * (0.05 + 0.1 * pull) + sway;
     }
 }
