@@ -233,7 +233,12 @@ impl Model {
     ///
     /// # Errors
     /// [`ModelError`]; the previous scene and preset stay.
-    pub fn set_scene_and_preset(&mut self, scene: SceneChoice, mut preset: Preset, aspect: f32) -> Result<(), ModelError> {
+    pub fn set_scene_and_preset(
+        &mut self,
+        scene: SceneChoice,
+        mut preset: Preset,
+        aspect: f32,
+    ) -> Result<(), ModelError> {
         preset.simulation.wind = self.preset.simulation.wind.clone();
         *self = Self { orbit: self.orbit, tool: self.tool, ..Self::new(scene, preset, aspect)? };
         self.frame(aspect);
