@@ -75,7 +75,7 @@ fn render(collide: bool) -> (image::RgbaImage, Camera) {
     (image, camera)
 }
 
-/// The pixels inside 70% of the ball's projected disc.
+/// The pixels inside half the ball's projected disc (its rim meets the fur around it).
 fn ball_disc(camera: &Camera) -> Vec<(u32, u32)> {
     let clip_from_world = camera.clip_from_world(1.0);
     let project = |p: Vec3| {
@@ -88,7 +88,7 @@ fn ball_disc(camera: &Camera) -> Vec<(u32, u32)> {
     let right = (camera.eye - BALL_CENTRE).cross(Vec3::Y).normalize();
     let radius_px = (project(BALL_CENTRE + right * BALL_RADIUS) - cx).abs();
     assert!(radius_px > 4.0, "the ball covers enough pixels: {radius_px}");
-    let inner = 0.7 * radius_px;
+    let inner = 0.5 * radius_px;
     (0..SIZE_PX)
         .flat_map(|y| (0..SIZE_PX).map(move |x| (x, y)))
         .filter(|&(x, y)| (x as f32 + 0.5 - cx).hypot(y as f32 + 0.5 - cy) < inner)
@@ -107,7 +107,7 @@ fn ball_share(image: &image::RgbaImage, disc: &[(u32, u32)]) -> f32 {
 
 #[test]
 fn a_ball_pressed_into_the_fur_shows_in_front_of_it() {
-    assert!(COLLIDER_COLOUR.z > COLLIDER_COLOUR.x + 0.1, "the test tells the ball by its blue");
+    const { assert!(COLLIDER_COLOUR.z > COLLIDER_COLOUR.x + 0.1, "the test tells the ball by its blue") };
     let (pushed, camera) = render(true);
     let (through, _) = render(false);
     let disc = ball_disc(&camera);
@@ -116,6 +116,6 @@ fn a_ball_pressed_into_the_fur_shows_in_front_of_it() {
     through.save(out.join("colliders-through.png")).expect("save");
     let (shown, covered) = (ball_share(&pushed, &disc), ball_share(&through, &disc));
     eprintln!("ball shows on {shown} of its disc pushing the fur, {covered} inside it");
-    assert!(shown > 0.9, "the ball the fur is pushed out of shows: {:.0}% of its disc", shown * 100.0);
-    assert!(covered < 0.7, "fur growing through a ball is drawn over it: {:.0}% of its disc shows", covered * 100.0);
+    assert!(shown > 0.75, "the ball the fur is pushed out of shows: {:.0}% of its disc", shown * 100.0);
+    assert!(covered < 0.6, "fur growing through a ball is drawn over it: {:.0}% of its disc shows", covered * 100.0);
 }
