@@ -233,7 +233,12 @@ impl Model {
     ///
     /// # Errors
     /// [`ModelError`]; the previous scene and preset stay.
-    pub fn set_scene_and_preset(&mut self, scene: SceneChoice, mut preset: Preset, aspect: f32) -> Result<(), ModelError> {
+    pub fn set_scene_and_preset(
+        &mut self,
+        scene: SceneChoice,
+        mut preset: Preset,
+        aspect: f32,
+    ) -> Result<(), ModelError> {
         preset.simulation.wind = self.preset.simulation.wind.clone();
         *self = Self { orbit: self.orbit, tool: self.tool, ..Self::new(scene, preset, aspect)? };
         self.frame(aspect);
@@ -475,8 +480,8 @@ impl Model {
     }
 }
 
-/// The glTF Fox (Khronos sample, CC BY 4.0; see assets/CREDITS.md), embedded: a page reads
-/// no files. Its groom (`fox_groomed.groom`) is tied to this mesh as `Mesh::load` reads it.
+/// The glTF Fox (Khronos glTF-Sample-Assets; credits and licence in assets/CREDITS.md, and on
+/// the page), embedded: a page reads no files. Its groom (`fox_groomed.groom`) is tied to this mesh as `Mesh::load` reads it.
 const FOX_GLB: &[u8] = include_bytes!("../../../assets/meshes/Fox.glb");
 /// The Fox's name in messages, as `pelt render` names it.
 pub const FOX_NAME: &str = "assets/meshes/Fox.glb";

@@ -40,8 +40,7 @@ const IMAGES: [(&str, &[u8]); 2] = [
 ];
 
 /// Groom files a preset may name on the page, by file name.
-const GROOMS: [(&str, &[u8]); 1] =
-    [("fox_groomed.groom", include_bytes!("../../../assets/presets/fox_groomed.groom"))];
+const GROOMS: [(&str, &[u8]); 1] = [("fox_groomed.groom", include_bytes!("../../../assets/presets/fox_groomed.groom"))];
 
 /// The groom `preset`'s `[groom]` names on `mesh` (`None` for a uniform coat): its `file` from
 /// the grooms the page ships (by file name), its maps from the mesh's vertex colour sets. An
@@ -70,7 +69,8 @@ pub fn web_groom(preset: &Preset, mesh: &Mesh, mesh_name: &str) -> Result<Option
     // The maps beside the file: vertex colour sets load as anywhere; images cannot be read here.
     let maps = GroomParams { file: None, ..params.clone() };
     if let Some((key, image)) = maps.files().into_iter().next() {
-        let problem = format!("a web page cannot read image files; only the images it ships can be named ({})", shipped(&IMAGES));
+        let problem =
+            format!("a web page cannot read image files; only the images it ships can be named ({})", shipped(&IMAGES));
         let key = key.trim_start_matches("groom.").to_owned();
         return Err(fail(GroomError::Image { key, image: image.to_path_buf(), problem }));
     }
@@ -197,7 +197,7 @@ mod tests {
             .unwrap_or_else(|e| panic!("{e}"));
         let groom = fox.structure.groom.as_ref().expect("the groomed Fox has a groom");
         let length = groom.length.as_ref().expect("a length map");
-        assert!(length.iter().any(|l| *l == 0.0), "no bald vertex");
+        assert!(length.contains(&0.0), "no bald vertex");
         assert!(length.iter().any(|l| *l > 1.0), "nothing longer than the preset's length");
         let bald = length.iter().filter(|l| **l == 0.0).count();
         let zero_lengths = fox.structure.lengths.iter().filter(|l| **l == 0.0).count();
