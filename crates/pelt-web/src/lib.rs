@@ -10,8 +10,10 @@
 #![warn(missing_docs)]
 
 pub mod model;
+pub mod orbit;
 pub mod page_gpu;
 pub mod presets;
+pub mod scene;
 pub mod tools;
 
 #[cfg(target_arch = "wasm32")]
