@@ -104,6 +104,7 @@
 #![warn(missing_docs)]
 
 mod camera;
+mod colliders;
 mod contact;
 mod driver;
 mod error;
@@ -129,7 +130,8 @@ mod textures;
 mod view;
 
 pub use camera::Camera;
-pub use driver::{FurDriver, KernelChoice, SimKernel, cpu_secs_per_step, gpu_secs_per_step};
+pub use colliders::{COLLIDER_COLOUR, ColliderMeshes, HAND_COLOUR};
+pub use driver::{FurDriver, KernelChoice, SimKernel, cpu_secs_per_step, gpu_secs_per_step, gpu_secs_per_step_of};
 pub use error::RenderError;
 pub use fur::{FurStates, GpuFur};
 pub use geometry::POSITIONS_USAGE;

@@ -1,6 +1,7 @@
 //! What one groom brush dab costs while painting, as the viewer pays it: the dab itself (the
-//! editor), regrowing the rest positions, the simulation restarted on them, and the GPU upload
-//! (length and comb: new vertex buffers, `FurDriver::set_structure`; tint: the per-vertex groom
+//! editor), regrowing the rest positions, the simulation taking the reshaped strands in place
+//! (`FurStepper::regroom`), and the GPU upload
+//! (length, cut and comb: new vertex buffers, `FurDriver::set_structure`; tint: the per-vertex groom
 //! rewritten, `FurDriver::set_groom`; submitted and waited for), on the bunny and the Fox; and,
 //! for comparison, the textures a dab does not rebuild. For BENCHMARKS.md:
 //! `cargo run --release -p pelt --example stroke_cost` (`DABS=40` dabs per row).
@@ -36,7 +37,7 @@ fn main() -> anyhow::Result<()> {
         let textures_ms = started.elapsed().as_secs_f64() * 1e3;
         let params = preset.fur_params(&mesh);
         let radius = mesh.bounding_sphere().1;
-        for kind in [BrushKind::Grow, BrushKind::Comb, BrushKind::Tint] {
+        for kind in [BrushKind::Grow, BrushKind::Cut, BrushKind::Comb, BrushKind::Tint] {
             // Groomed from the start (a white tint), as a fur being painted is.
             let groom = Groom { tint: Some(vec![Vec3::ONE; mesh.vertex_count()]), ..Groom::default() };
             let mut structure = FurStructure::new_groomed(mesh.clone(), &params, Some(groom.clone()))?;
@@ -54,14 +55,17 @@ fn main() -> anyhow::Result<()> {
                 editor.stroke_to(&brush, point);
                 let t1 = Instant::now();
                 let reshaped = kind != BrushKind::Tint;
+                let mut strands = Vec::new();
                 if reshaped {
-                    structure = FurStructure::new_groomed(mesh.clone(), &params, Some(editor.groom().clone()))?;
+                    let regrown = FurStructure::new_groomed(mesh.clone(), &params, Some(editor.groom().clone()))?;
+                    strands = structure.changed_strands(&regrown);
+                    structure = regrown;
                 } else {
                     structure.groom = Some(editor.groom().clone());
                 }
                 let t2 = Instant::now();
                 if reshaped {
-                    stepper.set_structure(&structure, &preset.simulation)?;
+                    stepper.regroom(&structure, &strands)?;
                 }
                 let t3 = Instant::now();
                 if reshaped {

@@ -237,6 +237,23 @@ impl FurStructure {
         (0..self.mesh.edges.len()).filter(|&e| self.edge_has_fins(e)).map(|e| e as u32).collect()
     }
 
+    /// The base vertices whose strand differs between this structure and `other` (the same
+    /// mesh regrown with another groom): length, growth direction, or whether it is bald, to
+    /// the bit. What a groom edit hands [`crate::sim::Simulation::regroom`].
+    #[must_use]
+    pub fn changed_strands(&self, other: &FurStructure) -> Vec<u32> {
+        let bald = |fur: &FurStructure, j: usize| fur.groom.as_ref().is_some_and(|g| g.is_bald(j));
+        (0..self.vertex_count().min(other.vertex_count()))
+            .filter(|&j| {
+                self.lengths[j].to_bits() != other.lengths[j].to_bits()
+                    || self.directions[j].to_array().map(f32::to_bits)
+                        != other.directions[j].to_array().map(f32::to_bits)
+                    || bald(self, j) != bald(other, j)
+            })
+            .map(|j| j as u32)
+            .collect()
+    }
+
     /// `V`, the base vertex count (the stride between layers).
     #[must_use]
     pub fn vertex_count(&self) -> usize {

@@ -137,3 +137,68 @@ impl StrokeList {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::builtin::Builtin;
+
+    fn problem(text: &str) -> String {
+        StrokeList::from_toml_str(text, Path::new("brushes/fox.strokes")).unwrap_err().to_string()
+    }
+
+    const GOOD: &str = "[[stroke]]\nbrush = \"cut\"\nradius = 0.3\npoints = [[0.0, 1.0, 0.0]]\n";
+
+    #[test]
+    fn parse_errors_name_the_file_the_stroke_and_the_key() {
+        let cases = [
+            ("[[stroke]]\nbrush = \"paint\"\nradius = 0.3\npoints = []\n", "stroke 1: brush: \"paint\" is not one of"),
+            (&format!("{GOOD}[[stroke]]\nbrush = \"grow\"\nradius = -1.0\npoints = []\n"), "stroke 2: radius"),
+            (&format!("{GOOD}falloff = \"sharp\"\n"), "stroke 1: falloff: \"sharp\""),
+            (&format!("{GOOD}mirror = \"w\"\n"), "stroke 1: mirror: \"w\""),
+            (&format!("{GOOD}map = \"colour\"\n"), "stroke 1: map: \"colour\""),
+            (&format!("{GOOD}strength = 1.5\n"), "stroke 1: strength: must be within 0..=1, got 1.5"),
+            (&format!("{GOOD}colour = [0.5, 2.0, 0.0]\n"), "stroke 1: colour"),
+            ("[[stroke]]\nbrush = \"cut\"\nradius = 0.3\npoints = [[nan, 0.0, 0.0]]\n", "stroke 1: points"),
+            ("[[stroke]]\nbrush = \"cut\"\nradius = 0.3\npoints = [[0.0, 0.0, 0.0]]\nsize = 2\n", "size"),
+            ("[[stroke]\n", "brushes/fox.strokes"),
+        ];
+        for (text, expected) in cases {
+            let message = problem(text);
+            assert!(message.starts_with("brushes/fox.strokes: "), "{message}");
+            assert!(message.contains(expected), "{expected:?} not in {message:?}");
+        }
+        let missing = StrokeList::load(Path::new("no/such.strokes")).unwrap_err().to_string();
+        assert!(missing.starts_with("no/such.strokes: "), "{missing}");
+    }
+
+    #[test]
+    fn a_list_replays_to_the_same_groom_bytes() {
+        let (mesh, _) = Builtin::Sphere.mesh();
+        let p = |j: usize| mesh.positions[j].to_array();
+        let text = format!(
+            "[[stroke]]\nbrush = \"cut\"\nradius = 0.4\nfalloff = \"constant\"\nmirror = \"x\"\npoints = [{:?}, {:?}]\n\
+             [[stroke]]\nbrush = \"comb\"\nradius = 0.5\nstrength = 0.7\npoints = [{:?}, {:?}, {:?}]\n\
+             [[stroke]]\nbrush = \"tint\"\nradius = 0.5\ncolour = [0.9, 0.4, 0.1]\npoints = [{:?}]\n",
+            p(3),
+            p(40),
+            p(100),
+            p(101),
+            p(140),
+            p(200)
+        );
+        let list = StrokeList::from_toml_str(&text, Path::new("three.strokes")).unwrap();
+        assert_eq!(list.strokes.len(), 3);
+        assert_eq!(list.strokes[0].0.mirror, Some(Axis::X));
+        let replay = || {
+            let mut editor = GroomEditor::new(&mesh, None, Vec3::Y).unwrap();
+            list.apply(&mut editor);
+            assert_eq!(editor.history(), (3, 0), "one undo step per stroke");
+            editor.groom().to_file_bytes(&mesh).unwrap()
+        };
+        let first = replay();
+        assert_eq!(first, replay());
+        let uniform = GroomEditor::new(&mesh, None, Vec3::Y).unwrap().groom().to_file_bytes(&mesh).unwrap();
+        assert_ne!(first, uniform, "the strokes painted");
+    }
+}

@@ -315,25 +315,45 @@ impl RestBatches {
             is_straight: vec![true; batches],
         };
         for j in 0..v {
-            let (b, lane) = (j / LANES, j % LANES);
-            let segment = |k: usize| positions[(k + 1) * v + j] - positions[k * v + j];
-            for k in 0..layers {
-                let direction = segment(k).normalize_or_zero();
-                rest.lengths[b * layers + k][lane] = if direction == Vec3::ZERO { 0.0 } else { segment(k).length() };
-                for c in 0..3 {
-                    rest.directions[b * layers + k][c][lane] = direction[c];
-                }
-            }
-            match straight_direction(positions[j], (0..layers).map(segment)) {
-                Some(direction) => {
-                    for c in 0..3 {
-                        rest.straight[b][c][lane] = direction[c];
-                    }
-                }
-                None => rest.is_straight[b] = false,
-            }
+            rest.set_strand(positions, v, layers, j);
         }
         rest
+    }
+
+    /// Recomputes the batches holding `strands` from `positions` (a regroomed fur's shared array
+    /// of the same `v` and `layers`), as [`RestBatches::new`] makes them.
+    pub fn update(&mut self, positions: &[Vec3], v: usize, layers: usize, strands: &[u32]) {
+        let mut batches: Vec<usize> = strands.iter().map(|&j| j as usize / LANES).collect();
+        batches.sort_unstable();
+        batches.dedup();
+        for b in batches {
+            // A batch's form is decided by all its strands: start it over.
+            self.straight[b] = [[0.0; LANES], [1.0; LANES], [0.0; LANES]];
+            self.is_straight[b] = true;
+            for j in b * LANES..((b + 1) * LANES).min(v) {
+                self.set_strand(positions, v, layers, j);
+            }
+        }
+    }
+
+    fn set_strand(&mut self, positions: &[Vec3], v: usize, layers: usize, j: usize) {
+        let (b, lane) = (j / LANES, j % LANES);
+        let segment = |k: usize| positions[(k + 1) * v + j] - positions[k * v + j];
+        for k in 0..layers {
+            let direction = segment(k).normalize_or_zero();
+            self.lengths[b * layers + k][lane] = if direction == Vec3::ZERO { 0.0 } else { segment(k).length() };
+            for c in 0..3 {
+                self.directions[b * layers + k][c][lane] = direction[c];
+            }
+        }
+        match straight_direction(positions[j], (0..layers).map(segment)) {
+            Some(direction) => {
+                for c in 0..3 {
+                    self.straight[b][c][lane] = direction[c];
+                }
+            }
+            None => self.is_straight[b] = false,
+        }
     }
 
     /// Segment `k`'s rest length in lane `lane` of batch `b`.

@@ -12,9 +12,10 @@ use web_time::Instant;
 use glam::{Quat, Vec3, Vec4};
 use rayon::prelude::*;
 
+use super::contact::skin::skin_planes_of;
 use super::contact::{
-    Collider, ContactStep, ContactStrands, Grasp, GraspParams, MAX_STEP_COLLIDERS, Resolve, SKIN_PLANES, StepCollider,
-    skin_planes,
+    Collider, ContactStep, ContactStrands, Grasp, GraspParams, MAX_STEP_COLLIDERS, Resolve, SKIN_PLANES, SkinSurface,
+    StepCollider, skin_surface,
 };
 use super::dispatch::{self, CpuKernel};
 use super::field::{ForceField, Touch};
@@ -24,6 +25,8 @@ use super::kernel::{LANES, RestBatches, Step, VecLanes};
 use super::pick::{Hit, pick};
 use super::{ParamError, SimParams, WindParams};
 use crate::fur::FurStructure;
+
+mod regroom;
 
 /// Errors from building or driving a [`Simulation`].
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
@@ -149,6 +152,10 @@ pub struct Simulation {
     touch_on_step_roots: bool,
     /// Each strand's skin planes (see `contact::skin`).
     skin: Vec<[Vec4; SKIN_PLANES]>,
+    /// The skin triangles where the planes do not suffice (see `contact::surface`).
+    surface: SkinSurface,
+    /// The grid cell the skin planes were found in (the longest strand's reach).
+    skin_cell: f32,
     /// Colliders the host or a script placed.
     colliders: Vec<Collider>,
     /// The grasp holding (or springing back), if any.
@@ -184,6 +191,7 @@ impl Simulation {
         debug_assert!(centre.is_finite());
         let nodes = v * (layers + 1);
         let batch_nodes = batches * (layers + 1);
+        let (skin_cell, skin) = skin_planes_of(fur, 0..v);
         let mut simulation = Self {
             params: params.clone(),
             layers: fur.layers,
@@ -220,7 +228,9 @@ impl Simulation {
             },
             roots_moved: false,
             touch_on_step_roots: false,
-            skin: skin_planes(fur),
+            surface: skin_surface(fur, &skin),
+            skin,
+            skin_cell,
             colliders: Vec::new(),
             grasp: None,
         };
@@ -680,7 +690,12 @@ impl Simulation {
     /// The per-strand contact inputs: skin planes and the grasp's weights.
     #[must_use]
     pub fn contact_strands(&self) -> ContactStrands<'_> {
-        ContactStrands { skin: &self.skin, grasp_weights: self.grasp.as_ref().map_or(&[], |g| g.weights()) }
+        ContactStrands {
+            skin: &self.skin,
+            grasp_weights: self.grasp.as_ref().map_or(&[], |g| g.weights()),
+            surface: &self.surface,
+            rest_roots: &self.rest_roots,
+        }
     }
 
     /// The nearest hit of a ray with the base mesh at its current root positions.

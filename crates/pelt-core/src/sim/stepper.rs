@@ -332,6 +332,16 @@ impl FurStepper {
         &mut self.simulation
     }
 
+    /// Takes a regroomed `structure`'s rest shape for `strands` (the vertices a length, comb or
+    /// cut dab reshaped, [`FurStructure::changed_strands`]) in place: [`Simulation::regroom`],
+    /// the cheap path for painting. The wetness, script, pose and clip stay.
+    ///
+    /// # Errors
+    /// As [`Simulation::regroom`].
+    pub fn regroom(&mut self, structure: &FurStructure, strands: &[u32]) -> Result<(), SimError> {
+        self.simulation.regroom(structure, strands)
+    }
+
     /// Replaces the simulation (a new structure); the next pose restarts it.
     ///
     /// # Errors

@@ -6,7 +6,8 @@
 //!
 //! Ribbons are built on the CPU once per shape of the fur (a state of the shared array) and serve
 //! every view: each node carries its position, direction, root normal, colour and half width,
-//! and the vertex shader turns the width toward the camera.
+//! and the vertex shader turns the width toward the camera. A wet reference's strands (their
+//! root's wetness) darken and shine as `wet.wgsl` makes the shells do.
 
 use bytemuck::{Pod, Zeroable};
 use glam::{Vec3, Vec4};
@@ -29,10 +30,11 @@ struct RibbonVertex {
     normal: [f32; 3],
     colour_height: [f32; 4],
     half_width: f32,
+    wetness: f32,
 }
 
-const VERTEX_ATTRIBUTES: [wgpu::VertexAttribute; 5] = wgpu::vertex_attr_array![
-    0 => Float32x3, 1 => Float32x3, 2 => Float32x3, 3 => Float32x4, 4 => Float32
+const VERTEX_ATTRIBUTES: [wgpu::VertexAttribute; 6] = wgpu::vertex_attr_array![
+    0 => Float32x3, 1 => Float32x3, 2 => Float32x3, 3 => Float32x4, 4 => Float32, 5 => Float32
 ];
 
 /// The strand pipeline for the target of a [`FurRenderer`] (its layouts, so it draws with the
@@ -188,6 +190,7 @@ impl StrandRibbons {
                         normal: normal.to_array(),
                         colour_height,
                         half_width: half_width * side,
+                        wetness: placed.wetness,
                     });
                 }
                 if k + 1 < points.len() {
@@ -235,7 +238,7 @@ mod tests {
 
     #[test]
     fn ribbon_vertex_mirrors_strand_vertex() {
-        let rust = rust_layout!(RibbonVertex { position, tangent, normal, colour_height, half_width });
+        let rust = rust_layout!(RibbonVertex { position, tangent, normal, colour_height, half_width, wetness });
         assert_vertex_mirrors(&strands_shader_source(), "StrandVertex", &rust, &VERTEX_ATTRIBUTES);
     }
 }

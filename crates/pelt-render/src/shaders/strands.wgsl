@@ -1,6 +1,7 @@
 // The explicit strand reference: every strand of the seeded field as a camera-facing ribbon, lit
-// by the same `hair_lighting` as the shells and fins. Appended to `shading.wgsl`; reads the view
-// (group 0) and the fur's object uniform (group 1, binding 0: transform and look), no textures.
+// by the same `hair_lighting` as the shells and fins, darkened and shining when wet (`wet.wgsl`).
+// Appended to `shading.wgsl` and `wet.wgsl`; reads the view (group 0) and the fur's object
+// uniform (group 1, binding 0: transform and look), no textures.
 
 struct StrandVertex {
     // Strand node, model space.
@@ -13,6 +14,8 @@ struct StrandVertex {
     @location(3) colour_height: vec4<f32>,
     // Half the ribbon's width (world units), signed: the side of the strand this vertex is on.
     @location(4) half_width: f32,
+    // The coat's wetness at the strand's root (0 dry).
+    @location(5) wetness: f32,
 }
 
 @vertex
@@ -36,7 +39,8 @@ fn vs_strand(in: StrandVertex) -> Varyings {
     out.slice = 0;
     out.height = in.colour_height.a;
     out.fade = 1.0;
-    out.surface_uv = vec2<f32>(0.0);
+    // The wetness travels in `surface_uv.x`, which strands do not otherwise use.
+    out.surface_uv = vec2<f32>(in.wetness, 0.0);
     return out;
 }
 
@@ -44,7 +48,14 @@ fn vs_strand(in: StrandVertex) -> Varyings {
 @fragment
 fn fs_strand(in: Varyings) -> @location(0) vec4<f32> {
     // The albedo travels in `tile_position`, which strands do not otherwise use.
-    let albedo = in.tile_position;
-    let colour = hair_lighting(albedo, normalize(in.tangent), normalize(in.normal), in.world_position, in.height);
-    return vec4<f32>(colour, 1.0);
+    var albedo = in.tile_position;
+    var terms = hair_terms(normalize(in.tangent), normalize(in.normal), in.world_position, in.height);
+    // A uniform branch: a wet strand darkens and shines as `wet_groom` and `wet_terms` make the
+    // shells do; a dry coat keeps `hair_lighting`'s very arithmetic.
+    if object.wet_any != 0u {
+        let w = clamp(in.surface_uv.x, 0.0, 1.0);
+        albedo *= 1.0 - object.wet_darkening * w;
+        terms = wet_terms(terms, w);
+    }
+    return vec4<f32>(hair_colour(albedo, terms, in.height), 1.0);
 }

@@ -57,6 +57,15 @@ impl Mask {
         Self { bits: grown.bits.iter().map(|b| !b).collect(), ..*self }
     }
 
+    /// The share of this mask's pixels that `other` holds too (0 for an empty mask).
+    pub fn share_of(&self, other: &Self) -> f64 {
+        let total = self.count();
+        if total == 0 {
+            return 0.0;
+        }
+        self.minus(&self.minus(other)).count() as f64 / total as f64
+    }
+
     pub fn count(&self) -> usize {
         self.bits.iter().filter(|b| **b).count()
     }

@@ -9,7 +9,7 @@ use std::path::PathBuf;
 
 use anyhow::{Context as _, bail};
 use glam::{Mat4, Vec3};
-use pelt_core::reference::StrandReference;
+use pelt_core::reference::{StrandReference, WetClumps};
 use pelt_core::sim::{FurStepper, SimParams, WindParams};
 use pelt_core::{Builtin, FurStructure, Mesh, Preset, texture};
 use pelt_render::{
@@ -47,6 +47,11 @@ pub struct Args {
     /// Wind x,y,z (direction and strength); calm without it.
     #[arg(long, value_name = "X,Y,Z", value_parser = crate::values::parse_vec3, allow_hyphen_values = true)]
     wind: Option<Vec3>,
+    /// A uniformly wet coat, 0 (dry) to 1 (soaked), held, as `pelt render --wetness` wets it:
+    /// the shells darken, shine and clump, and the strands gather into the same clumps and
+    /// darken and shine alike (the preset's `[wet]` says how much).
+    #[arg(long, value_name = "W", value_parser = crate::values::parse_wetness)]
+    wetness: Option<f32>,
     /// Write the results as JSON here.
     #[arg(long, value_name = "FILE")]
     json: Option<PathBuf>,
@@ -74,6 +79,7 @@ struct Figures {
     model: String,
     view: String,
     wind: [f32; 3],
+    wetness: f32,
     ssim_fur_shells_fins: f64,
     ssim_fur_shells: f64,
     ssim_silhouette_shells_fins: f64,
@@ -82,6 +88,10 @@ struct Figures {
     /// The reference against itself moved a quarter pixel (with 4x supersampling; `1 /
     /// supersample` pixel below that): how much SSIM sub-pixel placement alone costs.
     ssim_fur_reference_shifted: f64,
+    /// The share of the skin's pixels the strands hide (differ from the bare skin there).
+    coverage_strands: f64,
+    /// The same for shells + fins.
+    coverage_shells_fins: f64,
 }
 
 #[derive(Debug, serde::Serialize)]
@@ -115,8 +125,6 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     // One strand field: the textures are drawn from it and the reference places it.
     let field = preset.strand_field()?;
     let textures = texture::generate_from(preset.layers, &field);
-    let look = FurLook::default();
-    let reference = StrandReference::new(&fur, field, tile_mapping(&fur.mesh, &look))?;
 
     let wind = args.wind.unwrap_or(Vec3::ZERO);
     let direction = wind.try_normalize().unwrap_or(Vec3::X);
@@ -126,6 +134,9 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     };
     let mut stepper = FurStepper::new(&fur, &preset.simulation)?;
     stepper.simulation_mut().set_wind(&simulation_params.wind)?;
+    if args.wetness.is_some() {
+        stepper.set_wet(&crate::render::wet_params(&preset, args.wetness))?;
+    }
 
     let (width, height) = args.size;
     let gpu = Gpu::new(args.backend)?;
@@ -142,6 +153,20 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let shell_side = Side::new(&shells, &fur, &textures, &mut stepper, &plain)?;
     let strand_side = Side::new(&strands, &fur, &textures, &mut stepper, &plain)?;
     let positions = stepper.simulation().positions();
+    let mapping = tile_mapping(&fur.mesh, &FurLook::default());
+    // The strands of a wet coat gather into the clumps the shells draw.
+    let reference = if stepper.wetness().is_dry() {
+        StrandReference::new(&fur, field, mapping)?
+    } else {
+        let wet = stepper.wet();
+        let clumps = WetClumps {
+            wetness: stepper.wetness().values().to_vec(),
+            clump_size: wet.clump_size,
+            clump_strength: wet.clump_strength,
+            groom_clump: fur.groom.as_ref().and_then(|g| g.clump.clone()),
+        };
+        StrandReference::wet(&fur, field, mapping, &clumps)?
+    };
     let strand_renderer = StrandRenderer::new(&strands.gpu.device, &strand_side.renderer)?;
     let ribbons =
         StrandRibbons::new(&strands.gpu.device, &reference, positions, &fur.mesh.normals, &fur.mesh.triangles)?;
@@ -157,7 +182,11 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         .fold((Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)), |(l, h), p| (l.min(*p), h.max(*p)));
     let centre = (low + high) * 0.5;
     let aspect = width as f32 / height as f32;
-    let wind_tag = if wind == Vec3::ZERO { String::new() } else { "-wind".to_owned() };
+    let wetness = args.wetness.unwrap_or(0.0);
+    let mut tag = if wind == Vec3::ZERO { String::new() } else { "-wind".to_owned() };
+    if wetness > 0.0 {
+        tag += &format!("-wet{wetness}");
+    }
     let mut results = Vec::new();
     for (name, azimuth) in &views {
         let camera =
@@ -202,6 +231,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             model: model.clone(),
             view: name.clone(),
             wind: wind.to_array(),
+            wetness,
             ssim_fur_shells_fins: ssim(&shells_fins, &fur_mask)?,
             ssim_fur_shells: ssim(&shells_only, &fur_mask)?,
             ssim_silhouette_shells_fins: ssim(&shells_fins, &band)?,
@@ -209,10 +239,12 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             mean_colour_difference: metrics::mean_colour_difference(&shells_fins, &reference_image, &fur_mask)
                 .unwrap_or(0.0),
             ssim_fur_reference_shifted: ssim(&shifted_reference, &fur_mask)?,
+            coverage_strands: body.share_of(&Mask::differing(&reference_image, &skin, CHANGED)),
+            coverage_shells_fins: body.share_of(&Mask::differing(&shells_fins, &skin, CHANGED)),
         };
         let heat = metrics::heat_map(&shells_fins, &reference_image, 0.25);
         let sheet = metrics::side_by_side(&[&shells_fins, &shells_only, &reference_image, &heat], 4, [255, 255, 255]);
-        let path = args.out.join(format!("{model}-{name}{wind_tag}.png"));
+        let path = args.out.join(format!("{model}-{name}{tag}.png"));
         sheet.save(&path).with_context(|| format!("cannot write {}", path.display()))?;
         println!(
             "{model:>8} {name:<5} wind {wind:<14} SSIM fur: shells+fins {:.3}, shells {:.3}; silhouette: shells+fins {:.3}, \
@@ -232,6 +264,10 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         println!(
             "{:>8} {name:<5} the strands against themselves {shift}/{factor} pixel off: SSIM fur {:.3}",
             "", result.ssim_fur_reference_shifted
+        );
+        println!(
+            "{:>8} {name:<5} the skin hidden: by the strands {:.3}, by shells+fins {:.3}",
+            "", result.coverage_strands, result.coverage_shells_fins
         );
         println!(
             "{:>8} {name:<5} luma mean/local contrast over the fur: shells+fins {}, shells {}, strands {}",

@@ -1,6 +1,7 @@
 //! Groom painting: the panel's brush section, and the model's strokes on the rest surface under
 //! the pointer's posed hit, with undo and redo. Length and direction strokes regrow the fur's
-//! rest positions (the GPU's vertex buffers, never the textures); density, clump and tint
+//! rest positions (the simulation takes the reshaped strands in place, `FurStepper::regroom`;
+//! the GPU its vertex buffers, never the textures); density, clump and tint
 //! rewrite the GPU's per-vertex groom in place (`FurDriver::set_groom`).
 
 use glam::Vec3;
@@ -147,10 +148,13 @@ impl Model {
     fn regroom(&mut self, maps: &[GroomMap]) -> anyhow::Result<()> {
         let groom = Some(self.groom_editor.groom().clone()).filter(|g| !g.is_uniform());
         if maps.iter().any(|m| matches!(m, GroomMap::Length | GroomMap::Direction)) {
-            self.structure = regrow(self.structure.mesh.clone(), &self.settings.preset, &self.groom_editor)?;
+            let regrown = regrow(self.structure.mesh.clone(), &self.settings.preset, &self.groom_editor)?;
+            let strands = self.structure.changed_strands(&regrown);
+            self.structure = regrown;
             self.footprint = self.structure.footprint();
-            // The stepper keeps its clip: an animated fur goes on playing on the new rest pose.
-            self.stepper.set_structure(&self.structure, &self.settings.preset.simulation)?;
+            // Only the reshaped strands change in the simulation; it keeps its clip, wind and
+            // wetness, and an animated fur goes on playing on the new rest pose.
+            self.stepper.regroom(&self.structure, &strands)?;
             self.touch = None;
             self.structure_regrown = true;
         } else {

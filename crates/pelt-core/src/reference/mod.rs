@@ -17,12 +17,19 @@
 //! past its edges), of the triangle's three columns of the shared array, each read at height `t`
 //! (between layers `floor(t L)` and the next, and along the last segment past the tips). The
 //! strands therefore follow the simulated fur exactly as the shells do.
+//!
+//! A wet coat ([`StrandReference::wet`]) gathers each strand into the shells' clumps
+//! ([`WetClumps`], the `clumps` module) before it is placed, so wet strands are clumped geometry.
+
+mod clumps;
 
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 
 use crate::fur::FurStructure;
 use crate::texture::{Strand, StrandField};
+
+pub use clumps::{CLUMP_PARTING, WetClumps, gather_amount, gathered, nearest_centre};
 
 /// How tile coordinates are laid on a mesh (the shell renderer's mapping).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -52,6 +59,9 @@ pub struct PlacedStrand {
     /// triangle, so a strand is as wide as the shell texels that draw it there (a stretched uv
     /// triangle or a tilted triplanar projection widens them).
     pub world_per_texel: f32,
+    /// The coat's wetness at the root (0 for a dry reference): the ribbons darken and shine
+    /// with it as `wet.wgsl` does.
+    pub wetness: f32,
 }
 
 /// Where one node of a placed strand is, relative to its triangle.
@@ -81,6 +91,9 @@ pub enum ReferenceError {
     /// A mapping that is zero, negative or not finite.
     #[error("tile mapping must be finite and positive, got {0}")]
     Mapping(String),
+    /// Wet clumps that do not fit the fur.
+    #[error("wet reference: {0}")]
+    Wet(String),
 }
 
 /// Every strand of a field placed on one fur structure.
@@ -109,6 +122,38 @@ impl StrandReference {
     /// # Errors
     /// [`ReferenceError::Mapping`] for a mapping that is not finite and positive.
     pub fn new(fur: &FurStructure, field: StrandField, mapping: TileMapping) -> Result<Self, ReferenceError> {
+        Self::build(fur, field, mapping, None)
+    }
+
+    /// Places every strand of `field` on `fur`'s base mesh through `mapping`, each gathered into
+    /// the clumps a coat wet by `wet` shows on the shells.
+    ///
+    /// # Errors
+    /// [`ReferenceError::Mapping`] for a mapping that is not finite and positive,
+    /// [`ReferenceError::Wet`] for a wetness or groom clump map not one value per base vertex,
+    /// or a clump size that is not finite and positive.
+    pub fn wet(
+        fur: &FurStructure,
+        field: StrandField,
+        mapping: TileMapping,
+        wet: &WetClumps,
+    ) -> Result<Self, ReferenceError> {
+        let vertices = fur.mesh.vertex_count();
+        if wet.wetness.len() != vertices || wet.groom_clump.as_ref().is_some_and(|c| c.len() != vertices) {
+            return Err(ReferenceError::Wet(format!("wetness and clump maps need {vertices} values, one per vertex")));
+        }
+        if !(wet.clump_size.is_finite() && wet.clump_size > 0.0) {
+            return Err(ReferenceError::Wet(format!("clump size must be finite and positive, got {}", wet.clump_size)));
+        }
+        Self::build(fur, field, mapping, Some(wet))
+    }
+
+    fn build(
+        fur: &FurStructure,
+        field: StrandField,
+        mapping: TileMapping,
+        wet: Option<&WetClumps>,
+    ) -> Result<Self, ReferenceError> {
         let scale = [mapping.tiles_per_uv, mapping.tiles_per_world];
         if !scale.iter().all(|s| s.is_finite() && *s > 0.0) {
             return Err(ReferenceError::Mapping(format!("{mapping:?}")));
@@ -137,9 +182,24 @@ impl StrandReference {
                         return;
                     }
                     let texels_per_world = mapping.tiles_per_world * size;
+                    let corner = mesh.triangles[t].map(|j| j as usize);
+                    let at_root = |value: &dyn Fn(usize) -> f32| {
+                        value(corner[0]) * weights.x + value(corner[1]) * weights.y + value(corner[2]) * weights.z
+                    };
+                    let (wetness, clump) = wet.map_or((0.0, 0.0), |wet| {
+                        (at_root(&|j| wet.wetness[j].clamp(0.0, 1.0)), at_root(&|j| wet.vertex_clump(j)))
+                    });
+                    let cell_texels = wet.map_or(1.0, |wet| wet.clump_size);
                     let nodes = node_heights(strand.length_factor(), layers)
                         .map(|height| {
-                            let shift = strand.centre(height) - strand.root();
+                            let lean = strand.centre(height) - strand.root();
+                            // A wet strand's cross-section gathered into its clump (dry: as is).
+                            let amount = gather_amount(clump, height);
+                            let shift = if amount > 0.0 {
+                                gathered(root, root + lean, amount, cell_texels) - root
+                            } else {
+                                lean
+                            };
                             let mut barycentric = triangle.barycentric(root + shift);
                             // Where the tile is stretched thin over the surface (a squeezed uv
                             // triangle), a few texels of lean would reach far across the mesh:
@@ -163,6 +223,7 @@ impl StrandReference {
                         node_count: nodes.len() as u32,
                         root_radius: 0.0,
                         world_per_texel: local_world_per_texel,
+                        wetness,
                     };
                     placed.push((strand, nodes));
                 });

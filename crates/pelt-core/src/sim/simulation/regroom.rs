@@ -1,0 +1,49 @@
+//! A groom dab on a running simulation: the strands it reshaped take their new rest shape and
+//! skin planes in place, so painting never rebuilds the simulation (the skin planes of every
+//! strand are most of [`Simulation::new`]'s cost).
+
+use super::{SimError, Simulation, skin_planes_of, skin_surface};
+use crate::fur::FurStructure;
+
+impl Simulation {
+    /// Takes `fur`'s rest shape for `strands` (the base vertices whose length or direction a
+    /// groom edit changed; `fur` is this simulation's structure regrown, same mesh and `L`),
+    /// and restarts from the current base and time as a new simulation would. Every other
+    /// setting (wind, field, stability, wetness, colliders, pose) stays. The rest shape and skin
+    /// planes are those [`Simulation::new`] makes from `fur`, to the bit.
+    ///
+    /// # Errors
+    /// [`SimError::Size`] for a structure of another vertex count or layer count, or a strand
+    /// index past its vertices.
+    pub fn regroom(&mut self, fur: &FurStructure, strands: &[u32]) -> Result<(), SimError> {
+        let v = self.vertex_count;
+        let layers = self.layers as usize;
+        if fur.layers != self.layers || fur.vertex_count() != v || fur.positions.len() != v * (layers + 1) {
+            return Err(SimError::Size {
+                what: "the regroomed shared vertex array",
+                expected: v * (layers + 1),
+                got: fur.positions.len(),
+            });
+        }
+        if let Some(&bad) = strands.iter().find(|&&j| j as usize >= v) {
+            return Err(SimError::Size { what: "the regroomed strands' indices", expected: v, got: bad as usize + 1 });
+        }
+        if strands.is_empty() {
+            return Ok(());
+        }
+        self.rest.update(&fur.positions, v, layers, strands);
+        let (cell, planes) = skin_planes_of(fur, strands.iter().map(|&j| j as usize));
+        if cell.to_bits() == self.skin_cell.to_bits() {
+            for (&j, planes) in strands.iter().zip(planes) {
+                self.skin[j as usize] = planes;
+            }
+        } else {
+            // The longest strand changed: the grid, and so every strand's tie order, with it.
+            (self.skin_cell, self.skin) = skin_planes_of(fur, 0..v);
+        }
+        // Which strands need triangles depends on their planes and reach; rebuilt whole, as new.
+        self.surface = skin_surface(fur, &self.skin);
+        self.restart();
+        Ok(())
+    }
+}
