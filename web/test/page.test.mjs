@@ -335,7 +335,6 @@ test('grab: press and hold on the fur grasps it, a drag pulls it, release lets i
   await page.mouse.up();
   await page.waitForFunction(() => window.pelt.stats.grabbing === false, { timeout: 30_000 });
   await useTool(page, 'touch');
-  await frames(page, 4);
 
   // Here the grasp changed 767 pixels, all within 0.6 bunny radius of the press; without the
   // grasp nothing changes (fewer than 50 pixels move with nothing on the fur).
@@ -393,7 +392,6 @@ test('sponge: the fur under it turns darker and the rest keeps its colour', asyn
   const wet = await shot(page, 'sponge-wet');
   await page.click('#dry');
   await page.waitForFunction(() => window.pelt.stats.wettest === 0, { timeout: 30_000 });
-  await frames(page, 6);
 
   // Brightness (sum of channels) of the bunny's pixels near the press and far from it.
   const bg = background(dry);
@@ -488,13 +486,13 @@ test('the groomed Fox draws: bald and shorter where its groom says, longer on th
   await page.click('input[name=scene][value=fox]');
   await page.waitForFunction(() => window.pelt.stats.preset === 'fox_groomed', { timeout: 120_000 });
   await settled(page);
-  await frames(page, 10);
+  await frames(page, 4);
   const groomed = await shot(page, 'fox-groomed');
   // fox.toml: the same coat, uniform at the length the groom gives the Fox's body.
   await setControl(page, '#preset', 'fox');
   await page.waitForFunction(() => window.pelt.stats.preset === 'fox', { timeout: 120_000 });
   await settled(page);
-  await frames(page, 10);
+  await frames(page, 4);
   const uniform = await shot(page, 'fox-uniform');
   assert.ok(await page.$eval('input[name=scene][value=fox]', (e) => e.checked), 'the scene menu does not show the Fox');
 

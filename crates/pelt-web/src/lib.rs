@@ -1,5 +1,6 @@
-//! Pelt in the browser: the bunny and the paper's try-on scene drawn with WebGPU, patted with
-//! pointer events (several at once), with wind, the shipped presets, fur length and colour.
+//! Pelt in the browser: the bunny, the paper's try-on scene and the groomed Fox drawn with
+//! WebGPU, patted, parted with a finger, grasped and sponged wet with pointer events (several at
+//! once), with wind, the shipped presets, fur length and colour.
 //!
 //! [`model`] and [`presets`] hold the page's state and [`page_gpu`] its frame on a GPU device;
 //! none touches a browser API, so they are tested natively (the frame on lavapipe, against
@@ -9,8 +10,10 @@
 #![warn(missing_docs)]
 
 pub mod model;
+pub mod orbit;
 pub mod page_gpu;
 pub mod presets;
+pub mod scene;
 pub mod tools;
 
 #[cfg(target_arch = "wasm32")]

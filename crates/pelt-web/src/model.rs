@@ -3,55 +3,20 @@
 //! orbit camera. Nothing here touches a browser API, so it is tested natively.
 
 use glam::{Vec2, Vec3};
-use pelt_core::mesh::builtin::{TryOnScene, try_on_scene};
 use pelt_core::sim::{FurStepper, Touch};
 use pelt_core::texture::Rgb;
-use pelt_core::{Builtin, FurStructure, ImportOptions, Mesh, Preset};
+use pelt_core::{FurStructure, Mesh, Preset};
 use pelt_render::Camera;
 
-use crate::presets;
+pub use crate::orbit::Orbit;
+pub use crate::scene::{FOX_NAME, SceneChoice};
+use crate::scene::{grow, load_scene, stepper};
 use crate::tools::{Tool, Tools};
 
 /// Touch radius as a fraction of the furred mesh's bounding radius (the viewer's default brush).
 const BRUSH_PER_RADIUS: f32 = 0.25;
 /// A long stall (a tab in the background) must not fast-forward the scene.
 const MAX_FRAME_SECS: f64 = 0.25;
-/// Degrees turned per CSS pixel dragged.
-const ORBIT_DEG_PER_PX: f32 = 0.4;
-
-/// What the page shows.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum SceneChoice {
-    /// The Stanford bunny, furred all over.
-    Bunny,
-    /// The paper's try-on: a plain body wearing a furred skirt.
-    TryOn,
-    /// The glTF Fox in its rest pose (the groomed Fox's mesh).
-    Fox,
-}
-
-impl SceneChoice {
-    /// `"bunny"`, `"tryon"` or `"fox"`.
-    #[must_use]
-    pub fn from_name(name: &str) -> Option<Self> {
-        match name {
-            "bunny" => Some(Self::Bunny),
-            "tryon" => Some(Self::TryOn),
-            "fox" => Some(Self::Fox),
-            _ => None,
-        }
-    }
-
-    /// The name [`SceneChoice::from_name`] takes.
-    #[must_use]
-    pub fn name(self) -> &'static str {
-        match self {
-            Self::Bunny => "bunny",
-            Self::TryOn => "tryon",
-            Self::Fox => "fox",
-        }
-    }
-}
 
 /// Why the page's state could not change; the page shows the message and keeps what it had.
 #[derive(Debug, thiserror::Error)]
@@ -71,53 +36,6 @@ pub enum ModelError {
     /// A value from a control out of its range.
     #[error("{0}")]
     Control(String),
-}
-
-/// An orbit about a target; angles in degrees as `Camera::orbit` takes them.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub struct Orbit {
-    /// The point looked at.
-    pub target: Vec3,
-    /// Turn about +Y, from +Z toward +X.
-    pub azimuth_deg: f32,
-    /// Lift toward +Y.
-    pub elevation_deg: f32,
-    /// Eye to target.
-    pub distance: f32,
-}
-
-impl Orbit {
-    /// The camera of this orbit.
-    #[must_use]
-    pub fn camera(&self) -> Camera {
-        Camera::orbit(self.target, self.azimuth_deg, self.elevation_deg, self.distance)
-    }
-
-    /// Turns by a drag of `drag_css_px` (x right, y down).
-    pub fn rotate(&mut self, drag_css_px: Vec2) {
-        self.azimuth_deg -= drag_css_px.x * ORBIT_DEG_PER_PX;
-        self.elevation_deg = (self.elevation_deg + drag_css_px.y * ORBIT_DEG_PER_PX).clamp(-85.0, 85.0);
-    }
-
-    /// Moves toward the target for `factor < 1` and away for `factor > 1`, within sane bounds.
-    pub fn zoom(&mut self, factor: f32, framed_distance: f32) {
-        if factor.is_finite() && factor > 0.0 {
-            self.distance = (self.distance * factor).clamp(framed_distance * 0.15, framed_distance * 6.0);
-        }
-    }
-
-    /// The world-space ray `(origin, unit direction)` through `pixel` of a view of `size`
-    /// (same units, from the top-left corner).
-    #[must_use]
-    pub fn ray(&self, pixel: Vec2, size: Vec2) -> (Vec3, Vec3) {
-        let size = size.max(Vec2::ONE);
-        let camera = self.camera();
-        let ndc = Vec2::new(pixel.x / size.x * 2.0 - 1.0, 1.0 - pixel.y / size.y * 2.0);
-        let world_from_clip = camera.clip_from_world(size.x / size.y).inverse();
-        let near = world_from_clip.project_point3(ndc.extend(0.0));
-        let far = world_from_clip.project_point3(ndc.extend(1.0));
-        (camera.eye, (far - near).normalize_or((self.target - camera.eye).normalize_or(Vec3::NEG_Z)))
-    }
 }
 
 /// One pointer patting the fur: the touch, and the plane facing the camera it drags across.
@@ -478,45 +396,6 @@ impl Model {
         let time_secs = self.tick(frame_secs)?;
         Ok(self.stepper.advance_to(time_secs)?)
     }
-}
-
-/// The glTF Fox (Khronos sample, CC BY 4.0; see assets/CREDITS.md), embedded: a page reads
-/// no files. Its groom (`fox_groomed.groom`) is tied to this mesh as `Mesh::load` reads it.
-const FOX_GLB: &[u8] = include_bytes!("../../../assets/meshes/Fox.glb");
-/// The Fox's name in messages, as `pelt render` names it.
-pub const FOX_NAME: &str = "assets/meshes/Fox.glb";
-
-/// The furred mesh and the plain body (try-on only).
-fn load_scene(scene: SceneChoice) -> Result<(Mesh, Option<Mesh>), ModelError> {
-    Ok(match scene {
-        SceneChoice::Bunny => (Builtin::Bunny.mesh().0, None),
-        SceneChoice::TryOn => {
-            let TryOnScene { garment, body, .. } = try_on_scene(&ImportOptions::default())?;
-            (garment, Some(body))
-        }
-        SceneChoice::Fox => {
-            (Mesh::from_gltf_slice(FOX_GLB, std::path::Path::new(FOX_NAME), &ImportOptions::default())?.0, None)
-        }
-    })
-}
-
-/// Grows the rest pose of `preset`'s fur on `scene`'s `mesh` (length relative to the mesh's
-/// radius), groomed as its `[groom]` says (from the grooms the page ships).
-fn grow(mesh: Mesh, scene: SceneChoice, preset: &Preset) -> Result<FurStructure, ModelError> {
-    let params = preset.fur_params(&mesh);
-    let mesh_name = match scene {
-        SceneChoice::Fox => FOX_NAME.to_owned(),
-        other => format!("the {} mesh", other.name()),
-    };
-    let groom = presets::web_groom(preset, &mesh, &mesh_name)?;
-    Ok(FurStructure::new_groomed(mesh, &params, groom)?)
-}
-
-/// The simulation of `structure` with `preset`'s `[simulation]` and `[wet]`.
-fn stepper(structure: &FurStructure, preset: &Preset) -> Result<FurStepper, ModelError> {
-    let mut stepper = FurStepper::new(structure, &preset.simulation)?;
-    stepper.set_wet(&preset.wet)?;
-    Ok(stepper)
 }
 
 #[cfg(test)]
