@@ -122,3 +122,29 @@ fn bad_wet_input_is_named_by_file_and_key() {
     assert!(error.contains("pond.toml") && error.contains("water[0].normal"), "{error}");
     let _ = Vec3::ZERO;
 }
+
+/// A sponge on a coat that has been dry for a while wets it, and the water then dries at the
+/// preset's rate from that moment: the dry spell is not replayed over it, nor the clock reset.
+#[test]
+fn a_sponge_after_a_dry_spell_wets_and_dries_from_then() {
+    let fur = bunny_fur();
+    let mut stepper = pelt_core::sim::FurStepper::new(&fur, &SimParams::default()).expect("stepper");
+    let wet = WetParams { drying_per_sec: 0.1, ..WetParams::default() };
+    stepper.set_wet(&wet).expect("wet params");
+    let rate_hz = f64::from(SimParams::default().rate_hz);
+    let mut time_secs = 0.0;
+    while time_secs < 30.0 {
+        time_secs += 1.0 / 30.0;
+        stepper.advance_to(time_secs).expect("dry step");
+    }
+    assert!(stepper.wetness().is_dry());
+    let centre = fur.mesh.positions[0];
+    stepper.sponge(centre, 0.05, 1.0);
+    time_secs += 1.0 / 30.0;
+    stepper.advance_to(time_secs).expect("step after the sponge");
+    let under = stepper.wetness().values()[0];
+    // One frame of drying at most: 1/30 s at 0.1 a second, within a tick of the step's rounding.
+    let most_dried = 0.1 * (1.0 / 30.0 + 1.0 / rate_hz) as f32;
+    assert!(under >= 1.0 - most_dried - 1e-6, "wetness under the sponge {under}, dried by more than a frame");
+    assert!(stepper.simulation().wetness().is_some(), "the simulation sees the water");
+}

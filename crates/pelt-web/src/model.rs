@@ -384,7 +384,7 @@ impl Model {
             held.touch.apply(strength, held.touch.presence(now, release_secs), field.values_mut());
         }
         let radius = self.mesh_radius();
-        self.tools.apply(&mut self.stepper, &self.structure.mesh.normals, radius, now)?;
+        self.tools.apply(&mut self.stepper, radius, now)?;
         Ok(self.clock_secs)
     }
 

@@ -5,7 +5,6 @@
 
 use glam::{Quat, Vec3};
 use pelt_core::sim::{Collider, FurStepper, GraspParams, Shape};
-use pelt_core::wet::{WetSources, WetSurface};
 
 use crate::model::ModelError;
 
@@ -199,35 +198,18 @@ impl Tools {
     }
 
     /// Before the step at `time_secs`: the fingers become the simulation's colliders there, and
-    /// each pressed sponge wets the fur under it. `normals` are the base's (the page does not
-    /// pose it).
+    /// each pressed sponge wets the fur under it.
     ///
     /// # Errors
     /// [`ModelError::Sim`] for a collider the simulation refuses.
-    pub fn apply(
-        &mut self,
-        stepper: &mut FurStepper,
-        normals: &[Vec3],
-        mesh_radius: f32,
-        time_secs: f64,
-    ) -> Result<(), ModelError> {
+    pub fn apply(&mut self, stepper: &mut FurStepper, mesh_radius: f32, time_secs: f64) -> Result<(), ModelError> {
         if !self.fingers.is_empty() || self.fingers_given {
             let colliders: Vec<Collider> =
                 self.fingers.iter().map(|f| finger_collider(f, mesh_radius, time_secs)).collect();
             stepper.simulation_mut().set_colliders(&colliders)?;
             self.fingers_given = !colliders.is_empty();
         }
-        let mut points = self.sponges.iter().filter_map(|s| s.point).peekable();
-        if points.peek().is_some() && stepper.wetness().is_dry() {
-            // The stepper leaves a dry coat's wetness clock where it was last wet (or before its
-            // first tick), and the step would replay the drying (or the start) from there over
-            // the fresh water: the clock comes to now first.
-            let roots = stepper.simulation().roots().to_vec();
-            let rate_hz = stepper.simulation().params().rate_hz;
-            let params = stepper.wet().clone();
-            let surface = WetSurface { positions: &roots, normals, radius: mesh_radius };
-            stepper.wetness_mut().advance_to(time_secs, rate_hz, WetSources::default(), &params, surface);
-        }
+        let points = self.sponges.iter().filter_map(|s| s.point);
         for point in points {
             stepper.sponge(point, SPONGE_PER_RADIUS * mesh_radius, 1.0);
         }

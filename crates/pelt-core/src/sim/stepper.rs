@@ -224,22 +224,24 @@ impl FurStepper {
     /// Advances the wetness to `time_secs` on the posed base and hands it to the simulation.
     fn advance_wetness(&mut self, time_secs: f64) -> Result<(), SimError> {
         let sources = self.scene.as_ref().map(Scene::wet_sources).unwrap_or_default();
+        let simulation = &self.simulation;
         if !sources.is_empty() || !self.wetness.is_dry() {
-            let simulation = &self.simulation;
             self.wet_normals.clear();
             self.wet_normals.extend(simulation.frames().iter().zip(&self.mesh.normals).map(|(q, n)| *q * *n));
-            self.wetness.advance_to(
-                time_secs,
-                simulation.params().rate_hz,
-                sources,
-                &self.wet,
-                WetSurface {
-                    positions: simulation.roots(),
-                    normals: &self.wet_normals,
-                    radius: simulation.bounding_radius(),
-                },
-            );
         }
+        // A dry coat's clock moves too (nothing else to do then), so a sponge on it later is
+        // not dried away by replayed ticks, nor reset as if time had begun.
+        self.wetness.advance_to(
+            time_secs,
+            simulation.params().rate_hz,
+            sources,
+            &self.wet,
+            WetSurface {
+                positions: simulation.roots(),
+                normals: &self.wet_normals,
+                radius: simulation.bounding_radius(),
+            },
+        );
         let wet = (!self.wetness.is_dry()).then(|| self.wetness.values());
         if wet.is_some() || self.simulation.wetness().is_some() {
             self.simulation.set_wetness(wet, &self.wet)?;
