@@ -3,8 +3,10 @@
 //! with pelt-core and simulates it (the fur swings as the Fox moves).
 //!
 //! `cargo run --release -p bevy_pelt --example fox [--ignore-rust-version] -- [PRESET] [--screenshot PNG]`
-//! (PRESET is relative to the repository's `assets/`, default `presets/fox.toml`: the Fox's own
-//! texture carried into its fur).
+//! (PRESET is relative to the repository's `assets/`, default `presets/fox_groomed.toml`: the
+//! Fox's own texture carried into its fur, groomed by `fox_groomed.groom`: bald eyes, nose and
+//! inner ears, a short face and legs, a long tail and a chest ruff; editing the preset or the
+//! groom file while the example runs regrows the fur).
 //!
 //! Right-drag orbits, the wheel zooms. 1, 2 and 3 play Survey, Walk and Run; Space pauses.
 //! `--screenshot PNG` saves a frame and exits.
@@ -38,7 +40,7 @@ fn main() {
                 screenshot_frame: 120,
             },
         ))
-        .insert_resource(Args::from_env("presets/fox.toml"))
+        .insert_resource(Args::from_env("presets/fox_groomed.toml"))
         .add_systems(Startup, setup)
         .add_systems(Update, (grow_fur, animation_keys))
         .run();

@@ -1,6 +1,7 @@
-//! The main world: the [`Fur`] component, building a fur from its mesh and preset, and the
-//! simulation systems (gravity, [`FurWind`], [`FurTouch`], the base following the entity's
-//! transform or Bevy's skeleton, with pelt-core's inertia).
+//! The main world: the [`Fur`] component, building a fur from its mesh and preset (groomed by
+//! its `[groom]` table), and the simulation systems (gravity, [`FurWind`], [`FurTouch`], the
+//! base following the entity's transform or Bevy's skeleton, with pelt-core's inertia; the
+//! colliders, grasps and sponges of [`crate::contact`] and [`crate::wet`]).
 //!
 //! pelt-core simulates the base where it is in the world (divided by one uniform scale, see
 //! [`crate::base`]), so the roots' acceleration is the body's and pelt-core's `Inertia` makes the
@@ -20,12 +21,15 @@ use bevy::shape::Ray3d;
 use pelt_core::anim::Skin;
 use pelt_core::sim::{FurStepper, WindParams};
 use pelt_core::texture::FurTextures;
+use pelt_core::wet::WetParams;
 use pelt_core::{FurStructure, Simulation};
 
 use crate::base::Base;
+use crate::contact::{FurCollider, FurGrasp, Grasps, apply_colliders, apply_grasp};
 use crate::convert::{to_pelt, to_pelt_affine, to_pelt_mat4};
 use crate::mesh::{pelt_mesh, pelt_skin};
 use crate::preset::FurPreset;
+use crate::wet::{FurSponge, apply_sponges};
 
 /// Grows fur on this entity's [`Mesh3d`] from a [`FurPreset`].
 ///
@@ -130,6 +134,12 @@ pub struct FurState {
     skin: Option<Skin>,
     base: Base,
     radius: f32,
+    /// The [`FurGrasp`] entity this fur follows.
+    holding: Option<Entity>,
+    /// The wetness per base vertex this frame, `None` while dry.
+    pub(crate) wetness: Option<Arc<Vec<f32>>>,
+    /// The preset's `[wet]`: what wetness does to the look.
+    pub(crate) wet: WetParams,
 }
 
 impl FurState {
@@ -147,10 +157,16 @@ impl FurState {
         self.world_from_simulation
     }
 
-    /// The unified shell-and-fin structure at rest.
+    /// The unified shell-and-fin structure at rest (its `groom`, when the preset has one).
     #[must_use]
     pub fn structure(&self) -> &FurStructure {
         &self.structure
+    }
+
+    /// Each base vertex's wetness in `0..=1`, as the last step left it.
+    #[must_use]
+    pub fn wetness(&self) -> &[f32] {
+        self.stepper.wetness().values()
     }
 }
 
@@ -225,9 +241,11 @@ fn build(
     }
     let params = preset.preset.fur_params(&mesh);
     let radius = mesh.bounding_sphere().1;
-    let structure = FurStructure::new(mesh, &params).map_err(|e| format!("{}: {e}", preset.preset.file().display()))?;
-    let stepper = FurStepper::new(&structure, &preset.preset.simulation)
-        .map_err(|e| format!("{}: {e}", preset.preset.file().display()))?;
+    let groom = preset.groom(&mesh, label).map_err(|e| e.to_string())?;
+    let file = preset.preset.file().display();
+    let structure = FurStructure::new_groomed(mesh, &params, groom).map_err(|e| format!("{file}: {e}"))?;
+    let mut stepper = FurStepper::new(&structure, &preset.preset.simulation).map_err(|e| format!("{file}: {e}"))?;
+    stepper.set_wet(&preset.preset.wet).map_err(|e| format!("{file}: {e}"))?;
     let positions = Arc::new(stepper.simulation().positions().to_vec());
     Ok(FurState {
         structure: Arc::new(structure),
@@ -243,6 +261,9 @@ fn build(
         skin,
         base: Base::default(),
         radius,
+        holding: None,
+        wetness: None,
+        wet: preset.preset.wet.clone(),
     })
 }
 
@@ -254,11 +275,21 @@ pub(crate) fn simulate_furs(
     presets: Res<Assets<FurPreset>>,
     bindposes: Res<Assets<SkinnedMeshInverseBindposes>>,
     joints: Query<&GlobalTransform>,
+    colliders: Query<(Entity, &FurCollider, &GlobalTransform)>,
+    grasps: Query<(Entity, &FurGrasp, &GlobalTransform)>,
+    sponges: Query<(&FurSponge, &GlobalTransform)>,
     mut touch: ResMut<FurTouch>,
     mut furs: FurQuery,
 ) {
     let now = time.elapsed_secs_f64();
     update_touch(&mut touch, &mut furs);
+    let mut colliders: Vec<(Entity, FurCollider, GlobalTransform)> =
+        colliders.iter().map(|(entity, collider, transform)| (entity, *collider, *transform)).collect();
+    colliders.sort_by_key(|(entity, ..)| *entity);
+    let mut grasps: Grasps =
+        grasps.iter().map(|(entity, grasp, transform)| (entity, *grasp, transform.translation())).collect();
+    grasps.sort_by_key(|(entity, ..)| *entity);
+    let sponges: Vec<_> = sponges.iter().map(|(sponge, transform)| (transform.translation(), *sponge)).collect();
     let mut joint_matrices = Vec::new();
     for (entity, fur, transform, skinned, mut state) in &mut furs {
         let state = &mut *state;
@@ -277,6 +308,15 @@ pub(crate) fn simulate_furs(
             error!("fur on {entity}: {problem}");
             continue;
         }
+        let scale = base.scale;
+        let simulation = state.stepper.simulation_mut();
+        if let Err(problem) = apply_colliders(simulation, &colliders, scale, now) {
+            error!("fur on {entity}: {problem}");
+        }
+        if let Err(problem) = apply_grasp(simulation, &mut state.holding, &grasps, scale, now) {
+            error!("fur on {entity}: {problem}");
+        }
+        apply_sponges(&mut state.stepper, &sponges, scale);
         state.world_from_simulation = base.world_from_simulation();
         state.centre_world = state.world_from_simulation.transform_point3(box_centre(&base.positions));
         let mut params = state.stepper.simulation().params().clone();
@@ -300,6 +340,8 @@ pub(crate) fn simulate_furs(
         }
         state.positions = Arc::new(state.stepper.simulation().positions().to_vec());
         state.normals = Arc::new(state.base.normals.clone());
+        let wetness = state.stepper.wetness();
+        state.wetness = (!wetness.is_dry()).then(|| Arc::new(wetness.values().to_vec()));
     }
 }
 

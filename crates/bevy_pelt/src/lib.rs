@@ -21,6 +21,13 @@
 //!
 //! - [`Fur`] on an entity with a `Mesh3d` grows fur from a [`FurPreset`] (a `.toml` asset, hot
 //!   reloaded with Bevy's `file_watcher` feature; a bad file is an asset load error naming it).
+//!   A preset's `[groom]` (a `.groom` file, PNG maps) loads with it and reloads when its files
+//!   change: bald, short, long, combed, clumped and tinted regions.
+//! - [`FurCollider`] (sphere, capsule, box, plane) on any entity pushes every fur out of its
+//!   shape, following the entity's `GlobalTransform` (a physics body, an animated prop); a fast
+//!   one sweeps the fur along its path. [`FurGrasp`] is a hand a host moves, closes and opens.
+//! - [`FurSponge`] wets (or dries) the fur it touches; the preset's `[wet]` says what wetness
+//!   does (heavier, softer strands; darker, shinier, clumped look) and how fast it dries.
 //! - The simulation runs in `PostUpdate` after transforms (and after Bevy's animation): the
 //!   preset's gravity (world space), [`FurWind`], touch from a ray ([`FurTouch`]), and pelt-core's
 //!   inertia (the fur lags, swings and settles as the base accelerates). The base follows the
@@ -39,11 +46,13 @@
 #![allow(clippy::type_complexity, clippy::too_many_arguments)]
 
 mod base;
+mod contact;
 mod convert;
 mod fur;
 mod mesh;
 mod preset;
 mod render;
+mod wet;
 
 use bevy::app::{App, Plugin, PostUpdate};
 use bevy::asset::AssetApp;
@@ -53,6 +62,7 @@ use bevy::ecs::schedule::IntoScheduleConfigs;
 use bevy::render::{ExtractSchedule, Render, RenderApp, RenderSystems};
 use bevy::transform::TransformSystems;
 
+pub use contact::{FurCollider, FurGrasp, FurShape};
 pub use fur::{Fur, FurState, FurTouch, FurWind};
 /// Pelt's core (presets, structure, simulation).
 pub use pelt_core;
@@ -60,6 +70,7 @@ pub use pelt_core;
 pub use pelt_render;
 pub use preset::{FurPreset, FurPresetLoader};
 pub use render::FurLight;
+pub use wet::FurSponge;
 
 /// Adds fur: the [`FurPreset`] asset and loader, the build and simulation systems, and the
 /// render-world extraction, upload and drawing. Add it after Bevy's `DefaultPlugins`.

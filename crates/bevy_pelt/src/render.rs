@@ -17,6 +17,7 @@ use bevy::render::view::{ExtractedView, Msaa, ResolvedCompositingSpace, ViewDept
 use pelt_core::FurStructure;
 use pelt_core::sim::SimParams;
 use pelt_core::texture::FurTextures;
+use pelt_core::wet::WetParams;
 use pelt_render::{
     FurDrawSettings, FurDriver, FurRenderer, FurTarget, FurView, KernelChoice, Light, LightDirection, ViewData,
 };
@@ -77,6 +78,8 @@ struct ExtractedFur {
     world_from_simulation: glam::Mat4,
     centre_world: glam::Vec3,
     skin: bool,
+    wetness: Option<Arc<Vec<f32>>>,
+    wet: WetParams,
 }
 
 pub(crate) fn extract_furs(
@@ -112,6 +115,8 @@ pub(crate) fn extract_furs(
             world_from_simulation: state.world_from_simulation,
             centre_world: state.centre_world,
             skin: fur.skin,
+            wetness: state.wetness.clone(),
+            wet: state.wet.clone(),
         });
     }
 }
@@ -241,6 +246,9 @@ pub(crate) fn prepare_furs(
             }
             let Some(entry) = gpu.furs.get_mut(&key) else { continue };
             entry.fur.set_world_from_model(fur.world_from_simulation);
+            if let Err(problem) = entry.fur.show_wet(queue, fur.wetness.as_deref().map(Vec::as_slice), &fur.wet) {
+                error!("Pelt cannot show the wetness of {}: {problem}", fur.entity);
+            }
             // Before the first simulated frame the normals are the rest ones the fur starts with.
             let normals = (!fur.normals.is_empty()).then_some(&fur.normals[..]);
             if let Err(problem) = entry.fur.show_state(queue, &fur.positions, normals) {

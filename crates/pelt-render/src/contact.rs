@@ -3,7 +3,7 @@
 //! `ContactStep` per step slot, its skin planes and the grasp's weights.
 
 use pelt_core::FurStructure;
-use pelt_core::sim::contact::{MAX_STEP_COLLIDERS, SKIN_PLANES, skin_planes};
+use pelt_core::sim::contact::{MAX_STEP_COLLIDERS, SKIN_PLANES, SURFACE_WORDS, SkinSurface, skin_planes, skin_surface};
 use pelt_core::sim::{ContactStep, ContactStrands};
 
 /// Step slots: one per slot of the simulation's uniform ring.
@@ -30,21 +30,61 @@ fn colliders_first(v: usize, slot: usize) -> usize {
     weights_first(v) + v.div_ceil(4) + slot * MAX_STEP_COLLIDERS * COLLIDER_WORDS
 }
 
-impl GpuContact {
-    /// The buffer's size in bytes for `v` strands.
-    pub fn bytes(v: usize) -> u64 {
-        colliders_first(v, CONTACT_SLOTS) as u64 * 16
+// A strand's header packs its triangle count in 6 bits.
+const _: () = assert!(pelt_core::sim::contact::surface::MAX_STRAND_TRIANGLES < 64);
+
+/// The skin's planes and triangles of one fur, as the buffer packs them.
+pub(crate) struct Skin {
+    planes: Vec<[glam::Vec4; SKIN_PLANES]>,
+    surface: SkinSurface,
+}
+
+impl Skin {
+    /// `structure`'s skin planes and triangles (`pelt_core::sim::contact`).
+    pub fn new(structure: &FurStructure) -> Self {
+        let planes = skin_planes(structure);
+        let surface = skin_surface(structure, &planes);
+        Self { planes, surface }
     }
 
-    /// The buffer with `structure`'s skin planes and no collider or grasp.
-    pub fn new(device: &wgpu::Device, structure: &FurStructure) -> Self {
+    /// vec4s of the triangle part: a header per strand (rest root, `first << 6 | count`), the
+    /// lists four indices a vec4, then the triangles.
+    fn words(&self) -> usize {
+        self.planes.len() + self.surface.lists.len().div_ceil(4) + self.surface.triangles.len() * SURFACE_WORDS
+    }
+}
+
+impl GpuContact {
+    /// The buffer's size in bytes for `skin`'s fur.
+    pub fn bytes(skin: &Skin) -> u64 {
+        (colliders_first(skin.planes.len(), CONTACT_SLOTS) + skin.words()) as u64 * 16
+    }
+
+    /// The buffer with `structure`'s skin planes and triangles and no collider or grasp.
+    pub fn new(device: &wgpu::Device, structure: &FurStructure, skin: &Skin) -> Self {
         let v = structure.vertex_count();
         let mut words = vec![[0.0_f32; 4]; colliders_first(v, CONTACT_SLOTS)];
-        for (j, planes) in skin_planes(structure).iter().enumerate() {
+        for (j, planes) in skin.planes.iter().enumerate() {
             for (p, plane) in planes.iter().enumerate() {
                 words[SKIN_FIRST + j * SKIN_PLANES + p] = plane.to_array();
             }
         }
+        // The triangles (`simulation_contact.wgsl`'s `surface_closest`).
+        let surface = &skin.surface;
+        for (j, [first, count]) in surface.strands.iter().enumerate() {
+            let root = structure.positions[j];
+            words.push(root.extend(f32::from_bits((first << 6) | count)).to_array());
+        }
+        // Each list entry is its triangle's first vec4, counted from the strands' headers.
+        let triangles_first = (v + surface.lists.len().div_ceil(4)) as u32;
+        words.extend(surface.lists.chunks(4).map(|c| {
+            let mut w = [0.0_f32; 4];
+            for (slot, index) in w.iter_mut().zip(c) {
+                *slot = f32::from_bits(triangles_first + index * SURFACE_WORDS as u32);
+            }
+            w
+        }));
+        words.extend(surface.triangles.iter().flat_map(|t| t.map(|w| w.to_array())));
         let buffer = wgpu::util::DeviceExt::create_buffer_init(
             device,
             &wgpu::util::BufferInitDescriptor {

@@ -298,10 +298,25 @@ impl FurDriver {
     /// values uploaded while any vertex is wet, the shaders' wet paths off when none is.
     fn show_wetness(&mut self, queue: &wgpu::Queue, stepper: &FurStepper) -> Result<(), RenderError> {
         let wetness = stepper.wetness();
-        self.frame.wet = !wetness.is_dry();
-        self.frame.look = self.frame.look.with_wet(stepper.wet());
-        if self.frame.wet {
-            self.fur.set_wetness(queue, wetness.values())?;
+        self.show_wet(queue, (!wetness.is_dry()).then(|| wetness.values()), stepper.wet())
+    }
+
+    /// Shows a wetness simulated elsewhere (a host whose [`FurStepper`] lives apart, as for
+    /// [`FurDriver::show_state`]): `wetness` per base vertex in `0..=1` (`None` when dry, which
+    /// draws the dry bytes) and what it does to the look (`wet`, the preset's `[wet]`).
+    ///
+    /// # Errors
+    /// [`RenderError::Count`] unless there are `V` values.
+    pub fn show_wet(
+        &mut self,
+        queue: &wgpu::Queue,
+        wetness: Option<&[f32]>,
+        wet: &pelt_core::wet::WetParams,
+    ) -> Result<(), RenderError> {
+        self.frame.wet = wetness.is_some();
+        self.frame.look = self.frame.look.with_wet(wet);
+        if let Some(values) = wetness {
+            self.fur.set_wetness(queue, values)?;
         }
         Ok(())
     }
@@ -493,9 +508,27 @@ pub fn gpu_secs_per_step(
     steps: u32,
     runs: usize,
 ) -> Result<f64, RenderError> {
+    let mut stepper = FurStepper::new(structure, params)?;
+    gpu_secs_per_step_of(device, queue, renderer, structure, params, &mut stepper, steps, runs)
+}
+
+/// [`gpu_secs_per_step`] with the host's own `stepper` (colliders placed, a body set, a script).
+///
+/// # Errors
+/// As [`gpu_secs_per_step`].
+#[allow(clippy::too_many_arguments)]
+pub fn gpu_secs_per_step_of(
+    device: &wgpu::Device,
+    queue: &wgpu::Queue,
+    renderer: &FurRenderer,
+    structure: &FurStructure,
+    params: &SimParams,
+    stepper: &mut FurStepper,
+    steps: u32,
+    runs: usize,
+) -> Result<f64, RenderError> {
     let mut driver =
         FurDriver::new(device, queue, renderer, structure, &FurTextures::blank(), params, KernelChoice::Gpu)?;
-    let mut stepper = FurStepper::new(structure, params)?;
     let rate = f64::from(params.rate_hz);
     let mut step = 1_u32;
     let mut run = |driver: &mut FurDriver| -> Result<f64, RenderError> {
@@ -504,7 +537,7 @@ pub fn gpu_secs_per_step(
         // Each step takes its own uniform slot of the GPU simulation's ring (up to 64 a
         // submission), so every dispatch bends with its own step's inputs.
         for _ in 0..steps {
-            driver.advance_to(device, queue, &mut stepper, f64::from(step) / rate)?;
+            driver.advance_to(device, queue, stepper, f64::from(step) / rate)?;
             step += 1;
             driver.record(&mut encoder)?;
         }

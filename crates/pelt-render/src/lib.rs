@@ -129,7 +129,7 @@ mod textures;
 mod view;
 
 pub use camera::Camera;
-pub use driver::{FurDriver, KernelChoice, SimKernel, cpu_secs_per_step, gpu_secs_per_step};
+pub use driver::{FurDriver, KernelChoice, SimKernel, cpu_secs_per_step, gpu_secs_per_step, gpu_secs_per_step_of};
 pub use error::RenderError;
 pub use fur::{FurStates, GpuFur};
 pub use geometry::POSITIONS_USAGE;

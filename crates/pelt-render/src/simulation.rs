@@ -14,7 +14,7 @@ use pelt_core::FurStructure;
 use pelt_core::sim::{ContactStep, InertiaStep, InputVersions, Simulation, StepInputs, StrandInputs, kernel_rest};
 
 use crate::RenderError;
-use crate::contact::{CONTACT_SLOTS, GpuContact};
+use crate::contact::{CONTACT_SLOTS, GpuContact, Skin};
 use crate::fur::GpuFur;
 use crate::requirements::{ErrorScope, check_size};
 use crate::shaders::simulation_shader_source;
@@ -352,8 +352,9 @@ impl GpuSimulation {
             v.max(1) as u64 * STATE_BYTES,
             storage_usage | wgpu::BufferUsages::COPY_SRC,
         );
-        check_size(device, "simulation contact", GpuContact::bytes(v))?;
-        let contact = GpuContact::new(device, structure);
+        let skin = Skin::new(structure);
+        check_size(device, "simulation contact", GpuContact::bytes(&skin))?;
+        let contact = GpuContact::new(device, structure, &skin);
         let wet = WetInputs::new(device, v);
         scope.pop("creating the GPU simulation")?;
         Ok(Self {

@@ -365,7 +365,11 @@ fn worst_segment_error(structure: &FurStructure, positions: &[Vec3]) -> f32 {
 /// The same fur on both kernels with contact: the skin under strong gravity and downward wind, a
 /// ball, a thin capsule and a box moving through the fur on the back, a hand lifting a tuft and
 /// letting go. At every step at least 99% of the nodes agree within the bound of the other
-/// agreement tests (1e-4 strand lengths).
+/// agreement tests (1e-4 strand lengths) and every node within 0.15. Contact's response is
+/// continuous where it can be (friction ramps in with depth, the grip's segment turns in part, a
+/// turn's side is pinned where the least turn's is ill-conditioned), so a collider's side no
+/// longer flips on a last-bit difference; a node whose end lies on the medial axis of a concave
+/// spot of the skin can still take the other face's plane.
 #[test]
 fn gpu_and_cpu_agree_with_contact() {
     use pelt_core::sim::{Collider, ContactParams, GraspParams, Shape};
@@ -447,6 +451,7 @@ fn gpu_and_cpu_agree_with_contact() {
             current.len()
         );
         most_apart = most_apart.max(apart);
+        assert!(difference <= 0.15, "step {step}: a node is {difference} strand lengths from the CPU's");
         worst = worst.max(difference);
         moved = moved.max(worst_relative_difference(&structure, &current, &structure.positions));
     }

@@ -5,6 +5,7 @@
 //! a reader (or CI) runs in one go.
 
 mod anim;
+mod contact;
 mod models;
 mod render;
 mod report;
@@ -50,6 +51,10 @@ pub struct Args {
     /// 1e-5 of its strand's length.
     #[arg(long)]
     pub soak: bool,
+    /// Instead of the report: the kernels' node updates per second on the bunny at 32 layers
+    /// with contact off, the skin only, and the skin with 8 colliders, CPU and GPU.
+    #[arg(long, conflicts_with = "soak")]
+    pub contact: bool,
     /// Time the models with this preset (its look, textures, simulation and groom; the layer
     /// counts stay the table's) instead of the default one, e.g. a groomed Fox against the
     /// uniform coat: `--model fox --preset assets/presets/fox_groomed.toml`. Its groom must fit
@@ -141,6 +146,9 @@ impl Plan<'_> {
 pub fn run(args: &Args) -> anyhow::Result<()> {
     if args.soak {
         return soak::run(args.steps, args.gpu_steps);
+    }
+    if args.contact {
+        return contact::run(args.quick);
     }
     let started = Instant::now();
     for name in &args.models {

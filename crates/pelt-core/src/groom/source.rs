@@ -105,11 +105,31 @@ impl GroomParams {
         mesh_name: &str,
         resolve: impl Fn(&Path) -> PathBuf,
     ) -> Result<Option<Groom>, GroomError> {
+        self.load_with(mesh, mesh_name, resolve, |path| std::fs::read(path))
+    }
+
+    /// [`GroomParams::load`] reading each file's bytes with `read` (a host with its own asset
+    /// I/O, such as Bevy's asset server, hands over the bytes it read for the resolved path).
+    ///
+    /// # Errors
+    /// As [`GroomParams::load`]; `read`'s error becomes [`GroomError::Io`] (the groom file) or
+    /// [`GroomError::Image`] (a map) naming the file.
+    pub fn load_with(
+        &self,
+        mesh: &Mesh,
+        mesh_name: &str,
+        resolve: impl Fn(&Path) -> PathBuf,
+        read: impl Fn(&Path) -> std::io::Result<Vec<u8>>,
+    ) -> Result<Option<Groom>, GroomError> {
         if self.is_empty() {
             return Ok(None);
         }
         let mut groom = match &self.file {
-            Some(file) => Groom::load(&resolve(file), mesh, mesh_name)?,
+            Some(file) => {
+                let file = resolve(file);
+                let bytes = read(&file).map_err(|error| GroomError::Io { file: file.clone(), error })?;
+                Groom::from_file_bytes(&bytes, &file, mesh, mesh_name)?
+            }
             None => Groom::default(),
         };
         for map in GroomMap::ALL {
@@ -122,7 +142,8 @@ impl GroomParams {
                     if mesh.corner_uvs.is_none() {
                         return Err(GroomError::NoUvs { key, image, mesh: mesh_name.to_owned() });
                     }
-                    let decoded = MapImage::load(&image).map_err(error)?;
+                    let bytes = read(&image).map_err(|e| error(e.to_string()))?;
+                    let decoded = MapImage::decode(&bytes).map_err(error)?;
                     if map == GroomMap::Direction && !decoded.has_colour {
                         return Err(error(
                             "a direction map needs red and green channels, but this image is grey".to_owned(),
@@ -205,13 +226,9 @@ struct MapImage {
 
 impl MapImage {
     /// Decodes an 8- or 16-bit PNG.
-    fn load(path: &Path) -> Result<Self, String> {
-        if !path.is_file() {
-            return Err("no such file".to_owned());
-        }
-        let reader = image::ImageReader::open(path)
-            .and_then(image::ImageReader::with_guessed_format)
-            .map_err(|e| e.to_string())?;
+    fn decode(bytes: &[u8]) -> Result<Self, String> {
+        let reader =
+            image::ImageReader::new(std::io::Cursor::new(bytes)).with_guessed_format().map_err(|e| e.to_string())?;
         if reader.format() != Some(image::ImageFormat::Png) {
             return Err("not a PNG (groom maps are 8- or 16-bit PNG)".to_owned());
         }

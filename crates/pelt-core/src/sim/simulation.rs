@@ -14,7 +14,8 @@ use rayon::prelude::*;
 
 use super::contact::skin::skin_planes_of;
 use super::contact::{
-    Collider, ContactStep, ContactStrands, Grasp, GraspParams, MAX_STEP_COLLIDERS, Resolve, SKIN_PLANES, StepCollider,
+    Collider, ContactStep, ContactStrands, Grasp, GraspParams, MAX_STEP_COLLIDERS, Resolve, SKIN_PLANES, SkinSurface,
+    StepCollider, skin_surface,
 };
 use super::dispatch::{self, CpuKernel};
 use super::field::{ForceField, Touch};
@@ -151,6 +152,8 @@ pub struct Simulation {
     touch_on_step_roots: bool,
     /// Each strand's skin planes (see `contact::skin`).
     skin: Vec<[Vec4; SKIN_PLANES]>,
+    /// The skin triangles where the planes do not suffice (see `contact::surface`).
+    surface: SkinSurface,
     /// The grid cell the skin planes were found in (the longest strand's reach).
     skin_cell: f32,
     /// Colliders the host or a script placed.
@@ -225,6 +228,7 @@ impl Simulation {
             },
             roots_moved: false,
             touch_on_step_roots: false,
+            surface: skin_surface(fur, &skin),
             skin,
             skin_cell,
             colliders: Vec::new(),
@@ -686,7 +690,12 @@ impl Simulation {
     /// The per-strand contact inputs: skin planes and the grasp's weights.
     #[must_use]
     pub fn contact_strands(&self) -> ContactStrands<'_> {
-        ContactStrands { skin: &self.skin, grasp_weights: self.grasp.as_ref().map_or(&[], |g| g.weights()) }
+        ContactStrands {
+            skin: &self.skin,
+            grasp_weights: self.grasp.as_ref().map_or(&[], |g| g.weights()),
+            surface: &self.surface,
+            rest_roots: &self.rest_roots,
+        }
     }
 
     /// The nearest hit of a ray with the base mesh at its current root positions.

@@ -8,7 +8,12 @@
 //   from CONTACT_SKIN: SKIN_PLANES planes per strand (n xyz in the rest frame, h);
 //   then ceil(V / 4) vec4s of grasp weights, 4 strands each;
 //   then per slot CONTACT_COLLIDERS colliders of 5 vec4s: (centre, radius),
-//     (half extents, kind as bits), rotation, (travel, friction), (bound, grasp hand, -, -).
+//     (half extents, kind as bits), rotation, (travel, friction), (bound, grasp hand, -, -);
+//   then the skin's triangles (`contact::surface`), from `surface_first`: per strand (rest root,
+//     first << 6 | count as bits), the lists (each entry its triangle's first vec4 from
+//     `surface_first`), the triangles of 10 vec4s (a, b, c, face normal, edge ab, bc, ca and
+//     corner a, b, c pseudonormals; a bounding ball's centre in a, b, c's w, its radius in the
+//     face normal's).
 
 @group(0) @binding(5) var<storage, read> contact: array<vec4<f32>>;
 
@@ -19,6 +24,9 @@ const CONTACT_COLLIDERS: u32 = 128u;
 const COLLIDER_WORDS: u32 = 5u;
 const NEAR_COLLIDERS: u32 = 32u;
 const CONTACT_MARGIN: f32 = 1e-5;
+const CONTACT_SIDE_BIAS: f32 = 0.01;
+const CONTACT_FRICTION_DEPTH: f32 = 0.25;
+const CONTACT_SKIP_SLACK: f32 = 1.001;
 
 struct Closest {
     surface: vec3<f32>,
@@ -103,14 +111,124 @@ fn normalize_or(x: vec3<f32>, fallback: vec3<f32>) -> vec3<f32> {
 }
 
 // `contact::turn_above`: the unit direction nearest `u` with `n . result >= floor`.
-fn turn_above(u: vec3<f32>, n: vec3<f32>, floor_in: f32) -> vec3<f32> {
+// A little of `hint` picks the side where `u` points against `n` (`CONTACT_SIDE_BIAS`).
+fn turn_above(u: vec3<f32>, n: vec3<f32>, floor_in: f32, hint: vec3<f32>) -> vec3<f32> {
     let floor = clamp(floor_in, -1.0, 1.0);
     let along = dot(n, u);
     if along >= floor {
         return u;
     }
-    let side = normalize_or(u - n * along, any_orthonormal(n));
+    let side = normalize_or((u - n * along) + (hint - n * dot(n, hint)) * CONTACT_SIDE_BIAS, any_orthonormal(n));
     return normalize(n * floor + side * sqrt(max(1.0 - floor * floor, 0.0)));
+}
+
+fn surface_first(v: u32) -> u32 {
+    return CONTACT_SKIN + SKIN_PLANES * v + (v + 3u) / 4u + CONTACT_SLOTS * CONTACT_COLLIDERS * COLLIDER_WORDS;
+}
+
+// One strand's skin triangles, posed with its root and frame.
+struct Surface {
+    first: u32,
+    count: u32,
+    rest_root: vec3<f32>,
+    root: vec3<f32>,
+    frame: vec4<f32>,
+}
+
+fn list_entry(base: u32, i: u32) -> u32 {
+    return bitcast<u32>(contact[base + i / 4u][i % 4u]);
+}
+
+// `surface::closest_feature`: the closest point of triangle abc to p and its feature's word.
+fn closest_feature(p: vec3<f32>, a: vec3<f32>, b: vec3<f32>, c: vec3<f32>) -> vec4<f32> {
+    let ab = b - a;
+    let ac = c - a;
+    let ap = p - a;
+    let d1 = dot(ab, ap);
+    let d2 = dot(ac, ap);
+    if d1 <= 0.0 && d2 <= 0.0 {
+        return vec4<f32>(a, 7.0);
+    }
+    let bp = p - b;
+    let d3 = dot(ab, bp);
+    let d4 = dot(ac, bp);
+    if d3 >= 0.0 && d4 <= d3 {
+        return vec4<f32>(b, 8.0);
+    }
+    let vc = d1 * d4 - d3 * d2;
+    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
+        return vec4<f32>(a + ab * (d1 / (d1 - d3)), 4.0);
+    }
+    let cp = p - c;
+    let d5 = dot(ab, cp);
+    let d6 = dot(ac, cp);
+    if d6 >= 0.0 && d5 <= d6 {
+        return vec4<f32>(c, 9.0);
+    }
+    let vb = d5 * d2 - d1 * d6;
+    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
+        return vec4<f32>(a + ac * (d2 / (d2 - d6)), 6.0);
+    }
+    let va = d3 * d6 - d5 * d4;
+    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
+        return vec4<f32>(b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6))), 5.0);
+    }
+    let denominator = 1.0 / (va + vb + vc);
+    return vec4<f32>(a + ab * (vb * denominator) + ac * (vc * denominator), 3.0);
+}
+
+// `SkinSurface::closest_posed`: the closest point, pseudonormal and signed distance of the
+// strand's triangles to world point x (distance +inf without triangles).
+fn surface_closest(s: Surface, x: vec3<f32>, v: u32) -> Closest {
+    var best = Closest(x, vec3<f32>(0.0, 1.0, 0.0), 3.4e38);
+    if s.count == 0u {
+        return best;
+    }
+    let origin = surface_first(v);
+    let local = s.rest_root + rotate(conjugate(s.frame), x - s.root);
+    var best_d2 = 3.4e38;
+    var found = false;
+    for (var i = 0u; i < s.count; i++) {
+        let t = origin + list_entry(origin + v + s.first / 4u, s.first % 4u + i);
+        let ball = length(local - vec3<f32>(contact[t].w, contact[t + 1u].w, contact[t + 2u].w)) - contact[t + 3u].w;
+        if found && ball > 0.0 && ball * ball >= best_d2 {
+            continue;
+        }
+        let hit = closest_feature(local, contact[t].xyz, contact[t + 1u].xyz, contact[t + 2u].xyz);
+        let gap = local - hit.xyz;
+        let d2 = dot(gap, gap);
+        if !found || d2 < best_d2 {
+            found = true;
+            best_d2 = d2;
+            best.surface = hit.xyz;
+            best.normal = contact[t + u32(hit.w)].xyz;
+        }
+    }
+    let distance = sqrt(best_d2);
+    let signed = select(distance, -distance, dot(best.normal, local - best.surface) < 0.0);
+    return Closest(s.root + rotate(s.frame, best.surface - s.rest_root), rotate(s.frame, best.normal), signed);
+}
+
+// `contact::clearance`: how far x is from touching a skin plane, a collider or the skin's
+// triangles (negative: touching).
+fn clearance(
+    x: vec3<f32>,
+    root: vec3<f32>,
+    planes: ptr<function, array<vec4<f32>, 8>>,
+    plane_count: u32,
+    near: ptr<function, array<u32, 32>>,
+    near_count: u32,
+    surface: Surface,
+    v: u32,
+) -> f32 {
+    var least = 3.4e38;
+    for (var p = 0u; p < plane_count; p++) {
+        least = min(least, dot((*planes)[p].xyz, x - root) + (*planes)[p].w);
+    }
+    for (var i = 0u; i < near_count; i++) {
+        least = min(least, collider_closest((*near)[i], x).distance);
+    }
+    return min(least, surface_closest(surface, x, v).distance);
 }
 
 fn strand_grasp_weight(j: u32, v: u32) -> f32 {
@@ -160,20 +278,23 @@ fn contact_strand(j: u32, v: u32, layers: u32, root: vec3<f32>, frame: vec4<f32>
             near_count += 1u;
         }
     }
+    var surface = Surface(0u, 0u, vec3<f32>(0.0), root, frame);
+    if skin {
+        let header = contact[surface_first(v) + j];
+        let packed = bitcast<u32>(header.w);
+        surface = Surface(packed >> 6u, packed & 63u, header.xyz, root, frame);
+    }
     // Whether anything touches the strand; if not, it stays as the bend made it.
+    // `Resolve::solve_strand`: after one `clearance` away the nodes within it need no test.
     var touches = held != 0.0;
-    for (var k = 1u; k <= layers && !touches; k++) {
-        let x = read_node(j, v, k);
-        for (var p = 0u; p < plane_count; p++) {
-            if dot(planes[p].xyz, x - root) < -planes[p].w {
-                touches = true;
-            }
+    var budget = 0.0;
+    for (var k = 0u; k < layers && !touches; k++) {
+        budget -= rest_segments[k * v + j].w * CONTACT_SKIP_SLACK;
+        if budget > 0.0 {
+            continue;
         }
-        for (var i = 0u; i < near_count; i++) {
-            if collider_closest(near[i], x).distance < 0.0 {
-                touches = true;
-            }
-        }
+        budget = clearance(read_node(j, v, k + 1u), root, &planes, plane_count, &near, near_count, surface, v);
+        touches = budget < 0.0;
     }
     if !touches {
         return;
@@ -185,6 +306,10 @@ fn contact_strand(j: u32, v: u32, layers: u32, root: vec3<f32>, frame: vec4<f32>
     var arc = 0.0;
     var previous_bent = root;
     var p = root;
+    // `Resolve::solve_strand`'s hint: the way the segment before went.
+    let across = rotate(frame, vec3<f32>(1.0, 0.0, 0.0));
+    var hint = across;
+    var walk_budget = 0.0;
     for (var k = 0u; k < layers; k++) {
         let segment_length = rest_segments[k * v + j].w;
         let bent = read_node(j, v, k + 1u);
@@ -195,11 +320,18 @@ fn contact_strand(j: u32, v: u32, layers: u32, root: vec3<f32>, frame: vec4<f32>
         }
         var u = normalize_or(bent - previous_bent, vec3<f32>(0.0, 1.0, 0.0));
         previous_bent = bent;
-        if held != 0.0 && has_grip && arc < grip_distance {
-            u = normalize_or(u + (toward - u) * held, u);
+        let before_grip = clamp((grip_distance - arc) / segment_length, 0.0, 1.0);
+        if held != 0.0 && has_grip && before_grip > 0.0 {
+            u = normalize_or(u + (toward - u) * (held * before_grip), u);
         }
         arc += segment_length;
-        for (var round = 0u; round < 8u; round++) {
+        // Where the start is clear by more than the segment, no end can touch anything.
+        let step = segment_length * CONTACT_SKIP_SLACK;
+        if walk_budget <= step {
+            walk_budget = clearance(p, root, &planes, plane_count, &near, near_count, surface, v);
+        }
+        walk_budget -= step;
+        for (var round = 0u; round < 8u && walk_budget <= 0.0; round++) {
             var moved = false;
             for (var i = 0u; i < near_count; i++) {
                 let c = near[i];
@@ -211,7 +343,8 @@ fn contact_strand(j: u32, v: u32, layers: u32, root: vec3<f32>, frame: vec4<f32>
                 if round == 0u && friction > 0.0 {
                     let travel = contact[c + 3u].xyz;
                     let slide = travel - hit.normal * dot(hit.normal, travel);
-                    u = normalize_or(u * segment_length + slide * friction, u);
+                    let depth = min(-hit.distance / (CONTACT_FRICTION_DEPTH * segment_length), 1.0);
+                    u = normalize_or(u * segment_length + slide * (friction * depth), u);
                 }
                 var floor = dot(hit.normal, hit.surface - p) / segment_length;
                 var normal = hit.normal;
@@ -220,21 +353,34 @@ fn contact_strand(j: u32, v: u32, layers: u32, root: vec3<f32>, frame: vec4<f32>
                     floor = dot(start.normal, start.surface - p) / segment_length;
                     normal = start.normal;
                 }
-                u = turn_above(u, normal, floor + CONTACT_MARGIN);
+                u = turn_above(u, normal, floor + CONTACT_MARGIN, hint);
                 moved = true;
             }
             for (var q = 0u; q < plane_count; q++) {
                 let n = planes[q].xyz;
                 let floor = (-planes[q].w - dot(n, p - root)) / segment_length;
                 if dot(n, u) < floor {
-                    u = turn_above(u, n, floor + CONTACT_MARGIN);
+                    u = turn_above(u, n, floor + CONTACT_MARGIN, hint);
                     moved = true;
                 }
+            }
+            let below = surface_closest(surface, p + u * segment_length, v);
+            if below.distance < 0.0 {
+                var floor = dot(below.normal, below.surface - p) / segment_length;
+                var normal = below.normal;
+                if floor > 1.0 - CONTACT_MARGIN {
+                    let start = surface_closest(surface, p, v);
+                    floor = dot(start.normal, start.surface - p) / segment_length;
+                    normal = start.normal;
+                }
+                u = turn_above(u, normal, floor + CONTACT_MARGIN, hint);
+                moved = true;
             }
             if !moved {
                 break;
             }
         }
+        hint = u + across * 0.5;
         p = p + u * segment_length;
         write_node(j, v, k + 1u, p);
     }

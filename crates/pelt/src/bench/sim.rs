@@ -101,7 +101,7 @@ fn literal_rate(fur: &FurStructure, params: &SimParams, budget: SimBudget) -> f6
 /// The median over `budget.runs` runs of `nodes_per_pass * passes / seconds`, each run
 /// repeating `pass` for at least `budget.min_run_secs` after one untimed pass (caches, pages,
 /// thread pool).
-fn median_rate(budget: SimBudget, nodes_per_pass: f64, pass: &mut dyn FnMut()) -> f64 {
+pub(super) fn median_rate(budget: SimBudget, nodes_per_pass: f64, pass: &mut dyn FnMut()) -> f64 {
     pass();
     let mut rates: Vec<f64> = (0..budget.runs.max(1))
         .map(|_| {

@@ -10,8 +10,9 @@
 //! force or collider pushes a node below it. A strand that touches nothing is left as the bend
 //! made it, bit for bit.
 //!
-//! - Friction: a node touching a moving collider is first carried `friction` times the
-//!   collider's motion over the step along its surface.
+//! - Friction: a node inside a moving collider is first carried up to `friction` times the
+//!   collider's motion over the step along its surface (all of it from a quarter segment in,
+//!   less nearer the surface, so the response has no jump there).
 //! - At rest: the result is a function of the step's inputs, so still inputs give the same
 //!   nodes every step: no jitter.
 //! - No tunnelling: a collider's path within the step is sampled at most one thickness (a
@@ -27,6 +28,7 @@
 mod collider;
 mod grasp;
 pub mod skin;
+pub mod surface;
 
 use glam::{Quat, Vec3, Vec4};
 use rayon::prelude::*;
@@ -34,6 +36,7 @@ use rayon::prelude::*;
 pub use collider::{Collider, ColliderKey, SWEEP_RADII_PER_STEP, Shape, StepCollider};
 pub use grasp::{Grasp, GraspParams};
 pub use skin::{SKIN_PLANES, skin_planes};
+pub use surface::{SURFACE_WORDS, SkinSurface, skin_surface};
 
 use super::kernel::{LANES, RestBatches, VecLanes};
 
@@ -81,6 +84,10 @@ pub struct ContactStrands<'a> {
     pub skin: &'a [[Vec4; SKIN_PLANES]],
     /// How far each strand is held by the grasp (empty without one).
     pub grasp_weights: &'a [f32],
+    /// The skin triangles strands test where their planes do not suffice, in the rest mesh's space.
+    pub surface: &'a SkinSurface,
+    /// Each strand's root in the rest mesh (where its node is taken to test `surface`).
+    pub rest_roots: &'a [Vec3],
 }
 
 /// Everything the CPU pass reads.
@@ -96,6 +103,15 @@ pub(crate) struct Resolve<'a> {
 
 /// A little beyond a surface, relative to the segment's length, so rounding leaves nodes outside.
 const MARGIN: f32 = 1e-5;
+
+/// A little more than a segment's length is taken off a clearance per segment, for rounding.
+const SKIP_SLACK: f32 = 1.001;
+
+/// How deep, relative to the segment's length, a node's end takes a collider's full friction.
+const FRICTION_DEPTH: f32 = 0.25;
+
+/// How much a turn's hint weighs against the side `u` already leans to (see `turn_above`).
+const SIDE_BIAS: f32 = 0.01;
 
 impl Resolve<'_> {
     /// Applies contact to every strand of `nodes` (batch-major, `L + 1` nodes per batch).
@@ -175,19 +191,44 @@ impl Resolve<'_> {
             }
         }
         let planes = &planes[..plane_count];
+        let surface = Surface {
+            j,
+            root,
+            frame,
+            rest_root: self.strands.rest_roots.get(j).copied().unwrap_or(root),
+            on: self.step.skin && !self.strands.surface.strand(j).is_empty(),
+            triangles: self.strands.surface,
+        };
         let colliders = near.iter();
-        let touches = held != 0.0
-            || nodes[1..].iter().any(|&x| {
-                planes.iter().any(|(n, h)| n.dot(x - root) < -h) || colliders.clone().any(|c| c.closest(x).2 < 0.0)
-            });
+        let clearance = |x: Vec3| clearance(x, root, planes, &surface, colliders.clone());
+        // A node is at most a segment's length nearer anything than the node before, so after
+        // one `clearance` away the nodes within it need no test.
+        let mut touches = held != 0.0;
+        let mut budget = 0.0_f32;
+        for k in 0..self.layers {
+            if touches {
+                break;
+            }
+            budget -= self.rest.length(b, lane, k) * SKIP_SLACK;
+            if budget > 0.0 {
+                continue;
+            }
+            budget = clearance(nodes[k + 1]);
+            touches = budget < 0.0;
+        }
         if !touches {
             return false;
         }
+        let mut budget = 0.0_f32;
         let grip = self.step.grip - root;
         let grip_distance = grip.length();
         let grip_direction = grip.try_normalize();
         let mut arc = 0.0;
         let mut previous_bent = nodes[0];
+        // Which way a segment turns where every way is as near (see `turn_above`): the way the
+        // segment before went, and the strand's own X axis where that points into the surface.
+        let across = frame * Vec3::X;
+        let mut hint = across;
         for k in 0..self.layers {
             let length = self.rest.length(b, lane, k);
             let bent = nodes[k + 1];
@@ -202,20 +243,34 @@ impl Resolve<'_> {
             if held != 0.0
                 && let Some(toward) = grip_direction
             {
-                // Up to the grip the strand runs to it; the rest sticks out of the hand.
-                if arc < grip_distance {
-                    u = (u + (toward - u) * held).try_normalize().unwrap_or(u);
+                // Up to the grip the strand runs to it; the rest sticks out of the hand. The
+                // segment the grip falls in turns in part, so no rounding of `arc` flips it.
+                let before_grip = ((grip_distance - arc) / length).clamp(0.0, 1.0);
+                if before_grip > 0.0 {
+                    u = (u + (toward - u) * (held * before_grip)).try_normalize().unwrap_or(u);
                 }
             }
             arc += length;
-            let u = self.constrain(p, u, length, root, planes, colliders.clone());
+            // Where the start is clear by more than the segment, no end can touch anything.
+            let step = length * SKIP_SLACK;
+            if budget <= step {
+                budget = clearance(p);
+            }
+            budget -= step;
+            let u = if budget > 0.0 {
+                u
+            } else {
+                self.constrain(p, u, length, root, planes, &surface, hint, colliders.clone())
+            };
+            hint = u + across * 0.5;
             nodes[k + 1] = p + u * length;
         }
         true
     }
 
-    /// The direction nearest `u` whose segment from `p` ends outside every collider and above
-    /// every skin plane (skin last).
+    /// The direction nearest `u` whose segment from `p` ends outside every collider, above
+    /// every skin plane and in front of the skin's triangles (skin last).
+    #[allow(clippy::too_many_arguments)]
     fn constrain<'c>(
         &self,
         p: Vec3,
@@ -223,6 +278,8 @@ impl Resolve<'_> {
         length: f32,
         root: Vec3,
         planes: &[(Vec3, f32)],
+        surface: &Surface<'_>,
+        hint: Vec3,
         colliders: impl Iterator<Item = &'c &'c StepCollider> + Clone,
     ) -> Vec3 {
         for pass in 0..8 {
@@ -234,8 +291,11 @@ impl Resolve<'_> {
                     continue;
                 }
                 if pass == 0 && c.friction > 0.0 {
+                    // Full friction from FRICTION_DEPTH in, none at the surface: no jump where
+                    // a node's end crosses it.
                     let slide = c.travel - n * n.dot(c.travel);
-                    u = (u * length + slide * c.friction).try_normalize().unwrap_or(u);
+                    let depth = (-distance / (FRICTION_DEPTH * length)).min(1.0);
+                    u = (u * length + slide * (c.friction * depth)).try_normalize().unwrap_or(u);
                 }
                 let mut floor = n.dot(s - p) / length;
                 let mut normal = n;
@@ -246,15 +306,29 @@ impl Resolve<'_> {
                     floor = n.dot(s - p) / length;
                     normal = n;
                 }
-                u = turn_above(u, normal, floor + MARGIN);
+                u = turn_above(u, normal, floor + MARGIN, hint);
                 moved = true;
             }
             for &(n, h) in planes {
                 let floor = (-h - n.dot(p - root)) / length;
                 if n.dot(u) < floor {
-                    u = turn_above(u, n, floor + MARGIN);
+                    u = turn_above(u, n, floor + MARGIN, hint);
                     moved = true;
                 }
+            }
+            if let Some((s, n, distance)) = surface.closest(p + u * length)
+                && distance < 0.0
+            {
+                let mut floor = n.dot(s - p) / length;
+                let mut normal = n;
+                if floor > 1.0 - MARGIN
+                    && let Some((s, n, _)) = surface.closest(p)
+                {
+                    floor = n.dot(s - p) / length;
+                    normal = n;
+                }
+                u = turn_above(u, normal, floor + MARGIN, hint);
+                moved = true;
             }
             if !moved {
                 break;
@@ -264,14 +338,64 @@ impl Resolve<'_> {
     }
 }
 
+/// How far `x` is from touching anything: the least of its heights above the skin planes, its
+/// distances outside the colliders and in front of the skin's triangles (negative: touching).
+/// Each moves by at most as much as `x` does.
+fn clearance<'c>(
+    x: Vec3,
+    root: Vec3,
+    planes: &[(Vec3, f32)],
+    surface: &Surface<'_>,
+    colliders: impl Iterator<Item = &'c &'c StepCollider>,
+) -> f32 {
+    let mut least = f32::MAX;
+    for &(n, h) in planes {
+        least = least.min(n.dot(x - root) + h);
+    }
+    for c in colliders {
+        least = least.min(c.closest(x).2);
+    }
+    if let Some((_, _, d)) = surface.closest(x) {
+        least = least.min(d);
+    }
+    least
+}
+
+/// One strand's skin triangles, posed with its root and frame.
+struct Surface<'a> {
+    j: usize,
+    root: Vec3,
+    frame: Quat,
+    rest_root: Vec3,
+    on: bool,
+    triangles: &'a SkinSurface,
+}
+
+impl Surface<'_> {
+    /// The closest point, pseudonormal and signed distance of the strand's triangles to world
+    /// point `x`; `None` where the strand has none or the skin is off.
+    fn closest(&self, x: Vec3) -> Option<(Vec3, Vec3, f32)> {
+        if !self.on {
+            return None;
+        }
+        self.triangles.closest_posed(self.j, x, self.root, self.frame, self.rest_root)
+    }
+}
+
 /// The unit direction nearest unit `u` with `n . result >= floor` (`n` unit): `u` itself when it
 /// already is, else on the cone `n . result = floor` in the plane of `u` and `n`.
-fn turn_above(u: Vec3, n: Vec3, floor: f32) -> Vec3 {
+///
+/// Where `u` points (nearly) against `n`, every side is (nearly) as near and the least turn's
+/// side would follow `u`'s last bits; a little of `hint` decides it there, so kernels that
+/// round differently turn the same way.
+fn turn_above(u: Vec3, n: Vec3, floor: f32, hint: Vec3) -> Vec3 {
     let floor = floor.clamp(-1.0, 1.0);
     let along = n.dot(u);
     if along >= floor {
         return u;
     }
-    let side = (u - n * along).try_normalize().unwrap_or_else(|| n.any_orthonormal_vector());
+    let side = ((u - n * along) + (hint - n * n.dot(hint)) * SIDE_BIAS)
+        .try_normalize()
+        .unwrap_or_else(|| n.any_orthonormal_vector());
     (n * floor + side * (1.0 - floor * floor).max(0.0).sqrt()).normalize()
 }

@@ -45,7 +45,12 @@ pub(crate) fn skin_planes_of(
     let reach: Vec<f32> = (0..v)
         .map(|j| (0..layers).map(|k| positions[(k + 1) * v + j].distance(positions[k * v + j])).sum::<f32>())
         .collect();
-    let cell = reach.iter().copied().fold(0.0_f32, f32::max).max(1e-6);
+    // Cells no smaller than a 32nd of the mesh: short or bald fur must not bin each triangle
+    // into millions of cells.
+    let (lo, hi) = mesh.positions.iter().fold((Vec3::MAX, Vec3::MIN), |(l, h), p| (l.min(*p), h.max(*p)));
+    let extent = (hi - lo).max_element();
+    let floor = if extent.is_finite() && extent > 0.0 { extent / 32.0 } else { 1.0 };
+    let cell = reach.iter().copied().fold(0.0_f32, f32::max).max(floor);
     let grid = Grid::new(&mesh.positions, &mesh.triangles, cell);
     let mut stamp = vec![u32::MAX; mesh.triangles.len()];
     let mut candidates: Vec<Vec4> = Vec::new();
@@ -123,13 +128,13 @@ pub(crate) fn skin_planes_of(
 }
 
 /// Triangles binned by the cells their boxes cover.
-struct Grid {
+pub(super) struct Grid {
     cell: f32,
     bins: HashMap<[i32; 3], Vec<u32>>,
 }
 
 impl Grid {
-    fn new(points: &[Vec3], triangles: &[[u32; 3]], cell: f32) -> Self {
+    pub(super) fn new(points: &[Vec3], triangles: &[[u32; 3]], cell: f32) -> Self {
         let mut bins: HashMap<[i32; 3], Vec<u32>> = HashMap::new();
         let key = |p: Vec3| (p / cell).floor().as_ivec3().to_array();
         for (t, tri) in triangles.iter().enumerate() {
@@ -146,7 +151,7 @@ impl Grid {
         Self { cell, bins }
     }
 
-    fn near(&self, p: Vec3, r: f32, mut visit: impl FnMut(u32)) {
+    pub(super) fn near(&self, p: Vec3, r: f32, mut visit: impl FnMut(u32)) {
         let key = |p: Vec3| (p / self.cell).floor().as_ivec3().to_array();
         let (lo, hi) = (key(p - Vec3::splat(r)), key(p + Vec3::splat(r)));
         for x in lo[0]..=hi[0] {
@@ -162,7 +167,7 @@ impl Grid {
 }
 
 /// Distance from `p` to the triangle `abc` (Ericson, Real-Time Collision Detection 5.1.5).
-fn distance_to_triangle(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> f32 {
+pub(super) fn distance_to_triangle(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> f32 {
     let (ab, ac, ap) = (b - a, c - a, p - a);
     let (d1, d2) = (ab.dot(ap), ac.dot(ap));
     if d1 <= 0.0 && d2 <= 0.0 {
@@ -192,4 +197,22 @@ fn distance_to_triangle(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> f32 {
     }
     let denominator = 1.0 / (va + vb + vc);
     p.distance(a + ab * (vb * denominator) + ac * (vc * denominator))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fur::{FurLength, FurParams, GrowthDirection};
+    use crate::mesh::builtin::Builtin;
+
+    /// A bald coat (every strand of length 0) gets its planes at once: the triangle grid's cells
+    /// do not shrink with the fur.
+    #[test]
+    fn a_bald_coat_has_planes_without_a_huge_grid() {
+        let (mesh, _) = Builtin::Sphere.mesh();
+        let params = FurParams { layers: 8, length: FurLength::Constant(0.0), direction: GrowthDirection::default() };
+        let fur = FurStructure::new(mesh, &params).unwrap();
+        let planes = skin_planes(&fur);
+        assert_eq!(planes.len(), fur.vertex_count());
+    }
 }

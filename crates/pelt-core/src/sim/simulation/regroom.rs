@@ -2,7 +2,7 @@
 //! skin planes in place, so painting never rebuilds the simulation (the skin planes of every
 //! strand are most of [`Simulation::new`]'s cost).
 
-use super::{SimError, Simulation, skin_planes_of};
+use super::{SimError, Simulation, skin_planes_of, skin_surface};
 use crate::fur::FurStructure;
 
 impl Simulation {
@@ -41,6 +41,8 @@ impl Simulation {
             // The longest strand changed: the grid, and so every strand's tie order, with it.
             (self.skin_cell, self.skin) = skin_planes_of(fur, 0..v);
         }
+        // Which strands need triangles depends on their planes and reach; rebuilt whole, as new.
+        self.surface = skin_surface(fur, &self.skin);
         self.restart();
         Ok(())
     }

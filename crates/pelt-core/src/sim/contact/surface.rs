@@ -1,0 +1,332 @@
+//! The fur's own skin as triangles, where a strand's skin planes do not suffice.
+//!
+//! At saddles and concave spots the intersection of a strand's skin planes (see [`skin`](super::skin))
+//! reaches below the surface. For such a strand the triangles that reach into that intersection
+//! within the strand's reach are kept, with every triangle sharing a vertex with one; after the
+//! planes, a node whose closest point on them lies behind the surface (signed by the
+//! angle-weighted pseudonormal of the feature it lies on: face, edge or vertex) is turned out
+//! above the plane through that point. Triangles are stored once, in the rest mesh's space; a
+//! node is taken there by its strand's root and frame, as the planes are, so the test follows
+//! skinning and rigid motion with no per-step mesh query. Strands on convex skin keep none and
+//! pay nothing.
+
+use std::collections::HashMap;
+
+use glam::{Quat, Vec3, Vec4};
+
+use super::skin::{Grid, SKIN_PLANES, distance_to_triangle};
+use crate::fur::FurStructure;
+
+/// Words per stored triangle: its corners `a`, `b`, `c`, its face normal, the pseudonormals of
+/// its edges `ab`, `bc`, `ca` and of its corners `a`, `b`, `c` (each a unit `xyz`, `w` unused).
+pub const SURFACE_WORDS: usize = 10;
+
+/// Most triangles one strand keeps (the nearest to its root first).
+pub const MAX_STRAND_TRIANGLES: usize = 48;
+
+/// The skin triangles every strand tests its nodes against, from [`skin_surface`].
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct SkinSurface {
+    /// The stored triangles, in the rest mesh's space ([`SURFACE_WORDS`] words each).
+    pub triangles: Vec<[Vec4; SURFACE_WORDS]>,
+    /// Per strand, `(first, count)` in `lists`; count 0 for strands the planes suffice for.
+    pub strands: Vec<[u32; 2]>,
+    /// Triangle indices (into `triangles`) of every strand, one run per strand.
+    pub lists: Vec<u32>,
+}
+
+impl SkinSurface {
+    /// The triangles strand `j` tests.
+    #[must_use]
+    pub fn strand(&self, j: usize) -> &[u32] {
+        let [first, count] = self.strands.get(j).copied().unwrap_or([0, 0]);
+        &self.lists[first as usize..(first + count) as usize]
+    }
+
+    /// The closest point of strand `j`'s triangles to `x` (rest space): `(point, pseudonormal,
+    /// signed distance)`, negative behind the surface; `None` without triangles.
+    #[must_use]
+    pub fn closest(&self, j: usize, x: Vec3) -> Option<(Vec3, Vec3, f32)> {
+        let mut best: Option<(f32, Vec3, Vec3)> = None;
+        for &t in self.strand(j) {
+            let words = &self.triangles[t as usize];
+            let (point, feature) = closest_feature(x, words[0].truncate(), words[1].truncate(), words[2].truncate());
+            let d2 = (x - point).length_squared();
+            if best.is_none_or(|(b, _, _)| d2 < b) {
+                best = Some((d2, point, words[feature].truncate()));
+            }
+        }
+        best.map(|(d2, point, normal)| {
+            let distance = d2.sqrt();
+            (point, normal, if normal.dot(x - point) < 0.0 { -distance } else { distance })
+        })
+    }
+
+    /// [`SkinSurface::closest`] for a posed node: `x` in the world, the strand's posed `root`
+    /// and `frame`, its `rest_root`; the point and normal come back in the world.
+    #[must_use]
+    pub fn closest_posed(
+        &self,
+        j: usize,
+        x: Vec3,
+        root: Vec3,
+        frame: Quat,
+        rest_root: Vec3,
+    ) -> Option<(Vec3, Vec3, f32)> {
+        let local = rest_root + frame.conjugate() * (x - root);
+        self.closest(j, local).map(|(point, normal, d)| (root + frame * (point - rest_root), frame * normal, d))
+    }
+}
+
+/// The closest point of triangle `abc` to `p` and the word of its feature's normal (Ericson,
+/// Real-Time Collision Detection 5.1.5, with the region it ends in).
+pub(crate) fn closest_feature(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> (Vec3, usize) {
+    let (ab, ac, ap) = (b - a, c - a, p - a);
+    let (d1, d2) = (ab.dot(ap), ac.dot(ap));
+    if d1 <= 0.0 && d2 <= 0.0 {
+        return (a, 7);
+    }
+    let bp = p - b;
+    let (d3, d4) = (ab.dot(bp), ac.dot(bp));
+    if d3 >= 0.0 && d4 <= d3 {
+        return (b, 8);
+    }
+    let vc = d1 * d4 - d3 * d2;
+    if vc <= 0.0 && d1 >= 0.0 && d3 <= 0.0 {
+        return (a + ab * (d1 / (d1 - d3)), 4);
+    }
+    let cp = p - c;
+    let (d5, d6) = (ab.dot(cp), ac.dot(cp));
+    if d6 >= 0.0 && d5 <= d6 {
+        return (c, 9);
+    }
+    let vb = d5 * d2 - d1 * d6;
+    if vb <= 0.0 && d2 >= 0.0 && d6 <= 0.0 {
+        return (a + ac * (d2 / (d2 - d6)), 6);
+    }
+    let va = d3 * d6 - d5 * d4;
+    if va <= 0.0 && (d4 - d3) >= 0.0 && (d5 - d6) >= 0.0 {
+        return (b + (c - b) * ((d4 - d3) / ((d4 - d3) + (d5 - d6))), 5);
+    }
+    let denominator = 1.0 / (va + vb + vc);
+    (a + ab * (vb * denominator) + ac * (vc * denominator), 3)
+}
+
+/// The triangles each strand of `fur` tests, given its skin `planes` (from
+/// [`skin_planes`](super::skin_planes)).
+#[must_use]
+pub fn skin_surface(fur: &FurStructure, planes: &[[Vec4; SKIN_PLANES]]) -> SkinSurface {
+    let v = fur.vertex_count();
+    let layers = fur.layers as usize;
+    let positions = &fur.positions;
+    let mesh = &fur.mesh;
+    let points = &mesh.positions;
+    let reach: Vec<f32> = (0..v)
+        .map(|j| (0..layers).map(|k| positions[(k + 1) * v + j].distance(positions[k * v + j])).sum::<f32>())
+        .collect();
+    let cell = reach.iter().copied().fold(0.0_f32, f32::max).max(1e-6);
+    let grid = Grid::new(points, &mesh.triangles, cell);
+    let words = triangle_words(points, &mesh.triangles);
+    let mut corner_triangles: Vec<Vec<u32>> = vec![Vec::new(); points.len()];
+    for (t, tri) in mesh.triangles.iter().enumerate() {
+        if words[t].is_some() {
+            for &i in tri {
+                corner_triangles[i as usize].push(t as u32);
+            }
+        }
+    }
+    let mut surface = SkinSurface { strands: Vec::with_capacity(v), ..SkinSurface::default() };
+    let mut stored: HashMap<u32, u32> = HashMap::new();
+    let mut stamp = vec![u32::MAX; mesh.triangles.len()];
+    let mut polygon = Vec::new();
+    let mut kept: Vec<(f32, u32)> = Vec::new();
+    for j in 0..v {
+        let root = positions[j];
+        let r = reach[j] * 1.05;
+        let first = surface.lists.len() as u32;
+        kept.clear();
+        if r > 0.0 && j < planes.len() {
+            let strand_planes: Vec<Vec4> = planes[j].iter().copied().filter(|p| p.truncate() != Vec3::ZERO).collect();
+            let mut hits = Vec::new();
+            grid.near(root, r, |t| {
+                if stamp[t as usize] == j as u32 || words[t as usize].is_none() {
+                    return;
+                }
+                stamp[t as usize] = j as u32;
+                let [a, b, c] = mesh.triangles[t as usize].map(|i| points[i as usize]);
+                if distance_to_triangle(root, a, b, c) > r {
+                    return;
+                }
+                polygon.clear();
+                polygon.extend([a, b, c]);
+                for plane in &strand_planes {
+                    clip(&mut polygon, plane.truncate(), plane.w - 1e-4 * r, root);
+                }
+                let inside = polygon.len() >= 3
+                    && (1..polygon.len() - 1)
+                        .any(|i| distance_to_triangle(root, polygon[0], polygon[i], polygon[i + 1]) <= r);
+                if inside {
+                    hits.push(t);
+                }
+            });
+            // The hits and every triangle sharing a corner with one, so the closest point of a
+            // node behind a hit is among them.
+            for &t in &hits {
+                for &i in &mesh.triangles[t as usize] {
+                    for &n in &corner_triangles[i as usize] {
+                        if !kept.iter().any(|&(_, k)| k == n) {
+                            let [a, b, c] = mesh.triangles[n as usize].map(|i| points[i as usize]);
+                            kept.push((distance_to_triangle(root, a, b, c), n));
+                        }
+                    }
+                }
+            }
+            kept.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
+            kept.truncate(MAX_STRAND_TRIANGLES);
+        }
+        for &(_, t) in &kept {
+            let next = surface.triangles.len() as u32;
+            let index = *stored.entry(t).or_insert_with(|| {
+                surface.triangles.push(words[t as usize].expect("kept triangles have area"));
+                next
+            });
+            surface.lists.push(index);
+        }
+        surface.strands.push([first, kept.len() as u32]);
+    }
+    surface
+}
+
+/// Each triangle's corners and pseudonormals (Baerentzen and Aanaes 2005); `None` for one with
+/// no area.
+fn triangle_words(points: &[Vec3], triangles: &[[u32; 3]]) -> Vec<Option<[Vec4; SURFACE_WORDS]>> {
+    let faces: Vec<Option<Vec3>> = triangles
+        .iter()
+        .map(|t| {
+            let [a, b, c] = t.map(|i| points[i as usize]);
+            (b - a).cross(c - a).try_normalize()
+        })
+        .collect();
+    let mut edges: HashMap<(u32, u32), Vec3> = HashMap::new();
+    let mut corners = vec![Vec3::ZERO; points.len()];
+    for (tri, face) in triangles.iter().zip(&faces) {
+        let Some(n) = face else { continue };
+        for e in 0..3 {
+            let (i, k) = (tri[e], tri[(e + 1) % 3]);
+            *edges.entry((i.min(k), i.max(k))).or_default() += *n;
+            let (p, q, s) = (points[i as usize], points[k as usize], points[tri[(e + 2) % 3] as usize]);
+            let angle = (q - p).angle_between(s - p);
+            if angle.is_finite() {
+                corners[i as usize] += *n * angle;
+            }
+        }
+    }
+    triangles
+        .iter()
+        .zip(&faces)
+        .map(|(tri, face)| {
+            let n = (*face)?;
+            let edge = |e: usize| {
+                let (i, k) = (tri[e], tri[(e + 1) % 3]);
+                edges[&(i.min(k), i.max(k))].try_normalize().unwrap_or(n)
+            };
+            let corner = |e: usize| corners[tri[e] as usize].try_normalize().unwrap_or(n);
+            let [a, b, c] = tri.map(|i| points[i as usize]);
+            Some([a, b, c, n, edge(0), edge(1), edge(2), corner(0), corner(1), corner(2)].map(|w| w.extend(0.0)))
+        })
+        .collect()
+}
+
+/// Clips the convex `polygon` to the side of the plane where `n . (x - root) >= -h`.
+fn clip(polygon: &mut Vec<Vec3>, n: Vec3, h: f32, root: Vec3) {
+    if polygon.is_empty() {
+        return;
+    }
+    let side = |x: Vec3| n.dot(x - root) + h;
+    let mut out = Vec::with_capacity(polygon.len() + 1);
+    for i in 0..polygon.len() {
+        let (x, y) = (polygon[i], polygon[(i + 1) % polygon.len()]);
+        let (sx, sy) = (side(x), side(y));
+        if sx >= 0.0 {
+            out.push(x);
+        }
+        if (sx >= 0.0) != (sy >= 0.0) {
+            out.push(x + (y - x) * (sx / (sx - sy)));
+        }
+    }
+    *polygon = out;
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fur::{FurLength, FurParams, GrowthDirection};
+    use crate::mesh::builtin::Builtin;
+    use crate::sim::contact::skin_planes;
+
+    fn furred(builtin: Builtin) -> FurStructure {
+        let (mesh, _) = builtin.mesh();
+        let radius = mesh.bounding_sphere().1;
+        let direction = GrowthDirection { random_angle_rad: 0.4, seed: 5, ..GrowthDirection::default() };
+        FurStructure::new(mesh, &FurParams { layers: 8, length: FurLength::Constant(0.12 * radius), direction })
+            .unwrap()
+    }
+
+    /// Strands on convex skin keep no triangles (they cost nothing); the torus's saddles keep
+    /// some, at most the cap, never on its convex outer rim.
+    #[test]
+    fn only_strands_where_the_planes_fall_short_keep_triangles() {
+        let sphere = furred(Builtin::Sphere);
+        let surface = skin_surface(&sphere, &skin_planes(&sphere));
+        assert!(surface.lists.is_empty(), "{} triangles kept on a sphere", surface.lists.len());
+        let torus = furred(Builtin::Torus);
+        let surface = skin_surface(&torus, &skin_planes(&torus));
+        let v = torus.vertex_count();
+        let kept = surface.strands.iter().filter(|[_, count]| *count > 0).count();
+        let most = surface.strands.iter().map(|[_, count]| *count).max().unwrap_or(0);
+        eprintln!("torus: {kept} of {v} strands keep triangles, at most {most}, {} in all", surface.lists.len());
+        assert!(kept > 0 && most as usize <= MAX_STRAND_TRIANGLES);
+        // The outer rim (farthest from the axis) is convex.
+        for j in 0..v {
+            let p = torus.positions[j];
+            if p.x.hypot(p.z) > 1.25 {
+                assert_eq!(surface.strand(j).len(), 0, "strand {j} at {p} on the convex rim");
+            }
+        }
+    }
+
+    /// The closest point and its feature against a dense sampling of the triangle.
+    #[test]
+    fn closest_features_match_sampling() {
+        let (a, b, c) = (Vec3::new(0.0, 0.0, 0.0), Vec3::new(1.0, 0.1, 0.0), Vec3::new(0.3, 0.9, 0.2));
+        let mut state = 7_u32;
+        let mut next = move || {
+            state = state.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+            (state >> 8) as f32 / (1 << 24) as f32 * 3.0 - 1.0
+        };
+        for _ in 0..200 {
+            let p = Vec3::new(next(), next(), next());
+            let (point, feature) = closest_feature(p, a, b, c);
+            let n = 200;
+            let mut best = f32::MAX;
+            for i in 0..=n {
+                for k in 0..=n - i {
+                    let (s, t) = (i as f32 / n as f32, k as f32 / n as f32);
+                    best = best.min(p.distance(a + (b - a) * s + (c - a) * t));
+                }
+            }
+            assert!((p.distance(point) - best).abs() < 2e-2, "{p}: {} vs sampled {best}", p.distance(point));
+            // The feature is where the point lies: a corner, an edge's inside or the face's.
+            let on_segment = |u: Vec3, w: Vec3| (point - u).cross(w - u).length() < 1e-4;
+            match feature {
+                7 => assert!(point.distance(a) < 1e-5),
+                8 => assert!(point.distance(b) < 1e-5),
+                9 => assert!(point.distance(c) < 1e-5),
+                4 => assert!(on_segment(a, b)),
+                5 => assert!(on_segment(b, c)),
+                6 => assert!(on_segment(c, a)),
+                _ => assert_eq!(feature, 3),
+            }
+        }
+    }
+}

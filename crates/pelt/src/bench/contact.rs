@@ -1,0 +1,139 @@
+//! `pelt bench --contact`: what contact costs the kernels. The bunny at 32 layers (default
+//! preset, a steady wind so every strand moves) steps with contact off, the skin only, and the
+//! skin with 8 colliders resting in the fur all round it; each kernel's node updates per second
+//! are timed the way the report times them (`Simulation` steps on all threads; the GPU kernel
+//! through the driver `--sim gpu` runs).
+
+use std::hint::black_box;
+
+use glam::{Quat, Vec3};
+use pelt_core::sim::{Collider, ContactParams, FurStepper, Shape, SimParams, Simulation};
+use pelt_core::{Builtin, FurStructure, Preset};
+use pelt_render::{Backend, Gpu};
+
+use super::sim::{SIM_RATE_HZ, SimBudget, median_rate};
+
+/// Layers the figures are taken at.
+const LAYERS: u32 = 32;
+/// Colliders of the third case.
+const COLLIDERS: usize = 8;
+
+/// One case: its name, whether the skin is on, its colliders.
+struct Case {
+    name: &'static str,
+    skin: bool,
+    colliders: Vec<Collider>,
+}
+
+/// 8 colliders (spheres, capsules and boxes in turn) spread over the fur, each sunk into it at
+/// half the fur's length above a vertex, a tenth of the mesh's radius across.
+fn colliders(fur: &FurStructure) -> Vec<Collider> {
+    let (_, radius) = fur.mesh.bounding_sphere();
+    let length = fur.lengths.iter().copied().fold(0.0, f32::max);
+    let v = fur.vertex_count();
+    (0..COLLIDERS)
+        .map(|i| {
+            let j = (i * v) / COLLIDERS + v / (2 * COLLIDERS);
+            let size = 0.1 * radius;
+            let shape = match i % 3 {
+                0 => Shape::Sphere { radius: size },
+                1 => Shape::Capsule { radius: 0.5 * size, half_length: size },
+                _ => Shape::Box { half_extents: Vec3::splat(0.7 * size) },
+            };
+            let centre = fur.positions[j] + fur.mesh.normals[j] * (0.5 * length + size);
+            Collider {
+                appear_secs: 0.0,
+                ..Collider::at(i as u32, shape, 0.0, centre, Quat::from_rotation_y(0.3 * i as f32))
+            }
+        })
+        .collect()
+}
+
+fn params(skin: bool) -> SimParams {
+    let mut params = Preset::default().simulation;
+    params.contact = ContactParams { skin };
+    params.rate_hz = SIM_RATE_HZ;
+    params.interpolate = false;
+    if params.wind.strength == 0.0 {
+        params.wind.strength = 0.5;
+    }
+    params
+}
+
+/// Runs the cases and prints the table (Markdown).
+pub fn run(quick: bool) -> anyhow::Result<()> {
+    let mut preset = Preset::default();
+    preset.layers = LAYERS;
+    let fur = preset.grow(Builtin::Bunny.mesh().0, "bunny")?;
+    let budget = if quick {
+        SimBudget { runs: 3, min_run_secs: 0.05, drawn_frames: 0 }
+    } else {
+        SimBudget { runs: 7, min_run_secs: 0.5, drawn_frames: 0 }
+    };
+    let (gpu_steps, gpu_runs) = if quick { (4, 3) } else { (30, 7) };
+    let gpu = Gpu::new(Backend::Auto);
+    if let Err(error) = &gpu {
+        eprintln!("pelt bench: no GPU adapter, the GPU column is empty: {error:#}");
+    }
+    let cases = [
+        Case { name: "off", skin: false, colliders: Vec::new() },
+        Case { name: "skin", skin: true, colliders: Vec::new() },
+        Case { name: "skin + 8 colliders", skin: true, colliders: colliders(&fur) },
+    ];
+    let nodes = (fur.vertex_count() * LAYERS as usize) as f64;
+    let mut rows = Vec::new();
+    for case in &cases {
+        eprintln!("pelt bench: contact {}", case.name);
+        let params = params(case.skin);
+        let mut simulation = Simulation::new(&fur, &params)?;
+        simulation.set_colliders(&case.colliders)?;
+        let mut time = 0.0;
+        let cpu = median_rate(budget, nodes, &mut || {
+            time += 1.0 / f64::from(SIM_RATE_HZ);
+            simulation.step_at(time);
+            black_box(simulation.steps_taken());
+        });
+        let gpu_rate = match &gpu {
+            Ok(gpu) => {
+                let renderer = crate::sim_kernel::timing_renderer(&gpu.device)?;
+                let mut stepper = FurStepper::new(&fur, &params)?;
+                stepper.simulation_mut().set_colliders(&case.colliders)?;
+                let secs = pelt_render::gpu_secs_per_step_of(
+                    &gpu.device,
+                    &gpu.queue,
+                    &renderer,
+                    &fur,
+                    &params,
+                    &mut stepper,
+                    gpu_steps,
+                    gpu_runs,
+                )?;
+                Some(nodes / secs)
+            }
+            Err(_) => None,
+        };
+        rows.push((case.name, cpu, gpu_rate));
+    }
+    let (_, cpu_off, gpu_off) = rows[0];
+    let mut md = format!(
+        "| bunny, L = {LAYERS}, {} strands | CPU node updates/s (all threads) | contact's share | GPU node updates/s | contact's share |\n|---|---|---|---|---|\n",
+        fur.vertex_count()
+    );
+    for (name, cpu, gpu_rate) in rows {
+        // The share of the kernel's time contact takes: 1 - (time off / time on).
+        let share = |off: f64, on: f64| format!("{:.0}%", 100.0 * (1.0 - on / off));
+        let gpu_cells = match (gpu_rate, gpu_off) {
+            (Some(on), Some(off)) => (format!("{:.3e}", on), share(off, on)),
+            _ => ("-".to_owned(), "-".to_owned()),
+        };
+        md.push_str(&format!(
+            "| {name} | {:.3e} | {} | {} | {} |\n",
+            cpu,
+            share(cpu_off, cpu),
+            gpu_cells.0,
+            gpu_cells.1
+        ));
+    }
+    println!("{md}");
+    Ok(())
+}
