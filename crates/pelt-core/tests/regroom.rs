@@ -49,6 +49,7 @@ fn dabs_in_place_equal_a_rebuilt_simulation_to_the_bit() {
         let mut rebuilt = Simulation::new(&structure, &simulation_params).unwrap();
         rebuilt.advance_to(time_secs);
         assert!(skin_bits(&running) == skin_bits(&rebuilt), "{kind:?}: skin planes");
+        assert!(running.contact_strands().surface == rebuilt.contact_strands().surface, "{kind:?}: skin triangles");
         assert!(position_bits(&running) == position_bits(&rebuilt), "{kind:?}: state after the dab");
         for _ in 0..6 {
             time_secs += 1.0 / 30.0;

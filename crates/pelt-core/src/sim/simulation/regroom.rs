@@ -41,6 +41,8 @@ impl Simulation {
             // The longest strand changed: the grid, and so every strand's tie order, with it.
             (self.skin_cell, self.skin) = skin_planes_of(fur, 0..v);
         }
+        // Which strands keep skin triangles follows from their planes and reach.
+        self.surface = skin_surface(fur, &self.skin);
         // Which strands need triangles depends on their planes and reach; rebuilt whole, as new.
         self.surface = skin_surface(fur, &self.skin);
         self.restart();
