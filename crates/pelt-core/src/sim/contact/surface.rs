@@ -33,6 +33,8 @@ pub struct SkinSurface {
     pub strands: Vec<[u32; 2]>,
     /// Triangle indices (into `triangles`) of every strand, one run per strand.
     pub lists: Vec<u32>,
+    /// The mesh triangle each stored triangle is.
+    pub mesh_triangles: Vec<u32>,
 }
 
 impl SkinSurface {
@@ -116,6 +118,16 @@ pub(crate) fn closest_feature(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> (Vec3, usiz
 /// [`skin_planes`](super::skin_planes)).
 #[must_use]
 pub fn skin_surface(fur: &FurStructure, planes: &[[Vec4; SKIN_PLANES]]) -> SkinSurface {
+    skin_surface_reusing(fur, planes, None)
+}
+
+/// [`skin_surface`], the strands not `changed` keeping their triangles from `previous` (a groom
+/// dab reshaped the others): the same surface, found for the changed strands alone.
+pub(crate) fn skin_surface_reusing(
+    fur: &FurStructure,
+    planes: &[[Vec4; SKIN_PLANES]],
+    reuse: Option<(&SkinSurface, &[bool])>,
+) -> SkinSurface {
     let v = fur.vertex_count();
     let layers = fur.layers as usize;
     let positions = &fur.positions;
@@ -145,7 +157,9 @@ pub fn skin_surface(fur: &FurStructure, planes: &[[Vec4; SKIN_PLANES]]) -> SkinS
         let r = reach[j] * 1.05;
         let first = surface.lists.len() as u32;
         kept.clear();
-        if r > 0.0 && j < planes.len() {
+        if let Some((previous, _)) = reuse.filter(|(_, changed)| !changed[j]) {
+            kept.extend(previous.strand(j).iter().map(|&k| (0.0, previous.mesh_triangles[k as usize])));
+        } else if r > 0.0 && j < planes.len() {
             let strand_planes: Vec<Vec4> = planes[j].iter().copied().filter(|p| p.truncate() != Vec3::ZERO).collect();
             let mut hits = Vec::new();
             grid.near(root, r, |t| {
@@ -188,6 +202,7 @@ pub fn skin_surface(fur: &FurStructure, planes: &[[Vec4; SKIN_PLANES]]) -> SkinS
             let next = surface.triangles.len() as u32;
             let index = *stored.entry(t).or_insert_with(|| {
                 surface.triangles.push(words[t as usize].expect("kept triangles have area"));
+                surface.mesh_triangles.push(t);
                 next
             });
             surface.lists.push(index);

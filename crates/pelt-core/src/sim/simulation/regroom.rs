@@ -2,7 +2,7 @@
 //! skin planes in place, so painting never rebuilds the simulation (the skin planes of every
 //! strand are most of [`Simulation::new`]'s cost).
 
-use super::{SimError, Simulation, skin_planes_of, skin_surface};
+use super::{SimError, Simulation, skin_planes_of, skin_surface_reusing};
 use crate::fur::FurStructure;
 
 impl Simulation {
@@ -32,19 +32,26 @@ impl Simulation {
             return Ok(());
         }
         self.rest.update(&fur.positions, v, layers, strands);
+        let mut changed = vec![false; v];
+        for &j in strands {
+            changed[j as usize] = true;
+        }
         let (cell, planes) = skin_planes_of(fur, strands.iter().map(|&j| j as usize));
         if cell.to_bits() == self.skin_cell.to_bits() {
             for (&j, planes) in strands.iter().zip(planes) {
                 self.skin[j as usize] = planes;
             }
         } else {
-            // The longest strand changed: the grid, and so every strand's tie order, with it.
-            (self.skin_cell, self.skin) = skin_planes_of(fur, 0..v);
+            // The longest strand changed: the grid, and so any strand's tie order, with it.
+            let (cell, all) = skin_planes_of(fur, 0..v);
+            for (j, (old, new)) in self.skin.iter().zip(&all).enumerate() {
+                changed[j] |=
+                    old.map(|p| p.to_array().map(f32::to_bits)) != new.map(|p| p.to_array().map(f32::to_bits));
+            }
+            (self.skin_cell, self.skin) = (cell, all);
         }
-        // Which strands keep skin triangles follows from their planes and reach.
-        self.surface = skin_surface(fur, &self.skin);
-        // Which strands need triangles depends on their planes and reach; rebuilt whole, as new.
-        self.surface = skin_surface(fur, &self.skin);
+        // The skin triangles a strand keeps follow from its planes and reach alone.
+        self.surface = skin_surface_reusing(fur, &self.skin, Some((&self.surface, &changed)));
         self.restart();
         Ok(())
     }
