@@ -106,6 +106,7 @@ async function start() {
     return;
   }
   applyWind();
+  attempt((a) => a.set_tool(tool));
   syncControls();
   requestAnimationFrame(frame);
 }
@@ -119,6 +120,11 @@ function restart(why) {
 
 function syncControls() {
   if (!app) return;
+  // A scene or preset change can bring the other along (a Fox preset shows the Fox).
+  scene = app.scene();
+  presetName = app.preset_name();
+  for (const radio of document.querySelectorAll('input[name=scene]')) radio.checked = radio.value === scene;
+  if ([...$('preset').options].some((o) => o.value === presetName)) $('preset').value = presetName;
   $('length').value = app.length();
   $('length-value').textContent = app.length().toFixed(3);
   $('colour').value = app.colour();
@@ -132,8 +138,10 @@ function applyWind() {
   attempt((a) => a.set_wind(strength, direction));
 }
 
-// Pointers: one that lands on the fur pats it; others turn the view, two of them pinch-zoom.
-const patting = new Set();
+// Pointers: one that lands on the fur takes the tool; others turn the view, two of them pinch-zoom.
+// The finger also follows a hovering mouse.
+let tool = 'touch';
+const pressing = new Set();
 const turning = new Map();
 function local(event) {
   const rect = canvas.getBoundingClientRect();
@@ -144,7 +152,7 @@ canvas.addEventListener('pointerdown', (event) => {
   canvas.setPointerCapture(event.pointerId);
   const [x, y] = local(event);
   if (event.button === 0 && !event.altKey && app.pointer_down(event.pointerId, x, y)) {
-    patting.add(event.pointerId);
+    pressing.add(event.pointerId);
   } else {
     turning.set(event.pointerId, [x, y]);
   }
@@ -153,7 +161,7 @@ canvas.addEventListener('pointerdown', (event) => {
 canvas.addEventListener('pointermove', (event) => {
   if (!app) return;
   const [x, y] = local(event);
-  if (patting.has(event.pointerId)) {
+  if (pressing.has(event.pointerId)) {
     app.pointer_move(event.pointerId, x, y);
   } else if (turning.has(event.pointerId)) {
     const [px, py] = turning.get(event.pointerId);
@@ -166,25 +174,37 @@ canvas.addEventListener('pointermove', (event) => {
       app.orbit(x - px, y - py);
     }
     turning.set(event.pointerId, [x, y]);
+  } else if (tool === 'finger' && event.pointerType === 'mouse') {
+    app.pointer_move(event.pointerId, x, y);
   }
 });
 function release(event) {
-  if (app && patting.delete(event.pointerId)) app.pointer_up(event.pointerId);
+  if (app && (pressing.delete(event.pointerId) || tool === 'finger')) app.pointer_up(event.pointerId);
   turning.delete(event.pointerId);
 }
 canvas.addEventListener('pointerup', release);
 canvas.addEventListener('pointercancel', release);
 canvas.addEventListener('lostpointercapture', release);
+canvas.addEventListener('pointerleave', release);
 canvas.addEventListener('wheel', (event) => {
   event.preventDefault();
   attempt((a) => a.zoom(Math.pow(1.0015, event.deltaY)));
 }, { passive: false });
 
 // Controls.
+for (const radio of document.querySelectorAll('input[name=tool]')) {
+  radio.addEventListener('change', () => {
+    if (attempt((a) => a.set_tool(radio.value))) {
+      tool = radio.value;
+      pressing.clear();
+    }
+  });
+}
+$('dry').addEventListener('click', () => attempt((a) => a.dry()));
 for (const radio of document.querySelectorAll('input[name=scene]')) {
   radio.addEventListener('change', () => {
-    scene = radio.value;
-    attempt((a) => a.set_scene(scene));
+    // The Fox brings its groomed preset (textures to make); other scenes keep the preset.
+    slow(`loading the ${radio.value} scene…`, (a) => a.set_scene(radio.value));
   });
 }
 $('frame').addEventListener('click', () => attempt((a) => a.reset_view()));

@@ -295,6 +295,124 @@ test('a pointer drag changes the fur where it presses and not elsewhere; release
   assert.deepEqual(page.problems, []);
 });
 
+/** Clicks the tool's radio and waits until the app uses it. */
+async function useTool(page, name) {
+  await page.click(`input[name=tool][value=${name}]`);
+  await page.waitForFunction((n) => window.pelt.stats.tool === n, { timeout: 30_000 }, name);
+}
+
+/** The bunny's pixels in `image`: the press point (their centroid) and their radius in pixels. */
+function bunnyCentre(image) {
+  const bg = background(image);
+  const body = select(image, (p) => differs(p, bg, 10));
+  const press = [Math.round(mean(body.xs)), Math.round(mean(body.ys))];
+  assert.ok(differs(pixel(image, ...press), bg, 10), 'the bunny\'s centroid is not on the bunny');
+  return { press, radiusPx: Math.sqrt(body.count / Math.PI) };
+}
+
+/** Changed pixels between two shots: how many, and how many lie within `reach` of `press`. */
+function changes(a, b, press, reach) {
+  const changed = select(a, (p, x, y) => differs(p, pixel(b, x, y), 24));
+  const near = changed.xs.filter((x, i) => Math.hypot(x - press[0], changed.ys[i] - press[1]) < reach).length;
+  return { count: changed.count, near };
+}
+
+test('grab: press and hold on the fur grasps it, a drag pulls it, release lets it go', async () => {
+  const page = await bunnyPage();
+  await useTool(page, 'grab');
+  await frames(page, 2);
+  const still = await shot(page, 'grab-still');
+  const { press, radiusPx } = bunnyCentre(still);
+  const box = await (await page.$('#fur')).boundingBox();
+  await page.mouse.move(box.x + press[0], box.y + press[1]);
+  await page.mouse.down();
+  await page.waitForFunction(() => window.pelt.stats.grabbing === true, { timeout: 30_000 });
+  for (let step = 1; step <= 8; step++) {
+    await page.mouse.move(box.x + press[0], box.y + press[1] - (40 * step) / 8);
+  }
+  await frames(page, 6);
+  const held = await shot(page, 'grab-held');
+  await page.mouse.up();
+  await page.waitForFunction(() => window.pelt.stats.grabbing === false, { timeout: 30_000 });
+  await useTool(page, 'touch');
+  await frames(page, 4);
+
+  // Here the grasp changed 767 pixels, all within 0.6 bunny radius of the press; without the
+  // grasp nothing changes (fewer than 50 pixels move with nothing on the fur).
+  const changed = changes(held, still, press, 0.6 * radiusPx);
+  console.log(`grab: ${changed.count} pixels changed, ${changed.near} near the press`);
+  assert.ok(changed.count > 300, `the grab changed only ${changed.count} pixels`);
+  assert.ok(changed.near > 0.9 * changed.count, `${changed.count - changed.near} of ${changed.count} changed pixels lie far from the press`);
+  assert.deepEqual(page.problems, []);
+});
+
+test('finger: the pointer over the fur parts it, and leaving lets it stand again', async () => {
+  const page = await bunnyPage();
+  await useTool(page, 'finger');
+  await frames(page, 2);
+  const still = await shot(page, 'finger-still');
+  const { press, radiusPx } = bunnyCentre(still);
+  const box = await (await page.$('#fur')).boundingBox();
+  // Hovering, no button: the finger follows the mouse.
+  await page.mouse.move(box.x + press[0] - 20, box.y + press[1]);
+  await page.mouse.move(box.x + press[0], box.y + press[1]);
+  await page.waitForFunction(() => window.pelt.stats.fingers === 1, { timeout: 30_000 });
+  await frames(page, 6);
+  const pressed = await shot(page, 'finger-in');
+  // Off the canvas, onto the panel: the finger lifts.
+  await page.mouse.move(box.x + box.width + 100, box.y + 100);
+  await page.waitForFunction(() => window.pelt.stats.fingers === 0, { timeout: 30_000 });
+  await useTool(page, 'touch');
+  await frames(page, 8);
+  const lifted = await shot(page, 'finger-out');
+
+  // Here the finger changed 726 pixels (a hole in the fur down to the skin), all near it.
+  const changed = changes(pressed, still, press, 0.5 * radiusPx);
+  console.log(`finger: ${changed.count} pixels changed, ${changed.near} near the pointer`);
+  assert.ok(changed.count > 150, `the finger changed only ${changed.count} pixels`);
+  assert.ok(changed.near > 0.9 * changed.count, `${changed.count - changed.near} of ${changed.count} changed pixels lie far from the finger`);
+  const left = changes(lifted, still, press, 0.5 * radiusPx);
+  assert.ok(left.count < Math.max(50, 0.1 * changed.count), `${left.count} pixels stay changed after the finger left`);
+  assert.deepEqual(page.problems, []);
+});
+
+test('sponge: the fur under it turns darker and the rest keeps its colour', async () => {
+  const page = await bunnyPage();
+  await useTool(page, 'sponge');
+  await frames(page, 2);
+  const dry = await shot(page, 'sponge-dry');
+  const { press, radiusPx } = bunnyCentre(dry);
+  const box = await (await page.$('#fur')).boundingBox();
+  await page.mouse.move(box.x + press[0], box.y + press[1]);
+  await page.mouse.down();
+  await page.mouse.move(box.x + press[0] + 4, box.y + press[1]);
+  await page.waitForFunction(() => window.pelt.stats.wettest > 0.9, { timeout: 30_000 });
+  await page.mouse.up();
+  await useTool(page, 'touch');
+  await frames(page, 6);
+  const wet = await shot(page, 'sponge-wet');
+  await page.click('#dry');
+  await page.waitForFunction(() => window.pelt.stats.wettest === 0, { timeout: 30_000 });
+  await frames(page, 6);
+
+  // Brightness (sum of channels) of the bunny's pixels near the press and far from it.
+  const bg = background(dry);
+  const brightness = (image, keep) => {
+    const chosen = select(image, (p, x, y) => differs(p, bg, 10) && keep(Math.hypot(x - press[0], y - press[1])));
+    return mean(chosen.xs.map((x, i) => pixel(image, x, chosen.ys[i]).reduce((a, b) => a + b, 0)));
+  };
+  // Here the wet fur under the sponge went from 220 to 194 (0.88), the fur far from it not at all.
+  const under = (d) => d < 0.1 * radiusPx;
+  const far = (d) => d > 0.6 * radiusPx;
+  const report = `under the sponge ${brightness(dry, under).toFixed(1)} -> ${brightness(wet, under).toFixed(1)}, ` +
+    `far from it ${brightness(dry, far).toFixed(1)} -> ${brightness(wet, far).toFixed(1)}`;
+  console.log(`sponge: ${report}`);
+  assert.ok(brightness(wet, under) < 0.93 * brightness(dry, under), `the wet fur is not darker: ${report}`);
+  assert.ok(Math.abs(brightness(wet, far) - brightness(dry, far)) < 0.03 * brightness(dry, far),
+    `the fur far from the sponge changed: ${report}`);
+  assert.deepEqual(page.problems, []);
+});
+
 test('switching to try-on draws the body plain and the skirt furred', async () => {
   const page = await bunnyPage();
   await page.click('input[name=scene][value=tryon]');
@@ -362,6 +480,40 @@ test('two touches at once pat two places', async () => {
   await session.send('Input.dispatchTouchEvent', { type: 'touchEnd', touchPoints: [] });
   await page.waitForFunction(() => window.pelt.stats.touches === 0, { timeout: 30_000 });
   await session.detach();
+  assert.deepEqual(page.problems, []);
+});
+
+test('the groomed Fox draws: bald and shorter where its groom says, longer on the chest and tail', async () => {
+  const page = await bunnyPage();
+  await page.click('input[name=scene][value=fox]');
+  await page.waitForFunction(() => window.pelt.stats.preset === 'fox_groomed', { timeout: 120_000 });
+  await settled(page);
+  await frames(page, 10);
+  const groomed = await shot(page, 'fox-groomed');
+  // fox.toml: the same coat, uniform at the length the groom gives the Fox's body.
+  await setControl(page, '#preset', 'fox');
+  await page.waitForFunction(() => window.pelt.stats.preset === 'fox', { timeout: 120_000 });
+  await settled(page);
+  await frames(page, 10);
+  const uniform = await shot(page, 'fox-uniform');
+  assert.ok(await page.$eval('input[name=scene][value=fox]', (e) => e.checked), 'the scene menu does not show the Fox');
+
+  const bg = background(groomed);
+  const drawnGroomed = (x, y) => differs(pixel(groomed, x, y), bg, 10);
+  const drawnUniform = (x, y) => differs(pixel(uniform, x, y), bg, 10);
+  const area = groomed.width * groomed.height;
+  const fox = select(groomed, (p, x, y) => drawnGroomed(x, y));
+  const onlyUniform = select(groomed, (p, x, y) => drawnUniform(x, y) && !drawnGroomed(x, y));
+  const onlyGroomed = select(groomed, (p, x, y) => drawnGroomed(x, y) && !drawnUniform(x, y));
+  const report = `the groomed Fox covers ${fox.count} pixels; ${onlyUniform.count} only the uniform coat covers, ` +
+    `${onlyGroomed.count} only the groomed one`;
+  console.log(`fox: ${report}`);
+  assert.ok(fox.count > 0.03 * area, `the Fox is hardly drawn: ${report}`);
+  // The bald nose, eyes and inner ears and the short face and legs: the uniform coat reaches
+  // where the groomed one does not (here 10% of the Fox's pixels); the ruff and the tail reach
+  // where the uniform one does not (here 3%). A uniform length (no groom) gives one of the two.
+  assert.ok(onlyUniform.count > 0.05 * fox.count, `the groom shortens nothing: ${report}`);
+  assert.ok(onlyGroomed.count > 0.012 * fox.count, `the groom lengthens nothing: ${report}`);
   assert.deepEqual(page.problems, []);
 });
 

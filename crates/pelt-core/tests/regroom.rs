@@ -1,6 +1,6 @@
 //! Length, cut and comb dabs on a running simulation (`Simulation::regroom`, only the reshaped
 //! strands) leave it as a simulation built anew on the regrown structure: the same skin planes
-//! and the same states, to the bit, now and over the following steps.
+//! and triangles and the same states, to the bit, now and over the following steps.
 
 use glam::Vec3;
 use pelt_core::groom::{Brush, BrushKind, GroomEditor};
@@ -24,6 +24,8 @@ fn dabs_in_place_equal_a_rebuilt_simulation_to_the_bit() {
     let radius = mesh.bounding_sphere().1;
     let mut simulation_params = preset.simulation.clone();
     simulation_params.wind = WindParams { direction: Vec3::X, strength: 0.8, ..simulation_params.wind.clone() };
+    // The skin's planes and triangles take part in every step.
+    simulation_params.contact.skin = true;
     let mut structure = FurStructure::new_groomed(mesh.clone(), &params, None).unwrap();
     let mut running = Simulation::new(&structure, &simulation_params).unwrap();
     let mut editor = GroomEditor::new(&mesh, None, preset.direction.comb).unwrap();
@@ -31,7 +33,17 @@ fn dabs_in_place_equal_a_rebuilt_simulation_to_the_bit() {
     running.advance_to(time_secs);
     // Grow lengthens the longest strands (every skin plane is found again), cut and comb leave
     // the longest alone (only the touched strands' are).
-    for (kind, at) in [(BrushKind::Cut, 900), (BrushKind::Grow, 100), (BrushKind::Comb, 1500), (BrushKind::Cut, 60)] {
+    // The last dab shortens the strand keeping the most skin triangles (a concave spot).
+    let surface = &running.contact_strands().surface;
+    let concave = (0..mesh.vertex_count()).max_by_key(|&j| (surface.strand(j).len(), j)).unwrap();
+    assert!(!surface.strand(concave).is_empty(), "the bunny has concave spots");
+    for (kind, at) in [
+        (BrushKind::Cut, 900),
+        (BrushKind::Grow, 100),
+        (BrushKind::Comb, 1500),
+        (BrushKind::Cut, 60),
+        (BrushKind::Cut, concave),
+    ] {
         let brush = Brush { kind, radius: 0.15 * radius, strength: 0.6, ..Brush::default() };
         editor.begin_stroke();
         for step in 0..3 {

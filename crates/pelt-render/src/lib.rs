@@ -104,6 +104,7 @@
 #![warn(missing_docs)]
 
 mod camera;
+mod colliders;
 mod contact;
 mod driver;
 mod error;
@@ -129,6 +130,7 @@ mod textures;
 mod view;
 
 pub use camera::Camera;
+pub use colliders::{COLLIDER_COLOUR, ColliderMeshes, HAND_COLOUR};
 pub use driver::{FurDriver, KernelChoice, SimKernel, cpu_secs_per_step, gpu_secs_per_step, gpu_secs_per_step_of};
 pub use error::RenderError;
 pub use fur::{FurStates, GpuFur};

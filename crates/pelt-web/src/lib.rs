@@ -11,6 +11,7 @@
 pub mod model;
 pub mod page_gpu;
 pub mod presets;
+pub mod tools;
 
 #[cfg(target_arch = "wasm32")]
 mod gpu;

@@ -1,6 +1,6 @@
 //! The page's state apart from the browser: the scene, the preset with the page's overrides,
-//! the fur and its simulation, the pointers patting it and the orbit camera. Nothing here
-//! touches a browser API, so it is tested natively.
+//! the fur and its simulation, the pointers on it (patting, or the other [`Tool`]s) and the
+//! orbit camera. Nothing here touches a browser API, so it is tested natively.
 
 use glam::{Vec2, Vec3};
 use pelt_core::mesh::builtin::{TryOnScene, try_on_scene};
@@ -8,6 +8,9 @@ use pelt_core::sim::{FurStepper, Touch};
 use pelt_core::texture::Rgb;
 use pelt_core::{Builtin, FurStructure, ImportOptions, Mesh, Preset};
 use pelt_render::Camera;
+
+use crate::presets;
+use crate::tools::{Tool, Tools};
 
 /// Touch radius as a fraction of the furred mesh's bounding radius (the viewer's default brush).
 const BRUSH_PER_RADIUS: f32 = 0.25;
@@ -23,16 +26,29 @@ pub enum SceneChoice {
     Bunny,
     /// The paper's try-on: a plain body wearing a furred skirt.
     TryOn,
+    /// The glTF Fox in its rest pose (the groomed Fox's mesh).
+    Fox,
 }
 
 impl SceneChoice {
-    /// `"bunny"` or `"tryon"`.
+    /// `"bunny"`, `"tryon"` or `"fox"`.
     #[must_use]
     pub fn from_name(name: &str) -> Option<Self> {
         match name {
             "bunny" => Some(Self::Bunny),
             "tryon" => Some(Self::TryOn),
+            "fox" => Some(Self::Fox),
             _ => None,
+        }
+    }
+
+    /// The name [`SceneChoice::from_name`] takes.
+    #[must_use]
+    pub fn name(self) -> &'static str {
+        match self {
+            Self::Bunny => "bunny",
+            Self::TryOn => "tryon",
+            Self::Fox => "fox",
         }
     }
 }
@@ -112,6 +128,21 @@ struct PointerTouch {
     plane_normal: Vec3,
 }
 
+/// What the pointers do now, for the page's figures and its tests.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct PointerStats {
+    /// The tool a pointer landing on the fur takes.
+    pub tool: Tool,
+    /// Pointers patting (held, not fading).
+    pub touches: usize,
+    /// Fingers on the fur.
+    pub fingers: usize,
+    /// Whether a pointer holds a grasp.
+    pub grabbing: bool,
+    /// The wettest base vertex's wetness, `0..=1`.
+    pub wettest: f32,
+}
+
 /// Everything the page shows, without the GPU.
 #[derive(Debug)]
 pub struct Model {
@@ -133,6 +164,10 @@ pub struct Model {
     /// Pointers on the fur, held or fading after release. Several at once: each is a `Touch`
     /// written into the simulation's user force field, which the core leaves to applications.
     touches: Vec<PointerTouch>,
+    /// What a pointer landing on the fur does.
+    tool: Tool,
+    /// Fingers, the grab and sponges.
+    tools: Tools,
     /// Simulation time (seconds).
     clock_secs: f64,
 }
@@ -144,8 +179,8 @@ impl Model {
     /// [`ModelError`] if the preset does not fit the mesh.
     pub fn new(scene: SceneChoice, preset: Preset, aspect: f32) -> Result<Self, ModelError> {
         let (mesh, body) = load_scene(scene)?;
-        let structure = grow(mesh, &preset)?;
-        let stepper = FurStepper::new(&structure, &preset.simulation)?;
+        let structure = grow(mesh, scene, &preset)?;
+        let stepper = stepper(&structure, &preset)?;
         let orbit = Orbit { target: Vec3::ZERO, azimuth_deg: 35.0, elevation_deg: 15.0, distance: 1.0 };
         let mut model = Self {
             scene,
@@ -156,6 +191,8 @@ impl Model {
             orbit,
             framed_distance: 1.0,
             touches: Vec::new(),
+            tool: Tool::default(),
+            tools: Tools::default(),
             clock_secs: 0.0,
         };
         model.frame(aspect);
@@ -188,7 +225,22 @@ impl Model {
     /// # Errors
     /// [`ModelError`]; the previous scene stays.
     pub fn set_scene(&mut self, scene: SceneChoice, aspect: f32) -> Result<(), ModelError> {
-        *self = Self { orbit: self.orbit, ..Self::new(scene, self.preset.clone(), aspect)? };
+        self.set_scene_and_preset(scene, self.preset.clone(), aspect)
+    }
+
+    /// Switches the scene and the preset at once (a groomed preset fits one mesh only),
+    /// keeping the page's wind and tool; the fur, simulation and pointers start anew.
+    ///
+    /// # Errors
+    /// [`ModelError`]; the previous scene and preset stay.
+    pub fn set_scene_and_preset(
+        &mut self,
+        scene: SceneChoice,
+        mut preset: Preset,
+        aspect: f32,
+    ) -> Result<(), ModelError> {
+        preset.simulation.wind = self.preset.simulation.wind.clone();
+        *self = Self { orbit: self.orbit, tool: self.tool, ..Self::new(scene, preset, aspect)? };
         self.frame(aspect);
         Ok(())
     }
@@ -243,18 +295,111 @@ impl Model {
 
     fn rebuild(&mut self, preset: Preset) -> Result<(), ModelError> {
         preset.validate()?;
-        let structure = grow(self.structure.mesh.clone(), &preset)?;
-        let stepper = FurStepper::new(&structure, &preset.simulation)?;
+        let structure = grow(self.structure.mesh.clone(), self.scene, &preset)?;
+        let stepper = stepper(&structure, &preset)?;
         self.preset = preset;
         self.structure = structure;
         self.stepper = stepper;
         self.touches.clear();
+        self.tools = Tools::default();
         Ok(())
     }
 
-    /// A pointer went down at `pixel` of a view of `size`: on the fur it starts patting (true),
+    /// What a pointer landing on the fur does from now on; every pointer on the fur lets go.
+    pub fn set_tool(&mut self, tool: Tool) {
+        for held in &mut self.touches {
+            held.touch.released_at_secs.get_or_insert(self.clock_secs);
+        }
+        self.tools.release_all(&mut self.stepper, self.clock_secs);
+        self.tool = tool;
+    }
+
+    /// The tool in use.
+    #[must_use]
+    pub fn tool(&self) -> Tool {
+        self.tool
+    }
+
+    /// Dries the whole coat at once.
+    pub fn dry(&mut self) {
+        self.stepper.wetness_mut().set_uniform(0.0);
+    }
+
+    /// What the pointers do now.
+    #[must_use]
+    pub fn stats(&self) -> PointerStats {
+        PointerStats {
+            tool: self.tool,
+            touches: self.touches_held(),
+            fingers: self.tools.fingers(),
+            grabbing: self.tools.grabbing(),
+            wettest: self.stepper.wetness().values().iter().copied().fold(0.0, f32::max),
+        }
+    }
+
+    /// Where the ray through `pixel` of a view of `size` meets the skin, and the ray's direction.
+    fn pick(&self, pixel: Vec2, size: Vec2) -> (Vec3, Vec3, Option<Vec3>) {
+        let (origin, direction) = self.orbit.ray(pixel, size);
+        let hit = self.stepper.simulation().pick(&self.structure.mesh.triangles, origin, direction);
+        (origin, direction, hit.map(|h| h.point))
+    }
+
+    fn mesh_radius(&self) -> f32 {
+        self.structure.mesh.bounding_sphere().1
+    }
+
+    /// A pointer went down at `pixel` of a view of `size`: on the fur it takes the tool (true),
     /// elsewhere it does nothing (false: the page orbits with it instead).
     pub fn pointer_down(&mut self, pointer_id: i32, pixel: Vec2, size: Vec2) -> bool {
+        let (_, direction, hit) = self.pick(pixel, size);
+        let Some(hit) = hit else { return false };
+        match self.tool {
+            Tool::Touch => self.touch_down(pointer_id, pixel, size),
+            Tool::Finger => self.tools.finger(pointer_id, direction, Some(hit)),
+            Tool::Grab => {
+                let (radius, now) = (self.mesh_radius(), self.clock_secs);
+                // The grasp's values are finite and positive by construction; a refusal is no grasp.
+                self.tools.grab_begin(&mut self.stepper, pointer_id, hit, direction, radius, now).unwrap_or(false)
+            }
+            Tool::Sponge => {
+                self.tools.sponge(pointer_id, Some(hit));
+                true
+            }
+        }
+    }
+
+    /// A pointer moved, pressed or (for the finger) hovering: true when it acts on the fur.
+    pub fn pointer_move(&mut self, pointer_id: i32, pixel: Vec2, size: Vec2) -> bool {
+        match self.tool {
+            Tool::Touch => self.touch_move(pointer_id, pixel, size),
+            Tool::Finger => {
+                let (_, direction, hit) = self.pick(pixel, size);
+                self.tools.finger(pointer_id, direction, hit)
+            }
+            Tool::Grab => {
+                let (origin, direction) = self.orbit.ray(pixel, size);
+                self.tools.grab_move(&mut self.stepper, pointer_id, origin, direction).unwrap_or(false)
+            }
+            Tool::Sponge => {
+                if !self.tools.has_sponge(pointer_id) {
+                    return false;
+                }
+                let (_, _, hit) = self.pick(pixel, size);
+                self.tools.sponge(pointer_id, hit);
+                true
+            }
+        }
+    }
+
+    /// Whether `pointer_id` acts on the fur now (patting, a finger, the grasp or a sponge).
+    #[must_use]
+    pub fn pointer_held(&self, pointer_id: i32) -> bool {
+        self.touches.iter().any(|t| t.pointer_id == pointer_id && t.touch.released_at_secs.is_none())
+            || self.tools.has_grab(pointer_id)
+            || self.tools.has_sponge(pointer_id)
+    }
+
+    fn touch_down(&mut self, pointer_id: i32, pixel: Vec2, size: Vec2) -> bool {
         let (origin, direction) = self.orbit.ray(pixel, size);
         let simulation = self.stepper.simulation();
         let Some(hit) = simulation.pick(&self.structure.mesh.triangles, origin, direction) else { return false };
@@ -267,7 +412,7 @@ impl Model {
 
     /// A patting pointer moved: the fur under it is pushed along the drag. False when the
     /// pointer is not patting.
-    pub fn pointer_move(&mut self, pointer_id: i32, pixel: Vec2, size: Vec2) -> bool {
+    fn touch_move(&mut self, pointer_id: i32, pixel: Vec2, size: Vec2) -> bool {
         let (origin, direction) = self.orbit.ray(pixel, size);
         let Some(held) =
             self.touches.iter_mut().find(|t| t.pointer_id == pointer_id && t.touch.released_at_secs.is_none())
@@ -285,12 +430,14 @@ impl Model {
         true
     }
 
-    /// A pointer went up or was cancelled: its touch fades out as the preset says.
+    /// A pointer went up, was cancelled or left: its touch fades out as the preset says, its
+    /// finger lifts, its grasp opens, its sponge comes off.
     pub fn pointer_up(&mut self, pointer_id: i32) {
         let now = self.clock_secs;
         for held in self.touches.iter_mut().filter(|t| t.pointer_id == pointer_id) {
             held.touch.released_at_secs.get_or_insert(now);
         }
+        self.tools.release(&mut self.stepper, pointer_id, now);
     }
 
     /// Pointers patting now (held, not fading).
@@ -300,9 +447,13 @@ impl Model {
     }
 
     /// Moves the page's clock by `frame_secs` of wall time (capped, so a tab coming back from
-    /// the background does not fast-forward) and writes the pointers' touches into the
-    /// simulation's force field: the time the frame driver then advances the stepper to.
-    pub fn tick(&mut self, frame_secs: f64) -> f64 {
+    /// the background does not fast-forward), writes the pointers' touches into the
+    /// simulation's force field, its fingers into its colliders and its sponges into the
+    /// wetness: the time the frame driver then advances the stepper to.
+    ///
+    /// # Errors
+    /// [`ModelError::Sim`] for a finger the simulation refuses.
+    pub fn tick(&mut self, frame_secs: f64) -> Result<f64, ModelError> {
         if frame_secs.is_finite() && frame_secs > 0.0 {
             self.clock_secs += frame_secs.min(MAX_FRAME_SECS);
         }
@@ -314,7 +465,9 @@ impl Model {
         for held in &self.touches {
             held.touch.apply(strength, held.touch.presence(now, release_secs), field.values_mut());
         }
-        self.clock_secs
+        let radius = self.mesh_radius();
+        self.tools.apply(&mut self.stepper, &self.structure.mesh.normals, radius, now)?;
+        Ok(self.clock_secs)
     }
 
     /// A frame without a GPU: [`Model::tick`], then the stepper on the CPU.
@@ -322,10 +475,16 @@ impl Model {
     /// # Errors
     /// [`ModelError::Sim`] for a step the simulation refuses.
     pub fn simulate(&mut self, frame_secs: f64) -> Result<(), ModelError> {
-        let time_secs = self.tick(frame_secs);
+        let time_secs = self.tick(frame_secs)?;
         Ok(self.stepper.advance_to(time_secs)?)
     }
 }
+
+/// The glTF Fox (Khronos sample, CC BY 4.0; see assets/CREDITS.md), embedded: a page reads
+/// no files. Its groom (`fox_groomed.groom`) is tied to this mesh as `Mesh::load` reads it.
+const FOX_GLB: &[u8] = include_bytes!("../../../assets/meshes/Fox.glb");
+/// The Fox's name in messages, as `pelt render` names it.
+pub const FOX_NAME: &str = "assets/meshes/Fox.glb";
 
 /// The furred mesh and the plain body (try-on only).
 fn load_scene(scene: SceneChoice) -> Result<(Mesh, Option<Mesh>), ModelError> {
@@ -335,13 +494,29 @@ fn load_scene(scene: SceneChoice) -> Result<(Mesh, Option<Mesh>), ModelError> {
             let TryOnScene { garment, body, .. } = try_on_scene(&ImportOptions::default())?;
             (garment, Some(body))
         }
+        SceneChoice::Fox => {
+            (Mesh::from_gltf_slice(FOX_GLB, std::path::Path::new(FOX_NAME), &ImportOptions::default())?.0, None)
+        }
     })
 }
 
-/// Grows the rest pose of `preset`'s fur on `mesh` (length relative to the mesh's radius).
-fn grow(mesh: Mesh, preset: &Preset) -> Result<FurStructure, ModelError> {
+/// Grows the rest pose of `preset`'s fur on `scene`'s `mesh` (length relative to the mesh's
+/// radius), groomed as its `[groom]` says (from the grooms the page ships).
+fn grow(mesh: Mesh, scene: SceneChoice, preset: &Preset) -> Result<FurStructure, ModelError> {
     let params = preset.fur_params(&mesh);
-    Ok(FurStructure::new(mesh, &params)?)
+    let mesh_name = match scene {
+        SceneChoice::Fox => FOX_NAME.to_owned(),
+        other => format!("the {} mesh", other.name()),
+    };
+    let groom = presets::web_groom(preset, &mesh, &mesh_name)?;
+    Ok(FurStructure::new_groomed(mesh, &params, groom)?)
+}
+
+/// The simulation of `structure` with `preset`'s `[simulation]` and `[wet]`.
+fn stepper(structure: &FurStructure, preset: &Preset) -> Result<FurStepper, ModelError> {
+    let mut stepper = FurStepper::new(structure, &preset.simulation)?;
+    stepper.set_wet(&preset.wet)?;
+    Ok(stepper)
 }
 
 #[cfg(test)]

@@ -159,7 +159,7 @@ impl PageGpu {
         model: &mut Model,
         frame_secs: f64,
     ) -> Result<(), String> {
-        let time_secs = model.tick(frame_secs);
+        let time_secs = model.tick(frame_secs).map_err(|e| e.to_string())?;
         self.driver.advance_to(device, queue, &mut model.stepper, time_secs).map_err(|e| e.to_string())
     }
 

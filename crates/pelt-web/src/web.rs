@@ -9,6 +9,7 @@ use web_time::Instant;
 use crate::gpu::{CanvasGpu, Skipped};
 use crate::model::{Model, SceneChoice};
 use crate::presets;
+use crate::tools::Tool;
 
 fn message(error: impl std::fmt::Display) -> JsValue {
     JsValue::from_str(&error.to_string())
@@ -126,27 +127,62 @@ impl PeltApp {
         }
     }
 
-    /// Shows `"bunny"` or `"tryon"`.
+    /// Shows `"bunny"`, `"tryon"` or `"fox"`. A shipped preset made for another mesh gives way:
+    /// the Fox takes `fox_groomed`, the others `default` after a Fox preset.
     ///
     /// # Errors
     /// A message; the scene stays.
     pub fn set_scene(&mut self, name: &str) -> Result<(), JsValue> {
         let choice = SceneChoice::from_name(name).ok_or_else(|| message(format!("no scene is called {name:?}")))?;
-        let started = Instant::now();
-        self.model.set_scene(choice, self.aspect()).map_err(message)?;
-        self.structure_ms = started.elapsed().as_secs_f64() * 1e3;
-        self.gpu.set_structure(&self.model).map_err(message)
+        let shipped = presets::SHIPPED.iter().any(|(n, _)| *n == self.preset_name);
+        let made_for = presets::made_for(&self.preset_name);
+        let swap = match choice {
+            SceneChoice::Fox if shipped && made_for != Some("fox") => Some("fox_groomed"),
+            _ if made_for.is_some_and(|scene| scene != name) => Some("default"),
+            _ => None,
+        };
+        match swap {
+            Some(preset) => self.switch(choice, preset),
+            None => {
+                let started = Instant::now();
+                self.model.set_scene(choice, self.aspect()).map_err(message)?;
+                self.structure_ms = started.elapsed().as_secs_f64() * 1e3;
+                self.gpu.set_structure(&self.model).map_err(message)
+            }
+        }
     }
 
-    /// Uses the shipped preset `name` (fur length and colour come from it).
+    /// Uses the shipped preset `name` (fur length and colour come from it); one made for a mesh
+    /// (the Fox's) shows that mesh.
     ///
     /// # Errors
     /// A message; the preset stays.
     pub fn set_preset(&mut self, name: &str) -> Result<(), JsValue> {
+        if let Some(scene) = presets::made_for(name).and_then(SceneChoice::from_name)
+            && scene != self.model.scene
+        {
+            return self.switch(scene, name);
+        }
         let preset = presets::shipped(name).map_err(message)?;
         self.use_preset(preset)?;
         name.clone_into(&mut self.preset_name);
         Ok(())
+    }
+
+    /// Shows `scene` with the shipped preset `name`.
+    fn switch(&mut self, scene: SceneChoice, name: &str) -> Result<(), JsValue> {
+        let preset = presets::shipped(name).map_err(message)?;
+        // Textures first: a preset whose textures fail leaves everything as it was.
+        let started = Instant::now();
+        let made = presets::web_textures(&preset).map_err(message)?;
+        let texture_ms = started.elapsed().as_secs_f64() * 1e3;
+        let started = Instant::now();
+        self.model.set_scene_and_preset(scene, preset, self.aspect()).map_err(message)?;
+        self.structure_ms = started.elapsed().as_secs_f64() * 1e3;
+        self.texture_ms = texture_ms;
+        name.clone_into(&mut self.preset_name);
+        self.gpu.set_structure(&self.model).map_err(message)?;
+        self.gpu.set_textures(&made.textures, made.tile_scale).map_err(message)
     }
 
     /// Uses a preset file the user picked (`text`, named `file_name` in messages).
@@ -208,20 +244,48 @@ impl PeltApp {
         self.model.set_wind(strength, direction_deg).map_err(message)
     }
 
-    /// A pointer went down at CSS pixel `(x, y)` of the canvas: true when it pats the fur,
-    /// false when it missed (the page orbits with it).
+    /// A pointer went down at CSS pixel `(x, y)` of the canvas: true when it takes the tool on
+    /// the fur, false when it missed (the page orbits with it).
     pub fn pointer_down(&mut self, pointer_id: i32, x: f32, y: f32) -> bool {
         self.model.pointer_down(pointer_id, Vec2::new(x, y), self.css_size)
     }
 
-    /// A pointer moved; true when it is patting.
+    /// A pointer moved (pressed, or hovering with the finger); true when it acts on the fur.
     pub fn pointer_move(&mut self, pointer_id: i32, x: f32, y: f32) -> bool {
         self.model.pointer_move(pointer_id, Vec2::new(x, y), self.css_size)
     }
 
-    /// A pointer went up or was cancelled.
+    /// A pointer went up, was cancelled or left the canvas.
     pub fn pointer_up(&mut self, pointer_id: i32) {
         self.model.pointer_up(pointer_id);
+    }
+
+    /// What a pointer landing on the fur does: `"touch"` (pat), `"finger"`, `"grab"` or
+    /// `"sponge"`. Every pointer on the fur lets go.
+    ///
+    /// # Errors
+    /// A message for an unknown tool; the tool stays.
+    pub fn set_tool(&mut self, name: &str) -> Result<(), JsValue> {
+        let tool = Tool::from_name(name).ok_or_else(|| message(format!("no tool is called {name:?}")))?;
+        self.model.set_tool(tool);
+        Ok(())
+    }
+
+    /// Dries the whole coat at once.
+    pub fn dry(&mut self) {
+        self.model.dry();
+    }
+
+    /// The scene shown (`"bunny"`, `"tryon"` or `"fox"`), for the page's controls.
+    #[must_use]
+    pub fn scene(&self) -> String {
+        self.model.scene.name().to_owned()
+    }
+
+    /// The preset's name (a shipped one's, or the picked file's), for the page's menu.
+    #[must_use]
+    pub fn preset_name(&self) -> String {
+        self.preset_name.clone()
     }
 
     /// Orbits by a drag of CSS pixels.
@@ -256,11 +320,13 @@ impl PeltApp {
     #[must_use]
     pub fn stats(&self) -> String {
         let structure = &self.model.structure;
+        let pointers = self.model.stats();
         format!(
             concat!(
                 "{{\"frame_ms\":{:.3},\"sim_ms\":{:.3},\"texture_ms\":{:.1},\"structure_ms\":{:.1},",
                 "\"frames_drawn\":{},\"frames_skipped\":{},\"vertices\":{},\"layers\":{},\"tile_px\":{},",
-                "\"touches\":{},\"preset\":{},\"adapter\":{}}}"
+                "\"touches\":{},\"tool\":{},\"fingers\":{},\"grabbing\":{},\"wettest\":{:.3},",
+                "\"scene\":{},\"preset\":{},\"adapter\":{}}}"
             ),
             self.frame_ms,
             self.sim_ms,
@@ -271,7 +337,12 @@ impl PeltApp {
             structure.positions.len(),
             structure.layers,
             presets::WEB_TILE_PX.min(self.model.preset.texture.size),
-            self.model.touches_held(),
+            pointers.touches,
+            json_string(pointers.tool.name()),
+            pointers.fingers,
+            pointers.grabbing,
+            pointers.wettest,
+            json_string(self.model.scene.name()),
             json_string(&self.preset_name),
             json_string(&self.gpu.adapter_name),
         )

@@ -8,11 +8,11 @@ use std::time::{Duration, Instant};
 use anyhow::{Context as _, bail};
 use glam::{Mat4, Vec3};
 use pelt_core::anim::{Pose, Rig};
-use pelt_core::sim::{FurStepper, Scene, WindParams};
+use pelt_core::sim::{FurStepper, Scene, SceneCamera, WindParams};
 use pelt_core::{Builtin, FurStructure, Mesh, Preset, Stage};
 use pelt_render::{
-    Backend, Camera, FurDrawSettings, FurDriver, FurTarget, FurView, Gpu, HEADLESS_FORMAT, Headless, PlainMesh,
-    SAMPLE_COUNT, Studio, default_sample_count,
+    Backend, Camera, ColliderMeshes, FurDrawSettings, FurDriver, FurTarget, FurView, Gpu, HEADLESS_FORMAT, Headless,
+    PlainMesh, SAMPLE_COUNT, Studio, default_sample_count,
 };
 
 use crate::lod;
@@ -203,7 +203,8 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         mesh.prepare(queue, Mat4::IDENTITY);
     }
     let motion_keys = stepper.scene().map_or(&[][..], |s| &s.motion[..]);
-    let camera = camera(args, &preset, &fur, &plain, motion_keys, frames, headless.aspect_ratio());
+    let scene_camera = stepper.scene().and_then(|s| s.camera.as_ref());
+    let camera = camera(args, &preset, &fur, &plain, (motion_keys, scene_camera), frames, headless.aspect_ratio());
     let studio = Studio::default();
     let view = FurView::new(device, &renderer);
     view.prepare(queue, &studio.view_data(&camera, headless.aspect_ratio()));
@@ -236,6 +237,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         }
         _ => None,
     };
+    let mut colliders = ColliderMeshes::new();
     let (mut render_time, mut simulation_time) = (Duration::ZERO, Duration::ZERO);
     let mut body_pose = Pose::default();
     for frame in 0..frames {
@@ -259,6 +261,10 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                 mesh.prepare(queue, stepper.world_from_model());
             }
         }
+        let simulation = stepper.simulation();
+        let shown = simulation.shown_colliders(time_secs);
+        let plane_half_size = 1.5 * simulation.bounding_radius();
+        colliders.update(device, queue, &renderer, &shown, stepper.world_from_model(), plane_half_size)?;
         let image = headless.render_with(
             studio.background,
             |encoder| driver.record_view(encoder, &renderer, &view),
@@ -266,6 +272,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                 for mesh in &plain_meshes {
                     renderer.draw_plain(pass, &view, mesh);
                 }
+                colliders.draw(pass, &renderer, &view);
                 driver.draw(pass, &renderer, &view, &settings);
             },
         )?;
@@ -327,14 +334,15 @@ fn choose_animation(args: &Args, rig: Option<&Rig>) -> anyhow::Result<Option<usi
     }
 }
 
-/// `--camera`, or a view that frames the fur (and any plain meshes) tightly, wherever the
-/// script's motion takes them: from the preset's `[render]` angles, else from the front left.
+/// `--camera`, else the script's `[camera]`, else a view that frames the fur (and any plain
+/// meshes) tightly, wherever the script's motion takes them: from the preset's `[render]`
+/// angles, else from the front left.
 fn camera(
     args: &Args,
     preset: &Preset,
     fur: &FurStructure,
     plain: &[Mesh],
-    motion: &[pelt_core::sim::MotionKey],
+    (motion, scene_camera): (&[pelt_core::sim::MotionKey], Option<&SceneCamera>),
     frames: u32,
     aspect_ratio: f32,
 ) -> Camera {
@@ -356,11 +364,19 @@ fn camera(
     let (low, high) = all_points()
         .fold((Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)), |(lo, hi), p| (lo.min(p), hi.max(p)));
     let centre = (low + high) * 0.5;
-    match args.camera {
-        Some(v) => Camera::orbit(centre, v.x, v.y, v.z),
-        None => {
+    let fur_length = fur.lengths.iter().copied().fold(0.0, f32::max);
+    match (args.camera, scene_camera) {
+        (Some(v), _) => Camera::orbit(centre, v.x, v.y, v.z),
+        (None, Some(scene)) => {
+            let target = scene.target.unwrap_or(centre);
+            let (azimuth, elevation) = (scene.azimuth_deg, scene.elevation_deg);
+            match scene.distance {
+                Some(distance) => Camera::orbit(target, azimuth, elevation, distance),
+                None => Camera::framing_points(target, all_points(), fur_length, azimuth, elevation, aspect_ratio),
+            }
+        }
+        (None, None) => {
             let points = all_points();
-            let fur_length = fur.lengths.iter().copied().fold(0.0, f32::max);
             let azimuth = preset.render.camera_azimuth_deg.unwrap_or(30.0);
             let elevation = preset.render.camera_elevation_deg.unwrap_or(15.0);
             Camera::framing_points(centre, points, fur_length, azimuth, elevation, aspect_ratio)

@@ -5,6 +5,7 @@
 mod app;
 mod camera;
 mod capture;
+mod contact;
 mod fur;
 mod gpu;
 mod model;

@@ -36,6 +36,7 @@ mod lanes;
 pub mod motion;
 pub mod pick;
 pub mod scene;
+mod shown;
 pub mod simulation;
 #[cfg(feature = "lab")]
 pub mod soak;
@@ -57,7 +58,7 @@ pub use inputs::{InputVersions, StepInputs, StrandInputs};
 pub use kernel::{KernelRest, kernel_rest};
 pub use motion::{Ease, MotionKey};
 pub use pick::{Hit, pick};
-pub use scene::{Scene, SceneError, Stroke, WindKey};
+pub use scene::{Scene, SceneCamera, SceneError, Stroke, WindKey};
 pub use simulation::{SimError, Simulation};
 #[cfg(feature = "lab")]
 pub use soak::{SoakReport, SoakStep, SoakSubject, soak};

@@ -48,6 +48,12 @@
 //! time_secs = 0.0
 //! point = [0.0, -1.0, 0.0]
 //! normal = [0.0, 1.0, 0.0]
+//!
+//! [camera]                         # optional: where `pelt render` looks from (unless --camera)
+//! target = [2.8, 5.9, 0.2]         # optional: default the meshes' centre
+//! azimuth_deg = 60.0               # around +Y from +Z toward +X
+//! elevation_deg = 35.0
+//! distance = 8.0                   # optional: default the meshes framed
 //! ```
 //!
 //! Stroke points are world positions, on or near the base surface, which keeps a script
@@ -279,6 +285,22 @@ impl SceneGrasp {
     }
 }
 
+/// The camera a scene is seen from (`[camera]`): an orbit about `target`.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneCamera {
+    /// The point looked at; default the centre of the meshes.
+    #[serde(default)]
+    pub target: Option<Vec3>,
+    /// Turn around +Y from +Z toward +X, degrees.
+    pub azimuth_deg: f32,
+    /// Lift toward +Y, degrees, -89 to 89.
+    pub elevation_deg: f32,
+    /// From the target, world units; default: the meshes framed.
+    #[serde(default)]
+    pub distance: Option<f32>,
+}
+
 /// A parsed, validated scene script.
 #[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -307,6 +329,9 @@ pub struct Scene {
     /// Water level keyframes, sorted by time.
     #[serde(default)]
     pub water: Vec<WaterKey>,
+    /// The camera; default: the host's own.
+    #[serde(default)]
+    pub camera: Option<SceneCamera>,
 }
 
 impl Scene {
@@ -408,6 +433,16 @@ impl Scene {
                 return Err((format!("grasp[{i}].path[{k}]"), "must be finite".into()));
             }
             grasp.params().validate().map_err(|(key, problem)| (format!("grasp[{i}].{key}"), problem))?;
+        }
+        if let Some(camera) = &self.camera {
+            if camera.target.is_some_and(|t| !t.is_finite()) {
+                return Err(("camera.target".into(), "must be finite".into()));
+            }
+            range("camera.azimuth_deg".into(), camera.azimuth_deg, -3600.0, 3600.0)?;
+            range("camera.elevation_deg".into(), camera.elevation_deg, -89.0, 89.0)?;
+            if let Some(distance) = camera.distance {
+                range("camera.distance".into(), distance, f32::MIN_POSITIVE, f32::MAX)?;
+            }
         }
         Ok(())
     }
@@ -531,5 +566,24 @@ impl Scene {
             sim.grasp_end(grasp.end_secs);
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_camera_is_read_and_checked() {
+        let text = "[camera]\ntarget = [1.0, 2.0, 3.0]\nazimuth_deg = 60.0\nelevation_deg = 30.0\n";
+        let scene = Scene::from_toml_str(text, Path::new("a.toml")).expect("a valid camera");
+        let camera = scene.camera.expect("the camera is kept");
+        assert_eq!((camera.target, camera.azimuth_deg, camera.distance), (Some(Vec3::new(1.0, 2.0, 3.0)), 60.0, None));
+        let bad = "[camera]\nazimuth_deg = 0.0\nelevation_deg = 95.0\n";
+        let error = Scene::from_toml_str(bad, Path::new("b.toml")).unwrap_err().to_string();
+        assert!(error.contains("b.toml") && error.contains("camera.elevation_deg"), "{error}");
+        let bad = "[camera]\nazimuth_deg = 0.0\nelevation_deg = 5.0\ndistance = 0.0\n";
+        let error = Scene::from_toml_str(bad, Path::new("c.toml")).unwrap_err().to_string();
+        assert!(error.contains("camera.distance"), "{error}");
     }
 }

@@ -13,7 +13,6 @@ use glam::{Quat, Vec3, Vec4};
 use rayon::prelude::*;
 
 use super::contact::skin::skin_planes_of;
-use super::contact::surface::skin_surface_reusing;
 use super::contact::{
     Collider, ContactStep, ContactStrands, Grasp, GraspParams, MAX_STEP_COLLIDERS, Resolve, SKIN_PLANES, SkinSurface,
     StepCollider, skin_surface,

@@ -153,6 +153,11 @@ impl App {
         if requests.save_preset {
             model.save_preset();
         }
+        if requests.remove_ball
+            && let Err(error) = super::contact::remove_ball(model.stepper.simulation_mut())
+        {
+            model.status = format!("{error:#}");
+        }
         if (requests.undo || requests.redo)
             && let Err(error) = model.undo_groom(requests.redo)
         {

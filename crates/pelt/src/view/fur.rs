@@ -6,8 +6,8 @@ use pelt_core::sim::{FurStepper, SimParams};
 use pelt_core::texture::FurTextures;
 use pelt_core::{FurStructure, Mesh};
 use pelt_render::{
-    Camera, FurDrawSettings, FurDriver, FurFrame, FurLevel, FurRenderer, FurView, KernelChoice, PlainMesh,
-    SeparatedFur, SeparatedRenderer, SimKernel, Studio,
+    Camera, ColliderMeshes, FurDrawSettings, FurDriver, FurFrame, FurLevel, FurRenderer, FurView, KernelChoice,
+    PlainMesh, SeparatedFur, SeparatedRenderer, SimKernel, Studio,
 };
 
 use super::camera::OrbitCamera;
@@ -30,6 +30,8 @@ pub struct FurScene {
     separated: Option<(SeparatedRenderer, SeparatedFur)>,
     /// The furless body both structures are drawn with (the try-on scene's).
     body: Option<PlainMesh>,
+    /// The simulation's colliders and the grasp's hand, as they stand.
+    colliders: ColliderMeshes,
     view: FurView,
     textures: FurTextures,
     pub settings: FurDrawSettings,
@@ -54,6 +56,7 @@ impl FurScene {
             driver,
             separated: None,
             body: None,
+            colliders: ColliderMeshes::new(),
             view,
             textures: textures.clone(),
             settings: FurDrawSettings::SILHOUETTE,
@@ -116,6 +119,11 @@ impl FurScene {
             self.driver.record(&mut encoder)?;
             gpu.queue.submit([encoder.finish()]);
         }
+        let simulation = stepper.simulation();
+        let shown = simulation.shown_colliders(time_secs);
+        let plane_half_size = 1.5 * simulation.bounding_radius();
+        let world_from_model = stepper.world_from_model();
+        self.colliders.update(&gpu.device, &gpu.queue, &self.renderer, &shown, world_from_model, plane_half_size)?;
         Ok(())
     }
 
@@ -212,6 +220,7 @@ impl FurScene {
             if let Some(body) = &self.body {
                 self.renderer.draw_plain(&mut pass, &self.view, body);
             }
+            self.colliders.draw(&mut pass, &self.renderer, &self.view);
             match separated {
                 Some((renderer, fur)) => renderer.draw(&mut pass, &self.view, fur, &self.settings),
                 None => self.driver.draw(&mut pass, &self.renderer, &self.view, &self.settings),

@@ -70,6 +70,8 @@ pub(super) struct Model {
     /// Why the kernel in use was chosen (the overlay shows it).
     pub(super) kernel_reason: String,
     pub(super) touch: Option<TouchDrag>,
+    /// The ball or the grab being dragged.
+    pub(super) contact_drag: Option<super::contact::ContactDrag>,
     /// The groom being painted (the structure's groom, with its strokes' history).
     pub(super) groom_editor: pelt_core::groom::GroomEditor,
     /// A paint stroke is in progress.
@@ -220,6 +222,7 @@ impl Model {
             sim_choice: args.sim,
             kernel_reason: String::new(),
             touch: None,
+            contact_drag: None,
             wind_strength_on: 1.0,
             textures: Some(textures),
             texture_job: None,

@@ -87,6 +87,8 @@ pub struct Settings {
     pub paint: super::paint::PaintSettings,
     /// Rain, water, the sponge and the coat's wetness.
     pub wet: WetControls,
+    /// The ball and the grab.
+    pub contact: super::contact::ContactControls,
 }
 
 /// The animation controls: which clip, playing or not, speed and the timeline.
@@ -116,6 +118,7 @@ impl Settings {
             animation: AnimationSettings::default(),
             paint: super::paint::PaintSettings::default(),
             wet: WetControls::default(),
+            contact: super::contact::ContactControls::default(),
         }
     }
 }
@@ -162,6 +165,8 @@ pub struct Requests {
     /// Undo or redo a groom stroke.
     pub undo: bool,
     pub redo: bool,
+    /// Take the ball out of the fur.
+    pub remove_ball: bool,
 }
 
 impl Requests {
@@ -172,6 +177,7 @@ impl Requests {
         self.load_preset |= other.load_preset;
         self.undo |= other.undo;
         self.redo |= other.redo;
+        self.remove_ball |= other.remove_ball;
     }
 }
 
@@ -343,6 +349,9 @@ pub fn show(
             changes.simulation |= *sim != before;
         });
         section(ui, "Wet", true, |ui| changes.wet.merge(wet_ui(ui, &mut settings.wet, &mut settings.preset.wet)));
+        section(ui, "Contact", true, |ui| {
+            requests.remove_ball |= super::contact::contact_ui(ui, &mut settings.contact)
+        });
         section(ui, "Drawing", true, |ui| {
             let draw = &mut settings.draw;
             ui.horizontal(|ui| {

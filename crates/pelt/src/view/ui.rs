@@ -133,8 +133,13 @@ impl Model {
             .and_then(|ray| self.stepper.simulation().pick(&self.structure.mesh.triangles, ray.origin, ray.direction));
 
         let paint = self.settings.paint.on;
+        let contact = !paint && self.contact_input(&response, ray, hover_hit.map(|hit| hit.point))?;
         let sponging = !paint && self.settings.wet.sponge && primary && !modifiers.alt && hover_hit.is_some();
-        if paint && (self.painting || (response.drag_started_by(egui::PointerButton::Primary) && hover_hit.is_some())) {
+        if contact {
+            // The ball or the grip holds the pointer: no orbit or touch while it is dragged.
+        } else if paint
+            && (self.painting || (response.drag_started_by(egui::PointerButton::Primary) && hover_hit.is_some()))
+        {
             if (primary || response.drag_started_by(egui::PointerButton::Primary))
                 && let Some(ray) = ray
             {
@@ -152,8 +157,8 @@ impl Model {
             let plane_normal = (self.camera.target - self.camera.eye()).normalize_or(Vec3::NEG_Z);
             self.touch = Some(TouchDrag { hit: hit.point, plane_normal });
         }
-        if self.painting {
-            // The stroke holds the pointer: no orbit while painting.
+        if self.painting || contact {
+            // The stroke, the ball or the grip holds the pointer: no orbit.
         } else if let Some(touch) = self.touch {
             if primary && let Some(ray) = ray {
                 let along = ray.direction.dot(touch.plane_normal);
@@ -182,6 +187,36 @@ impl Model {
             self.overlay(&painter, rect);
         }
         Ok(())
+    }
+
+    /// The contact tools' share of the pointer: a press on the fur, the drag and the release
+    /// drive the ball or the grab. True while one is dragged.
+    fn contact_input(
+        &mut self,
+        response: &egui::Response,
+        ray: Option<super::camera::Ray>,
+        hit: Option<Vec3>,
+    ) -> anyhow::Result<bool> {
+        use super::contact::{PointerEvent, handle};
+        let event = if response.drag_started_by(egui::PointerButton::Primary)
+            && let Some(hit) = hit
+            && self.contact_drag.is_none()
+        {
+            let view_direction = self.camera.target - self.camera.eye();
+            Some(PointerEvent::Press { hit, view_direction })
+        } else if self.contact_drag.is_some() {
+            match ray {
+                Some(ray) if response.dragged_by(egui::PointerButton::Primary) => {
+                    Some(PointerEvent::Move { origin: ray.origin, direction: ray.direction })
+                }
+                _ => Some(PointerEvent::Release),
+            }
+        } else {
+            None
+        };
+        let Some(event) = event else { return Ok(false) };
+        let radius = self.structure.mesh.bounding_sphere().1;
+        Ok(handle(self.stepper.simulation_mut(), &self.settings.contact, radius, &mut self.contact_drag, event)?)
     }
 
     /// The brush under the pointer, sized to the touch radius at the fur it would touch; while

@@ -1,11 +1,13 @@
-//! Contact: the fur against its own skin ([`skin`]), colliders a host or a script places
-//! ([`Collider`]) and a grasping hand ([`Grasp`]).
+//! Contact: the fur against its own skin ([`skin`] planes, and [`surface`] triangles where the
+//! planes fall short), colliders a host or a script places ([`Collider`]) and a grasping hand
+//! ([`Grasp`]).
 //!
 //! Contact runs after the bend, on its result, per strand, root first: segment `k` keeps the
 //! direction the bend gave it (turned toward the grip for held strands), is turned by the least
-//! angle that puts its end outside every collider and above every skin plane (the plane tangent
-//! to the collider at the end's closest point, or where that cannot be reached, at the segment's
-//! start's), and the strand beyond moves with it. Each segment keeps its rest length exactly (a
+//! angle that puts its end outside every collider, above every skin plane and in front of the
+//! strand's skin triangles (the plane tangent to the collider or skin at the end's closest
+//! point, or where that cannot be reached, at the segment's start's), and the strand beyond
+//! moves with it. Each segment keeps its rest length exactly (a
 //! unit direction times the length), roots never move, and the skin is enforced last, so no
 //! force or collider pushes a node below it. A strand that touches nothing is left as the bend
 //! made it, bit for bit.
@@ -19,6 +21,11 @@
 //!   sphere's or capsule's radius, a box's smallest half extent) apart, up to
 //!   [`SWEEP_RADII_PER_STEP`] thicknesses per step, and the fur is pushed out of every sample:
 //!   nothing the collider passed over in the step is left inside its path.
+//! - Continuity: the response has no jump the kernels' last-bit differences could flip (see
+//!   `turn_above` and the grip's segment), except where an end lies on the medial axis of a
+//!   concave spot of the skin.
+//! - Cost: a node a clearance away from everything leaves the nodes within that distance
+//!   untested (a node moves at most a segment's length from the one before).
 //! - No fling: a collider grows in over [`Collider::appear_secs`] after it appears (or jumps
 //!   faster than the sweep), so fur it appears in is pushed out over a few steps.
 //!

@@ -10,7 +10,8 @@
 //! the strand's posed frame and root, so they follow skinning and rigid motion with no per-step
 //! mesh query, and a node is tested with a dot product per plane: the same small per-strand
 //! input for the CPU and the GPU kernel. Planes are relaxed where the rest strand itself would
-//! cross them, so the rest pose is never moved.
+//! cross them, so the rest pose is never moved. Where the intersection of the planes still
+//! reaches below the surface (saddles, creases), [`surface`](super::surface) keeps triangles.
 
 use std::collections::HashMap;
 
@@ -45,12 +46,7 @@ pub(crate) fn skin_planes_of(
     let reach: Vec<f32> = (0..v)
         .map(|j| (0..layers).map(|k| positions[(k + 1) * v + j].distance(positions[k * v + j])).sum::<f32>())
         .collect();
-    // Cells no smaller than a 32nd of the mesh: short or bald fur must not bin each triangle
-    // into millions of cells.
-    let (lo, hi) = mesh.positions.iter().fold((Vec3::MAX, Vec3::MIN), |(l, h), p| (l.min(*p), h.max(*p)));
-    let extent = (hi - lo).max_element();
-    let floor = if extent.is_finite() && extent > 0.0 { extent / 32.0 } else { 1.0 };
-    let cell = reach.iter().copied().fold(0.0_f32, f32::max).max(floor);
+    let cell = grid_cell(&mesh.positions, &reach);
     let grid = Grid::new(&mesh.positions, &mesh.triangles, cell);
     let mut stamp = vec![u32::MAX; mesh.triangles.len()];
     let mut candidates: Vec<Vec4> = Vec::new();
@@ -167,6 +163,15 @@ impl Grid {
 }
 
 /// Distance from `p` to the triangle `abc` (Ericson, Real-Time Collision Detection 5.1.5).
+/// The triangle grid's cell for strands of `reach`: the longest reach, but no smaller than a
+/// 32nd of the mesh, so short or bald fur does not bin each triangle into millions of cells.
+pub(super) fn grid_cell(points: &[Vec3], reach: &[f32]) -> f32 {
+    let (lo, hi) = points.iter().fold((Vec3::MAX, Vec3::MIN), |(l, h), p| (l.min(*p), h.max(*p)));
+    let extent = (hi - lo).max_element();
+    let floor = if extent.is_finite() && extent > 0.0 { extent / 32.0 } else { 1.0 };
+    reach.iter().copied().fold(0.0_f32, f32::max).max(floor)
+}
+
 pub(super) fn distance_to_triangle(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> f32 {
     let (ab, ac, ap) = (b - a, c - a, p - a);
     let (d1, d2) = (ab.dot(ap), ac.dot(ap));
@@ -205,8 +210,8 @@ mod tests {
     use crate::fur::{FurLength, FurParams, GrowthDirection};
     use crate::mesh::builtin::Builtin;
 
-    /// A bald coat (every strand of length 0) gets its planes at once: the triangle grid's cells
-    /// do not shrink with the fur.
+    /// A bald coat (every strand of length 0) gets its planes and skin triangles at once: the
+    /// triangle grid's cells do not shrink with the fur.
     #[test]
     fn a_bald_coat_has_planes_without_a_huge_grid() {
         let (mesh, _) = Builtin::Sphere.mesh();
@@ -214,5 +219,7 @@ mod tests {
         let fur = FurStructure::new(mesh, &params).unwrap();
         let planes = skin_planes(&fur);
         assert_eq!(planes.len(), fur.vertex_count());
+        let surface = super::super::skin_surface(&fur, &planes);
+        assert_eq!(surface.strands.len(), fur.vertex_count());
     }
 }

@@ -14,7 +14,7 @@ use std::collections::HashMap;
 
 use glam::{Quat, Vec3, Vec4};
 
-use super::skin::{Grid, SKIN_PLANES, distance_to_triangle};
+use super::skin::{Grid, SKIN_PLANES, distance_to_triangle, grid_cell};
 use crate::fur::FurStructure;
 
 /// Words per stored triangle: its corners `a`, `b`, `c`, its face normal, the pseudonormals of
@@ -33,7 +33,7 @@ pub struct SkinSurface {
     pub strands: Vec<[u32; 2]>,
     /// Triangle indices (into `triangles`) of every strand, one run per strand.
     pub lists: Vec<u32>,
-    /// The mesh triangle each stored triangle is.
+    /// Each stored triangle's index in the mesh.
     pub mesh_triangles: Vec<u32>,
 }
 
@@ -118,51 +118,97 @@ pub(crate) fn closest_feature(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> (Vec3, usiz
 /// [`skin_planes`](super::skin_planes)).
 #[must_use]
 pub fn skin_surface(fur: &FurStructure, planes: &[[Vec4; SKIN_PLANES]]) -> SkinSurface {
-    skin_surface_reusing(fur, planes, None)
+    let mut scan = Scan::new(fur);
+    let kept: Vec<Vec<u32>> = (0..fur.vertex_count()).map(|j| scan.strand(fur, planes, j)).collect();
+    pack(&scan.words, kept.iter().map(Vec::as_slice))
 }
 
-/// [`skin_surface`], the strands not `changed` keeping their triangles from `previous` (a groom
-/// dab reshaped the others): the same surface, found for the changed strands alone.
-pub(crate) fn skin_surface_reusing(
+/// `surface` (this fur's [`skin_surface`] before a groom dab) with `strands` found again for
+/// `fur`'s new rest shape and `planes`: equal to [`skin_surface`] of the new fur, to the bit, at
+/// the cost of the reshaped strands alone.
+pub(crate) fn skin_surface_of(
+    surface: &SkinSurface,
     fur: &FurStructure,
     planes: &[[Vec4; SKIN_PLANES]],
-    reuse: Option<(&SkinSurface, &[bool])>,
+    strands: &[u32],
 ) -> SkinSurface {
-    let v = fur.vertex_count();
-    let layers = fur.layers as usize;
-    let positions = &fur.positions;
-    let mesh = &fur.mesh;
-    let points = &mesh.positions;
-    let reach: Vec<f32> = (0..v)
-        .map(|j| (0..layers).map(|k| positions[(k + 1) * v + j].distance(positions[k * v + j])).sum::<f32>())
+    let mut scan = Scan::new(fur);
+    let mut kept: Vec<Vec<u32>> = (0..fur.vertex_count())
+        .map(|j| surface.strand(j).iter().map(|&t| surface.mesh_triangles[t as usize]).collect())
         .collect();
-    let cell = reach.iter().copied().fold(0.0_f32, f32::max).max(1e-6);
-    let grid = Grid::new(points, &mesh.triangles, cell);
-    let words = triangle_words(points, &mesh.triangles);
-    let mut corner_triangles: Vec<Vec<u32>> = vec![Vec::new(); points.len()];
-    for (t, tri) in mesh.triangles.iter().enumerate() {
-        if words[t].is_some() {
-            for &i in tri {
-                corner_triangles[i as usize].push(t as u32);
+    for &j in strands {
+        kept[j as usize] = scan.strand(fur, planes, j as usize);
+    }
+    pack(&scan.words, kept.iter().map(Vec::as_slice))
+}
+
+/// Stores each strand's triangles (mesh triangle indices), every triangle once, in the order
+/// strands first reach them.
+fn pack<'a>(words: &[Option<[Vec4; SURFACE_WORDS]>], kept: impl Iterator<Item = &'a [u32]>) -> SkinSurface {
+    let mut surface = SkinSurface::default();
+    let mut stored: HashMap<u32, u32> = HashMap::new();
+    for strand in kept {
+        let first = surface.lists.len() as u32;
+        for &t in strand {
+            let next = surface.triangles.len() as u32;
+            let index = *stored.entry(t).or_insert_with(|| {
+                surface.triangles.push(words[t as usize].expect("kept triangles have area"));
+                surface.mesh_triangles.push(t);
+                next
+            });
+            surface.lists.push(index);
+        }
+        surface.strands.push([first, strand.len() as u32]);
+    }
+    surface
+}
+
+/// What finding a strand's triangles needs: the mesh's triangles binned, their words, and which
+/// triangles meet at each corner.
+struct Scan {
+    reach: Vec<f32>,
+    grid: Grid,
+    words: Vec<Option<[Vec4; SURFACE_WORDS]>>,
+    corner_triangles: Vec<Vec<u32>>,
+    stamp: Vec<u32>,
+}
+
+impl Scan {
+    fn new(fur: &FurStructure) -> Self {
+        let v = fur.vertex_count();
+        let layers = fur.layers as usize;
+        let positions = &fur.positions;
+        let mesh = &fur.mesh;
+        let points = &mesh.positions;
+        let reach: Vec<f32> = (0..v)
+            .map(|j| (0..layers).map(|k| positions[(k + 1) * v + j].distance(positions[k * v + j])).sum::<f32>())
+            .collect();
+        let grid = Grid::new(points, &mesh.triangles, grid_cell(points, &reach));
+        let words = triangle_words(points, &mesh.triangles);
+        let mut corner_triangles: Vec<Vec<u32>> = vec![Vec::new(); points.len()];
+        for (t, tri) in mesh.triangles.iter().enumerate() {
+            if words[t].is_some() {
+                for &i in tri {
+                    corner_triangles[i as usize].push(t as u32);
+                }
             }
         }
+        Self { reach, grid, words, corner_triangles, stamp: vec![u32::MAX; mesh.triangles.len()] }
     }
-    let mut surface = SkinSurface { strands: Vec::with_capacity(v), ..SkinSurface::default() };
-    let mut stored: HashMap<u32, u32> = HashMap::new();
-    let mut stamp = vec![u32::MAX; mesh.triangles.len()];
-    let mut polygon = Vec::new();
-    let mut kept: Vec<(f32, u32)> = Vec::new();
-    for j in 0..v {
-        let root = positions[j];
-        let r = reach[j] * 1.05;
-        let first = surface.lists.len() as u32;
-        kept.clear();
-        if let Some((previous, _)) = reuse.filter(|(_, changed)| !changed[j]) {
-            kept.extend(previous.strand(j).iter().map(|&k| (0.0, previous.mesh_triangles[k as usize])));
-        } else if r > 0.0 && j < planes.len() {
+
+    /// Strand `j`'s triangles (mesh triangle indices), the nearest to its root first.
+    fn strand(&mut self, fur: &FurStructure, planes: &[[Vec4; SKIN_PLANES]], j: usize) -> Vec<u32> {
+        let mesh = &fur.mesh;
+        let points = &mesh.positions;
+        let root = fur.positions[j];
+        let r = self.reach[j] * 1.05;
+        let mut kept: Vec<(f32, u32)> = Vec::new();
+        if r > 0.0 && j < planes.len() {
             let strand_planes: Vec<Vec4> = planes[j].iter().copied().filter(|p| p.truncate() != Vec3::ZERO).collect();
             let mut hits = Vec::new();
-            grid.near(root, r, |t| {
+            let mut polygon = Vec::new();
+            let (stamp, words) = (&mut self.stamp, &self.words);
+            self.grid.near(root, r, |t| {
                 if stamp[t as usize] == j as u32 || words[t as usize].is_none() {
                     return;
                 }
@@ -187,7 +233,7 @@ pub(crate) fn skin_surface_reusing(
             // node behind a hit is among them.
             for &t in &hits {
                 for &i in &mesh.triangles[t as usize] {
-                    for &n in &corner_triangles[i as usize] {
+                    for &n in &self.corner_triangles[i as usize] {
                         if !kept.iter().any(|&(_, k)| k == n) {
                             let [a, b, c] = mesh.triangles[n as usize].map(|i| points[i as usize]);
                             kept.push((distance_to_triangle(root, a, b, c), n));
@@ -198,18 +244,8 @@ pub(crate) fn skin_surface_reusing(
             kept.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
             kept.truncate(MAX_STRAND_TRIANGLES);
         }
-        for &(_, t) in &kept {
-            let next = surface.triangles.len() as u32;
-            let index = *stored.entry(t).or_insert_with(|| {
-                surface.triangles.push(words[t as usize].expect("kept triangles have area"));
-                surface.mesh_triangles.push(t);
-                next
-            });
-            surface.lists.push(index);
-        }
-        surface.strands.push([first, kept.len() as u32]);
+        kept.into_iter().map(|(_, t)| t).collect()
     }
-    surface
 }
 
 /// Each triangle's corners and pseudonormals (Baerentzen and Aanaes 2005); `None` for one with

@@ -2,8 +2,9 @@
 //! skin planes in place, so painting never rebuilds the simulation (the skin planes of every
 //! strand are most of [`Simulation::new`]'s cost).
 
-use super::{SimError, Simulation, skin_planes_of, skin_surface_reusing};
+use super::{SimError, Simulation, skin_planes_of};
 use crate::fur::FurStructure;
+use crate::sim::contact::surface::skin_surface_of;
 
 impl Simulation {
     /// Takes `fur`'s rest shape for `strands` (the base vertices whose length or direction a
@@ -32,26 +33,25 @@ impl Simulation {
             return Ok(());
         }
         self.rest.update(&fur.positions, v, layers, strands);
-        let mut changed = vec![false; v];
-        for &j in strands {
-            changed[j as usize] = true;
-        }
         let (cell, planes) = skin_planes_of(fur, strands.iter().map(|&j| j as usize));
         if cell.to_bits() == self.skin_cell.to_bits() {
             for (&j, planes) in strands.iter().zip(planes) {
                 self.skin[j as usize] = planes;
             }
+            self.surface = skin_surface_of(&self.surface, fur, &self.skin, strands);
         } else {
-            // The longest strand changed: the grid, and so any strand's tie order, with it.
+            // The longest strand changed: the grid, and so any strand's tie order, with it. The
+            // skin triangles are found again for the strands whose planes moved too.
             let (cell, all) = skin_planes_of(fur, 0..v);
-            for (j, (old, new)) in self.skin.iter().zip(&all).enumerate() {
-                changed[j] |=
-                    old.map(|p| p.to_array().map(f32::to_bits)) != new.map(|p| p.to_array().map(f32::to_bits));
-            }
+            let bits =
+                |planes: &[glam::Vec4]| planes.iter().flat_map(|p| p.to_array().map(f32::to_bits)).collect::<Vec<_>>();
+            let mut changed: Vec<u32> = strands.to_vec();
+            changed.extend((0..v).filter(|&j| bits(&self.skin[j]) != bits(&all[j])).map(|j| j as u32));
+            changed.sort_unstable();
+            changed.dedup();
             (self.skin_cell, self.skin) = (cell, all);
+            self.surface = skin_surface_of(&self.surface, fur, &self.skin, &changed);
         }
-        // The skin triangles a strand keeps follow from its planes and reach alone.
-        self.surface = skin_surface_reusing(fur, &self.skin, Some((&self.surface, &changed)));
         self.restart();
         Ok(())
     }

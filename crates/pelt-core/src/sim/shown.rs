@@ -1,0 +1,83 @@
+//! What a host draws of the colliders: each one once, where and as large as it is at a time.
+
+use super::contact::StepCollider;
+use super::simulation::Simulation;
+
+impl Simulation {
+    /// The colliders as they stand at `time_secs`, one each, for drawing: the grasp's hand first
+    /// (while it holds), then every collider present then at the pose and the size it has grown
+    /// to ([`StepCollider::grasp_hand`] tells the hand apart). These are the shapes the fur is
+    /// pushed out of (the step's own pose, without the samples along its path).
+    #[must_use]
+    pub fn shown_colliders(&self, time_secs: f64) -> Vec<StepCollider> {
+        let step_secs = 1.0 / f64::from(self.params().rate_hz);
+        let mut shown = Vec::new();
+        if let Some(grasp) = self.grasp().filter(|g| g.hand_radius > 0.0 && g.released_at_secs.is_none()) {
+            let mut hand = StepCollider::ball(grasp.grip, grasp.hand_radius);
+            hand.grasp_hand = true;
+            shown.push(hand);
+        }
+        let mut samples = Vec::new();
+        for collider in self.colliders() {
+            samples.clear();
+            collider.push_step(time_secs, step_secs, self.bounding_radius(), &mut samples);
+            // The step's own pose comes last, after the samples along the way.
+            if let Some(last) = samples.last() {
+                shown.push(*last);
+            }
+        }
+        shown
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::{Quat, Vec3};
+
+    use crate::fur::FurLength;
+    use crate::sim::contact::{Collider, ColliderKey, Shape};
+    use crate::{Builtin, FurParams, FurStructure};
+
+    use super::*;
+
+    fn simulation() -> Simulation {
+        let (mesh, _) = Builtin::Sphere.mesh();
+        let structure = FurStructure::new(
+            mesh,
+            &FurParams { layers: 4, length: FurLength::Constant(0.2), direction: Default::default() },
+        )
+        .expect("a sphere grows fur");
+        Simulation::new(&structure, &crate::sim::SimParams::default()).expect("default parameters")
+    }
+
+    #[test]
+    fn colliders_show_at_their_pose_once_grown() {
+        let mut sim = simulation();
+        let mut ball = Collider::at(7, Shape::Sphere { radius: 0.5 }, 1.0, Vec3::new(0.0, 2.0, 0.0), Quat::IDENTITY);
+        ball.keys.push(ColliderKey { time_secs: 3.0, position: Vec3::new(0.0, 4.0, 0.0), rotation: Quat::IDENTITY });
+        sim.set_colliders(&[ball]).expect("a valid ball");
+        assert!(sim.shown_colliders(0.5).is_empty(), "absent before its first key");
+        let growing = sim.shown_colliders(1.1);
+        assert_eq!(growing.len(), 1);
+        assert!(growing[0].radius > 0.0 && growing[0].radius < 0.5, "grows in: {}", growing[0].radius);
+        let later = sim.shown_colliders(2.0);
+        assert_eq!(later.len(), 1, "one pose however far it moved in the step");
+        assert!((later[0].radius - 0.5).abs() < 1e-6);
+        assert!(later[0].centre.distance(Vec3::new(0.0, 3.0, 0.0)) < 1e-5, "{}", later[0].centre);
+        assert!(!later[0].grasp_hand);
+    }
+
+    #[test]
+    fn the_holding_hand_shows_first() {
+        let mut sim = simulation();
+        let point = Vec3::new(0.0, 1.0, 0.0);
+        sim.grasp_begin(point, 0.4, 0.2, crate::sim::contact::GraspParams::default(), 0.0).expect("a valid grasp");
+        sim.grasp_move(Vec3::new(0.0, 1.5, 0.0)).expect("a finite point");
+        let shown = sim.shown_colliders(0.5);
+        assert_eq!(shown.len(), 1);
+        assert!(shown[0].grasp_hand && (shown[0].radius - 0.2).abs() < 1e-6);
+        assert_eq!(shown[0].centre, Vec3::new(0.0, 1.5, 0.0));
+        sim.grasp_end(0.6);
+        assert!(sim.shown_colliders(0.7).is_empty(), "the hand is gone once it lets go");
+    }
+}
