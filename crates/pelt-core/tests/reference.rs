@@ -245,3 +245,48 @@ fn strands_are_as_wide_as_the_texels_that_draw_them() {
     }
     assert!(seen[0] > 100 && seen[1] > 100, "strands on each half: {seen:?}");
 }
+
+/// Mean distance from each point to its nearest other point (brute force: the oracle).
+fn mean_nearest_distance(points: &[Vec3]) -> f32 {
+    let total: f32 = points
+        .iter()
+        .enumerate()
+        .map(|(i, p)| {
+            points
+                .iter()
+                .enumerate()
+                .filter(|(k, _)| *k != i)
+                .map(|(_, q)| p.distance(*q))
+                .fold(f32::INFINITY, f32::min)
+        })
+        .sum();
+    total / points.len() as f32
+}
+
+#[test]
+fn wet_strands_gather_into_clumps_and_dry_ones_stay_put() {
+    use pelt_core::reference::WetClumps;
+    let preset = Preset::default();
+    let (fur, dry) = place(Builtin::Sphere.mesh().0, &preset, &straight_params());
+    let v = fur.vertex_count();
+    let wet_with = |wetness: f32| {
+        let clumps = WetClumps { wetness: vec![wetness; v], clump_size: 12.0, clump_strength: 0.8, groom_clump: None };
+        StrandReference::wet(&fur, dry.field.clone(), mapping(&fur.mesh), &clumps).unwrap()
+    };
+    // Wetness 0 gathers nothing: the dry reference, node for node.
+    let zero = wet_with(0.0);
+    assert_eq!(zero.nodes, dry.nodes);
+    let wet = wet_with(0.8);
+    assert_eq!(wet.strands.len(), dry.strands.len(), "the same strands, moved");
+    assert!(wet.strands.iter().all(|s| (s.wetness - 0.8).abs() < 1e-6));
+    let tips = |reference: &StrandReference| {
+        let nodes = reference.node_positions(&fur.positions).unwrap();
+        reference.strands.iter().map(|s| nodes[(s.first_node + s.node_count - 1) as usize]).collect::<Vec<_>>()
+    };
+    // A soaked tip moves 0.6 * 0.8 * 0.8 = 0.38 of the way to its clump's centre, so tips of
+    // one clump stand closer: their nearest neighbours at most 0.8 of the dry distance.
+    let (dry_spacing, wet_spacing) = (mean_nearest_distance(&tips(&dry)), mean_nearest_distance(&tips(&wet)));
+    assert!(wet_spacing < 0.8 * dry_spacing, "tip spacing wet {wet_spacing} against dry {dry_spacing}");
+    let bad = WetClumps { wetness: vec![0.5; 3], clump_size: 12.0, clump_strength: 0.8, groom_clump: None };
+    assert!(StrandReference::wet(&fur, dry.field.clone(), mapping(&fur.mesh), &bad).is_err());
+}

@@ -94,7 +94,7 @@ fn strands_panel_luma(sheet: &image::RgbaImage) -> f64 {
 }
 
 #[test]
-fn wet_strands_are_clumped_and_darker_and_wetness_zero_is_dry() {
+fn wet_strands_are_darker_and_wetness_zero_is_dry() {
     let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("cli_fidelity_wet");
     let _ = std::fs::remove_dir_all(&dir);
     std::fs::create_dir_all(&dir).expect("temp dir");
@@ -103,18 +103,15 @@ fn wet_strands_are_clumped_and_darker_and_wetness_zero_is_dry() {
     assert_eq!(zero, dry, "--wetness 0 measures what no --wetness does");
     assert!(zero_bytes == dry_bytes, "--wetness 0 writes the dry image's bytes");
     let (wet, wet_sheet, _) = fidelity_front(&dir, "wet", &["--wetness", "0.8"]);
-    assert_eq!(wet["wetness"].as_f64(), Some(f64::from(0.8f32)));
-    // Gathered into clumps, the strands leave partings: they hide at least 3 points less skin
-    // (0.922 -> 0.874 on the bunny's front at 256x256).
-    let coverage = |r: &serde_json::Value| r["coverage_strands"].as_f64().expect("coverage_strands");
-    assert!(coverage(&wet) < coverage(&dry) - 0.03, "wet {} against dry {}", coverage(&wet), coverage(&dry));
+    assert_eq!(wet["wetness"].as_f64(), Some(0.8));
     // Darkened by `[wet] darkening` (0.5 at 0.8 wet: albedo times 0.6): 10 luma levels at least.
     let (dry_luma, wet_luma) = (strands_panel_luma(&dry_sheet), strands_panel_luma(&wet_sheet));
+    eprintln!("strands' luma: dry {dry_luma:.1}, wet {wet_luma:.1}");
     assert!(wet_luma < dry_luma - 10.0, "wet strands' luma {wet_luma} against dry {dry_luma}");
 
     for bad in ["1.5", "NaN", "-0.1"] {
         let output = Command::new(env!("CARGO_BIN_EXE_pelt"))
-            .args(["fidelity", "--builtin", "sphere", "--wetness", bad])
+            .args(["fidelity", "--builtin", "sphere", &format!("--wetness={bad}")])
             .current_dir(&dir)
             .output()
             .expect("run pelt");

@@ -2,7 +2,7 @@
 //! skin planes in place, so painting never rebuilds the simulation (the skin planes of every
 //! strand are most of [`Simulation::new`]'s cost).
 
-use super::{SimError, Simulation, skin_planes_of, skin_surface};
+use super::{SimError, Simulation, skin_planes_of};
 use crate::fur::FurStructure;
 use crate::sim::contact::surface::skin_surface_of;
 
@@ -40,9 +40,17 @@ impl Simulation {
             }
             self.surface = skin_surface_of(&self.surface, fur, &self.skin, strands);
         } else {
-            // The longest strand changed: the grid, and so every strand's tie order, with it.
-            (self.skin_cell, self.skin) = skin_planes_of(fur, 0..v);
-            self.surface = skin_surface(fur, &self.skin);
+            // The longest strand changed: the grid, and so any strand's tie order, with it. The
+            // skin triangles are found again for the strands whose planes moved too.
+            let (cell, all) = skin_planes_of(fur, 0..v);
+            let bits =
+                |planes: &[glam::Vec4]| planes.iter().flat_map(|p| p.to_array().map(f32::to_bits)).collect::<Vec<_>>();
+            let mut changed: Vec<u32> = strands.to_vec();
+            changed.extend((0..v).filter(|&j| bits(&self.skin[j]) != bits(&all[j])).map(|j| j as u32));
+            changed.sort_unstable();
+            changed.dedup();
+            (self.skin_cell, self.skin) = (cell, all);
+            self.surface = skin_surface_of(&self.surface, fur, &self.skin, &changed);
         }
         self.restart();
         Ok(())
