@@ -222,15 +222,16 @@ impl FurStepper {
     }
 
     /// Advances the wetness to `time_secs` on the posed base and hands it to the simulation.
-    fn advance_wetness(&mut self, time_secs: f64) -> Result<(), SimError> {
+    /// Wetness (rain, water, drying) up to `time_secs`. A dry coat's clock moves too (nothing
+    /// else to do then), so a sponge on it later is not dried away by replayed ticks, nor reset
+    /// as if time had begun.
+    fn advance_wetness_clock(&mut self, time_secs: f64) {
         let sources = self.scene.as_ref().map(Scene::wet_sources).unwrap_or_default();
         let simulation = &self.simulation;
         if !sources.is_empty() || !self.wetness.is_dry() {
             self.wet_normals.clear();
             self.wet_normals.extend(simulation.frames().iter().zip(&self.mesh.normals).map(|(q, n)| *q * *n));
         }
-        // A dry coat's clock moves too (nothing else to do then), so a sponge on it later is
-        // not dried away by replayed ticks, nor reset as if time had begun.
         self.wetness.advance_to(
             time_secs,
             simulation.params().rate_hz,
@@ -242,6 +243,10 @@ impl FurStepper {
                 radius: simulation.bounding_radius(),
             },
         );
+    }
+
+    fn advance_wetness(&mut self, time_secs: f64) -> Result<(), SimError> {
+        self.advance_wetness_clock(time_secs);
         let wet = (!self.wetness.is_dry()).then(|| self.wetness.values());
         if wet.is_some() || self.simulation.wetness().is_some() {
             self.simulation.set_wetness(wet, &self.wet)?;
@@ -282,6 +287,9 @@ impl FurStepper {
     /// Presses a sponge at `centre` (the posed base's space): the wetness within `radius` moves
     /// toward `amount` (0 dries, 1 soaks) with a smooth falloff.
     pub fn sponge(&mut self, centre: Vec3, radius: f32, amount: f32) {
+        // The clock first comes to the last step's time, so the next step dries this water
+        // for the time since then only (and a first step does not start the coat over it).
+        self.advance_wetness_clock(self.simulation.time_secs());
         self.wetness.sponge(self.simulation.roots(), centre, radius, amount);
     }
 
