@@ -539,8 +539,11 @@ impl Scene {
             }
         }
         if !self.colliders.is_empty() {
-            let colliders: Vec<Collider> =
+            let ours = SCENE_COLLIDER_IDS..SCENE_COLLIDER_IDS + self.colliders.len() as u32;
+            let mut colliders: Vec<Collider> =
                 self.colliders.iter().enumerate().map(|(i, c)| c.collider(SCENE_COLLIDER_IDS + i as u32)).collect();
+            // A host's colliders (the viewer's ball, a walking body's capsules) stay, joined by id.
+            colliders.extend(sim.colliders().iter().filter(|c| !ours.contains(&c.id)).cloned());
             if sim.colliders() != colliders.as_slice() {
                 sim.set_colliders(&colliders)?;
             }
@@ -585,5 +588,32 @@ mod tests {
         let bad = "[camera]\nazimuth_deg = 0.0\nelevation_deg = 5.0\ndistance = 0.0\n";
         let error = Scene::from_toml_str(bad, Path::new("c.toml")).unwrap_err().to_string();
         assert!(error.contains("camera.distance"), "{error}");
+    }
+
+    /// A script's colliders leave a host's (the viewer's ball) in place, joined by id, so the
+    /// host's collider neither vanishes nor grows in again every frame.
+    #[test]
+    fn a_scripts_colliders_keep_the_hosts() {
+        use crate::fur::{FurLength, FurParams, FurStructure, GrowthDirection};
+        use crate::mesh::builtin::Builtin;
+        use crate::sim::contact::Shape;
+        let text = "[[collider]]\nshape = { kind = \"sphere\", radius = 0.2 }\n\
+                    keys = [{ time_secs = 0.0, position = [0.0, 2.0, 0.0] }]\n";
+        let scene = Scene::from_toml_str(text, Path::new("s.toml")).expect("a valid scene");
+        let (mesh, _) = Builtin::Sphere.mesh();
+        let params = FurParams { layers: 4, length: FurLength::Constant(0.1), direction: GrowthDirection::default() };
+        let fur = FurStructure::new(mesh, &params).expect("fur");
+        let mut sim = Simulation::new(&fur, &crate::sim::SimParams::default()).expect("simulation");
+        let ball = Collider::at(7, Shape::Sphere { radius: 0.3 }, 0.0, Vec3::new(0.0, 1.0, 0.0), glam::Quat::IDENTITY);
+        sim.set_colliders(&[ball]).expect("the host's ball");
+        sim.advance_to(0.1);
+        let appeared = sim.colliders()[0].appeared_secs;
+        for time_secs in [0.2, 0.3] {
+            scene.apply(time_secs, &mut sim).expect("apply");
+            sim.advance_to(time_secs);
+        }
+        let ids: Vec<u32> = sim.colliders().iter().map(|c| c.id).collect();
+        assert_eq!(ids, vec![SCENE_COLLIDER_IDS, 7]);
+        assert_eq!(sim.colliders()[1].appeared_secs, appeared, "the ball did not appear again");
     }
 }
