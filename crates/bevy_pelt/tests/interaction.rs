@@ -3,7 +3,7 @@
 //! holds at the grip and lets them go, a sponge wets what it touches (and the wet fur draws
 //! darker), and a groomed preset, hot reloaded, leaves bald vertices bare.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::sync::{Arc, Mutex};
 use std::time::Duration;
 
@@ -11,50 +11,19 @@ use bevy::asset::RenderAssetUsages;
 use bevy::camera::RenderTarget;
 use bevy::core_pipeline::tonemapping::Tonemapping;
 use bevy::prelude::*;
-use bevy::render::RenderPlugin;
-use bevy::render::render_resource::{PollType, TextureFormat};
-use bevy::render::renderer::RenderDevice;
+use bevy::render::render_resource::TextureFormat;
 use bevy::render::view::screenshot::{Screenshot, ScreenshotCaptured};
-use bevy::time::TimeUpdateStrategy;
-use bevy::window::ExitCondition;
-use bevy::winit::WinitPlugin;
-use bevy_pelt::{Fur, FurCollider, FurGrasp, FurPreset, FurSponge, FurState, PeltPlugin};
+use bevy_pelt::{Fur, FurCollider, FurGrasp, FurPreset, FurSponge, FurState};
 
 const SIZE: u32 = 128;
 
-fn test_assets() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/assets")
-}
+mod common;
+use common::{test_assets, update};
 
 /// A headless app on `assets` whose frames are each a sixtieth of a second, however fast the
 /// machine draws; `watch` turns on Bevy's file watcher.
 fn headless_app(assets: &Path, watch: bool) -> App {
-    let mut app = App::new();
-    app.add_plugins((
-        DefaultPlugins
-            .set(WindowPlugin { primary_window: None, exit_condition: ExitCondition::DontExit, ..default() })
-            .set(RenderPlugin { synchronous_pipeline_compilation: true, ..default() })
-            .set(AssetPlugin {
-                file_path: assets.to_string_lossy().into_owned(),
-                watch_for_changes_override: Some(watch),
-                ..default()
-            })
-            .disable::<WinitPlugin>(),
-        PeltPlugin,
-    ));
-    app.insert_resource(TimeUpdateStrategy::ManualDuration(Duration::from_secs_f64(1.0 / 60.0)));
-    app.finish();
-    app.cleanup();
-    app
-}
-
-fn update(app: &mut App) {
-    app.update();
-    app.world()
-        .resource::<RenderDevice>()
-        .wgpu_device()
-        .poll(PollType::Wait { submission_index: None, timeout: None })
-        .expect("the device answers");
+    common::headless_app(assets, watch, Some(Duration::from_secs_f64(1.0 / 60.0)))
 }
 
 /// A ball of radius 0.5 (1,692 vertices) furred with `preset`.

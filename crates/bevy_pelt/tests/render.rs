@@ -13,45 +13,20 @@ use bevy::core_pipeline::tonemapping::Tonemapping;
 use bevy::mesh::VertexAttributeValues;
 use bevy::mesh::skinning::{SkinnedMesh, SkinnedMeshInverseBindposes};
 use bevy::prelude::*;
-use bevy::render::RenderPlugin;
-use bevy::render::render_resource::{PollType, TextureFormat};
-use bevy::render::renderer::RenderDevice;
+use bevy::render::render_resource::TextureFormat;
 use bevy::render::view::screenshot::{Screenshot, ScreenshotCaptured};
-use bevy::window::ExitCondition;
-use bevy::winit::WinitPlugin;
-use bevy_pelt::{Fur, FurPreset, FurState, PeltPlugin};
+use bevy_pelt::{Fur, FurPreset, FurState};
 
 const SIZE: u32 = 160;
 const BACKDROP: Color = Color::srgb(0.1, 0.2, 0.6);
 const CUBE: Color = Color::srgb(0.5, 0.5, 0.5);
 const WALL: Color = Color::srgb(0.8, 0.1, 0.1);
 
-fn assets() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/assets")
-}
+mod common;
+use common::{test_assets as assets, update};
 
 fn headless_app(assets: &Path) -> App {
-    let mut app = App::new();
-    app.add_plugins((
-        DefaultPlugins
-            .set(WindowPlugin { primary_window: None, exit_condition: ExitCondition::DontExit, ..default() })
-            .set(RenderPlugin { synchronous_pipeline_compilation: true, ..default() })
-            .set(AssetPlugin { file_path: assets.to_string_lossy().into_owned(), ..default() })
-            .disable::<WinitPlugin>(),
-        PeltPlugin,
-    ));
-    app.finish();
-    app.cleanup();
-    app
-}
-
-fn update(app: &mut App) {
-    app.update();
-    app.world()
-        .resource::<RenderDevice>()
-        .wgpu_device()
-        .poll(PollType::Wait { submission_index: None, timeout: None })
-        .expect("the device answers");
+    common::headless_app(assets, false, None)
 }
 
 /// Runs a headless app with `targets` image targets (`SIZE` square, sRGB) until every furred

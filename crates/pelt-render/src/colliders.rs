@@ -112,15 +112,7 @@ fn capsule(half_length: f32) -> RawMesh {
 /// The cube from -1 to 1, four vertices and a flat normal per face.
 fn cube() -> RawMesh {
     let mut raw = RawMesh { normals: Some(Vec::new()), ..RawMesh::default() };
-    // (normal, u, v) with u x v = normal, so each face winds counter-clockwise from outside.
-    for (normal, u, v) in [
-        (Vec3::X, Vec3::NEG_Z, Vec3::Y),
-        (Vec3::NEG_X, Vec3::Z, Vec3::Y),
-        (Vec3::Y, Vec3::X, Vec3::NEG_Z),
-        (Vec3::NEG_Y, Vec3::X, Vec3::Z),
-        (Vec3::Z, Vec3::X, Vec3::Y),
-        (Vec3::NEG_Z, Vec3::NEG_X, Vec3::Y),
-    ] {
+    for (normal, u, v) in pelt_core::mesh::builtin::CUBE_FACES {
         let base = raw.positions.len() as u32;
         for (a, b) in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)] {
             raw.positions.push(normal + u * a + v * b);

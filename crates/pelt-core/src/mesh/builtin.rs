@@ -106,20 +106,22 @@ impl fmt::Display for Builtin {
     }
 }
 
+/// A cube's faces as (normal, u axis, v axis) with u x v = normal, so faces laid out along u and
+/// v wind counter-clockwise from outside.
+pub const CUBE_FACES: [(Vec3, Vec3, Vec3); 6] = [
+    (Vec3::X, Vec3::NEG_Z, Vec3::Y),
+    (Vec3::NEG_X, Vec3::Z, Vec3::Y),
+    (Vec3::Y, Vec3::X, Vec3::NEG_Z),
+    (Vec3::NEG_Y, Vec3::X, Vec3::Z),
+    (Vec3::Z, Vec3::X, Vec3::Y),
+    (Vec3::NEG_Z, Vec3::NEG_X, Vec3::Y),
+];
+
 /// A cube of side 2 with `n x n` vertices per face (shared along the cube's edges after welding).
 fn grid_box(n: u32) -> RawMesh {
     let mut raw = RawMesh { uvs: Some(Vec::new()), ..RawMesh::default() };
-    // (normal, u axis, v axis) with u x v = normal so faces wind counter-clockwise from outside.
-    let faces = [
-        (Vec3::X, Vec3::NEG_Z, Vec3::Y),
-        (Vec3::NEG_X, Vec3::Z, Vec3::Y),
-        (Vec3::Y, Vec3::X, Vec3::NEG_Z),
-        (Vec3::NEG_Y, Vec3::X, Vec3::Z),
-        (Vec3::Z, Vec3::X, Vec3::Y),
-        (Vec3::NEG_Z, Vec3::NEG_X, Vec3::Y),
-    ];
     let step = 1.0 / (n - 1) as f32;
-    for (normal, u_axis, v_axis) in faces {
+    for (normal, u_axis, v_axis) in CUBE_FACES {
         let base = raw.positions.len() as u32;
         for row in 0..n {
             for col in 0..n {
