@@ -75,9 +75,9 @@ use glam::{EulerRot, Mat4, Quat, Vec3};
 
 use super::MAX_FORCE;
 use super::contact::{Collider, ColliderKey, ColliderMesh, GraspParams, Shape};
-use crate::mesh::{ImportOptions, Mesh};
 use super::motion::{self, MotionKey};
 use super::simulation::{SimError, Simulation};
+use crate::mesh::{ImportOptions, Mesh};
 use crate::wet::{self, RainKey, WaterKey, WetSources};
 
 /// Errors from reading a scene; each names the file and, where it can, the key.
@@ -261,7 +261,8 @@ impl SceneShape {
                 format!("must be between 2 and {MAX_MESH_RESOLUTION}, got {resolution}"),
             ));
         }
-        let (mesh, _) = Mesh::load(&file, &ImportOptions::default()).map_err(|e| ("shape.path".into(), e.to_string()))?;
+        let (mesh, _) =
+            Mesh::load(&file, &ImportOptions::default()).map_err(|e| ("shape.path".into(), e.to_string()))?;
         let mesh = ColliderMesh::new(mesh, *resolution)
             .map_err(|e| ("shape.path".to_owned(), format!("{}: {e}", file.display())))?;
         *baked = Some(Arc::new(mesh));
@@ -638,8 +639,12 @@ impl Scene {
         }
         if !self.colliders.is_empty() {
             let ours = SCENE_COLLIDER_IDS..SCENE_COLLIDER_IDS + self.colliders.len() as u32;
-            let mut colliders: Vec<Collider> =
-                self.colliders.iter().enumerate().filter_map(|(i, c)| c.collider(SCENE_COLLIDER_IDS + i as u32)).collect();
+            let mut colliders: Vec<Collider> = self
+                .colliders
+                .iter()
+                .enumerate()
+                .filter_map(|(i, c)| c.collider(SCENE_COLLIDER_IDS + i as u32))
+                .collect();
             // A host's colliders (the viewer's ball, a walking body's capsules) stay, joined by id.
             colliders.extend(sim.colliders().iter().filter(|c| !ours.contains(&c.id)).cloned());
             if sim.colliders() != colliders.as_slice() {
