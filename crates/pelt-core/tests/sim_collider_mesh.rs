@@ -56,7 +56,7 @@ impl Solid {
         let rays = [
             DVec3::new(0.5377, 0.8031, 0.2566),
             DVec3::new(-0.3124, 0.1822, 0.9323),
-            DVec3::new(0.7071, -0.6, -0.3743),
+            DVec3::new(0.7, -0.6, -0.3743),
         ];
         rays.iter().filter(|d| self.crossings(p, d.normalize()) % 2 == 1).count() >= 2
     }
@@ -168,7 +168,7 @@ fn a_mesh_collider_keeps_the_fur_out() {
         ..SimParams::default()
     };
     let mut sim = Simulation::new(&fur, &params).unwrap();
-    sim.set_colliders(&[collider.clone()]).unwrap();
+    sim.set_colliders(std::slice::from_ref(&collider)).unwrap();
     let (mut worst, mut near, mut checked) = (0.0_f64, 0, 0);
     for n in 1..=33 {
         let t = f64::from(n) / 30.0;
