@@ -53,11 +53,8 @@ impl Solid {
         if p.cmplt(self.lo).any() || p.cmpgt(self.hi).any() {
             return false;
         }
-        let rays = [
-            DVec3::new(0.5377, 0.8031, 0.2566),
-            DVec3::new(-0.3124, 0.1822, 0.9323),
-            DVec3::new(0.7, -0.6, -0.3743),
-        ];
+        let rays =
+            [DVec3::new(0.5377, 0.8031, 0.2566), DVec3::new(-0.3124, 0.1822, 0.9323), DVec3::new(0.7, -0.6, -0.3743)];
         rays.iter().filter(|d| self.crossings(p, d.normalize()) % 2 == 1).count() >= 2
     }
 
