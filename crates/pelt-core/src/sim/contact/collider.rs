@@ -138,7 +138,7 @@ pub struct Collider {
     pub appeared_secs: Option<f64>,
 }
 
-/// The largest speed, in the collider's radii (a box's smallest half extent) per step, at which
+/// The largest speed, in the collider's radii (a box's, or a mesh's box's, smallest half extent) per step, at which
 /// a collider's whole path within a step is swept: faster, it jumps (no fur is pushed between).
 pub const SWEEP_RADII_PER_STEP: f32 = 8.0;
 

@@ -326,10 +326,12 @@ mod tests {
 
     use super::*;
     use crate::mesh::builtin::Builtin;
-    use crate::sim::{Collider, ContactParams, CpuKernel, GraspParams, Shape, SimParams, Simulation, WindParams};
+    use crate::sim::{
+        Collider, ColliderMesh, ContactParams, CpuKernel, GraspParams, Shape, SimParams, Simulation, WindParams,
+    };
     use crate::{FurStructure, Preset};
 
-    /// The screen only saves time: with the skin, colliders of every shape moving through the
+    /// The screen only saves time: with the skin, colliders of every shape (a mesh too) moving through the
     /// fur and a grasp, under strong wind and gravity, the nodes are the same bits with and
     /// without it, for both instruction sets.
     #[test]
@@ -354,6 +356,9 @@ mod tests {
             simulation
         };
         let mut runs = [make(CpuKernel::Auto, true), make(CpuKernel::Auto, false), make(CpuKernel::Portable, true)];
+        let (sphere, _) = Builtin::Sphere.mesh();
+        let pebble_radius = sphere.positions.iter().map(|p| p.length()).fold(0.0, f32::max);
+        let pebble = std::sync::Arc::new(ColliderMesh::new(sphere, 12).expect("a closed sphere"));
         let mut free = Simulation::new(&fur, &SimParams { contact: ContactParams { skin: false }, ..params.clone() })
             .expect("simulation");
         let mut touched = 0;
@@ -388,6 +393,13 @@ mod tests {
                     t,
                     hit + normal * (0.2 * length),
                     Quat::from_rotation_arc(Vec3::Y, -normal),
+                ),
+                Collider::at(
+                    5,
+                    Shape::Mesh { mesh: pebble.clone(), scale: 0.7 * length / pebble_radius },
+                    t,
+                    hit + normal * (0.6 * length) - Vec3::X * x,
+                    Quat::from_rotation_z(0.3),
                 ),
             ];
             for simulation in &mut runs {
