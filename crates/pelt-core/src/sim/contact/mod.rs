@@ -24,7 +24,7 @@
 //! - Continuity: the response has no jump the kernels' last-bit differences could flip (see
 //!   `turn_above` and the grip's segment), except where an end lies on the medial axis of a
 //!   concave spot of the skin.
-//! - Cost: a batch's eight strands are screened at once first ([`screen`]): only those with a
+//! - Cost: a batch's eight strands are screened at once first (`screen`): only those with a
 //!   node near a skin plane or a collider, with skin triangles, or held, are solved. Within a
 //!   strand, a node a clearance away from everything leaves the nodes within that distance
 //!   untested (a node moves at most a segment's length from the one before).
