@@ -49,7 +49,8 @@ pub use crate::param::ParamError;
 
 pub use bend::{BEND_GAIN, bend_strand, bend_strand_literal, bend_weight};
 pub use contact::{
-    Collider, ColliderKey, ContactParams, ContactStep, ContactStrands, Grasp, GraspParams, Shape, StepCollider,
+    Collider, ColliderKey, ContactParams, ContactStep, ContactStrands, Grasp, GraspParams, HAND_PARTS, Shape,
+    StepCollider,
 };
 pub use dispatch::CpuKernel;
 pub use field::{ForceField, Touch};
