@@ -21,8 +21,8 @@ impl Simulation {
             samples.clear();
             collider.push_step(time_secs, step_secs, self.bounding_radius(), &mut samples);
             // The step's own pose comes last, after the samples along the way.
-            if let Some(last) = samples.last() {
-                shown.push(*last);
+            if let Some(last) = samples.pop() {
+                shown.push(last);
             }
         }
         shown
