@@ -49,8 +49,8 @@ pub use crate::param::ParamError;
 
 pub use bend::{BEND_GAIN, bend_strand, bend_strand_literal, bend_weight};
 pub use contact::{
-    Collider, ColliderKey, ColliderMesh, ContactParams, ContactStep, ContactStrands, Grasp, GraspParams, Shape,
-    StepCollider,
+    Collider, ColliderKey, ColliderMesh, ContactParams, ContactStep, ContactStrands, Grasp, GraspParams, HAND_PARTS,
+    Shape, StepCollider,
 };
 pub use dispatch::CpuKernel;
 pub use field::{ForceField, Touch};

@@ -36,7 +36,8 @@
 //! start_secs = 1.0
 //! end_secs = 3.0
 //! radius = 0.5                     # strands rooted within this are gathered
-//! hand_radius = 0.2                # optional (default 0): a ball at the grip pushing the rest
+//! hand_radius = 0.2                # optional (default 0): the hand's size (fingers, thumb,
+//!                                  # palm about the grip), pushing the strands it does not hold
 //! path = [[0.0, 5.2, 2.6], [0.0, 6.0, 2.6]]
 //! close_secs = 0.3                 # optional, and spring_hz (2) and damping (0.35) likewise
 //!
@@ -332,7 +333,9 @@ pub struct SceneGrasp {
     pub end_secs: f64,
     /// Strands rooted within this distance of `path[0]` are gathered.
     pub radius: f32,
-    /// A ball about the grip that pushes the strands it does not hold (default 0: none).
+    /// The size of the hand about the grip (fingers, thumb and palm, see
+    /// [`Grasp::hand`](super::contact::Grasp::hand)) that pushes the strands it does not hold
+    /// (default 0: none).
     #[serde(default)]
     pub hand_radius: f32,
     /// World points of the grip, at one segment per equal share of the hold.

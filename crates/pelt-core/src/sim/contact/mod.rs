@@ -44,7 +44,7 @@ use glam::{Quat, Vec3, Vec4};
 use rayon::prelude::*;
 
 pub use collider::{Collider, ColliderKey, ColliderMesh, SWEEP_RADII_PER_STEP, Shape, StepCollider};
-pub use grasp::{Grasp, GraspParams};
+pub use grasp::{Grasp, GraspParams, HAND_PARTS};
 pub use skin::{SKIN_PLANES, skin_planes};
 pub use surface::{SURFACE_WORDS, SkinSurface, skin_surface};
 
