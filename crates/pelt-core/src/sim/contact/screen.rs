@@ -325,20 +325,22 @@ mod tests {
     use glam::{Quat, Vec3};
 
     use super::*;
+    use crate::fur::{FurLength, FurParams, FurStructure, GrowthDirection};
     use crate::mesh::builtin::Builtin;
     use crate::sim::{
         Collider, ColliderMesh, ContactParams, CpuKernel, GraspParams, Shape, SimParams, Simulation, WindParams,
     };
-    use crate::{FurStructure, Preset};
 
     /// The screen only saves time: with the skin, colliders of every shape (a mesh too) moving through the
     /// fur and a grasp, under strong wind and gravity, the nodes are the same bits with and
     /// without it, for both instruction sets.
     #[test]
     fn screening_changes_no_bit() {
-        let mut preset = Preset::default();
-        preset.layers = 12;
-        let fur: FurStructure = preset.grow(Builtin::Bunny.mesh().0, "bunny").expect("fur");
+        let (mesh, _) = Builtin::Bunny.mesh();
+        let length = 0.08 * mesh.bounding_sphere().1;
+        let direction = GrowthDirection { random_angle_rad: 0.3, seed: 2, ..GrowthDirection::default() };
+        let fur = FurStructure::new(mesh, &FurParams { layers: 12, length: FurLength::Constant(length), direction })
+            .expect("fur");
         let params = SimParams {
             gravity_strength: 4.0,
             wind: WindParams { direction: Vec3::new(0.3, -1.0, 0.2), strength: 3.0, seed: 7, ..WindParams::default() },
