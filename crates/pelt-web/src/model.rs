@@ -595,7 +595,7 @@ mod tests {
             .zip(colliders.iter().filter(|c| capsule(c)))
             .any(|(now, before)| now != before);
         assert!(legs_moved > 0.1 * height, "the body walks: a vertex moved {legs_moved}");
-        assert!(skirt_moved > 0.05 * height, "the skirt walks with it: a vertex moved {skirt_moved}");
+        assert!(skirt_moved > 0.03 * height, "the skirt walks with it: a vertex moved {skirt_moved}");
         assert!(capsules_moved, "the capsules walk with the body");
         // A rebuilt coat (new length) keeps the walk and the colliders.
         model.set_length(0.1).unwrap();
