@@ -3,12 +3,17 @@
 //! The kernel ([`super::kernel`]) is one source compiled twice: inside [`bend_pairs_avx2`], with
 //! AVX2 and FMA enabled (256-bit lanes, fused multiply-adds in hardware), and as plain code for
 //! any other CPU. Both perform the same IEEE operations in the same order, so they give the same
-//! bytes (a test compares them). The AVX2 copy is only called after `is_x86_feature_detected!`
-//! says the CPU has both features: that check is the one `unsafe` in the crate.
+//! bytes (a test compares them). Contact's screen ([`screen`]) is compiled twice the same way.
+//! An AVX2 copy is only called after `is_x86_feature_detected!` says the CPU has both features:
+//! those calls are the only `unsafe` in the crate.
 #![allow(unsafe_code)]
 
 use rayon::prelude::*;
 
+use glam::{Quat, Vec3};
+
+use super::contact::screen::{self, Batch, BatchPlanes};
+use super::contact::{ContactStrands, StepCollider};
 use super::kernel::{Step, VecLanes};
 
 /// Which instructions the CPU bend uses ([`Simulation::set_cpu_kernel`](super::Simulation::set_cpu_kernel)).
@@ -91,4 +96,39 @@ fn bend_pairs(step: &Step<'_>, first_pair: usize, pair_nodes: usize, nodes: &mut
 #[target_feature(enable = "avx2,fma")]
 fn bend_pairs_avx2(step: &Step<'_>, first_pair: usize, pair_nodes: usize, nodes: &mut [VecLanes]) {
     bend_pairs(step, first_pair, pair_nodes, nodes);
+}
+
+/// The lanes of a batch contact solves ([`screen::lanes_to_solve`]), with the best instructions
+/// the CPU has (the same answer either way: plain IEEE arithmetic, no fused operations).
+pub(crate) fn screen(
+    kernel: CpuKernel,
+    batch: &Batch<'_>,
+    strands: &ContactStrands<'_>,
+    skin: Option<&BatchPlanes>,
+    roots: &[Vec3],
+    frames: &[Quat],
+    near: &[&StepCollider],
+) -> u32 {
+    #[cfg(target_arch = "x86_64")]
+    if kernel.resolve() == CpuKernel::Avx2Fma && CpuKernel::avx2_fma_available() {
+        // SAFETY: `screen_avx2` needs AVX2 and FMA, and the CPU has both (checked on the line
+        // above); it is otherwise safe code.
+        return unsafe { screen_avx2(batch, strands, skin, roots, frames, near) };
+    }
+    let _ = kernel;
+    screen::lanes_to_solve(batch, strands, skin, roots, frames, near)
+}
+
+/// The screen compiled with AVX2 and FMA.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2,fma")]
+fn screen_avx2(
+    batch: &Batch<'_>,
+    strands: &ContactStrands<'_>,
+    skin: Option<&BatchPlanes>,
+    roots: &[Vec3],
+    frames: &[Quat],
+    near: &[&StepCollider],
+) -> u32 {
+    screen::lanes_to_solve(batch, strands, skin, roots, frames, near)
 }

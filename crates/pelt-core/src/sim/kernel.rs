@@ -361,6 +361,23 @@ impl RestBatches {
         self.lengths[b * (self.lengths.len() / self.is_straight.len().max(1)) + k][lane]
     }
 
+    /// Batch `b`'s rest segment lengths, root first, a lane per strand.
+    pub fn lengths_of(&self, b: usize) -> &[Lanes] {
+        let layers = self.lengths.len() / self.is_straight.len().max(1);
+        &self.lengths[b * layers..(b + 1) * layers]
+    }
+
+    /// Each lane's strand length in batch `b`: its rest segments summed root first.
+    pub fn reach(&self, b: usize) -> Lanes {
+        let mut reach = [0.0; LANES];
+        for lengths in self.lengths_of(b) {
+            for (r, l) in reach.iter_mut().zip(lengths) {
+                *r += l;
+            }
+        }
+        reach
+    }
+
     /// The share of batches the straight form bends.
     pub fn straight_share(&self) -> f32 {
         if self.is_straight.is_empty() {

@@ -14,8 +14,8 @@ use rayon::prelude::*;
 
 use super::contact::skin::skin_planes_of;
 use super::contact::{
-    Collider, ContactStep, ContactStrands, Grasp, GraspParams, MAX_STEP_COLLIDERS, Resolve, SKIN_PLANES, SkinSurface,
-    StepCollider, skin_surface,
+    BatchPlanes, Collider, ContactStep, ContactStrands, Grasp, GraspParams, MAX_STEP_COLLIDERS, Resolve, SKIN_PLANES,
+    SkinSurface, StepCollider, skin_lanes, skin_surface,
 };
 use super::dispatch::{self, CpuKernel};
 use super::field::{ForceField, Touch};
@@ -109,6 +109,9 @@ pub struct Simulation {
     /// The rest shape, batch-major, in the kernel's layout.
     rest: RestBatches,
     cpu_kernel: CpuKernel,
+    /// Whether contact screens batches before solving strands (off only to test that the
+    /// screen changes nothing).
+    pub(crate) contact_screen: bool,
     rest_normals: Vec<Vec3>,
     rest_roots: Vec<Vec3>,
     roots: Vec<Vec3>,
@@ -152,6 +155,8 @@ pub struct Simulation {
     touch_on_step_roots: bool,
     /// Each strand's skin planes (see `contact::skin`).
     skin: Vec<[Vec4; SKIN_PLANES]>,
+    /// The same planes batch by batch, for the CPU's contact screen.
+    skin_lanes: Vec<BatchPlanes>,
     /// The skin triangles where the planes do not suffice (see `contact::surface`).
     surface: SkinSurface,
     /// The grid cell the skin planes were found in (the longest strand's reach).
@@ -198,6 +203,7 @@ impl Simulation {
             vertex_count: v,
             rest: RestBatches::new(&fur.positions, v, layers),
             cpu_kernel: CpuKernel::Auto,
+            contact_screen: true,
             rest_normals: fur.mesh.normals.clone(),
             rest_roots: roots.clone(),
             roots,
@@ -229,6 +235,7 @@ impl Simulation {
             roots_moved: false,
             touch_on_step_roots: false,
             surface: skin_surface(fur, &skin),
+            skin_lanes: skin_lanes(&skin),
             skin,
             skin_cell,
             colliders: Vec::new(),
@@ -1023,6 +1030,9 @@ impl Simulation {
         Resolve {
             step: &contact,
             strands: self.contact_strands(),
+            skin_lanes: &self.skin_lanes,
+            kernel: self.cpu_kernel,
+            screen: self.contact_screen,
             roots: strands.roots,
             frames: strands.frames,
             rest: &self.rest,

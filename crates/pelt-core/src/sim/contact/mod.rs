@@ -34,6 +34,7 @@
 
 mod collider;
 mod grasp;
+pub(crate) mod screen;
 pub mod skin;
 pub mod surface;
 
@@ -45,6 +46,9 @@ pub use grasp::{Grasp, GraspParams};
 pub use skin::{SKIN_PLANES, skin_planes};
 pub use surface::{SURFACE_WORDS, SkinSurface, skin_surface};
 
+pub(crate) use screen::{BatchPlanes, skin_lanes};
+
+use super::dispatch::{self, CpuKernel};
 use super::kernel::{LANES, RestBatches, VecLanes};
 
 /// Most collider samples one step holds (after the sweep); more are dropped, last first.
@@ -101,6 +105,12 @@ pub struct ContactStrands<'a> {
 pub(crate) struct Resolve<'a> {
     pub step: &'a ContactStep,
     pub strands: ContactStrands<'a>,
+    /// The skin planes batch by batch (see [`skin_lanes`]).
+    pub skin_lanes: &'a [BatchPlanes],
+    /// Which instructions the screen runs with.
+    pub kernel: CpuKernel,
+    /// Whether to screen (else every strand within reach of anything is solved).
+    pub screen: bool,
     pub roots: &'a [Vec3],
     pub frames: &'a [Quat],
     pub rest: &'a RestBatches,
@@ -134,8 +144,7 @@ impl Resolve<'_> {
         let lanes = LANES.min(self.vertex_count - b * LANES);
         // A collider can reach a strand when its bound comes within the strand's length of the
         // root (every node, moved or not, lies within that); the GPU kernel tests the same.
-        let reach: [f32; LANES] =
-            std::array::from_fn(|lane| (0..self.layers).map(|k| self.rest.length(b, lane, k)).sum::<f32>());
+        let reach = self.rest.reach(b);
         let roots = &self.roots[b * LANES..b * LANES + lanes];
         let (lo, hi) =
             roots.iter().fold((Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)), |(l, h), r| (l.min(*r), h.max(*r)));
@@ -149,11 +158,26 @@ impl Resolve<'_> {
                 gap.length() <= c.bound + batch_reach
             })
             .collect();
+        let held: [f32; LANES] = std::array::from_fn(|lane| {
+            let weight = self.strands.grasp_weights.get(b * LANES + lane).copied().unwrap_or(0.0);
+            if lane < lanes { weight * self.step.grip_presence } else { 0.0 }
+        });
+        let screened =
+            screen::Batch { b, lanes, nodes: batch, lengths: self.rest.lengths_of(b), reach: &reach, held: &held };
+        let skin = self.step.skin.then(|| &self.skin_lanes[b]);
+        let solve = if self.screen {
+            dispatch::screen(self.kernel, &screened, &self.strands, skin, self.roots, self.frames, &near)
+        } else {
+            (1 << lanes) - 1
+        };
+        if solve == 0 {
+            return;
+        }
         let mut strand = Vec::with_capacity(batch.len());
         let mut reaching = Vec::with_capacity(near.len());
-        for lane in 0..lanes {
+        for lane in (0..lanes).filter(|lane| solve & (1 << lane) != 0) {
             let j = b * LANES + lane;
-            let held = self.strands.grasp_weights.get(j).copied().unwrap_or(0.0) * self.step.grip_presence;
+            let held = held[lane];
             reaching.clear();
             // Strands the grasp holds pass through its hand.
             reaching.extend(near.iter().copied().filter(|c| {

@@ -18,7 +18,9 @@ use super::skin::{Grid, SKIN_PLANES, distance_to_triangle, grid_cell};
 use crate::fur::FurStructure;
 
 /// Words per stored triangle: its corners `a`, `b`, `c`, its face normal, the pseudonormals of
-/// its edges `ab`, `bc`, `ca` and of its corners `a`, `b`, `c` (each a unit `xyz`, `w` unused).
+/// its edges `ab`, `bc`, `ca` and of its corners `a`, `b`, `c` (each a unit `xyz`); the first
+/// word's `w` is the radius of the ball about the triangle's centroid that holds it (a query
+/// skips a triangle that ball shows farther than the nearest found), the others' `w` unused.
 pub const SURFACE_WORDS: usize = 10;
 
 /// Most triangles one strand keeps (the nearest to its root first).
@@ -50,9 +52,21 @@ impl SkinSurface {
     #[must_use]
     pub fn closest(&self, j: usize, x: Vec3) -> Option<(Vec3, Vec3, f32)> {
         let mut best: Option<(f32, Vec3, Vec3)> = None;
+        // What rounding can take off a ball's distance: a few dozen ulps of the coordinates.
+        let slack = 4e-6 * x.abs().max_element();
         for &t in self.strand(j) {
             let words = &self.triangles[t as usize];
-            let (point, feature) = closest_feature(x, words[0].truncate(), words[1].truncate(), words[2].truncate());
+            let (a, b, c) = (words[0].truncate(), words[1].truncate(), words[2].truncate());
+            if let Some((nearest, _, _)) = best {
+                let radius = words[0].w;
+                let gap = x.distance(centroid(a, b, c)) - radius - slack - 4e-6 * radius;
+                // Only a triangle strictly nearer replaces the best: one whose ball is no
+                // nearer cannot be, whatever its closest point.
+                if gap > 0.0 && gap * gap >= nearest {
+                    continue;
+                }
+            }
+            let (point, feature) = closest_feature(x, a, b, c);
             let d2 = (x - point).length_squared();
             if best.is_none_or(|(b, _, _)| d2 < b) {
                 best = Some((d2, point, words[feature].truncate()));
@@ -78,6 +92,11 @@ impl SkinSurface {
         let local = rest_root + frame.conjugate() * (x - root);
         self.closest(j, local).map(|(point, normal, d)| (root + frame * (point - rest_root), frame * normal, d))
     }
+}
+
+/// The centre of the ball a triangle's first word's `w` is the radius of.
+fn centroid(a: Vec3, b: Vec3, c: Vec3) -> Vec3 {
+    (a + b + c) * (1.0 / 3.0)
 }
 
 /// The closest point of triangle `abc` to `p` and the word of its feature's normal (Ericson,
@@ -283,7 +302,11 @@ fn triangle_words(points: &[Vec3], triangles: &[[u32; 3]]) -> Vec<Option<[Vec4; 
             };
             let corner = |e: usize| corners[tri[e] as usize].try_normalize().unwrap_or(n);
             let [a, b, c] = tri.map(|i| points[i as usize]);
-            Some([a, b, c, n, edge(0), edge(1), edge(2), corner(0), corner(1), corner(2)].map(|w| w.extend(0.0)))
+            let mut words =
+                [a, b, c, n, edge(0), edge(1), edge(2), corner(0), corner(1), corner(2)].map(|w| w.extend(0.0));
+            let centre = centroid(a, b, c);
+            words[0].w = [a, b, c].iter().map(|y| y.distance(centre)).fold(0.0, f32::max);
+            Some(words)
         })
         .collect()
 }
