@@ -600,7 +600,7 @@ mod tests {
         // A rebuilt coat (new length) keeps the walk and the colliders.
         model.set_length(0.1).unwrap();
         model.simulate(FRAME_SECS).unwrap();
-        assert!(model.stepper.moves() && model.stepper.simulation().colliders().iter().any(|c| capsule(c)));
+        assert!(model.stepper.moves() && model.stepper.simulation().colliders().iter().any(capsule));
         assert!(model.stepper.simulation().positions().iter().all(|p| p.is_finite()));
     }
 
