@@ -118,15 +118,15 @@ pub struct FurGrasp {
     pub closed: bool,
     /// Strands rooted within this distance (world units) of the closing point are held.
     pub radius: f32,
-    /// Radius of the hand's ball (world units), which pushes the strands it does not hold; 0 for
-    /// none.
+    /// Size of the hand (world units; fingers, thumb and palm about the grip, see
+    /// `pelt_core::sim::Grasp::hand`), which pushes the strands it does not hold; 0 for none.
     pub hand_radius: f32,
     /// How fast it closes and how the fur springs back.
     pub params: GraspParams,
 }
 
 impl FurGrasp {
-    /// An open hand gathering within `radius`, with no ball.
+    /// An open hand gathering within `radius`, with no fingers that push.
     #[must_use]
     pub fn new(radius: f32) -> Self {
         Self { closed: false, radius, hand_radius: 0.0, params: GraspParams::default() }

@@ -11,6 +11,9 @@ use pelt_core::{Builtin, Preset};
 
 fn main() {
     let case = std::env::args().nth(1).unwrap_or_else(|| "skin".into());
+    if case.starts_with("tryon") {
+        return try_on(&case);
+    }
     let mut preset = Preset::default();
     preset.layers = 32;
     let fur = preset.grow(Builtin::Bunny.mesh().0, "bunny").unwrap();
@@ -72,4 +75,41 @@ fn cpu_secs() -> f64 {
     let fields: Vec<&str> = stat.rsplit(')').next().unwrap_or("").split_whitespace().collect();
     let ticks = |i: usize| fields.get(i).and_then(|f| f.parse::<f64>().ok()).unwrap_or(0.0);
     (ticks(11) + ticks(12)) / 100.0
+}
+
+/// The walking try-on's skirt (`tryon`: the skin; `tryon-body`: and the body's capsules).
+fn try_on(case: &str) {
+    use pelt_core::{FurStepper, ImportOptions, Stage, StageSource};
+    let stage = Stage::load(&StageSource::builtin("tryon").unwrap(), &[], &ImportOptions::default()).unwrap();
+    let mut preset = Preset::default();
+    preset.layers = 32;
+    let fur = preset.grow(stage.fur_mesh.clone(), "tryon").unwrap();
+    let mut params = preset.simulation.clone();
+    params.contact = ContactParams { skin: true };
+    params.rate_hz = 60.0;
+    params.interpolate = false;
+    let mut stepper = FurStepper::new(&fur, &params).unwrap();
+    stepper.set_clip(stage.rig.clone().unwrap(), Some(0));
+    if case == "tryon-body" {
+        let body = stage.body.as_ref().unwrap();
+        stepper.set_body(Some((stage.plain[0].clone(), body.rig.clone(), body.capsules.clone())));
+    }
+    let steps: usize = std::env::var("STEPS").ok().and_then(|s| s.parse().ok()).unwrap_or(600);
+    let mut secs = 0.0;
+    for step in 0..steps {
+        stepper.advance_to(step as f64 / 60.0).unwrap();
+        secs += stepper.simulation().last_step_secs();
+    }
+    let colliders = stepper.simulation().colliders().len();
+    let step = stepper.simulation().contact_step(steps as f64 / 60.0);
+    let roots = stepper.simulation().roots();
+    let inside = roots.iter().filter(|r| step.colliders.iter().any(|c| c.closest(**r).2 < 0.0)).count();
+    let reach = fur.lengths.iter().copied().fold(0.0, f32::max);
+    let near = roots.iter().filter(|r| step.colliders.iter().any(|c| c.closest(**r).2 < reach)).count();
+    println!("roots inside a capsule {inside}, within a strand length {near}, samples {}", step.colliders.len());
+    println!(
+        "{case}: {} strands, {colliders} colliders, {:.3e} node updates/s (step time)",
+        fur.vertex_count(),
+        (steps * fur.vertex_count() * 32) as f64 / secs
+    );
 }

@@ -329,6 +329,7 @@ impl Probe {
             }
             Shape::Box { half_extents } => box_distance(x, self.centre, self.turn, half_extents),
             Shape::Plane => (self.turn * Vec3::Y).dot(x - self.centre),
+            _ => unreachable!("no mesh probes here (tests/sim_collider_mesh.rs has them)"),
         }
     }
 }
@@ -373,7 +374,7 @@ fn colliders_keep_the_fur_out() {
         let colliders: Vec<Collider> = probes(t)
             .iter()
             .enumerate()
-            .map(|(i, p)| Collider { appear_secs: 0.0, ..Collider::at(i as u32, p.shape, t, p.centre, p.turn) })
+            .map(|(i, p)| Collider { appear_secs: 0.0, ..Collider::at(i as u32, p.shape.clone(), t, p.centre, p.turn) })
             .collect();
         sim.set_colliders(&colliders).unwrap();
         sim.advance_to(t);
@@ -482,7 +483,7 @@ fn a_hundred_thousand_steps_with_fast_colliders() {
                     let phase = t * (1.7 + i as f64) + i as f64;
                     let at = Vec3::new(phase.sin() as f32, (phase * 1.3).cos() as f32, (phase * 0.7).sin() as f32);
                     let turn = Quat::from_rotation_y(phase as f32) * Quat::from_rotation_x(1.1 * phase as f32);
-                    Collider::at(i as u32, *shape, t, at * 1.3 * radius, turn)
+                    Collider::at(i as u32, shape.clone(), t, at * 1.3 * radius, turn)
                 })
                 .collect();
             sim.set_colliders(&colliders).unwrap();

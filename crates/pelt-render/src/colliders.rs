@@ -1,13 +1,15 @@
 //! The colliders a simulation pushes its fur out of, drawn as shaded plain meshes (spheres,
-//! capsules, boxes, planes and the grasp's hand), posed each frame and depth-tested with the fur.
+//! capsules, boxes, planes, mesh colliders' own meshes and the grasp's hand), posed each frame
+//! and depth-tested with the fur.
 
 use std::f32::consts::{PI, TAU};
 use std::path::Path;
+use std::sync::Arc;
 
 use glam::{Mat4, Vec3};
 use pelt_core::Mesh;
 use pelt_core::mesh::{ImportOptions, RawMesh};
-use pelt_core::sim::StepCollider;
+use pelt_core::sim::{ColliderMesh, StepCollider};
 
 use crate::RenderError;
 use crate::plain::PlainMesh;
@@ -25,7 +27,7 @@ const SEGMENTS: u32 = 40;
 
 /// The shape of one mesh in its own frame: everything a collider's mesh depends on besides the
 /// pose and a uniform scale.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 enum MeshShape {
     /// A unit ball.
     Sphere,
@@ -35,6 +37,8 @@ enum MeshShape {
     Box,
     /// A square from -1 to 1 in XZ, normal +Y.
     Plane,
+    /// A mesh collider's own mesh (the same `Arc`: the same mesh).
+    Mesh(Arc<ColliderMesh>),
 }
 
 /// The mesh, the colour and the transform from mesh to simulation space of one collider.
@@ -50,15 +54,19 @@ fn placement(collider: &StepCollider, plane_half_size: f32) -> (MeshShape, Vec3,
             (MeshShape::Capsule { half_length }, colour, posed(Vec3::splat(collider.radius)))
         }
         StepCollider::BOX => (MeshShape::Box, colour, posed(collider.half_extents)),
+        StepCollider::MESH if let Some(mesh) = &collider.mesh => {
+            (MeshShape::Mesh(Arc::clone(mesh)), colour, posed(Vec3::splat(collider.radius)))
+        }
         _ => (MeshShape::Plane, colour, posed(Vec3::splat(plane_half_size))),
     }
 }
 
 /// A triangle mesh of `shape` (counter-clockwise from outside, unit normals).
-fn shape_mesh(shape: MeshShape) -> Mesh {
+fn shape_mesh(shape: &MeshShape) -> Mesh {
     let raw = match shape {
+        MeshShape::Mesh(mesh) => return mesh.mesh().clone(),
         MeshShape::Sphere => capsule(0.0),
-        MeshShape::Capsule { half_length } => capsule(half_length),
+        MeshShape::Capsule { half_length } => capsule(*half_length),
         MeshShape::Box => cube(),
         MeshShape::Plane => square(),
     };
@@ -190,7 +198,8 @@ impl ColliderMeshes {
             let index = self.shown;
             let stale = self.slots.get(index).is_none_or(|slot| slot.shape != shape || slot.colour != colour);
             if stale {
-                let slot = Slot { shape, colour, mesh: PlainMesh::new(device, renderer, &shape_mesh(shape), colour)? };
+                let mesh = PlainMesh::new(device, renderer, &shape_mesh(&shape), colour)?;
+                let slot = Slot { shape, colour, mesh };
                 if index < self.slots.len() {
                     self.slots[index] = slot;
                 } else {
@@ -261,7 +270,7 @@ mod tests {
         ];
         for collider in colliders {
             let (shape, _, model_from_mesh) = placement(&collider, 3.0);
-            let mesh = shape_mesh(shape);
+            let mesh = shape_mesh(&shape);
             let normal_from_mesh = glam::Mat3::from_mat4(model_from_mesh).inverse().transpose();
             for (p, n) in mesh.positions.iter().zip(&mesh.normals) {
                 let x = model_from_mesh.transform_point3(*p);

@@ -1,8 +1,12 @@
 //! The GPU side of `pelt_core::sim::contact`: one storage buffer holding what the kernel's
 //! `contact_strand` (`simulation_contact.wgsl`) reads, packed from the simulation's
-//! `ContactStep` per step slot, its skin planes and the grasp's weights.
+//! `ContactStep` per step slot, its skin planes and the grasp's weights; and one holding the
+//! distance fields of mesh colliders, each uploaded once.
+
+use std::sync::Arc;
 
 use pelt_core::FurStructure;
+use pelt_core::sim::ColliderMesh;
 use pelt_core::sim::contact::{MAX_STEP_COLLIDERS, SKIN_PLANES, SURFACE_WORDS, SkinSurface, skin_planes, skin_surface};
 use pelt_core::sim::{ContactStep, ContactStrands};
 
@@ -20,6 +24,25 @@ pub(crate) struct GpuContact {
     vertex_count: usize,
     /// The grasp weights uploaded (empty: all zero).
     weights: Vec<f32>,
+    /// Mesh colliders' distance fields (`simulation_contact.wgsl`'s `sdf_fields`).
+    pub fields_buffer: wgpu::Buffer,
+    /// The fields in `fields_buffer` and where each begins (in f32s); kept alive, so no other
+    /// field can take an `Arc`'s address while it is listed.
+    fields: Vec<(Arc<ColliderMesh>, u32)>,
+}
+
+/// f32s before a field's values: (origin xyz, cell), (dims xyz as bits, -).
+const FIELD_HEADER: usize = 8;
+
+fn fields_buffer(device: &wgpu::Device, words: &[f32]) -> wgpu::Buffer {
+    wgpu::util::DeviceExt::create_buffer_init(
+        device,
+        &wgpu::util::BufferInitDescriptor {
+            label: Some("pelt simulation mesh collider fields"),
+            contents: bytemuck::cast_slice(words),
+            usage: wgpu::BufferUsages::STORAGE,
+        },
+    )
 }
 
 fn weights_first(v: usize) -> usize {
@@ -93,7 +116,42 @@ impl GpuContact {
                 usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
             },
         );
-        Self { buffer, vertex_count: v, weights: Vec::new() }
+        let fields_buffer = fields_buffer(device, &[0.0; 4]);
+        Self { buffer, vertex_count: v, weights: Vec::new(), fields_buffer, fields: Vec::new() }
+    }
+
+    /// Uploads the fields of the mesh colliders in `steps` not uploaded yet; true when the
+    /// fields buffer was replaced (its bind groups with it). A new field rebuilds the buffer
+    /// with the fields `steps` use, dropping the rest; a field already there is not written again.
+    pub fn upload_fields(&mut self, device: &wgpu::Device, steps: &[ContactStep]) -> bool {
+        let used = || steps.iter().flat_map(|s| s.colliders.iter().filter_map(|c| c.mesh.as_ref()));
+        if used().all(|m| self.offset(m).is_some()) {
+            return false;
+        }
+        let mut words = Vec::new();
+        self.fields.clear();
+        for mesh in used() {
+            if self.offset(mesh).is_some() {
+                continue;
+            }
+            let field = mesh.field();
+            let offset = u32::try_from(words.len()).unwrap_or(u32::MAX);
+            let dims = field.dims().map(|n| f32::from_bits(n as u32));
+            words.extend(field.origin().to_array());
+            words.push(field.cell());
+            words.extend(dims);
+            words.push(0.0);
+            debug_assert_eq!(words.len() - offset as usize, FIELD_HEADER);
+            words.extend_from_slice(field.values());
+            self.fields.push((Arc::clone(mesh), offset));
+        }
+        self.fields_buffer = fields_buffer(device, &words);
+        true
+    }
+
+    /// Where `mesh`'s field begins in the fields buffer, if it is there.
+    fn offset(&self, mesh: &Arc<ColliderMesh>) -> Option<u32> {
+        self.fields.iter().find(|(m, _)| Arc::ptr_eq(m, mesh)).map(|(_, offset)| *offset)
     }
 
     /// Writes step slot `slot`'s header and colliders.
@@ -115,7 +173,13 @@ impl GpuContact {
                     c.half_extents.extend(f32::from_bits(c.kind)).to_array(),
                     c.rotation.to_array(),
                     c.travel.extend(c.friction).to_array(),
-                    [c.bound, if c.grasp_hand { 1.0 } else { 0.0 }, 0.0, 0.0],
+                    [
+                        c.bound,
+                        if c.grasp_hand { 1.0 } else { 0.0 },
+                        // A mesh's field, uploaded by `upload_fields` first.
+                        f32::from_bits(c.mesh.as_ref().and_then(|m| self.offset(m)).unwrap_or(0)),
+                        0.0,
+                    ],
                 ]
             })
             .collect();

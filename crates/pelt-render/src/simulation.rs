@@ -31,7 +31,7 @@ const RING_SLOTS: u64 = 64;
 // Each ring slot has its own contact slot, for the same reason.
 const _: () = assert!(RING_SLOTS == CONTACT_SLOTS as u64);
 /// Storage buffers the compute stage binds.
-const STORAGE_BUFFERS: u32 = 6;
+const STORAGE_BUFFERS: u32 = 7;
 
 /// One step's inputs; the layout of `Step` in `simulation.wgsl`.
 #[repr(C)]
@@ -309,6 +309,7 @@ impl GpuSimulation {
                 storage(4, false),
                 storage(5, true),
                 storage(6, true),
+                storage(7, true),
             ],
         });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -459,6 +460,13 @@ impl GpuSimulation {
         let history = if start_over { 0 } else { self.dispatched_history };
         self.pending_history = settle_inertia(&mut self.pending, history);
         self.contact.write_strands(queue, &simulation.contact_strands());
+        if self.contact.upload_fields(device, &self.pending_contact) {
+            // The fields buffer is new: bind it.
+            self.bind_groups.clear();
+            for buffer in [fur.current_positions(), fur.previous_positions()] {
+                self.bind_group_for(device, buffer)?;
+            }
+        }
         for slot in 0..self.pending.len() {
             let ring_slot = (self.ring + slot as u64) % RING_SLOTS;
             self.pending[slot].grid[1] = ring_slot as u32;
@@ -567,6 +575,7 @@ impl GpuSimulation {
                 wgpu::BindGroupEntry { binding: 4, resource: output.as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 5, resource: self.contact.buffer.as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 6, resource: self.wet.buffer.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 7, resource: self.contact.fields_buffer.as_entire_binding() },
             ],
         });
         scope.pop("binding the GPU simulation to the fur")?;

@@ -82,6 +82,36 @@ impl BodyCapsules {
         Self { bones }
     }
 
+    /// Shrinks every capsule that holds one of `points` (bind pose) until none lies within
+    /// `margin` of it, and returns how many shrank. A capsule's radius is the median of its
+    /// vertices' distances, so it bulges out of the body where the body is thinner; a garment
+    /// on the body (the try-on's skirt) would have fur rooted inside it, which no collision
+    /// response can free.
+    pub fn clear_of(&mut self, points: &[Vec3], margin: f32) -> usize {
+        let mut shrunk = 0;
+        for bone in &mut self.bones {
+            let rest = bone.rest;
+            let axis = rest.b - rest.a;
+            let nearest = points
+                .iter()
+                .map(|&p| {
+                    let t = if axis.length_squared() > 0.0 {
+                        ((p - rest.a).dot(axis) / axis.length_squared()).clamp(0.0, 1.0)
+                    } else {
+                        0.0
+                    };
+                    p.distance(rest.a + axis * t)
+                })
+                .fold(f32::INFINITY, f32::min);
+            let radius = (nearest - margin).max(f32::MIN_POSITIVE);
+            if radius < rest.radius {
+                bone.rest.radius = radius;
+                shrunk += 1;
+            }
+        }
+        shrunk
+    }
+
     /// The capsules in `pose` (which [`Rig::pose`] filled for the body), in the space the pose
     /// is in; `world_from_model` places them (the script's motion) and must be rigid.
     #[must_use]

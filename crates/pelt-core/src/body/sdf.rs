@@ -108,6 +108,18 @@ impl MeshSdf {
         self.cell
     }
 
+    /// The grid's first node in the mesh's space.
+    #[must_use]
+    pub fn origin(&self) -> Vec3 {
+        self.origin
+    }
+
+    /// The signed distances at the grid nodes, x fastest, then y, then z (the GPU's copy).
+    #[must_use]
+    pub fn values(&self) -> &[f32] {
+        &self.values
+    }
+
     /// Where the mesh is: its rigid motion (rotation, translation, one uniform scale).
     ///
     /// # Errors
@@ -151,7 +163,16 @@ impl MeshSdf {
     /// gradient points away from it.
     #[must_use]
     pub fn distance_gradient(&self, p: Vec3) -> (f32, Vec3) {
-        let local = self.local_from_world.transform_point3(p);
+        let (distance, gradient) = self.local_distance_gradient(self.local_from_world.transform_point3(p));
+        let world_gradient = (self.world_from_local.transform_vector3(gradient) / self.scale).normalize_or_zero();
+        (distance * self.scale, world_gradient)
+    }
+
+    /// Signed distance and gradient at `local`, a point in the mesh's own space (the transform
+    /// ignored; the gradient not normalised). `simulation_contact.wgsl`'s `sdf_closest` repeats
+    /// it operation for operation.
+    #[must_use]
+    pub fn local_distance_gradient(&self, local: Vec3) -> (f32, Vec3) {
         let g = (local - self.origin) / self.cell;
         let top = Vec3::new(self.dims[0] as f32, self.dims[1] as f32, self.dims[2] as f32) - 1.0;
         let inside = g.clamp(Vec3::ZERO, top);
@@ -184,8 +205,7 @@ impl MeshSdf {
             distance += outside.length();
             gradient = outside.normalize();
         }
-        let world_gradient = (self.world_from_local.transform_vector3(gradient) / self.scale).normalize_or_zero();
-        (distance * self.scale, world_gradient)
+        (distance, gradient)
     }
 }
 

@@ -2,7 +2,10 @@
 //! of the closest point on the body's surface (the barycentric blend of that triangle's three
 //! vertices), the usual try-on transfer. Where the garment stands away from the body the closest
 //! point can lie between bones (a skirt's hem between the legs finds the inner thighs of both),
-//! and the vertex gets a blend of them: [`TransferReport`] says how far and how many.
+//! and the vertex gets a blend of them: [`TransferReport`] says how far and how many. A garment
+//! vertex farther than the allowed distance from the body (a strap or a hem standing off it)
+//! follows the nearest garment vertex that is within it, and the report counts them; a garment
+//! with no vertex within it is an error.
 
 use glam::Vec3;
 use rayon::prelude::*;
@@ -24,10 +27,11 @@ pub enum TransferError {
     /// The body has no triangles.
     #[error("the body has no triangles to take weights from")]
     EmptyBody,
-    /// A garment vertex has no body surface within the allowed distance.
+    /// No garment vertex has body surface within the allowed distance.
     #[error(
-        "garment vertex {vertex} at {position:?} is {distance:.4} from the nearest body surface, farther than \
-         the allowed {max_distance:.4}: the garment does not sit on this body (place or scale it onto the body)"
+        "all {count} garment vertices are farther than the allowed {max_distance:.4} from the body's surface \
+         (vertex {vertex} at {position:?} is {distance:.4} from it): the garment does not sit on this body \
+         (place or scale it onto the body)"
     )]
     TooFar {
         /// The first such vertex.
@@ -66,6 +70,11 @@ pub struct TransferReport {
     /// Vertices that had more than four joints among their triangle's corners and kept the
     /// four heaviest.
     pub truncated: usize,
+    /// Vertices farther than the allowed distance from the body: each takes the weights of the
+    /// nearest garment vertex within it.
+    pub far: usize,
+    /// The allowed distance.
+    pub max_distance: f32,
 }
 
 impl std::fmt::Display for TransferReport {
@@ -80,7 +89,15 @@ impl std::fmt::Display for TransferReport {
             self.mean_distance,
             self.blended,
             self.truncated
-        )
+        )?;
+        if self.far > 0 {
+            write!(
+                f,
+                "; {} farther than {:.4} from the body follow their nearest garment vertex within it",
+                self.far, self.max_distance
+            )?;
+        }
+        Ok(())
     }
 }
 
@@ -194,11 +211,12 @@ fn dominant(inf: &Influences) -> u32 {
 
 /// A rig for `garment` that follows `body`'s skeleton and clips: each garment vertex takes the
 /// blended weights of the closest point on the body's surface (both meshes in the body's bind
-/// pose). Vertices farther than `max_distance` from the body are an error.
+/// pose). A vertex farther than `max_distance` from the body takes the weights of the nearest
+/// garment vertex within it (the lowest index among equally near ones); the report counts them.
 ///
 /// # Errors
 /// [`TransferError`] for a rig of another mesh, an empty body, a non-finite position or a
-/// garment vertex with no body surface within `max_distance`.
+/// garment with no vertex within `max_distance` of the body.
 pub fn transfer_weights(
     body: &Mesh,
     body_rig: &Rig,
@@ -235,15 +253,38 @@ pub fn transfer_weights(
             (influences, distance, mixed, truncated)
         })
         .collect();
-    let too_far: Vec<usize> = (0..found.len()).filter(|&v| found[v].1.is_nan() || found[v].1 > max_distance).collect();
-    if let Some(&vertex) = too_far.first() {
+    let is_far = |v: usize| found[v].1.is_nan() || found[v].1 > max_distance;
+    let near: Vec<usize> = (0..found.len()).filter(|&v| !is_far(v)).collect();
+    let far: Vec<usize> = (0..found.len()).filter(|&v| is_far(v)).collect();
+    if near.is_empty()
+        && let Some(&vertex) = far.first()
+    {
         return Err(TransferError::TooFar {
             vertex,
             position: garment.positions[vertex],
             distance: found[vertex].1,
             max_distance,
-            count: too_far.len(),
+            count: far.len(),
         });
+    }
+    // Each far vertex follows the nearest near one (first index on ties: `min_by` keeps the first).
+    let followed: Vec<(usize, usize)> = far
+        .par_iter()
+        .map(|&v| {
+            let p = garment.positions[v];
+            let nearest = near
+                .iter()
+                .copied()
+                .min_by(|&a, &b| {
+                    garment.positions[a].distance_squared(p).total_cmp(&garment.positions[b].distance_squared(p))
+                })
+                .expect("checked: one near vertex at least");
+            (v, nearest)
+        })
+        .collect();
+    let mut found = found;
+    for &(v, nearest) in &followed {
+        found[v].0 = found[nearest].0;
     }
     let distances = found.iter().map(|f| f.1);
     let report = TransferReport {
@@ -252,6 +293,8 @@ pub fn transfer_weights(
         mean_distance: distances.sum::<f32>() / found.len().max(1) as f32,
         blended: found.iter().filter(|f| f.2).count(),
         truncated: found.iter().filter(|f| f.3).count(),
+        far: far.len(),
+        max_distance,
     };
     let influences = found.into_iter().map(|f| f.0).collect();
     Ok((body_rig.with_influences(influences), report))
@@ -359,11 +402,32 @@ mod tests {
         assert_eq!(count, far.vertex_count());
         assert!(distance > 4.0);
         assert!(error.to_string().contains("does not sit on this body"), "{error}");
+        assert!(error.to_string().starts_with(&format!("all {} garment vertices", far.vertex_count())), "{error}");
         let nan = points(vec![Vec3::NAN]);
         assert!(matches!(
             transfer_weights(&scene.body, &scene.body_rig, &nan, 1.0),
             Err(TransferError::NonFinite { what: "garment", vertex: 0 })
         ));
+    }
+
+    #[test]
+    fn far_garment_vertices_follow_their_nearest_near_neighbour_and_are_reported() {
+        let scene = walking_try_on(&ImportOptions::default()).unwrap();
+        let body = &scene.body;
+        let on_body = |v: usize| body.positions[v];
+        // Two points on the body and a strap hanging off the second: 1 and 2 far away from it.
+        let near_a = on_body(0);
+        let near_b = on_body(body.vertex_count() / 2);
+        let off = Vec3::new(0.0, 0.0, 3.0);
+        let garment = points(vec![near_a, near_b + off, near_b, near_b + off * 1.5]);
+        let (rig, report) = transfer_weights(body, &scene.body_rig, &garment, 0.1).unwrap();
+        assert_eq!(report.far, 2, "{report}");
+        assert!(report.to_string().contains("2 farther than 0.1000 from the body follow"), "{report}");
+        assert_eq!(rig.influences()[1], rig.influences()[2], "the strap follows the vertex it hangs from");
+        assert_eq!(rig.influences()[3], rig.influences()[2]);
+        assert_close(&weights_of(&rig, 2), &weights_of(&scene.body_rig, body.vertex_count() / 2), "on the body");
+        let (_, all_near) = transfer_weights(body, &scene.body_rig, &points(vec![near_a]), 0.1).unwrap();
+        assert!(all_near.far == 0 && !all_near.to_string().contains("farther"), "{all_near}");
     }
 
     #[test]

@@ -76,7 +76,9 @@ pub fn walking_try_on(options: &ImportOptions) -> Result<WalkingTryOn, BodyError
     crate::mesh::tuck_under(&mut body, &garment, 0.01 * radius, 0.1 * radius);
     let height = body.bounds().1.y - body.bounds().0.y;
     let (garment_rig, transfer) = transfer_weights(&body, &body_rig, &garment, MAX_TRANSFER_DISTANCE * height)?;
-    let capsules = BodyCapsules::fit(&body, &body_rig);
+    let mut capsules = BodyCapsules::fit(&body, &body_rig);
+    // The skirt's fur grows from outside every capsule.
+    capsules.clear_of(&garment.positions, 0.005 * radius);
     Ok(WalkingTryOn { garment, garment_report, garment_rig, transfer, body, body_rig, capsules })
 }
 

@@ -49,7 +49,8 @@ pub use crate::param::ParamError;
 
 pub use bend::{BEND_GAIN, bend_strand, bend_strand_literal, bend_weight};
 pub use contact::{
-    Collider, ColliderKey, ContactParams, ContactStep, ContactStrands, Grasp, GraspParams, Shape, StepCollider,
+    Collider, ColliderKey, ColliderMesh, ContactParams, ContactStep, ContactStrands, Grasp, GraspParams, HAND_PARTS,
+    Shape, StepCollider,
 };
 pub use dispatch::CpuKernel;
 pub use field::{ForceField, Touch};
@@ -58,7 +59,7 @@ pub use inputs::{InputVersions, StepInputs, StrandInputs};
 pub use kernel::{KernelRest, kernel_rest};
 pub use motion::{Ease, MotionKey};
 pub use pick::{Hit, pick};
-pub use scene::{Scene, SceneCamera, SceneError, Stroke, WindKey};
+pub use scene::{Scene, SceneCamera, SceneCollider, SceneError, SceneShape, Stroke, WindKey};
 pub use simulation::{SimError, Simulation};
 #[cfg(feature = "lab")]
 pub use soak::{SoakReport, SoakStep, SoakSubject, soak};

@@ -25,7 +25,9 @@
 //!
 //! [[collider]]                     # a collider on keyframed poses (see `sim::contact`)
 //! shape = { kind = "sphere", radius = 0.5 }   # or capsule (radius, half_length), box
-//!                                  # (half_extents), plane (local +Y up)
+//!                                  # (half_extents), plane (local +Y up), mesh (path: a closed
+//!                                  # mesh file beside the script, resolution = 32 cells of its
+//!                                  # field along its longest side, scale = 1)
 //! friction = 0.3                   # optional (default 0.3), 0..=1
 //! appear_secs = 0.25               # optional: grows in over this after its first key
 //! keys = [{ time_secs = 0.0, position = [0.0, 5.0, 2.0], rotation_deg = [0.0, 0.0, 0.0] }]
@@ -34,7 +36,8 @@
 //! start_secs = 1.0
 //! end_secs = 3.0
 //! radius = 0.5                     # strands rooted within this are gathered
-//! hand_radius = 0.2                # optional (default 0): a ball at the grip pushing the rest
+//! hand_radius = 0.2                # optional (default 0): the hand's size (fingers, thumb,
+//!                                  # palm about the grip), pushing the strands it does not hold
 //! path = [[0.0, 5.2, 2.6], [0.0, 6.0, 2.6]]
 //! close_secs = 0.3                 # optional, and spring_hz (2) and damping (0.35) likewise
 //!
@@ -67,13 +70,15 @@
 //! draw the plain meshes with the same transform.
 
 use std::path::{Path, PathBuf};
+use std::sync::Arc;
 
 use glam::{EulerRot, Mat4, Quat, Vec3};
 
 use super::MAX_FORCE;
-use super::contact::{Collider, ColliderKey, GraspParams, Shape};
+use super::contact::{Collider, ColliderKey, ColliderMesh, GraspParams, Shape};
 use super::motion::{self, MotionKey};
 use super::simulation::{SimError, Simulation};
+use crate::mesh::{ImportOptions, Mesh};
 use crate::wet::{self, RainKey, WaterKey, WetSources};
 
 /// Errors from reading a scene; each names the file and, where it can, the key.
@@ -180,12 +185,98 @@ pub struct SceneColliderKey {
     pub rotation_deg: Vec3,
 }
 
+/// A scripted collider's shape: [`Shape`]'s, with a mesh named by its file.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
+pub enum SceneShape {
+    /// [`Shape::Sphere`].
+    Sphere {
+        /// World units.
+        radius: f32,
+    },
+    /// [`Shape::Capsule`].
+    Capsule {
+        /// World units.
+        radius: f32,
+        /// Half the segment's length.
+        half_length: f32,
+    },
+    /// [`Shape::Box`].
+    Box {
+        /// Half its size along the local axes.
+        half_extents: Vec3,
+    },
+    /// [`Shape::Plane`].
+    Plane,
+    /// [`Shape::Mesh`]: a closed mesh file, baked when the script loads.
+    Mesh {
+        /// The mesh file (`.obj`, `.gltf`, `.glb`), relative to the script's folder.
+        path: PathBuf,
+        /// Cells of its distance field along its longest side (default 32).
+        #[serde(default = "default_mesh_resolution")]
+        resolution: usize,
+        /// Uniform scale (default 1).
+        #[serde(default = "default_mesh_scale")]
+        scale: f32,
+        /// The mesh and its field, once loaded ([`Scene::load`], [`Scene::from_toml_str`]).
+        #[serde(skip)]
+        baked: Option<Arc<ColliderMesh>>,
+    },
+}
+
+fn default_mesh_resolution() -> usize {
+    32
+}
+
+fn default_mesh_scale() -> f32 {
+    1.0
+}
+
+/// Most cells a script's mesh field may have along its longest side (the bake's cost grows
+/// with their cube).
+const MAX_MESH_RESOLUTION: usize = 128;
+
+impl SceneShape {
+    /// The collider's shape; `None` for a mesh not loaded.
+    #[must_use]
+    pub fn shape(&self) -> Option<Shape> {
+        Some(match self {
+            Self::Sphere { radius } => Shape::Sphere { radius: *radius },
+            Self::Capsule { radius, half_length } => Shape::Capsule { radius: *radius, half_length: *half_length },
+            Self::Box { half_extents } => Shape::Box { half_extents: *half_extents },
+            Self::Plane => Shape::Plane,
+            Self::Mesh { scale, baked, .. } => Shape::Mesh { mesh: Arc::clone(baked.as_ref()?), scale: *scale },
+        })
+    }
+
+    /// Loads and bakes a mesh shape's file, `path` relative to `folder`; the others are left.
+    ///
+    /// # Errors
+    /// `(key, problem)`: the problem names the mesh file (it cannot be read, is not closed, ...).
+    fn load(&mut self, folder: &Path) -> Result<(), (String, String)> {
+        let Self::Mesh { path, resolution, baked, .. } = self else { return Ok(()) };
+        let file = folder.join(&*path);
+        if !(2..=MAX_MESH_RESOLUTION).contains(resolution) {
+            return Err((
+                "shape.resolution".into(),
+                format!("must be between 2 and {MAX_MESH_RESOLUTION}, got {resolution}"),
+            ));
+        }
+        let (mesh, _) =
+            Mesh::load(&file, &ImportOptions::default()).map_err(|e| ("shape.path".into(), e.to_string()))?;
+        let mesh = ColliderMesh::new(mesh, *resolution)
+            .map_err(|e| ("shape.path".to_owned(), format!("{}: {e}", file.display())))?;
+        *baked = Some(Arc::new(mesh));
+        Ok(())
+    }
+}
+
 /// A scripted collider (`[[collider]]`).
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct SceneCollider {
     /// Its shape.
-    pub shape: Shape,
+    pub shape: SceneShape,
     /// See [`Collider::friction`] (default 0.3).
     #[serde(default = "default_friction")]
     pub friction: f32,
@@ -205,9 +296,9 @@ fn default_appear_secs() -> f32 {
 }
 
 impl SceneCollider {
-    /// The collider it describes, with `id`.
+    /// The collider it describes, with `id`; `None` for a mesh not loaded.
     #[must_use]
-    pub fn collider(&self, id: u32) -> Collider {
+    pub fn collider(&self, id: u32) -> Option<Collider> {
         let keys = self
             .keys
             .iter()
@@ -220,14 +311,14 @@ impl SceneCollider {
                 }
             })
             .collect();
-        Collider {
+        Some(Collider {
             id,
-            shape: self.shape,
+            shape: self.shape.shape()?,
             keys,
             friction: self.friction,
             appear_secs: self.appear_secs,
             appeared_secs: None,
-        }
+        })
     }
 }
 
@@ -242,7 +333,9 @@ pub struct SceneGrasp {
     pub end_secs: f64,
     /// Strands rooted within this distance of `path[0]` are gathered.
     pub radius: f32,
-    /// A ball about the grip that pushes the strands it does not hold (default 0: none).
+    /// The size of the hand about the grip (fingers, thumb and palm, see
+    /// [`Grasp::hand`](super::contact::Grasp::hand)) that pushes the strands it does not hold
+    /// (default 0: none).
     #[serde(default)]
     pub hand_radius: f32,
     /// World points of the grip, at one segment per equal share of the hold.
@@ -351,10 +444,18 @@ impl Scene {
     /// [`SceneError::Parse`] for TOML or type errors (the message shows the key and line),
     /// [`SceneError::Invalid`] for values out of range.
     pub fn from_toml_str(text: &str, name: &Path) -> Result<Self, SceneError> {
-        let scene: Self = toml::from_str(text).map_err(|e| SceneError::Parse {
+        let mut scene: Self = toml::from_str(text).map_err(|e| SceneError::Parse {
             file: name.to_path_buf(),
             message: e.to_string().trim_end().to_owned(),
         })?;
+        let folder = name.parent().unwrap_or(Path::new(""));
+        for (i, collider) in scene.colliders.iter_mut().enumerate() {
+            collider.shape.load(folder).map_err(|(key, problem)| SceneError::Invalid {
+                file: name.to_path_buf(),
+                key: format!("collider[{i}].{key}"),
+                problem,
+            })?;
+        }
         scene.validate().map_err(|(key, problem)| SceneError::Invalid { file: name.to_path_buf(), key, problem })?;
         Ok(scene)
     }
@@ -415,6 +516,7 @@ impl Scene {
             }
             collider
                 .collider(i as u32)
+                .ok_or_else(|| ("shape".to_owned(), "the mesh is not loaded".to_owned()))?
                 .validate()
                 .map_err(|(key, problem)| (format!("collider[{i}].{key}"), problem))?;
         }
@@ -540,8 +642,12 @@ impl Scene {
         }
         if !self.colliders.is_empty() {
             let ours = SCENE_COLLIDER_IDS..SCENE_COLLIDER_IDS + self.colliders.len() as u32;
-            let mut colliders: Vec<Collider> =
-                self.colliders.iter().enumerate().map(|(i, c)| c.collider(SCENE_COLLIDER_IDS + i as u32)).collect();
+            let mut colliders: Vec<Collider> = self
+                .colliders
+                .iter()
+                .enumerate()
+                .filter_map(|(i, c)| c.collider(SCENE_COLLIDER_IDS + i as u32))
+                .collect();
             // A host's colliders (the viewer's ball, a walking body's capsules) stay, joined by id.
             colliders.extend(sim.colliders().iter().filter(|c| !ours.contains(&c.id)).cloned());
             if sim.colliders() != colliders.as_slice() {

@@ -5,25 +5,24 @@ use super::simulation::Simulation;
 
 impl Simulation {
     /// The colliders as they stand at `time_secs`, one each, for drawing: the grasp's hand first
-    /// (while it holds), then every collider present then at the pose and the size it has grown
-    /// to ([`StepCollider::grasp_hand`] tells the hand apart). These are the shapes the fur is
+    /// (its fingers, thumb and palm while it holds and opens), then every collider present then
+    /// at the pose and the size it has grown to ([`StepCollider::grasp_hand`] tells the hand
+    /// apart). These are the shapes the fur is
     /// pushed out of (the step's own pose, without the samples along its path).
     #[must_use]
     pub fn shown_colliders(&self, time_secs: f64) -> Vec<StepCollider> {
         let step_secs = 1.0 / f64::from(self.params().rate_hz);
         let mut shown = Vec::new();
-        if let Some(grasp) = self.grasp().filter(|g| g.hand_radius > 0.0 && g.released_at_secs.is_none()) {
-            let mut hand = StepCollider::ball(grasp.grip, grasp.hand_radius);
-            hand.grasp_hand = true;
-            shown.push(hand);
+        if let Some(grasp) = self.grasp() {
+            shown.extend(grasp.hand(time_secs));
         }
         let mut samples = Vec::new();
         for collider in self.colliders() {
             samples.clear();
             collider.push_step(time_secs, step_secs, self.bounding_radius(), &mut samples);
             // The step's own pose comes last, after the samples along the way.
-            if let Some(last) = samples.last() {
-                shown.push(*last);
+            if let Some(last) = samples.pop() {
+                shown.push(last);
             }
         }
         shown
@@ -72,12 +71,23 @@ mod tests {
         let mut sim = simulation();
         let point = Vec3::new(0.0, 1.0, 0.0);
         sim.grasp_begin(point, 0.4, 0.2, crate::sim::contact::GraspParams::default(), 0.0).expect("a valid grasp");
-        sim.grasp_move(Vec3::new(0.0, 1.5, 0.0)).expect("a finite point");
+        let grip = Vec3::new(0.0, 1.5, 0.0);
+        sim.grasp_move(grip).expect("a finite point");
+        let ball = Collider::at(7, Shape::Sphere { radius: 0.5 }, 0.0, Vec3::new(3.0, 0.0, 0.0), Quat::IDENTITY);
+        sim.set_colliders(&[ball]).expect("a valid ball");
         let shown = sim.shown_colliders(0.5);
-        assert_eq!(shown.len(), 1);
-        assert!(shown[0].grasp_hand && (shown[0].radius - 0.2).abs() < 1e-6);
-        assert_eq!(shown[0].centre, Vec3::new(0.0, 1.5, 0.0));
+        assert_eq!(shown.len(), crate::sim::contact::HAND_PARTS + 1);
+        let (hand, rest) = shown.split_at(crate::sim::contact::HAND_PARTS);
+        assert!(hand.iter().all(|c| c.grasp_hand) && !rest[0].grasp_hand, "the hand first, then the ball");
+        assert_eq!(hand.iter().filter(|c| c.kind == StepCollider::CAPSULE).count(), 5, "four fingers and a thumb");
+        for part in hand {
+            assert!(part.centre.distance(grip) + part.bound <= 3.0 * 0.2, "the hand lies about the grip: {part:?}");
+        }
         sim.grasp_end(0.6);
-        assert!(sim.shown_colliders(0.7).is_empty(), "the hand is gone once it lets go");
+        let opening = sim.shown_colliders(0.7);
+        assert_eq!(opening.len(), crate::sim::contact::HAND_PARTS + 1, "the hand opens after letting go");
+        let height = |parts: &[StepCollider]| parts.iter().map(|c| c.centre.y).sum::<f32>();
+        assert!(height(&opening[..6]) > height(hand), "and withdraws");
+        assert_eq!(sim.shown_colliders(0.95).len(), 1, "the hand is gone once open");
     }
 }

@@ -15,7 +15,7 @@ use rayon::prelude::*;
 use super::contact::skin::skin_planes_of;
 use super::contact::{
     BatchPlanes, Collider, ContactStep, ContactStrands, Grasp, GraspParams, MAX_STEP_COLLIDERS, Resolve, SKIN_PLANES,
-    SkinSurface, StepCollider, skin_lanes, skin_surface,
+    SkinSurface, skin_lanes, skin_surface,
 };
 use super::dispatch::{self, CpuKernel};
 use super::field::{ForceField, Touch};
@@ -610,8 +610,9 @@ impl Simulation {
     }
 
     /// Closes a hand at `point` at `time_secs` (simulation time): the strands rooted within `radius` are gathered toward the grip
-    /// (moved by [`Simulation::grasp_move`]); a ball of `hand_radius` (0: none) about the grip
-    /// pushes the strands it does not hold. Replaces a grasp in progress.
+    /// (moved by [`Simulation::grasp_move`]); a hand of `hand_radius` (0: none; see
+    /// [`Grasp::hand`]) about the grip pushes the strands it does not hold. Replaces a grasp in
+    /// progress.
     ///
     /// # Errors
     /// [`SimError::NonFinite`] for a non-finite point; [`SimError::TouchRadius`] for a radius
@@ -638,7 +639,8 @@ impl Simulation {
         if !time_secs.is_finite() {
             return Err(SimError::NonFinite { what: "the grasp time", value: time_secs.to_string() });
         }
-        self.grasp = Some(Grasp::new(point, radius, hand_radius, time_secs, params, &self.roots));
+        let normals: Vec<Vec3> = self.frames.iter().zip(&self.rest_normals).map(|(frame, n)| *frame * *n).collect();
+        self.grasp = Some(Grasp::new(point, radius, hand_radius, time_secs, params, &self.roots, &normals));
         Ok(())
     }
 
@@ -670,8 +672,8 @@ impl Simulation {
     }
 
     /// What every strand shares in the contact of the step at `time_secs`: the skin switch, the
-    /// colliders there (sampled along their paths within the step, grown since they appeared,
-    /// the grasp's hand last), the grip and its presence. Read by every kernel.
+    /// colliders there (the grasp's hand first, then the colliders sampled along their paths
+    /// within the step, grown since they appeared), the grip and its presence. Read by every kernel.
     #[must_use]
     pub fn contact_step(&self, time_secs: f64) -> ContactStep {
         let step_secs = 1.0 / f64::from(self.params.rate_hz);
@@ -681,11 +683,7 @@ impl Simulation {
         }
         let mut step = ContactStep { skin: self.params.contact.skin, ..ContactStep::default() };
         if let Some(grasp) = &self.grasp {
-            if grasp.hand_radius > 0.0 && grasp.released_at_secs.is_none() {
-                let mut hand = StepCollider::ball(grasp.grip, grasp.hand_radius);
-                hand.grasp_hand = true;
-                colliders.insert(0, hand);
-            }
+            colliders.splice(0..0, grasp.hand(time_secs));
             step.grip = grasp.grip;
             step.grip_presence = grasp.presence(time_secs);
         }

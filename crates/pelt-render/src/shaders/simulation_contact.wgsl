@@ -8,7 +8,8 @@
 //   from CONTACT_SKIN: SKIN_PLANES planes per strand (n xyz in the rest frame, h);
 //   then ceil(V / 4) vec4s of grasp weights, 4 strands each;
 //   then per slot CONTACT_COLLIDERS colliders of 5 vec4s: (centre, radius),
-//     (half extents, kind as bits), rotation, (travel, friction), (bound, grasp hand, -, -);
+//     (half extents, kind as bits), rotation, (travel, friction), (bound, grasp hand, field as
+//     bits, -) (a mesh's radius is its scale, its field where it begins in `sdf_fields`);
 //   then the skin's triangles (`contact::surface`), from `surface_first`: per strand (rest root,
 //     first << 6 | count as bits), the lists (each entry its triangle's first vec4 from
 //     `surface_first`), the triangles of 10 vec4s (a, b, c, face normal, edge ab, bc, ca and
@@ -16,6 +17,9 @@
 //     face normal's).
 
 @group(0) @binding(5) var<storage, read> contact: array<vec4<f32>>;
+// Mesh colliders' distance fields (`contact.rs`'s `upload_fields`), each: origin xyz, cell,
+// dims xyz as bits, -, then the values, x fastest.
+@group(0) @binding(7) var<storage, read> sdf_fields: array<f32>;
 
 const CONTACT_SLOTS: u32 = 64u;
 const CONTACT_SKIN: u32 = 2u * CONTACT_SLOTS;
@@ -90,8 +94,65 @@ fn collider_closest(c: u32, x: vec3<f32>) -> Closest {
         normal[axis] = sign;
         return Closest(centre + rotate(turn, surface), rotate(turn, normal), q[axis]);
     }
+    if kind == 4u {
+        return sdf_closest(x, centre, turn, radius, bitcast<u32>(contact[c + 4u].z), up);
+    }
     let distance = dot(up, x - centre);
     return Closest(x - up * distance, up, distance);
+}
+
+fn sdf_value(field: u32, dims: vec3<u32>, at: vec3<u32>) -> f32 {
+    return sdf_fields[field + 8u + at.x + dims.x * (at.y + dims.y * at.z)];
+}
+
+fn sdf_lerp(a: f32, b: f32, t: f32) -> f32 {
+    return a + (b - a) * t;
+}
+
+// `StepCollider::closest` of a mesh: `MeshSdf::local_distance_gradient` at x in the mesh's
+// frame (scaled by `scale`), operation for operation.
+fn sdf_closest(x: vec3<f32>, centre: vec3<f32>, turn: vec4<f32>, scale: f32, field: u32, up: vec3<f32>) -> Closest {
+    let origin = vec3<f32>(sdf_fields[field], sdf_fields[field + 1u], sdf_fields[field + 2u]);
+    let cell = sdf_fields[field + 3u];
+    let dims = vec3<u32>(
+        bitcast<u32>(sdf_fields[field + 4u]),
+        bitcast<u32>(sdf_fields[field + 5u]),
+        bitcast<u32>(sdf_fields[field + 6u]),
+    );
+    let local = rotate(conjugate(turn), x - centre) / scale;
+    let g = (local - origin) / cell;
+    let top = vec3<f32>(dims) - 1.0;
+    let inside = clamp(g, vec3<f32>(0.0), top);
+    let base = max(min(floor(inside), top - 1.0), vec3<f32>(0.0));
+    let f = inside - base;
+    let b = vec3<u32>(base);
+    let v000 = sdf_value(field, dims, b);
+    let v100 = sdf_value(field, dims, b + vec3<u32>(1u, 0u, 0u));
+    let v010 = sdf_value(field, dims, b + vec3<u32>(0u, 1u, 0u));
+    let v110 = sdf_value(field, dims, b + vec3<u32>(1u, 1u, 0u));
+    let v001 = sdf_value(field, dims, b + vec3<u32>(0u, 0u, 1u));
+    let v101 = sdf_value(field, dims, b + vec3<u32>(1u, 0u, 1u));
+    let v011 = sdf_value(field, dims, b + vec3<u32>(0u, 1u, 1u));
+    let v111 = sdf_value(field, dims, b + vec3<u32>(1u, 1u, 1u));
+    let c00 = sdf_lerp(v000, v100, f.x);
+    let c10 = sdf_lerp(v010, v110, f.x);
+    let c01 = sdf_lerp(v001, v101, f.x);
+    let c11 = sdf_lerp(v011, v111, f.x);
+    let c0 = sdf_lerp(c00, c10, f.y);
+    let c1 = sdf_lerp(c01, c11, f.y);
+    var distance = sdf_lerp(c0, c1, f.z);
+    let dx = sdf_lerp(sdf_lerp(v100 - v000, v110 - v010, f.y), sdf_lerp(v101 - v001, v111 - v011, f.y), f.z);
+    let dy = sdf_lerp(sdf_lerp(v010 - v000, v110 - v100, f.x), sdf_lerp(v011 - v001, v111 - v101, f.x), f.z);
+    let dz = c1 - c0;
+    var gradient = vec3<f32>(dx, dy, dz) / cell;
+    let outside = (g - inside) * cell;
+    if any(outside != vec3<f32>(0.0)) {
+        distance += length(outside);
+        gradient = normalize(outside);
+    }
+    let normal = normalize_or(rotate(turn, gradient), up);
+    let d = distance * scale;
+    return Closest(x - normal * d, normal, d);
 }
 
 // Any unit vector perpendicular to unit `n` (`glam::Vec3::any_orthonormal_vector`).

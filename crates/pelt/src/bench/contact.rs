@@ -2,13 +2,16 @@
 //! preset, a steady wind so every strand moves) steps with contact off, the skin only, and the
 //! skin with 8 colliders resting in the fur all round it; each kernel's node updates per second
 //! are timed the way the report times them (`Simulation` steps on all threads; the GPU kernel
-//! through the driver `--sim gpu` runs).
+//! through the driver `--sim gpu` runs). The walking try-on's skirt (32 layers) steps with
+//! contact off, the skin, and the skin and the body's capsules; its CPU figure is the
+//! simulation's own step time (`Simulation::last_step_secs`), so posing the skirt and the body
+//! every step is not counted.
 
 use std::hint::black_box;
 
 use glam::{Quat, Vec3};
 use pelt_core::sim::{Collider, ContactParams, FurStepper, Shape, SimParams, Simulation};
-use pelt_core::{Builtin, FurStructure, Preset};
+use pelt_core::{Builtin, FurStructure, ImportOptions, Preset, Stage, StageSource};
 use pelt_render::{Backend, Gpu};
 
 use super::sim::{SIM_RATE_HZ, SimBudget, median_rate};
@@ -114,12 +117,80 @@ pub fn run(quick: bool) -> anyhow::Result<()> {
         };
         rows.push((case.name, cpu, gpu_rate));
     }
+    let mut md = table(&format!("bunny, L = {LAYERS}, {} strands", fur.vertex_count()), &rows);
+    md.push_str(&try_on(quick, gpu.as_ref().ok())?);
+    println!("{md}");
+    Ok(())
+}
+
+/// The walking try-on's rows: the skirt's fur off, with its skin, and with the body too.
+fn try_on(quick: bool, gpu: Option<&Gpu>) -> anyhow::Result<String> {
+    let stage = Stage::load(&StageSource::builtin("tryon")?, &[], &ImportOptions::default())?;
+    let (Some(rig), Some(body), Some(body_mesh)) = (stage.rig.clone(), stage.body.as_ref(), stage.plain.first()) else {
+        anyhow::bail!("the try-on stage has no walking body");
+    };
+    let mut preset = Preset::default();
+    preset.layers = LAYERS;
+    let fur = preset.grow(stage.fur_mesh.clone(), "tryon")?;
+    let nodes = (fur.vertex_count() * LAYERS as usize) as f64;
+    let steps = if quick { 20 } else { 240 };
+    let (gpu_steps, gpu_runs) = if quick { (4, 3) } else { (30, 7) };
+    let mut rows = Vec::new();
+    for (name, skin, with_body) in [("off", false, false), ("skin", true, false), ("skin + body", true, true)] {
+        eprintln!("pelt bench: contact, try-on {name}");
+        let params = params(skin);
+        let stepper = || -> anyhow::Result<FurStepper> {
+            let mut stepper = FurStepper::new(&fur, &params)?;
+            stepper.set_clip(rig.clone(), Some(0));
+            if with_body {
+                stepper.set_body(Some((body_mesh.clone(), body.rig.clone(), body.capsules.clone())));
+            }
+            Ok(stepper)
+        };
+        let mut cpu_stepper = stepper()?;
+        let mut rates = Vec::new();
+        let mut time = 0.0;
+        for _ in 0..if quick { 3 } else { 7 } {
+            let mut secs = 0.0;
+            for _ in 0..steps {
+                time += 1.0 / f64::from(SIM_RATE_HZ);
+                cpu_stepper.advance_to(time)?;
+                secs += cpu_stepper.simulation().last_step_secs();
+            }
+            rates.push(steps as f64 * nodes / secs);
+        }
+        rates.sort_by(f64::total_cmp);
+        let cpu = rates[rates.len() / 2];
+        let gpu_rate = match gpu {
+            Some(gpu) => {
+                let renderer = crate::sim_kernel::timing_renderer(&gpu.device)?;
+                let mut stepper = stepper()?;
+                let secs = pelt_render::gpu_secs_per_step_of(
+                    &gpu.device,
+                    &gpu.queue,
+                    &renderer,
+                    &fur,
+                    &params,
+                    &mut stepper,
+                    gpu_steps,
+                    gpu_runs,
+                )?;
+                Some(nodes / secs)
+            }
+            None => None,
+        };
+        rows.push((name, cpu, gpu_rate));
+    }
+    Ok(table(&format!("walking try-on's skirt, L = {LAYERS}, {} strands", fur.vertex_count()), &rows))
+}
+
+/// A Markdown table of `rows` (`name`, CPU rate, GPU rate), the first row contact off.
+fn table(title: &str, rows: &[(&str, f64, Option<f64>)]) -> String {
     let (_, cpu_off, gpu_off) = rows[0];
     let mut md = format!(
-        "| bunny, L = {LAYERS}, {} strands | CPU node updates/s (all threads) | contact's share | GPU node updates/s | contact's share |\n|---|---|---|---|---|\n",
-        fur.vertex_count()
+        "| {title} | CPU node updates/s (all threads) | contact's share | GPU node updates/s | contact's share |\n|---|---|---|---|---|\n"
     );
-    for (name, cpu, gpu_rate) in rows {
+    for &(name, cpu, gpu_rate) in rows {
         // The share of the kernel's time contact takes: 1 - (time off / time on).
         let share = |off: f64, on: f64| format!("{:.0}%", 100.0 * (1.0 - on / off));
         let gpu_cells = match (gpu_rate, gpu_off) {
@@ -134,6 +205,6 @@ pub fn run(quick: bool) -> anyhow::Result<()> {
             gpu_cells.1
         ));
     }
-    println!("{md}");
-    Ok(())
+    md.push('\n');
+    md
 }

@@ -190,6 +190,9 @@ impl App {
                 running.fur.pose_body(&running.gpu, positions, normals, world_from_model)?;
             }
             model.took(started.elapsed().as_secs_f64());
+        } else {
+            // Paused: the colliders still follow what the pointer does to them.
+            running.fur.show_colliders(&running.gpu, &model.stepper, model.stepper.simulation().time_secs())?;
         }
         if requests.screenshot {
             model.screenshot_pending = true;

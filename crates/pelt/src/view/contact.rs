@@ -37,6 +37,16 @@ impl Default for ContactControls {
     }
 }
 
+/// The size the pointer's circle shows for the tool: the ball's radius, or the grab's reach;
+/// `None` when left-drag pats (the touch's size shows then).
+pub fn tool_radius(controls: &ContactControls, mesh_radius: f32) -> Option<f32> {
+    match controls.tool {
+        ContactTool::Off => None,
+        ContactTool::Ball => Some(controls.ball_per_radius * mesh_radius),
+        ContactTool::Grab => Some(controls.grab_per_radius * mesh_radius),
+    }
+}
+
 /// The contact section of the panel; true when the ball is to go (another tool, or removed).
 pub fn contact_ui(ui: &mut egui::Ui, controls: &mut ContactControls) -> bool {
     let before = controls.tool;
@@ -209,6 +219,38 @@ mod tests {
         assert!(!handle(&mut sim, &controls, 2.0, &mut drag, PointerEvent::Release).unwrap());
         assert_eq!(sim.grasp().unwrap().released_at_secs, Some(0.4), "let go on release");
         assert!(sim.colliders().is_empty(), "a grab places no ball");
+    }
+
+    #[test]
+    fn the_circle_shows_the_ball_or_the_grab_reach() {
+        let mut controls =
+            ContactControls { ball_per_radius: 0.2, grab_per_radius: 0.05, ..ContactControls::default() };
+        assert_eq!(tool_radius(&controls, 2.0), None, "patting shows the touch's size");
+        controls.tool = ContactTool::Ball;
+        assert_eq!(tool_radius(&controls, 2.0), Some(0.4));
+        let mut sim = simulation();
+        let mut drag = None;
+        handle(&mut sim, &controls, 2.0, &mut drag, press()).unwrap();
+        assert_eq!(sim.colliders()[0].shape, Shape::Sphere { radius: tool_radius(&controls, 2.0).unwrap() });
+        controls.tool = ContactTool::Grab;
+        assert_eq!(tool_radius(&controls, 2.0), Some(0.1));
+    }
+
+    /// Paused (the clock stands), a dragged ball is drawn where it is dragged at once.
+    #[test]
+    fn a_ball_dragged_while_paused_shows_where_dragged() {
+        let mut sim = simulation();
+        let controls = ContactControls { tool: ContactTool::Ball, ..ContactControls::default() };
+        let mut drag = None;
+        sim.advance_to(0.1);
+        handle(&mut sim, &controls, 2.0, &mut drag, press()).unwrap();
+        sim.advance_to(0.5);
+        handle(&mut sim, &controls, 2.0, &mut drag, ray_through(0.3, 0.1)).unwrap();
+        handle(&mut sim, &controls, 2.0, &mut drag, ray_through(0.6, 0.2)).unwrap();
+        let shown = sim.shown_colliders(sim.time_secs());
+        assert_eq!(shown.len(), 1);
+        assert!(shown[0].centre.distance(Vec3::new(0.6, 0.2, 1.0)) < 1e-6, "{}", shown[0].centre);
+        assert!((shown[0].radius - controls.ball_per_radius * 2.0).abs() < 1e-6, "at full size");
     }
 
     #[test]

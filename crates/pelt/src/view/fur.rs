@@ -119,6 +119,17 @@ impl FurScene {
             self.driver.record(&mut encoder)?;
             gpu.queue.submit([encoder.finish()]);
         }
+        self.show_colliders(gpu, stepper, time_secs)
+    }
+
+    /// Poses the drawn colliders as they stand at `time_secs` (also while paused, so a dragged
+    /// ball moves on screen at once).
+    pub fn show_colliders(
+        &mut self,
+        gpu: &pelt_render::Gpu,
+        stepper: &FurStepper,
+        time_secs: f64,
+    ) -> anyhow::Result<()> {
         let simulation = stepper.simulation();
         let shown = simulation.shown_colliders(time_secs);
         let plane_half_size = 1.5 * simulation.bounding_radius();

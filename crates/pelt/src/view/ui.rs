@@ -183,7 +183,10 @@ impl Model {
             }
         }
         if self.settings.overlay {
-            self.brush(&painter, rect, pointer, hover_hit.map(|hit| hit.point), brush_radius);
+            // Ball and grab show their own size; painting, sponging and patting the brush's.
+            let mesh_radius = self.structure.mesh.bounding_sphere().1;
+            let circle = if paint { None } else { super::contact::tool_radius(&self.settings.contact, mesh_radius) };
+            self.brush(&painter, rect, pointer, hover_hit.map(|hit| hit.point), circle.unwrap_or(brush_radius));
             self.overlay(&painter, rect);
         }
         Ok(())
@@ -219,8 +222,8 @@ impl Model {
         Ok(handle(self.stepper.simulation_mut(), &self.settings.contact, radius, &mut self.contact_drag, event)?)
     }
 
-    /// The brush under the pointer, sized to the touch radius at the fur it would touch; while
-    /// patting, the drag from the hit point.
+    /// The brush under the pointer, sized to `radius` (the touch's, the ball's or the grab's)
+    /// at the fur it would touch; while patting, the drag from the hit point.
     fn brush(
         &self,
         painter: &egui::Painter,

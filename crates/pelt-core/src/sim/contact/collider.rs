@@ -1,10 +1,65 @@
-//! Colliders a host or a script places: sphere, capsule, oriented box and plane, each on a
-//! keyframed pose, validated, and resolved into the flat [`StepCollider`]s one step reads.
+//! Colliders a host or a script places: sphere, capsule, oriented box, plane and closed mesh,
+//! each on a keyframed pose, validated, and resolved into the flat [`StepCollider`]s one step
+//! reads.
+
+use std::sync::Arc;
 
 use glam::{Quat, Vec3};
 
+use crate::body::{MeshSdf, SdfError};
+use crate::mesh::Mesh;
+
+/// A closed mesh as a collider's shape: the mesh (what hosts draw) and its signed distance
+/// field, baked once (what contact reads).
+///
+/// A [`Shape::Mesh`] holds it behind an [`Arc`] rather than an id into a table the
+/// simulation keeps: every step's [`StepCollider`]s then carry the field itself (a pointer
+/// copy per sample), `StepCollider::closest` needs no table beside it, and the GPU side keys
+/// its one upload per field on the `Arc`'s identity.
+#[derive(Clone, Debug)]
+pub struct ColliderMesh {
+    mesh: Mesh,
+    field: MeshSdf,
+    half_extents: Vec3,
+    reach: f32,
+}
+
+impl ColliderMesh {
+    /// Bakes `mesh` (in the collider's own frame: the pose moves its origin) with `resolution`
+    /// cells along its longest side.
+    ///
+    /// # Errors
+    /// The [`SdfError`] of [`MeshSdf::bake`]: [`SdfError::NotClosed`] for a mesh with holes.
+    pub fn new(mesh: Mesh, resolution: usize) -> Result<Self, SdfError> {
+        let field = MeshSdf::bake(&mesh, resolution)?;
+        let (lo, hi) = mesh.bounds();
+        let reach = mesh.positions.iter().map(|p| p.length()).fold(0.0, f32::max);
+        Ok(Self { half_extents: (hi - lo) * 0.5, reach, mesh, field })
+    }
+
+    /// The mesh, in the collider's frame.
+    #[must_use]
+    pub fn mesh(&self) -> &Mesh {
+        &self.mesh
+    }
+
+    /// Its signed distance field (its own transform unused: the collider's pose places it).
+    #[must_use]
+    pub fn field(&self) -> &MeshSdf {
+        &self.field
+    }
+}
+
+impl PartialEq for ColliderMesh {
+    /// The same mesh at once (hosts compare colliders every frame), else by content.
+    fn eq(&self, other: &Self) -> bool {
+        std::ptr::eq(self, other)
+            || (self.mesh == other.mesh && self.field == other.field && self.half_extents == other.half_extents)
+    }
+}
+
 /// The shape of a [`Collider`] in its own frame (the pose moves and turns it).
-#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(tag = "kind", rename_all = "snake_case", deny_unknown_fields)]
 pub enum Shape {
     /// A ball of `radius` about the pose's position.
@@ -26,15 +81,27 @@ pub enum Shape {
     },
     /// The half-space below the plane through the pose's position with local `+Y` as normal.
     Plane,
+    /// A closed mesh about the pose's position, scaled by `scale` (scripts name its file; see
+    /// `sim::scene`).
+    #[serde(skip)]
+    Mesh {
+        /// The mesh and its field.
+        mesh: Arc<ColliderMesh>,
+        /// Uniform scale, finite and positive.
+        scale: f32,
+    },
 }
 
 impl Shape {
-    /// The smallest size across the shape (the unit of the sweep's spacing); infinite for a plane.
-    fn thickness(self) -> f32 {
+    /// The smallest size across the shape (the unit of the sweep's spacing); infinite for a
+    /// plane. A mesh's is its bounding box's smallest half extent: a sample spacing that can
+    /// still step over a thin part of a mesh that is thinner than its box.
+    fn thickness(&self) -> f32 {
         match self {
-            Self::Sphere { radius } | Self::Capsule { radius, .. } => radius,
+            Self::Sphere { radius } | Self::Capsule { radius, .. } => *radius,
             Self::Box { half_extents } => half_extents.min_element(),
             Self::Plane => f32::INFINITY,
+            Self::Mesh { mesh, scale } => mesh.half_extents.min_element() * scale,
         }
     }
 }
@@ -71,21 +138,21 @@ pub struct Collider {
     pub appeared_secs: Option<f64>,
 }
 
-/// The largest speed, in the collider's radii (a box's smallest half extent) per step, at which
+/// The largest speed, in the collider's radii (a box's, or a mesh's box's, smallest half extent) per step, at which
 /// a collider's whole path within a step is swept: faster, it jumps (no fur is pushed between).
 pub const SWEEP_RADII_PER_STEP: f32 = 8.0;
 
 /// A collider as one step reads it: its pose at the step's time (or one of the poses sampled
 /// along its path within the step), at the size it has grown to. Shared by every kernel.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub struct StepCollider {
-    /// 0 sphere, 1 capsule, 2 box, 3 plane.
+    /// 0 sphere, 1 capsule, 2 box, 3 plane, 4 mesh.
     pub kind: u32,
     /// Centre (a plane's point).
     pub centre: Vec3,
     /// Turn from the shape's frame.
     pub rotation: Quat,
-    /// Sphere and capsule radius (0 for a box or plane).
+    /// Sphere and capsule radius, a mesh's scale (0 for a box or plane).
     pub radius: f32,
     /// A box's half extents; a capsule's `(0, half_length, 0)`.
     pub half_extents: Vec3,
@@ -97,6 +164,8 @@ pub struct StepCollider {
     pub grasp_hand: bool,
     /// Radius of a ball about `centre` holding the shape (infinite for a plane).
     pub bound: f32,
+    /// A mesh's shape (`None` for the others).
+    pub mesh: Option<Arc<ColliderMesh>>,
 }
 
 impl StepCollider {
@@ -108,6 +177,8 @@ impl StepCollider {
     pub const BOX: u32 = 2;
     /// Kind code of a plane.
     pub const PLANE: u32 = 3;
+    /// Kind code of a mesh.
+    pub const MESH: u32 = 4;
 
     /// A ball (the grasp's hand).
     #[must_use]
@@ -122,6 +193,7 @@ impl StepCollider {
             friction: 0.0,
             grasp_hand: false,
             bound: radius,
+            mesh: None,
         }
     }
 
@@ -168,6 +240,16 @@ impl StepCollider {
                     (self.centre + self.rotation * surface, self.rotation * normal, q[axis])
                 }
             }
+            Self::MESH if let Some(mesh) = &self.mesh => {
+                // The field's distance in the mesh's frame, scaled; the surface point one
+                // distance back along the normal (the field's gradient).
+                let scale = self.radius;
+                let local = (self.rotation.inverse() * (x - self.centre)) / scale;
+                let (distance, gradient) = mesh.field.local_distance_gradient(local);
+                let normal = (self.rotation * gradient).try_normalize().unwrap_or(self.rotation * Vec3::Y);
+                let distance = distance * scale;
+                (x - normal * distance, normal, distance)
+            }
             _ => {
                 let normal = self.rotation * Vec3::Y;
                 let distance = normal.dot(x - self.centre);
@@ -206,11 +288,11 @@ impl Collider {
                 Err((key.to_owned(), format!("must be finite and positive, got {value}")))
             }
         };
-        match self.shape {
-            Shape::Sphere { radius } => positive("radius", radius)?,
+        match &self.shape {
+            Shape::Sphere { radius } => positive("radius", *radius)?,
             Shape::Capsule { radius, half_length } => {
-                positive("radius", radius)?;
-                if !(half_length.is_finite() && half_length >= 0.0) {
+                positive("radius", *radius)?;
+                if !(half_length.is_finite() && *half_length >= 0.0) {
                     return Err(("half_length".into(), format!("must be finite and at least 0, got {half_length}")));
                 }
             }
@@ -220,6 +302,7 @@ impl Collider {
                 }
             }
             Shape::Plane => {}
+            Shape::Mesh { scale, .. } => positive("scale", *scale)?,
         }
         if !(self.friction.is_finite() && (0.0..=1.0).contains(&self.friction)) {
             return Err(("friction".into(), format!("must be between 0 and 1, got {}", self.friction)));
@@ -331,8 +414,9 @@ impl Collider {
                 friction: self.friction,
                 grasp_hand: false,
                 bound: 0.0,
+                mesh: None,
             };
-            match self.shape {
+            match &self.shape {
                 Shape::Sphere { radius } => {
                     collider.radius = radius * grown;
                     collider.bound = collider.radius;
@@ -353,6 +437,13 @@ impl Collider {
                     // Rises from one fur radius below to its place as it grows.
                     collider.centre -= (turn * Vec3::Y) * (2.0 * fur_radius * (1.0 - grown));
                     collider.bound = f32::INFINITY;
+                }
+                Shape::Mesh { mesh, scale } => {
+                    // Grows about the mesh's origin, as the others grow about their centres.
+                    collider.kind = StepCollider::MESH;
+                    collider.radius = scale * grown;
+                    collider.bound = mesh.reach * collider.radius;
+                    collider.mesh = Some(Arc::clone(mesh));
                 }
             }
             out.push(collider);

@@ -18,13 +18,15 @@
 //! - At rest: the result is a function of the step's inputs, so still inputs give the same
 //!   nodes every step: no jitter.
 //! - No tunnelling: a collider's path within the step is sampled at most one thickness (a
-//!   sphere's or capsule's radius, a box's smallest half extent) apart, up to
+//!   sphere's or capsule's radius, a box's or a mesh's box's smallest half extent) apart, up to
 //!   [`SWEEP_RADII_PER_STEP`] thicknesses per step, and the fur is pushed out of every sample:
 //!   nothing the collider passed over in the step is left inside its path.
 //! - Continuity: the response has no jump the kernels' last-bit differences could flip (see
 //!   `turn_above` and the grip's segment), except where an end lies on the medial axis of a
 //!   concave spot of the skin.
-//! - Cost: a node a clearance away from everything leaves the nodes within that distance
+//! - Cost: a batch's eight strands are screened at once first (`screen`): only those with a
+//!   node near a skin plane or a collider, with skin triangles, or held, are solved. Within a
+//!   strand, a node a clearance away from everything leaves the nodes within that distance
 //!   untested (a node moves at most a segment's length from the one before).
 //! - No fling: a collider grows in over [`Collider::appear_secs`] after it appears (or jumps
 //!   faster than the sweep), so fur it appears in is pushed out over a few steps.
@@ -41,8 +43,8 @@ pub mod surface;
 use glam::{Quat, Vec3, Vec4};
 use rayon::prelude::*;
 
-pub use collider::{Collider, ColliderKey, SWEEP_RADII_PER_STEP, Shape, StepCollider};
-pub use grasp::{Grasp, GraspParams};
+pub use collider::{Collider, ColliderKey, ColliderMesh, SWEEP_RADII_PER_STEP, Shape, StepCollider};
+pub use grasp::{Grasp, GraspParams, HAND_PARTS};
 pub use skin::{SKIN_PLANES, skin_planes};
 pub use surface::{SURFACE_WORDS, SkinSurface, skin_surface};
 

@@ -42,16 +42,46 @@ pub(crate) struct Batch<'a> {
     pub held: &'a Lanes,
 }
 
-/// A collider as the screen tests it: a ball (or, for a plane, its half-space), with the lanes
-/// it cannot reach pushed infinitely far away.
+/// A collider as the screen tests it, with the lanes it cannot reach pushed infinitely far away.
 struct Bound {
     centre: [f32; 3],
-    /// The ball's radius (0 for a plane).
-    radius: f32,
-    /// A plane's normal (`None` for a ball).
-    normal: Option<[f32; 3]>,
+    shape: BoundShape,
     /// 0 where the lane's strand can reach the collider, infinite where it cannot.
     away: Lanes,
+}
+
+/// A collider's shape as signed distances the screen evaluates (each 1-Lipschitz, none more
+/// than the collider's own).
+enum BoundShape {
+    /// A ball: a sphere, or the bounding ball of a shape the screen has no exact form for.
+    Ball { radius: f32 },
+    /// The points within `radius` of the segment `centre +- axis * half_length`.
+    Capsule { axis: [f32; 3], half_length: f32, radius: f32 },
+    /// An oriented box: `axes` are its local axes in the world.
+    Box { axes: [[f32; 3]; 3], half_extents: [f32; 3] },
+    /// The half-space below the plane with this normal.
+    Plane { normal: [f32; 3] },
+}
+
+impl BoundShape {
+    /// The shape of `c`; `None` for an unbounded shape the screen cannot test.
+    fn of(c: &StepCollider) -> Option<Self> {
+        Some(match c.kind {
+            StepCollider::SPHERE => Self::Ball { radius: c.radius },
+            StepCollider::CAPSULE => Self::Capsule {
+                axis: (c.rotation * Vec3::Y).to_array(),
+                half_length: c.half_extents.y,
+                radius: c.radius,
+            },
+            StepCollider::BOX => Self::Box {
+                axes: [Vec3::X, Vec3::Y, Vec3::Z].map(|a| (c.rotation * a).to_array()),
+                half_extents: c.half_extents.to_array(),
+            },
+            StepCollider::PLANE => Self::Plane { normal: (c.rotation * Vec3::Y).to_array() },
+            _ if c.bound.is_finite() => Self::Ball { radius: c.bound },
+            _ => return None,
+        })
+    }
 }
 
 /// The lanes (bit `lane`) of `batch` that may touch the skin planes, a skin triangle, a
@@ -100,23 +130,26 @@ pub(crate) fn lanes_to_solve(
         None => 0,
     };
     let planes = &planes[..count];
-    let bounds: Vec<Bound> = near
-        .iter()
-        .filter_map(|c| {
-            let away: Lanes = std::array::from_fn(|lane| {
-                let reaches =
-                    lane < batch.lanes && roots[first + lane].distance(c.centre) <= c.bound + batch.reach[lane];
-                if reaches { 0.0 } else { f32::INFINITY }
-            });
-            let finite = c.bound.is_finite();
-            away.contains(&0.0).then(|| Bound {
-                centre: c.centre.to_array(),
-                radius: if finite { c.bound } else { 0.0 },
-                normal: (!finite).then(|| (c.rotation * Vec3::Y).to_array()),
-                away,
-            })
-        })
-        .collect();
+    let mut bounds: Vec<Bound> = Vec::with_capacity(near.len());
+    for c in near {
+        let away: Lanes = std::array::from_fn(|lane| {
+            let reaches = lane < batch.lanes && roots[first + lane].distance(c.centre) <= c.bound + batch.reach[lane];
+            if reaches { 0.0 } else { f32::INFINITY }
+        });
+        if !away.contains(&0.0) {
+            continue;
+        }
+        match BoundShape::of(c) {
+            Some(shape) => bounds.push(Bound { centre: c.centre.to_array(), shape, away }),
+            None => {
+                for lane in 0..batch.lanes {
+                    if away[lane] == 0.0 {
+                        solve |= 1 << lane;
+                    }
+                }
+            }
+        }
+    }
     if planes.is_empty() && bounds.is_empty() {
         return solve;
     }
@@ -226,13 +259,44 @@ fn clearance(node: &VecLanes, root: &VecLanes, planes: &[[Lanes; 4]], bounds: &[
     }
     for bound in bounds {
         let [cx, cy, cz] = bound.centre;
+        let mut gap = [0.0; LANES];
+        match bound.shape {
+            BoundShape::Ball { radius } => {
+                for lane in 0..LANES {
+                    let (x, y, z) = (node[0][lane] - cx, node[1][lane] - cy, node[2][lane] - cz);
+                    gap[lane] = (x * x + y * y + z * z).sqrt() - radius;
+                }
+            }
+            BoundShape::Capsule { axis: [ax, ay, az], half_length, radius } => {
+                for lane in 0..LANES {
+                    let (x, y, z) = (node[0][lane] - cx, node[1][lane] - cy, node[2][lane] - cz);
+                    let t = (ax * x + ay * y + az * z).max(-half_length).min(half_length);
+                    let (x, y, z) = (x - ax * t, y - ay * t, z - az * t);
+                    gap[lane] = (x * x + y * y + z * z).sqrt() - radius;
+                }
+            }
+            BoundShape::Box { axes, half_extents } => {
+                for lane in 0..LANES {
+                    let (x, y, z) = (node[0][lane] - cx, node[1][lane] - cy, node[2][lane] - cz);
+                    let (mut outside, mut inside) = (0.0_f32, f32::NEG_INFINITY);
+                    for (axis, half) in axes.iter().zip(half_extents) {
+                        let q = (axis[0] * x + axis[1] * y + axis[2] * z).abs() - half;
+                        let out = q.max(0.0);
+                        outside += out * out;
+                        inside = inside.max(q);
+                    }
+                    gap[lane] = outside.sqrt() + inside.min(0.0);
+                }
+            }
+            BoundShape::Plane { normal: [nx, ny, nz] } => {
+                for lane in 0..LANES {
+                    gap[lane] = nx * (node[0][lane] - cx) + ny * (node[1][lane] - cy) + nz * (node[2][lane] - cz);
+                }
+            }
+        }
         for lane in 0..LANES {
-            let (x, y, z) = (node[0][lane] - cx, node[1][lane] - cy, node[2][lane] - cz);
-            let gap = match bound.normal {
-                Some([nx, ny, nz]) => nx * x + ny * y + nz * z,
-                None => (x * x + y * y + z * z).sqrt() - bound.radius,
-            } + bound.away[lane];
-            least[lane] = if gap < least[lane] { gap } else { least[lane] };
+            let g = gap[lane] + bound.away[lane];
+            least[lane] = if g < least[lane] { g } else { least[lane] };
         }
     }
     least
@@ -262,10 +326,12 @@ mod tests {
 
     use super::*;
     use crate::mesh::builtin::Builtin;
-    use crate::sim::{Collider, ContactParams, CpuKernel, GraspParams, Shape, SimParams, Simulation, WindParams};
+    use crate::sim::{
+        Collider, ColliderMesh, ContactParams, CpuKernel, GraspParams, Shape, SimParams, Simulation, WindParams,
+    };
     use crate::{FurStructure, Preset};
 
-    /// The screen only saves time: with the skin, colliders of every shape moving through the
+    /// The screen only saves time: with the skin, colliders of every shape (a mesh too) moving through the
     /// fur and a grasp, under strong wind and gravity, the nodes are the same bits with and
     /// without it, for both instruction sets.
     #[test]
@@ -290,6 +356,9 @@ mod tests {
             simulation
         };
         let mut runs = [make(CpuKernel::Auto, true), make(CpuKernel::Auto, false), make(CpuKernel::Portable, true)];
+        let (sphere, _) = Builtin::Sphere.mesh();
+        let pebble_radius = sphere.positions.iter().map(|p| p.length()).fold(0.0, f32::max);
+        let pebble = std::sync::Arc::new(ColliderMesh::new(sphere, 12).expect("a closed sphere"));
         let mut free = Simulation::new(&fur, &SimParams { contact: ContactParams { skin: false }, ..params.clone() })
             .expect("simulation");
         let mut touched = 0;
@@ -324,6 +393,13 @@ mod tests {
                     t,
                     hit + normal * (0.2 * length),
                     Quat::from_rotation_arc(Vec3::Y, -normal),
+                ),
+                Collider::at(
+                    5,
+                    Shape::Mesh { mesh: pebble.clone(), scale: 0.7 * length / pebble_radius },
+                    t,
+                    hit + normal * (0.6 * length) - Vec3::X * x,
+                    Quat::from_rotation_z(0.3),
                 ),
             ];
             for simulation in &mut runs {
