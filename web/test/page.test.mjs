@@ -411,25 +411,59 @@ test('sponge: the fur under it turns darker and the rest keeps its colour', asyn
   assert.deepEqual(page.problems, []);
 });
 
-test('switching to try-on draws the body plain and the skirt furred', async () => {
+test('the try-on body walks: its legs move and the furred skirt moves with them', async () => {
   const page = await bunnyPage();
   await page.click('input[name=scene][value=tryon]');
+  await page.waitForFunction(() => window.pelt.stats.scene === 'tryon', { timeout: 120_000 });
   await frames(page, 5);
+  const first = await page.evaluate(() => window.pelt.stats);
   const image = await shot(page, 'tryon');
+  // Half a walk cycle later (the page's clock moves at most 0.25 s a frame): the legs have swapped.
+  const cycle = first.walk_cycle_secs;
+  assert.ok(cycle > 0.5, `the try-on has no walk cycle: ${JSON.stringify(first)}`);
+  let advanced = 0;
+  for (let k = 0; k < 16 && !(advanced > 0.35 * cycle && advanced < 0.65 * cycle); k++) {
+    await frames(page, 1);
+    const now = await page.evaluate(() => window.pelt.stats.walk_secs);
+    advanced = (((now - first.walk_secs) % cycle) + cycle) % cycle;
+  }
+  const later = await shot(page, 'tryon-later');
   await page.click('input[name=scene][value=bunny]');
   await frames(page, 6);
+  assert.equal(await page.evaluate(() => window.pelt.stats.walk_secs), null, 'the bunny walks');
 
   const area = image.width * image.height;
-  const skin = select(image, isSkin);
+  for (const [name, picture] of [['first', image], ['later', later]]) {
+    const skin = select(picture, isSkin);
+    const fur = select(picture, isFur);
+    assert.ok(skin.count > 0.02 * area, `${name}: only ${skin.count} body-coloured pixels`);
+    assert.ok(fur.count > 0.005 * area, `${name}: only ${fur.count} fur-coloured pixels`);
+    // The skirt sits on the hips: below the head and above the feet of the body.
+    const top = Math.min(...skin.ys);
+    const bottom = Math.max(...skin.ys);
+    const furY = (mean(fur.ys) - top) / (bottom - top);
+    assert.ok(furY > 0.3 && furY < 0.75, `${name}: the fur's centre is at ${furY.toFixed(2)} of the body's height`);
+    assert.ok(Math.min(...fur.ys) > top + 0.15 * (bottom - top), `${name}: fur reaches the head`);
+  }
+  // The legs: body-coloured pixels below the skirt's hem (the lowest fur pixel of either shot).
   const fur = select(image, isFur);
-  assert.ok(skin.count > 0.02 * area, `only ${skin.count} body-coloured pixels`);
-  assert.ok(fur.count > 0.005 * area, `only ${fur.count} fur-coloured pixels`);
-  // The skirt sits on the hips: below the head and above the feet of the body.
-  const top = Math.min(...skin.ys);
-  const bottom = Math.max(...skin.ys);
-  const furY = (mean(fur.ys) - top) / (bottom - top);
-  assert.ok(furY > 0.3 && furY < 0.75, `the fur's centre is at ${furY.toFixed(2)} of the body's height`);
-  assert.ok(Math.min(...fur.ys) > top + 0.15 * (bottom - top), 'fur reaches the head');
+  const furLater = select(later, isFur);
+  const hem = Math.max(...fur.ys, ...furLater.ys);
+  const legs = (picture) => select(picture, (p, x, y) => y > hem && isSkin(p));
+  const legsFirst = legs(image);
+  const legsMoved = select(image, (p, x, y) => y > hem && (isSkin(p) || isSkin(pixel(later, x, y))) &&
+    differs(p, pixel(later, x, y), 24));
+  // The skirt: fur-coloured pixels in either shot that changed.
+  const skirtMoved = select(image, (p, x, y) => (isFur(p) || isFur(pixel(later, x, y))) &&
+    differs(p, pixel(later, x, y), 24));
+  const report = `${advanced.toFixed(2)} s of a ${cycle.toFixed(2)} s walk apart: ${legsMoved.count} leg pixels ` +
+    `of ${legsFirst.count} changed, ${skirtMoved.count} skirt pixels of ${fur.count}`;
+  console.log(`walk: ${report}`);
+  assert.ok(advanced > 0.35 * cycle && advanced < 0.65 * cycle, `the walk's clock did not move on: ${report}`);
+  // A frozen walk changes neither (a still scene changes fewer than 50 pixels, the drag test shows).
+  assert.ok(legsFirst.count > 0.002 * area, `no legs below the skirt: ${report}`);
+  assert.ok(legsMoved.count > 0.4 * legsFirst.count, `the legs do not move: ${report}`);
+  assert.ok(skirtMoved.count > 0.1 * fur.count, `the skirt does not move with the legs: ${report}`);
   assert.deepEqual(page.problems, []);
 });
 

@@ -47,16 +47,69 @@ fn golden_box() {
     check_golden("box", &rig.render(&gpu_fur, &framed(&fur, 1.0), &settings()));
 }
 
+/// The walking try-on's golden frame: 0.75 s into the walk, mid-stride (the legs wide apart),
+/// the skirt skinned to them, its fur colliding with the body's capsules.
+const TRYON_WALK_SECS: f64 = 0.75;
+
+/// The walking try-on (`pelt render --builtin tryon`'s stage) at `walk_secs` of `clip` (`None`:
+/// standing in the rest pose): the skirt's fur simulated from the start at 30 steps a second,
+/// colliding with the body's capsules; the body drawn posed with the same clip.
+fn render_walking_tryon(walk_secs: f64, clip: Option<usize>) -> image::RgbaImage {
+    use pelt_core::anim::Pose;
+    use pelt_core::sim::{FurStepper, SimParams};
+    use pelt_core::{ImportOptions, Stage, StageSource};
+
+    let stage = Stage::load(&StageSource::TryOn, &[], &ImportOptions::default()).expect("try-on stage");
+    let (rig, body, body_mesh) = (stage.rig.expect("skirt rig"), stage.body.expect("walking body"), &stage.plain[0]);
+    let garment = grow(stage.fur_mesh, 16, 0.3);
+    let mut stepper = FurStepper::new(&garment, &SimParams::default()).expect("stepper");
+    stepper.set_clip(rig, clip);
+    stepper.set_body(Some((body_mesh.clone(), body.rig.clone(), body.capsules.clone())));
+    let steps = (walk_secs * 30.0).round() as u32;
+    for step in 0..=steps {
+        stepper.advance_to(f64::from(step) / 30.0).expect("step");
+    }
+    let time_secs = f64::from(steps) / 30.0;
+    let render = Rig::new(SIZE, SIZE);
+    let fur = render.fur(&garment, &strand_textures(256, 16, [30, 20, 45], [150, 110, 190]));
+    fur.set_positions(render.queue(), stepper.simulation().positions()).expect("positions");
+    if let Some(pose) = stepper.moved_pose() {
+        fur.set_base_normals(render.queue(), &pose.normals).expect("normals");
+    }
+    let plain = render.plain(body_mesh, Vec3::new(0.6, 0.45, 0.38));
+    let mut body_pose = Pose::default();
+    body.rig.pose(body_mesh, clip, time_secs, &mut body_pose);
+    plain.set_pose(render.queue(), &body_pose.positions, &body_pose.normals).expect("body pose");
+    // Framed on the posed body, from 60 degrees off its walk: the stride and the skirt's front.
+    let (low, high) = body_pose
+        .positions
+        .iter()
+        .fold((Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)), |(l, h), p| (l.min(*p), h.max(*p)));
+    let centre = 0.5 * (low + high);
+    let camera = Camera::framing(centre, 0.5 * (high - low).length() * 1.05, 60.0, 10.0, 1.0);
+    render.render_scene(&[&plain], Some(&fur), &camera, &settings())
+}
+
 #[test]
 fn golden_tryon() {
-    let body = load_asset("female_generic.obj");
-    let garment = grow(load_asset("skirthelper.obj"), 16, 0.12);
-    let rig = Rig::new(SIZE, SIZE);
-    let fur = rig.fur(&garment, &strand_textures(256, 16, [30, 20, 45], [150, 110, 190]));
-    let body = rig.plain(&body, Vec3::new(0.6, 0.45, 0.38));
-    let (centre, radius) = garment.mesh.bounding_sphere();
-    let camera = Camera::framing(centre, radius * 1.6, 25.0, 10.0, 1.0);
-    check_golden("tryon", &rig.render_scene(&[&body], Some(&fur), &camera, &settings()));
+    check_golden("tryon", &render_walking_tryon(TRYON_WALK_SECS, Some(0)));
+}
+
+/// The try-on golden guards the walk: the standing body fails it, and so does the body half a
+/// step later (the legs the other way round).
+#[test]
+fn golden_tryon_fails_standing_or_on_another_step() {
+    for (what, image) in [
+        ("the standing body", render_walking_tryon(TRYON_WALK_SECS, None)),
+        ("another step", render_walking_tryon(TRYON_WALK_SECS + 1.0, Some(0))),
+    ] {
+        let difference = golden_difference("tryon", &image);
+        eprintln!(
+            "try-on, {what}: mean {:.2}, p99 {}, band {:.2}",
+            difference.mean, difference.p99, difference.silhouette_mean
+        );
+        assert!(!difference.within_limits(), "the try-on with {what} passed its golden test");
+    }
 }
 
 #[test]

@@ -9,7 +9,7 @@ use pelt_core::{FurStructure, Mesh, Preset};
 use pelt_render::Camera;
 
 pub use crate::orbit::Orbit;
-pub use crate::scene::{FOX_NAME, SceneChoice};
+pub use crate::scene::{FOX_NAME, SceneChoice, WalkingBody};
 use crate::scene::{grow, load_scene, stepper};
 use crate::tools::{Tool, Tools};
 
@@ -70,8 +70,10 @@ pub struct Model {
     pub preset: Preset,
     /// The fur's rest pose.
     pub structure: FurStructure,
-    /// The try-on body, drawn plain.
+    /// The try-on body, drawn plain (its bind pose; [`Model::pose_body`] walks it).
     pub body: Option<Mesh>,
+    /// The try-on body's walk: its rig, the skirt's and the capsules the fur collides with.
+    walking: Option<WalkingBody>,
     /// The simulation of `structure`, stepped by the page's frame driver (or by
     /// [`Model::simulate`] without a GPU).
     pub stepper: FurStepper,
@@ -96,15 +98,17 @@ impl Model {
     /// # Errors
     /// [`ModelError`] if the preset does not fit the mesh.
     pub fn new(scene: SceneChoice, preset: Preset, aspect: f32) -> Result<Self, ModelError> {
-        let (mesh, body) = load_scene(scene)?;
+        let (mesh, walking) = load_scene(scene)?;
         let structure = grow(mesh, scene, &preset)?;
-        let stepper = stepper(&structure, &preset)?;
+        let stepper = stepper(&structure, &preset, walking.as_ref())?;
+        let body = walking.as_ref().map(|w| w.mesh.clone());
         let orbit = Orbit { target: Vec3::ZERO, azimuth_deg: 35.0, elevation_deg: 15.0, distance: 1.0 };
         let mut model = Self {
             scene,
             preset,
             structure,
             body,
+            walking,
             stepper,
             orbit,
             framed_distance: 1.0,
@@ -214,7 +218,7 @@ impl Model {
     fn rebuild(&mut self, preset: Preset) -> Result<(), ModelError> {
         preset.validate()?;
         let structure = grow(self.structure.mesh.clone(), self.scene, &preset)?;
-        let stepper = stepper(&structure, &preset)?;
+        let stepper = stepper(&structure, &preset, self.walking.as_ref())?;
         self.preset = preset;
         self.structure = structure;
         self.stepper = stepper;
@@ -396,6 +400,26 @@ impl Model {
         let time_secs = self.tick(frame_secs)?;
         Ok(self.stepper.advance_to(time_secs)?)
     }
+
+    /// The try-on body posed at the page's clock, where the stepper poses the skirt (the walk's
+    /// clock is the simulation's): its positions and normals; `None` on other scenes.
+    pub fn pose_body(&mut self) -> Option<(&[Vec3], &[Vec3])> {
+        let clock_secs = self.clock_secs;
+        self.walking.as_mut().map(|w| w.pose(clock_secs))
+    }
+
+    /// Where the walk is in its cycle (seconds from its start), `None` without a walking body.
+    #[must_use]
+    pub fn walk_secs(&self) -> Option<f64> {
+        let cycle = self.walk_cycle_secs()?;
+        Some(if cycle > 0.0 { self.clock_secs.rem_euclid(cycle) } else { 0.0 })
+    }
+
+    /// The walk cycle's length in seconds, `None` without a walking body.
+    #[must_use]
+    pub fn walk_cycle_secs(&self) -> Option<f64> {
+        Some(f64::from(self.walking.as_ref()?.cycle_secs()))
+    }
 }
 
 #[cfg(test)]
@@ -538,6 +562,46 @@ mod tests {
         assert!(model.stepper.simulation().positions().iter().all(|p| p.is_finite()));
         assert_eq!(SceneChoice::from_name("tryon"), Some(SceneChoice::TryOn));
         assert_eq!(SceneChoice::from_name("cat"), None);
+    }
+
+    #[test]
+    fn the_try_on_body_walks_and_the_skirt_and_its_colliders_walk_with_it() {
+        let mut model = Model::new(SceneChoice::TryOn, Preset::default(), 1.0).unwrap();
+        let body = model.body.clone().expect("a body");
+        let height = body.bounds().1.y - body.bounds().0.y;
+        let v = model.structure.vertex_count();
+        let capsule = |c: &pelt_core::sim::contact::Collider| {
+            c.id.wrapping_sub(pelt_core::sim::stepper::BODY_COLLIDER_IDS) < 0x1_0000
+        };
+        model.simulate(FRAME_SECS).unwrap();
+        let colliders = model.stepper.simulation().colliders().to_vec();
+        assert!(colliders.iter().filter(|c| capsule(c)).count() >= 10, "the body's capsules collide with the fur");
+        let legs = model.pose_body().unwrap().0.to_vec();
+        let skirt = model.stepper.simulation().positions()[..v].to_vec();
+        // Half a step on (the walk's clock is the page's).
+        for _ in 0..15 {
+            model.simulate(FRAME_SECS).unwrap();
+        }
+        assert!((model.walk_secs().unwrap() - 16.0 * FRAME_SECS).abs() < 1e-9);
+        let moved = |a: &[Vec3], b: &[Vec3]| a.iter().zip(b).map(|(p, q)| p.distance(*q)).fold(0.0, f32::max);
+        let legs_moved = moved(&legs, model.pose_body().unwrap().0);
+        let skirt_moved = moved(&skirt, &model.stepper.simulation().positions()[..v]);
+        let capsules_moved = model
+            .stepper
+            .simulation()
+            .colliders()
+            .iter()
+            .filter(|c| capsule(c))
+            .zip(colliders.iter().filter(|c| capsule(c)))
+            .any(|(now, before)| now != before);
+        assert!(legs_moved > 0.1 * height, "the body walks: a vertex moved {legs_moved}");
+        assert!(skirt_moved > 0.03 * height, "the skirt walks with it: a vertex moved {skirt_moved}");
+        assert!(capsules_moved, "the capsules walk with the body");
+        // A rebuilt coat (new length) keeps the walk and the colliders.
+        model.set_length(0.1).unwrap();
+        model.simulate(FRAME_SECS).unwrap();
+        assert!(model.stepper.moves() && model.stepper.simulation().colliders().iter().any(capsule));
+        assert!(model.stepper.simulation().positions().iter().all(|p| p.is_finite()));
     }
 
     #[test]

@@ -148,7 +148,8 @@ impl PageGpu {
     }
 
     /// Advances the model by `frame_secs` of wall time: its clock and touches
-    /// ([`Model::tick`]), then the fur through the driver (simulation step and upload).
+    /// ([`Model::tick`]), then the fur through the driver (simulation step and upload) and the
+    /// walking try-on body.
     ///
     /// # Errors
     /// The driver's message.
@@ -160,7 +161,12 @@ impl PageGpu {
         frame_secs: f64,
     ) -> Result<(), String> {
         let time_secs = model.tick(frame_secs).map_err(|e| e.to_string())?;
-        self.driver.advance_to(device, queue, &mut model.stepper, time_secs).map_err(|e| e.to_string())
+        self.driver.advance_to(device, queue, &mut model.stepper, time_secs).map_err(|e| e.to_string())?;
+        // The walking try-on body takes the skirt's clip at the same time.
+        if let (Some(body), Some((positions, normals))) = (&self.body, model.pose_body()) {
+            body.set_pose(queue, positions, normals).map_err(|e| e.to_string())?;
+        }
+        Ok(())
     }
 
     /// Draws `model` from its orbit, copies the frame into `canvas` (a texture of the size last

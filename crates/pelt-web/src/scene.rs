@@ -1,9 +1,12 @@
 //! The scenes the page shows and how each grows its fur: the meshes (the Fox embedded), the
-//! groomed structure and its simulation with the preset's `[simulation]` and `[wet]`.
+//! groomed structure and its simulation with the preset's `[simulation]` and `[wet]`; the
+//! try-on's body walks, as in `pelt render --builtin tryon`.
 
-use pelt_core::mesh::builtin::{TryOnScene, try_on_scene};
+use glam::Vec3;
+use pelt_core::anim::{Pose, Rig};
 use pelt_core::sim::FurStepper;
-use pelt_core::{Builtin, FurStructure, ImportOptions, Mesh, Preset};
+use pelt_core::stage::StageBody;
+use pelt_core::{Builtin, FurStructure, ImportOptions, Mesh, Preset, Stage, StageSource};
 
 use crate::model::ModelError;
 use crate::presets;
@@ -13,7 +16,7 @@ use crate::presets;
 pub enum SceneChoice {
     /// The Stanford bunny, furred all over.
     Bunny,
-    /// The paper's try-on: a plain body wearing a furred skirt.
+    /// The paper's try-on: a plain body walking on the spot in a furred skirt.
     TryOn,
     /// The glTF Fox in its rest pose (the groomed Fox's mesh).
     Fox,
@@ -48,13 +51,52 @@ const FOX_GLB: &[u8] = include_bytes!("../../../assets/meshes/Fox.glb");
 /// The Fox's name in messages, as `pelt render` names it.
 pub const FOX_NAME: &str = "assets/meshes/Fox.glb";
 
-/// The furred mesh and the plain body (try-on only).
-pub(crate) fn load_scene(scene: SceneChoice) -> Result<(Mesh, Option<Mesh>), ModelError> {
+/// The clip the try-on body walks with (its only one).
+const WALK_CLIP: usize = 0;
+
+/// The try-on's walking body: drawn plain, posed with the skirt's clip at the page's clock, its
+/// capsules colliding with the skirt's fur (the stage `pelt render --builtin tryon` loads).
+#[derive(Clone, Debug)]
+pub struct WalkingBody {
+    /// The body in its bind pose.
+    pub mesh: Mesh,
+    /// The skirt's rig: the body's skeleton and walk, with the skirt's transferred weights.
+    pub garment_rig: Rig,
+    /// The body's rig and capsules.
+    pub body: StageBody,
+    pose: Pose,
+}
+
+impl WalkingBody {
+    /// The walk's length in seconds (it loops).
+    #[must_use]
+    pub fn cycle_secs(&self) -> f32 {
+        self.garment_rig.animations()[WALK_CLIP].duration_secs()
+    }
+
+    /// Poses the body at `clip_secs` of the walk: its positions and normals.
+    pub fn pose(&mut self, clip_secs: f64) -> (&[Vec3], &[Vec3]) {
+        self.body.rig.pose(&self.mesh, Some(WALK_CLIP), clip_secs, &mut self.pose);
+        (&self.pose.positions, &self.pose.normals)
+    }
+}
+
+/// The furred mesh and the try-on's walking body.
+pub(crate) fn load_scene(scene: SceneChoice) -> Result<(Mesh, Option<WalkingBody>), ModelError> {
     Ok(match scene {
         SceneChoice::Bunny => (Builtin::Bunny.mesh().0, None),
         SceneChoice::TryOn => {
-            let TryOnScene { garment, body, .. } = try_on_scene(&ImportOptions::default())?;
-            (garment, Some(body))
+            let stage = Stage::load(&StageSource::TryOn, &[], &ImportOptions::default())?;
+            let missing = || pelt_core::MeshError::Parse {
+                file: "tryon".into(),
+                line: None,
+                message: "the try-on stage has no walking body".to_owned(),
+            };
+            let (Some(garment_rig), Some(body), Some(mesh)) = (stage.rig, stage.body, stage.plain.into_iter().next())
+            else {
+                return Err(missing().into());
+            };
+            (stage.fur_mesh, Some(WalkingBody { mesh, garment_rig, body, pose: Pose::default() }))
         }
         SceneChoice::Fox => {
             (Mesh::from_gltf_slice(FOX_GLB, std::path::Path::new(FOX_NAME), &ImportOptions::default())?.0, None)
@@ -74,9 +116,20 @@ pub(crate) fn grow(mesh: Mesh, scene: SceneChoice, preset: &Preset) -> Result<Fu
     Ok(FurStructure::new_groomed(mesh, &params, groom)?)
 }
 
-/// The simulation of `structure` with `preset`'s `[simulation]` and `[wet]`.
-pub(crate) fn stepper(structure: &FurStructure, preset: &Preset) -> Result<FurStepper, ModelError> {
+/// The simulation of `structure` with `preset`'s `[simulation]` and `[wet]`; on the try-on the
+/// skirt plays the walk (clip time = simulation time, as `pelt render`'s catwalk) and the body's
+/// capsules push its fur out of the legs.
+pub(crate) fn stepper(
+    structure: &FurStructure,
+    preset: &Preset,
+    walking: Option<&WalkingBody>,
+) -> Result<FurStepper, ModelError> {
     let mut stepper = FurStepper::new(structure, &preset.simulation)?;
     stepper.set_wet(&preset.wet)?;
+    if let Some(walking) = walking {
+        stepper.set_clip(walking.garment_rig.clone(), Some(WALK_CLIP));
+        let body = &walking.body;
+        stepper.set_body(Some((walking.mesh.clone(), body.rig.clone(), body.capsules.clone())));
+    }
     Ok(stepper)
 }

@@ -204,10 +204,12 @@ impl Tools {
     /// [`ModelError::Sim`] for a collider the simulation refuses.
     pub fn apply(&mut self, stepper: &mut FurStepper, mesh_radius: f32, time_secs: f64) -> Result<(), ModelError> {
         if !self.fingers.is_empty() || self.fingers_given {
-            let colliders: Vec<Collider> =
-                self.fingers.iter().map(|f| finger_collider(f, mesh_radius, time_secs)).collect();
+            // Others' colliders (the walking body's capsules) stay.
+            let mut colliders: Vec<Collider> =
+                stepper.simulation().colliders().iter().filter(|c| !is_finger(c.id)).cloned().collect();
+            colliders.extend(self.fingers.iter().map(|f| finger_collider(f, mesh_radius, time_secs)));
             stepper.simulation_mut().set_colliders(&colliders)?;
-            self.fingers_given = !colliders.is_empty();
+            self.fingers_given = !self.fingers.is_empty();
         }
         let points = self.sponges.iter().filter_map(|s| s.point);
         for point in points {
@@ -215,6 +217,11 @@ impl Tools {
         }
         Ok(())
     }
+}
+
+/// Whether collider `id` is one of the fingers'.
+fn is_finger(id: u32) -> bool {
+    id.wrapping_sub(FINGER_COLLIDER_IDS) <= 0xffff
 }
 
 /// The finger as a capsule along its ray: the tip's centre at the skin, the rest toward the eye.

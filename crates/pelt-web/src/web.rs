@@ -326,7 +326,7 @@ impl PeltApp {
                 "{{\"frame_ms\":{:.3},\"sim_ms\":{:.3},\"texture_ms\":{:.1},\"structure_ms\":{:.1},",
                 "\"frames_drawn\":{},\"frames_skipped\":{},\"vertices\":{},\"layers\":{},\"tile_px\":{},",
                 "\"touches\":{},\"tool\":{},\"fingers\":{},\"grabbing\":{},\"wettest\":{:.3},",
-                "\"scene\":{},\"preset\":{},\"adapter\":{}}}"
+                "\"scene\":{},\"preset\":{},\"adapter\":{},\"walk_secs\":{},\"walk_cycle_secs\":{}}}"
             ),
             self.frame_ms,
             self.sim_ms,
@@ -345,6 +345,9 @@ impl PeltApp {
             json_string(self.model.scene.name()),
             json_string(&self.preset_name),
             json_string(&self.gpu.adapter_name),
+            // Where the try-on body is in its walk cycle; null on other scenes.
+            self.model.walk_secs().map_or_else(|| "null".to_owned(), |t| format!("{t:.3}")),
+            self.model.walk_cycle_secs().map_or_else(|| "null".to_owned(), |t| format!("{t:.3}")),
         )
     }
 

@@ -9,9 +9,10 @@ use std::path::PathBuf;
 
 use anyhow::{Context as _, bail};
 use glam::{Mat4, Vec3};
+use pelt_core::anim::Pose;
 use pelt_core::reference::{StrandReference, WetClumps};
 use pelt_core::sim::{FurStepper, SimParams, WindParams};
-use pelt_core::{Builtin, FurStructure, Mesh, Preset, texture};
+use pelt_core::{Builtin, FurStructure, Mesh, Preset, Stage, texture};
 use pelt_render::{
     Backend, Camera, DEFAULT_BACKGROUND, FurDrawSettings, FurDriver, FurLook, FurRenderer, FurTarget, FurView, Gpu,
     HEADLESS_FORMAT, Headless, KernelChoice, Light, PlainMesh, StrandRenderer, StrandRibbons, default_sample_count,
@@ -22,7 +23,8 @@ use self::metrics::Mask;
 use crate::mesh_args::MeshArgs;
 use crate::render::PLAIN_COLOUR;
 
-/// Seconds simulated before the pictures are taken (the fur settles under gravity and wind).
+/// Seconds simulated before the pictures are taken (the fur settles under gravity and wind; the
+/// try-on body is 1.5 s into its walk, the right leg back and bent).
 const SETTLE_SECS: f64 = 1.5;
 /// Colour difference (0..=1) a channel must pass for a pixel to count as changed.
 const CHANGED: u8 = 3;
@@ -120,7 +122,8 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         Some(path) => Preset::load(path)?,
         None => Preset::default(),
     };
-    let (model, mesh, plain) = load_meshes(&args.mesh)?;
+    let (model, stage) = load_meshes(&args.mesh)?;
+    let Stage { fur_mesh: mesh, rig, mut plain, body, .. } = stage;
     let fur = preset.grow(mesh, &model)?;
     // One strand field: the textures are drawn from it and the reference places it.
     let field = preset.strand_field()?;
@@ -136,6 +139,16 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     stepper.simulation_mut().set_wind(&simulation_params.wind)?;
     if args.wetness.is_some() {
         stepper.set_wet(&crate::render::wet_params(&preset, args.wetness))?;
+    }
+    // The try-on walks: the skirt and the body posed at `SETTLE_SECS` of the walk, the skirt's
+    // fur pushed out of the legs by the body's capsules (as `pelt render --builtin tryon`).
+    if let (Some(rig), Some(body), Some(body_mesh)) = (rig, &body, plain.first_mut()) {
+        stepper.set_clip(rig, Some(0));
+        stepper.set_body(Some((body_mesh.clone(), body.rig.clone(), body.capsules.clone())));
+        let mut pose = Pose::default();
+        body.rig.pose(body_mesh, Some(0), SETTLE_SECS, &mut pose);
+        body_mesh.positions = pose.positions;
+        body_mesh.normals = pose.normals;
     }
 
     let (width, height) = args.size;
@@ -168,15 +181,16 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         StrandReference::wet(&fur, field, mapping, &clumps)?
     };
     let strand_renderer = StrandRenderer::new(&strands.gpu.device, &strand_side.renderer)?;
-    let ribbons =
-        StrandRibbons::new(&strands.gpu.device, &reference, positions, &fur.mesh.normals, &fur.mesh.triangles)?;
+    let normals = stepper.moved_pose().map_or(&fur.mesh.normals, |pose| &pose.normals);
+    let ribbons = StrandRibbons::new(&strands.gpu.device, &reference, positions, normals, &fur.mesh.triangles)?;
 
     std::fs::create_dir_all(&args.out).with_context(|| format!("cannot create {}", args.out.display()))?;
     let front = preset.render.camera_azimuth_deg.unwrap_or(30.0);
     let elevation = preset.render.camera_elevation_deg.unwrap_or(15.0);
     let fur_length = fur.lengths.iter().copied().fold(0.0, f32::max);
-    let points: Vec<Vec3> =
-        std::iter::once(&fur.mesh).chain(&plain).flat_map(|m| m.positions.iter().copied()).collect();
+    // The posed skin (the simulation's roots) and the plain meshes.
+    let roots = &positions[..fur.mesh.vertex_count()];
+    let points: Vec<Vec3> = roots.iter().chain(plain.iter().flat_map(|m| &m.positions)).copied().collect();
     let (low, high) = points
         .iter()
         .fold((Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)), |(l, h), p| (l.min(*p), h.max(*p)));
@@ -293,11 +307,10 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// The model's name, its furry mesh and any plain ones (the try-on body).
-fn load_meshes(args: &MeshArgs) -> anyhow::Result<(String, Mesh, Vec<Mesh>)> {
+/// The model's name and its stage (the furry mesh, any plain ones: the try-on body).
+fn load_meshes(args: &MeshArgs) -> anyhow::Result<(String, Stage)> {
     let name = args.source(Builtin::Bunny)?.name();
-    let stage = args.stage(Builtin::Bunny, &[])?;
-    Ok((name, stage.fur_mesh, stage.plain))
+    Ok((name, args.stage(Builtin::Bunny, &[])?))
 }
 
 /// One headless target's renderer, fur, view and plain meshes.
