@@ -175,7 +175,8 @@ impl ColliderMeshes {
     }
 
     /// Poses a mesh for each of `colliders` (in simulation space, placed in the world by
-    /// `world_from_model`, the fur's own transform). A plane is drawn as a square of
+    /// `world_from_model`: identity where the simulation runs in the world, as a
+    /// `FurStepper`'s does, the fur's own transform where a host draws it under one). A plane is drawn as a square of
     /// `plane_half_size` about its point (the fur's bounding radius or so).
     ///
     /// # Errors

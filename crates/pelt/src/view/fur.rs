@@ -133,8 +133,9 @@ impl FurScene {
         let simulation = stepper.simulation();
         let shown = simulation.shown_colliders(time_secs);
         let plane_half_size = 1.5 * simulation.bounding_radius();
-        let world_from_model = stepper.world_from_model();
-        self.colliders.update(&gpu.device, &gpu.queue, &self.renderer, &shown, world_from_model, plane_half_size)?;
+        // The simulation runs in the world (the stepper poses the base with the script's
+        // motion), so its colliders are drawn where they are.
+        self.colliders.update(&gpu.device, &gpu.queue, &self.renderer, &shown, Mat4::IDENTITY, plane_half_size)?;
         Ok(())
     }
 
