@@ -10,6 +10,8 @@ use pelt_core::sim::ColliderMesh;
 use pelt_core::sim::contact::{MAX_STEP_COLLIDERS, SKIN_PLANES, SURFACE_WORDS, SkinSurface, skin_planes, skin_surface};
 use pelt_core::sim::{ContactStep, ContactStrands};
 
+use crate::RenderError;
+
 /// Step slots: one per slot of the simulation's uniform ring.
 pub(crate) const CONTACT_SLOTS: usize = 64;
 /// vec4s per collider.
@@ -43,6 +45,16 @@ fn fields_buffer(device: &wgpu::Device, words: &[f32]) -> wgpu::Buffer {
             usage: wgpu::BufferUsages::STORAGE,
         },
     )
+}
+
+/// Whether `words` floats of fields fit one storage buffer binding of a device with `limits`.
+fn fields_fit(words: usize, limits: &wgpu::Limits) -> Result<(), RenderError> {
+    let bytes = 4 * words as u64;
+    let limit = limits.max_storage_buffer_binding_size.min(limits.max_buffer_size);
+    if bytes > limit {
+        return Err(RenderError::TooLarge { what: "mesh colliders' distance fields", bytes, limit });
+    }
+    Ok(())
 }
 
 fn weights_first(v: usize) -> usize {
@@ -123,15 +135,19 @@ impl GpuContact {
     /// Uploads the fields of the mesh colliders in `steps` not uploaded yet; true when the
     /// fields buffer was replaced (its bind groups with it). A new field rebuilds the buffer
     /// with the fields `steps` use, dropping the rest; a field already there is not written again.
-    pub fn upload_fields(&mut self, device: &wgpu::Device, steps: &[ContactStep]) -> bool {
+    ///
+    /// # Errors
+    /// [`RenderError::TooLarge`] when the fields would exceed the device's storage buffer
+    /// limits (a host's field baked finer than this GPU holds); nothing changes then.
+    pub fn upload_fields(&mut self, device: &wgpu::Device, steps: &[ContactStep]) -> Result<bool, RenderError> {
         let used = || steps.iter().flat_map(|s| s.colliders.iter().filter_map(|c| c.mesh.as_ref()));
         if used().all(|m| self.offset(m).is_some()) {
-            return false;
+            return Ok(false);
         }
         let mut words = Vec::new();
-        self.fields.clear();
+        let mut fields: Vec<(Arc<ColliderMesh>, u32)> = Vec::new();
         for mesh in used() {
-            if self.offset(mesh).is_some() {
+            if fields.iter().any(|(m, _)| Arc::ptr_eq(m, mesh)) {
                 continue;
             }
             let field = mesh.field();
@@ -143,10 +159,12 @@ impl GpuContact {
             words.push(0.0);
             debug_assert_eq!(words.len() - offset as usize, FIELD_HEADER);
             words.extend_from_slice(field.values());
-            self.fields.push((Arc::clone(mesh), offset));
+            fields.push((Arc::clone(mesh), offset));
         }
+        fields_fit(words.len(), &device.limits())?;
+        self.fields = fields;
         self.fields_buffer = fields_buffer(device, &words);
-        true
+        Ok(true)
     }
 
     /// Where `mesh`'s field begins in the fields buffer, if it is there.
@@ -206,5 +224,22 @@ impl GpuContact {
             queue.write_buffer(&self.buffer, weights_first(v) as u64 * 16, bytemuck::cast_slice(&packed));
         }
         self.weights = strands.grasp_weights.to_vec();
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Fields past the device's storage binding (or buffer) limit are refused with both sizes.
+    #[test]
+    fn fields_past_the_binding_limit_are_a_clear_error() {
+        let limits = wgpu::Limits { max_storage_buffer_binding_size: 1 << 20, ..wgpu::Limits::default() };
+        assert!(fields_fit(1 << 18, &limits).is_ok());
+        let error = fields_fit((1 << 18) + 1, &limits).expect_err("over the limit");
+        let message = error.to_string();
+        assert!(message.contains("1048580") && message.contains("1048576"), "{message}");
+        let small_buffers = wgpu::Limits { max_buffer_size: 1 << 10, ..wgpu::Limits::default() };
+        assert!(fields_fit(1 << 9, &small_buffers).is_err());
     }
 }

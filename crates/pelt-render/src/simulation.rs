@@ -460,7 +460,7 @@ impl GpuSimulation {
         let history = if start_over { 0 } else { self.dispatched_history };
         self.pending_history = settle_inertia(&mut self.pending, history);
         self.contact.write_strands(queue, &simulation.contact_strands());
-        if self.contact.upload_fields(device, &self.pending_contact) {
+        if self.contact.upload_fields(device, &self.pending_contact)? {
             // The fields buffer is new: bind it.
             self.bind_groups.clear();
             for buffer in [fur.current_positions(), fur.previous_positions()] {
