@@ -1,4 +1,4 @@
-//! Contact between fur and the scene: [`FurCollider`]s (sphere, capsule, box, plane) on entities,
+//! Contact between fur and the scene: [`FurCollider`]s (sphere, capsule, box, plane, closed mesh) on entities,
 //! so a Bevy body, physics-driven or animated, pushes fur; and [`FurGrasp`], a hand a host opens
 //! and closes. Both take their pose from the entity's `GlobalTransform` every frame.
 //!
@@ -7,16 +7,20 @@
 //! and one that appears inside the fur grows in over a quarter of a second instead of flinging
 //! it.
 
+use std::sync::Arc;
+
 use bevy::ecs::prelude::*;
 use bevy::math::Vec3;
 use bevy::prelude::GlobalTransform;
+use pelt_core::Mesh;
+use pelt_core::body::SdfError;
 use pelt_core::sim::contact::{Collider, GraspParams, Shape};
-use pelt_core::sim::{SimError, Simulation};
+use pelt_core::sim::{ColliderMesh, SimError, Simulation};
 
 use crate::convert::to_pelt;
 
 /// A collider shape in the entity's own frame, before its `GlobalTransform`'s scale.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 pub enum FurShape {
     /// A ball about the entity's origin.
     Sphere {
@@ -38,12 +42,16 @@ pub enum FurShape {
     },
     /// The half-space below the plane through the origin with local `+Y` as its normal.
     Plane,
+    /// A closed mesh (pelt's axes and units, about the entity's origin) as its baked distance
+    /// field, shared by every fur (see [`FurCollider::mesh`]).
+    Mesh(Arc<ColliderMesh>),
 }
 
 /// Pushes fur out of a shape that follows this entity's `GlobalTransform` (a ball thrown through
 /// a coat, a hand, a wall). The transform's scale scales the shape (a ball takes its largest axis,
-/// a capsule its largest across X and Z for the radius and Y for the length).
-#[derive(Component, Clone, Copy, Debug, PartialEq)]
+/// a capsule its largest across X and Z for the radius and Y for the length, a mesh its largest
+/// axis).
+#[derive(Component, Clone, Debug, PartialEq)]
 #[require(GlobalTransform)]
 pub struct FurCollider {
     /// The shape.
@@ -77,6 +85,15 @@ impl FurCollider {
         Self { shape: FurShape::Plane, friction: 0.3 }
     }
 
+    /// A closed `mesh` (in the entity's frame, pelt's axes), baked once into a distance field
+    /// of `resolution` cells along its longest side (32 resolves a hand-sized prop).
+    ///
+    /// # Errors
+    /// [`SdfError::NotClosed`] for a mesh with holes, and the other [`SdfError`]s of baking.
+    pub fn mesh(mesh: Mesh, resolution: usize) -> Result<Self, SdfError> {
+        Ok(Self { shape: FurShape::Mesh(Arc::new(ColliderMesh::new(mesh, resolution)?)), friction: 0.3 })
+    }
+
     /// This collider with `friction`.
     #[must_use]
     pub fn with_friction(self, friction: f32) -> Self {
@@ -95,6 +112,7 @@ impl FurCollider {
             }
             FurShape::Cuboid { half_size } => Shape::Box { half_extents: to_pelt(half_size * scale) },
             FurShape::Plane => Shape::Plane,
+            FurShape::Mesh(ref mesh) => Shape::Mesh { mesh: Arc::clone(mesh), scale: scale.max_element() },
         };
         let rotation = glam::Quat::from_array(rotation.to_array());
         let position = to_pelt(translation) / simulation_scale;

@@ -284,7 +284,7 @@ pub(crate) fn simulate_furs(
     let now = time.elapsed_secs_f64();
     update_touch(&mut touch, &mut furs);
     let mut colliders: Vec<(Entity, FurCollider, GlobalTransform)> =
-        colliders.iter().map(|(entity, collider, transform)| (entity, *collider, *transform)).collect();
+        colliders.iter().map(|(entity, collider, transform)| (entity, collider.clone(), *transform)).collect();
     colliders.sort_by_key(|(entity, ..)| *entity);
     let mut grasps: Grasps =
         grasps.iter().map(|(entity, grasp, transform)| (entity, *grasp, transform.translation())).collect();

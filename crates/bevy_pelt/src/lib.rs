@@ -23,7 +23,7 @@
 //!   reloaded with Bevy's `file_watcher` feature; a bad file is an asset load error naming it).
 //!   A preset's `[groom]` (a `.groom` file, PNG maps) loads with it and reloads when its files
 //!   change: bald, short, long, combed, clumped and tinted regions.
-//! - [`FurCollider`] (sphere, capsule, box, plane) on any entity pushes every fur out of its
+//! - [`FurCollider`] (sphere, capsule, box, plane, closed mesh) on any entity pushes every fur out of its
 //!   shape, following the entity's `GlobalTransform` (a physics body, an animated prop); a fast
 //!   one sweeps the fur along its path. [`FurGrasp`] is a hand a host moves, closes and opens.
 //! - [`FurSponge`] wets (or dries) the fur it touches; the preset's `[wet]` says what wetness

@@ -110,6 +110,34 @@ fn a_collider_pushes_the_fur_out_of_it() {
     }
 }
 
+/// A closed mesh on an entity (pelt's built-in sphere, scaled by the transform) pushes the fur
+/// out of it as a sphere collider does: no node stays inside the mesh's inscribed ball.
+#[test]
+fn a_mesh_collider_pushes_the_fur_out_of_it() {
+    let mut app = headless_app(&test_assets(), false);
+    let ball = spawn_furred_ball(&mut app, "presets/contact.toml");
+    wait_built(&mut app, ball, 5);
+    let (rest, v) = world_nodes(&app, ball);
+    let length = rest[rest.len() - v].distance(rest[0]);
+    let (centre, radius) = (Vec3::new(0.0, 0.5 + 0.6 * length, 0.0), 0.5 * length);
+    let before = inside(&rest, centre, radius);
+    assert!(before > 10, "only {before} nodes stand where the collider goes");
+    let (sphere, _) = bevy_pelt::pelt_core::Builtin::Sphere.mesh();
+    let mesh_radius = sphere.positions.iter().map(|p| p.length()).fold(0.0, f32::max);
+    let collider = FurCollider::mesh(sphere, 24).expect("the built-in sphere is closed");
+    app.world_mut()
+        .spawn((collider, Transform::from_translation(centre).with_scale(Vec3::splat(radius / mesh_radius))));
+    for _ in 0..30 {
+        update(&mut app);
+    }
+    let (pushed, _) = world_nodes(&app, ball);
+    // The mesh's faces lie a little inside its vertices' sphere, and the field is trilinear:
+    // 0.9 of the radius is well inside both.
+    assert_eq!(inside(&pushed, centre, radius * 0.9), 0, "nodes left inside the mesh collider");
+    let moved = rest.iter().zip(&pushed).filter(|(a, b)| a.distance(**b) > 1e-3).count();
+    assert!(moved >= before, "{moved} nodes moved");
+}
+
 /// A closed grasp gathers the tips it holds toward the grip and carries them when it moves;
 /// opened, they spring back to rest.
 #[test]
