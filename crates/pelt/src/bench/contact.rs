@@ -73,7 +73,6 @@ pub fn run(quick: bool) -> anyhow::Result<()> {
     } else {
         SimBudget { runs: 7, min_run_secs: 0.5, drawn_frames: 0 }
     };
-    let (gpu_steps, gpu_runs) = if quick { (4, 3) } else { (30, 7) };
     let gpu = Gpu::new(Backend::Auto);
     if let Err(error) = &gpu {
         eprintln!("pelt bench: no GPU adapter, the GPU column is empty: {error:#}");
@@ -96,24 +95,13 @@ pub fn run(quick: bool) -> anyhow::Result<()> {
             simulation.step_at(time);
             black_box(simulation.steps_taken());
         });
-        let gpu_rate = match &gpu {
-            Ok(gpu) => {
-                let renderer = crate::sim_kernel::timing_renderer(&gpu.device)?;
+        let gpu_rate = match gpu.as_ref().ok() {
+            Some(gpu) => {
                 let mut stepper = FurStepper::new(&fur, &params)?;
                 stepper.simulation_mut().set_colliders(&case.colliders)?;
-                let secs = pelt_render::gpu_secs_per_step_of(
-                    &gpu.device,
-                    &gpu.queue,
-                    &renderer,
-                    &fur,
-                    &params,
-                    &mut stepper,
-                    gpu_steps,
-                    gpu_runs,
-                )?;
-                Some(nodes / secs)
+                Some(gpu_rate(gpu, &fur, &params, stepper, quick)?)
             }
-            Err(_) => None,
+            None => None,
         };
         rows.push((case.name, cpu, gpu_rate));
     }
@@ -134,7 +122,6 @@ fn try_on(quick: bool, gpu: Option<&Gpu>) -> anyhow::Result<String> {
     let fur = preset.grow(stage.fur_mesh.clone(), "tryon")?;
     let nodes = (fur.vertex_count() * LAYERS as usize) as f64;
     let steps = if quick { 20 } else { 240 };
-    let (gpu_steps, gpu_runs) = if quick { (4, 3) } else { (30, 7) };
     let mut rows = Vec::new();
     for (name, skin, with_body) in [("off", false, false), ("skin", true, false), ("skin + body", true, true)] {
         eprintln!("pelt bench: contact, try-on {name}");
@@ -162,26 +149,27 @@ fn try_on(quick: bool, gpu: Option<&Gpu>) -> anyhow::Result<String> {
         rates.sort_by(f64::total_cmp);
         let cpu = rates[rates.len() / 2];
         let gpu_rate = match gpu {
-            Some(gpu) => {
-                let renderer = crate::sim_kernel::timing_renderer(&gpu.device)?;
-                let mut stepper = stepper()?;
-                let secs = pelt_render::gpu_secs_per_step_of(
-                    &gpu.device,
-                    &gpu.queue,
-                    &renderer,
-                    &fur,
-                    &params,
-                    &mut stepper,
-                    gpu_steps,
-                    gpu_runs,
-                )?;
-                Some(nodes / secs)
-            }
+            Some(gpu) => Some(gpu_rate(gpu, &fur, &params, stepper()?, quick)?),
             None => None,
         };
         rows.push((name, cpu, gpu_rate));
     }
     Ok(table(&format!("walking try-on's skirt, L = {LAYERS}, {} strands", fur.vertex_count()), &rows))
+}
+
+/// The GPU kernel's node updates per second stepping `stepper` (the driver `--sim gpu` runs).
+fn gpu_rate(
+    gpu: &Gpu,
+    fur: &FurStructure,
+    params: &SimParams,
+    mut stepper: FurStepper,
+    quick: bool,
+) -> anyhow::Result<f64> {
+    let (steps, runs) = if quick { (4, 3) } else { (30, 7) };
+    let renderer = crate::sim_kernel::timing_renderer(&gpu.device)?;
+    let secs =
+        pelt_render::gpu_secs_per_step_of(&gpu.device, &gpu.queue, &renderer, fur, params, &mut stepper, steps, runs)?;
+    Ok((fur.vertex_count() * fur.layers as usize) as f64 / secs)
 }
 
 /// A Markdown table of `rows` (`name`, CPU rate, GPU rate), the first row contact off.
