@@ -13,7 +13,7 @@ use rayon::prelude::*;
 use glam::{Quat, Vec3};
 
 use super::contact::screen::{self, Batch, BatchPlanes};
-use super::contact::{ContactStrands, StepCollider};
+use super::contact::{ContactStrands, Resolve, StepCollider};
 use super::kernel::{Step, VecLanes};
 
 /// Which instructions the CPU bend uses ([`Simulation::set_cpu_kernel`](super::Simulation::set_cpu_kernel)).
@@ -66,22 +66,33 @@ impl CpuKernel {
 /// Pairs of batches per parallel task: enough work to pay for the task, small enough to balance.
 const PAIRS_PER_TASK: usize = 4;
 
-/// Bends every strand of `step` into `nodes` (batch-major, `L + 1` nodes per batch).
-pub(crate) fn bend_all(kernel: CpuKernel, step: &Step<'_>, nodes: &mut [VecLanes]) {
+/// Bends every strand of `step` into `nodes` (batch-major, `L + 1` nodes per batch), then
+/// applies `contact` to each batch in the same task, while its nodes are still in cache.
+pub(crate) fn bend_all(kernel: CpuKernel, step: &Step<'_>, contact: Option<&Resolve<'_>>, nodes: &mut [VecLanes]) {
     let avx2 = kernel.resolve() == CpuKernel::Avx2Fma;
     let pair_nodes = 2 * (step.layers + 1);
+    let contact = contact.filter(|c| c.step.is_active());
     nodes.par_chunks_mut(pair_nodes * PAIRS_PER_TASK).enumerate().for_each(|(task, chunk)| {
         let first_pair = task * PAIRS_PER_TASK;
-        #[cfg(target_arch = "x86_64")]
-        if avx2 && CpuKernel::avx2_fma_available() {
-            // SAFETY: `bend_pairs_avx2` needs AVX2 and FMA, and the CPU has both (checked on
-            // the line above); it is otherwise safe code.
-            unsafe { bend_pairs_avx2(step, first_pair, pair_nodes, chunk) };
-            return;
+        bend_chunk(avx2, step, first_pair, pair_nodes, chunk);
+        if let Some(contact) = contact {
+            for (i, batch) in chunk.chunks_mut(step.layers + 1).enumerate() {
+                contact.batch(2 * first_pair + i, batch);
+            }
         }
-        let _ = avx2;
-        bend_pairs(step, first_pair, pair_nodes, chunk);
     });
+}
+
+fn bend_chunk(avx2: bool, step: &Step<'_>, first_pair: usize, pair_nodes: usize, chunk: &mut [VecLanes]) {
+    #[cfg(target_arch = "x86_64")]
+    if avx2 && CpuKernel::avx2_fma_available() {
+        // SAFETY: `bend_pairs_avx2` needs AVX2 and FMA, and the CPU has both (checked on the
+        // line above); it is otherwise safe code.
+        unsafe { bend_pairs_avx2(step, first_pair, pair_nodes, chunk) };
+        return;
+    }
+    let _ = avx2;
+    bend_pairs(step, first_pair, pair_nodes, chunk);
 }
 
 #[inline(always)]

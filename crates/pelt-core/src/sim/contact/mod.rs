@@ -27,7 +27,10 @@
 //! - Cost: a batch's eight strands are screened at once first (`screen`): only those with a
 //!   node near a skin plane or a collider, with skin triangles, or held, are solved. Within a
 //!   strand, a node a clearance away from everything leaves the nodes within that distance
-//!   untested (a node moves at most a segment's length from the one before).
+//!   untested (a node moves at most a segment's length from the one before), and a node's
+//!   distance to the skin's triangles is bounded by the last one it measured less how far it
+//!   moved since (`SurfaceMemory`; above the planes, where that distance has no jump). Contact
+//!   runs in the bend's parallel tasks, on each batch while it is in cache.
 //! - No fling: a collider grows in over [`Collider::appear_secs`] after it appears (or jumps
 //!   faster than the sweep), so fur it appears in is pushed out over a few steps.
 //!
@@ -41,11 +44,11 @@ pub mod skin;
 pub mod surface;
 
 use glam::{Quat, Vec3, Vec4};
-use rayon::prelude::*;
 
 pub use collider::{Collider, ColliderKey, ColliderMesh, SWEEP_RADII_PER_STEP, Shape, StepCollider};
 pub use grasp::{Grasp, GraspParams, HAND_PARTS};
 pub use skin::{SKIN_PLANES, skin_planes};
+pub(crate) use surface::SurfaceMemory;
 pub use surface::{SURFACE_WORDS, SkinSurface, skin_surface};
 
 pub(crate) use screen::{BatchPlanes, skin_lanes};
@@ -109,6 +112,8 @@ pub(crate) struct Resolve<'a> {
     pub strands: ContactStrands<'a>,
     /// The skin planes batch by batch (see [`skin_lanes`]).
     pub skin_lanes: &'a [BatchPlanes],
+    /// What the skin triangles' strands last measured (read only while screening).
+    pub surface_memory: &'a SurfaceMemory,
     /// Which instructions the screen runs with.
     pub kernel: CpuKernel,
     /// Whether to screen (else every strand within reach of anything is solved).
@@ -133,16 +138,8 @@ const FRICTION_DEPTH: f32 = 0.25;
 const SIDE_BIAS: f32 = 0.01;
 
 impl Resolve<'_> {
-    /// Applies contact to every strand of `nodes` (batch-major, `L + 1` nodes per batch).
-    pub fn apply(&self, nodes: &mut [VecLanes]) {
-        if !self.step.is_active() {
-            return;
-        }
-        let count = self.layers + 1;
-        nodes.par_chunks_mut(count).enumerate().with_min_len(8).for_each(|(b, batch)| self.batch(b, batch));
-    }
-
-    fn batch(&self, b: usize, batch: &mut [VecLanes]) {
+    /// Applies contact to batch `b`'s nodes (`L + 1` of them, as the bend left them).
+    pub fn batch(&self, b: usize, batch: &mut [VecLanes]) {
         let lanes = LANES.min(self.vertex_count - b * LANES);
         // A collider can reach a strand when its bound comes within the strand's length of the
         // root (every node, moved or not, lies within that); the GPU kernel tests the same.
@@ -231,6 +228,7 @@ impl Resolve<'_> {
             rest_root: self.strands.rest_roots.get(j).copied().unwrap_or(root),
             on: self.step.skin && !self.strands.surface.strand(j).is_empty(),
             triangles: self.strands.surface,
+            memory: self.screen.then_some(self.surface_memory),
         };
         let colliders = near.iter();
         let clearance = |x: Vec3| clearance(x, root, planes, &surface, colliders.clone());
@@ -246,7 +244,13 @@ impl Resolve<'_> {
             if budget > 0.0 {
                 continue;
             }
-            budget = clearance(nodes[k + 1]);
+            let x = nodes[k + 1];
+            budget = surface.clearance(
+                k,
+                x,
+                cheap_clearance(x, root, planes, colliders.clone()),
+                self.rest.length(b, lane, k),
+            );
             touches = budget < 0.0;
         }
         if !touches {
@@ -381,15 +385,26 @@ fn clearance<'c>(
     surface: &Surface<'_>,
     colliders: impl Iterator<Item = &'c &'c StepCollider>,
 ) -> f32 {
+    let least = cheap_clearance(x, root, planes, colliders);
+    match surface.closest(x) {
+        Some((_, _, d)) => least.min(d),
+        None => least,
+    }
+}
+
+/// [`clearance`] without the skin's triangles.
+fn cheap_clearance<'c>(
+    x: Vec3,
+    root: Vec3,
+    planes: &[(Vec3, f32)],
+    colliders: impl Iterator<Item = &'c &'c StepCollider>,
+) -> f32 {
     let mut least = f32::MAX;
     for &(n, h) in planes {
         least = least.min(n.dot(x - root) + h);
     }
     for c in colliders {
         least = least.min(c.closest(x).2);
-    }
-    if let Some((_, _, d)) = surface.closest(x) {
-        least = least.min(d);
     }
     least
 }
@@ -402,6 +417,8 @@ struct Surface<'a> {
     rest_root: Vec3,
     on: bool,
     triangles: &'a SkinSurface,
+    /// What the strand's nodes last measured, where the screen may use it.
+    memory: Option<&'a SurfaceMemory>,
 }
 
 impl Surface<'_> {
@@ -412,6 +429,28 @@ impl Surface<'_> {
             return None;
         }
         self.triangles.closest_posed(self.j, x, self.root, self.frame, self.rest_root)
+    }
+
+    /// The least of `cheap` (node `k + 1`'s clearance from everything else) and its distance in
+    /// front of the triangles, or a lower bound on that no less than `cheap` or `length` where
+    /// the memory gives one (so no touch is missed and little budget lost).
+    fn clearance(&self, k: usize, x: Vec3, cheap: f32, length: f32) -> f32 {
+        if !self.on {
+            return cheap;
+        }
+        let local = self.rest_root + self.frame.conjugate() * (x - self.root);
+        if let Some(memory) = self.memory {
+            let bound = memory.bound(self.j, k, local);
+            if bound >= cheap.min(length) {
+                return cheap.min(bound);
+            }
+        }
+        let Some((_, _, d)) = self.triangles.closest(self.j, local) else { return cheap };
+        // Below a plane (cheap < 0) the triangles' signed distance can jump: not remembered.
+        if let Some(memory) = self.memory.filter(|_| cheap >= 0.0) {
+            memory.remember(self.j, k, local, d);
+        }
+        cheap.min(d)
     }
 }
 

@@ -88,10 +88,11 @@ impl BoundShape {
 /// collider of `near` or the grip: the ones contact solves.
 ///
 /// Every node is tested, but not every node is evaluated: a node lies a segment's length from
-/// the one before, and planes and balls are 1-Lipschitz, so a lane whose last evaluated node
-/// cleared everything by `c` cannot touch within the next `c` of its length (the per-strand
-/// solve skips nodes the same way). A node is evaluated, for all eight lanes at once, when some
-/// lane's budget runs out.
+/// the one before, and planes and collider distances are 1-Lipschitz, so a lane whose last
+/// evaluated node cleared the planes (or a collider) by `c` cannot touch them within the next
+/// `c` of its length (the per-strand solve skips nodes the same way). The planes and each
+/// collider keep their own budgets; a node is evaluated against one, for all eight lanes at
+/// once, when some lane's budget for it runs out.
 #[inline(always)]
 pub(crate) fn lanes_to_solve(
     batch: &Batch<'_>,
@@ -153,13 +154,32 @@ pub(crate) fn lanes_to_solve(
     if planes.is_empty() && bounds.is_empty() {
         return solve;
     }
+    // The planes and each collider keep their own budgets: a collider far from the batch is
+    // evaluated once or twice, however often the planes near the roots are.
+    if !planes.is_empty() {
+        solve |= touching(batch, solve, &tolerance, |node| plane_clearance(node, &root, planes));
+    }
+    for bound in &bounds {
+        if solve == all {
+            break;
+        }
+        solve |= touching(batch, solve, &tolerance, |node| bound_clearance(node, bound));
+    }
+    solve & all
+}
+
+/// The lanes of `batch` not in `solve` with a node whose `clear`ance (1-Lipschitz in the node,
+/// per lane) falls below their `tolerance`. A node is evaluated, for all eight lanes at once,
+/// when some lane's budget runs out.
+#[inline(always)]
+fn touching(batch: &Batch<'_>, solve: u32, tolerance: &Lanes, clear: impl Fn(&VecLanes) -> Lanes) -> u32 {
     // Lanes already solved, and lanes past the batch's strands, never ask for an evaluation.
     let mut budget: Lanes =
         std::array::from_fn(|lane| if lane >= batch.lanes || solve & (1 << lane) != 0 { f32::INFINITY } else { -1.0 });
     let mut lowest = [f32::INFINITY; LANES];
     for (node, lengths) in batch.nodes[1..].iter().zip(batch.lengths) {
         if budget.iter().any(|b| *b < 0.0) {
-            let clear = clearance(node, &root, planes, &bounds);
+            let clear = clear(node);
             for lane in 0..LANES {
                 let c = clear[lane] - tolerance[lane];
                 lowest[lane] = if c < lowest[lane] { c } else { lowest[lane] };
@@ -171,12 +191,13 @@ pub(crate) fn lanes_to_solve(
             budget[lane] -= lengths[lane] * SKIP_SLACK;
         }
     }
+    let mut touch = 0;
     for lane in 0..batch.lanes {
         if lowest[lane] < 0.0 {
-            solve |= 1 << lane;
+            touch |= 1 << lane;
         }
     }
-    solve & all
+    touch
 }
 
 /// A batch's skin planes, lane by lane, as [`skin_lanes`] stores them.
@@ -237,10 +258,9 @@ fn posed_planes(
     skin.count
 }
 
-/// Per lane, the least of the node's heights above its skin planes and its distances outside
-/// the bounds (each 1-Lipschitz in the node).
+/// Per lane, the least of the node's heights above its skin planes (1-Lipschitz in the node).
 #[inline(always)]
-fn clearance(node: &VecLanes, root: &VecLanes, planes: &[[Lanes; 4]], bounds: &[Bound]) -> Lanes {
+fn plane_clearance(node: &VecLanes, root: &VecLanes, planes: &[[Lanes; 4]]) -> Lanes {
     let mut least = [f32::INFINITY; LANES];
     let mut d = [[0.0; LANES]; 3];
     for lane in 0..LANES {
@@ -257,49 +277,53 @@ fn clearance(node: &VecLanes, root: &VecLanes, planes: &[[Lanes; 4]], bounds: &[
             least[lane] = if h < least[lane] { h } else { least[lane] };
         }
     }
-    for bound in bounds {
-        let [cx, cy, cz] = bound.centre;
-        let mut gap = [0.0; LANES];
-        match bound.shape {
-            BoundShape::Ball { radius } => {
-                for lane in 0..LANES {
-                    let (x, y, z) = (node[0][lane] - cx, node[1][lane] - cy, node[2][lane] - cz);
-                    gap[lane] = (x * x + y * y + z * z).sqrt() - radius;
-                }
-            }
-            BoundShape::Capsule { axis: [ax, ay, az], half_length, radius } => {
-                for lane in 0..LANES {
-                    let (x, y, z) = (node[0][lane] - cx, node[1][lane] - cy, node[2][lane] - cz);
-                    let t = (ax * x + ay * y + az * z).max(-half_length).min(half_length);
-                    let (x, y, z) = (x - ax * t, y - ay * t, z - az * t);
-                    gap[lane] = (x * x + y * y + z * z).sqrt() - radius;
-                }
-            }
-            BoundShape::Box { axes, half_extents } => {
-                for lane in 0..LANES {
-                    let (x, y, z) = (node[0][lane] - cx, node[1][lane] - cy, node[2][lane] - cz);
-                    let (mut outside, mut inside) = (0.0_f32, f32::NEG_INFINITY);
-                    for (axis, half) in axes.iter().zip(half_extents) {
-                        let q = (axis[0] * x + axis[1] * y + axis[2] * z).abs() - half;
-                        let out = q.max(0.0);
-                        outside += out * out;
-                        inside = inside.max(q);
-                    }
-                    gap[lane] = outside.sqrt() + inside.min(0.0);
-                }
-            }
-            BoundShape::Plane { normal: [nx, ny, nz] } => {
-                for lane in 0..LANES {
-                    gap[lane] = nx * (node[0][lane] - cx) + ny * (node[1][lane] - cy) + nz * (node[2][lane] - cz);
-                }
+    least
+}
+
+/// Per lane, the node's distance outside `bound` (1-Lipschitz in the node), infinite for lanes
+/// that cannot reach it.
+#[inline(always)]
+fn bound_clearance(node: &VecLanes, bound: &Bound) -> Lanes {
+    let [cx, cy, cz] = bound.centre;
+    let mut gap = [0.0; LANES];
+    match bound.shape {
+        BoundShape::Ball { radius } => {
+            for lane in 0..LANES {
+                let (x, y, z) = (node[0][lane] - cx, node[1][lane] - cy, node[2][lane] - cz);
+                gap[lane] = (x * x + y * y + z * z).sqrt() - radius;
             }
         }
-        for lane in 0..LANES {
-            let g = gap[lane] + bound.away[lane];
-            least[lane] = if g < least[lane] { g } else { least[lane] };
+        BoundShape::Capsule { axis: [ax, ay, az], half_length, radius } => {
+            for lane in 0..LANES {
+                let (x, y, z) = (node[0][lane] - cx, node[1][lane] - cy, node[2][lane] - cz);
+                let t = (ax * x + ay * y + az * z).max(-half_length).min(half_length);
+                let (x, y, z) = (x - ax * t, y - ay * t, z - az * t);
+                gap[lane] = (x * x + y * y + z * z).sqrt() - radius;
+            }
+        }
+        BoundShape::Box { axes, half_extents } => {
+            for lane in 0..LANES {
+                let (x, y, z) = (node[0][lane] - cx, node[1][lane] - cy, node[2][lane] - cz);
+                let (mut outside, mut inside) = (0.0_f32, f32::NEG_INFINITY);
+                for (axis, half) in axes.iter().zip(half_extents) {
+                    let q = (axis[0] * x + axis[1] * y + axis[2] * z).abs() - half;
+                    let out = q.max(0.0);
+                    outside += out * out;
+                    inside = inside.max(q);
+                }
+                gap[lane] = outside.sqrt() + inside.min(0.0);
+            }
+        }
+        BoundShape::Plane { normal: [nx, ny, nz] } => {
+            for lane in 0..LANES {
+                gap[lane] = nx * (node[0][lane] - cx) + ny * (node[1][lane] - cy) + nz * (node[2][lane] - cz);
+            }
         }
     }
-    least
+    for lane in 0..LANES {
+        gap[lane] += bound.away[lane];
+    }
+    gap
 }
 
 /// `v` turned by the unit quaternions `q` (`xyzw`), lane by lane: `v + w t + q x t` with
