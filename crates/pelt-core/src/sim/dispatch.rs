@@ -13,7 +13,7 @@ use rayon::prelude::*;
 use glam::{Quat, Vec3};
 
 use super::contact::screen::{self, Batch, BatchPlanes};
-use super::contact::{ContactStrands, Resolve, StepCollider};
+use super::contact::{Resolve, StepCollider};
 use super::kernel::{Step, VecLanes};
 
 /// Which instructions the CPU bend uses ([`Simulation::set_cpu_kernel`](super::Simulation::set_cpu_kernel)).
@@ -114,7 +114,6 @@ fn bend_pairs_avx2(step: &Step<'_>, first_pair: usize, pair_nodes: usize, nodes:
 pub(crate) fn screen(
     kernel: CpuKernel,
     batch: &Batch<'_>,
-    strands: &ContactStrands<'_>,
     skin: Option<&BatchPlanes>,
     roots: &[Vec3],
     frames: &[Quat],
@@ -124,10 +123,10 @@ pub(crate) fn screen(
     if kernel.resolve() == CpuKernel::Avx2Fma && CpuKernel::avx2_fma_available() {
         // SAFETY: `screen_avx2` needs AVX2 and FMA, and the CPU has both (checked on the line
         // above); it is otherwise safe code.
-        return unsafe { screen_avx2(batch, strands, skin, roots, frames, near) };
+        return unsafe { screen_avx2(batch, skin, roots, frames, near) };
     }
     let _ = kernel;
-    screen::lanes_to_solve(batch, strands, skin, roots, frames, near)
+    screen::lanes_to_solve(batch, skin, roots, frames, near)
 }
 
 /// The screen compiled with AVX2 and FMA.
@@ -135,11 +134,10 @@ pub(crate) fn screen(
 #[target_feature(enable = "avx2,fma")]
 fn screen_avx2(
     batch: &Batch<'_>,
-    strands: &ContactStrands<'_>,
     skin: Option<&BatchPlanes>,
     roots: &[Vec3],
     frames: &[Quat],
     near: &[&StepCollider],
 ) -> u32 {
-    screen::lanes_to_solve(batch, strands, skin, roots, frames, near)
+    screen::lanes_to_solve(batch, skin, roots, frames, near)
 }

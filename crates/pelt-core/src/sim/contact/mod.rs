@@ -164,11 +164,20 @@ impl Resolve<'_> {
         let screened =
             screen::Batch { b, lanes, nodes: batch, lengths: self.rest.lengths_of(b), reach: &reach, held: &held };
         let skin = self.step.skin.then(|| &self.skin_lanes[b]);
-        let solve = if self.screen {
-            dispatch::screen(self.kernel, &screened, &self.strands, skin, self.roots, self.frames, &near)
+        let mut solve = if self.screen {
+            dispatch::screen(self.kernel, &screened, skin, self.roots, self.frames, &near)
         } else {
             (1 << lanes) - 1
         };
+        if self.step.skin && self.screen {
+            // The screen cleared these of the planes and colliders: their triangles remain.
+            let cleared = !solve;
+            for lane in (0..lanes).filter(|lane| cleared & (1 << lane) != 0) {
+                if self.touches_triangles(b * LANES + lane, b, lane, batch) {
+                    solve |= 1 << lane;
+                }
+            }
+        }
         if solve == 0 {
             return;
         }
@@ -195,6 +204,37 @@ impl Resolve<'_> {
                 }
             }
         }
+    }
+
+    /// Whether a node of strand `j` (lane `lane` of batch `b`, clear of its planes and the
+    /// colliders) may lie behind its skin triangles.
+    fn touches_triangles(&self, j: usize, b: usize, lane: usize, batch: &[VecLanes]) -> bool {
+        if self.strands.surface.strand(j).is_empty() {
+            return false;
+        }
+        let surface = Surface {
+            j,
+            root: self.roots[j],
+            frame: self.frames[j],
+            rest_root: self.strands.rest_roots.get(j).copied().unwrap_or(self.roots[j]),
+            on: true,
+            triangles: self.strands.surface,
+            memory: Some(self.surface_memory),
+        };
+        let mut budget = 0.0_f32;
+        for k in 0..self.layers {
+            budget -= self.rest.length(b, lane, k) * SKIP_SLACK;
+            if budget > 0.0 {
+                continue;
+            }
+            let node = &batch[k + 1];
+            // Nothing else is within reach (the screen showed it), so only the triangles bound.
+            budget = surface.clearance(k, Vec3::new(node[0][lane], node[1][lane], node[2][lane]), f32::MAX);
+            if budget < 0.0 {
+                return true;
+            }
+        }
+        false
     }
 
     /// Solves one strand in place; false when nothing touched it (left as it was).
@@ -245,12 +285,7 @@ impl Resolve<'_> {
                 continue;
             }
             let x = nodes[k + 1];
-            budget = surface.clearance(
-                k,
-                x,
-                cheap_clearance(x, root, planes, colliders.clone()),
-                self.rest.length(b, lane, k),
-            );
+            budget = surface.clearance(k, x, cheap_clearance(x, root, planes, colliders.clone()));
             touches = budget < 0.0;
         }
         if !touches {
@@ -432,16 +467,16 @@ impl Surface<'_> {
     }
 
     /// The least of `cheap` (node `k + 1`'s clearance from everything else) and its distance in
-    /// front of the triangles, or a lower bound on that no less than `cheap` or `length` where
-    /// the memory gives one (so no touch is missed and little budget lost).
-    fn clearance(&self, k: usize, x: Vec3, cheap: f32, length: f32) -> f32 {
+    /// front of the triangles, or a lower bound on that where the memory shows the node in front
+    /// (or `cheap` the lesser anyway): no touch is missed, a little skipping may be.
+    fn clearance(&self, k: usize, x: Vec3, cheap: f32) -> f32 {
         if !self.on {
             return cheap;
         }
         let local = self.rest_root + self.frame.conjugate() * (x - self.root);
         if let Some(memory) = self.memory {
             let bound = memory.bound(self.j, k, local);
-            if bound >= cheap.min(length) {
+            if bound >= 0.0 || bound >= cheap {
                 return cheap.min(bound);
             }
         }

@@ -8,14 +8,15 @@
 //! A lane that clears everything by [`SCREEN_MARGIN`] of a segment is left as the bend made it,
 //! which is what the solve would do with it (it only changes a strand with a node below a plane
 //! or inside a collider); every other lane is solved as before, so the screen changes no byte of
-//! the result, only the time. Strands with skin triangles or held by the grasp are always solved.
+//! the result, only the time. Strands held by the grasp are always solved; of those the screen
+//! leaves, strands with skin triangles are still tested against them, one by one.
 
 // Index loops over the batch's lanes are the form LLVM turns into one vector instruction.
 #![allow(clippy::needless_range_loop)]
 
 use glam::Vec3;
 
-use super::{ContactStrands, SKIN_PLANES, StepCollider};
+use super::{SKIN_PLANES, StepCollider};
 use crate::sim::kernel::{LANES, Lanes, VecLanes};
 
 /// How far (in segments of the strand's mean length) a node must clear a plane or a collider's
@@ -84,8 +85,9 @@ impl BoundShape {
     }
 }
 
-/// The lanes (bit `lane`) of `batch` that may touch the skin planes, a skin triangle, a
-/// collider of `near` or the grip: the ones contact solves.
+/// The lanes (bit `lane`) of `batch` that may touch the skin planes, a collider of `near` or
+/// the grip: the ones contact solves. (Of the others, the solve still tests those with skin
+/// triangles against them.)
 ///
 /// Every node is tested, but not every node is evaluated: a node lies a segment's length from
 /// the one before, and planes and collider distances are 1-Lipschitz, so a lane whose last
@@ -96,7 +98,6 @@ impl BoundShape {
 #[inline(always)]
 pub(crate) fn lanes_to_solve(
     batch: &Batch<'_>,
-    strands: &ContactStrands<'_>,
     skin: Option<&BatchPlanes>,
     roots: &[Vec3],
     frames: &[glam::Quat],
@@ -106,9 +107,7 @@ pub(crate) fn lanes_to_solve(
     let all = (1_u32 << batch.lanes) - 1;
     let mut solve = 0_u32;
     for lane in 0..batch.lanes {
-        let j = first + lane;
-        let triangles = skin.is_some() && !strands.surface.strand(j).is_empty();
-        if triangles || batch.held[lane] != 0.0 {
+        if batch.held[lane] != 0.0 {
             solve |= 1 << lane;
         }
     }
@@ -459,6 +458,98 @@ mod tests {
         // Contact moved many nodes, so the comparison means something.
         assert!(touched > 100, "contact moved only {touched} nodes");
         eprintln!("contact moved up to {touched} nodes");
+    }
+
+    /// Strands the screen clears of their planes and the colliders are still tested against their
+    /// skin triangles: on the bunny, each strand with triangles that has a spot above its planes
+    /// but behind its triangles (where its planes' intersection reaches below the skin: creases,
+    /// the ears' bases) is bent to it. The screened solve gives the unscreened one's bits, and moves those strands in
+    /// front of their triangles (failed with the screen's strands left untested against them).
+    #[test]
+    fn strands_clear_of_their_planes_still_meet_their_triangles() {
+        use crate::sim::contact::{ContactStep, ContactStrands, Resolve, SurfaceMemory, skin_planes, skin_surface};
+        use crate::sim::kernel::RestBatches;
+        let (mesh, _) = Builtin::Bunny.mesh();
+        let length = 0.08 * mesh.bounding_sphere().1;
+        let fur = FurStructure::new(
+            mesh,
+            &FurParams { layers: 8, length: FurLength::Constant(length), direction: GrowthDirection::default() },
+        )
+        .expect("fur");
+        let (v, layers) = (fur.vertex_count(), fur.layers as usize);
+        let planes = skin_planes(&fur);
+        let surface = skin_surface(&fur, &planes);
+        let mut state = 3_u32;
+        let mut next = move || {
+            state = state.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
+            (state >> 8) as f32 / (1 << 24) as f32 * 2.0 - 1.0
+        };
+        // Every strand's nodes at rest (batch-major), then the chosen strands' bent to their spot.
+        let mut nodes = vec![[[0.0_f32; LANES]; 3]; v.div_ceil(LANES) * (layers + 1)];
+        let mut put = |j: usize, k: usize, x: Vec3| {
+            for c in 0..3 {
+                nodes[(j / LANES) * (layers + 1) + k][c][j % LANES] = x[c];
+            }
+        };
+        for j in 0..v {
+            for k in 0..=layers {
+                put(j, k, fur.positions[k * v + j]);
+            }
+        }
+        let mut bent = Vec::new();
+        for j in (0..v).filter(|&j| !surface.strand(j).is_empty()) {
+            let root = fur.positions[j];
+            let spot = (0..20000).map(|_| root + Vec3::new(next(), next(), next()) * length).find(|&x| {
+                x.distance(root) < 0.9 * length
+                    && planes[j].iter().all(|p| p.truncate().dot(x - root) + p.w > 0.001 * length)
+                    && surface.closest(j, x).is_some_and(|(_, _, s)| s < -0.01 * length)
+            });
+            if let Some(spot) = spot {
+                for k in 1..=layers {
+                    put(j, k, spot);
+                }
+                bent.push(j);
+            }
+        }
+        assert!(bent.len() >= 5, "only {} strands have a spot above their planes behind their triangles", bent.len());
+        let rest = RestBatches::new(&fur.positions, v, layers);
+        let lanes = skin_lanes(&planes);
+        let memory = SurfaceMemory::new(&surface, layers);
+        let step = ContactStep { skin: true, ..ContactStep::default() };
+        let roots = &fur.positions[..v];
+        let frames = vec![Quat::IDENTITY; v];
+        let solved = |screen: bool| {
+            let resolve = Resolve {
+                step: &step,
+                strands: ContactStrands { skin: &planes, grasp_weights: &[], surface: &surface, rest_roots: roots },
+                skin_lanes: &lanes,
+                surface_memory: &memory,
+                kernel: CpuKernel::Auto,
+                screen,
+                roots,
+                frames: &frames,
+                rest: &rest,
+                layers,
+                vertex_count: v,
+            };
+            let mut out = nodes.clone();
+            for (b, batch) in out.chunks_mut(layers + 1).enumerate() {
+                resolve.batch(b, batch);
+            }
+            out
+        };
+        let (screened, unscreened) = (solved(true), solved(false));
+        let bits = |n: &[VecLanes]| n.iter().flatten().flatten().map(|x| x.to_bits()).collect::<Vec<_>>();
+        assert!(bits(&screened) == bits(&unscreened), "the screen changed a node");
+        for &j in &bent {
+            for k in 1..=layers {
+                let node = screened[(j / LANES) * (layers + 1) + k];
+                let x = Vec3::new(node[0][j % LANES], node[1][j % LANES], node[2][j % LANES]);
+                let (_, _, s) = surface.closest(j, x).expect("triangles");
+                assert!(s >= -1e-4 * length, "strand {j} node {k}: {s} behind its triangles");
+            }
+        }
+        eprintln!("{} strands bent behind their triangles", bent.len());
     }
 
     /// The lane rotation turns vectors as glam's quaternions do.
