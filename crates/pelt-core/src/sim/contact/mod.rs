@@ -271,7 +271,6 @@ impl Resolve<'_> {
             memory: self.screen.then_some(self.surface_memory),
         };
         let colliders = near.iter();
-        let clearance = |x: Vec3| clearance(x, root, planes, &surface, colliders.clone());
         // A node is at most a segment's length nearer anything than the node before, so after
         // one `clearance` away the nodes within it need no test.
         let mut touches = held != 0.0;
@@ -326,13 +325,19 @@ impl Resolve<'_> {
             // Where the start is clear by more than the segment, no end can touch anything.
             let step = length * SKIP_SLACK;
             if budget <= step {
-                budget = clearance(p);
+                let cheap = cheap_clearance(p, root, planes, colliders.clone());
+                budget = match k.checked_sub(1) {
+                    Some(node) => surface.clearance(node, p, cheap),
+                    // The root lies on its skin: no nearer than 0 to its triangles.
+                    None if surface.on => cheap.min(0.0),
+                    None => cheap,
+                };
             }
             budget -= step;
             let u = if budget > 0.0 {
                 u
             } else {
-                self.constrain(p, u, length, root, planes, &surface, hint, colliders.clone())
+                self.constrain(k, p, u, length, root, planes, &surface, hint, colliders.clone())
             };
             hint = u + across * 0.5;
             nodes[k + 1] = p + u * length;
@@ -345,6 +350,7 @@ impl Resolve<'_> {
     #[allow(clippy::too_many_arguments)]
     fn constrain<'c>(
         &self,
+        k: usize,
         p: Vec3,
         mut u: Vec3,
         length: f32,
@@ -388,7 +394,10 @@ impl Resolve<'_> {
                     moved = true;
                 }
             }
-            if let Some((s, n, distance)) = surface.closest(p + u * length)
+            let q = p + u * length;
+            let above = planes.iter().all(|&(n, h)| n.dot(q - root) + h >= 0.0);
+            if !(above && surface.surely_in_front(k, q))
+                && let Some((s, n, distance)) = surface.closest(q)
                 && distance < 0.0
             {
                 let mut floor = n.dot(s - p) / length;
@@ -410,24 +419,9 @@ impl Resolve<'_> {
     }
 }
 
-/// How far `x` is from touching anything: the least of its heights above the skin planes, its
-/// distances outside the colliders and in front of the skin's triangles (negative: touching).
-/// Each moves by at most as much as `x` does.
-fn clearance<'c>(
-    x: Vec3,
-    root: Vec3,
-    planes: &[(Vec3, f32)],
-    surface: &Surface<'_>,
-    colliders: impl Iterator<Item = &'c &'c StepCollider>,
-) -> f32 {
-    let least = cheap_clearance(x, root, planes, colliders);
-    match surface.closest(x) {
-        Some((_, _, d)) => least.min(d),
-        None => least,
-    }
-}
-
-/// [`clearance`] without the skin's triangles.
+/// How far `x` is from touching a skin plane or a collider: the least of its heights above the
+/// planes and its distances outside the colliders (negative: touching). Each moves by at most
+/// as much as `x` does; the skin's triangles add theirs through [`Surface::clearance`].
 fn cheap_clearance<'c>(
     x: Vec3,
     root: Vec3,
@@ -464,6 +458,14 @@ impl Surface<'_> {
             return None;
         }
         self.triangles.closest_posed(self.j, x, self.root, self.frame, self.rest_root)
+    }
+
+    /// Whether the memory shows node `k + 1` at `x` (above the planes) in front of the triangles.
+    fn surely_in_front(&self, k: usize, x: Vec3) -> bool {
+        self.on
+            && self.memory.is_some_and(|memory| {
+                memory.bound(self.j, k, self.rest_root + self.frame.conjugate() * (x - self.root)) >= 0.0
+            })
     }
 
     /// The least of `cheap` (node `k + 1`'s clearance from everything else) and its distance in
