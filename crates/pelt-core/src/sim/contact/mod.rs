@@ -24,13 +24,15 @@
 //! - Continuity: the response has no jump the kernels' last-bit differences could flip (see
 //!   `turn_above` and the grip's segment), except where an end lies on the medial axis of a
 //!   concave spot of the skin.
-//! - Cost: a batch's eight strands are screened at once first (`screen`): only those with a
-//!   node near a skin plane or a collider, with skin triangles, or held, are solved. Within a
-//!   strand, a node a clearance away from everything leaves the nodes within that distance
-//!   untested (a node moves at most a segment's length from the one before), and a node's
-//!   distance to the skin's triangles is bounded by the last one it measured less how far it
-//!   moved since (`SurfaceMemory`; above the planes, where that distance has no jump). Contact
-//!   runs in the bend's parallel tasks, on each batch while it is in cache.
+//! - Cost: a batch's eight strands are screened at once first (`screen`) against their skin
+//!   planes and the colliders; those it clears are then tested against their skin triangles,
+//!   if they keep any, and only strands that may touch something, or are held, are solved.
+//!   Within a strand, a node a clearance away from everything leaves the nodes within that
+//!   distance untested (a node moves at most a segment's length from the one before), and a
+//!   node's distance to the skin's triangles is bounded by the last one it measured less how
+//!   far it moved since (`SurfaceMemory`; above the planes, where that distance has no jump), so
+//!   triangles are scanned only for nodes that come near them. Contact runs in the bend's
+//!   parallel tasks, on each batch while it is in cache.
 //! - No fling: a collider grows in over [`Collider::appear_secs`] after it appears (or jumps
 //!   faster than the sweep), so fur it appears in is pushed out over a few steps.
 //!

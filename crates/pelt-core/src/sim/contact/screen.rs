@@ -3,8 +3,8 @@
 //! Nearly every strand touches nothing in a step (on the bunny under wind, fewer than one in a
 //! hundred reaches its skin planes), and the per-strand solve ([`super::Resolve`]) costs most of
 //! its time finding that out. The screen tests every node of the batch's eight strands at once
-//! against their skin planes (posed by each lane's frame) and against the bounding ball of every
-//! collider within reach, in plain lane arithmetic the compiler turns into vector instructions.
+//! against their skin planes (posed by each lane's frame) and against every collider within
+//! reach (its exact distance, or a mesh's bounding ball), in plain lane arithmetic the compiler turns into vector instructions.
 //! A lane that clears everything by [`SCREEN_MARGIN`] of a segment is left as the bend made it,
 //! which is what the solve would do with it (it only changes a strand with a node below a plane
 //! or inside a collider); every other lane is solved as before, so the screen changes no byte of
