@@ -13,7 +13,7 @@ use rayon::prelude::*;
 use glam::{Quat, Vec3};
 
 use super::contact::screen::{self, Batch, BatchPlanes};
-use super::contact::{Resolve, StepCollider};
+use super::contact::{Near, Resolve};
 use super::kernel::{Step, VecLanes};
 
 /// Which instructions the CPU bend uses ([`Simulation::set_cpu_kernel`](super::Simulation::set_cpu_kernel)).
@@ -117,7 +117,7 @@ pub(crate) fn screen(
     skin: Option<&BatchPlanes>,
     roots: &[Vec3],
     frames: &[Quat],
-    near: &[&StepCollider],
+    near: Near<'_>,
 ) -> u32 {
     #[cfg(target_arch = "x86_64")]
     if kernel.resolve() == CpuKernel::Avx2Fma && CpuKernel::avx2_fma_available() {
@@ -132,12 +132,6 @@ pub(crate) fn screen(
 /// The screen compiled with AVX2 and FMA.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2,fma")]
-fn screen_avx2(
-    batch: &Batch<'_>,
-    skin: Option<&BatchPlanes>,
-    roots: &[Vec3],
-    frames: &[Quat],
-    near: &[&StepCollider],
-) -> u32 {
+fn screen_avx2(batch: &Batch<'_>, skin: Option<&BatchPlanes>, roots: &[Vec3], frames: &[Quat], near: Near<'_>) -> u32 {
     screen::lanes_to_solve(batch, skin, roots, frames, near)
 }

@@ -108,6 +108,32 @@ pub struct ContactStrands<'a> {
     pub rest_roots: &'a [Vec3],
 }
 
+/// The colliders of a step near a batch: a bit per collider (a step holds at most
+/// [`MAX_STEP_COLLIDERS`]), so finding them allocates nothing.
+#[derive(Clone, Copy)]
+pub(crate) struct Near<'a> {
+    colliders: &'a [StepCollider],
+    bits: u128,
+}
+
+const _: () = assert!(MAX_STEP_COLLIDERS <= u128::BITS as usize);
+
+impl<'a> Near<'a> {
+    fn within(colliders: &'a [StepCollider], near: impl Fn(&StepCollider) -> bool) -> Self {
+        let bits = colliders
+            .iter()
+            .take(MAX_STEP_COLLIDERS)
+            .enumerate()
+            .fold(0_u128, |bits, (i, c)| if near(c) { bits | (1 << i) } else { bits });
+        Self { colliders, bits }
+    }
+
+    /// The near colliders, in the step's order.
+    pub(crate) fn iter(self) -> impl Iterator<Item = &'a StepCollider> {
+        self.colliders.iter().enumerate().filter(move |(i, _)| self.bits & (1 << i) != 0).map(|(_, c)| c)
+    }
+}
+
 /// Everything the CPU pass reads.
 pub(crate) struct Resolve<'a> {
     pub step: &'a ContactStep,
@@ -150,15 +176,10 @@ impl Resolve<'_> {
         let (lo, hi) =
             roots.iter().fold((Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)), |(l, h), r| (l.min(*r), h.max(*r)));
         let batch_reach = reach[..lanes].iter().copied().fold(0.0, f32::max);
-        let near: Vec<&StepCollider> = self
-            .step
-            .colliders
-            .iter()
-            .filter(|c| {
-                let gap = (lo - c.centre).max(c.centre - hi).max(Vec3::ZERO);
-                gap.length() <= c.bound + batch_reach
-            })
-            .collect();
+        let near = Near::within(&self.step.colliders, |c| {
+            let gap = (lo - c.centre).max(c.centre - hi).max(Vec3::ZERO);
+            gap.length() <= c.bound + batch_reach
+        });
         let held: [f32; LANES] = std::array::from_fn(|lane| {
             let weight = self.strands.grasp_weights.get(b * LANES + lane).copied().unwrap_or(0.0);
             if lane < lanes { weight * self.step.grip_presence } else { 0.0 }
@@ -167,7 +188,7 @@ impl Resolve<'_> {
             screen::Batch { b, lanes, nodes: batch, lengths: self.rest.lengths_of(b), reach: &reach, held: &held };
         let skin = self.step.skin.then(|| &self.skin_lanes[b]);
         let mut solve = if self.screen {
-            dispatch::screen(self.kernel, &screened, skin, self.roots, self.frames, &near)
+            dispatch::screen(self.kernel, &screened, skin, self.roots, self.frames, near)
         } else {
             (1 << lanes) - 1
         };
@@ -184,13 +205,13 @@ impl Resolve<'_> {
             return;
         }
         let mut strand = Vec::with_capacity(batch.len());
-        let mut reaching = Vec::with_capacity(near.len());
+        let mut reaching = Vec::new();
         for lane in (0..lanes).filter(|lane| solve & (1 << lane) != 0) {
             let j = b * LANES + lane;
             let held = held[lane];
             reaching.clear();
             // Strands the grasp holds pass through its hand.
-            reaching.extend(near.iter().copied().filter(|c| {
+            reaching.extend(near.iter().filter(|c| {
                 !(c.grasp_hand && held != 0.0) && self.roots[j].distance(c.centre) <= c.bound + reach[lane]
             }));
             if !self.step.skin && reaching.is_empty() && held == 0.0 {

@@ -16,7 +16,7 @@
 
 use glam::Vec3;
 
-use super::{SKIN_PLANES, StepCollider};
+use super::{Near, SKIN_PLANES, StepCollider};
 use crate::sim::kernel::{LANES, Lanes, VecLanes};
 
 /// How far (in segments of the strand's mean length) a node must clear a plane or a collider's
@@ -101,7 +101,7 @@ pub(crate) fn lanes_to_solve(
     skin: Option<&BatchPlanes>,
     roots: &[Vec3],
     frames: &[glam::Quat],
-    near: &[&StepCollider],
+    near: Near<'_>,
 ) -> u32 {
     let first = batch.b * LANES;
     let all = (1_u32 << batch.lanes) - 1;
@@ -130,8 +130,15 @@ pub(crate) fn lanes_to_solve(
         None => 0,
     };
     let planes = &planes[..count];
-    let mut bounds: Vec<Bound> = Vec::with_capacity(near.len());
-    for c in near {
+    // The planes and each collider keep their own budgets: a collider far from the batch is
+    // evaluated once or twice, however often the planes near the roots are.
+    if !planes.is_empty() {
+        solve |= touching(batch, solve, &tolerance, |node| plane_clearance(node, &root, planes));
+    }
+    for c in near.iter() {
+        if solve == all {
+            break;
+        }
         let away: Lanes = std::array::from_fn(|lane| {
             let reaches = lane < batch.lanes && roots[first + lane].distance(c.centre) <= c.bound + batch.reach[lane];
             if reaches { 0.0 } else { f32::INFINITY }
@@ -140,7 +147,10 @@ pub(crate) fn lanes_to_solve(
             continue;
         }
         match BoundShape::of(c) {
-            Some(shape) => bounds.push(Bound { centre: c.centre.to_array(), shape, away }),
+            Some(shape) => {
+                let bound = Bound { centre: c.centre.to_array(), shape, away };
+                solve |= touching(batch, solve, &tolerance, |node| bound_clearance(node, &bound));
+            }
             None => {
                 for lane in 0..batch.lanes {
                     if away[lane] == 0.0 {
@@ -149,20 +159,6 @@ pub(crate) fn lanes_to_solve(
                 }
             }
         }
-    }
-    if planes.is_empty() && bounds.is_empty() {
-        return solve;
-    }
-    // The planes and each collider keep their own budgets: a collider far from the batch is
-    // evaluated once or twice, however often the planes near the roots are.
-    if !planes.is_empty() {
-        solve |= touching(batch, solve, &tolerance, |node| plane_clearance(node, &root, planes));
-    }
-    for bound in &bounds {
-        if solve == all {
-            break;
-        }
-        solve |= touching(batch, solve, &tolerance, |node| bound_clearance(node, bound));
     }
     solve & all
 }
