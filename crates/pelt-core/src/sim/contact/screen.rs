@@ -133,7 +133,7 @@ pub(crate) fn lanes_to_solve(
     // The planes and each collider keep their own budgets: a collider far from the batch is
     // evaluated once or twice, however often the planes near the roots are.
     if !planes.is_empty() {
-        solve |= touching(batch, solve, &tolerance, |node| plane_clearance(node, &root, planes));
+        solve |= touching(batch, solve, &tolerance, &Planes { root: &root, planes });
     }
     for c in near.iter() {
         if solve == all {
@@ -149,7 +149,7 @@ pub(crate) fn lanes_to_solve(
         match BoundShape::of(c) {
             Some(shape) => {
                 let bound = Bound { centre: c.centre.to_array(), shape, away };
-                solve |= touching(batch, solve, &tolerance, |node| bound_clearance(node, &bound));
+                solve |= touching(batch, solve, &tolerance, &bound);
             }
             None => {
                 for lane in 0..batch.lanes {
@@ -167,14 +167,15 @@ pub(crate) fn lanes_to_solve(
 /// per lane) falls below their `tolerance`. A node is evaluated, for all eight lanes at once,
 /// when some lane's budget runs out.
 #[inline(always)]
-fn touching(batch: &Batch<'_>, solve: u32, tolerance: &Lanes, clear: impl Fn(&VecLanes) -> Lanes) -> u32 {
+fn touching(batch: &Batch<'_>, solve: u32, tolerance: &Lanes, clear: &impl Clearance) -> u32 {
     // Lanes already solved, and lanes past the batch's strands, never ask for an evaluation.
     let mut budget: Lanes =
         std::array::from_fn(|lane| if lane >= batch.lanes || solve & (1 << lane) != 0 { f32::INFINITY } else { -1.0 });
     let mut lowest = [f32::INFINITY; LANES];
-    for (node, lengths) in batch.nodes[1..].iter().zip(batch.lengths) {
+    let nodes = &batch.nodes[1..];
+    for (i, node) in nodes.iter().enumerate() {
         if budget.iter().any(|b| *b < 0.0) {
-            let clear = clear(node);
+            let clear = clear.at(node);
             for lane in 0..LANES {
                 let c = clear[lane] - tolerance[lane];
                 lowest[lane] = if c < lowest[lane] { c } else { lowest[lane] };
@@ -182,8 +183,11 @@ fn touching(batch: &Batch<'_>, solve: u32, tolerance: &Lanes, clear: impl Fn(&Ve
                 budget[lane] = if c < 0.0 || budget[lane] == f32::INFINITY { f32::INFINITY } else { c };
             }
         }
-        for lane in 0..LANES {
-            budget[lane] -= lengths[lane] * SKIP_SLACK;
+        // The next node lies one segment (the next one) further on.
+        if let Some(lengths) = batch.lengths.get(i + 1) {
+            for lane in 0..LANES {
+                budget[lane] -= lengths[lane] * SKIP_SLACK;
+            }
         }
     }
     let mut touch = 0;
@@ -193,6 +197,31 @@ fn touching(batch: &Batch<'_>, solve: u32, tolerance: &Lanes, clear: impl Fn(&Ve
         }
     }
     touch
+}
+
+/// A clearance the screen evaluates for eight nodes at once (1-Lipschitz in the node, per lane).
+trait Clearance {
+    fn at(&self, node: &VecLanes) -> Lanes;
+}
+
+/// The skin planes (posed) about the roots.
+struct Planes<'a> {
+    root: &'a VecLanes,
+    planes: &'a [[Lanes; 4]],
+}
+
+impl Clearance for Planes<'_> {
+    #[inline(always)]
+    fn at(&self, node: &VecLanes) -> Lanes {
+        plane_clearance(node, self.root, self.planes)
+    }
+}
+
+impl Clearance for Bound {
+    #[inline(always)]
+    fn at(&self, node: &VecLanes) -> Lanes {
+        bound_clearance(node, self)
+    }
 }
 
 /// A batch's skin planes, lane by lane, as [`skin_lanes`] stores them.
