@@ -172,6 +172,9 @@ fn touching(batch: &Batch<'_>, solve: u32, tolerance: &Lanes, clear: &impl Clear
     let mut budget: Lanes =
         std::array::from_fn(|lane| if lane >= batch.lanes || solve & (1 << lane) != 0 { f32::INFINITY } else { -1.0 });
     let mut lowest = [f32::INFINITY; LANES];
+    // How much of each lane's strand lies beyond the node, with the slack the budgets take off.
+    let first = batch.lengths.first().copied().unwrap_or([0.0; LANES]);
+    let mut beyond: Lanes = std::array::from_fn(|lane| (batch.reach[lane] - first[lane]) * SKIP_SLACK);
     let nodes = &batch.nodes[1..];
     for (i, node) in nodes.iter().enumerate() {
         if budget.iter().any(|b| *b < 0.0) {
@@ -182,11 +185,16 @@ fn touching(batch: &Batch<'_>, solve: u32, tolerance: &Lanes, clear: &impl Clear
                 // A lane that touches needs no more evaluations: it is solved whatever follows.
                 budget[lane] = if c < 0.0 || budget[lane] == f32::INFINITY { f32::INFINITY } else { c };
             }
+            // Every lane clear of the rest of its strand: nothing further can touch.
+            if (0..LANES).all(|lane| budget[lane] > beyond[lane]) {
+                break;
+            }
         }
         // The next node lies one segment (the next one) further on.
         if let Some(lengths) = batch.lengths.get(i + 1) {
             for lane in 0..LANES {
                 budget[lane] -= lengths[lane] * SKIP_SLACK;
+                beyond[lane] -= lengths[lane] * SKIP_SLACK;
             }
         }
     }
