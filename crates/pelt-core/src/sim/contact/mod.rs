@@ -296,21 +296,23 @@ impl Resolve<'_> {
         let colliders = near.iter();
         // A node is at most a segment's length nearer anything than the node before, so after
         // one `clearance` away the nodes within it need no test.
-        let mut touches = held != 0.0;
+        // The first segment whose end may touch: the ends before it are clear, so the walk
+        // below keeps their directions without testing them.
+        let mut first_touch = if held == 0.0 { self.layers } else { 0 };
         let mut budget = 0.0_f32;
-        for k in 0..self.layers {
-            if touches {
-                break;
-            }
+        for k in 0..first_touch {
             budget -= self.rest.length(b, lane, k) * SKIP_SLACK;
             if budget > 0.0 {
                 continue;
             }
             let x = nodes[k + 1];
             budget = surface.clearance(k, x, cheap_clearance(x, root, planes, colliders.clone()));
-            touches = budget < 0.0;
+            if budget < 0.0 {
+                first_touch = k;
+                break;
+            }
         }
-        if !touches {
+        if first_touch == self.layers {
             return false;
         }
         let mut budget = 0.0_f32;
@@ -347,6 +349,11 @@ impl Resolve<'_> {
             arc += length;
             // Where the start is clear by more than the segment, no end can touch anything.
             let step = length * SKIP_SLACK;
+            if k < first_touch {
+                hint = u + across * 0.5;
+                nodes[k + 1] = p + u * length;
+                continue;
+            }
             if budget <= step {
                 let cheap = cheap_clearance(p, root, planes, colliders.clone());
                 budget = match k.checked_sub(1) {
