@@ -229,21 +229,26 @@ impl Resolve<'_> {
         }
     }
 
+    /// Strand `j`'s skin triangles, posed, with the memory where the screen is on.
+    fn surface(&self, j: usize) -> Surface<'_> {
+        Surface {
+            j,
+            root: self.roots[j],
+            frame: self.frames[j],
+            rest_root: self.strands.rest_roots.get(j).copied().unwrap_or(self.roots[j]),
+            on: self.step.skin && !self.strands.surface.strand(j).is_empty(),
+            triangles: self.strands.surface,
+            memory: self.screen.then_some(self.surface_memory),
+        }
+    }
+
     /// Whether a node of strand `j` (lane `lane` of batch `b`, clear of its planes and the
     /// colliders) may lie behind its skin triangles.
     fn touches_triangles(&self, j: usize, b: usize, lane: usize, batch: &[VecLanes]) -> bool {
         if self.strands.surface.strand(j).is_empty() {
             return false;
         }
-        let surface = Surface {
-            j,
-            root: self.roots[j],
-            frame: self.frames[j],
-            rest_root: self.strands.rest_roots.get(j).copied().unwrap_or(self.roots[j]),
-            on: true,
-            triangles: self.strands.surface,
-            memory: Some(self.surface_memory),
-        };
+        let surface = self.surface(j);
         let mut budget = 0.0_f32;
         for k in 0..self.layers {
             budget -= self.rest.length(b, lane, k) * SKIP_SLACK;
@@ -284,15 +289,7 @@ impl Resolve<'_> {
             }
         }
         let planes = &planes[..plane_count];
-        let surface = Surface {
-            j,
-            root,
-            frame,
-            rest_root: self.strands.rest_roots.get(j).copied().unwrap_or(root),
-            on: self.step.skin && !self.strands.surface.strand(j).is_empty(),
-            triangles: self.strands.surface,
-            memory: self.screen.then_some(self.surface_memory),
-        };
+        let surface = self.surface(j);
         let colliders = near.iter();
         // A node is at most a segment's length nearer anything than the node before, so after
         // one `clearance` away the nodes within it need no test.
