@@ -369,7 +369,9 @@ fn worst_segment_error(structure: &FurStructure, positions: &[Vec3]) -> f32 {
 /// continuous where it can be (friction ramps in with depth, the grip's segment turns in part, a
 /// turn's side is pinned where the least turn's is ill-conditioned), so a collider's side no
 /// longer flips on a last-bit difference; a node whose end lies on the medial axis of a concave
-/// spot of the skin can still take the other face's plane.
+/// spot of the skin can still take the other face's plane. And no GPU node above its strand's
+/// skin planes lies behind its skin triangles (failed when the GPU's triangle cull read each
+/// triangle's bounding ball from the wrong words and skipped the nearest triangle).
 #[test]
 fn gpu_and_cpu_agree_with_contact() {
     use pelt_core::sim::{Collider, ContactParams, GraspParams, Shape};
@@ -393,6 +395,11 @@ fn gpu_and_cpu_agree_with_contact() {
     control.set_cpu_bending(false);
     let mut rig = GpuRig::new(Backend::Vulkan, &structure);
     let (mut worst, mut moved, mut most_apart) = (0.0_f32, 0.0_f32, 0_usize);
+    // The strands that keep skin triangles (creases, the ears' bases), and their planes.
+    let planes = pelt_core::sim::contact::skin_planes(&structure);
+    let surface = pelt_core::sim::contact::skin_surface(&structure, &planes);
+    let kept: Vec<usize> = (0..v).filter(|&j| !surface.strand(j).is_empty()).collect();
+    let mut deepest = 0.0_f32;
     for step in 1..=90_u32 {
         let t = f64::from(step) / RATE_HZ;
         let x = (0.3 * (t * 3.0).sin()) as f32 * radius;
@@ -435,6 +442,19 @@ fn gpu_and_cpu_agree_with_contact() {
         }
         let (_, current) = rig.step(&control);
         let expected = cpu_state(&cpu, 1.0);
+        // No GPU node above its strand's planes lies behind its triangles (the body stays at
+        // rest, so the rest mesh is where it is).
+        for &j in &kept {
+            let root = structure.positions[j];
+            for k in 1..=structure.layers as usize {
+                let x = current[k * v + j];
+                let above = planes[j].iter().all(|p| p.truncate().dot(x - root) + p.w >= 0.0);
+                if let Some((_, _, d)) = surface.closest(j, x).filter(|_| above) {
+                    deepest = deepest.max(-d / length);
+                }
+            }
+        }
+        assert!(deepest <= 1e-4, "step {step}: a GPU node is {deepest} strand lengths behind its skin triangles");
         let difference = worst_relative_difference(&structure, &current, &expected);
         // Contact branches (which face of a box, which side of a thin capsule) can flip on the
         // kernels' last-bit differences, so a few strands may part; nearly all must agree.
@@ -456,7 +476,11 @@ fn gpu_and_cpu_agree_with_contact() {
         moved = moved.max(worst_relative_difference(&structure, &current, &structure.positions));
     }
     assert!(moved > 0.3, "the fur hardly moved ({moved} strand lengths)");
-    eprintln!("contact: worst GPU/CPU difference {worst:e} strand lengths, at most {most_apart} nodes beyond 1e-4");
+    eprintln!(
+        "contact: worst GPU/CPU difference {worst:e} strand lengths, at most {most_apart} nodes beyond 1e-4; \
+         {} strands keep skin triangles, none behind them by more than {deepest:e}",
+        kept.len()
+    );
 }
 
 /// A plain mesh collider (the pebble, its distance field read by both kernels) dragged and turned

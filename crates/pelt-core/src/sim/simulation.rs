@@ -15,7 +15,7 @@ use rayon::prelude::*;
 use super::contact::skin::skin_planes_of;
 use super::contact::{
     BatchPlanes, Collider, ContactStep, ContactStrands, Grasp, GraspParams, MAX_STEP_COLLIDERS, Resolve, SKIN_PLANES,
-    SkinSurface, SurfaceMemory, skin_lanes, skin_surface,
+    SkinSurface, skin_lanes, skin_surface,
 };
 use super::dispatch::{self, CpuKernel};
 use super::field::{ForceField, Touch};
@@ -159,8 +159,6 @@ pub struct Simulation {
     skin_lanes: Vec<BatchPlanes>,
     /// The skin triangles where the planes do not suffice (see `contact::surface`).
     surface: SkinSurface,
-    /// What their strands' nodes last measured to them (the screen's, never a node's).
-    surface_memory: SurfaceMemory,
     /// The grid cell the skin planes were found in (the longest strand's reach).
     skin_cell: f32,
     /// Colliders the host or a script placed.
@@ -237,14 +235,12 @@ impl Simulation {
             roots_moved: false,
             touch_on_step_roots: false,
             surface: skin_surface(fur, &skin),
-            surface_memory: SurfaceMemory::default(),
             skin_lanes: skin_lanes(&skin),
             skin,
             skin_cell,
             colliders: Vec::new(),
             grasp: None,
         };
-        simulation.surface_memory = SurfaceMemory::new(&simulation.surface, layers);
         simulation.jump_to_step(0);
         simulation.update_output();
         Ok(simulation)
@@ -1032,7 +1028,6 @@ impl Simulation {
             step: &contact,
             strands: self.contact_strands(),
             skin_lanes: &self.skin_lanes,
-            surface_memory: &self.surface_memory,
             kernel: self.cpu_kernel,
             screen: self.contact_screen,
             roots: strands.roots,

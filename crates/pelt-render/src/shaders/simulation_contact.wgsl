@@ -247,15 +247,23 @@ fn surface_closest(s: Surface, x: vec3<f32>, v: u32) -> Closest {
     }
     let origin = surface_first(v);
     let local = s.rest_root + rotate(conjugate(s.frame), x - s.root);
+    // What rounding can take off a ball's distance: a few dozen ulps of the coordinates.
+    let slack = 4e-6 * max(max(abs(local.x), abs(local.y)), abs(local.z));
     var best_d2 = 3.4e38;
     var found = false;
     for (var i = 0u; i < s.count; i++) {
         let t = origin + list_entry(origin + v + s.first / 4u, s.first % 4u + i);
-        let ball = length(local - vec3<f32>(contact[t].w, contact[t + 1u].w, contact[t + 2u].w)) - contact[t + 3u].w;
+        let a = contact[t].xyz;
+        let b = contact[t + 1u].xyz;
+        let c = contact[t + 2u].xyz;
+        // `SkinSurface::closest`'s cull: the ball about the centroid (radius in the first word's
+        // w) farther than the nearest found, past rounding, holds no nearer point.
+        let radius = contact[t].w;
+        let ball = length(local - (a + b + c) * (1.0 / 3.0)) - radius * (1.0 + 4e-6) - slack;
         if found && ball > 0.0 && ball * ball >= best_d2 {
             continue;
         }
-        let hit = closest_feature(local, contact[t].xyz, contact[t + 1u].xyz, contact[t + 2u].xyz);
+        let hit = closest_feature(local, a, b, c);
         let gap = local - hit.xyz;
         let d2 = dot(gap, gap);
         if !found || d2 < best_d2 {
@@ -270,17 +278,15 @@ fn surface_closest(s: Surface, x: vec3<f32>, v: u32) -> Closest {
     return Closest(s.root + rotate(s.frame, best.surface - s.rest_root), rotate(s.frame, best.normal), signed);
 }
 
-// `contact::clearance`: how far x is from touching a skin plane, a collider or the skin's
-// triangles (negative: touching).
-fn clearance(
+// `contact::cheap_clearance`: how far x is from touching a skin plane or a collider (negative:
+// touching).
+fn cheap_clearance(
     x: vec3<f32>,
     root: vec3<f32>,
     planes: ptr<function, array<vec4<f32>, 8>>,
     plane_count: u32,
     near: ptr<function, array<u32, 32>>,
     near_count: u32,
-    surface: Surface,
-    v: u32,
 ) -> f32 {
     var least = 3.4e38;
     for (var p = 0u; p < plane_count; p++) {
@@ -289,7 +295,12 @@ fn clearance(
     for (var i = 0u; i < near_count; i++) {
         least = min(least, collider_closest((*near)[i], x).distance);
     }
-    return min(least, surface_closest(surface, x, v).distance);
+    return least;
+}
+
+// `Surface::clearance`: the least of `cheap` and x's distance in front of the triangles.
+fn surface_clearance(s: Surface, x: vec3<f32>, cheap: f32, v: u32) -> f32 {
+    return min(cheap, surface_closest(s, x, v).distance);
 }
 
 fn strand_grasp_weight(j: u32, v: u32) -> f32 {
@@ -346,18 +357,22 @@ fn contact_strand(j: u32, v: u32, layers: u32, root: vec3<f32>, frame: vec4<f32>
         surface = Surface(packed >> 6u, packed & 63u, header.xyz, root, frame);
     }
     // Whether anything touches the strand; if not, it stays as the bend made it.
-    // `Resolve::solve_strand`: after one `clearance` away the nodes within it need no test.
-    var touches = held != 0.0;
+    // `Resolve::solve_strand`: after one clearance away the nodes within it need no test; the
+    // first segment whose end may touch is where the walk starts testing.
+    var first_touch = select(layers, 0u, held != 0.0);
     var budget = 0.0;
-    for (var k = 0u; k < layers && !touches; k++) {
+    for (var k = 0u; k < first_touch; k++) {
         budget -= rest_segments[k * v + j].w * CONTACT_SKIP_SLACK;
         if budget > 0.0 {
             continue;
         }
-        budget = clearance(read_node(j, v, k + 1u), root, &planes, plane_count, &near, near_count, surface, v);
-        touches = budget < 0.0;
+        let x = read_node(j, v, k + 1u);
+        budget = surface_clearance(surface, x, cheap_clearance(x, root, &planes, plane_count, &near, near_count), v);
+        if budget < 0.0 {
+            first_touch = k;
+        }
     }
-    if !touches {
+    if first_touch == layers {
         return;
     }
     let to_grip = grip - root;
@@ -388,8 +403,20 @@ fn contact_strand(j: u32, v: u32, layers: u32, root: vec3<f32>, frame: vec4<f32>
         arc += segment_length;
         // Where the start is clear by more than the segment, no end can touch anything.
         let step = segment_length * CONTACT_SKIP_SLACK;
+        if k < first_touch {
+            hint = u + across * 0.5;
+            p = p + u * segment_length;
+            write_node(j, v, k + 1u, p);
+            continue;
+        }
         if walk_budget <= step {
-            walk_budget = clearance(p, root, &planes, plane_count, &near, near_count, surface, v);
+            let cheap = cheap_clearance(p, root, &planes, plane_count, &near, near_count);
+            if k == 0u {
+                // The root lies on its skin: no nearer than 0 to its triangles.
+                walk_budget = select(cheap, min(cheap, 0.0), surface.count > 0u);
+            } else {
+                walk_budget = surface_clearance(surface, p, cheap, v);
+            }
         }
         walk_budget -= step;
         for (var round = 0u; round < 8u && walk_budget <= 0.0; round++) {

@@ -29,10 +29,8 @@
 //!   if they keep any, and only strands that may touch something, or are held, are solved.
 //!   Within a strand, a node a clearance away from everything leaves the nodes within that
 //!   distance untested (a node moves at most a segment's length from the one before), and a
-//!   node's distance to the skin's triangles is bounded by the last one it measured less how
-//!   far it moved since (`SurfaceMemory`; above the planes, where that distance has no jump), so
-//!   triangles are scanned only for nodes that come near them. Contact runs in the bend's
-//!   parallel tasks, on each batch while it is in cache.
+//!   touching strand's walk starts testing at the first segment whose end may touch. Contact
+//!   runs in the bend's parallel tasks, on each batch while it is in cache.
 //! - No fling: a collider grows in over [`Collider::appear_secs`] after it appears (or jumps
 //!   faster than the sweep), so fur it appears in is pushed out over a few steps.
 //!
@@ -50,7 +48,6 @@ use glam::{Quat, Vec3, Vec4};
 pub use collider::{Collider, ColliderKey, ColliderMesh, SWEEP_RADII_PER_STEP, Shape, StepCollider};
 pub use grasp::{Grasp, GraspParams, HAND_PARTS};
 pub use skin::{SKIN_PLANES, skin_planes};
-pub(crate) use surface::SurfaceMemory;
 pub use surface::{SURFACE_WORDS, SkinSurface, skin_surface};
 
 pub(crate) use screen::{BatchPlanes, skin_lanes};
@@ -140,8 +137,6 @@ pub(crate) struct Resolve<'a> {
     pub strands: ContactStrands<'a>,
     /// The skin planes batch by batch (see [`skin_lanes`]).
     pub skin_lanes: &'a [BatchPlanes],
-    /// What the skin triangles' strands last measured (read only while screening).
-    pub surface_memory: &'a SurfaceMemory,
     /// Which instructions the screen runs with.
     pub kernel: CpuKernel,
     /// Whether to screen (else every strand within reach of anything is solved).
@@ -229,7 +224,7 @@ impl Resolve<'_> {
         }
     }
 
-    /// Strand `j`'s skin triangles, posed, with the memory where the screen is on.
+    /// Strand `j`'s skin triangles, posed.
     fn surface(&self, j: usize) -> Surface<'_> {
         Surface {
             j,
@@ -238,7 +233,6 @@ impl Resolve<'_> {
             rest_root: self.strands.rest_roots.get(j).copied().unwrap_or(self.roots[j]),
             on: self.step.skin && !self.strands.surface.strand(j).is_empty(),
             triangles: self.strands.surface,
-            memory: self.screen.then_some(self.surface_memory),
         }
     }
 
@@ -257,7 +251,7 @@ impl Resolve<'_> {
             }
             let node = &batch[k + 1];
             // Nothing else is within reach (the screen showed it), so only the triangles bound.
-            budget = surface.clearance(k, Vec3::new(node[0][lane], node[1][lane], node[2][lane]), f32::MAX);
+            budget = surface.clearance(Vec3::new(node[0][lane], node[1][lane], node[2][lane]), f32::MAX);
             if budget < 0.0 {
                 return true;
             }
@@ -303,7 +297,7 @@ impl Resolve<'_> {
                 continue;
             }
             let x = nodes[k + 1];
-            budget = surface.clearance(k, x, cheap_clearance(x, root, planes, colliders.clone()));
+            budget = surface.clearance(x, cheap_clearance(x, root, planes, colliders.clone()));
             if budget < 0.0 {
                 first_touch = k;
                 break;
@@ -353,18 +347,17 @@ impl Resolve<'_> {
             }
             if budget <= step {
                 let cheap = cheap_clearance(p, root, planes, colliders.clone());
-                budget = match k.checked_sub(1) {
-                    Some(node) => surface.clearance(node, p, cheap),
+                budget = match k {
                     // The root lies on its skin: no nearer than 0 to its triangles.
-                    None if surface.on => cheap.min(0.0),
-                    None => cheap,
+                    0 if surface.on => cheap.min(0.0),
+                    _ => surface.clearance(p, cheap),
                 };
             }
             budget -= step;
             let u = if budget > 0.0 {
                 u
             } else {
-                self.constrain(k, p, u, length, root, planes, &surface, hint, colliders.clone())
+                self.constrain(p, u, length, root, planes, &surface, hint, colliders.clone())
             };
             hint = u + across * 0.5;
             nodes[k + 1] = p + u * length;
@@ -377,7 +370,6 @@ impl Resolve<'_> {
     #[allow(clippy::too_many_arguments)]
     fn constrain<'c>(
         &self,
-        k: usize,
         p: Vec3,
         mut u: Vec3,
         length: f32,
@@ -421,10 +413,7 @@ impl Resolve<'_> {
                     moved = true;
                 }
             }
-            let q = p + u * length;
-            let above = planes.iter().all(|&(n, h)| n.dot(q - root) + h >= 0.0);
-            if !(above && surface.surely_in_front(k, q))
-                && let Some((s, n, distance)) = surface.closest(q)
+            if let Some((s, n, distance)) = surface.closest(p + u * length)
                 && distance < 0.0
             {
                 let mut floor = n.dot(s - p) / length;
@@ -473,8 +462,6 @@ struct Surface<'a> {
     rest_root: Vec3,
     on: bool,
     triangles: &'a SkinSurface,
-    /// What the strand's nodes last measured, where the screen may use it.
-    memory: Option<&'a SurfaceMemory>,
 }
 
 impl Surface<'_> {
@@ -487,34 +474,13 @@ impl Surface<'_> {
         self.triangles.closest_posed(self.j, x, self.root, self.frame, self.rest_root)
     }
 
-    /// Whether the memory shows node `k + 1` at `x` (above the planes) in front of the triangles.
-    fn surely_in_front(&self, k: usize, x: Vec3) -> bool {
-        self.on
-            && self.memory.is_some_and(|memory| {
-                memory.bound(self.j, k, self.rest_root + self.frame.conjugate() * (x - self.root)) >= 0.0
-            })
-    }
-
-    /// The least of `cheap` (node `k + 1`'s clearance from everything else) and its distance in
-    /// front of the triangles, or a lower bound on that where the memory shows the node in front
-    /// (or `cheap` the lesser anyway): no touch is missed, a little skipping may be.
-    fn clearance(&self, k: usize, x: Vec3, cheap: f32) -> f32 {
-        if !self.on {
-            return cheap;
+    /// The least of `cheap` (a node's clearance from everything else) and its distance in front
+    /// of the triangles.
+    fn clearance(&self, x: Vec3, cheap: f32) -> f32 {
+        match self.closest(x) {
+            Some((_, _, d)) => cheap.min(d),
+            None => cheap,
         }
-        let local = self.rest_root + self.frame.conjugate() * (x - self.root);
-        if let Some(memory) = self.memory {
-            let bound = memory.bound(self.j, k, local);
-            if bound >= 0.0 || bound >= cheap {
-                return cheap.min(bound);
-            }
-        }
-        let Some((_, _, d)) = self.triangles.closest(self.j, local) else { return cheap };
-        // Below a plane (cheap < 0) the triangles' signed distance can jump: not remembered.
-        if let Some(memory) = self.memory.filter(|_| cheap >= 0.0) {
-            memory.remember(self.j, k, local, d);
-        }
-        cheap.min(d)
     }
 }
 

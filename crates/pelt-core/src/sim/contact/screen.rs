@@ -500,7 +500,7 @@ mod tests {
     /// front of their triangles (failed with the screen's strands left untested against them).
     #[test]
     fn strands_clear_of_their_planes_still_meet_their_triangles() {
-        use crate::sim::contact::{ContactStep, ContactStrands, Resolve, SurfaceMemory, skin_planes, skin_surface};
+        use crate::sim::contact::{ContactStep, ContactStrands, Resolve, skin_planes, skin_surface};
         use crate::sim::kernel::RestBatches;
         let (mesh, _) = Builtin::Bunny.mesh();
         let length = 0.08 * mesh.bounding_sphere().1;
@@ -547,7 +547,6 @@ mod tests {
         assert!(bent.len() >= 5, "only {} strands have a spot above their planes behind their triangles", bent.len());
         let rest = RestBatches::new(&fur.positions, v, layers);
         let lanes = skin_lanes(&planes);
-        let memory = SurfaceMemory::new(&surface, layers);
         let step = ContactStep { skin: true, ..ContactStep::default() };
         let roots = &fur.positions[..v];
         let frames = vec![Quat::IDENTITY; v];
@@ -556,7 +555,6 @@ mod tests {
                 step: &step,
                 strands: ContactStrands { skin: &planes, grasp_weights: &[], surface: &surface, rest_roots: roots },
                 skin_lanes: &lanes,
-                surface_memory: &memory,
                 kernel: CpuKernel::Auto,
                 screen,
                 roots,

@@ -11,7 +11,6 @@
 //! pay nothing.
 
 use std::collections::HashMap;
-use std::sync::atomic::{AtomicU32, Ordering};
 
 use glam::{Quat, Vec3, Vec4};
 
@@ -95,68 +94,6 @@ impl SkinSurface {
     ) -> Option<(Vec3, Vec3, f32)> {
         let local = rest_root + frame.conjugate() * (x - root);
         self.closest(j, local).map(|(point, normal, d)| (root + frame * (point - rest_root), frame * normal, d))
-    }
-}
-
-/// The last exact distance each node of a strand with skin triangles measured to them, with
-/// where the node was (in the rest mesh's space): the distance is 1-Lipschitz, so a node that
-/// moved `m` since is at least that distance less `m` in front, a bound that costs a rotation
-/// instead of a triangle scan. Fur that sways a little per step keeps most of its bounds.
-///
-/// One entry per node; a step's thread is the only one touching its batch's entries, so relaxed
-/// atomics suffice, and only the cost depends on what they hold, never a node.
-#[derive(Debug, Default)]
-pub(crate) struct SurfaceMemory {
-    /// Per strand, its first entry, or `u32::MAX` for a strand without triangles.
-    first: Vec<u32>,
-    /// `x, y, z, distance` bits per node; distance minus infinity before the first measure.
-    entries: Vec<[AtomicU32; 4]>,
-}
-
-impl SurfaceMemory {
-    /// Empty memory for every strand of `surface` with `layers` nodes above its root.
-    pub(crate) fn new(surface: &SkinSurface, layers: usize) -> Self {
-        let mut next = 0_u32;
-        let first = surface
-            .strands
-            .iter()
-            .map(|&[_, count]| {
-                if count == 0 {
-                    return u32::MAX;
-                }
-                next += layers as u32;
-                next - layers as u32
-            })
-            .collect();
-        let entries =
-            (0..next).map(|_| [0.0, 0.0, 0.0, f32::NEG_INFINITY].map(|w: f32| AtomicU32::new(w.to_bits()))).collect();
-        Self { first, entries }
-    }
-
-    fn entry(&self, j: usize, node: usize) -> Option<&[AtomicU32; 4]> {
-        let first = *self.first.get(j)?;
-        if first == u32::MAX {
-            return None;
-        }
-        self.entries.get(first as usize + node)
-    }
-
-    /// A lower bound on strand `j`'s node `node`'s signed distance at `local` (rest space);
-    /// minus infinity where nothing was measured.
-    pub(crate) fn bound(&self, j: usize, node: usize, local: Vec3) -> f32 {
-        let Some(entry) = self.entry(j, node) else { return f32::NEG_INFINITY };
-        let [x, y, z, d] = entry.each_ref().map(|w| f32::from_bits(w.load(Ordering::Relaxed)));
-        // The slack covers the rounding of both distances (a few ulps of the coordinates).
-        d - local.distance(Vec3::new(x, y, z)) - 4e-6 * local.abs().max_element().max(1.0)
-    }
-
-    /// Keeps `distance`, measured at `local`, for strand `j`'s node `node`.
-    pub(crate) fn remember(&self, j: usize, node: usize, local: Vec3, distance: f32) {
-        if let Some(entry) = self.entry(j, node) {
-            for (word, value) in entry.iter().zip([local.x, local.y, local.z, distance]) {
-                word.store(value.to_bits(), Ordering::Relaxed);
-            }
-        }
     }
 }
 
@@ -436,48 +373,6 @@ mod tests {
                 assert_eq!(surface.strand(j).len(), 0, "strand {j} at {p} on the convex rim");
             }
         }
-    }
-
-    /// Above a strand's skin planes (where the solve reads it), a remembered distance less the
-    /// move since is a lower bound on the exact distance, for nodes wandering about every kept
-    /// strand's reach on the torus's saddles (failed with the remembered distance taken as a
-    /// tenth of the reach larger). Below the planes the kept triangles' signed distance can jump
-    /// (a triangle the strand does not keep may be nearer there), so nothing is remembered.
-    #[test]
-    fn remembered_distances_bound_the_exact_ones() {
-        let torus = furred(Builtin::Torus);
-        let planes = skin_planes(&torus);
-        let surface = skin_surface(&torus, &planes);
-        let memory = SurfaceMemory::new(&surface, 1);
-        let mut state = 11_u32;
-        let mut next = move || {
-            state = state.wrapping_mul(1_664_525).wrapping_add(1_013_904_223);
-            (state >> 8) as f32 / (1 << 24) as f32 * 2.0 - 1.0
-        };
-        let (mut tested, mut close) = (0, 0);
-        for j in (0..torus.vertex_count()).filter(|&j| !surface.strand(j).is_empty()) {
-            let root = torus.positions[j];
-            let reach = torus.lengths[j];
-            let above = |x: Vec3| planes[j].iter().all(|p| p.truncate().dot(x - root) >= -p.w);
-            assert_eq!(memory.bound(j, 0, root), f32::NEG_INFINITY, "strand {j}: a bound before any measure");
-            let mut x = root + torus.mesh.normals[j] * (0.5 * reach);
-            for _ in 0..400 {
-                let step = Vec3::new(next(), next(), next()) * (0.2 * reach);
-                let moved = root + (x + step - root).clamp_length_max(reach);
-                if above(moved) {
-                    let (_, _, exact) = surface.closest(j, moved).expect("triangles");
-                    let bound = memory.bound(j, 0, moved);
-                    assert!(bound <= exact, "strand {j}: bound {bound} above the exact {exact} at {moved}");
-                    tested += 1;
-                    close += usize::from(exact - bound < 0.05 * reach);
-                    memory.remember(j, 0, moved, exact);
-                }
-                x = moved;
-            }
-        }
-        // Tight enough to save evaluations, and the test reaches where it is tight.
-        assert!(tested > 1000 && close > tested / 20, "{close} of {tested} bounds within a twentieth of the reach");
-        eprintln!("{close} of {tested} bounds within a twentieth of the reach");
     }
 
     /// The closest point and its feature against a dense sampling of the triangle.

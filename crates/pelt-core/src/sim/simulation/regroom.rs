@@ -2,7 +2,7 @@
 //! skin planes in place, so painting never rebuilds the simulation (the skin planes of every
 //! strand are most of [`Simulation::new`]'s cost).
 
-use super::{SimError, Simulation, SurfaceMemory, skin_lanes, skin_planes_of};
+use super::{SimError, Simulation, skin_lanes, skin_planes_of};
 use crate::fur::FurStructure;
 use crate::sim::contact::surface::skin_surface_of;
 
@@ -53,7 +53,6 @@ impl Simulation {
             self.surface = skin_surface_of(&self.surface, fur, &self.skin, &changed);
         }
         self.skin_lanes = skin_lanes(&self.skin);
-        self.surface_memory = SurfaceMemory::new(&self.surface, layers);
         self.restart();
         Ok(())
     }
