@@ -1,8 +1,11 @@
 //! The grasp's hand (fingers, thumb and palm about the grip) and bad contact input, checked with
 //! the test's own distance formulas (no `sim::contact` code).
 
+mod common;
+
 use std::path::Path;
 
+use common::back;
 use glam::{Quat, Vec3};
 use pelt_core::fur::{FurLength, FurParams, FurStructure, GrowthDirection};
 use pelt_core::mesh::builtin::Builtin;
@@ -17,20 +20,6 @@ fn bunny_fur(length_fraction: f32) -> FurStructure {
     let direction = GrowthDirection { random_angle_rad: 0.4, seed: 5, ..GrowthDirection::default() };
     let params = FurParams { layers: 8, length: FurLength::Constant(length_fraction * radius), direction };
     FurStructure::new(mesh, &params).unwrap()
-}
-
-/// A vertex on the bunny's back: facing up, nearest the middle of its box across X and Z.
-fn back(fur: &FurStructure) -> usize {
-    let p = &fur.mesh.positions;
-    let (lo, hi) = p.iter().fold((Vec3::MAX, Vec3::MIN), |(l, h), x| (l.min(*x), h.max(*x)));
-    let middle = (lo + hi) * 0.5;
-    (0..p.len())
-        .filter(|&j| fur.mesh.normals[j].y > 0.9)
-        .min_by(|&a, &b| {
-            let d = |j: usize| (p[j] - middle).with_y(0.0).length();
-            d(a).total_cmp(&d(b))
-        })
-        .unwrap()
 }
 
 /// A part's ends (a ball's twice) and radius, from its pose alone.

@@ -3,9 +3,12 @@
 //! triangles, read here), sharing no code with the baked field or the contact kernels; and a
 //! scene script's mesh collider loads relative to the script, or fails naming the file.
 
+mod common;
+
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
+use common::back;
 use glam::{DVec3, Quat, Vec3};
 use pelt_core::fur::{FurLength, FurParams, FurStructure, GrowthDirection};
 use pelt_core::mesh::builtin::Builtin;
@@ -105,17 +108,6 @@ fn fur() -> (FurStructure, f32) {
     let direction = GrowthDirection { random_angle_rad: 0.4, seed: 5, ..GrowthDirection::default() };
     let params = FurParams { layers: 12, length: FurLength::Constant(0.12 * radius), direction };
     (FurStructure::new(mesh, &params).unwrap(), radius)
-}
-
-/// The bunny's vertex on its back nearest the middle, with an upward normal.
-fn back(fur: &FurStructure) -> usize {
-    let p = &fur.mesh.positions;
-    let (lo, hi) = fur.mesh.bounds();
-    let middle = (lo + hi) * 0.5;
-    (0..p.len())
-        .filter(|&j| fur.mesh.normals[j].y > 0.9)
-        .min_by(|&a, &b| (p[a] - middle).with_y(0.0).length().total_cmp(&(p[b] - middle).with_y(0.0).length()))
-        .unwrap()
 }
 
 const RESOLUTION: usize = 32;

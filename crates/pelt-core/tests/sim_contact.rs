@@ -2,9 +2,12 @@
 //! `sim::contact` (the skin against the closest point of the base mesh in f64, signed by the
 //! angle-weighted pseudonormal; colliders by their own distance formulas).
 
+mod common;
+
 use std::collections::HashMap;
 use std::path::Path;
 
+use common::back;
 use glam::{DVec3, Quat, Vec3};
 use pelt_core::fur::{FurLength, FurParams, FurStructure, GrowthDirection};
 use pelt_core::mesh::builtin::Builtin;
@@ -183,20 +186,6 @@ fn below_skin(
         }
     }
     (deepest, count)
-}
-
-/// A vertex on the bunny's back: facing up, nearest the middle of its box across X and Z.
-fn back(fur: &FurStructure) -> usize {
-    let p = &fur.mesh.positions;
-    let (lo, hi) = p.iter().fold((Vec3::MAX, Vec3::MIN), |(l, h), x| (l.min(*x), h.max(*x)));
-    let middle = (lo + hi) * 0.5;
-    (0..p.len())
-        .filter(|&j| fur.mesh.normals[j].y > 0.9)
-        .min_by(|&a, &b| {
-            let d = |j: usize| (p[j] - middle).with_y(0.0).length();
-            d(a).total_cmp(&d(b))
-        })
-        .unwrap()
 }
 
 fn bunny() -> (FurStructure, MeshOracle, f32) {
