@@ -239,10 +239,10 @@ impl Resolve<'_> {
     /// Whether a node of strand `j` (lane `lane` of batch `b`, clear of its planes and the
     /// colliders) may lie behind its skin triangles.
     fn touches_triangles(&self, j: usize, b: usize, lane: usize, batch: &[VecLanes]) -> bool {
-        if self.strands.surface.strand(j).is_empty() {
+        let surface = self.surface(j);
+        if !surface.on {
             return false;
         }
-        let surface = self.surface(j);
         let mut budget = 0.0_f32;
         for k in 0..self.layers {
             budget -= self.rest.length(b, lane, k) * SKIP_SLACK;
