@@ -287,6 +287,52 @@ fn below_the_skin_under_wind_pat_and_swing(builtin: Builtin) {
 }
 
 /// Distance from `x` to each collider shape, written out here (negative inside).
+/// Strands that wind and gravity press into the skin lie down along it: no segment turns back
+/// on the one before (a turn past 120 degrees), on the bunny's back, flanks and creases. (The
+/// least turn onto a plane pressed nearly along its normal took its side from the bent
+/// direction's small tangential part, and such strands folded into a zig-zag.)
+#[test]
+fn strands_pressed_into_the_skin_lie_down_without_folding() {
+    let (fur, oracle, _) = bunny();
+    let v = fur.vertex_count();
+    let layers = fur.layers as usize;
+    let params = SimParams {
+        gravity_strength: 6.0,
+        wind: WindParams { direction: Vec3::new(0.2, -1.0, 0.1), strength: 4.0, seed: 3, ..WindParams::default() },
+        ..with_skin(true)
+    };
+    let mut sim = Simulation::new(&fur, &params).unwrap();
+    let (mut folded, mut pressed) = (Vec::new(), 0);
+    run(&mut sim, 60, |_, _| {});
+    for _ in 0..30 {
+        run(&mut sim, 1, |_, _| {});
+        let positions = sim.positions();
+        for j in 0..v {
+            let node = |k: usize| positions[k * v + j];
+            let folds = (1..layers)
+                .filter(|&k| {
+                    let (a, b) = (node(k) - node(k - 1), node(k + 1) - node(k));
+                    a.normalize().dot(b.normalize()) < -0.5
+                })
+                .count();
+            if folds > 0 && !folded.contains(&j) {
+                folded.push(j);
+            }
+        }
+        pressed = pressed.max(
+            (0..v * (layers + 1))
+                .filter(|&n| {
+                    let near = 0.02 * f64::from(fur.lengths[n % v]);
+                    n >= v && oracle.signed_distance(positions[n]).is_some_and(|d| d.abs() < near)
+                })
+                .count(),
+        );
+    }
+    eprintln!("{} strands fold; at most {pressed} nodes lie on the skin", folded.len());
+    assert!(pressed > 1000, "the wind presses the fur onto the skin ({pressed} nodes on it)");
+    assert!(folded.is_empty(), "strands {folded:?} fold back on themselves");
+}
+
 fn sphere_distance(x: Vec3, centre: Vec3, radius: f32) -> f32 {
     x.distance(centre) - radius
 }

@@ -364,14 +364,14 @@ fn worst_segment_error(structure: &FurStructure, positions: &[Vec3]) -> f32 {
 
 /// The same fur on both kernels with contact: the skin under strong gravity and downward wind, a
 /// ball, a thin capsule and a box moving through the fur on the back, a hand lifting a tuft and
-/// letting go. At every step at least 99% of the nodes agree within the bound of the other
-/// agreement tests (1e-4 strand lengths) and every node within 0.15. Contact's response is
-/// continuous where it can be (friction ramps in with depth, the grip's segment turns in part, a
-/// turn's side is pinned where the least turn's is ill-conditioned), so a collider's side no
-/// longer flips on a last-bit difference; a node whose end lies on the medial axis of a concave
-/// spot of the skin can still take the other face's plane. And no GPU node above its strand's
-/// skin planes lies behind its skin triangles (failed when the GPU's triangle cull read each
-/// triangle's bounding ball from the wrong words and skipped the nearest triangle).
+/// letting go. At every step every node agrees within the bound of the other agreement tests
+/// (1e-4 strand lengths). Contact's response is continuous where it can be (friction ramps in
+/// with depth, the grip's segment turns in part, a turn's side leans the strand's own way as
+/// deep as the segment points into a plane), so no branch flips on a last-bit difference. (With
+/// the least turn's side alone, strands pressed into a crease folded and parted by up to 0.1
+/// strand lengths.) And no GPU node above its strand's skin planes lies behind its skin
+/// triangles (failed when the GPU's triangle cull read each triangle's bounding ball from the
+/// wrong words and skipped the nearest triangle).
 #[test]
 fn gpu_and_cpu_agree_with_contact() {
     use pelt_core::sim::{Collider, ContactParams, GraspParams, Shape};
@@ -394,7 +394,7 @@ fn gpu_and_cpu_agree_with_contact() {
     let mut control = Simulation::new(&structure, &params).expect("simulation");
     control.set_cpu_bending(false);
     let mut rig = GpuRig::new(Backend::Vulkan, &structure);
-    let (mut worst, mut moved, mut most_apart) = (0.0_f32, 0.0_f32, 0_usize);
+    let (mut worst, mut moved) = (0.0_f32, 0.0_f32);
     // The strands that keep skin triangles (creases, the ears' bases), and their planes.
     let planes = pelt_core::sim::contact::skin_planes(&structure);
     let surface = pelt_core::sim::contact::skin_surface(&structure, &planes);
@@ -456,36 +456,21 @@ fn gpu_and_cpu_agree_with_contact() {
         }
         assert!(deepest <= 1e-4, "step {step}: a GPU node is {deepest} strand lengths behind its skin triangles");
         let difference = worst_relative_difference(&structure, &current, &expected);
-        // Contact branches (which face of a box, which side of a thin capsule) can flip on the
-        // kernels' last-bit differences, so a few strands may part; nearly all must agree.
-        let apart = current
-            .iter()
-            .zip(&expected)
-            .enumerate()
-            .map(|(n, (g, c))| g.distance(*c) / structure.lengths[n % v])
-            .filter(|d| d.is_nan() || *d > 1e-4)
-            .count();
-        assert!(
-            apart * 100 <= current.len(),
-            "step {step}: {apart} of {} nodes apart (worst {difference})",
-            current.len()
-        );
-        most_apart = most_apart.max(apart);
-        assert!(difference <= 0.15, "step {step}: a node is {difference} strand lengths from the CPU's");
+        assert!(difference <= 1e-4, "step {step}: a node is {difference} strand lengths from the CPU's");
         worst = worst.max(difference);
         moved = moved.max(worst_relative_difference(&structure, &current, &structure.positions));
     }
     assert!(moved > 0.3, "the fur hardly moved ({moved} strand lengths)");
     eprintln!(
-        "contact: worst GPU/CPU difference {worst:e} strand lengths, at most {most_apart} nodes beyond 1e-4; \
+        "contact: worst GPU/CPU difference {worst:e} strand lengths; \
          {} strands keep skin triangles, none behind them by more than {deepest:e}",
         kept.len()
     );
 }
 
 /// A plain mesh collider (the pebble, its distance field read by both kernels) dragged and turned
-/// across the back: the GPU agrees with the CPU as with the other shapes (nearly every node
-/// within 1e-4 of a strand length; a few may part where a contact branch flips on last bits).
+/// across the back: the GPU agrees with the CPU as with the other shapes (every node within
+/// 1e-4 of a strand length at every step).
 #[test]
 fn gpu_and_cpu_agree_with_a_mesh_collider() {
     use pelt_core::mesh::{ImportOptions, Mesh};
@@ -513,7 +498,7 @@ fn gpu_and_cpu_agree_with_a_mesh_collider() {
     let mut control = Simulation::new(&structure, &params).expect("simulation");
     control.set_cpu_bending(false);
     let mut rig = GpuRig::new(Backend::Vulkan, &structure);
-    let (mut worst, mut moved, mut most_apart) = (0.0_f32, 0.0_f32, 0_usize);
+    let (mut worst, mut moved) = (0.0_f32, 0.0_f32);
     for step in 1..=45_u32 {
         let t = f64::from(step) / RATE_HZ;
         let x = (0.1 * (t * 3.0).sin()) as f32 * radius;
@@ -531,25 +516,10 @@ fn gpu_and_cpu_agree_with_a_mesh_collider() {
         let (_, current) = rig.step(&control);
         let expected = cpu_state(&cpu, 1.0);
         let difference = worst_relative_difference(&structure, &current, &expected);
-        let apart = current
-            .iter()
-            .zip(&expected)
-            .enumerate()
-            .map(|(n, (g, c))| g.distance(*c) / structure.lengths[n % v])
-            .filter(|d| d.is_nan() || *d > 1e-4)
-            .count();
-        assert!(
-            apart * 100 <= current.len(),
-            "step {step}: {apart} of {} nodes apart (worst {difference})",
-            current.len()
-        );
-        most_apart = most_apart.max(apart);
-        assert!(difference <= 0.15, "step {step}: a node is {difference} strand lengths from the CPU's");
+        assert!(difference <= 1e-4, "step {step}: a node is {difference} strand lengths from the CPU's");
         worst = worst.max(difference);
         moved = moved.max(worst_relative_difference(&structure, &current, &structure.positions));
     }
     assert!(moved > 0.3, "the fur hardly moved ({moved} strand lengths)");
-    eprintln!(
-        "mesh collider: worst GPU/CPU difference {worst:e} strand lengths, at most {most_apart} nodes beyond 1e-4"
-    );
+    eprintln!("mesh collider: worst GPU/CPU difference {worst:e} strand lengths");
 }

@@ -28,7 +28,7 @@ const CONTACT_COLLIDERS: u32 = 128u;
 const COLLIDER_WORDS: u32 = 5u;
 const NEAR_COLLIDERS: u32 = 32u;
 const CONTACT_MARGIN: f32 = 1e-5;
-const CONTACT_SIDE_BIAS: f32 = 0.01;
+const CONTACT_SIDE_BIAS: f32 = 1.0;
 const CONTACT_FRICTION_DEPTH: f32 = 0.25;
 const CONTACT_SKIP_SLACK: f32 = 1.001;
 
@@ -171,15 +171,15 @@ fn normalize_or(x: vec3<f32>, fallback: vec3<f32>) -> vec3<f32> {
     return fallback;
 }
 
-// `contact::turn_above`: the unit direction nearest `u` with `n . result >= floor`.
-// A little of `hint` picks the side where `u` points against `n` (`CONTACT_SIDE_BIAS`).
+// `contact::turn_above`: a unit direction near `u` with `n . result >= floor`, on the side of
+// `u` plus `hint` weighed by how far `u` lies below the cone (`CONTACT_SIDE_BIAS`).
 fn turn_above(u: vec3<f32>, n: vec3<f32>, floor_in: f32, hint: vec3<f32>) -> vec3<f32> {
     let floor = clamp(floor_in, -1.0, 1.0);
     let along = dot(n, u);
     if along >= floor {
         return u;
     }
-    let side = normalize_or((u - n * along) + (hint - n * dot(n, hint)) * CONTACT_SIDE_BIAS, any_orthonormal(n));
+    let side = normalize_or((u - n * along) + (hint - n * dot(n, hint)) * (CONTACT_SIDE_BIAS * (floor - along)), any_orthonormal(n));
     return normalize(n * floor + side * sqrt(max(1.0 - floor * floor, 0.0)));
 }
 

@@ -6,9 +6,10 @@
 //! direction the bend gave it (turned toward the grip for held strands), is turned by the least
 //! angle that puts its end outside every collider, above every skin plane and in front of the
 //! strand's skin triangles (the plane tangent to the collider or skin at the end's closest
-//! point, or where that cannot be reached, at the segment's start's), and the strand beyond
-//! moves with it. Each segment keeps its rest length exactly (a
-//! unit direction times the length), roots never move, and the skin is enforced last, so no
+//! point, or where that cannot be reached, at the segment's start's; where the segment points
+//! into that plane nearly along its normal, it leans the way the strand ran, see `turn_above`),
+//! and the strand beyond moves with it. Each segment keeps its rest length exactly (a unit
+//! direction times the length), roots never move, and the skin is enforced last, so no
 //! force or collider pushes a node below it. A strand that touches nothing is left as the bend
 //! made it, bit for bit.
 //!
@@ -157,8 +158,9 @@ const SKIP_SLACK: f32 = 1.001;
 /// How deep, relative to the segment's length, a node's end takes a collider's full friction.
 const FRICTION_DEPTH: f32 = 0.25;
 
-/// How much a turn's hint weighs against the side `u` already leans to (see `turn_above`).
-const SIDE_BIAS: f32 = 0.01;
+/// How much a turn's hint (the way the segment before went) weighs against the side `u`
+/// leans to, per unit of how far `u` lies below the cone it is turned onto (see `turn_above`).
+const SIDE_BIAS: f32 = 1.0;
 
 impl Resolve<'_> {
     /// Applies contact to batch `b`'s nodes (`L + 1` of them, as the bend left them).
@@ -484,19 +486,23 @@ impl Surface<'_> {
     }
 }
 
-/// The unit direction nearest unit `u` with `n . result >= floor` (`n` unit): `u` itself when it
-/// already is, else on the cone `n . result = floor` in the plane of `u` and `n`.
+/// A unit direction near unit `u` with `n . result >= floor` (`n` unit): `u` itself when it
+/// already is, else on the cone `n . result = floor`, to the side of `u` plus a part of `hint`.
 ///
-/// Where `u` points (nearly) against `n`, every side is (nearly) as near and the least turn's
-/// side would follow `u`'s last bits; a little of `hint` decides it there, so kernels that
-/// round differently turn the same way.
+/// The least turn (to the side of `u` alone) is ill-conditioned where `u` points into the plane
+/// nearly along `-n`: every side is nearly as near, and the side follows `u`'s small tangential
+/// part, which swings from one segment to the next (a strand pressed into a crease folded back
+/// and forth) and with each kernel's rounding. So `hint` joins `u`'s side weighed by how far `u`
+/// lies below the cone ([`SIDE_BIAS`] times `floor - n . u`): a strand pressed in steeply lies
+/// down the way it ran, one that grazes the cone turns by nearly the least angle, and the
+/// result is continuous where `u` crosses the cone (the weight is 0 there).
 fn turn_above(u: Vec3, n: Vec3, floor: f32, hint: Vec3) -> Vec3 {
     let floor = floor.clamp(-1.0, 1.0);
     let along = n.dot(u);
     if along >= floor {
         return u;
     }
-    let side = ((u - n * along) + (hint - n * n.dot(hint)) * SIDE_BIAS)
+    let side = ((u - n * along) + (hint - n * n.dot(hint)) * (SIDE_BIAS * (floor - along)))
         .try_normalize()
         .unwrap_or_else(|| n.any_orthonormal_vector());
     (n * floor + side * (1.0 - floor * floor).max(0.0).sqrt()).normalize()
