@@ -23,6 +23,12 @@ use crate::fur::FurStructure;
 /// skips a triangle that ball shows farther than the nearest found), the others' `w` unused.
 pub const SURFACE_WORDS: usize = 10;
 
+/// How far (relative to a strand's reach) a triangle may rise into the intersection of the
+/// strand's planes before the strand keeps it: half the skin's stated bound (no node more than
+/// 1e-5 of the fur's length below it), so a face the planes were fitted to, lying on its plane
+/// to rounding, is not kept, and one rising farther is.
+const KEEP_TOLERANCE: f32 = 5e-6;
+
 /// Most triangles one strand keeps (the nearest to its root first).
 pub const MAX_STRAND_TRIANGLES: usize = 48;
 
@@ -245,7 +251,7 @@ impl Scan {
                 polygon.clear();
                 polygon.extend([a, b, c]);
                 for plane in &strand_planes {
-                    clip(&mut polygon, plane.truncate(), plane.w - 1e-4 * r, root);
+                    clip(&mut polygon, plane.truncate(), plane.w - KEEP_TOLERANCE * r, root);
                 }
                 let inside = polygon.len() >= 3
                     && (1..polygon.len() - 1)
