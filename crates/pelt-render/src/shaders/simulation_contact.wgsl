@@ -23,7 +23,7 @@
 
 const CONTACT_SLOTS: u32 = 64u;
 const CONTACT_SKIN: u32 = 2u * CONTACT_SLOTS;
-const SKIN_PLANES: u32 = 8u;
+const SKIN_PLANES: u32 = 16u;
 const CONTACT_COLLIDERS: u32 = 128u;
 const COLLIDER_WORDS: u32 = 5u;
 const NEAR_COLLIDERS: u32 = 32u;
@@ -283,7 +283,7 @@ fn surface_closest(s: Surface, x: vec3<f32>, v: u32) -> Closest {
 fn cheap_clearance(
     x: vec3<f32>,
     root: vec3<f32>,
-    planes: ptr<function, array<vec4<f32>, 8>>,
+    planes: ptr<function, array<vec4<f32>, SKIN_PLANES>>,
     plane_count: u32,
     near: ptr<function, array<u32, 32>>,
     near_count: u32,
@@ -320,7 +320,7 @@ fn contact_strand(j: u32, v: u32, layers: u32, root: vec3<f32>, frame: vec4<f32>
     let grip = contact[2u * slot + 1u].xyz;
     let held = strand_grasp_weight(j, v) * presence;
 
-    var planes: array<vec4<f32>, 8>;
+    var planes: array<vec4<f32>, SKIN_PLANES>;
     var plane_count = 0u;
     if skin {
         for (var p = 0u; p < SKIN_PLANES; p++) {

@@ -503,7 +503,7 @@ mod tests {
         use crate::sim::contact::{ContactStep, ContactStrands, Resolve, skin_planes, skin_surface};
         use crate::sim::kernel::RestBatches;
         let (mesh, _) = Builtin::Bunny.mesh();
-        let length = 0.08 * mesh.bounding_sphere().1;
+        let length = 0.4 * mesh.bounding_sphere().1;
         let fur = FurStructure::new(
             mesh,
             &FurParams { layers: 8, length: FurLength::Constant(length), direction: GrowthDirection::default() },

@@ -20,7 +20,7 @@ use glam::{Vec3, Vec4};
 use crate::fur::FurStructure;
 
 /// Half-spaces per strand.
-pub const SKIN_PLANES: usize = 8;
+pub const SKIN_PLANES: usize = 16;
 
 /// An unused plane: `0 . x >= -1` holds everywhere.
 const NO_PLANE: Vec4 = Vec4::new(0.0, 0.0, 0.0, 1.0);
