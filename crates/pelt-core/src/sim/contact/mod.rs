@@ -245,20 +245,34 @@ impl Resolve<'_> {
         if !surface.on {
             return false;
         }
+        // Nothing else is within reach (the screen showed it), so only the triangles bound.
+        let node = |i: usize| Vec3::new(batch[i][0][lane], batch[i][1][lane], batch[i][2][lane]);
+        self.first_touch(b, lane, node, |x| surface.clearance(x, f32::MAX)).is_some()
+    }
+
+    /// The first segment (`k`, ending at node `k + 1`) of lane `lane` of batch `b` whose end's
+    /// `clearance` is negative, `None` where none is. A node is at most a segment's length
+    /// nearer anything than the node before, so after one `clearance` away the nodes within it
+    /// need no evaluation.
+    fn first_touch(
+        &self,
+        b: usize,
+        lane: usize,
+        node: impl Fn(usize) -> Vec3,
+        clearance: impl Fn(Vec3) -> f32,
+    ) -> Option<usize> {
         let mut budget = 0.0_f32;
         for k in 0..self.layers {
             budget -= self.rest.length(b, lane, k) * SKIP_SLACK;
             if budget > 0.0 {
                 continue;
             }
-            let node = &batch[k + 1];
-            // Nothing else is within reach (the screen showed it), so only the triangles bound.
-            budget = surface.clearance(Vec3::new(node[0][lane], node[1][lane], node[2][lane]), f32::MAX);
+            budget = clearance(node(k + 1));
             if budget < 0.0 {
-                return true;
+                return Some(k);
             }
         }
-        false
+        None
     }
 
     /// Solves one strand in place; false when nothing touched it (left as it was).
@@ -287,27 +301,17 @@ impl Resolve<'_> {
         let planes = &planes[..plane_count];
         let surface = self.surface(j);
         let colliders = near.iter();
-        // A node is at most a segment's length nearer anything than the node before, so after
-        // one `clearance` away the nodes within it need no test.
         // The first segment whose end may touch: the ends before it are clear, so the walk
         // below keeps their directions without testing them.
-        let mut first_touch = if held == 0.0 { self.layers } else { 0 };
-        let mut budget = 0.0_f32;
-        for k in 0..first_touch {
-            budget -= self.rest.length(b, lane, k) * SKIP_SLACK;
-            if budget > 0.0 {
-                continue;
+        let first_touch = if held == 0.0 {
+            let clearance = |x: Vec3| surface.clearance(x, cheap_clearance(x, root, planes, colliders.clone()));
+            match self.first_touch(b, lane, |i| nodes[i], clearance) {
+                Some(k) => k,
+                None => return false,
             }
-            let x = nodes[k + 1];
-            budget = surface.clearance(x, cheap_clearance(x, root, planes, colliders.clone()));
-            if budget < 0.0 {
-                first_touch = k;
-                break;
-            }
-        }
-        if first_touch == self.layers {
-            return false;
-        }
+        } else {
+            0
+        };
         let mut budget = 0.0_f32;
         let grip = self.step.grip - root;
         let grip_distance = grip.length();

@@ -4,8 +4,8 @@
 //! hundred reaches its skin planes), and the per-strand solve ([`super::Resolve`]) costs most of
 //! its time finding that out. The screen tests every node of the batch's eight strands at once
 //! against their skin planes (posed by each lane's frame) and against every collider within
-//! reach (its exact distance, or a mesh's bounding ball), in plain lane arithmetic the compiler turns into vector instructions.
-//! A lane that clears everything by [`SCREEN_MARGIN`] of a segment is left as the bend made it,
+//! reach (its exact distance, or a mesh's bounding ball), in plain lane arithmetic the compiler
+//! turns into vector instructions. A lane that clears everything by [`SCREEN_MARGIN`] of a segment is left as the bend made it,
 //! which is what the solve would do with it (it only changes a strand with a node below a plane
 //! or inside a collider); every other lane is solved as before, so the screen changes no byte of
 //! the result, only the time. Strands held by the grasp are always solved; of those the screen
@@ -496,8 +496,9 @@ mod tests {
     /// Strands the screen clears of their planes and the colliders are still tested against their
     /// skin triangles: on the bunny, each strand with triangles that has a spot above its planes
     /// but behind its triangles (where its planes' intersection reaches below the skin: creases,
-    /// the ears' bases) is bent to it. The screened solve gives the unscreened one's bits, and moves those strands in
-    /// front of their triangles (failed with the screen's strands left untested against them).
+    /// the ears' bases) is bent to it. The screened solve gives the unscreened one's bits, and
+    /// moves those strands in front of their triangles (failed with the screen's strands left
+    /// untested against them).
     #[test]
     fn strands_clear_of_their_planes_still_meet_their_triangles() {
         use crate::sim::contact::{ContactStep, ContactStrands, Resolve, skin_planes, skin_surface};
