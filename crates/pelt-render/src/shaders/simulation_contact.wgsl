@@ -1,6 +1,6 @@
 // Contact after the bend (`pelt_core::sim::contact`): the skin planes, the colliders and the
-// grasp, per strand, root first, on the nodes `step_strands` just wrote. Appended to
-// `simulation.wgsl`; `step_strands` calls `contact_strand` last.
+// grasp, per strand, root first, on the nodes the bend just wrote. Appended to
+// `simulation.wgsl`; `step_strands_with_contact` is the kernel of steps with contact.
 //
 // `contact` layout, in vec4s (V strands, `grid.y` the step's slot):
 //   [2 s], [2 s + 1] for slot s < CONTACT_SLOTS: (collider count, skin on, grip presence, -),
@@ -306,6 +306,18 @@ fn surface_clearance(s: Surface, x: vec3<f32>, cheap: f32, v: u32) -> f32 {
 fn strand_grasp_weight(j: u32, v: u32) -> f32 {
     let at = CONTACT_SKIN + SKIN_PLANES * v + j / 4u;
     return contact[at][j % 4u];
+}
+
+// A step with contact (`ContactStep::is_active`): the bend, then contact on its nodes.
+@compute @workgroup_size(64)
+fn step_strands_with_contact(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index) lane: u32) {
+    let j = step_strand_index(group, lane);
+    let v = inputs.next_tick_counts.z;
+    if j >= v {
+        return;
+    }
+    bend_strand(j);
+    contact_strand(j, v, inputs.next_tick_counts.w, strand_root(j).xyz, strand_frame(j, v));
 }
 
 fn contact_strand(j: u32, v: u32, layers: u32, root: vec3<f32>, frame: vec4<f32>) {
