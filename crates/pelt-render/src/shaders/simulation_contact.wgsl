@@ -345,7 +345,7 @@ fn contact_strand(j: u32, v: u32, layers: u32, root: vec3<f32>, frame: vec4<f32>
     }
     // Colliders that can reach the strand (its nodes lie within its length of the root).
     var strand_length = 0.0;
-    for (var k = 0u; k < layers; k++) {
+    for (var k = 0u; k < layers && count > 0u; k++) {
         strand_length += rest_segments[k * v + j].w;
     }
     let first = CONTACT_SKIN + SKIN_PLANES * v + (v + 3u) / 4u + slot * CONTACT_COLLIDERS * COLLIDER_WORDS;
