@@ -488,6 +488,55 @@ fn colliders_keep_the_fur_out() {
     assert!(worst_skin <= SKIN_EPSILON, "a node {worst_skin:e} of the fur's length below the skin");
 }
 
+/// Contact leaves the nodes before a strand's first touch as the bend made them, to the bit:
+/// balls pressed into the fur on the back change no node below the first that comes within 1%
+/// of the fur's length of one (the sphere's own distance) in the same step without them.
+#[test]
+fn nodes_before_the_first_touch_keep_the_bends_bytes() {
+    let (fur, _, radius) = bunny();
+    let v = fur.vertex_count();
+    let length = fur.lengths[0];
+    let ball = 0.1 * radius;
+    let up: Vec<usize> = (0..v).filter(|&j| fur.mesh.normals[j].y > 0.9).collect();
+    let centres: Vec<Vec3> = up
+        .iter()
+        .step_by(up.len().div_ceil(8))
+        .map(|&j| fur.mesh.positions[j] + fur.mesh.normals[j] * (0.4 * length + ball))
+        .collect();
+    let colliders: Vec<Collider> = centres
+        .iter()
+        .enumerate()
+        .map(|(i, &c)| Collider {
+            appear_secs: 0.0,
+            ..Collider::at(i as u32, Shape::Sphere { radius: ball }, 0.0, c, Quat::IDENTITY)
+        })
+        .collect();
+    let params = SimParams { wind: WindParams { strength: 0.5, ..WindParams::default() }, ..with_skin(false) };
+    let mut touched = Simulation::new(&fur, &params).unwrap();
+    let mut free = Simulation::new(&fur, &params).unwrap();
+    touched.set_colliders(&colliders).unwrap();
+    // One step from the same state: the free simulation's nodes are the bend's.
+    free.advance_to(1.0 / 30.0);
+    touched.advance_to(1.0 / 30.0);
+    let (a, b) = (touched.positions(), free.positions());
+    let (mut strands, mut kept, mut pushed) = (0, 0, 0);
+    for j in 0..v {
+        let distance =
+            |k: usize| centres.iter().map(|&c| sphere_distance(b[k * v + j], c, ball)).fold(f32::MAX, f32::min);
+        let Some(first) = (1..=fur.layers as usize).find(|&k| distance(k) < 0.01 * length) else { continue };
+        strands += 1;
+        for k in 1..first {
+            assert!(a[k * v + j] == b[k * v + j], "strand {j}: node {k} (of {first} before a ball) moved");
+            kept += 1;
+        }
+        pushed += usize::from((first..=fur.layers as usize).any(|k| a[k * v + j] != b[k * v + j]));
+    }
+    assert!(
+        strands > 10 && kept > 80 && pushed > 10,
+        "the balls reached {strands} strands ({kept} nodes before them), pushed {pushed}"
+    );
+}
+
 /// A hand closes on the back, lifts a tuft and lets go. While it holds (after closing), every
 /// strand it holds fully has a node within one segment of the grip, or where the grip is beyond
 /// its length, its tip within 1% of `distance - length` of it; after release every node is back within 1e-3 of the fur's length of its free pose

@@ -150,12 +150,14 @@ fn step_strand_index(group: vec3<u32>, lane: u32) -> u32 {
 fn step_strands(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index) lane: u32) {
     let j = step_strand_index(group, lane);
     if j < inputs.next_tick_counts.z {
-        bend_strand(j);
+        bend_strand(j, false);
     }
 }
 
-// Strand j's nodes bent by the step's forces (Equation 1), written to `positions`.
-fn bend_strand(j: u32) {
+// Strand j's nodes bent by the step's forces (Equation 1), written to `positions`; with
+// `screening`, each node also goes to contact's `screen_node` as it is made (`step_strands`
+// passes false, so it compiles without it).
+fn bend_strand(j: u32, screening: bool) {
     let v = inputs.next_tick_counts.z;
     let layers = inputs.next_tick_counts.w;
     let root_stability = strand_root(j);
@@ -192,9 +194,9 @@ fn bend_strand(j: u32) {
     positions[j * 3u + 2u] = root.z;
     let straight = rest_segments[layers * v + j];
     if straight.w > 0.0 {
-        bend_straight(j, v, layers, root, frame, straight.xyz, force_direction, scale);
+        bend_straight(j, v, layers, root, frame, straight.xyz, force_direction, scale, screening);
     } else {
-        bend_general(j, v, layers, root, frame, force_direction, scale);
+        bend_general(j, v, layers, root, frame, force_direction, scale, screening);
     }
 }
 
@@ -219,7 +221,17 @@ fn write_node(j: u32, v: u32, k: u32, node: vec3<f32>) {
 // stays in the plane of its direction `d` and the force `f`: segment k ends at the angle
 // `a_(k+1) = a_k (1 - w_k)` from f, turned by `a_0 - a_(k+1)` from d toward `e`, the unit normal
 // to d in that plane (built from its own length, so lengths hold near an antiparallel force).
-fn bend_straight(j: u32, v: u32, layers: u32, root: vec3<f32>, frame: vec4<f32>, rest_direction: vec3<f32>, f: vec3<f32>, scale: f32) {
+fn bend_straight(
+    j: u32,
+    v: u32,
+    layers: u32,
+    root: vec3<f32>,
+    frame: vec4<f32>,
+    rest_direction: vec3<f32>,
+    f: vec3<f32>,
+    scale: f32,
+    screening: bool,
+) {
     let d = rotate(frame, rest_direction);
     let axis = cross(d, f);
     let sine = length(axis);
@@ -242,14 +254,27 @@ fn bend_straight(j: u32, v: u32, layers: u32, root: vec3<f32>, frame: vec4<f32>,
         let half = sin_cos_quarter_turn((start - remaining) * 0.5);
         let cos_turn = 1.0 - 2.0 * half.x * half.x;
         let sin_turn = 2.0 * half.x * half.y;
-        node += (e * sin_turn + d * cos_turn) * rest_segments[k * v + j].w;
+        let segment_length = rest_segments[k * v + j].w;
+        node += (e * sin_turn + d * cos_turn) * segment_length;
         write_node(j, v, k + 1u, node);
+        if screening {
+            screen_node(k, node, segment_length, root);
+        }
     }
 }
 
 // `sim/kernel.rs`'s `bend_general` (and `bend::bend_strand`): any strand, by a running
 // quaternion; each segment is its rest direction under the turned frame, so it keeps its length.
-fn bend_general(j: u32, v: u32, layers: u32, root: vec3<f32>, frame: vec4<f32>, f: vec3<f32>, scale: f32) {
+fn bend_general(
+    j: u32,
+    v: u32,
+    layers: u32,
+    root: vec3<f32>,
+    frame: vec4<f32>,
+    f: vec3<f32>,
+    scale: f32,
+    screening: bool,
+) {
     var turned = frame;
     var node = root;
     for (var k = 0u; k < layers; k++) {
@@ -268,5 +293,8 @@ fn bend_general(j: u32, v: u32, layers: u32, root: vec3<f32>, frame: vec4<f32>, 
         }
         node += rotate(turned, rest.xyz) * rest.w;
         write_node(j, v, k + 1u, node);
+        if screening {
+            screen_node(k, node, rest.w, root);
+        }
     }
 }

@@ -278,29 +278,40 @@ fn surface_closest(s: Surface, x: vec3<f32>, v: u32) -> Closest {
     return Closest(s.root + rotate(s.frame, best.surface - s.rest_root), rotate(s.frame, best.normal), signed);
 }
 
+// One strand's contact in a step, set up by `contact_setup` before its bend: its skin planes
+// turned with its frame, the colliders that can reach it, its triangles, its grasp weight.
+// Then the bend hands each node to `screen_node` while it is still in registers, which clears
+// nodes by a bound cheaper than the clearance, and `find_first_touch` tests from the first node
+// the bound did not clear. The bound is cheap because, where lanes diverge, a GPU (lavapipe
+// always) runs the code of a branch or loop body any lane takes for every lane.
+var<private> contact_planes: array<vec4<f32>, SKIN_PLANES>;
+var<private> contact_plane_count: u32;
+var<private> contact_near: array<u32, NEAR_COLLIDERS>;
+var<private> contact_near_count: u32;
+var<private> contact_surface: Surface;
+var<private> contact_held: f32;
+// The first segment whose end the bound did not clear (the strand's layers while none) and how
+// far the last node bounded was from touching, less the segments since (nodes within it need no
+// bound).
+var<private> screen_from: u32;
+var<private> screen_budget: f32;
+
 // `contact::cheap_clearance`: how far x is from touching a skin plane or a collider (negative:
 // touching).
-fn cheap_clearance(
-    x: vec3<f32>,
-    root: vec3<f32>,
-    planes: ptr<function, array<vec4<f32>, SKIN_PLANES>>,
-    plane_count: u32,
-    near: ptr<function, array<u32, 32>>,
-    near_count: u32,
-) -> f32 {
+fn cheap_clearance(x: vec3<f32>, root: vec3<f32>) -> f32 {
     var least = 3.4e38;
-    for (var p = 0u; p < plane_count; p++) {
-        least = min(least, dot((*planes)[p].xyz, x - root) + (*planes)[p].w);
+    for (var p = 0u; p < contact_plane_count; p++) {
+        least = min(least, dot(contact_planes[p].xyz, x - root) + contact_planes[p].w);
     }
-    for (var i = 0u; i < near_count; i++) {
-        least = min(least, collider_closest((*near)[i], x).distance);
+    for (var i = 0u; i < contact_near_count; i++) {
+        least = min(least, collider_closest(contact_near[i], x).distance);
     }
     return least;
 }
 
 // `Surface::clearance`: the least of `cheap` and x's distance in front of the triangles.
-fn surface_clearance(s: Surface, x: vec3<f32>, cheap: f32, v: u32) -> f32 {
-    return min(cheap, surface_closest(s, x, v).distance);
+fn surface_clearance(x: vec3<f32>, cheap: f32, v: u32) -> f32 {
+    return min(cheap, surface_closest(contact_surface, x, v).distance);
 }
 
 fn strand_grasp_weight(j: u32, v: u32) -> f32 {
@@ -308,7 +319,8 @@ fn strand_grasp_weight(j: u32, v: u32) -> f32 {
     return contact[at][j % 4u];
 }
 
-// A step with contact (`ContactStep::is_active`): the bend, then contact on its nodes.
+// A step with contact (`ContactStep::is_active`): the bend, screening its nodes, then contact
+// from the first segment that may touch.
 @compute @workgroup_size(64)
 fn step_strands_with_contact(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index) lane: u32) {
     let j = step_strand_index(group, lane);
@@ -316,30 +328,40 @@ fn step_strands_with_contact(@builtin(workgroup_id) group: vec3<u32>, @builtin(l
     if j >= v {
         return;
     }
-    bend_strand(j);
-    contact_strand(j, v, inputs.next_tick_counts.w, strand_root(j).xyz, strand_frame(j, v));
+    let layers = inputs.next_tick_counts.w;
+    let root = strand_root(j).xyz;
+    let frame = strand_frame(j, v);
+    let touching = contact_setup(j, v, layers, root, frame);
+    bend_strand(j, touching);
+    if touching && screen_from < layers {
+        var first_touch = 0u;
+        if contact_held == 0.0 {
+            first_touch = find_first_touch(j, v, layers, root);
+        }
+        if first_touch < layers {
+            contact_strand(j, v, layers, root, frame, first_touch);
+        }
+    }
 }
 
-fn contact_strand(j: u32, v: u32, layers: u32, root: vec3<f32>, frame: vec4<f32>) {
+// Strand j's contact inputs for this step (false: nothing can touch the fur this step).
+fn contact_setup(j: u32, v: u32, layers: u32, root: vec3<f32>, frame: vec4<f32>) -> bool {
     let slot = inputs.grid.y;
     let header = contact[2u * slot];
     let count = bitcast<u32>(header.x);
     let skin = header.y > 0.0;
     let presence = header.z;
     if count == 0u && !skin && presence == 0.0 {
-        return;
+        return false;
     }
-    let grip = contact[2u * slot + 1u].xyz;
-    let held = strand_grasp_weight(j, v) * presence;
-
-    var planes: array<vec4<f32>, SKIN_PLANES>;
-    var plane_count = 0u;
+    contact_held = strand_grasp_weight(j, v) * presence;
+    contact_plane_count = 0u;
     if skin {
         for (var p = 0u; p < SKIN_PLANES; p++) {
             let plane = contact[CONTACT_SKIN + j * SKIN_PLANES + p];
             if any(plane.xyz != vec3<f32>(0.0)) {
-                planes[plane_count] = vec4<f32>(rotate(frame, plane.xyz), plane.w);
-                plane_count += 1u;
+                contact_planes[contact_plane_count] = vec4<f32>(rotate(frame, plane.xyz), plane.w);
+                contact_plane_count += 1u;
             }
         }
     }
@@ -349,56 +371,104 @@ fn contact_strand(j: u32, v: u32, layers: u32, root: vec3<f32>, frame: vec4<f32>
         strand_length += rest_segments[k * v + j].w;
     }
     let first = CONTACT_SKIN + SKIN_PLANES * v + (v + 3u) / 4u + slot * CONTACT_COLLIDERS * COLLIDER_WORDS;
-    var near: array<u32, 32>;
-    var near_count = 0u;
-    for (var i = 0u; i < count && near_count < NEAR_COLLIDERS; i++) {
+    contact_near_count = 0u;
+    for (var i = 0u; i < count && contact_near_count < NEAR_COLLIDERS; i++) {
         let c = first + i * COLLIDER_WORDS;
         let bound = contact[c + 4u];
-        if bound.y > 0.0 && held != 0.0 {
+        if bound.y > 0.0 && contact_held != 0.0 {
             continue;
         }
         if distance(root, contact[c].xyz) <= bound.x + strand_length {
-            near[near_count] = c;
-            near_count += 1u;
+            contact_near[contact_near_count] = c;
+            contact_near_count += 1u;
         }
     }
-    var surface = Surface(0u, 0u, vec3<f32>(0.0), root, frame);
+    contact_surface = Surface(0u, 0u, vec3<f32>(0.0), root, frame);
     if skin {
         let header = contact[surface_first(v) + j];
         let packed = bitcast<u32>(header.w);
-        surface = Surface(packed >> 6u, packed & 63u, header.xyz, root, frame);
+        contact_surface = Surface(packed >> 6u, packed & 63u, header.xyz, root, frame);
     }
-    // Whether anything touches the strand; if not, it stays as the bend made it.
-    // `Resolve::solve_strand`: after one clearance away the nodes within it need no test; the
-    // first segment whose end may touch is where the walk starts testing.
-    var first_touch = select(layers, 0u, held != 0.0);
+    // A held strand is solved from its root; one with triangles has no cheap bound.
+    screen_from = select(layers, 0u, contact_held != 0.0 || contact_surface.count > 0u);
+    screen_budget = 0.0;
+    return true;
+}
+
+// At most the clearance of x (`cheap_clearance` without triangles): the skin planes' heights
+// and each collider's distance from the ball that holds it.
+fn bound_clearance(x: vec3<f32>, root: vec3<f32>) -> f32 {
+    var least = 3.4e38;
+    for (var p = 0u; p < contact_plane_count; p++) {
+        least = min(least, dot(contact_planes[p].xyz, x - root) + contact_planes[p].w);
+    }
+    for (var i = 0u; i < contact_near_count; i++) {
+        let c = contact_near[i];
+        least = min(least, distance(x, contact[c].xyz) - contact[c + 4u].x);
+    }
+    return least;
+}
+
+// A budgeted walk with the bound: `node` ends segment k (of `segment_length`).
+fn screen_node(k: u32, node: vec3<f32>, segment_length: f32, root: vec3<f32>) {
+    if k >= screen_from {
+        return;
+    }
+    screen_budget -= segment_length * CONTACT_SKIP_SLACK;
+    if screen_budget > 0.0 {
+        return;
+    }
+    screen_budget = bound_clearance(node, root);
+    if screen_budget < 0.0 {
+        screen_from = k;
+    }
+}
+
+// `Resolve::first_touch` from `screen_from` (the nodes before it are clear): the first segment
+// whose end touches, or `layers`. Nodes within the last clearance found, less the segments
+// since, need no test; clearance grows by at most the arc, so which nodes are tested does not
+// change the segment found.
+fn find_first_touch(j: u32, v: u32, layers: u32, root: vec3<f32>) -> u32 {
     var budget = 0.0;
-    for (var k = 0u; k < first_touch; k++) {
+    for (var k = screen_from; k < layers; k++) {
         budget -= rest_segments[k * v + j].w * CONTACT_SKIP_SLACK;
         if budget > 0.0 {
             continue;
         }
         let x = read_node(j, v, k + 1u);
-        budget = surface_clearance(surface, x, cheap_clearance(x, root, &planes, plane_count, &near, near_count), v);
+        budget = surface_clearance(x, cheap_clearance(x, root), v);
         if budget < 0.0 {
-            first_touch = k;
+            return k;
         }
     }
-    if first_touch == layers {
-        return;
-    }
+    return layers;
+}
+
+// `Resolve::solve_strand` from `first_touch` on: the nodes before it keep the bend's positions.
+fn contact_strand(j: u32, v: u32, layers: u32, root: vec3<f32>, frame: vec4<f32>, first_touch: u32) {
+    let held = contact_held;
+    let surface = contact_surface;
+    let grip = contact[2u * inputs.grid.y + 1u].xyz;
     let to_grip = grip - root;
     let grip_distance = length(to_grip);
     let has_grip = grip_distance > 0.0;
     let toward = to_grip / select(1.0, grip_distance, has_grip);
+    // The arc matters to held strands only, and those start at the root.
     var arc = 0.0;
-    var previous_bent = root;
-    var p = root;
+    var previous_bent = read_node(j, v, first_touch);
+    var p = previous_bent;
     // `Resolve::solve_strand`'s hint: the way the segment before went.
     let across = rotate(frame, vec3<f32>(1.0, 0.0, 0.0));
     var hint = across;
+    for (var m = first_touch; m > 0u; m--) {
+        if rest_segments[(m - 1u) * v + j].w > 0.0 {
+            let u = normalize_or(read_node(j, v, m) - read_node(j, v, m - 1u), vec3<f32>(0.0, 1.0, 0.0));
+            hint = u + across * 0.5;
+            break;
+        }
+    }
     var walk_budget = 0.0;
-    for (var k = 0u; k < layers; k++) {
+    for (var k = first_touch; k < layers; k++) {
         let segment_length = rest_segments[k * v + j].w;
         let bent = read_node(j, v, k + 1u);
         if segment_length <= 0.0 {
@@ -415,26 +485,20 @@ fn contact_strand(j: u32, v: u32, layers: u32, root: vec3<f32>, frame: vec4<f32>
         arc += segment_length;
         // Where the start is clear by more than the segment, no end can touch anything.
         let step = segment_length * CONTACT_SKIP_SLACK;
-        if k < first_touch {
-            hint = u + across * 0.5;
-            p = p + u * segment_length;
-            write_node(j, v, k + 1u, p);
-            continue;
-        }
         if walk_budget <= step {
-            let cheap = cheap_clearance(p, root, &planes, plane_count, &near, near_count);
+            let cheap = cheap_clearance(p, root);
             if k == 0u {
                 // The root lies on its skin: no nearer than 0 to its triangles.
                 walk_budget = select(cheap, min(cheap, 0.0), surface.count > 0u);
             } else {
-                walk_budget = surface_clearance(surface, p, cheap, v);
+                walk_budget = surface_clearance(p, cheap, v);
             }
         }
         walk_budget -= step;
         for (var round = 0u; round < 8u && walk_budget <= 0.0; round++) {
             var moved = false;
-            for (var i = 0u; i < near_count; i++) {
-                let c = near[i];
+            for (var i = 0u; i < contact_near_count; i++) {
+                let c = contact_near[i];
                 let hit = collider_closest(c, p + u * segment_length);
                 if hit.distance >= 0.0 {
                     continue;
@@ -456,9 +520,9 @@ fn contact_strand(j: u32, v: u32, layers: u32, root: vec3<f32>, frame: vec4<f32>
                 u = turn_above(u, normal, floor + CONTACT_MARGIN, hint);
                 moved = true;
             }
-            for (var q = 0u; q < plane_count; q++) {
-                let n = planes[q].xyz;
-                let floor = (-planes[q].w - dot(n, p - root)) / segment_length;
+            for (var q = 0u; q < contact_plane_count; q++) {
+                let n = contact_planes[q].xyz;
+                let floor = (-contact_planes[q].w - dot(n, p - root)) / segment_length;
                 if dot(n, u) < floor {
                     u = turn_above(u, n, floor + CONTACT_MARGIN, hint);
                     moved = true;

@@ -302,7 +302,7 @@ impl Resolve<'_> {
         let surface = self.surface(j);
         let colliders = near.iter();
         // The first segment whose end may touch: the ends before it are clear, so the walk
-        // below keeps their directions without testing them.
+        // below leaves them as the bend made them.
         let first_touch = if held == 0.0 {
             let clearance = |x: Vec3| surface.clearance(x, cheap_clearance(x, root, planes, colliders.clone()));
             match self.first_touch(b, lane, |i| nodes[i], clearance) {
@@ -347,8 +347,8 @@ impl Resolve<'_> {
             // Where the start is clear by more than the segment, no end can touch anything.
             let step = length * SKIP_SLACK;
             if k < first_touch {
+                // The bend's node stands: a segment clear of everything is not rewritten.
                 hint = u + across * 0.5;
-                nodes[k + 1] = p + u * length;
                 continue;
             }
             if budget <= step {
