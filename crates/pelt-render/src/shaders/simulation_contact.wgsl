@@ -357,12 +357,14 @@ fn contact_setup(j: u32, v: u32, layers: u32, root: vec3<f32>, frame: vec4<f32>)
     contact_held = strand_grasp_weight(j, v) * presence;
     contact_plane_count = 0u;
     if skin {
+        // A strand's planes fill the first of its slots (`skin_planes`).
         for (var p = 0u; p < SKIN_PLANES; p++) {
             let plane = contact[CONTACT_SKIN + j * SKIN_PLANES + p];
-            if any(plane.xyz != vec3<f32>(0.0)) {
-                contact_planes[contact_plane_count] = vec4<f32>(rotate(frame, plane.xyz), plane.w);
-                contact_plane_count += 1u;
+            if all(plane.xyz == vec3<f32>(0.0)) {
+                break;
             }
+            contact_planes[p] = vec4<f32>(rotate(frame, plane.xyz), plane.w);
+            contact_plane_count += 1u;
         }
     }
     // Colliders that can reach the strand (its nodes lie within its length of the root).
