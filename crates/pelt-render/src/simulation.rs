@@ -161,8 +161,10 @@ fn settle_inertia(pending: &mut [StepUniform], mut history: u8) -> u8 {
 pub struct GpuSimulation {
     pipeline: wgpu::ComputePipeline,
     touch_pipeline: wgpu::ComputePipeline,
-    /// `step_strands_with_contact`: the kernel of steps whose contact is active.
+    /// `step_strands_with_contact`: the kernel of steps whose contact is active, compiled
+    /// without mesh colliders' code (`MESH_COLLIDERS`) and with it.
     contact_pipeline: wgpu::ComputePipeline,
+    mesh_contact_pipeline: wgpu::ComputePipeline,
     layout: wgpu::BindGroupLayout,
     step_uniforms: wgpu::Buffer,
     rest_segments: wgpu::Buffer,
@@ -319,19 +321,23 @@ impl GpuSimulation {
             bind_group_layouts: &[Some(&layout)],
             immediate_size: 0,
         });
-        let compute_pipeline = |entry_point| {
+        let compute_pipeline = |entry_point, constants: &[(&str, f64)]| {
             device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
                 label: Some(entry_point),
                 layout: Some(&pipeline_layout),
                 module: &module,
                 entry_point: Some(entry_point),
-                compilation_options: wgpu::PipelineCompilationOptions::default(),
+                compilation_options: wgpu::PipelineCompilationOptions {
+                    constants,
+                    ..wgpu::PipelineCompilationOptions::default()
+                },
                 cache: None,
             })
         };
-        let pipeline = compute_pipeline("step_strands");
-        let touch_pipeline = compute_pipeline("weigh_touch");
-        let contact_pipeline = compute_pipeline("step_strands_with_contact");
+        let pipeline = compute_pipeline("step_strands", &[]);
+        let touch_pipeline = compute_pipeline("weigh_touch", &[]);
+        let contact_pipeline = compute_pipeline("step_strands_with_contact", &[("MESH_COLLIDERS", 0.0)]);
+        let mesh_contact_pipeline = compute_pipeline("step_strands_with_contact", &[]);
         let buffer = |label, size: u64, usage| {
             device.create_buffer(&wgpu::BufferDescriptor { label: Some(label), size, usage, mapped_at_creation: false })
         };
@@ -365,6 +371,7 @@ impl GpuSimulation {
             pipeline,
             touch_pipeline,
             contact_pipeline,
+            mesh_contact_pipeline,
             layout,
             step_uniforms,
             rest_segments,
@@ -520,8 +527,11 @@ impl GpuSimulation {
                 label: Some("pelt simulation step"),
                 timestamp_writes: None,
             });
-            let contact = self.pending_contact.get(slot).is_some_and(ContactStep::is_active);
-            pass.set_pipeline(if contact { &self.contact_pipeline } else { &self.pipeline });
+            pass.set_pipeline(match self.pending_contact.get(slot) {
+                Some(step) if step.colliders.iter().any(|c| c.mesh.is_some()) => &self.mesh_contact_pipeline,
+                Some(step) if step.is_active() => &self.contact_pipeline,
+                _ => &self.pipeline,
+            });
             pass.set_bind_group(0, bind_group, &[self.slot_offset(slot) as u32]);
             pass.dispatch_workgroups(self.grid[0], self.grid[1], 1);
         }

@@ -21,6 +21,10 @@
 // dims xyz as bits, -, then the values, x fastest.
 @group(0) @binding(7) var<storage, read> sdf_fields: array<f32>;
 
+// Whether the kernel reads mesh colliders' fields: steps without a mesh collider run a pipeline
+// compiled without that code (it costs where lanes diverge even when no lane takes it).
+override MESH_COLLIDERS: bool = true;
+
 const CONTACT_SLOTS: u32 = 64u;
 const CONTACT_SKIN: u32 = 2u * CONTACT_SLOTS;
 const SKIN_PLANES: u32 = 16u;
@@ -94,7 +98,7 @@ fn collider_closest(c: u32, x: vec3<f32>) -> Closest {
         normal[axis] = sign;
         return Closest(centre + rotate(turn, surface), rotate(turn, normal), q[axis]);
     }
-    if kind == 4u {
+    if MESH_COLLIDERS && kind == 4u {
         return sdf_closest(x, centre, turn, radius, bitcast<u32>(contact[c + 4u].z), up);
     }
     let distance = dot(up, x - centre);
