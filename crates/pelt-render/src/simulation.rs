@@ -23,6 +23,12 @@ use crate::shaders::simulation_shader_source;
 const WORKGROUP: u32 = 64;
 /// Bytes per step's uniform slot: the largest `min_uniform_buffer_offset_alignment` allowed.
 const STEP_SLOT_BYTES: u64 = 256;
+/// Which of `GpuSimulation::contact_pipelines` steps `step`: the one compiled without
+/// colliders' code (0), without mesh colliders' (1), or with both (2).
+fn contact_kernel(step: &ContactStep) -> usize {
+    if step.colliders.iter().any(|c| c.mesh.is_some()) { 2 } else { usize::from(!step.colliders.is_empty()) }
+}
+
 /// Steps one prepare/dispatch pair can hold: only the last two states are ever kept.
 const STEP_SLOTS: usize = 2;
 /// Uniform slots in the ring the steps take in turn: a host recording up to this many steps into
@@ -162,9 +168,8 @@ pub struct GpuSimulation {
     pipeline: wgpu::ComputePipeline,
     touch_pipeline: wgpu::ComputePipeline,
     /// `step_strands_with_contact`: the kernel of steps whose contact is active, compiled
-    /// without mesh colliders' code (`MESH_COLLIDERS`) and with it.
-    contact_pipeline: wgpu::ComputePipeline,
-    mesh_contact_pipeline: wgpu::ComputePipeline,
+    /// without colliders' code, with colliders but no mesh's, and with both (`contact_kernel`).
+    contact_pipelines: [wgpu::ComputePipeline; 3],
     layout: wgpu::BindGroupLayout,
     step_uniforms: wgpu::Buffer,
     rest_segments: wgpu::Buffer,
@@ -336,8 +341,8 @@ impl GpuSimulation {
         };
         let pipeline = compute_pipeline("step_strands", &[]);
         let touch_pipeline = compute_pipeline("weigh_touch", &[]);
-        let contact_pipeline = compute_pipeline("step_strands_with_contact", &[("MESH_COLLIDERS", 0.0)]);
-        let mesh_contact_pipeline = compute_pipeline("step_strands_with_contact", &[]);
+        let contact_pipelines = [&[("COLLIDERS", 0.0), ("MESH_COLLIDERS", 0.0)][..], &[("MESH_COLLIDERS", 0.0)], &[]]
+            .map(|constants| compute_pipeline("step_strands_with_contact", constants));
         let buffer = |label, size: u64, usage| {
             device.create_buffer(&wgpu::BufferDescriptor { label: Some(label), size, usage, mapped_at_creation: false })
         };
@@ -370,8 +375,7 @@ impl GpuSimulation {
         Ok(Self {
             pipeline,
             touch_pipeline,
-            contact_pipeline,
-            mesh_contact_pipeline,
+            contact_pipelines,
             layout,
             step_uniforms,
             rest_segments,
@@ -528,8 +532,7 @@ impl GpuSimulation {
                 timestamp_writes: None,
             });
             pass.set_pipeline(match self.pending_contact.get(slot) {
-                Some(step) if step.colliders.iter().any(|c| c.mesh.is_some()) => &self.mesh_contact_pipeline,
-                Some(step) if step.is_active() => &self.contact_pipeline,
+                Some(step) if step.is_active() => &self.contact_pipelines[contact_kernel(step)],
                 _ => &self.pipeline,
             });
             pass.set_bind_group(0, bind_group, &[self.slot_offset(slot) as u32]);

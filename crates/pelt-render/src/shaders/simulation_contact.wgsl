@@ -21,8 +21,9 @@
 // dims xyz as bits, -, then the values, x fastest.
 @group(0) @binding(7) var<storage, read> sdf_fields: array<f32>;
 
-// Whether the kernel reads mesh colliders' fields: steps without a mesh collider run a pipeline
-// compiled without that code (it costs where lanes diverge even when no lane takes it).
+// Whether the kernel reads colliders, and mesh colliders' fields: steps without them run a
+// pipeline compiled without that code (it costs where lanes diverge even when no lane takes it).
+override COLLIDERS: bool = true;
 override MESH_COLLIDERS: bool = true;
 
 const CONTACT_SLOTS: u32 = 64u;
@@ -307,7 +308,7 @@ fn cheap_clearance(x: vec3<f32>, root: vec3<f32>) -> f32 {
     for (var p = 0u; p < contact_plane_count; p++) {
         least = min(least, dot(contact_planes[p].xyz, x - root) + contact_planes[p].w);
     }
-    for (var i = 0u; i < contact_near_count; i++) {
+    for (var i = 0u; COLLIDERS && i < contact_near_count; i++) {
         least = min(least, collider_closest(contact_near[i], x).distance);
     }
     return least;
@@ -378,7 +379,7 @@ fn contact_setup(j: u32, v: u32, layers: u32, root: vec3<f32>, frame: vec4<f32>)
     }
     let first = CONTACT_SKIN + SKIN_PLANES * v + (v + 3u) / 4u + slot * CONTACT_COLLIDERS * COLLIDER_WORDS;
     contact_near_count = 0u;
-    for (var i = 0u; i < count && contact_near_count < NEAR_COLLIDERS; i++) {
+    for (var i = 0u; COLLIDERS && i < count && contact_near_count < NEAR_COLLIDERS; i++) {
         let c = first + i * COLLIDER_WORDS;
         let bound = contact[c + 4u];
         if bound.y > 0.0 && contact_held != 0.0 {
@@ -408,7 +409,7 @@ fn bound_clearance(x: vec3<f32>, root: vec3<f32>) -> f32 {
     for (var p = 0u; p < contact_plane_count; p++) {
         least = min(least, dot(contact_planes[p].xyz, x - root) + contact_planes[p].w);
     }
-    for (var i = 0u; i < contact_near_count; i++) {
+    for (var i = 0u; COLLIDERS && i < contact_near_count; i++) {
         let c = contact_near[i];
         least = min(least, distance(x, contact[c].xyz) - contact[c + 4u].x);
     }
@@ -503,7 +504,7 @@ fn contact_strand(j: u32, v: u32, layers: u32, root: vec3<f32>, frame: vec4<f32>
         walk_budget -= step;
         for (var round = 0u; round < 8u && walk_budget <= 0.0; round++) {
             var moved = false;
-            for (var i = 0u; i < contact_near_count; i++) {
+            for (var i = 0u; COLLIDERS && i < contact_near_count; i++) {
                 let c = contact_near[i];
                 let hit = collider_closest(c, p + u * segment_length);
                 if hit.distance >= 0.0 {
