@@ -292,6 +292,10 @@ fn surface_closest(s: Surface, x: vec3<f32>, v: u32) -> Closest {
 var<private> contact_planes: array<vec4<f32>, SKIN_PLANES>;
 var<private> contact_plane_count: u32;
 var<private> contact_near: array<u32, NEAR_COLLIDERS>;
+// Each near collider's core for the bound: a segment (from xyz, radius) to (xyz, -) swept by a
+// ball, the shape itself for a sphere or capsule, its bounding ball otherwise.
+var<private> contact_cores: array<vec4<f32>, NEAR_COLLIDERS>;
+var<private> contact_core_ends: array<vec3<f32>, NEAR_COLLIDERS>;
 var<private> contact_near_count: u32;
 var<private> contact_surface: Surface;
 var<private> contact_held: f32;
@@ -387,6 +391,17 @@ fn contact_setup(j: u32, v: u32, layers: u32, root: vec3<f32>, frame: vec4<f32>)
         }
         if distance(root, contact[c].xyz) <= bound.x + strand_length {
             contact_near[contact_near_count] = c;
+            let centre = contact[c].xyz;
+            let kind = bitcast<u32>(contact[c + 1u].w);
+            var reach = vec3<f32>(0.0);
+            var radius = bound.x;
+            if kind <= 1u {
+                // A sphere (its half length 0) or a capsule: the segment along its turned Y axis.
+                reach = rotate(contact[c + 2u], vec3<f32>(0.0, select(0.0, contact[c + 1u].y, kind == 1u), 0.0));
+                radius = contact[c].w;
+            }
+            contact_cores[contact_near_count] = vec4<f32>(centre - reach, radius);
+            contact_core_ends[contact_near_count] = centre + reach;
             contact_near_count += 1u;
         }
     }
@@ -403,15 +418,19 @@ fn contact_setup(j: u32, v: u32, layers: u32, root: vec3<f32>, frame: vec4<f32>)
 }
 
 // At most the clearance of x (`cheap_clearance` without triangles): the skin planes' heights
-// and each collider's distance from the ball that holds it.
+// and each collider's distance from its core (`contact_cores`).
 fn bound_clearance(x: vec3<f32>, root: vec3<f32>) -> f32 {
     var least = 3.4e38;
     for (var p = 0u; p < contact_plane_count; p++) {
         least = min(least, dot(contact_planes[p].xyz, x - root) + contact_planes[p].w);
     }
     for (var i = 0u; COLLIDERS && i < contact_near_count; i++) {
-        let c = contact_near[i];
-        least = min(least, distance(x, contact[c].xyz) - contact[c + 4u].x);
+        let a = contact_cores[i].xyz;
+        let ab = contact_core_ends[i] - a;
+        let t = clamp(dot(x - a, ab) / max(dot(ab, ab), 1e-30), 0.0, 1.0);
+        let d = distance(x, a + ab * t) - contact_cores[i].w;
+        // Less a few ulps, so rounding never clears a node the exact distance would not.
+        least = min(least, d - 4e-6 * (abs(d) + contact_cores[i].w + length(ab)));
     }
     return least;
 }
