@@ -26,7 +26,8 @@ pub const SKIN_PLANES: usize = 16;
 const NO_PLANE: Vec4 = Vec4::new(0.0, 0.0, 0.0, 1.0);
 
 /// The skin planes of every strand of `fur`: `(n, h)` in the strand's rest frame, the node `x`
-/// must satisfy `n . (x - root) >= -h`.
+/// must satisfy `n . (x - root) >= -h`. A strand's planes fill its first slots; the rest have
+/// `n` zero (the GPU kernel stops reading at the first).
 #[must_use]
 pub fn skin_planes(fur: &FurStructure) -> Vec<[Vec4; SKIN_PLANES]> {
     skin_planes_of(fur, 0..fur.vertex_count()).1
@@ -221,5 +222,28 @@ mod tests {
         assert_eq!(planes.len(), fur.vertex_count());
         let surface = super::super::skin_surface(&fur, &planes);
         assert_eq!(surface.strands.len(), fur.vertex_count());
+    }
+
+    /// Every strand's planes fill a prefix of its slots (the GPU kernel reads up to the first
+    /// unused one), on meshes with creases and saddles where strands take many planes.
+    #[test]
+    fn planes_fill_the_first_slots() {
+        for builtin in [Builtin::Bunny, Builtin::Torus] {
+            let (mesh, _) = builtin.mesh();
+            let params =
+                FurParams { layers: 8, length: FurLength::Constant(0.5), direction: GrowthDirection::default() };
+            let fur = FurStructure::new(mesh, &params).unwrap();
+            let planes = skin_planes(&fur);
+            let mut most = 0;
+            for (j, strand) in planes.iter().enumerate() {
+                let used = strand.iter().take_while(|p| p.truncate() != Vec3::ZERO).count();
+                assert!(
+                    strand[used..].iter().all(|p| p.truncate() == Vec3::ZERO),
+                    "{builtin:?} strand {j}: {strand:?}"
+                );
+                most = most.max(used);
+            }
+            assert!(most > 2, "{builtin:?}: no strand took more than {most} planes");
+        }
     }
 }
