@@ -362,6 +362,16 @@ fn worst_segment_error(structure: &FurStructure, positions: &[Vec3]) -> f32 {
     worst
 }
 
+/// The vertex on the back where the contact tests press: facing up, nearest the middle in x; its
+/// position and normal.
+fn back_facing_up(structure: &FurStructure) -> (Vec3, Vec3) {
+    let back = (0..structure.vertex_count())
+        .filter(|&j| structure.mesh.normals[j].y > 0.9)
+        .min_by(|&a, &b| structure.positions[a].x.abs().total_cmp(&structure.positions[b].x.abs()))
+        .expect("a vertex facing up");
+    (structure.positions[back], structure.mesh.normals[back])
+}
+
 /// The same fur on both kernels with contact: the skin under strong gravity and downward wind
 /// (alone for half a second, then with) a ball, a thin capsule and a box moving through the fur
 /// on the back, a hand lifting a tuft and
@@ -386,11 +396,7 @@ fn gpu_and_cpu_agree_with_contact() {
         contact: ContactParams { skin: true },
         ..SimParams::default()
     };
-    let back = (0..v)
-        .filter(|&j| structure.mesh.normals[j].y > 0.9)
-        .min_by(|&a, &b| structure.positions[a].x.abs().total_cmp(&structure.positions[b].x.abs()))
-        .expect("a vertex facing up");
-    let (hit, normal) = (structure.positions[back], structure.mesh.normals[back]);
+    let (hit, normal) = back_facing_up(&structure);
     let mut cpu = Simulation::new(&structure, &params).expect("simulation");
     let mut control = Simulation::new(&structure, &params).expect("simulation");
     control.set_cpu_bending(false);
@@ -479,7 +485,6 @@ fn gpu_and_cpu_agree_with_a_mesh_collider() {
     use pelt_core::mesh::{ImportOptions, Mesh};
     use pelt_core::sim::{Collider, ColliderMesh, ContactParams, Shape};
     let structure = builtin_fur(Builtin::Bunny, 16);
-    let v = structure.vertex_count();
     let radius = structure.mesh.bounding_sphere().1;
     let length = structure.lengths[0];
     let params = SimParams {
@@ -488,11 +493,7 @@ fn gpu_and_cpu_agree_with_a_mesh_collider() {
         contact: ContactParams { skin: true },
         ..SimParams::default()
     };
-    let back = (0..v)
-        .filter(|&j| structure.mesh.normals[j].y > 0.9)
-        .min_by(|&a, &b| structure.positions[a].x.abs().total_cmp(&structure.positions[b].x.abs()))
-        .expect("a vertex facing up");
-    let (hit, normal) = (structure.positions[back], structure.mesh.normals[back]);
+    let (hit, normal) = back_facing_up(&structure);
     let file = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets/meshes/pebble.obj");
     let (mesh, _) = Mesh::load(&file, &ImportOptions::default()).expect("the pebble");
     let pebble = std::sync::Arc::new(ColliderMesh::new(mesh, 24).expect("a closed pebble"));
@@ -536,7 +537,6 @@ fn gpu_and_cpu_agree_with_a_mesh_collider() {
 fn gpu_and_cpu_agree_with_colliders_alone() {
     use pelt_core::sim::{Collider, ContactParams, Shape};
     let structure = builtin_fur(Builtin::Bunny, 16);
-    let v = structure.vertex_count();
     let radius = structure.mesh.bounding_sphere().1;
     let length = structure.lengths[0];
     let params = SimParams {
@@ -544,11 +544,7 @@ fn gpu_and_cpu_agree_with_colliders_alone() {
         contact: ContactParams { skin: false },
         ..SimParams::default()
     };
-    let back = (0..v)
-        .filter(|&j| structure.mesh.normals[j].y > 0.9)
-        .min_by(|&a, &b| structure.positions[a].x.abs().total_cmp(&structure.positions[b].x.abs()))
-        .expect("a vertex facing up");
-    let (hit, normal) = (structure.positions[back], structure.mesh.normals[back]);
+    let (hit, normal) = back_facing_up(&structure);
     let mut cpu = Simulation::new(&structure, &params).expect("simulation");
     let mut free = Simulation::new(&structure, &params).expect("simulation");
     let mut control = Simulation::new(&structure, &params).expect("simulation");
