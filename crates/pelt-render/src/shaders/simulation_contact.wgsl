@@ -305,13 +305,19 @@ var<private> contact_held: f32;
 var<private> screen_from: u32;
 var<private> screen_budget: f32;
 
-// `contact::cheap_clearance`: how far x is from touching a skin plane or a collider (negative:
-// touching).
-fn cheap_clearance(x: vec3<f32>, root: vec3<f32>) -> f32 {
+// How far x is above the strand's lowest skin plane (3.4e38 without planes).
+fn plane_clearance(x: vec3<f32>, root: vec3<f32>) -> f32 {
     var least = 3.4e38;
     for (var p = 0u; p < contact_plane_count; p++) {
         least = min(least, dot(contact_planes[p].xyz, x - root) + contact_planes[p].w);
     }
+    return least;
+}
+
+// `contact::cheap_clearance`: how far x is from touching a skin plane or a collider (negative:
+// touching).
+fn cheap_clearance(x: vec3<f32>, root: vec3<f32>) -> f32 {
+    var least = plane_clearance(x, root);
     for (var i = 0u; COLLIDERS && i < contact_near_count; i++) {
         least = min(least, collider_closest(contact_near[i], x).distance);
     }
@@ -420,10 +426,7 @@ fn contact_setup(j: u32, v: u32, layers: u32, root: vec3<f32>, frame: vec4<f32>)
 // At most the clearance of x (`cheap_clearance` without triangles): the skin planes' heights
 // and each collider's distance from its core (`contact_cores`).
 fn bound_clearance(x: vec3<f32>, root: vec3<f32>) -> f32 {
-    var least = 3.4e38;
-    for (var p = 0u; p < contact_plane_count; p++) {
-        least = min(least, dot(contact_planes[p].xyz, x - root) + contact_planes[p].w);
-    }
+    var least = plane_clearance(x, root);
     for (var i = 0u; COLLIDERS && i < contact_near_count; i++) {
         let a = contact_cores[i].xyz;
         let ab = contact_core_ends[i] - a;
