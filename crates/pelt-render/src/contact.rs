@@ -1,13 +1,16 @@
-//! The GPU side of `pelt_core::sim::contact`: one storage buffer holding what the kernel's
-//! `contact_strand` (`simulation_contact.wgsl`) reads, packed from the simulation's
-//! `ContactStep` per step slot, its skin planes and the grasp's weights; and one holding the
-//! distance fields of mesh colliders, each uploaded once.
+//! The GPU side of `pelt_core::sim::contact`: one storage buffer holding what the kernels of
+//! `simulation_contact.wgsl` read, packed from the simulation's `ContactStep` per step slot, its
+//! skin planes and cones and the grasp's weights; one holding the distance fields of mesh
+//! colliders, each uploaded once; and the list of strands a step's screen could not clear, with
+//! the dispatch arguments of the kernel that solves them.
 
 use std::sync::Arc;
 
 use pelt_core::FurStructure;
 use pelt_core::sim::ColliderMesh;
-use pelt_core::sim::contact::{MAX_STEP_COLLIDERS, SKIN_PLANES, SURFACE_WORDS, SkinSurface, skin_planes, skin_surface};
+use pelt_core::sim::contact::{
+    MAX_STEP_COLLIDERS, SKIN_PLANES, SURFACE_WORDS, SkinSurface, skin_cone, skin_planes, skin_surface,
+};
 use pelt_core::sim::{ContactStep, ContactStrands};
 
 use crate::RenderError;
@@ -28,6 +31,11 @@ pub(crate) struct GpuContact {
     weights: Vec<f32>,
     /// Mesh colliders' distance fields (`simulation_contact.wgsl`'s `sdf_fields`).
     pub fields_buffer: wgpu::Buffer,
+    /// `simulation_contact.wgsl`'s `ContactWork`: the solve's workgroups and the listed strands.
+    pub work: wgpu::Buffer,
+    /// The solve's indirect dispatch arguments, copied from `work` (a dispatch cannot read its
+    /// arguments from a buffer it writes).
+    pub work_groups: wgpu::Buffer,
     /// The fields in `fields_buffer` and where each begins (in f32s); kept alive, so no other
     /// field can take an `Arc`'s address while it is listed.
     fields: Vec<(Arc<ColliderMesh>, u32)>,
@@ -57,8 +65,12 @@ fn fields_fit(words: usize, limits: &wgpu::Limits) -> Result<(), RenderError> {
     Ok(())
 }
 
-fn weights_first(v: usize) -> usize {
+fn cones_first(v: usize) -> usize {
     SKIN_FIRST + SKIN_PLANES * v
+}
+
+fn weights_first(v: usize) -> usize {
+    cones_first(v) + v
 }
 
 fn colliders_first(v: usize, slot: usize) -> usize {
@@ -82,6 +94,11 @@ impl Skin {
         Self { planes, surface }
     }
 
+    /// Each strand's cone (`skin_cone`), for the screen.
+    fn cones(&self) -> impl Iterator<Item = glam::Vec4> + '_ {
+        self.planes.iter().map(skin_cone)
+    }
+
     /// vec4s of the triangle part: a header per strand (rest root, `first << 6 | count`), the
     /// lists four indices a vec4, then the triangles.
     fn words(&self) -> usize {
@@ -95,6 +112,12 @@ impl GpuContact {
         (colliders_first(skin.planes.len(), CONTACT_SLOTS) + skin.words()) as u64 * 16
     }
 
+    /// Bytes of the list of a fur of `v` strands: the header (`groups`, `count`), and a strand
+    /// index and a segment per strand.
+    pub fn work_bytes(v: usize) -> u64 {
+        16 + 8 * v.max(1) as u64
+    }
+
     /// The buffer with `structure`'s skin planes and triangles and no collider or grasp.
     pub fn new(device: &wgpu::Device, structure: &FurStructure, skin: &Skin) -> Self {
         let v = structure.vertex_count();
@@ -103,6 +126,9 @@ impl GpuContact {
             for (p, plane) in planes.iter().enumerate() {
                 words[SKIN_FIRST + j * SKIN_PLANES + p] = plane.to_array();
             }
+        }
+        for (j, cone) in skin.cones().enumerate() {
+            words[cones_first(v) + j] = cone.to_array();
         }
         // The triangles (`simulation_contact.wgsl`'s `surface_closest`).
         let surface = &skin.surface;
@@ -129,7 +155,29 @@ impl GpuContact {
             },
         );
         let fields_buffer = fields_buffer(device, &[0.0; 4]);
-        Self { buffer, vertex_count: v, weights: Vec::new(), fields_buffer, fields: Vec::new() }
+        let work = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("pelt simulation contact list"),
+            size: Self::work_bytes(v),
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let work_groups = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("pelt simulation contact dispatch"),
+            size: 16,
+            usage: wgpu::BufferUsages::INDIRECT | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        Self { buffer, vertex_count: v, weights: Vec::new(), fields_buffer, work, work_groups, fields: Vec::new() }
+    }
+
+    /// Empties the list before a step's screen.
+    pub fn clear_work(&self, encoder: &mut wgpu::CommandEncoder) {
+        encoder.clear_buffer(&self.work, 0, Some(16));
+    }
+
+    /// The workgroups the screen counted, as the solve's dispatch arguments.
+    pub fn copy_work_groups(&self, encoder: &mut wgpu::CommandEncoder) {
+        encoder.copy_buffer_to_buffer(&self.work, 0, &self.work_groups, 0, 12);
     }
 
     /// Uploads the fields of the mesh colliders in `steps` not uploaded yet; true when the

@@ -3,9 +3,10 @@
 
 use crate::RenderError;
 
-/// Storage buffers the unified vertex shaders read: two position states, base normals, wedge
-/// uvs, topology, groom attributes and wetness.
-const STORAGE_BUFFERS_PER_STAGE: u32 = 7;
+/// Storage buffers a stage binds: the GPU simulation's compute stage 8 (WebGPU's default); the
+/// unified vertex shaders read 7 (two position states, base normals, wedge uvs, topology, groom
+/// attributes and wetness).
+const STORAGE_BUFFERS_PER_STAGE: u32 = 8;
 /// View, object and textures; the silhouette pass's fin list is group 3.
 const BIND_GROUPS: u32 = 4;
 /// The varyings of `shading.wgsl`.

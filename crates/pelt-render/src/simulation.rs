@@ -23,9 +23,9 @@ use crate::shaders::simulation_shader_source;
 const WORKGROUP: u32 = 64;
 /// Bytes per step's uniform slot: the largest `min_uniform_buffer_offset_alignment` allowed.
 const STEP_SLOT_BYTES: u64 = 256;
-/// Which of `GpuSimulation::contact_pipelines` steps `step`: the one compiled without
-/// colliders' code (0), without mesh colliders' (1), or with both (2).
-fn contact_kernel(step: &ContactStep) -> usize {
+/// Which of `GpuSimulation::solve_pipelines` solves `step`'s listed strands: the one compiled
+/// without colliders' code (0), without mesh colliders' (1), or with both (2).
+fn solve_kernel(step: &ContactStep) -> usize {
     if step.colliders.iter().any(|c| c.mesh.is_some()) { 2 } else { usize::from(!step.colliders.is_empty()) }
 }
 
@@ -36,8 +36,8 @@ const STEP_SLOTS: usize = 2;
 const RING_SLOTS: u64 = 64;
 // Each ring slot has its own contact slot, for the same reason.
 const _: () = assert!(RING_SLOTS == CONTACT_SLOTS as u64);
-/// Storage buffers the compute stage binds.
-const STORAGE_BUFFERS: u32 = 7;
+/// Storage buffers the compute stage binds (WebGPU's default limit).
+const STORAGE_BUFFERS: u32 = 8;
 
 /// One step's inputs; the layout of `Step` in `simulation.wgsl`.
 #[repr(C)]
@@ -167,9 +167,11 @@ fn settle_inertia(pending: &mut [StepUniform], mut history: u8) -> u8 {
 pub struct GpuSimulation {
     pipeline: wgpu::ComputePipeline,
     touch_pipeline: wgpu::ComputePipeline,
-    /// `step_strands_with_contact`: the kernel of steps whose contact is active, compiled
-    /// without colliders' code, with colliders but no mesh's, and with both (`contact_kernel`).
-    contact_pipelines: [wgpu::ComputePipeline; 3],
+    /// `step_strands_with_contact`: the bend and screen of steps whose contact is active.
+    contact_pipeline: wgpu::ComputePipeline,
+    /// `solve_contact`: the strands the screen listed, compiled without colliders' code, with
+    /// colliders but no mesh's, and with both (`solve_kernel`).
+    solve_pipelines: [wgpu::ComputePipeline; 3],
     layout: wgpu::BindGroupLayout,
     step_uniforms: wgpu::Buffer,
     rest_segments: wgpu::Buffer,
@@ -319,6 +321,7 @@ impl GpuSimulation {
                 storage(5, true),
                 storage(6, true),
                 storage(7, true),
+                storage(8, false),
             ],
         });
         let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
@@ -341,8 +344,9 @@ impl GpuSimulation {
         };
         let pipeline = compute_pipeline("step_strands", &[]);
         let touch_pipeline = compute_pipeline("weigh_touch", &[]);
-        let contact_pipelines = [&[("COLLIDERS", 0.0), ("MESH_COLLIDERS", 0.0)][..], &[("MESH_COLLIDERS", 0.0)], &[]]
-            .map(|constants| compute_pipeline("step_strands_with_contact", constants));
+        let contact_pipeline = compute_pipeline("step_strands_with_contact", &[]);
+        let solve_pipelines = [&[("COLLIDERS", 0.0), ("MESH_COLLIDERS", 0.0)][..], &[("MESH_COLLIDERS", 0.0)], &[]]
+            .map(|constants| compute_pipeline("solve_contact", constants));
         let buffer = |label, size: u64, usage| {
             device.create_buffer(&wgpu::BufferDescriptor { label: Some(label), size, usage, mapped_at_creation: false })
         };
@@ -369,13 +373,15 @@ impl GpuSimulation {
         );
         let skin = Skin::new(structure);
         check_size(device, "simulation contact", GpuContact::bytes(&skin))?;
+        check_size(device, "simulation contact list", GpuContact::work_bytes(v))?;
         let contact = GpuContact::new(device, structure, &skin);
         let wet = WetInputs::new(device, v);
         scope.pop("creating the GPU simulation")?;
         Ok(Self {
             pipeline,
             touch_pipeline,
-            contact_pipelines,
+            contact_pipeline,
+            solve_pipelines,
             layout,
             step_uniforms,
             rest_segments,
@@ -527,16 +533,30 @@ impl GpuSimulation {
             if self.vertex_count == 0 {
                 continue;
             }
+            let offset = [self.slot_offset(slot) as u32];
+            let contact = self.pending_contact.get(slot).filter(|step| step.is_active());
+            if contact.is_some() {
+                self.contact.clear_work(encoder);
+            }
             let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
                 label: Some("pelt simulation step"),
                 timestamp_writes: None,
             });
-            pass.set_pipeline(match self.pending_contact.get(slot) {
-                Some(step) if step.is_active() => &self.contact_pipelines[contact_kernel(step)],
-                _ => &self.pipeline,
-            });
-            pass.set_bind_group(0, bind_group, &[self.slot_offset(slot) as u32]);
+            pass.set_pipeline(if contact.is_some() { &self.contact_pipeline } else { &self.pipeline });
+            pass.set_bind_group(0, bind_group, &offset);
             pass.dispatch_workgroups(self.grid[0], self.grid[1], 1);
+            drop(pass);
+            if let Some(step) = contact {
+                // The listed strands' workgroups become the solve's dispatch arguments.
+                self.contact.copy_work_groups(encoder);
+                let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                    label: Some("pelt simulation contact"),
+                    timestamp_writes: None,
+                });
+                pass.set_pipeline(&self.solve_pipelines[solve_kernel(step)]);
+                pass.set_bind_group(0, bind_group, &offset);
+                pass.dispatch_workgroups_indirect(&self.contact.work_groups, 0);
+            }
         }
         self.ring = (self.ring + self.pending.len() as u64) % RING_SLOTS;
         self.pending.clear();
@@ -594,6 +614,7 @@ impl GpuSimulation {
                 wgpu::BindGroupEntry { binding: 5, resource: self.contact.buffer.as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 6, resource: self.wet.buffer.as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 7, resource: self.contact.fields_buffer.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 8, resource: self.contact.work.as_entire_binding() },
             ],
         });
         scope.pop("binding the GPU simulation to the fur")?;

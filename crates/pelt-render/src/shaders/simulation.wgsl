@@ -258,7 +258,7 @@ fn bend_straight(
         node += (e * sin_turn + d * cos_turn) * segment_length;
         write_node(j, v, k + 1u, node);
         if screening {
-            screen_node(k, node, segment_length, root);
+            screen_node(k, node, root);
         }
     }
 }
@@ -294,7 +294,7 @@ fn bend_general(
         node += rotate(turned, rest.xyz) * rest.w;
         write_node(j, v, k + 1u, node);
         if screening {
-            screen_node(k, node, rest.w, root);
+            screen_node(k, node, root);
         }
     }
 }

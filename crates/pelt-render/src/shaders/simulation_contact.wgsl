@@ -1,11 +1,15 @@
 // Contact after the bend (`pelt_core::sim::contact`): the skin planes, the colliders and the
 // grasp, per strand, root first, on the nodes the bend just wrote. Appended to
-// `simulation.wgsl`; `step_strands_with_contact` is the kernel of steps with contact.
+// `simulation.wgsl`. A step with contact runs two kernels: `step_strands_with_contact` bends
+// every strand and lists those a cheap screen cannot clear; `solve_contact`, dispatched
+// indirectly over that list, solves them.
 //
 // `contact` layout, in vec4s (V strands, `grid.y` the step's slot):
 //   [2 s], [2 s + 1] for slot s < CONTACT_SLOTS: (collider count, skin on, grip presence, -),
 //     (grip xyz, -);
 //   from CONTACT_SKIN: SKIN_PLANES planes per strand (n xyz in the rest frame, h);
+//   then a cone per strand (`pelt_core::sim::contact::skin_cone`: axis xyz in the rest frame,
+//     spread);
 //   then ceil(V / 4) vec4s of grasp weights, 4 strands each;
 //   then per slot CONTACT_COLLIDERS colliders of 5 vec4s: (centre, radius),
 //     (half extents, kind as bits), rotation, (travel, friction), (bound, grasp hand, field as
@@ -17,11 +21,21 @@
 //     face normal's).
 
 @group(0) @binding(5) var<storage, read> contact: array<vec4<f32>>;
+// What `step_strands_with_contact` lists for `solve_contact`: the indirect dispatch's workgroups
+// (x, y, z, copied to the dispatch's arguments), how many strands are listed, then each listed
+// strand's index and the first segment its screen did not clear.
+struct ContactWork {
+    groups: array<atomic<u32>, 3>,
+    count: atomic<u32>,
+    strands: array<vec2<u32>>,
+}
+
+@group(0) @binding(8) var<storage, read_write> contact_work: ContactWork;
 // Mesh colliders' distance fields (`contact.rs`'s `upload_fields`), each: origin xyz, cell,
 // dims xyz as bits, -, then the values, x fastest.
 @group(0) @binding(7) var<storage, read> sdf_fields: array<f32>;
 
-// Whether the kernel reads colliders, and mesh colliders' fields: steps without them run a
+// Whether `solve_contact` reads colliders, and mesh colliders' fields: steps without them run a
 // pipeline compiled without that code (it costs where lanes diverge even when no lane takes it).
 override COLLIDERS: bool = true;
 override MESH_COLLIDERS: bool = true;
@@ -188,8 +202,16 @@ fn turn_above(u: vec3<f32>, n: vec3<f32>, floor_in: f32, hint: vec3<f32>) -> vec
     return normalize(n * floor + side * sqrt(max(1.0 - floor * floor, 0.0)));
 }
 
+fn cones_first(v: u32) -> u32 {
+    return CONTACT_SKIN + SKIN_PLANES * v;
+}
+
+fn colliders_first(v: u32, slot: u32) -> u32 {
+    return cones_first(v) + v + (v + 3u) / 4u + slot * CONTACT_COLLIDERS * COLLIDER_WORDS;
+}
+
 fn surface_first(v: u32) -> u32 {
-    return CONTACT_SKIN + SKIN_PLANES * v + (v + 3u) / 4u + CONTACT_SLOTS * CONTACT_COLLIDERS * COLLIDER_WORDS;
+    return colliders_first(v, CONTACT_SLOTS);
 }
 
 // One strand's skin triangles, posed with its root and frame.
@@ -283,27 +305,25 @@ fn surface_closest(s: Surface, x: vec3<f32>, v: u32) -> Closest {
     return Closest(s.root + rotate(s.frame, best.surface - s.rest_root), rotate(s.frame, best.normal), signed);
 }
 
-// One strand's contact in a step, set up by `contact_setup` before its bend: its skin planes
-// turned with its frame, the colliders that can reach it, its triangles, its grasp weight.
-// Then the bend hands each node to `screen_node` while it is still in registers, which clears
-// nodes by a bound cheaper than the clearance, and `find_first_touch` tests from the first node
-// the bound did not clear. The bound is cheap because, where lanes diverge, a GPU (lavapipe
-// always) runs the code of a branch or loop body any lane takes for every lane.
+// One listed strand's contact in a step, set up by `contact_setup`: its skin planes turned with
+// its frame, the colliders that can reach it, its triangles, its grasp weight.
 var<private> contact_planes: array<vec4<f32>, SKIN_PLANES>;
 var<private> contact_plane_count: u32;
 var<private> contact_near: array<u32, NEAR_COLLIDERS>;
-// Each near collider's core for the bound: a segment (from xyz, radius) to (xyz, -) swept by a
-// ball, the shape itself for a sphere or capsule, its bounding ball otherwise.
-var<private> contact_cores: array<vec4<f32>, NEAR_COLLIDERS>;
-var<private> contact_core_ends: array<vec3<f32>, NEAR_COLLIDERS>;
 var<private> contact_near_count: u32;
 var<private> contact_surface: Surface;
 var<private> contact_held: f32;
-// The first segment whose end the bound did not clear (the strand's layers while none) and how
-// far the last node bounded was from touching, less the segments since (nodes within it need no
-// bound).
+
+// The screen of `step_strands_with_contact`, fed each node by the bend while it is in registers:
+// the strand's cone turned with its frame (axis xyz, spread; zero: the skin is off), the box
+// round its nodes, and the first segment whose end the cone did not clear (`layers`: none).
+// It does the same few operations at every node: a GPU runs the code of a branch any lane of a
+// vector takes for every lane (lavapipe runs every branch), so the exact tests wait for the
+// listed strands, where every lane needs them.
+var<private> screen_cone: vec4<f32>;
+var<private> screen_low: vec3<f32>;
+var<private> screen_high: vec3<f32>;
 var<private> screen_from: u32;
-var<private> screen_budget: f32;
 
 // How far x is above the strand's lowest skin plane (3.4e38 without planes).
 fn plane_clearance(x: vec3<f32>, root: vec3<f32>) -> f32 {
@@ -330,12 +350,12 @@ fn surface_clearance(x: vec3<f32>, cheap: f32, v: u32) -> f32 {
 }
 
 fn strand_grasp_weight(j: u32, v: u32) -> f32 {
-    let at = CONTACT_SKIN + SKIN_PLANES * v + j / 4u;
+    let at = cones_first(v) + v + j / 4u;
     return contact[at][j % 4u];
 }
 
-// A step with contact (`ContactStep::is_active`): the bend, screening its nodes, then contact
-// from the first segment that may touch.
+// A step with contact (`ContactStep::is_active`), first kernel: the bend with the screen, then
+// the strand listed for `solve_contact` unless the screen cleared every node.
 @compute @workgroup_size(64)
 fn step_strands_with_contact(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index) lane: u32) {
     let j = step_strand_index(group, lane);
@@ -345,13 +365,83 @@ fn step_strands_with_contact(@builtin(workgroup_id) group: vec3<u32>, @builtin(l
     }
     let layers = inputs.next_tick_counts.w;
     let root = strand_root(j).xyz;
-    let frame = strand_frame(j, v);
-    let touching = contact_setup(j, v, layers, root, frame);
-    bend_strand(j, touching);
-    if touching && screen_from < layers {
+    screen_start(j, v, layers, root, strand_frame(j, v));
+    bend_strand(j, true);
+    screen_finish(j, v, layers);
+}
+
+// The screen's state before the bend. A held strand is solved from its root, and so is one that
+// keeps skin triangles (the cone does not bound them).
+fn screen_start(j: u32, v: u32, layers: u32, root: vec3<f32>, frame: vec4<f32>) {
+    let header = contact[2u * inputs.grid.y];
+    let skin = header.y > 0.0;
+    screen_cone = vec4<f32>(0.0);
+    screen_from = layers;
+    if skin {
+        let cone = contact[cones_first(v) + j];
+        screen_cone = vec4<f32>(rotate(frame, cone.xyz), cone.w);
+        let triangles = bitcast<u32>(contact[surface_first(v) + j].w) & 63u;
+        screen_from = select(layers, 0u, triangles > 0u);
+    }
+    if strand_grasp_weight(j, v) * header.z != 0.0 {
+        screen_from = 0u;
+    }
+    screen_low = root;
+    screen_high = root;
+}
+
+// The screen of the node ending segment k: a node outside the cone may touch the skin.
+fn screen_node(k: u32, node: vec3<f32>, root: vec3<f32>) {
+    let d = node - root;
+    let clear = dot(screen_cone.xyz, d) >= screen_cone.w * length(d);
+    screen_from = min(screen_from, select(k, screen_from, clear));
+    screen_low = min(screen_low, node);
+    screen_high = max(screen_high, node);
+}
+
+// After the bend: a collider whose bounding ball reaches the box round the nodes may touch any
+// of them; then the strand is listed when any node was not cleared.
+fn screen_finish(j: u32, v: u32, layers: u32) {
+    let slot = inputs.grid.y;
+    let count = bitcast<u32>(contact[2u * slot].x);
+    let first = colliders_first(v, slot);
+    for (var i = 0u; i < count; i++) {
+        let c = first + i * COLLIDER_WORDS;
+        let centre = contact[c].xyz;
+        // A thousandth over the bound, so rounding never clears a node inside the collider.
+        if distance(clamp(centre, screen_low, screen_high), centre) <= contact[c + 4u].x * 1.001 {
+            screen_from = 0u;
+        }
+    }
+    if screen_from < layers {
+        let listed = atomicAdd(&contact_work.count, 1u);
+        contact_work.strands[listed] = vec2<u32>(j, screen_from);
+        // A workgroup of `solve_contact` per 64 listed, as many as the step's own grid is wide
+        // (each invocation then takes every so-many-th strand of the list).
+        if listed % WORKGROUP == 0u && listed / WORKGROUP < inputs.grid.x {
+            atomicAdd(&contact_work.groups[0], 1u);
+            atomicStore(&contact_work.groups[1], 1u);
+            atomicStore(&contact_work.groups[2], 1u);
+        }
+    }
+}
+
+// A step with contact, second kernel (dispatched with the groups `screen_finish` counted): each
+// listed strand's contact, from the first segment that touches on.
+@compute @workgroup_size(64)
+fn solve_contact(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
+    let v = inputs.next_tick_counts.z;
+    let layers = inputs.next_tick_counts.w;
+    let count = atomicLoad(&contact_work.count);
+    for (var i = id.x; i < count; i += groups.x * WORKGROUP) {
+        let listed = contact_work.strands[i];
+        let j = listed.x;
+        let root = strand_root(j).xyz;
+        let frame = strand_frame(j, v);
+        contact_setup(j, v, layers, root, frame);
         var first_touch = 0u;
         if contact_held == 0.0 {
-            first_touch = find_first_touch(j, v, layers, root);
+            first_touch = find_first_touch(j, v, layers, root, listed.y);
         }
         if first_touch < layers {
             contact_strand(j, v, layers, root, frame, first_touch);
@@ -359,16 +449,13 @@ fn step_strands_with_contact(@builtin(workgroup_id) group: vec3<u32>, @builtin(l
     }
 }
 
-// Strand j's contact inputs for this step (false: nothing can touch the fur this step).
-fn contact_setup(j: u32, v: u32, layers: u32, root: vec3<f32>, frame: vec4<f32>) -> bool {
+// Strand j's contact inputs for this step.
+fn contact_setup(j: u32, v: u32, layers: u32, root: vec3<f32>, frame: vec4<f32>) {
     let slot = inputs.grid.y;
     let header = contact[2u * slot];
     let count = bitcast<u32>(header.x);
     let skin = header.y > 0.0;
     let presence = header.z;
-    if count == 0u && !skin && presence == 0.0 {
-        return false;
-    }
     contact_held = strand_grasp_weight(j, v) * presence;
     contact_plane_count = 0u;
     if skin {
@@ -387,7 +474,7 @@ fn contact_setup(j: u32, v: u32, layers: u32, root: vec3<f32>, frame: vec4<f32>)
     for (var k = 0u; k < layers && count > 0u; k++) {
         strand_length += rest_segments[k * v + j].w;
     }
-    let first = CONTACT_SKIN + SKIN_PLANES * v + (v + 3u) / 4u + slot * CONTACT_COLLIDERS * COLLIDER_WORDS;
+    let first = colliders_first(v, slot);
     contact_near_count = 0u;
     for (var i = 0u; COLLIDERS && i < count && contact_near_count < NEAR_COLLIDERS; i++) {
         let c = first + i * COLLIDER_WORDS;
@@ -397,17 +484,6 @@ fn contact_setup(j: u32, v: u32, layers: u32, root: vec3<f32>, frame: vec4<f32>)
         }
         if distance(root, contact[c].xyz) <= bound.x + strand_length {
             contact_near[contact_near_count] = c;
-            let centre = contact[c].xyz;
-            let kind = bitcast<u32>(contact[c + 1u].w);
-            var reach = vec3<f32>(0.0);
-            var radius = bound.x;
-            if kind <= 1u {
-                // A sphere (its half length 0) or a capsule: the segment along its turned Y axis.
-                reach = rotate(contact[c + 2u], vec3<f32>(0.0, select(0.0, contact[c + 1u].y, kind == 1u), 0.0));
-                radius = contact[c].w;
-            }
-            contact_cores[contact_near_count] = vec4<f32>(centre - reach, radius);
-            contact_core_ends[contact_near_count] = centre + reach;
             contact_near_count += 1u;
         }
     }
@@ -417,49 +493,15 @@ fn contact_setup(j: u32, v: u32, layers: u32, root: vec3<f32>, frame: vec4<f32>)
         let packed = bitcast<u32>(header.w);
         contact_surface = Surface(packed >> 6u, packed & 63u, header.xyz, root, frame);
     }
-    // A held strand is solved from its root; one with triangles has no cheap bound.
-    screen_from = select(layers, 0u, contact_held != 0.0 || contact_surface.count > 0u);
-    screen_budget = 0.0;
-    return true;
 }
 
-// At most the clearance of x (`cheap_clearance` without triangles): the skin planes' heights
-// and each collider's distance from its core (`contact_cores`).
-fn bound_clearance(x: vec3<f32>, root: vec3<f32>) -> f32 {
-    var least = plane_clearance(x, root);
-    for (var i = 0u; COLLIDERS && i < contact_near_count; i++) {
-        let a = contact_cores[i].xyz;
-        let ab = contact_core_ends[i] - a;
-        let t = clamp(dot(x - a, ab) / max(dot(ab, ab), 1e-30), 0.0, 1.0);
-        let d = distance(x, a + ab * t) - contact_cores[i].w;
-        // Less a few ulps, so rounding never clears a node the exact distance would not.
-        least = min(least, d - 4e-6 * (abs(d) + contact_cores[i].w + length(ab)));
-    }
-    return least;
-}
-
-// A budgeted walk with the bound: `node` ends segment k (of `segment_length`).
-fn screen_node(k: u32, node: vec3<f32>, segment_length: f32, root: vec3<f32>) {
-    if k >= screen_from {
-        return;
-    }
-    screen_budget -= segment_length * CONTACT_SKIP_SLACK;
-    if screen_budget > 0.0 {
-        return;
-    }
-    screen_budget = bound_clearance(node, root);
-    if screen_budget < 0.0 {
-        screen_from = k;
-    }
-}
-
-// `Resolve::first_touch` from `screen_from` (the nodes before it are clear): the first segment
+// `Resolve::first_touch` from segment `start` (the nodes before it are clear): the first segment
 // whose end touches, or `layers`. Nodes within the last clearance found, less the segments
 // since, need no test; clearance grows by at most the arc, so which nodes are tested does not
 // change the segment found.
-fn find_first_touch(j: u32, v: u32, layers: u32, root: vec3<f32>) -> u32 {
+fn find_first_touch(j: u32, v: u32, layers: u32, root: vec3<f32>, start: u32) -> u32 {
     var budget = 0.0;
-    for (var k = screen_from; k < layers; k++) {
+    for (var k = start; k < layers; k++) {
         budget -= rest_segments[k * v + j].w * CONTACT_SKIP_SLACK;
         if budget > 0.0 {
             continue;

@@ -48,7 +48,7 @@ use glam::{Quat, Vec3, Vec4};
 
 pub use collider::{Collider, ColliderKey, ColliderMesh, SWEEP_RADII_PER_STEP, Shape, StepCollider};
 pub use grasp::{Grasp, GraspParams, HAND_PARTS};
-pub use skin::{SKIN_PLANES, skin_planes};
+pub use skin::{SKIN_PLANES, skin_cone, skin_planes};
 pub use surface::{SURFACE_WORDS, SkinSurface, skin_surface};
 
 pub(crate) use screen::{BatchPlanes, skin_lanes};

@@ -124,6 +124,30 @@ pub(crate) fn skin_planes_of(
     (cell, planes)
 }
 
+/// Rounds of [`skin_cone`]'s search for its axis.
+const CONE_ROUNDS: u32 = 64;
+
+/// One cone that holds within every plane of a strand's `planes` ([`skin_planes`]), for a
+/// screen cheaper than the planes: `(a, s)`, in the same rest frame, such that a node `x` with
+/// `a . (x - root) >= s |x - root|` satisfies every plane. Every plane's `h` is at least 0, and
+/// `n . d >= a . d - |n - a| |d|`, so `s` is the largest `|n - a|` (plus rounding's share); the
+/// axis `a` is searched to keep it small (Badoiu and Clarkson's walk toward the farthest normal,
+/// kept on the unit sphere). Zero without planes: every node passes.
+#[must_use]
+pub fn skin_cone(planes: &[Vec4; SKIN_PLANES]) -> Vec4 {
+    let normals: Vec<Vec3> = planes.iter().map(|p| p.truncate()).take_while(|n| *n != Vec3::ZERO).collect();
+    let Some(&first) = normals.first() else { return Vec4::ZERO };
+    let farthest = |a: Vec3| normals.iter().copied().max_by(|x, y| (*x - a).length().total_cmp(&(*y - a).length()));
+    let mut axis = first;
+    for round in 0..CONE_ROUNDS {
+        let Some(far) = farthest(axis) else { break };
+        axis = (axis + (far - axis) / (round as f32 + 2.0)).try_normalize().unwrap_or(axis);
+    }
+    let spread = normals.iter().map(|n| (*n - axis).length()).fold(0.0, f32::max);
+    // What rounding takes off a dot product of unit vectors, and off turning both by a frame.
+    axis.extend(spread * (1.0 + 1e-4) + 1e-5)
+}
+
 /// Triangles binned by the cells their boxes cover.
 pub(super) struct Grid {
     cell: f32,
@@ -244,6 +268,43 @@ mod tests {
                 most = most.max(used);
             }
             assert!(most > 2, "{builtin:?}: no strand took more than {most} planes");
+        }
+    }
+
+    /// A node a strand's cone clears is above every one of its planes (`n . d + h >= 0`, tested
+    /// plane by plane), for directions all round each strand of a bunny and a torus; and the
+    /// cone clears most of the upper half-space of a strand with one plane.
+    #[test]
+    fn the_cone_clears_only_what_every_plane_clears() {
+        let mut rng = crate::rng::Rng::new(7);
+        for builtin in [Builtin::Bunny, Builtin::Torus] {
+            let (mesh, _) = builtin.mesh();
+            let params =
+                FurParams { layers: 8, length: FurLength::Constant(0.5), direction: GrowthDirection::default() };
+            let fur = FurStructure::new(mesh, &params).unwrap();
+            let (mut cleared, mut tested) = (0, 0);
+            for (j, strand) in skin_planes(&fur).iter().enumerate() {
+                let cone = skin_cone(strand);
+                let used: Vec<Vec4> = strand.iter().copied().filter(|p| p.truncate() != Vec3::ZERO).collect();
+                for _ in 0..64 {
+                    let d = Vec3::new(rng.next_f32() - 0.5, rng.next_f32() - 0.5, rng.next_f32() - 0.5) * 2.0;
+                    if cone.truncate().dot(d) < cone.w * d.length() {
+                        continue;
+                    }
+                    cleared += 1;
+                    for plane in &used {
+                        let height = plane.x * d.x + plane.y * d.y + plane.z * d.z + plane.w;
+                        assert!(height >= 0.0, "{builtin:?} strand {j}: {d} below {plane} ({height}) in {cone}");
+                    }
+                }
+                tested += 64;
+                if used.len() == 1 {
+                    let n = used[0].truncate();
+                    let up = n * 0.9 + n.any_orthonormal_vector() * 0.43;
+                    assert!(cone.truncate().dot(up) >= cone.w * up.length(), "{builtin:?} strand {j}: {cone}");
+                }
+            }
+            assert!(cleared * 4 > tested, "{builtin:?}: the cones cleared {cleared} of {tested}");
         }
     }
 }
