@@ -27,6 +27,9 @@ const SKIN_FIRST: usize = 2 * CONTACT_SLOTS;
 pub(crate) struct GpuContact {
     pub buffer: wgpu::Buffer,
     vertex_count: usize,
+    /// The longest strand's length (a little over), in each slot's header: the solve's bound on
+    /// how far from its root a strand reaches.
+    reach: f32,
     /// The grasp weights uploaded (empty: all zero).
     weights: Vec<f32>,
     /// Mesh colliders' distance fields (`simulation_contact.wgsl`'s `sdf_fields`).
@@ -167,7 +170,22 @@ impl GpuContact {
             usage: wgpu::BufferUsages::INDIRECT | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        Self { buffer, vertex_count: v, weights: Vec::new(), fields_buffer, work, work_groups, fields: Vec::new() }
+        let layers = structure.layers as usize;
+        let reach = (0..v)
+            .map(|j| {
+                (0..layers).map(|k| structure.positions[(k + 1) * v + j].distance(structure.positions[k * v + j])).sum()
+            })
+            .fold(0.0_f32, f32::max);
+        Self {
+            buffer,
+            vertex_count: v,
+            reach: reach * 1.001,
+            weights: Vec::new(),
+            fields_buffer,
+            work,
+            work_groups,
+            fields: Vec::new(),
+        }
     }
 
     /// Empties the list before a step's screen.
@@ -224,7 +242,7 @@ impl GpuContact {
     pub fn write_slot(&self, queue: &wgpu::Queue, slot: usize, step: &ContactStep) {
         let count = step.colliders.len().min(MAX_STEP_COLLIDERS);
         let header = [
-            [f32::from_bits(count as u32), if step.skin { 1.0 } else { 0.0 }, step.grip_presence, 0.0],
+            [f32::from_bits(count as u32), if step.skin { 1.0 } else { 0.0 }, step.grip_presence, self.reach],
             step.grip.extend(0.0).to_array(),
         ];
         queue.write_buffer(&self.buffer, (2 * slot) as u64 * 16, bytemuck::cast_slice(&header));

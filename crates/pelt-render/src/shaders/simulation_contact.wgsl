@@ -5,8 +5,8 @@
 // indirectly over that list, solves them.
 //
 // `contact` layout, in vec4s (V strands, `grid.y` the step's slot):
-//   [2 s], [2 s + 1] for slot s < CONTACT_SLOTS: (collider count, skin on, grip presence, -),
-//     (grip xyz, -);
+//   [2 s], [2 s + 1] for slot s < CONTACT_SLOTS: (collider count, skin on, grip presence, the
+//     longest strand's length), (grip xyz, -);
 //   from CONTACT_SKIN: SKIN_PLANES planes per strand (n xyz in the rest frame, h);
 //   then a cone per strand (`pelt_core::sim::contact::skin_cone`: axis xyz in the rest frame,
 //     spread);
@@ -426,31 +426,61 @@ fn screen_finish(j: u32, v: u32, layers: u32) {
     }
 }
 
+// `solve_contact`'s workgroup: how many strands are listed, and the strands of its share that
+// touch (index, first touching segment), gathered so the walk runs on as few vectors as it can.
+var<workgroup> solve_listed: u32;
+var<workgroup> solve_touching: array<vec2<u32>, WORKGROUP>;
+var<workgroup> solve_touching_count: atomic<u32>;
+
 // A step with contact, second kernel (dispatched with the groups `screen_finish` counted): each
-// listed strand's contact, from the first segment that touches on.
+// listed strand's first touch, then the strands that touch gathered to the workgroup's first
+// lanes and walked from it. A vector none of whose lanes walks runs the walk's loops once, not
+// once per segment (lavapipe runs every branch; a GPU skips the vector).
 @compute @workgroup_size(64)
-fn solve_contact(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
+fn solve_contact(
+    @builtin(workgroup_id) group: vec3<u32>,
+    @builtin(local_invocation_index) lane: u32,
+    @builtin(num_workgroups) groups: vec3<u32>,
+) {
     let v = inputs.next_tick_counts.z;
     let layers = inputs.next_tick_counts.w;
-    let count = atomicLoad(&contact_work.count);
-    for (var i = id.x; i < count; i += groups.x * WORKGROUP) {
-        let listed = contact_work.strands[i];
-        let j = listed.x;
-        let root = strand_root(j).xyz;
-        let frame = strand_frame(j, v);
-        contact_setup(j, v, layers, root, frame);
-        var first_touch = 0u;
-        if contact_held == 0.0 {
-            first_touch = find_first_touch(j, v, layers, root, listed.y);
+    if lane == 0u {
+        solve_listed = atomicLoad(&contact_work.count);
+    }
+    let count = workgroupUniformLoad(&solve_listed);
+    for (var first = group.x * WORKGROUP; first < count; first += groups.x * WORKGROUP) {
+        let i = first + lane;
+        if i < count {
+            let listed = contact_work.strands[i];
+            let j = listed.x;
+            contact_setup(j, v, strand_root(j).xyz, strand_frame(j, v));
+            var first_touch = 0u;
+            if contact_held == 0.0 {
+                first_touch = find_first_touch(j, v, layers, strand_root(j).xyz, listed.y);
+            }
+            if first_touch < layers {
+                solve_touching[atomicAdd(&solve_touching_count, 1u)] = vec2<u32>(j, first_touch);
+            }
         }
-        if first_touch < layers {
-            contact_strand(j, v, layers, root, frame, first_touch);
+        workgroupBarrier();
+        if lane < atomicLoad(&solve_touching_count) {
+            let touching = solve_touching[lane];
+            let j = touching.x;
+            let root = strand_root(j).xyz;
+            let frame = strand_frame(j, v);
+            contact_setup(j, v, root, frame);
+            contact_strand(j, v, layers, root, frame, touching.y);
         }
+        workgroupBarrier();
+        if lane == 0u {
+            atomicStore(&solve_touching_count, 0u);
+        }
+        workgroupBarrier();
     }
 }
 
 // Strand j's contact inputs for this step.
-fn contact_setup(j: u32, v: u32, layers: u32, root: vec3<f32>, frame: vec4<f32>) {
+fn contact_setup(j: u32, v: u32, root: vec3<f32>, frame: vec4<f32>) {
     let slot = inputs.grid.y;
     let header = contact[2u * slot];
     let count = bitcast<u32>(header.x);
@@ -469,11 +499,8 @@ fn contact_setup(j: u32, v: u32, layers: u32, root: vec3<f32>, frame: vec4<f32>)
             contact_plane_count += 1u;
         }
     }
-    // Colliders that can reach the strand (its nodes lie within its length of the root).
-    var strand_length = 0.0;
-    for (var k = 0u; k < layers && count > 0u; k++) {
-        strand_length += rest_segments[k * v + j].w;
-    }
+    // Colliders that can reach the strand (its nodes lie within the longest strand's length of
+    // the root).
     let first = colliders_first(v, slot);
     contact_near_count = 0u;
     for (var i = 0u; COLLIDERS && i < count && contact_near_count < NEAR_COLLIDERS; i++) {
@@ -482,7 +509,7 @@ fn contact_setup(j: u32, v: u32, layers: u32, root: vec3<f32>, frame: vec4<f32>)
         if bound.y > 0.0 && contact_held != 0.0 {
             continue;
         }
-        if distance(root, contact[c].xyz) <= bound.x + strand_length {
+        if distance(root, contact[c].xyz) <= bound.x + header.w {
             contact_near[contact_near_count] = c;
             contact_near_count += 1u;
         }
@@ -498,18 +525,23 @@ fn contact_setup(j: u32, v: u32, layers: u32, root: vec3<f32>, frame: vec4<f32>)
 // `Resolve::first_touch` from segment `start` (the nodes before it are clear): the first segment
 // whose end touches, or `layers`. Nodes within the last clearance found, less the segments
 // since, need no test; clearance grows by at most the arc, so which nodes are tested does not
-// change the segment found.
+// change the segment found. The outer loop tests a node each time round and the inner one skips
+// the nodes the clearance covers, so a vector runs the tests as often as its lane that needs the
+// most of them, not once per segment.
 fn find_first_touch(j: u32, v: u32, layers: u32, root: vec3<f32>, start: u32) -> u32 {
-    var budget = 0.0;
-    for (var k = start; k < layers; k++) {
-        budget -= rest_segments[k * v + j].w * CONTACT_SKIP_SLACK;
-        if budget > 0.0 {
-            continue;
-        }
+    var k = start;
+    while k < layers {
         let x = read_node(j, v, k + 1u);
-        budget = surface_clearance(x, cheap_clearance(x, root), v);
+        var budget = surface_clearance(x, cheap_clearance(x, root), v);
         if budget < 0.0 {
             return k;
+        }
+        k += 1u;
+        for (; k < layers; k++) {
+            budget -= rest_segments[k * v + j].w * CONTACT_SKIP_SLACK;
+            if budget <= 0.0 {
+                break;
+            }
         }
     }
     return layers;
