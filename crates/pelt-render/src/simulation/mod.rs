@@ -11,7 +11,7 @@
 //! begins). Nothing is read back and the shared array never crosses the bus.
 
 use pelt_core::FurStructure;
-use pelt_core::sim::{ContactStep, InertiaStep, InputVersions, Simulation, StepInputs, StrandInputs, kernel_rest};
+use pelt_core::sim::{ContactStep, InputVersions, Simulation, kernel_rest};
 
 use crate::RenderError;
 use crate::contact::{CONTACT_SLOTS, GpuContact, Skin};
@@ -19,10 +19,14 @@ use crate::fur::GpuFur;
 use crate::requirements::{ErrorScope, check_size};
 use crate::shaders::simulation_shader_source;
 
+mod step;
+mod wet;
+
+use step::{STEP_SLOT_BYTES, StepUniform, settle_inertia, step_uniform};
+use wet::WetInputs;
+
 /// Strands per workgroup (`@workgroup_size` in `simulation.wgsl`).
 const WORKGROUP: u32 = 64;
-/// Bytes per step's uniform slot: the largest `min_uniform_buffer_offset_alignment` allowed.
-const STEP_SLOT_BYTES: u64 = 256;
 /// Which of `GpuSimulation::solve_pipelines` solves `step`'s listed strands: the one compiled
 /// without colliders' code (0), without mesh colliders' (1), or with both (2).
 fn solve_kernel(step: &ContactStep) -> usize {
@@ -39,116 +43,10 @@ const _: () = assert!(RING_SLOTS == CONTACT_SLOTS as u64);
 /// Storage buffers the compute stage binds (WebGPU's default limit).
 const STORAGE_BUFFERS: u32 = 8;
 
-/// One step's inputs; the layout of `Step` in `simulation.wgsl`.
-#[repr(C)]
-#[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
-struct StepUniform {
-    gravity: [f32; 4],
-    wind_direction: [f32; 4],
-    wind_shape: [f32; 4],
-    travelled_fraction: [f32; 4],
-    travelled_xy: [u32; 4],
-    travelled_z_seed: [u32; 4],
-    jitter_seed_tick: [u32; 4],
-    next_tick_counts: [u32; 4],
-    touch: [f32; 4],
-    grid: [u32; 4],
-    touch_centre: [f32; 4],
-    inertia: [f32; 4],
-    inertia_damp: [f32; 4],
-    inertia_kind: [u32; 4],
-}
-
-/// `InertiaStep`'s kinds as `simulation_inputs.wgsl` numbers them.
-const INERTIA_START: u32 = 0;
-const INERTIA_SHIFT: u32 = 1;
-const INERTIA_SHIFT_ZERO: u32 = 2;
-const INERTIA_SPRING: u32 = 3;
-
 /// Bytes per strand of the resident inputs (root and stability, frame, field) and of the state
 /// the GPU carries (last two roots and the touch weight, force, its rate of change).
 const STRAND_BYTES: u64 = 3 * 16;
 const STATE_BYTES: u64 = 4 * 16;
-
-// A slot holds one step, in the 16-byte units WGSL lays `Step` out in.
-const _: () =
-    assert!(size_of::<StepUniform>() as u64 <= STEP_SLOT_BYTES && (size_of::<StepUniform>() as u64).is_multiple_of(16));
-
-/// A u64 as WGSL's `vec2<u32>` (low word, high word).
-fn words(value: u64) -> [u32; 2] {
-    [value as u32, (value >> 32) as u32]
-}
-
-/// The uniform of one step: `inputs` repacked into `Step`'s layout (the gust travel's whole
-/// cells negated, as the shader adds them; 64-bit values as two words), with the inertia's step
-/// and the touch's centre and radius.
-fn step_uniform(
-    inputs: &StepInputs,
-    inertia: InertiaStep,
-    touch_centre: [f32; 4],
-    counts: [u32; 2],
-    grid_x: u32,
-) -> StepUniform {
-    let wind = &inputs.wind;
-    let [x, y, z] = wind.gust_travel_cells.map(|cells| words(cells.wrapping_neg() as u64));
-    let seed = words(wind.noise_seed);
-    let [tick_a, tick_b] = wind.jitter_ticks.map(words);
-    let jitter_seed = words(wind.jitter_seed);
-    StepUniform {
-        gravity: inputs.gravity.extend(0.0).to_array(),
-        wind_direction: wind.direction.extend(wind.strength).to_array(),
-        wind_shape: [
-            wind.gust_strength,
-            wind.jitter_force.unwrap_or(0.0),
-            wind.jitter_blend,
-            (1.0 / wind.gust_size) as f32,
-        ],
-        travelled_fraction: wind.gust_travel_fraction.extend(inputs.gain).to_array(),
-        travelled_xy: [x[0], x[1], y[0], y[1]],
-        travelled_z_seed: [z[0], z[1], seed[0], seed[1]],
-        jitter_seed_tick: [jitter_seed[0], jitter_seed[1], tick_a[0], tick_a[1]],
-        next_tick_counts: [tick_b[0], tick_b[1], counts[0], counts[1]],
-        touch: inputs.touch_force.extend(inputs.touch_presence).to_array(),
-        grid: [grid_x, 0, 0, 0],
-        touch_centre,
-        inertia: match inertia {
-            InertiaStep::Spring(spring) => [spring.dt, spring.dt_before, spring.scale, spring.stiffness_dt],
-            _ => [0.0; 4],
-        },
-        inertia_damp: match inertia {
-            InertiaStep::Spring(spring) => [spring.damp, 0.0, 0.0, 0.0],
-            _ => [0.0; 4],
-        },
-        inertia_kind: [
-            match inertia {
-                InertiaStep::Start => INERTIA_START,
-                InertiaStep::Shift { zero: false } => INERTIA_SHIFT,
-                InertiaStep::Shift { zero: true } => INERTIA_SHIFT_ZERO,
-                InertiaStep::Spring(_) => INERTIA_SPRING,
-            },
-            0,
-            0,
-            0,
-        ],
-    }
-}
-
-/// Makes a run of steps' inertia kinds one the GPU's state can follow, from `history` (how
-/// many steps the state has seen since it started, up to 2: 0 when it never started or missed
-/// steps): the first step after a gap starts over, a spring needs two steps of history.
-/// Returns the history after the run.
-fn settle_inertia(pending: &mut [StepUniform], mut history: u8) -> u8 {
-    for uniform in pending {
-        let kind = &mut uniform.inertia_kind[0];
-        if history == 0 {
-            *kind = INERTIA_START;
-        } else if *kind == INERTIA_SPRING && history < 2 {
-            *kind = INERTIA_SHIFT;
-        }
-        history = if *kind == INERTIA_START { 1 } else { (history + 1).min(2) };
-    }
-    history
-}
 
 /// A fur's simulation on the GPU: bends every strand exactly as `pelt_core::sim` defines it
 /// (Equation 1 as Pelt implements it, gravity, the wind with the same noise and seeds, the user
@@ -670,41 +568,6 @@ impl GpuSimulation {
     }
 }
 
-/// Wet strands' extra weight, kept apart from the other per-strand inputs (binding 5): per
-/// strand, gravity's factor and the mass on the inertial spring, both `1 + added_weight * w`. A
-/// wet strand's lower stability rides in the strands buffer ([`StrandInputs::stability_of`]).
-#[derive(Debug)]
-struct WetInputs {
-    buffer: wgpu::Buffer,
-    /// What the buffer holds; empty while it holds all ones.
-    uploaded: Vec<[f32; 2]>,
-}
-
-impl WetInputs {
-    fn new(device: &wgpu::Device, strands: usize) -> Self {
-        let buffer = wgpu::util::DeviceExt::create_buffer_init(
-            device,
-            &wgpu::util::BufferInitDescriptor {
-                label: Some("pelt simulation wet strands"),
-                contents: bytemuck::cast_slice(&vec![[1.0_f32; 2]; strands.max(1)]),
-                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
-            },
-        );
-        Self { buffer, uploaded: Vec::new() }
-    }
-
-    fn upload(&mut self, queue: &wgpu::Queue, inputs: &StrandInputs<'_>) {
-        if inputs.wetness.is_none() && self.uploaded.is_empty() {
-            return;
-        }
-        let scales: Vec<[f32; 2]> = (0..inputs.roots.len()).map(|j| [inputs.gravity_scale_of(j); 2]).collect();
-        if scales != self.uploaded {
-            queue.write_buffer(&self.buffer, 0, bytemuck::cast_slice(&scales));
-            self.uploaded = if inputs.wetness.is_none() { Vec::new() } else { scales };
-        }
-    }
-}
-
 fn check_shape(fur: &GpuFur, vertex_count: usize, layers: u32) -> Result<(), RenderError> {
     if fur.vertex_count() as usize != vertex_count || fur.layers() != layers {
         return Err(RenderError::Count {
@@ -737,45 +600,11 @@ mod tests {
     use super::*;
 
     #[test]
-    fn u64_splits_into_low_and_high_words() {
-        assert_eq!(words(0x0123_4567_89AB_CDEF), [0x89AB_CDEF, 0x0123_4567]);
-        assert_eq!(words(1_i64.wrapping_neg() as u64), [u32::MAX, u32::MAX]);
-    }
-
-    #[test]
     fn limits_are_checked_by_name() {
         let limits = GpuSimulation::required_limits(&wgpu::Limits::downlevel_defaults());
         assert!(check_limits(&limits).is_ok());
         let small = wgpu::Limits { max_compute_workgroup_size_x: 32, ..limits };
         let error = check_limits(&small).unwrap_err().to_string();
         assert!(error.contains("max_compute_workgroup_size_x = 32"), "{error}");
-    }
-}
-
-#[cfg(test)]
-mod mirror_tests {
-    use super::StepUniform;
-    use crate::shaders::{assert_mirrors, rust_layout, simulation_shader_source};
-
-    /// Member by member as naga lays `Step` out, not only the size.
-    #[test]
-    fn step_uniform_mirrors_step() {
-        let rust = rust_layout!(StepUniform {
-            gravity,
-            wind_direction,
-            wind_shape,
-            travelled_fraction,
-            travelled_xy,
-            travelled_z_seed,
-            jitter_seed_tick,
-            next_tick_counts,
-            touch,
-            grid,
-            touch_centre,
-            inertia,
-            inertia_damp,
-            inertia_kind
-        });
-        assert_mirrors(&simulation_shader_source(), "Step", &rust);
     }
 }
