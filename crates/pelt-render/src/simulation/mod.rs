@@ -52,7 +52,8 @@ const STATE_BYTES: u64 = 4 * 16;
 /// (Equation 1 as Pelt implements it, gravity, the wind with the same noise and seeds, the user
 /// field and the touch over it, the inertial force, posed roots and frames) in a compute pass,
 /// one invocation per strand, which also steps each strand's inertial force; a touch's weights
-/// come from a small pass when it begins. Each step writes the new state into
+/// come from a small pass when it begins. A step with contact (skin, colliders, a grasp) lists
+/// the strands its screen cannot clear and solves them in a second pass, dispatched indirectly. Each step writes the new state into
 /// [`GpuFur::current_positions`] after
 /// [`GpuFur::swap_states`]; the fur's vertex shader interpolates between its two states.
 ///
@@ -106,10 +107,11 @@ pub struct GpuSimulation {
 }
 
 impl GpuSimulation {
-    /// Downlevel capabilities the GPU simulation needs beyond the renderer's: compute shaders.
+    /// Downlevel capabilities the GPU simulation needs: compute shaders, and indirect dispatch
+    /// for contact's second pass.
     #[must_use]
     pub fn required_downlevel_flags() -> wgpu::DownlevelFlags {
-        wgpu::DownlevelFlags::COMPUTE_SHADERS
+        wgpu::DownlevelFlags::COMPUTE_SHADERS | wgpu::DownlevelFlags::INDIRECT_EXECUTION
     }
 
     /// `base` raised where the GPU simulation needs more (workgroups of 64, four storage
@@ -396,7 +398,8 @@ impl GpuSimulation {
     }
 
     /// Records the prepared steps into `encoder`: per step, [`GpuFur::swap_states`] and one
-    /// compute pass writing the new current state. Does nothing when no step is pending.
+    /// compute pass writing the new current state (with contact, a second one, dispatched
+    /// indirectly, solving the strands the first listed). Does nothing when no step is pending.
     ///
     /// # Errors
     /// [`RenderError::Count`] when `fur` is not the fur last given to
