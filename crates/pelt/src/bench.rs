@@ -7,6 +7,7 @@
 mod anim;
 mod contact;
 mod guard;
+mod load;
 mod models;
 mod render;
 mod report;
@@ -77,6 +78,14 @@ pub struct Args {
     /// (BENCHMARKS.md's "CI speed guard" table).
     #[arg(long, value_name = "FILE", conflicts_with_all = ["soak", "contact"])]
     pub guard: Option<PathBuf>,
+    /// Instead of the report: the time to a first frame phase by phase (parse, repair,
+    /// structure, textures, skin setup, GPU upload) for every mesh in the meshes folder and
+    /// each `--load-mesh`.
+    #[arg(long, conflicts_with_all = ["soak", "contact", "guard"])]
+    pub load: bool,
+    /// A mesh file `--load` also times (repeat for several).
+    #[arg(long = "load-mesh", value_name = "FILE", requires = "load")]
+    pub load_meshes: Vec<PathBuf>,
     /// Steps of `--soak` on the CPU kernel.
     #[arg(long, value_name = "N", default_value_t = 1_000_000, requires = "soak")]
     pub steps: u64,
@@ -159,6 +168,9 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     }
     if let Some(recorded) = &args.guard {
         return guard::run(recorded);
+    }
+    if args.load {
+        return load::run(&models::meshes_dir(args.meshes.as_deref()), &args.load_meshes);
     }
     let started = Instant::now();
     for name in &args.models {

@@ -131,7 +131,7 @@ fn frame_ratio((width, height): (u32, u32)) -> anyhow::Result<Figure> {
     view.prepare(queue, &studio.view_data(&camera, headless.aspect_ratio()));
     let lod = crate::lod::settings(&preset.render.lod, false);
     driver.set_level(crate::lod::level(&lod, &fur, camera.eye, camera.fov_y_rad, height));
-    let mut frame = |settings: FurDrawSettings| -> anyhow::Result<Duration> {
+    let frame = |settings: FurDrawSettings| -> anyhow::Result<Duration> {
         let started = Instant::now();
         headless.render_with(
             studio.background,

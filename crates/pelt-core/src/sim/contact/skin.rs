@@ -219,7 +219,7 @@ fn strand_planes(
     };
     let mut uncovered: Vec<u64> = bits(planes[0]).iter().map(|w| !w).collect();
     if let Some(last) = uncovered.last_mut()
-        && rising.len() % 64 != 0
+        && !rising.len().is_multiple_of(64)
     {
         *last &= (1 << (rising.len() % 64)) - 1;
     }
