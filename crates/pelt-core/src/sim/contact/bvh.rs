@@ -79,21 +79,9 @@ impl Bvh {
     /// Visits every triangle of a subtree `keep` accepts (given its box's corners `lo`, `hi`),
     /// skipping the subtrees it refuses. `keep` must accept every box that holds a triangle the
     /// caller wants: the visit order is the tree's, so callers that need an order sort.
-    pub(super) fn visit(&self, keep: impl FnMut(Vec3, Vec3) -> bool, mut visit: impl FnMut(u32)) {
-        self.visit_while(keep, |t| {
-            visit(t);
-            true
-        });
-    }
-
-    /// [`Bvh::visit`], stopping as soon as `visit` returns false; whether it ran to the end.
-    pub(super) fn visit_while(
-        &self,
-        mut keep: impl FnMut(Vec3, Vec3) -> bool,
-        mut visit: impl FnMut(u32) -> bool,
-    ) -> bool {
+    pub(super) fn visit(&self, mut keep: impl FnMut(Vec3, Vec3) -> bool, mut visit: impl FnMut(u32)) {
         if self.order.is_empty() {
-            return true;
+            return;
         }
         let mut stack = vec![0_u32];
         while let Some(n) = stack.pop() {
@@ -102,17 +90,12 @@ impl Bvh {
                 continue;
             }
             if node.count > 0 {
-                for &t in self.leaf(node) {
-                    if !visit(t) {
-                        return false;
-                    }
-                }
+                self.leaf(node).iter().for_each(|&t| visit(t));
             } else {
                 stack.push(node.first + 1);
                 stack.push(node.first);
             }
         }
-        true
     }
 
     /// Visits the triangles of the subtrees `keep` accepts, the box nearest `p` first, until
@@ -232,8 +215,8 @@ mod tests {
                 };
                 let mut seen = vec![false; mesh.triangles.len()];
                 bvh.visit(|lo, hi| box_may_reach(lo, hi, p, r, n, 0.0), |t| seen[t as usize] = true);
-                for t in 0..mesh.triangles.len() {
-                    assert!(!wanted(t) || seen[t], "{builtin:?}: triangle {t} missed");
+                for (t, seen) in seen.iter().enumerate() {
+                    assert!(!wanted(t) || *seen, "{builtin:?}: triangle {t} missed");
                 }
                 visited += seen.iter().filter(|s| **s).count();
                 visits += mesh.triangles.len();

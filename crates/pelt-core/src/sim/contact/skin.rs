@@ -153,10 +153,32 @@ fn strand_planes(
         let distance = distance_to_triangle(root, a, b, c);
         (distance <= r).then(|| (faces.key(a.min(b).min(c), root, r, t), distance, corners))
     };
-    let complete = faces.bvh.visit_while(keep, |t| {
-        rising.extend(rising_face(t));
-        rising.len() <= EXACT_RISING
-    });
+    // Nearest box first, all of them while the faces are few; past `EXACT_RISING` of them only
+    // the nearest `COVER_FACES` are wanted, and the walk stops once no nearer one can come.
+    // Both closures below read the heap of the nearest and the count (one writes, one reads):
+    // shared through cells.
+    let nearest = std::cell::RefCell::new(BinaryHeap::new());
+    let found = std::cell::Cell::new(0_usize);
+    faces.bvh.visit_nearest(
+        root,
+        keep,
+        |t| {
+            if let Some(face) = rising_face(t) {
+                let mut nearest = nearest.borrow_mut();
+                nearest.push(Nearest(face.1, face.0));
+                if nearest.len() > COVER_FACES {
+                    nearest.pop();
+                }
+                rising.push(face);
+                found.set(found.get() + 1);
+            }
+        },
+        |d| {
+            let nearest = nearest.borrow();
+            found.get() > EXACT_RISING && nearest.peek().is_some_and(|worst| d > worst.0)
+        },
+    );
+    let complete = rising.len() <= EXACT_RISING;
     let candidate = |[a, b, c]: [Vec3; 3]| {
         let nf = (b - a).cross(c - a).try_normalize()?;
         let d = nf.dot(root - a);
@@ -174,30 +196,7 @@ fn strand_planes(
     }
     if !complete || candidates.len() * rising.len() > EXACT_COVER_WORK {
         // The nearest faces (ties in the walk's order), so the thinned cover keeps the faces a
-        // strand meets first; where there are many, only they are looked for.
-        if !complete {
-            rising.clear();
-            // Both closures below read the heap (one pushes, one peeks): shared through a cell.
-            let nearest = std::cell::RefCell::new(BinaryHeap::new());
-            faces.bvh.visit_nearest(
-                root,
-                keep,
-                |t| {
-                    if let Some(face) = rising_face(t) {
-                        let mut nearest = nearest.borrow_mut();
-                        nearest.push(Nearest(face.1, face.0));
-                        if nearest.len() > COVER_FACES {
-                            nearest.pop();
-                        }
-                        rising.push(face);
-                    }
-                },
-                |d| {
-                    let nearest = nearest.borrow();
-                    nearest.len() >= COVER_FACES && nearest.peek().is_some_and(|worst| d > worst.0)
-                },
-            );
-        }
+        // strand meets first.
         rising.sort_by(|x, y| x.1.total_cmp(&y.1).then(x.0.cmp(&y.0)));
         rising.truncate(COVER_FACES);
         candidates = thin_candidates(rising.iter().filter_map(|(_, _, t)| candidate(*t)));
