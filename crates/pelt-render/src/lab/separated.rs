@@ -49,9 +49,16 @@ const VERTEX_ATTRIBUTES: [wgpu::VertexAttribute; 3] =
 pub struct SeparatedRenderer {
     target: FurTarget,
     skin: wgpu::RenderPipeline,
-    /// Blended, alpha-to-coverage.
+    /// Ungroomed furs, groomed ones (with the groom's varyings): shells and fins.
+    coats: [SeparatedCoat; 2],
+}
+
+/// One coat's separated pipelines.
+#[derive(Debug)]
+struct SeparatedCoat {
     /// Meshes without uvs, with uvs; each blended, alpha-to-coverage.
     shells: [[wgpu::RenderPipeline; 2]; 2],
+    /// Blended, alpha-to-coverage.
     fins: [wgpu::RenderPipeline; 2],
 }
 
@@ -74,7 +81,7 @@ impl SeparatedRenderer {
             step_mode: wgpu::VertexStepMode::Vertex,
             attributes: &VERTEX_ATTRIBUTES,
         })];
-        let build_for = |label: &str, (vertex_entry, fragment_entry), kind, mesh_uvs| {
+        let build_for = |label: &str, (vertex_entry, fragment_entry): (&str, &str), kind, mesh_uvs| {
             let source = PipelineSource {
                 mesh_uvs,
                 coat: None,
@@ -86,22 +93,33 @@ impl SeparatedRenderer {
             };
             create_pipeline(device, &target, label, &source, kind)
         };
-        let build = |label: &str, entries, kind| build_for(label, entries, kind, None);
+        let build = |label: &str, entries: (&str, &str), kind| build_for(label, entries, kind, None);
         let skin = build("pelt separated skin", ("vs_separated_skin", "fs_skin"), PassKind::Opaque);
-        // Without uvs, with uvs: each passes on only what its fragments read. The groom's terms
-        // ride along and the object's flags say whether they are read (`GROOM` left at 0).
-        let shells = [
-            ("vs_separated_shell_tiles", "fs_shell_tiles_groomed"),
-            ("vs_separated_shell_uvs", "fs_shell_uvs_groomed"),
-        ]
-        .map(|entries| {
-            let mesh_uvs = entries.1 == "fs_shell_uvs_groomed";
-            Transparency::BOTH.map(|t| build_for("pelt separated shells", entries, PassKind::Shells(t), Some(mesh_uvs)))
-        });
-        let fins = Transparency::BOTH
-            .map(|t| build("pelt separated fins", ("vs_separated_fin", "fs_separated_fin"), PassKind::Fins(t)));
+        // Without uvs, with uvs: each passes on only what its fragments read; the groomed coat
+        // adds the groom's terms, and the object's flags say whether they are read (`GROOM` 0).
+        let coat = |suffix: &str| {
+            let entry = |name: &str| format!("{name}{suffix}");
+            let shells = ["tiles", "uvs"].map(|walk| {
+                let entries = (entry(&format!("vs_separated_shell_{walk}")), entry(&format!("fs_shell_{walk}")));
+                Transparency::BOTH.map(|t| {
+                    let kind = PassKind::Shells(t);
+                    build_for(
+                        "pelt separated shells",
+                        (entries.0.as_str(), entries.1.as_str()),
+                        kind,
+                        Some(walk == "uvs"),
+                    )
+                })
+            });
+            let fin_entries = (entry("vs_separated_fin"), entry("fs_separated_fin"));
+            let fins = Transparency::BOTH.map(|t| {
+                build("pelt separated fins", (fin_entries.0.as_str(), fin_entries.1.as_str()), PassKind::Fins(t))
+            });
+            SeparatedCoat { shells, fins }
+        };
+        let coats = [coat(""), coat("_groomed")];
         scope.pop("building the separated pipelines")?;
-        Ok(Self { target, skin, shells, fins })
+        Ok(Self { target, skin, coats })
     }
 
     /// The target description the pipelines were built for.
@@ -128,15 +146,16 @@ impl SeparatedRenderer {
             pass.set_pipeline(&self.skin);
             pass.draw_indexed(0..fur.index_count, 0, 0..1);
         }
+        let coat = &self.coats[usize::from(fur.shape.groom_shading)];
         if settings.shells {
-            pass.set_pipeline(&self.shells[usize::from(fur.shape.has_uvs)][which]);
+            pass.set_pipeline(&coat.shells[usize::from(fur.shape.has_uvs)][which]);
             let furred = 3 * fur.shape.furred_triangle_count;
             for layer in fur.level.shell_layers(fur.shape.layers) {
                 pass.draw_indexed(0..furred, (layer * fur.shape.vertex_count) as i32, layer..layer + 1);
             }
         }
         if settings.fins {
-            pass.set_pipeline(&self.fins[which]);
+            pass.set_pipeline(&coat.fins[which]);
             pass.set_vertex_buffer(0, fur.fin_vertices.slice(..));
             pass.draw(0..fur.fin_vertex_count, 0..1);
         }

@@ -45,16 +45,28 @@ fn vs_separated_skin(in: VertexIn) -> Varyings {
 }
 
 // Shells: one draw per layer with a base-vertex offset; the instance index carries the layer.
-// Meshes without uvs and with them pass on what `fs_shell_tiles_groomed` and
-// `fs_shell_uvs_groomed` read, as the unified groomed shells do.
+// Meshes without uvs and with them pass on what `fs_shell_tiles` and `fs_shell_uvs` read, as
+// the unified shells do; a groomed fur's `_groomed` twins add the groom's terms.
 @vertex
-fn vs_separated_shell_tiles(in: VertexIn, @builtin(instance_index) layer: u32, @builtin(vertex_index) index: u32) -> GroomedShellTileVaryings {
+fn vs_separated_shell_tiles(in: VertexIn, @builtin(instance_index) layer: u32) -> ShellTileVaryings {
+    let v = separated_shell(in, layer);
+    return shell_tile_varyings(v, v.fade, separated_lod_blend(v));
+}
+
+@vertex
+fn vs_separated_shell_uvs(in: VertexIn, @builtin(instance_index) layer: u32) -> ShellUvVaryings {
+    let v = separated_shell(in, layer);
+    return shell_uv_varyings(v, v.fade, separated_lod_blend(v));
+}
+
+@vertex
+fn vs_separated_shell_tiles_groomed(in: VertexIn, @builtin(instance_index) layer: u32, @builtin(vertex_index) index: u32) -> GroomedShellTileVaryings {
     let v = separated_shell(in, layer);
     return groomed_shell_tile_varyings(v, v.fade, separated_lod_blend(v), separated_shell_groom(index));
 }
 
 @vertex
-fn vs_separated_shell_uvs(in: VertexIn, @builtin(instance_index) layer: u32, @builtin(vertex_index) index: u32) -> GroomedShellUvVaryings {
+fn vs_separated_shell_uvs_groomed(in: VertexIn, @builtin(instance_index) layer: u32, @builtin(vertex_index) index: u32) -> GroomedShellUvVaryings {
     let v = separated_shell(in, layer);
     return groomed_shell_uv_varyings(v, v.fade, separated_lod_blend(v), separated_shell_groom(index));
 }
@@ -109,8 +121,19 @@ fn separated_fin_fade(index: u32, normal: vec3<f32>) -> f32 {
     return smoothstep(1.0 - object.fin_fade_cos, 1.0, abs(dot(normal, to_camera)));
 }
 
-// `Varyings` and the groom's terms (a fin vertex's end of the edge).
+// What a separated fin fragment reads of `Varyings`.
 struct SeparatedFinVaryings {
+    @builtin(position) clip_position: vec4<f32>,
+    @location(0) world_position: vec3<f32>,
+    @location(1) normal: vec3<f32>,
+    @location(2) uv: vec2<f32>,
+    @location(3) height: f32,
+    @location(4) fade: f32,
+    @location(5) surface_uv: vec2<f32>,
+}
+
+// The same and the groom's terms (a fin vertex's end of the edge), for a groomed fur.
+struct GroomedSeparatedFinVaryings {
     @builtin(position) clip_position: vec4<f32>,
     @location(0) world_position: vec3<f32>,
     @location(1) normal: vec3<f32>,
@@ -125,7 +148,13 @@ struct SeparatedFinVaryings {
 @vertex
 fn vs_separated_fin(in: VertexIn, @builtin(vertex_index) index: u32) -> SeparatedFinVaryings {
     let v = separated_fin(in, index);
-    var out = SeparatedFinVaryings(v.clip_position, v.world_position, v.normal, v.uv, v.height, v.fade, v.surface_uv, vec4<f32>(1.0), 0.0);
+    return SeparatedFinVaryings(v.clip_position, v.world_position, v.normal, v.uv, v.height, v.fade, v.surface_uv);
+}
+
+@vertex
+fn vs_separated_fin_groomed(in: VertexIn, @builtin(vertex_index) index: u32) -> GroomedSeparatedFinVaryings {
+    let v = separated_fin(in, index);
+    var out = GroomedSeparatedFinVaryings(v.clip_position, v.world_position, v.normal, v.uv, v.height, v.fade, v.surface_uv, vec4<f32>(1.0), 0.0);
     if groom_on() && v.fade > 0.0 {
         let per_fin = max((arrayLength(&fin_vertex_floats) / 8u) / max(object.edge_count, 1u), 1u);
         // Side b of the edge sits at u > 0.
@@ -165,31 +194,33 @@ fn separated_fin(in: VertexIn, index: u32) -> Varyings {
 
 // Fins store no strand direction: it is the direction of growing height across the fin, from the
 // screen-space derivatives of position and uv.
-@fragment
-fn fs_separated_fin(in: SeparatedFinVaryings) -> @location(0) vec4<f32> {
-    let dp_dx = dpdx(in.world_position);
-    let dp_dy = dpdy(in.world_position);
-    let duv_dx = dpdx(in.uv);
-    let duv_dy = dpdy(in.uv);
+fn separated_fin_colour(world_position: vec3<f32>, normal: vec3<f32>, uv: vec2<f32>, height: f32, albedo: vec3<f32>, alpha: f32) -> vec4<f32> {
+    let dp_dx = dpdx(world_position);
+    let dp_dy = dpdy(world_position);
+    let duv_dx = dpdx(uv);
+    let duv_dy = dpdy(uv);
     let determinant = duv_dx.x * duv_dy.y - duv_dy.x * duv_dx.y;
     let up = (duv_dx.x * dp_dy - duv_dy.x * dp_dx) * sign(determinant);
+    let tangent = safe_normalize(up, normalize(normal));
+    let colour = hair_lighting(albedo, tangent, tangent, world_position, height);
+    return fur_output(colour, alpha);
+}
+
+@fragment
+fn fs_separated_fin(in: SeparatedFinVaryings) -> @location(0) vec4<f32> {
+    let texel = textureSample(fin_texture, fin_sampler, vec2<f32>(in.uv.x, 1.0 - in.uv.y));
+    let albedo = texel.rgb * surface_tint(in.surface_uv);
+    return separated_fin_colour(in.world_position, in.normal, in.uv, in.height, albedo, texel.a * in.fade);
+}
+
+// The unified fins' groom shading (`fs_fin_groomed`).
+@fragment
+fn fs_separated_fin_groomed(in: GroomedSeparatedFinVaryings) -> @location(0) vec4<f32> {
     let fin_uv = vec2<f32>(in.uv.x, 1.0 - in.uv.y);
-    var texel: vec4<f32>;
-    var groom_alpha = 1.0;
-    var groom_tint = vec3<f32>(1.0);
-    // A uniform branch: the unified fins' groom shading (`fs_fin_groomed`).
-    if groom_on() {
-        let cells = clump_cells_per_tile();
-        let along = clump_uv(vec2<f32>(fin_uv.x, 0.5 / cells), cells, groom_clump_amount(in.clump, in.height)).x;
-        texel = textureSampleGrad(fin_texture, fin_sampler, vec2<f32>(along, fin_uv.y), dpdx(fin_uv), dpdy(fin_uv));
-        groom_alpha = clamp(in.tint_density.a, 0.0, 1.0);
-        groom_tint = in.tint_density.rgb;
-    } else {
-        texel = textureSample(fin_texture, fin_sampler, fin_uv);
-    }
-    let normal = normalize(in.normal);
-    let tangent = safe_normalize(up, normal);
-    let albedo = texel.rgb * surface_tint(in.surface_uv) * groom_tint;
-    let colour = hair_lighting(albedo, tangent, tangent, in.world_position, in.height);
-    return fur_output(colour, texel.a * in.fade * groom_alpha);
+    let cells = clump_cells_per_tile();
+    let along = clump_uv(vec2<f32>(fin_uv.x, 0.5 / cells), cells, groom_clump_amount(in.clump, in.height)).x;
+    let texel = textureSampleGrad(fin_texture, fin_sampler, vec2<f32>(along, fin_uv.y), dpdx(fin_uv), dpdy(fin_uv));
+    let albedo = texel.rgb * surface_tint(in.surface_uv) * in.tint_density.rgb;
+    let alpha = texel.a * in.fade * clamp(in.tint_density.a, 0.0, 1.0);
+    return separated_fin_colour(in.world_position, in.normal, in.uv, in.height, albedo, alpha);
 }
