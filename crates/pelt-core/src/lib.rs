@@ -24,6 +24,7 @@ pub mod rng;
 pub mod sim;
 pub mod stage;
 pub mod texture;
+pub mod usd;
 pub mod wet;
 
 pub use fur::{FurParams, FurStructure, GrowthDirection, SeparatedStructure};
