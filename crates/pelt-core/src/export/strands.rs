@@ -13,6 +13,8 @@
 //! - Strands on bald triangles are left out; a groom's density keeps a strand where its seeded
 //!   keep value lies below the density at its root (as the shells keep it); `fraction` keeps a
 //!   seeded share of the rest.
+//! - `primvars:pelt:lengthFactor` per strand: its seeded length over its column's (strands end
+//!   at seeded heights), so a bake of the file finds the columns' lengths exactly.
 //! - Several frames become time samples on the points and extents (the mesh's too).
 //!
 //! The file is written through a temporary file and a rename: a failed write leaves nothing.
@@ -253,6 +255,13 @@ fn write_layer<W: Write>(out: W, input: &StrandExportInput<'_>, kept: &[usize]) 
     let colours: Vec<Vec3> = strands.iter().map(|placed| strand_colour(input, placed)).collect();
     usd.array("color3f[]", "primvars:displayColor", colours.iter().copied(), Some("uniform"), vec3)?;
     drop(colours);
+    usd.array(
+        "float[]",
+        "primvars:pelt:lengthFactor",
+        strands.iter().map(|placed| reference.field_strand(placed).length_factor()),
+        Some("uniform"),
+        |w, x| w.write_all(format_f32(x).as_bytes()),
+    )?;
     let points = |frame: &StrandFrame| -> std::io::Result<Vec<Vec3>> {
         let nodes = reference
             .node_positions(&frame.positions)

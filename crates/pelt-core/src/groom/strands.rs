@@ -9,9 +9,10 @@
 //! decide it): a vertex whose own curves are short stays short even beside long ones, and bald
 //! stays bald.
 //!
-//! - **length**: the curves' arc lengths over the field's mean strand length (a coat's strands
-//!   end at seeded heights below its tip), over the preset's length; a vertex shorter than half a
-//!   layer, or with no curve near it, is bald (0).
+//! - **length**: the curves' arc lengths over their strand length factor (Pelt's own
+//!   `primvars:pelt:lengthFactor`, else the field's mean: a coat's strands end at seeded heights
+//!   below its tip), over the preset's length; a vertex shorter than one layer's height of the
+//!   preset's fur, or with no curve near it, is bald (0).
 //! - **direction**: the curves' first segments, solved likewise, turned into the flow that makes
 //!   the preset grow that direction (its comb blend and random tilt included).
 //! - **density**: the curves' weights at a vertex over those of the field's strands at a uniform
@@ -25,7 +26,7 @@ use std::path::{Path, PathBuf};
 
 use glam::{Vec2, Vec3};
 
-use super::{Groom, GroomError, MAX_LENGTH_FACTOR, tangent_frames};
+use super::{Groom, GroomError, MAX_LENGTH_FACTOR};
 use crate::body::closest_on_triangle;
 use crate::mesh::Mesh;
 use crate::usd::{UpAxis, UsdCurves};
@@ -33,13 +34,13 @@ use crate::usd::{UpAxis, UsdCurves};
 /// Points each cubic segment is sampled at.
 const SAMPLES_PER_SEGMENT: usize = 4;
 /// How strongly a vertex's value is pulled toward its curves' weighted mean (against the fit).
-const PULL_TO_MEAN: f64 = 0.05;
+const PULL_TO_MEAN: f64 = 0.002;
 
 /// What a strand groom bakes against: the preset's fur on one mesh.
 pub struct StrandBakeParams<'a> {
     /// The preset's length per vertex, model units (before any groom).
     pub lengths: &'a [f32],
-    /// Layers of the fur (a vertex shorter than half a layer is bald).
+    /// Layers of the fur (a vertex shorter than one layer's height is bald).
     pub layers: u32,
     /// The strand field's mean length factor (its strands' mean length over the fur's).
     pub mean_length_factor: f32,
@@ -203,7 +204,8 @@ pub fn bake_strands(
             report.root_distance_max = report.root_distance_max.max(distance);
             let colour = set.colours.as_ref().map(|c| c[k]);
             let tip = line[line.len() - 1];
-            sums.add(mesh.triangles[triangle], weights, length / mean_factor, first.normalize(), root, tip, colour);
+            let factor = set.length_factors.as_ref().map_or(mean_factor, |f| f[k]);
+            sums.add(mesh.triangles[triangle], weights, length / factor, first.normalize(), root, tip, colour);
         }
     }
     if report.on_surface == 0 {
@@ -308,8 +310,7 @@ impl Sums {
         }
         let solved: Vec<Vec<f64>> =
             (0..4).map(|c| self.matrix.solve(&rhs.iter().map(|r| r[c]).collect::<Vec<_>>())).collect();
-        let frames = tangent_frames(mesh);
-        let bald_below = 0.5 / params.layers.max(1) as f32;
+        let bald_below = 1.0 / params.layers.max(1) as f32;
         let mut length = vec![0.0f32; v];
         let mut direction = vec![Vec2::ZERO; v];
         let mut density = vec![1.0f32; v];
@@ -321,14 +322,16 @@ impl Sums {
         }
         for j in 0..v {
             let preset = params.lengths[j];
-            let factor = if self.weight[j] > 0.0 && preset > 0.0 { solved[0][j] as f32 / preset } else { 0.0 };
+            // A column is its growth direction times its length: the blend of the corners'
+            // columns is what a strand follows, so the fit is of that vector.
+            let along = Vec3::new(solved[1][j] as f32, solved[2][j] as f32, solved[3][j] as f32);
+            let factor = if self.weight[j] > 0.0 && preset > 0.0 { along.length() / preset } else { 0.0 };
             if !(factor.is_finite() && factor >= bald_below) {
                 continue;
             }
             length[j] = factor.min(MAX_LENGTH_FACTOR);
-            let along = Vec3::new(solved[1][j] as f32, solved[2][j] as f32, solved[3][j] as f32);
             if let Some(wanted) = along.try_normalize() {
-                direction[j] = flow_for(j, wanted, mesh.normals[j], frames[j], params.grow);
+                direction[j] = flow_for(j, wanted, params.grow);
             }
             if expected[j] > 0.0 {
                 density[j] = (self.weight[j] as f32 / expected[j]).clamp(0.0, 1.0);
@@ -375,42 +378,43 @@ impl Sums {
     }
 }
 
-/// The flow (components in `-1..=1`, length at most 1) for which `grow` gives the direction
-/// closest to `wanted`: Gauss-Newton from the tangent part of `wanted`, the Jacobian by finite
-/// differences (whatever comb and tilt the preset adds, the flow that reproduces the direction).
-fn flow_for(
-    j: usize,
-    wanted: Vec3,
-    normal: Vec3,
-    frame: super::TangentFrame,
-    grow: &(dyn Fn(usize, Vec2) -> Vec3 + Sync),
-) -> Vec2 {
-    let along = wanted - normal * wanted.dot(normal);
-    let clamp = |f: Vec2| {
-        let f = f.clamp(Vec2::splat(-1.0), Vec2::splat(1.0));
-        if f.length() > 1.0 { f.normalize() } else { f }
-    };
-    let mut flow = clamp(Vec2::new(along.dot(frame.tangent), along.dot(frame.up)));
-    let step = 1e-3;
-    for _ in 0..12 {
-        let at = grow(j, flow);
-        let residual = at - wanted;
-        if residual.length() < 1e-5 {
-            break;
+/// The flow (length at most 1) for which `grow` gives the direction closest to `wanted`,
+/// whatever comb and tilt the preset adds: a coarse search over the flow's angle and length,
+/// then a pattern search that halves its steps. The preset's comb saturates at a flow of length
+/// 1, so the search stays in the unit disc.
+fn flow_for(j: usize, wanted: Vec3, grow: &(dyn Fn(usize, Vec2) -> Vec3 + Sync)) -> Vec2 {
+    let flow = |angle: f32, radius: f32| Vec2::from_angle(angle) * radius;
+    let score = |angle: f32, radius: f32| grow(j, flow(angle, radius)).dot(wanted);
+    let mut best = (0.0f32, 0.0f32, score(0.0, 0.0));
+    for a in 0..24 {
+        for r in 1..=6 {
+            let (angle, radius) = (a as f32 * std::f32::consts::TAU / 24.0, r as f32 / 6.0);
+            let s = score(angle, radius);
+            if s > best.2 {
+                best = (angle, radius, s);
+            }
         }
-        let dx = (grow(j, flow + Vec2::new(step, 0.0)) - at) / step;
-        let dy = (grow(j, flow + Vec2::new(0.0, step)) - at) / step;
-        // Normal equations of the 3x2 system, lightly damped.
-        let (a, b, d) = (dx.dot(dx) + 1e-6, dx.dot(dy), dy.dot(dy) + 1e-6);
-        let (gx, gy) = (-dx.dot(residual), -dy.dot(residual));
-        let det = a * d - b * b;
-        if !(det.is_finite() && det.abs() > 1e-12) {
-            break;
-        }
-        let delta = Vec2::new(d * gx - b * gy, a * gy - b * gx) / det;
-        flow = clamp(flow + delta);
     }
-    flow
+    let (mut angle_step, mut radius_step) = (std::f32::consts::TAU / 48.0, 1.0 / 12.0);
+    for _ in 0..40 {
+        let mut moved = false;
+        for (da, dr) in [(angle_step, 0.0), (-angle_step, 0.0), (0.0, radius_step), (0.0, -radius_step)] {
+            let (angle, radius) = (best.0 + da, (best.1 + dr).clamp(0.0, 1.0));
+            let s = score(angle, radius);
+            if s > best.2 {
+                best = (angle, radius, s);
+                moved = true;
+            }
+        }
+        if !moved {
+            angle_step *= 0.5;
+            radius_step *= 0.5;
+            if angle_step < 1e-4 {
+                break;
+            }
+        }
+    }
+    flow(best.0, best.1)
 }
 
 /// A symmetric matrix over the mesh's vertices with one-ring sparsity (rows of sorted columns).

@@ -58,6 +58,9 @@ pub struct Curves {
     /// One linear RGB colour per curve from `primvars:displayColor` (a constant colour repeated,
     /// a per-vertex one read at each curve's first point), if it has one.
     pub colours: Option<Vec<Vec3>>,
+    /// Each curve's length over its column's (`primvars:pelt:lengthFactor`, uniform), as Pelt
+    /// writes it: a coat's strands end at seeded heights, and this says where.
+    pub length_factors: Option<Vec<f32>>,
 }
 
 impl Curves {
@@ -477,6 +480,7 @@ struct RawCurves {
     basis: Option<String>,
     wrap: Option<String>,
     colour: Option<(Vec<f32>, String)>,
+    length_factors: Option<Vec<f32>>,
 }
 
 struct Parser<R: BufRead> {
@@ -684,6 +688,7 @@ impl<R: BufRead> Parser<R> {
                     basis: None,
                     wrap: None,
                     colour: None,
+                    length_factors: None,
                 });
                 Some(self.raw.len() - 1)
             }
@@ -791,6 +796,7 @@ impl<R: BufRead> Parser<R> {
                 "type" => raw.curve_type = text(value),
                 "basis" => raw.basis = text(value),
                 "wrap" => raw.wrap = text(value),
+                "primvars:pelt:lengthFactor" => raw.length_factors = floats(value),
                 "primvars:displayColor" => {
                     raw.colour = floats(value).map(|f| (f, interpolation.unwrap_or_else(|| "constant".to_owned())));
                 }
@@ -887,7 +893,29 @@ impl<R: BufRead> Parser<R> {
                     Some(curve_colours(&flat, &interpolation, &integer_counts).map_err(problem)?)
                 }
             };
-            curves.push(Curves { path, counts: integer_counts, points, curve_type, basis, wrap, colours });
+            let length_factors = match raw.length_factors {
+                Some(factors) if factors.len() != integer_counts.len() => {
+                    return Err(problem(format!(
+                        "primvars:pelt:lengthFactor has {} values for {} curves",
+                        factors.len(),
+                        integer_counts.len()
+                    )));
+                }
+                Some(factors) if factors.iter().any(|f| !(f.is_finite() && *f > 0.0)) => {
+                    return Err(problem("primvars:pelt:lengthFactor must be positive numbers".to_owned()));
+                }
+                other => other,
+            };
+            curves.push(Curves {
+                path,
+                counts: integer_counts,
+                points,
+                curve_type,
+                basis,
+                wrap,
+                colours,
+                length_factors,
+            });
         }
         let mut notes = Vec::new();
         if self.meta.references > 0 {
