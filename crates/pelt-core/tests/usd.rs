@@ -295,3 +295,42 @@ fn bad_curve_files_are_clear_errors_naming_the_file() {
     let error = with_strands(&preset, &missing).groom(&mesh, "sphere").unwrap_err().to_string();
     assert!(error.contains("missing.usda") && error.contains("cannot read"), "{error}");
 }
+
+/// A groom written by Pixar's USD library (`tests/fixtures/make_zup_groom.py`, usd-core): curves
+/// on the bunny's upper +X side in a Z-up centimetre stage, under a translated Xform, as pinned
+/// cubic B-splines, baked onto the Y-up metre bunny: every root lands on the surface, the fur
+/// grows on that side alone, along the normals, as long as the curves.
+#[test]
+fn a_z_up_centimetre_groom_from_usd_lands_on_the_right_side() {
+    let (mesh, _) = Mesh::load(&assets().join("meshes/bunny.obj"), &ImportOptions::default()).unwrap();
+    let preset = with_strands(&Preset::default(), &fixture("zup_cm_groom.usda"));
+    let (groom, report) = preset.groom_with_report(&mesh, "bunny.obj").unwrap();
+    let (groom, report) = (groom.unwrap(), report.unwrap());
+    assert_eq!((report.curves, report.on_surface, report.off_surface), (89, 89, 0), "{report}");
+    assert!(report.root_distance_max < 1e-4, "{report}");
+    let fur = preset.grow(mesh.clone(), "bunny.obj").unwrap();
+    let furred: Vec<usize> = (0..mesh.vertex_count()).filter(|&j| groom.length_factor(j) > 0.0).collect();
+    assert!(furred.len() >= 20, "{report}");
+    // The curves root on faces whose centres have x > 1 and y > 5: their corners lie within an
+    // edge or two of that.
+    let edge = mesh.mean_edge_length();
+    for &j in &furred {
+        let p = mesh.positions[j];
+        assert!(p.x > 1.0 - 3.0 * edge && p.y > 5.0 - 3.0 * edge, "vertex {j} at {p} is furred");
+    }
+    // 0.3 m curves over the field's mean strand length and the preset's length.
+    let field = preset.strand_field().unwrap();
+    let mean_factor = field.strands.iter().map(|s| s.length_factor()).sum::<f32>() / field.strands.len() as f32;
+    let expected = 0.3 / mean_factor / (preset.length * mesh.bounding_sphere().1);
+    let mut factors: Vec<f32> = furred.iter().map(|&j| groom.length_factor(j)).collect();
+    factors.sort_by(f32::total_cmp);
+    let median = factors[factors.len() / 2];
+    assert!((median / expected - 1.0).abs() < 0.15, "median length factor {median}, expected {expected}");
+    let mut angles: Vec<f32> = furred.iter().map(|&j| angle_deg(fur.directions[j], mesh.normals[j])).collect();
+    angles.sort_by(f32::total_cmp);
+    // The curves follow face normals, the vertices' normals average several faces.
+    assert!(angles[angles.len() / 2] < 12.0, "growth directions off the normals: {angles:?}");
+    // The file's colour over the preset's own (white by default) as a tint.
+    let tint = groom.tint.as_ref().unwrap()[furred[0]];
+    assert!(tint.x > tint.y && tint.y > tint.z, "{tint}");
+}

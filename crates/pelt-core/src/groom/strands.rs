@@ -18,8 +18,9 @@
 //! - **density**: the curves' weights at a vertex over those of the field's strands at a uniform
 //!   density (`expected_strands`), at most 1.
 //! - **clump**: how much closer together the tips of a vertex's curves lie than their roots.
-//! - **tint**: `primvars:displayColor` over the preset's own strand colour, per channel `0..=1`,
-//!   where the file has colours.
+//! - **tint**: `primvars:displayColor` over the preset's own strand colour, where the file has
+//!   colours; a tint only darkens, so a colour brighter than the preset's is scaled down to
+//!   `0..=1` keeping its hue.
 
 use std::collections::HashMap;
 use std::path::{Path, PathBuf};
@@ -364,7 +365,9 @@ impl Sums {
                         return Vec3::ONE;
                     }
                     let colour = self.colour[j] / self.weight[j] as f32;
-                    (colour / params.base_colours[j].max(Vec3::splat(1e-4))).clamp(Vec3::ZERO, Vec3::ONE)
+                    // A tint only darkens: a colour brighter than the preset's keeps its hue.
+                    let ratio = (colour / params.base_colours[j].max(Vec3::splat(1e-4))).max(Vec3::ZERO);
+                    (ratio / ratio.max_element().max(1.0)).clamp(Vec3::ZERO, Vec3::ONE)
                 })
                 .collect()
         });
