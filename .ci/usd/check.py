@@ -62,7 +62,10 @@ def main(path, line):
     if min(counts) < minimum:
         fail(path, f"a {curve_type} curve has {min(counts)} points")
     widths = curves.GetWidthsAttr().Get(time)
-    if curves.ComputeInterpolationForSize(len(widths), time) != UsdGeom.Tokens.vertex:
+    # Linear curves have as many varying values as vertices, so USD may name the size either way.
+    if curves.GetWidthsInterpolation() != UsdGeom.Tokens.vertex or curves.ComputeInterpolationForSize(
+        len(widths), time
+    ) not in (UsdGeom.Tokens.vertex, UsdGeom.Tokens.varying):
         fail(path, f"{len(widths)} widths do not make a per-vertex primvar")
     colours = UsdGeom.PrimvarsAPI(curves.GetPrim()).GetPrimvar("displayColor")
     if colours.GetInterpolation() != UsdGeom.Tokens.uniform or len(colours.Get(time)) != len(counts):
