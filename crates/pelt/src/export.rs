@@ -90,7 +90,7 @@ pub struct Args {
     #[arg(long, value_name = "W", value_parser = crate::values::parse_wetness)]
     pub wetness: Option<f32>,
     /// .usda: metres per unit of the mesh (`metersPerUnit`; glTF's metres by default).
-    #[arg(long, value_name = "M")]
+    #[arg(long, value_name = "M", allow_negative_numbers = true)]
     pub meters_per_unit: Option<f64>,
     /// Output: a .glb, a .gltf (its buffer written beside it as a .bin), or a .usda (the strands
     /// as USD hair curves on the base mesh).

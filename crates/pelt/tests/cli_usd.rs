@@ -87,12 +87,13 @@ fn bad_usd_arguments_fail_and_leave_no_file() {
     let folder = folder("bad");
     let usda = folder.join("fur.usda");
     let glb = folder.join("fur.glb");
+    let missing = folder.join("missing/fur.usda");
     let cases: [(&[&str], &str); 5] = [
         (&["--strand-fraction", "0", "-o", usda.to_str().unwrap()], "--strand-fraction must be above 0"),
         (&["--strand-fraction", "0.5", "-o", glb.to_str().unwrap()], "--strand-fraction: only a .usda export"),
         (&["--layers", "4", "-o", usda.to_str().unwrap()], "a .usda export writes strands"),
         (&["--meters-per-unit", "-1", "-o", usda.to_str().unwrap()], "--meters-per-unit must be a positive number"),
-        (&["-o", folder.join("missing/fur.usda").to_str().unwrap()], "cannot write"),
+        (&["-o", missing.to_str().unwrap()], "cannot write"),
     ];
     for (args, wanted) in cases {
         let mut all = vec!["export", "--builtin", "box"];
