@@ -230,8 +230,8 @@ pub fn bake_strands(
 struct Sums {
     /// `A^T A` of the barycentric weights, in the mesh's one-ring pattern.
     matrix: Sparse,
-    /// `A^T y` for length and for the three components of the length-weighted direction.
-    rhs: Vec<[f64; 4]>,
+    /// `A^T y` for the three components of the curves' length-weighted directions.
+    rhs: Vec<[f64; 3]>,
     /// Sum of weights and of squared weights per vertex.
     weight: Vec<f64>,
     weight_sq: Vec<f64>,
@@ -246,7 +246,7 @@ impl Sums {
         let v = mesh.vertex_count();
         Self {
             matrix: Sparse::new(mesh),
-            rhs: vec![[0.0; 4]; v],
+            rhs: vec![[0.0; 3]; v],
             weight: vec![0.0; v],
             weight_sq: vec![0.0; v],
             colour: vec![Vec3::ZERO; v],
@@ -272,10 +272,8 @@ impl Sums {
             for (b, &wb) in corners.iter().zip(&weights) {
                 self.matrix.add(*a, *b, wa * f64::from(wb));
             }
-            let rhs = &mut self.rhs[j];
-            rhs[0] += wa * f64::from(length);
-            for (c, x) in along.to_array().iter().enumerate() {
-                rhs[c + 1] += wa * f64::from(*x);
+            for (rhs, x) in self.rhs[j].iter_mut().zip(along.to_array()) {
+                *rhs += wa * f64::from(x);
             }
             self.weight[j] += wa;
             self.weight_sq[j] += wa * wa;
@@ -298,11 +296,11 @@ impl Sums {
         // Pull each vertex toward its weighted mean by a share of its own weight; a vertex no
         // curve reaches is pinned to 0 (bald).
         let mut rhs = self.rhs.clone();
-        for j in 0..v {
+        for (j, rhs) in rhs.iter_mut().enumerate() {
             let pull = PULL_TO_MEAN * self.weight_sq[j];
             if self.weight[j] > 0.0 {
-                for c in 0..4 {
-                    rhs[j][c] += pull * self.rhs[j][c] / self.weight[j];
+                for (value, own) in rhs.iter_mut().zip(self.rhs[j]) {
+                    *value += pull * own / self.weight[j];
                 }
                 self.matrix.add_diagonal(j, pull);
             } else {
@@ -310,7 +308,7 @@ impl Sums {
             }
         }
         let solved: Vec<Vec<f64>> =
-            (0..4).map(|c| self.matrix.solve(&rhs.iter().map(|r| r[c]).collect::<Vec<_>>())).collect();
+            (0..3).map(|c| self.matrix.solve(&rhs.iter().map(|r| r[c]).collect::<Vec<_>>())).collect();
         let bald_below = 1.0 / params.layers.max(1) as f32;
         let mut length = vec![0.0f32; v];
         let mut direction = vec![Vec2::ZERO; v];
@@ -325,7 +323,7 @@ impl Sums {
             let preset = params.lengths[j];
             // A column is its growth direction times its length: the blend of the corners'
             // columns is what a strand follows, so the fit is of that vector.
-            let along = Vec3::new(solved[1][j] as f32, solved[2][j] as f32, solved[3][j] as f32);
+            let along = Vec3::new(solved[0][j] as f32, solved[1][j] as f32, solved[2][j] as f32);
             let factor = if self.weight[j] > 0.0 && preset > 0.0 { along.length() / preset } else { 0.0 };
             if !(factor.is_finite() && factor >= bald_below) {
                 continue;

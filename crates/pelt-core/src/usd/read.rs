@@ -820,7 +820,7 @@ impl<R: BufRead> Parser<R> {
         }
         let mut locals = Vec::with_capacity(self.prims.len());
         for info in &self.prims {
-            locals.push(local_transform(info).map_err(|problem| content(problem))?);
+            locals.push(local_transform(info).map_err(&content)?);
         }
         let world = |mut prim: usize| {
             let mut matrix = Mat4::IDENTITY;
@@ -839,7 +839,7 @@ impl<R: BufRead> Parser<R> {
             let problem = |text: String| content(format!("{path}: {text}"));
             let counts = raw.counts.ok_or_else(|| problem("the BasisCurves has no curveVertexCounts".to_owned()))?;
             let flat = raw.points.ok_or_else(|| problem("the BasisCurves has no points".to_owned()))?;
-            if flat.len() % 3 != 0 {
+            if !flat.len().is_multiple_of(3) {
                 return Err(problem("points must be (x, y, z) triples".to_owned()));
             }
             let curve_type = match raw.curve_type.as_deref() {
@@ -937,7 +937,7 @@ impl<R: BufRead> Parser<R> {
 
 /// One colour per curve from `primvars:displayColor`'s values and interpolation.
 fn curve_colours(flat: &[f32], interpolation: &str, counts: &[u32]) -> Result<Vec<Vec3>, String> {
-    if flat.len() % 3 != 0 || flat.iter().any(|c| !c.is_finite()) {
+    if !flat.len().is_multiple_of(3) || flat.iter().any(|c| !c.is_finite()) {
         return Err("primvars:displayColor must be finite (r, g, b) triples".to_owned());
     }
     let colours: Vec<Vec3> = flat.chunks_exact(3).map(Vec3::from_slice).collect();

@@ -88,7 +88,7 @@ impl<W: Write> UsdaWriter<W> {
         self.indent()?;
         write!(self.out, "def {type_name} {}", quoted(name))?;
         if let Some(kind) = kind {
-            write!(self.out, " (\n")?;
+            writeln!(self.out, " (")?;
             self.depth += 1;
             self.indent()?;
             writeln!(self.out, "kind = {}", quoted(kind))?;
