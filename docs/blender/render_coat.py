@@ -32,6 +32,10 @@ low, high = Vector((1e9, 1e9, 1e9)), Vector((-1e9, -1e9, -1e9))
 for obj in scene.objects:
     if obj.type == "CURVES":
         obj.data.materials.append(hair)
+        if "displayColor" not in obj.data.attributes:
+            # No colours in the file: Pelt's default fur colour (#8a5a36, linear).
+            links.remove(shader.inputs["Base Color"].links[0])
+            shader.inputs["Base Color"].default_value = (0.254, 0.102, 0.036, 1.0)
     elif obj.type == "MESH":
         obj.data.materials.append(skin)
         for corner in obj.bound_box:
@@ -44,7 +48,7 @@ camera = bpy.data.objects.new("camera", bpy.data.cameras.new("camera"))
 scene.collection.objects.link(camera)
 scene.camera = camera
 camera.data.lens = 50
-distance = radius * 3.2
+distance = radius * 2.8
 # Blender is Z up; azimuth about Z from the front (-Y looking at +Y, as pelt's default framing).
 camera.location = centre + distance * Vector(
     (math.sin(azimuth) * math.cos(elevation), -math.cos(azimuth) * math.cos(elevation), math.sin(elevation))
@@ -56,7 +60,6 @@ sun.data.energy = 3.0
 sun.rotation_euler = (math.radians(40), 0, math.radians(30))
 scene.collection.objects.link(sun)
 world = bpy.data.worlds.new("world")
-world.use_nodes = True
 world.node_tree.nodes["Background"].inputs["Color"].default_value = (0.6, 0.65, 0.7, 1.0)
 world.node_tree.nodes["Background"].inputs["Strength"].default_value = 0.6
 scene.world = world

@@ -427,11 +427,14 @@ enum Value {
     Path,
     Tuple(Vec<Value>),
     List(Vec<Value>),
-    /// An array of numbers or of tuples of `arity` numbers, flattened.
+    /// An array of numbers or of tuples of `arity` numbers (not 3), flattened.
     Floats {
         flat: Vec<f32>,
         arity: usize,
     },
+    /// An array of triples (points, normals, colours), read straight into vectors so a curve
+    /// set's points are held once.
+    Triples(Vec<Vec3>),
     Other,
 }
 
@@ -475,11 +478,11 @@ struct RawCurves {
     prim: usize,
     path: String,
     counts: Option<Vec<f32>>,
-    points: Option<Vec<f32>>,
+    points: Option<Vec<Vec3>>,
     curve_type: Option<String>,
     basis: Option<String>,
     wrap: Option<String>,
-    colour: Option<(Vec<f32>, String)>,
+    colour: Option<(Vec<Vec3>, String)>,
     length_factors: Option<Vec<f32>>,
 }
 
@@ -597,6 +600,24 @@ impl<R: BufRead> Parser<R> {
         };
         let tuple = matches!(first, Value::Tuple(_));
         let arity = numbers.len();
+        if tuple && arity == 3 {
+            let mut triples = vec![Vec3::new(numbers[0] as f32, numbers[1] as f32, numbers[2] as f32)];
+            while self.lexer.eat(b',')? {
+                if *self.lexer.peek()? == Tok::Punct(b']') {
+                    break;
+                }
+                self.lexer.expect(b'(')?;
+                let x = self.number()?;
+                self.lexer.expect(b',')?;
+                let y = self.number()?;
+                self.lexer.expect(b',')?;
+                let z = self.number()?;
+                self.lexer.expect(b')')?;
+                triples.push(Vec3::new(x as f32, y as f32, z as f32));
+            }
+            self.lexer.expect(b']')?;
+            return Ok(Value::Triples(triples));
+        }
         let mut flat: Vec<f32> = numbers.iter().map(|&x| x as f32).collect();
         while self.lexer.eat(b',')? {
             if *self.lexer.peek()? == Tok::Punct(b']') {
@@ -790,15 +811,20 @@ impl<R: BufRead> Parser<R> {
                 _ => None,
             };
             let text = |value: Value| if let Value::Text(t) = value { Some(t) } else { None };
+            let triples = |value: Value| match value {
+                Value::Triples(triples) => Some(triples),
+                Value::List(items) if items.is_empty() => Some(Vec::new()),
+                _ => None,
+            };
             match name.as_str() {
-                "points" => raw.points = floats(value),
+                "points" => raw.points = triples(value),
                 "curveVertexCounts" => raw.counts = floats(value),
                 "type" => raw.curve_type = text(value),
                 "basis" => raw.basis = text(value),
                 "wrap" => raw.wrap = text(value),
                 "primvars:pelt:lengthFactor" => raw.length_factors = floats(value),
                 "primvars:displayColor" => {
-                    raw.colour = floats(value).map(|f| (f, interpolation.unwrap_or_else(|| "constant".to_owned())));
+                    raw.colour = triples(value).map(|c| (c, interpolation.unwrap_or_else(|| "constant".to_owned())));
                 }
                 _ => {}
             }
@@ -838,10 +864,8 @@ impl<R: BufRead> Parser<R> {
             let path = raw.path;
             let problem = |text: String| content(format!("{path}: {text}"));
             let counts = raw.counts.ok_or_else(|| problem("the BasisCurves has no curveVertexCounts".to_owned()))?;
-            let flat = raw.points.ok_or_else(|| problem("the BasisCurves has no points".to_owned()))?;
-            if !flat.len().is_multiple_of(3) {
-                return Err(problem("points must be (x, y, z) triples".to_owned()));
-            }
+            let mut points =
+                raw.points.ok_or_else(|| problem("the BasisCurves has no points as (x, y, z) triples".to_owned()))?;
             let curve_type = match raw.curve_type.as_deref() {
                 None | Some("cubic") => CurveType::Cubic,
                 Some("linear") => CurveType::Linear,
@@ -874,19 +898,19 @@ impl<R: BufRead> Parser<R> {
                 integer_counts.push(n as u32);
                 total += n as usize;
             }
-            if total != flat.len() / 3 {
+            if total != points.len() {
                 return Err(problem(format!(
                     "curveVertexCounts add up to {total} points, but there are {}",
-                    flat.len() / 3
+                    points.len()
                 )));
             }
-            if let Some(at) = flat.iter().position(|x| !x.is_finite()) {
-                return Err(problem(format!("point {} is not finite", at / 3)));
+            if let Some(at) = points.iter().position(|p| !p.is_finite()) {
+                return Err(problem(format!("point {at} is not finite")));
             }
             let matrix = world(raw.prim);
-            let points: Vec<Vec3> =
-                flat.chunks_exact(3).map(|c| matrix.transform_point3(Vec3::new(c[0], c[1], c[2]))).collect();
-            drop(flat);
+            for point in &mut points {
+                *point = matrix.transform_point3(*point);
+            }
             let colours = match raw.colour {
                 None => None,
                 Some((flat, interpolation)) => {
@@ -936,11 +960,10 @@ impl<R: BufRead> Parser<R> {
 }
 
 /// One colour per curve from `primvars:displayColor`'s values and interpolation.
-fn curve_colours(flat: &[f32], interpolation: &str, counts: &[u32]) -> Result<Vec<Vec3>, String> {
-    if !flat.len().is_multiple_of(3) || flat.iter().any(|c| !c.is_finite()) {
+fn curve_colours(colours: &[Vec3], interpolation: &str, counts: &[u32]) -> Result<Vec<Vec3>, String> {
+    if colours.iter().any(|c| !c.is_finite()) {
         return Err("primvars:displayColor must be finite (r, g, b) triples".to_owned());
     }
-    let colours: Vec<Vec3> = flat.chunks_exact(3).map(Vec3::from_slice).collect();
     let wrong = |expected: usize| {
         format!(
             "primvars:displayColor has {} colours, but {interpolation} interpolation needs {expected}",
@@ -949,7 +972,7 @@ fn curve_colours(flat: &[f32], interpolation: &str, counts: &[u32]) -> Result<Ve
     };
     match interpolation {
         "constant" => colours.first().map(|c| vec![*c; counts.len()]).ok_or_else(|| wrong(1)),
-        "uniform" if colours.len() == counts.len() => Ok(colours),
+        "uniform" if colours.len() == counts.len() => Ok(colours.to_vec()),
         "uniform" => Err(wrong(counts.len())),
         "vertex" | "varying" => {
             let total: usize = counts.iter().map(|&n| n as usize).sum();
