@@ -1,6 +1,8 @@
 //! One fur on the GPU in the unified structure: its shared vertex array (one or two simulation
 //! states), rest topology, uvs, base normals, textures and per-fur uniform.
 
+use std::sync::atomic::{AtomicBool, Ordering};
+
 use glam::Vec3;
 use pelt_core::FurStructure;
 use pelt_core::texture::FurTextures;
@@ -27,6 +29,30 @@ pub enum FurStates {
     Two,
 }
 
+/// Which of a fur's optional looks its shells and fins are drawn with: each has its own
+/// pipelines, so a dry, ungroomed coat runs none of the groom's or the wetness's shader code
+/// (`GROOM` and `WET` in `shading.wgsl`) and interpolates none of their varyings.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct Coat {
+    /// The groom's density, clump or tint reach the shading.
+    pub groomed: bool,
+    /// Some strand is wet.
+    pub wet: bool,
+}
+
+impl Coat {
+    /// Dry and ungroomed: the lean entry points.
+    pub const PLAIN: Self = Self { groomed: false, wet: false };
+    pub fn index(self) -> usize {
+        usize::from(self.groomed) | usize::from(self.wet) << 1
+    }
+
+    /// The entry point of `name`'s kind for this coat: the lean one, or its `_groomed` twin.
+    pub fn entry(self, name: &str) -> String {
+        if self == Self::PLAIN { name.to_owned() } else { format!("{name}_groomed") }
+    }
+}
+
 /// One fur's GPU data: draw it with [`FurRenderer::draw`](crate::FurRenderer::draw) into any pass
 /// of the renderer's target, as many furs per pass as you like.
 ///
@@ -49,6 +75,8 @@ pub struct GpuFur {
     level: PreparedLevel,
     /// The view-angle pass's output (none without layers to thin).
     shells: Option<ShellList>,
+    /// Whether the last `prepare`'s frame was wet (its coat's pipelines read the wetness).
+    wet: AtomicBool,
 }
 
 impl GpuFur {
@@ -69,7 +97,14 @@ impl GpuFur {
         let per_shell = geometry.as_ref().map_or(0, |g| g.shape.vertices_per_shell());
         let shells = shell_list(device, layouts, (structure, furred.as_ref()), per_shell);
         scope.pop("uploading the fur")?;
-        Ok(Self { geometry: geometry?, textures: textures?, fins: fins?, level: PreparedLevel::new(), shells: shells? })
+        Ok(Self {
+            geometry: geometry?,
+            textures: textures?,
+            fins: fins?,
+            level: PreparedLevel::new(),
+            shells: shells?,
+            wet: AtomicBool::new(false),
+        })
     }
 
     /// [`GpuFur::set_structure`] with the renderer's layouts.
@@ -141,6 +176,7 @@ impl GpuFur {
         let frame = if self.geometry.state_count() == 1 { FurFrame { interpolation: 1.0, ..*frame } } else { *frame };
         self.geometry.write_uniform(queue, &self.geometry.shape.uniform(&frame, self.textures.root_colour, textures));
         self.level.set(frame.level, self.geometry.shape.layers);
+        self.wet.store(frame.wet, Ordering::Relaxed);
         if let Some(list) = &self.shells {
             list.invalidate();
         }
@@ -294,6 +330,11 @@ impl GpuFur {
 
     pub(crate) fn geometry(&self) -> &UnifiedGeometry {
         &self.geometry
+    }
+
+    /// The coat the last `prepare` left the fur drawing with.
+    pub(crate) fn coat(&self) -> Coat {
+        Coat { groomed: self.geometry.shape.groom_shading, wet: self.wet.load(Ordering::Relaxed) }
     }
 
     pub(crate) fn textures_bind_group(&self) -> &wgpu::BindGroup {

@@ -77,6 +77,7 @@ impl SeparatedRenderer {
         let build_for = |label: &str, (vertex_entry, fragment_entry), kind, mesh_uvs| {
             let source = PipelineSource {
                 mesh_uvs,
+                coat: None,
                 layout: &layout,
                 module: &module,
                 vertex_entry,
@@ -87,14 +88,16 @@ impl SeparatedRenderer {
         };
         let build = |label: &str, entries, kind| build_for(label, entries, kind, None);
         let skin = build("pelt separated skin", ("vs_separated_skin", "fs_skin"), PassKind::Opaque);
-        // Without uvs, with uvs: each passes on only what its fragments read.
-        let shells = [("vs_separated_shell_tiles", "fs_shell_tiles"), ("vs_separated_shell_uvs", "fs_shell_uvs")].map(
-            |entries| {
-                let mesh_uvs = entries.1 == "fs_shell_uvs";
-                Transparency::BOTH
-                    .map(|t| build_for("pelt separated shells", entries, PassKind::Shells(t), Some(mesh_uvs)))
-            },
-        );
+        // Without uvs, with uvs: each passes on only what its fragments read. The groom's terms
+        // ride along and the object's flags say whether they are read (`GROOM` left at 0).
+        let shells = [
+            ("vs_separated_shell_tiles", "fs_shell_tiles_groomed"),
+            ("vs_separated_shell_uvs", "fs_shell_uvs_groomed"),
+        ]
+        .map(|entries| {
+            let mesh_uvs = entries.1 == "fs_shell_uvs_groomed";
+            Transparency::BOTH.map(|t| build_for("pelt separated shells", entries, PassKind::Shells(t), Some(mesh_uvs)))
+        });
         let fins = Transparency::BOTH
             .map(|t| build("pelt separated fins", ("vs_separated_fin", "fs_separated_fin"), PassKind::Fins(t)));
         scope.pop("building the separated pipelines")?;

@@ -15,8 +15,10 @@ mod pipeline;
 
 pub(crate) use pipeline::{PassKind, PipelineSource, Transparency, create_pipeline};
 
+use std::sync::OnceLock;
+
 use crate::RenderError;
-use crate::fur::GpuFur;
+use crate::fur::{Coat, GpuFur};
 use crate::listing::{DRAW_ARGS_BYTES, FIN_INSTANCE_LAYOUT, ListingPasses, ShellList};
 use crate::plain::PlainMesh;
 use crate::requirements::{ErrorScope, check_features_and_limits};
@@ -68,22 +70,80 @@ impl Default for FurDrawSettings {
     }
 }
 
-/// Pipelines for one way of walking the base triangles (see `unified.wgsl`).
+/// The coat-independent pipelines for one way of walking the base triangles (see
+/// `unified.wgsl`).
 #[derive(Debug)]
 struct SurfacePipelines {
     plain: wgpu::RenderPipeline,
     skin: wgpu::RenderPipeline,
-    /// Blended, alpha-to-coverage.
-    shells: [wgpu::RenderPipeline; 2],
-    /// Blended, alpha-to-coverage: shells over the view-angle pass's list.
-    listed_shells: [wgpu::RenderPipeline; 2],
+}
+
+/// One coat's shell and fin pipelines, each blended and alpha-to-coverage.
+#[derive(Debug)]
+struct CoatPipelines {
+    /// Meshes with uvs (by the corners' wedges), then meshes without (by the base triangles).
+    shells: [[wgpu::RenderPipeline; 2]; 2],
+    /// The same over the view-angle pass's list.
+    listed_shells: [[wgpu::RenderPipeline; 2]; 2],
+    /// Every edge.
+    fins: [wgpu::RenderPipeline; 2],
+    /// The silhouette pass's edges.
+    silhouette_fins: [wgpu::RenderPipeline; 2],
+}
+
+/// What building a coat's pipelines takes, kept so the groomed and wet coats are built the
+/// first time a fur draws with one (a dry, ungroomed scene never compiles them).
+#[derive(Debug)]
+struct CoatBuilder {
+    device: wgpu::Device,
+    module: wgpu::ShaderModule,
+    layout: wgpu::PipelineLayout,
+}
+
+impl CoatBuilder {
+    fn build(&self, target: &FurTarget, coat: Coat) -> CoatPipelines {
+        let build = |label: &str, vertex: &str, fragment: &str, kind: PassKind, (buffers, mesh_uvs)| {
+            let (vertex_entry, fragment_entry) = (coat.entry(vertex), coat.entry(fragment));
+            let source = PipelineSource {
+                mesh_uvs,
+                coat: Some(coat),
+                layout: &self.layout,
+                module: &self.module,
+                vertex_entry: &vertex_entry,
+                fragment_entry: &fragment_entry,
+                buffers,
+            };
+            create_pipeline(&self.device, target, label, &source, kind)
+        };
+        // Meshes with uvs walk wedges, meshes without base vertices: each walk's pipelines know
+        // which, and drop the other's work.
+        let walks = [("wedges", true), ("indexed", false)];
+        let shells = |listed: &str| {
+            walks.map(|(walk, mesh_uvs)| {
+                let vertex = format!("vs_shell_{walk}{listed}");
+                let fragment = if mesh_uvs { "fs_shell_uvs" } else { "fs_shell_tiles" };
+                Transparency::BOTH
+                    .map(|t| build("pelt shells", &vertex, fragment, PassKind::Shells(t), (&[][..], Some(mesh_uvs))))
+            })
+        };
+        let instances = [Some(FIN_INSTANCE_LAYOUT)];
+        CoatPipelines {
+            shells: shells(""),
+            listed_shells: shells("_listed"),
+            fins: Transparency::BOTH.map(|t| build("pelt fins", "vs_fin", "fs_fin", PassKind::Fins(t), (&[], None))),
+            silhouette_fins: Transparency::BOTH.map(|t| {
+                build("pelt silhouette fins", "vs_fin_silhouette", "fs_fin", PassKind::Fins(t), (&instances, None))
+            }),
+        }
+    }
 }
 
 /// The unified structure's pipelines for one [`FurTarget`], shared by every [`GpuFur`],
 /// [`PlainMesh`] and [`FurView`] made with it. Create it once per target description.
 ///
 /// Nothing here blocks, and it keeps no per-frame state: `draw` only records into the host's
-/// pass what `prepare` calls wrote before.
+/// pass what `prepare` calls wrote before. The pipelines of a groomed or wet coat are built the
+/// first time a fur draws with one.
 #[derive(Debug)]
 pub struct FurRenderer {
     target: FurTarget,
@@ -92,10 +152,9 @@ pub struct FurRenderer {
     wedges: SurfacePipelines,
     /// Meshes without uvs: indexed by the base triangles.
     indexed: SurfacePipelines,
-    /// Blended, alpha-to-coverage: every edge.
-    fins: [wgpu::RenderPipeline; 2],
-    /// Blended, alpha-to-coverage: the silhouette pass's edges.
-    silhouette_fins: [wgpu::RenderPipeline; 2],
+    /// Shells and fins per [`Coat`] (by [`Coat::index`]); the plain coat's built with the rest.
+    coats: [OnceLock<CoatPipelines>; 4],
+    coat_builder: CoatBuilder,
     /// The silhouette and view-angle passes.
     listing: ListingPasses,
 }
@@ -120,49 +179,33 @@ impl FurRenderer {
         });
         let fur_layout = layouts.pipeline_layout(device, "pelt unified", &layouts.unified_object, true);
         let plain_layout = layouts.pipeline_layout(device, "pelt plain", &layouts.unified_object, false);
-        let build_with =
-            |label: &str,
-             layout: &wgpu::PipelineLayout,
-             (vertex_entry, fragment_entry): (&str, &str),
-             kind: PassKind,
-             (buffers, mesh_uvs): (&[Option<wgpu::VertexBufferLayout<'_>>], Option<bool>)| {
-                let source =
-                    PipelineSource { mesh_uvs, layout, module: &module, vertex_entry, fragment_entry, buffers };
-                create_pipeline(device, &target, label, &source, kind)
-            };
-        let build = |label: &str, layout: &wgpu::PipelineLayout, entries: (&str, &str), kind: PassKind| {
-            build_with(label, layout, entries, kind, (&[], None))
-        };
-        // Meshes with uvs walk wedges, meshes without base vertices: each walk's pipelines know
-        // which, and drop the other's work.
         let surface = |walk: &str, mesh_uvs: bool| {
             let skin = format!("vs_skin_{walk}");
-            let shell = format!("vs_shell_{walk}");
-            let listed = format!("vs_shell_{walk}_listed");
-            let shell_fragment = if mesh_uvs { "fs_shell_uvs" } else { "fs_shell_tiles" };
-            let surface =
-                |label, layout, entries, kind| build_with(label, layout, entries, kind, (&[], Some(mesh_uvs)));
+            let build = |label, layout, fragment_entry| {
+                let source = PipelineSource {
+                    mesh_uvs: Some(mesh_uvs),
+                    coat: Some(Coat::PLAIN),
+                    layout,
+                    module: &module,
+                    vertex_entry: &skin,
+                    fragment_entry,
+                    buffers: &[],
+                };
+                create_pipeline(device, &target, label, &source, PassKind::Opaque)
+            };
             SurfacePipelines {
-                plain: surface("pelt plain", &plain_layout, (&skin, "fs_plain"), PassKind::Opaque),
-                skin: surface("pelt skin", &fur_layout, (&skin, "fs_skin"), PassKind::Opaque),
-                shells: Transparency::BOTH
-                    .map(|t| surface("pelt shells", &fur_layout, (&shell, shell_fragment), PassKind::Shells(t))),
-                listed_shells: Transparency::BOTH.map(|t| {
-                    surface("pelt listed shells", &fur_layout, (&listed, shell_fragment), PassKind::Shells(t))
-                }),
+                plain: build("pelt plain", &plain_layout, "fs_plain"),
+                skin: build("pelt skin", &fur_layout, "fs_skin"),
             }
         };
         let wedges = surface("wedges", true);
         let indexed = surface("indexed", false);
-        let fins = Transparency::BOTH.map(|t| build("pelt fins", &fur_layout, ("vs_fin", "fs_fin"), PassKind::Fins(t)));
-        let instances = [Some(FIN_INSTANCE_LAYOUT)];
-        let silhouette_fins = Transparency::BOTH.map(|t| {
-            let entries = ("vs_fin_silhouette", "fs_fin");
-            build_with("pelt silhouette fins", &fur_layout, entries, PassKind::Fins(t), (&instances, None))
-        });
+        let coat_builder = CoatBuilder { device: device.clone(), module, layout: fur_layout };
+        let coats = [(); 4].map(|()| OnceLock::new());
+        let _ = coats[Coat::PLAIN.index()].set(coat_builder.build(&target, Coat::PLAIN));
         let listing = ListingPasses::new(device, &layouts);
         scope.pop("building the fur pipelines")?;
-        Ok(Self { target, layouts, wedges, indexed, fins, silhouette_fins, listing })
+        Ok(Self { target, layouts, wedges, indexed, coats, coat_builder, listing })
     }
 
     /// The target description the pipelines were built for.
@@ -177,37 +220,42 @@ impl FurRenderer {
     /// With blending, draw opaque geometry first and furs after it, farthest first.
     pub fn draw(&self, pass: &mut wgpu::RenderPass<'_>, view: &FurView, fur: &GpuFur, settings: &FurDrawSettings) {
         let geometry = fur.geometry();
-        let surface = self.surface(geometry.shape.has_uvs);
+        let walk = usize::from(!geometry.shape.has_uvs);
         let which = Transparency::index(settings.alpha_to_coverage);
         pass.set_bind_group(0, view.bind_group(), &[]);
         pass.set_bind_group(1, geometry.bind_group(), &[]);
         pass.set_bind_group(2, fur.textures_bind_group(), &[]);
         if settings.skin {
-            pass.set_pipeline(&surface.skin);
+            pass.set_pipeline(&self.surface(geometry.shape.has_uvs).skin);
             geometry.draw_skin(pass);
         }
         let layers = geometry.shape.layers;
-        if settings.shells && layers > 0 {
+        if layers == 0 || !(settings.shells || settings.fins) {
+            return;
+        }
+        let coat = self.coat(fur.coat());
+        if settings.shells {
+            let shells = &coat.shells[walk][which];
             match fur.shell_list() {
                 Some(list) if list.recorded() && fur.prepared_level().by_view() => {
-                    draw_thinned_shells(pass, fur, surface, which, list);
+                    draw_thinned_shells(pass, fur, (shells, &coat.listed_shells[walk][which]), list);
                 }
                 _ => {
-                    pass.set_pipeline(&surface.shells[which]);
+                    pass.set_pipeline(shells);
                     geometry.draw_shells(pass, 0..fur.drawn_shells());
                 }
             }
         }
         // Fins after the shells: at the silhouette, where fins matter, they stand outside the
         // shells and must not be covered by the faded outer layers.
-        if settings.fins && layers > 0 {
+        if settings.fins {
             match fur.fin_list() {
                 Some(list) if settings.silhouette_fins => {
-                    pass.set_pipeline(&self.silhouette_fins[which]);
+                    pass.set_pipeline(&coat.silhouette_fins[which]);
                     geometry.draw_fin_list(pass, &list.instances, &list.draw);
                 }
                 _ => {
-                    pass.set_pipeline(&self.fins[which]);
+                    pass.set_pipeline(&coat.fins[which]);
                     geometry.draw_fins(pass, fur.drawn_shells());
                 }
             }
@@ -248,6 +296,11 @@ impl FurRenderer {
         if has_uvs { &self.wedges } else { &self.indexed }
     }
 
+    /// `coat`'s shell and fin pipelines, built on first use.
+    fn coat(&self, coat: Coat) -> &CoatPipelines {
+        self.coats[coat.index()].get_or_init(|| self.coat_builder.build(&self.target, coat))
+    }
+
     pub(crate) fn layouts(&self) -> &Layouts {
         &self.layouts
     }
@@ -258,19 +311,18 @@ impl FurRenderer {
 fn draw_thinned_shells(
     pass: &mut wgpu::RenderPass<'_>,
     fur: &GpuFur,
-    surface: &SurfacePipelines,
-    which: usize,
+    (shells, listed_shells): (&wgpu::RenderPipeline, &wgpu::RenderPipeline),
     list: &ShellList,
 ) {
     let geometry = fur.geometry();
     let layers = geometry.shape.layers;
     for shell in 0..fur.drawn_shells() {
         if fur.prepared_level().dropped_shell(layers, shell) {
-            pass.set_pipeline(&surface.listed_shells[which]);
+            pass.set_pipeline(listed_shells);
             pass.set_index_buffer(list.indices.slice(..), wgpu::IndexFormat::Uint32);
             pass.draw_indexed_indirect(&list.draws, u64::from(shell) * DRAW_ARGS_BYTES);
         } else {
-            pass.set_pipeline(&surface.shells[which]);
+            pass.set_pipeline(shells);
             geometry.draw_shells(pass, shell..shell + 1);
         }
     }

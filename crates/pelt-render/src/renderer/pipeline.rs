@@ -1,6 +1,7 @@
 //! Pipeline plumbing shared by the unified and the separated renderer: one function that builds
 //! every fur pipeline for a [`FurTarget`].
 
+use crate::fur::Coat;
 use crate::targets::FurTarget;
 
 /// How the fur's transparency is resolved.
@@ -35,6 +36,9 @@ pub(crate) struct PipelineSource<'a> {
     /// renderer walks meshes with and without them through separate pipelines): the shaders
     /// then drop the other case's varyings and fetches (`MESH_UVS` in `shading.wgsl`).
     pub mesh_uvs: Option<bool>,
+    /// The coat the pipeline draws, where it is fixed (the unified renderer's shells and fins);
+    /// `None` reads the object's flags.
+    pub coat: Option<Coat>,
     pub layout: &'a wgpu::PipelineLayout,
     pub module: &'a wgpu::ShaderModule,
     pub vertex_entry: &'a str,
@@ -67,7 +71,18 @@ pub(crate) fn create_pipeline(
         Some(true) => 1.0,
         Some(false) => 2.0,
     };
-    let constants = [("ALPHA_TO_COVERAGE", if coverage { 1.0 } else { 0.0 }), ("MESH_UVS", mesh_uvs)];
+    // 0 reads the object's flag, 1 is off, 2 on.
+    let switch = |on: Option<bool>| match on {
+        None => 0.0,
+        Some(false) => 1.0,
+        Some(true) => 2.0,
+    };
+    let constants = [
+        ("ALPHA_TO_COVERAGE", if coverage { 1.0 } else { 0.0 }),
+        ("MESH_UVS", mesh_uvs),
+        ("GROOM", switch(source.coat.map(|c| c.groomed))),
+        ("WET", switch(source.coat.map(|c| c.wet))),
+    ];
     let compilation_options = wgpu::PipelineCompilationOptions { constants: &constants, ..Default::default() };
     device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
         label: Some(label),

@@ -10,7 +10,7 @@
 
 fn separated_groom(vertex: u32) -> GroomShade {
     // A uniform branch: ungroomed furs read nothing.
-    if object.groom_shading == 0u {
+    if !groom_on() {
         return GROOM_NONE;
     }
     return groom_shade(groom_attributes[vertex]);
@@ -45,18 +45,18 @@ fn vs_separated_skin(in: VertexIn) -> Varyings {
 }
 
 // Shells: one draw per layer with a base-vertex offset; the instance index carries the layer.
-// Meshes without uvs and with them pass on what `fs_shell_tiles` and `fs_shell_uvs` read, as
-// the unified shells do.
+// Meshes without uvs and with them pass on what `fs_shell_tiles_groomed` and
+// `fs_shell_uvs_groomed` read, as the unified groomed shells do.
 @vertex
-fn vs_separated_shell_tiles(in: VertexIn, @builtin(instance_index) layer: u32, @builtin(vertex_index) index: u32) -> ShellTileVaryings {
+fn vs_separated_shell_tiles(in: VertexIn, @builtin(instance_index) layer: u32, @builtin(vertex_index) index: u32) -> GroomedShellTileVaryings {
     let v = separated_shell(in, layer);
-    return shell_tile_varyings(v, v.fade, separated_lod_blend(v), separated_shell_groom(index));
+    return groomed_shell_tile_varyings(v, v.fade, separated_lod_blend(v), separated_shell_groom(index));
 }
 
 @vertex
-fn vs_separated_shell_uvs(in: VertexIn, @builtin(instance_index) layer: u32, @builtin(vertex_index) index: u32) -> ShellUvVaryings {
+fn vs_separated_shell_uvs(in: VertexIn, @builtin(instance_index) layer: u32, @builtin(vertex_index) index: u32) -> GroomedShellUvVaryings {
     let v = separated_shell(in, layer);
-    return shell_uv_varyings(v, v.fade, separated_lod_blend(v), separated_shell_groom(index));
+    return groomed_shell_uv_varyings(v, v.fade, separated_lod_blend(v), separated_shell_groom(index));
 }
 
 // Each layer is drawn with base vertex `layer * V`, so the base vertex is the index modulo V.
@@ -126,7 +126,7 @@ struct SeparatedFinVaryings {
 fn vs_separated_fin(in: VertexIn, @builtin(vertex_index) index: u32) -> SeparatedFinVaryings {
     let v = separated_fin(in, index);
     var out = SeparatedFinVaryings(v.clip_position, v.world_position, v.normal, v.uv, v.height, v.fade, v.surface_uv, vec4<f32>(1.0), 0.0);
-    if object.groom_shading != 0u && v.fade > 0.0 {
+    if groom_on() && v.fade > 0.0 {
         let per_fin = max((arrayLength(&fin_vertex_floats) / 8u) / max(object.edge_count, 1u), 1u);
         // Side b of the edge sits at u > 0.
         let side = select(0u, 1u, in.uv.x > 0.0);
@@ -177,8 +177,8 @@ fn fs_separated_fin(in: SeparatedFinVaryings) -> @location(0) vec4<f32> {
     var texel: vec4<f32>;
     var groom_alpha = 1.0;
     var groom_tint = vec3<f32>(1.0);
-    // A uniform branch: the unified fins' groom shading (`fs_fin`).
-    if object.groom_shading != 0u {
+    // A uniform branch: the unified fins' groom shading (`fs_fin_groomed`).
+    if groom_on() {
         let cells = clump_cells_per_tile();
         let along = clump_uv(vec2<f32>(fin_uv.x, 0.5 / cells), cells, groom_clump_amount(in.clump, in.height)).x;
         texel = textureSampleGrad(fin_texture, fin_sampler, vec2<f32>(along, fin_uv.y), dpdx(fin_uv), dpdy(fin_uv));

@@ -86,6 +86,28 @@ struct Object {
 // premultiplied.
 override ALPHA_TO_COVERAGE: bool = false;
 
+// Set per pipeline for the unified coats (`renderer::Coat`): 1 off, 2 on, so a coat without a
+// groom's shading or without wetness compiles none of that code (a software rasteriser runs
+// every branch of a fragment, taken or not); 0 reads the object's flags instead.
+override GROOM: u32 = 0u;
+override WET: u32 = 0u;
+
+// Whether the groom's density, clump or tint reach the shading. Uniform.
+fn groom_on() -> bool {
+    if GROOM == 0u {
+        return object.groom_shading != 0u;
+    }
+    return GROOM == 2u;
+}
+
+// Whether some strand of the coat is wet (else the wetness is never read). Uniform.
+fn wet_on() -> bool {
+    if WET == 0u {
+        return object.wet_any != 0u;
+    }
+    return WET == 2u;
+}
+
 @group(0) @binding(0) var<uniform> view: View;
 @group(1) @binding(0) var<uniform> object: Object;
 @group(2) @binding(0) var shell_texture: texture_2d_array<f32>;
@@ -135,20 +157,37 @@ struct ShellTileVaryings {
     // `hair_terms` at the vertex.
     @location(0) @interpolate(perspective, centroid) lighting: vec4<f32>,
     // The opacity from the view angle (`shell_fade`), how far the layers the next coarser stride
-    // drops have faded here (`lod_vertex_blend`), the layer, and the groom's clump.
-    @location(1) @interpolate(perspective, centroid) fade_blend_layer: vec4<f32>,
+    // drops have faded here (`lod_vertex_blend`), and the layer.
+    @location(1) @interpolate(perspective, centroid) fade_blend_layer: vec3<f32>,
     // The root in tiles, model space, and the base normal picking its projection.
+    @location(2) @interpolate(perspective, centroid) tile_position: vec3<f32>,
+    @location(3) @interpolate(perspective, centroid) tile_normal: vec3<f32>,
+}
+
+struct ShellUvVaryings {
+    @builtin(position) clip_position: vec4<f32>,
+    @location(0) @interpolate(perspective, centroid) lighting: vec4<f32>,
+    @location(1) @interpolate(perspective, centroid) fade_blend_layer: vec3<f32>,
+    // The mesh uv in tiles (xy) and at the strand's root (zw, surface colour mode).
+    @location(2) @interpolate(perspective, centroid) uvs: vec4<f32>,
+}
+
+// The groomed or wet coats' shells: the lean ones' and the groom's terms at the root (its
+// clump rides in `fade_blend_layer.w`). Only their pipelines pay for the extra location.
+struct GroomedShellTileVaryings {
+    @builtin(position) clip_position: vec4<f32>,
+    @location(0) @interpolate(perspective, centroid) lighting: vec4<f32>,
+    @location(1) @interpolate(perspective, centroid) fade_blend_layer: vec4<f32>,
     @location(2) @interpolate(perspective, centroid) tile_position: vec3<f32>,
     @location(3) @interpolate(perspective, centroid) tile_normal: vec3<f32>,
     // The groom's tint (rgb) and density (`GroomShade`).
     @location(4) @interpolate(perspective, centroid) tint_density: vec4<f32>,
 }
 
-struct ShellUvVaryings {
+struct GroomedShellUvVaryings {
     @builtin(position) clip_position: vec4<f32>,
     @location(0) @interpolate(perspective, centroid) lighting: vec4<f32>,
     @location(1) @interpolate(perspective, centroid) fade_blend_layer: vec4<f32>,
-    // The mesh uv in tiles (xy) and at the strand's root (zw, surface colour mode).
     @location(2) @interpolate(perspective, centroid) uvs: vec4<f32>,
     @location(3) @interpolate(perspective, centroid) tint_density: vec4<f32>,
 }
@@ -183,18 +222,28 @@ fn shell_lighting(v: Varyings) -> vec4<f32> {
     return hair_terms(v.tangent, v.normal, v.world_position, layer_height(v.layer));
 }
 
-fn shell_tile_varyings(v: Varyings, fade: f32, lod_blend: f32, groom: GroomShade) -> ShellTileVaryings {
-    let fade_blend_layer = vec4<f32>(fade, lod_blend, f32(v.layer), groom.clump);
-    let tint_density = vec4<f32>(groom.tint, groom.density);
-    let lighting = wet_terms(shell_lighting(v), groom.wetness);
-    return ShellTileVaryings(v.clip_position, lighting, fade_blend_layer, v.tile_position, v.tile_normal, tint_density);
+fn shell_tile_varyings(v: Varyings, fade: f32, lod_blend: f32) -> ShellTileVaryings {
+    let fade_blend_layer = vec3<f32>(fade, lod_blend, f32(v.layer));
+    return ShellTileVaryings(v.clip_position, shell_lighting(v), fade_blend_layer, v.tile_position, v.tile_normal);
 }
 
-fn shell_uv_varyings(v: Varyings, fade: f32, lod_blend: f32, groom: GroomShade) -> ShellUvVaryings {
+fn shell_uv_varyings(v: Varyings, fade: f32, lod_blend: f32) -> ShellUvVaryings {
+    let fade_blend_layer = vec3<f32>(fade, lod_blend, f32(v.layer));
+    return ShellUvVaryings(v.clip_position, shell_lighting(v), fade_blend_layer, vec4<f32>(v.uv, v.surface_uv));
+}
+
+fn groomed_shell_tile_varyings(v: Varyings, fade: f32, lod_blend: f32, groom: GroomShade) -> GroomedShellTileVaryings {
     let fade_blend_layer = vec4<f32>(fade, lod_blend, f32(v.layer), groom.clump);
     let tint_density = vec4<f32>(groom.tint, groom.density);
     let lighting = wet_terms(shell_lighting(v), groom.wetness);
-    return ShellUvVaryings(v.clip_position, lighting, fade_blend_layer, vec4<f32>(v.uv, v.surface_uv), tint_density);
+    return GroomedShellTileVaryings(v.clip_position, lighting, fade_blend_layer, v.tile_position, v.tile_normal, tint_density);
+}
+
+fn groomed_shell_uv_varyings(v: Varyings, fade: f32, lod_blend: f32, groom: GroomShade) -> GroomedShellUvVaryings {
+    let fade_blend_layer = vec4<f32>(fade, lod_blend, f32(v.layer), groom.clump);
+    let tint_density = vec4<f32>(groom.tint, groom.density);
+    let lighting = wet_terms(shell_lighting(v), groom.wetness);
+    return GroomedShellUvVaryings(v.clip_position, lighting, fade_blend_layer, vec4<f32>(v.uv, v.surface_uv), tint_density);
 }
 
 // The layer a shell fragment carries: interpolated from three equal corners, so within rounding.
@@ -212,6 +261,13 @@ struct FinVaryings {
     @location(0) @interpolate(perspective, centroid) lighting_fade: vec4<f32>,
     // Along the edge in tiles, the height (0 at the roots, 1 at the tips), and the mesh uv at
     // this end of the edge (surface colour mode).
+    @location(1) @interpolate(perspective, centroid) uvs: vec4<f32>,
+}
+
+// The groomed or wet coats' fins: the lean ones' and the groom's terms.
+struct GroomedFinVaryings {
+    @builtin(position) clip_position: vec4<f32>,
+    @location(0) @interpolate(perspective, centroid) lighting_fade: vec4<f32>,
     @location(1) @interpolate(perspective, centroid) uvs: vec4<f32>,
     // The groom's tint and density, and its clump (`GroomShade`).
     @location(2) @interpolate(perspective, centroid) tint_density: vec4<f32>,
@@ -483,8 +539,8 @@ fn groomed_shell_texel(uv: vec2<f32>, slice: i32, groom: GroomShade, height: f32
     if !strand_kept(sampled, slice, groom.density) {
         texel.a = 0.0;
     }
-    // A uniform branch: only wet fur parts between its clumps.
-    if object.wet_any != 0u {
+    // Only wet fur parts between its clumps.
+    if wet_on() {
         texel.a *= clump_parting(uv, clump_cells_per_tile(), groom.clump, height);
     }
     return texel;
@@ -536,52 +592,50 @@ fn fs_skin(in: Varyings) -> @location(0) vec4<f32> {
 }
 
 // A shell fragment from its texel: fading, level of detail, the groom's tint and hair lighting.
-fn shell_colour(texel: vec4<f32>, surface_uv: vec2<f32>, lighting: vec4<f32>, fade_blend_layer: vec4<f32>, tint: vec3<f32>) -> vec4<f32> {
+fn shell_colour(texel: vec4<f32>, surface_uv: vec2<f32>, lighting: vec4<f32>, fade_blend_layer: vec3<f32>, tint: vec3<f32>) -> vec4<f32> {
     let layer = varying_layer(fade_blend_layer.z);
     let alpha = lod_alpha(texel.a * fade_blend_layer.x, layer, fade_blend_layer.y);
-    var albedo = texel.rgb * surface_tint(surface_uv);
-    if clump_shading() {
-        albedo *= tint;
-    }
+    let albedo = texel.rgb * surface_tint(surface_uv) * tint;
     return fur_output(hair_colour(albedo, lighting, layer_height(layer)), alpha);
 }
 
 // Shells of meshes without uvs (`vs_shell_indexed`, `vs_separated_shell_tiles`).
 @fragment
 fn fs_shell_tiles(in: ShellTileVaryings) -> @location(0) vec4<f32> {
-    let layer = varying_layer(in.fade_blend_layer.z);
-    var texel: vec4<f32>;
-    // A uniform branch: ungroomed dry furs fetch as they always have.
-    if clump_shading() {
-        let uv = tile_uv(in.tile_position, in.tile_normal);
-        let groom = shell_groom(in.fade_blend_layer, in.tint_density);
-        if object.groom_shading != 0u {
-            texel = groomed_shell_texel(uv, shell_slice(layer), groom, layer_height(layer));
-        } else {
-            texel = wet_shell_texel(uv, shell_slice(layer), groom.clump, layer_height(layer));
-        }
-    } else {
-        texel = tile_texel(in.tile_position, in.tile_normal, layer);
-    }
-    return shell_colour(texel, vec2<f32>(0.0), in.lighting, in.fade_blend_layer, in.tint_density.rgb);
+    let texel = tile_texel(in.tile_position, in.tile_normal, varying_layer(in.fade_blend_layer.z));
+    return shell_colour(texel, vec2<f32>(0.0), in.lighting, in.fade_blend_layer, vec3<f32>(1.0));
 }
 
 // Shells of meshes with uvs (`vs_shell_wedges`, `vs_separated_shell_uvs`).
 @fragment
 fn fs_shell_uvs(in: ShellUvVaryings) -> @location(0) vec4<f32> {
-    let layer = varying_layer(in.fade_blend_layer.z);
-    var texel: vec4<f32>;
-    if clump_shading() {
-        let groom = shell_groom(in.fade_blend_layer, in.tint_density);
-        if object.groom_shading != 0u {
-            texel = groomed_shell_texel(in.uvs.xy, shell_slice(layer), groom, layer_height(layer));
-        } else {
-            texel = wet_shell_texel(in.uvs.xy, shell_slice(layer), groom.clump, layer_height(layer));
-        }
-    } else {
-        texel = sample_shell(in.uvs.xy, shell_slice(layer));
+    let texel = sample_shell(in.uvs.xy, shell_slice(varying_layer(in.fade_blend_layer.z)));
+    return shell_colour(texel, in.uvs.zw, in.lighting, in.fade_blend_layer, vec3<f32>(1.0));
+}
+
+// A groomed or wet coat's shell texel at `uv` (tiles): a groom's clumped and thinned one, or a
+// wet coat's clumped and parted one.
+fn coat_shell_texel(uv: vec2<f32>, layer: u32, groom: GroomShade) -> vec4<f32> {
+    if groom_on() {
+        return groomed_shell_texel(uv, shell_slice(layer), groom, layer_height(layer));
     }
-    return shell_colour(texel, in.uvs.zw, in.lighting, in.fade_blend_layer, in.tint_density.rgb);
+    return wet_shell_texel(uv, shell_slice(layer), groom.clump, layer_height(layer));
+}
+
+@fragment
+fn fs_shell_tiles_groomed(in: GroomedShellTileVaryings) -> @location(0) vec4<f32> {
+    let layer = varying_layer(in.fade_blend_layer.z);
+    let groom = shell_groom(in.fade_blend_layer, in.tint_density);
+    let texel = coat_shell_texel(tile_uv(in.tile_position, in.tile_normal), layer, groom);
+    return shell_colour(texel, vec2<f32>(0.0), in.lighting, in.fade_blend_layer.xyz, in.tint_density.rgb);
+}
+
+@fragment
+fn fs_shell_uvs_groomed(in: GroomedShellUvVaryings) -> @location(0) vec4<f32> {
+    let layer = varying_layer(in.fade_blend_layer.z);
+    let groom = shell_groom(in.fade_blend_layer, in.tint_density);
+    let texel = coat_shell_texel(in.uvs.xy, layer, groom);
+    return shell_colour(texel, in.uvs.zw, in.lighting, in.fade_blend_layer.xyz, in.tint_density.rgb);
 }
 
 // Seen from the side the roots are less hidden than from above: fins light and occlude their
@@ -590,42 +644,49 @@ fn fin_lighting_height(height: f32) -> f32 {
     return sqrt(max(height, 0.0));
 }
 
+// Several fins overlap along a silhouette; thinning them keeps the fringe from reading as a
+// solid band, most of all at the roots where the shells already cover.
+fn fin_colour(texel: vec4<f32>, lighting_fade: vec4<f32>, uvs: vec4<f32>, tint: vec3<f32>, groom_alpha: f32) -> vec4<f32> {
+    let height = uvs.y;
+    let alpha = texel.a * lighting_fade.w * mix(0.15, 0.6, height) * groom_alpha;
+    let albedo = texel.rgb * surface_tint(uvs.zw) * tint;
+    let lit_height = fin_lighting_height(height);
+    let lighting = vec4<f32>(lighting_fade.xyz, occlusion(lit_height));
+    return fur_output(hair_colour(albedo, lighting, lit_height), alpha);
+}
+
+// Fin texture rows run from the tips (v = 0) to the roots (v = 1).
+fn fin_texture_uv(uvs: vec4<f32>) -> vec2<f32> {
+    return vec2<f32>(uvs.x, 1.0 - uvs.y);
+}
+
 @fragment
 fn fs_fin(in: FinVaryings) -> @location(0) vec4<f32> {
+    let texel = textureSample(fin_texture, fin_sampler, fin_texture_uv(in.uvs));
+    return fin_colour(texel, in.lighting_fade, in.uvs, vec3<f32>(1.0), 1.0);
+}
+
+// The fin is the side view of a band of strands: clumps gather along the edge, and a thinner
+// coat is a fainter fringe (the density scales its opacity).
+@fragment
+fn fs_fin_groomed(in: GroomedFinVaryings) -> @location(0) vec4<f32> {
     let height = in.uvs.y;
-    // Fin texture rows run from the tips (v = 0) to the roots (v = 1).
-    let fin_uv = vec2<f32>(in.uvs.x, 1.0 - height);
+    let fin_uv = fin_texture_uv(in.uvs);
+    let dx = dpdx(fin_uv);
+    let dy = dpdy(fin_uv);
+    let cells = clump_cells_per_tile();
+    let amount = groom_clump_amount(in.clump, height);
+    let along = clump_uv(vec2<f32>(fin_uv.x, 0.5 / cells), cells, amount).x;
     var texel: vec4<f32>;
-    var groom_alpha = 1.0;
-    var groom_tint = vec3<f32>(1.0);
-    // A uniform branch, as in the shells.
-    if clump_shading() {
-        // The fin is the side view of a band of strands: clumps gather along the edge, and a
-        // thinner coat is a fainter fringe (the density scales its opacity).
-        let dx = dpdx(fin_uv);
-        let dy = dpdy(fin_uv);
-        let cells = clump_cells_per_tile();
-        let amount = groom_clump_amount(in.clump, height);
-        let along = clump_uv(vec2<f32>(fin_uv.x, 0.5 / cells), cells, amount).x;
-        if object.groom_shading != 0u {
-            texel = textureSampleGrad(fin_texture, fin_sampler, vec2<f32>(along, fin_uv.y), dx, dy);
-        } else {
-            // Wet only: where nothing clumps, the dry fin's very fetch.
-            texel = textureSample(fin_texture, fin_sampler, vec2<f32>(select(fin_uv.x, along, amount > 0.0), fin_uv.y));
-        }
-        groom_alpha = clamp(in.tint_density.a, 0.0, 1.0);
-        if object.wet_any != 0u {
-            groom_alpha *= clump_parting(vec2<f32>(fin_uv.x, 0.5 / cells), cells, in.clump, height);
-        }
-        groom_tint = in.tint_density.rgb;
+    if groom_on() {
+        texel = textureSampleGrad(fin_texture, fin_sampler, vec2<f32>(along, fin_uv.y), dx, dy);
     } else {
-        texel = textureSample(fin_texture, fin_sampler, fin_uv);
+        // Wet only: where nothing clumps, the dry fin's very fetch.
+        texel = textureSample(fin_texture, fin_sampler, vec2<f32>(select(fin_uv.x, along, amount > 0.0), fin_uv.y));
     }
-    // Several fins overlap along a silhouette; thinning them keeps the fringe from reading as a
-    // solid band, most of all at the roots where the shells already cover.
-    let alpha = texel.a * in.lighting_fade.w * mix(0.15, 0.6, height) * groom_alpha;
-    let albedo = texel.rgb * surface_tint(in.uvs.zw) * groom_tint;
-    let lit_height = fin_lighting_height(height);
-    let lighting = vec4<f32>(in.lighting_fade.xyz, occlusion(lit_height));
-    return fur_output(hair_colour(albedo, lighting, lit_height), alpha);
+    var groom_alpha = clamp(in.tint_density.a, 0.0, 1.0);
+    if wet_on() {
+        groom_alpha *= clump_parting(vec2<f32>(fin_uv.x, 0.5 / cells), cells, in.clump, height);
+    }
+    return fin_colour(texel, in.lighting_fade, in.uvs, in.tint_density.rgb, groom_alpha);
 }

@@ -52,7 +52,7 @@ fn fs_strand(in: Varyings) -> @location(0) vec4<f32> {
     var terms = hair_terms(normalize(in.tangent), normalize(in.normal), in.world_position, in.height);
     // A uniform branch: a wet strand darkens and shines as `wet_groom` and `wet_terms` make the
     // shells do; a dry coat keeps `hair_lighting`'s very arithmetic.
-    if object.wet_any != 0u {
+    if wet_on() {
         let w = clamp(in.surface_uv.x, 0.0, 1.0);
         albedo *= 1.0 - object.wet_darkening * w;
         terms = wet_terms(terms, w);

@@ -23,18 +23,17 @@
 // rewritten in place when a groom is painted (`GpuFur::set_groom`).
 @group(1) @binding(6) var<storage, read> groom_attributes: array<GroomAttributes>;
 
-// A wetness per base vertex, read only while `object.wet_any` is set.
+// A wetness per base vertex, read only by the wet coats' pipelines (`wet_on`).
 @group(1) @binding(7) var<storage, read> wetness: array<f32>;
 
 // The groom's terms at base vertex `vertex` (the uniform fur's without groom shading), wet
 // where the fur is.
 fn vertex_groom(vertex: u32) -> GroomShade {
     var groom = GROOM_NONE;
-    // Uniform branches: ungroomed dry furs read nothing.
-    if object.groom_shading != 0u {
+    if groom_on() {
         groom = groom_shade(groom_attributes[vertex]);
     }
-    if object.wet_any != 0u {
+    if wet_on() {
         groom = wet_groom(groom, wetness[vertex]);
     }
     return groom;
@@ -150,7 +149,8 @@ fn vs_skin_indexed(@builtin(vertex_index) vertex: u32) -> Varyings {
 }
 
 // Shells: instance k draws the level of detail's shell k (layer k + 1 at full detail), passing
-// on only what their fragments read (the rest of `surface_varyings` is compiled away).
+// on only what their fragments read (the rest of `surface_varyings` is compiled away). Each
+// entry point has a `_groomed` twin for the groomed or wet coats, which adds the groom's terms.
 @vertex
 fn vs_shell_wedges(@builtin(vertex_index) wedge: u32, @builtin(instance_index) instance: u32) -> ShellUvVaryings {
     return shell_wedge(wedge, instance);
@@ -159,6 +159,16 @@ fn vs_shell_wedges(@builtin(vertex_index) wedge: u32, @builtin(instance_index) i
 @vertex
 fn vs_shell_indexed(@builtin(vertex_index) vertex: u32, @builtin(instance_index) instance: u32) -> ShellTileVaryings {
     return shell_vertex(vertex, instance);
+}
+
+@vertex
+fn vs_shell_wedges_groomed(@builtin(vertex_index) wedge: u32, @builtin(instance_index) instance: u32) -> GroomedShellUvVaryings {
+    return groomed_shell_wedge(wedge, instance);
+}
+
+@vertex
+fn vs_shell_indexed_groomed(@builtin(vertex_index) vertex: u32, @builtin(instance_index) instance: u32) -> GroomedShellTileVaryings {
+    return groomed_shell_vertex(vertex, instance);
 }
 
 // Shells through the view-angle list (`view_lod.wgsl`): one indirect draw per shell the view
@@ -174,15 +184,36 @@ fn vs_shell_indexed_listed(@builtin(vertex_index) index: u32) -> ShellTileVaryin
     return shell_vertex(index % object.vertex_count, index / object.vertex_count);
 }
 
+@vertex
+fn vs_shell_wedges_listed_groomed(@builtin(vertex_index) index: u32) -> GroomedShellUvVaryings {
+    return groomed_shell_wedge(index % object.wedge_count, index / object.wedge_count);
+}
+
+@vertex
+fn vs_shell_indexed_listed_groomed(@builtin(vertex_index) index: u32) -> GroomedShellTileVaryings {
+    return groomed_shell_vertex(index % object.vertex_count, index / object.vertex_count);
+}
+
 fn shell_wedge(wedge: u32, shell: u32) -> ShellUvVaryings {
     let vertex = wedge_vertex(wedge);
     let v = surface_varyings(vertex, wedge, lod_shell_layer(shell));
-    return shell_uv_varyings(v, shell_fade(v.normal, v.world_position), lod_shell_blend(vertex, v.normal), vertex_groom(vertex));
+    return shell_uv_varyings(v, shell_fade(v.normal, v.world_position), lod_shell_blend(vertex, v.normal));
 }
 
 fn shell_vertex(vertex: u32, shell: u32) -> ShellTileVaryings {
     let v = surface_varyings(vertex, 0u, lod_shell_layer(shell));
-    return shell_tile_varyings(v, shell_fade(v.normal, v.world_position), lod_shell_blend(vertex, v.normal), vertex_groom(vertex));
+    return shell_tile_varyings(v, shell_fade(v.normal, v.world_position), lod_shell_blend(vertex, v.normal));
+}
+
+fn groomed_shell_wedge(wedge: u32, shell: u32) -> GroomedShellUvVaryings {
+    let vertex = wedge_vertex(wedge);
+    let v = surface_varyings(vertex, wedge, lod_shell_layer(shell));
+    return groomed_shell_uv_varyings(v, shell_fade(v.normal, v.world_position), lod_shell_blend(vertex, v.normal), vertex_groom(vertex));
+}
+
+fn groomed_shell_vertex(vertex: u32, shell: u32) -> GroomedShellTileVaryings {
+    let v = surface_varyings(vertex, 0u, lod_shell_layer(shell));
+    return groomed_shell_tile_varyings(v, shell_fade(v.normal, v.world_position), lod_shell_blend(vertex, v.normal), vertex_groom(vertex));
 }
 
 // The level of detail's blend at base vertex `vertex` (world normal `normal`): the view angle
@@ -242,6 +273,12 @@ fn fin_node(layer: u32, vertex: u32) -> vec3<f32> {
     return here;
 }
 
+// The base vertex fin vertex `index` of `edge` stands on.
+fn fin_vertex(index: u32, edge: u32) -> u32 {
+    let edges_start = 3u * object.triangle_count;
+    return topology[edges_start + 2u * edge + index % 2u];
+}
+
 // The fin vertex `index` of a shown `edge` (fade > 0): node `index / 2` of the level of detail.
 fn fin_varyings(index: u32, edge: u32, fade: f32) -> FinVaryings {
     let side = index % 2u;
@@ -259,9 +296,7 @@ fn fin_varyings(index: u32, edge: u32, fade: f32) -> FinVaryings {
     let normal = safe_normalize(normal_a + world_from_model_normal(model_normal(b)), normal_a);
     let tangent = strand_tangent(layer, vertex, here, normal);
     // The occlusion (`w`) is the fragment's, from the interpolated height.
-    let terms = hair_terms(tangent, normal, position, 0.0);
-    let groom = vertex_groom(vertex);
-    out.lighting_fade = vec4<f32>(wet_terms(terms, groom.wetness).xyz, fade);
+    out.lighting_fade = vec4<f32>(hair_terms(tangent, normal, position, 0.0).xyz, fade);
     let offset = f32(hash(edge) & 0xffffu) / 65536.0;
     let along = f32(side) * distance(model_vertex(0u, a), model_vertex(0u, b)) * object.tiles_per_world;
     // The surface uv of this end of the edge, from its corner in the first face.
@@ -275,10 +310,21 @@ fn fin_varyings(index: u32, edge: u32, fade: f32) -> FinVaryings {
         }
     }
     out.uvs = vec4<f32>(offset + along, layer_height(layer), surface_uv);
-    out.tint_density = vec4<f32>(groom.tint, groom.density);
-    out.clump = groom.clump;
     return out;
 }
+
+// A groomed or wet coat's fin vertex: the lean one's, its highlight wet, and the groom's terms.
+fn groomed_fin_varyings(index: u32, edge: u32, fade: f32) -> GroomedFinVaryings {
+    let lean = fin_varyings(index, edge, fade);
+    let groom = vertex_groom(fin_vertex(index, edge));
+    let lighting = wet_terms(vec4<f32>(lean.lighting_fade.xyz, 0.0), groom.wetness).xyz;
+    let tint_density = vec4<f32>(groom.tint, groom.density);
+    return GroomedFinVaryings(lean.clip_position, vec4<f32>(lighting, fade), lean.uvs, tint_density, groom.clump);
+}
+
+// Where an edge's fin shows not at all (most of them): every vertex of it lands outside the
+// clip volume, so it costs no rasterisation, and returning early skips the rest of the shading.
+const HIDDEN_FIN_CORNER = vec4<f32>(2.0, 2.0, 2.0, 1.0);
 
 // Every edge (instance = edge), each vertex deciding whether its edge shows: for hosts that
 // record no silhouette pass.
@@ -286,13 +332,22 @@ fn fin_varyings(index: u32, edge: u32, fade: f32) -> FinVaryings {
 fn vs_fin(@builtin(vertex_index) index: u32, @builtin(instance_index) edge: u32) -> FinVaryings {
     let fade = fin_fade(edge);
     if fade <= 0.0 {
-        // Invisible fin (most of them): every vertex of the edge lands outside the clip volume,
-        // so it costs no rasterisation, and returning now skips the rest of the shading.
         var out: FinVaryings;
-        out.clip_position = vec4<f32>(2.0, 2.0, 2.0, 1.0);
+        out.clip_position = HIDDEN_FIN_CORNER;
         return out;
     }
     return fin_varyings(index, edge, fade);
+}
+
+@vertex
+fn vs_fin_groomed(@builtin(vertex_index) index: u32, @builtin(instance_index) edge: u32) -> GroomedFinVaryings {
+    let fade = fin_fade(edge);
+    if fade <= 0.0 {
+        var out: GroomedFinVaryings;
+        out.clip_position = HIDDEN_FIN_CORNER;
+        return out;
+    }
+    return groomed_fin_varyings(index, edge, fade);
 }
 
 // Silhouette edges only: `fin` = (edge, fade bits), one instance per edge the silhouette pass
@@ -300,4 +355,9 @@ fn vs_fin(@builtin(vertex_index) index: u32, @builtin(instance_index) edge: u32)
 @vertex
 fn vs_fin_silhouette(@builtin(vertex_index) index: u32, @location(0) fin: vec2<u32>) -> FinVaryings {
     return fin_varyings(index, fin.x, bitcast<f32>(fin.y));
+}
+
+@vertex
+fn vs_fin_silhouette_groomed(@builtin(vertex_index) index: u32, @location(0) fin: vec2<u32>) -> GroomedFinVaryings {
+    return groomed_fin_varyings(index, fin.x, bitcast<f32>(fin.y));
 }

@@ -1,14 +1,8 @@
 // Wet fur, appended to `shading.wgsl`: a strand's wetness (0 dry, 1 soaked) darkens its tint,
 // raises its Kajiya-Kay highlight term (sharper and stronger) and adds to its clump amount, all
 // per vertex; the fragments clump through the groom's `clump_uv` and part between clumps
-// (`clump_parting`). Every term here is the dry one at wetness 0, and the callers run it only
-// while `object.wet_any` is set.
-
-// Whether the shells and fins take the groomed path (clumps, tint, density): a groom's terms or
-// a wet coat. Uniform.
-fn clump_shading() -> bool {
-    return object.groom_shading != 0u || object.wet_any != 0u;
-}
+// (`clump_parting`). Every term here is the dry one at wetness 0, and only the wet coats'
+// pipelines run it (`wet_on`).
 
 // A strand's groom terms with its wetness `w`: the tint darkened, the clump amount raised.
 fn wet_groom(groom: GroomShade, wetness: f32) -> GroomShade {
@@ -23,7 +17,7 @@ fn wet_groom(groom: GroomShade, wetness: f32) -> GroomShade {
 // sharper and 1 + shine w times stronger: pow(x, k) * pow(s, 2 / shininess) to the
 // shininess / 2 is x^(k shininess / 2) * s. The terms themselves at w = 0.
 fn wet_terms(terms: vec4<f32>, wetness: f32) -> vec4<f32> {
-    if object.wet_any == 0u || wetness <= 0.0 {
+    if !wet_on() || wetness <= 0.0 {
         return terms;
     }
     let shine = 1.0 + object.wet_shine * clamp(wetness, 0.0, 1.0);
