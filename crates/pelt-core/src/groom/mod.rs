@@ -20,8 +20,10 @@ mod edit;
 mod file;
 mod frame;
 mod source;
+mod sparse;
 mod strands;
 mod strokes;
+mod surface_grid;
 
 use std::path::PathBuf;
 

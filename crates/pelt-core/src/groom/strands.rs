@@ -22,13 +22,13 @@
 //!   colours; a tint only darkens, so a colour brighter than the preset's is scaled down to
 //!   `0..=1` keeping its hue.
 
-use std::collections::HashMap;
 use std::path::{Path, PathBuf};
 
 use glam::{Vec2, Vec3};
 
+use super::sparse::Sparse;
+use super::surface_grid::TriangleGrid;
 use super::{Groom, GroomError, MAX_LENGTH_FACTOR};
-use crate::body::closest_on_triangle;
 use crate::mesh::Mesh;
 use crate::usd::{UpAxis, UsdCurves};
 
@@ -416,150 +416,4 @@ fn flow_for(j: usize, wanted: Vec3, grow: &(dyn Fn(usize, Vec2) -> Vec3 + Sync))
         }
     }
     flow(best.0, best.1)
-}
-
-/// A symmetric matrix over the mesh's vertices with one-ring sparsity (rows of sorted columns).
-struct Sparse {
-    starts: Vec<usize>,
-    columns: Vec<u32>,
-    values: Vec<f64>,
-}
-
-impl Sparse {
-    fn new(mesh: &Mesh) -> Self {
-        let v = mesh.vertex_count();
-        let mut rows: Vec<Vec<u32>> = (0..v as u32).map(|j| vec![j]).collect();
-        for t in &mesh.triangles {
-            for &a in t {
-                rows[a as usize].extend_from_slice(t);
-            }
-        }
-        let mut starts = Vec::with_capacity(v + 1);
-        let mut columns = Vec::new();
-        for row in &mut rows {
-            row.sort_unstable();
-            row.dedup();
-            starts.push(columns.len());
-            columns.extend_from_slice(row);
-        }
-        starts.push(columns.len());
-        let values = vec![0.0; columns.len()];
-        Self { starts, columns, values }
-    }
-
-    fn slot(&self, row: u32, column: u32) -> usize {
-        let (start, end) = (self.starts[row as usize], self.starts[row as usize + 1]);
-        let at = self.columns[start..end].binary_search(&column).expect("triangle corners share a one-ring row");
-        start + at
-    }
-
-    fn add(&mut self, row: u32, column: u32, value: f64) {
-        let slot = self.slot(row, column);
-        self.values[slot] += value;
-    }
-
-    fn add_diagonal(&mut self, j: usize, value: f64) {
-        self.add(j as u32, j as u32, value);
-    }
-
-    fn multiply(&self, x: &[f64], out: &mut [f64]) {
-        for (row, out) in out.iter_mut().enumerate() {
-            let (start, end) = (self.starts[row], self.starts[row + 1]);
-            *out = (start..end).map(|k| self.values[k] * x[self.columns[k] as usize]).sum();
-        }
-    }
-
-    /// Jacobi-preconditioned conjugate gradients (the matrix is symmetric positive definite).
-    fn solve(&self, b: &[f64]) -> Vec<f64> {
-        let n = b.len();
-        let diagonal: Vec<f64> = (0..n).map(|j| self.values[self.slot(j as u32, j as u32)].max(1e-12)).collect();
-        let mut x = vec![0.0; n];
-        let mut r = b.to_vec();
-        let mut z: Vec<f64> = r.iter().zip(&diagonal).map(|(r, d)| r / d).collect();
-        let mut p = z.clone();
-        let mut rz: f64 = r.iter().zip(&z).map(|(a, b)| a * b).sum();
-        let norm_b = b.iter().map(|x| x * x).sum::<f64>().sqrt().max(1e-30);
-        let mut q = vec![0.0; n];
-        for _ in 0..(4 * n).max(50) {
-            if r.iter().map(|x| x * x).sum::<f64>().sqrt() <= 1e-10 * norm_b {
-                break;
-            }
-            self.multiply(&p, &mut q);
-            let pq: f64 = p.iter().zip(&q).map(|(a, b)| a * b).sum();
-            if pq.abs() < 1e-300 {
-                break;
-            }
-            let alpha = rz / pq;
-            for k in 0..n {
-                x[k] += alpha * p[k];
-                r[k] -= alpha * q[k];
-            }
-            for k in 0..n {
-                z[k] = r[k] / diagonal[k];
-            }
-            let next: f64 = r.iter().zip(&z).map(|(a, b)| a * b).sum();
-            let beta = next / rz;
-            rz = next;
-            for k in 0..n {
-                p[k] = z[k] + beta * p[k];
-            }
-        }
-        x
-    }
-}
-
-/// The mesh's triangles bucketed in cubic cells, each triangle in every cell its box (grown by
-/// the tolerance) touches, so a root's cell lists every triangle within the tolerance of it.
-struct TriangleGrid {
-    cell: f32,
-    tolerance: f32,
-    cells: HashMap<[i32; 3], Vec<u32>>,
-}
-
-impl TriangleGrid {
-    fn new(mesh: &Mesh, tolerance: f32) -> Self {
-        let cell = (mesh.mean_edge_length() * 2.0).max(tolerance * 2.0).max(1e-6);
-        let mut cells: HashMap<[i32; 3], Vec<u32>> = HashMap::new();
-        let key = |p: Vec3| (p / cell).floor().as_ivec3().to_array();
-        for (t, corners) in mesh.triangles.iter().enumerate() {
-            let [a, b, c] = corners.map(|j| mesh.positions[j as usize]);
-            let low = key(a.min(b).min(c) - tolerance);
-            let high = key(a.max(b).max(c) + tolerance);
-            for x in low[0]..=high[0] {
-                for y in low[1]..=high[1] {
-                    for z in low[2]..=high[2] {
-                        cells.entry([x, y, z]).or_default().push(t as u32);
-                    }
-                }
-            }
-        }
-        Self { cell, tolerance, cells }
-    }
-
-    /// The closest point within the tolerance: triangle, barycentric weights, distance.
-    fn closest(&self, mesh: &Mesh, p: Vec3) -> Option<(usize, [f32; 3], f32)> {
-        let key = (p / self.cell).floor().as_ivec3().to_array();
-        let mut best: Option<(usize, [f32; 3], f32)> = None;
-        for &t in self.cells.get(&key)? {
-            let [a, b, c] = mesh.triangles[t as usize].map(|j| mesh.positions[j as usize]);
-            let w = closest_on_triangle(p, a, b, c);
-            let distance = (a * w[0] + b * w[1] + c * w[2]).distance(p);
-            if distance <= self.tolerance && best.is_none_or(|(_, _, d)| distance < d) {
-                best = Some((t as usize, w, distance));
-            }
-        }
-        best
-    }
-
-    /// The distance to the surface by brute force (for reporting how far off a root lies).
-    fn any_distance(&self, mesh: &Mesh, p: Vec3) -> f32 {
-        mesh.triangles
-            .iter()
-            .map(|t| {
-                let [a, b, c] = t.map(|j| mesh.positions[j as usize]);
-                let w = closest_on_triangle(p, a, b, c);
-                (a * w[0] + b * w[1] + c * w[2]).distance(p)
-            })
-            .fold(f32::INFINITY, f32::min)
-    }
 }

@@ -8,10 +8,11 @@
 //! - [`UsdaWriter`] (`write`) streams a layer to any `Write`: stage metadata, nested prims,
 //!   attributes with metadata, arrays written item by item and time samples, so a large curve
 //!   set is never formatted in memory first.
-//! - [`read_curves`] (`read`) reads a layer from a `BufRead` in one pass and keeps only what a
+//! - [`read_curves`] (`read`, over the tokens of `lex`) reads a layer from a `BufRead` in one pass and keeps only what a
 //!   strand groom needs: the stage's `upAxis` and `metersPerUnit`, every `BasisCurves` prim's
 //!   counts, points (the default value, else the earliest time sample), basis, type, wrap and
-//!   `primvars:displayColor`, each placed by its prims' `xformOp`s. Other values are parsed and
+//!   `primvars:displayColor`, each placed by its prims' `xformOp`s (`xform`); `curves` evaluates
+//!   each basis. Other values are parsed and
 //!   dropped; a curve set's points are held once, as `f32`.
 //!
 //! The grammar read: the `#usda 1.0` header; layer, prim and property metadata (`( ... )`, list
@@ -22,12 +23,16 @@
 //! comments. A binary crate file (`.usdc`) or a `.usdz` archive is refused with a message that
 //! says so.
 
+mod curves;
+mod lex;
 mod read;
 mod write;
+mod xform;
 
 use std::path::PathBuf;
 
-pub use read::{CurveBasis, CurveType, CurveWrap, Curves, UsdCurves, read_curves, read_curves_from};
+pub use curves::{CurveBasis, CurveType, CurveWrap, Curves};
+pub use read::{UsdCurves, read_curves, read_curves_from};
 pub use write::{StageMetadata, UpAxis, UsdaWriter, format_f32};
 
 /// Why a USD file could not be read.
