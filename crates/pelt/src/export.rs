@@ -93,7 +93,7 @@ pub struct Args {
     #[arg(long, value_name = "M", allow_negative_numbers = true)]
     pub meters_per_unit: Option<f64>,
     /// Output: a .glb, a .gltf (its buffer written beside it as a .bin), or a .usda (the strands
-    /// as USD hair curves on the base mesh).
+    /// as USD hair curves on the base mesh; .usd writes the same text).
     #[arg(short, long, default_value = "pelt.glb")]
     pub output: PathBuf,
 }
@@ -241,9 +241,9 @@ pub(crate) fn check_output(args: &Args) -> anyhow::Result<()> {
     let path = &args.output;
     if !matches!(
         path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref(),
-        Some("glb" | "gltf" | "usda")
+        Some("glb" | "gltf" | "usda" | "usd")
     ) {
-        bail!("{}: the output must end in .glb, .gltf or .usda", path.display());
+        bail!("{}: the output must end in .glb, .gltf or .usda (.usd)", path.display());
     }
     let folder = match path.parent() {
         Some(p) if !p.as_os_str().is_empty() => p,

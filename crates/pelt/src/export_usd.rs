@@ -29,9 +29,12 @@ pub enum Curves {
     CatmullRom,
 }
 
-/// Whether `path` names a USD text file.
+/// Whether `path` names a USD file Pelt writes: `.usda`, or `.usd` (USD tells text from binary
+/// by the content, and Pelt writes text).
 pub fn is_usda(path: &Path) -> bool {
-    path.extension().and_then(|e| e.to_str()).is_some_and(|e| e.eq_ignore_ascii_case("usda"))
+    path.extension()
+        .and_then(|e| e.to_str())
+        .is_some_and(|e| e.eq_ignore_ascii_case("usda") || e.eq_ignore_ascii_case("usd"))
 }
 
 pub fn run(args: &Args, started: Instant) -> anyhow::Result<()> {

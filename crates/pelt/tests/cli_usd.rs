@@ -167,7 +167,8 @@ fn help_names_every_command_on_its_first_line() {
 #[test]
 fn the_same_export_writes_the_same_bytes() {
     let folder = folder("same");
-    let (a, b) = (folder.join("a.usda"), folder.join("b.usda"));
+    // `.usd` is the same text as `.usda`.
+    let (a, b) = (folder.join("a.usda"), folder.join("b.usd"));
     for path in [&a, &b] {
         let args = ["export", "--builtin", "sphere", "--curves", "catmull-rom", "--strand-fraction", "0.3", "-o"];
         let mut all = args.to_vec();
