@@ -2,13 +2,17 @@
 # `pelt export ... -o *.usda` checked with Pixar's own USD library: exports strands (the bunny; the
 # groomed Fox as linear and as Catmull-Rom curves, thinned; the walking Fox with time samples; a
 # soaked bunny), then .ci/usd/check.py opens each with usd-core and compares it with the `usd:`
-# line pelt printed. Reuses the debug `pelt` that web/export-test built (no second profile); the
-# virtual environment is kept in the target folder, so a warm run installs nothing.
+# line pelt printed. Takes the `pelt` CI's tests built (PELT_BIN; no second profile); the virtual
+# environment is kept in the target folder, so a warm run installs nothing.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 target="${CARGO_TARGET_DIR:-target}"
-pelt="$target/debug/pelt"
-[ -x "$pelt" ] || cargo build -p pelt --locked
+# PELT_BIN: a `pelt` already built (CI passes the one its tests built); else one is built here.
+pelt="${PELT_BIN:-}"
+if [ -z "$pelt" ]; then
+  cargo build -p pelt --locked
+  pelt="$target/debug/pelt"
+fi
 venv="$target/usd-venv"
 if ! "$venv/bin/python" -c "import pxr.Usd" 2>/dev/null; then
   if ! python3 -m venv --help >/dev/null 2>&1 || ! python3 -c "import ensurepip" 2>/dev/null; then

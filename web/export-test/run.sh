@@ -6,8 +6,12 @@
 # adapter for `pelt render` (lavapipe in CI). Any failure, validator warnings included, fails it.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
-cargo build -p pelt --locked
-pelt="${CARGO_TARGET_DIR:-target}/debug/pelt"
+# PELT_BIN: a `pelt` already built (CI passes the one its tests built); else one is built here.
+pelt="${PELT_BIN:-}"
+if [ -z "$pelt" ]; then
+  cargo build -p pelt --locked
+  pelt="${CARGO_TARGET_DIR:-target}/debug/pelt"
+fi
 out=web/export-test/output
 rm -rf "$out"
 mkdir -p "$out"

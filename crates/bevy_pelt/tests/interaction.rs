@@ -17,7 +17,7 @@ use bevy_pelt::{Fur, FurCollider, FurGrasp, FurPreset, FurSponge, FurState};
 
 const SIZE: u32 = 128;
 
-mod common;
+use crate::common;
 use common::{test_assets, update};
 
 /// A headless app on `assets` whose frames are each a sixtieth of a second, however fast the

@@ -22,7 +22,7 @@ const BACKDROP: Color = Color::srgb(0.1, 0.2, 0.6);
 const CUBE: Color = Color::srgb(0.5, 0.5, 0.5);
 const WALL: Color = Color::srgb(0.8, 0.1, 0.1);
 
-mod common;
+use crate::common;
 use common::{test_assets as assets, update};
 
 fn headless_app(assets: &Path) -> App {

@@ -1,7 +1,7 @@
 //! The grasp's hand (fingers, thumb and palm about the grip) and bad contact input, checked with
 //! the test's own distance formulas (no `sim::contact` code).
 
-mod common;
+use crate::common;
 
 use std::path::Path;
 

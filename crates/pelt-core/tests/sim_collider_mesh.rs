@@ -3,7 +3,7 @@
 //! triangles, read here), sharing no code with the baked field or the contact kernels; and a
 //! scene script's mesh collider loads relative to the script, or fails naming the file.
 
-mod common;
+use crate::common;
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;

@@ -2,7 +2,7 @@
 //! `sim::contact` (the skin against the closest point of the base mesh in f64, signed by the
 //! angle-weighted pseudonormal; colliders by their own distance formulas).
 
-mod common;
+use crate::common;
 
 use std::collections::HashMap;
 use std::path::Path;

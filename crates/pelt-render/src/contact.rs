@@ -8,9 +8,7 @@ use std::sync::Arc;
 
 use pelt_core::FurStructure;
 use pelt_core::sim::ColliderMesh;
-use pelt_core::sim::contact::{
-    MAX_STEP_COLLIDERS, SKIN_PLANES, SURFACE_WORDS, SkinSurface, skin_cone, skin_planes, skin_surface,
-};
+use pelt_core::sim::contact::{MAX_STEP_COLLIDERS, SKIN_PLANES, SURFACE_WORDS, SkinSurface, skin_cone};
 use pelt_core::sim::{ContactStep, ContactStrands};
 
 use crate::RenderError;
@@ -92,9 +90,8 @@ pub(crate) struct Skin {
 impl Skin {
     /// `structure`'s skin planes and triangles (`pelt_core::sim::contact`).
     pub fn new(structure: &FurStructure) -> Self {
-        let planes = skin_planes(structure);
-        let surface = skin_surface(structure, &planes);
-        Self { planes, surface }
+        let setup = pelt_core::sim::contact::skin_setup(structure);
+        Self { planes: setup.planes.clone(), surface: setup.surface.clone() }
     }
 
     /// Each strand's cone (`skin_cone`), for the screen.

@@ -5,7 +5,7 @@
 //! shells, a few strands across the pebble, span straight through it between the strands around
 //! it, so fur shows over it either way.)
 
-mod common;
+use crate::common;
 
 use std::path::Path;
 

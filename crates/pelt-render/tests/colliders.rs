@@ -2,7 +2,7 @@
 //! it pushed aside, where the same ball, unknown to the simulation, is drawn over by the fur
 //! growing through it. Fails, never skips, without an adapter.
 
-mod common;
+use crate::common;
 
 use std::path::Path;
 

@@ -3,7 +3,7 @@
 //! GPU's steps still draws the CPU's state, and the same frames give the same bytes. Fails,
 //! never skips, without an adapter.
 
-mod common;
+use crate::common;
 
 use std::path::Path;
 

@@ -3,7 +3,7 @@
 //! screenshot. The golden comparison is checked to notice a scene without fur and fur built for
 //! the wrong depth convention.
 
-mod common;
+use crate::common;
 #[path = "../examples/embed/scene.rs"]
 mod scene;
 

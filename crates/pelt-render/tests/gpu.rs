@@ -1,6 +1,6 @@
 //! Renderer tests on a real adapter (lavapipe in CI). They fail, never skip, without one.
 
-mod common;
+use crate::common;
 
 use common::*;
 use glam::Vec3;

@@ -1,6 +1,6 @@
 //! Groomed furs on the GPU: bald triangles draw no shells and bald edges no fins.
 
-mod common;
+use crate::common;
 
 use std::path::Path;
 

@@ -3,7 +3,7 @@
 //! at x = 0 (left: the map's value, right: the uniform value), and the images are compared half
 //! by half, in linear light over black, against the same fur without a groom.
 
-mod common;
+use crate::common;
 
 use common::{Rig, strand_textures};
 use glam::{Vec3, Vec4Swizzles as _};

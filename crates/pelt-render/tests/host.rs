@@ -3,7 +3,7 @@
 //! reverse-Z targets, posed base normals, device checks and honest byte counts. They fail, never
 //! skip, without an adapter.
 
-mod common;
+use crate::common;
 
 use common::*;
 use glam::{Mat3, Mat4, Quat, Vec3};

@@ -1,7 +1,7 @@
 //! The lean shell path on a real adapter (lavapipe in CI; fails, never skips, without one): the
 //! economies it makes must not be seen.
 
-mod common;
+use crate::common;
 
 use std::path::Path;
 

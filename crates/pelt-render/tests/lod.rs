@@ -1,7 +1,7 @@
 //! Level of detail on a real adapter (lavapipe in CI; fails, never skips, without one): unseen
 //! at the default framing, and far cheaper at 4x the distance.
 
-mod common;
+use crate::common;
 
 use common::*;
 use std::collections::HashMap;

@@ -2,7 +2,7 @@
 //! llvmpipe (GL); and a GPU soak under extreme, changing inputs. Every test fails, never skips,
 //! without an adapter of its backend.
 
-mod common;
+use crate::common;
 
 use common::{BROWN_ROOT, BROWN_TIP, builtin_fur, strand_textures};
 use glam::{Quat, Vec3};

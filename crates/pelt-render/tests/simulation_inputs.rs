@@ -3,7 +3,7 @@
 //! strand state every step, for a still mesh under a touch and for a scripted rigid motion with
 //! a touch stroke. Fails, never skips, without an adapter.
 
-mod common;
+use crate::common;
 
 use std::path::Path;
 

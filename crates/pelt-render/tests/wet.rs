@@ -3,7 +3,7 @@
 //! coat's bytes, and the CPU and GPU kernels bend wet strands alike. Fails, never skips, without
 //! an adapter.
 
-mod common;
+use crate::common;
 
 use std::path::Path;
 

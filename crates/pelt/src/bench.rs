@@ -6,6 +6,8 @@
 
 mod anim;
 mod contact;
+mod guard;
+mod load;
 mod models;
 mod render;
 mod report;
@@ -70,6 +72,20 @@ pub struct Args {
     /// flight.
     #[arg(long = "size", value_name = "WIDTHxHEIGHT", value_parser = crate::values::parse_size)]
     pub sizes: Vec<(u32, u32)>,
+    /// Instead of the report: the speed guard CI runs. Times the default bunny frame against
+    /// its skin alone and the skin contact's setup against growing the fur, each pair in turns in
+    /// this one run, and fails if a ratio is more than 15% above the one recorded in FILE
+    /// (BENCHMARKS.md's "CI speed guard" table).
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["soak", "contact"])]
+    pub guard: Option<PathBuf>,
+    /// Instead of the report: the time to a first frame phase by phase (parse, repair,
+    /// structure, textures, skin setup, GPU upload) for every mesh in the meshes folder and
+    /// each `--load-mesh`.
+    #[arg(long, conflicts_with_all = ["soak", "contact", "guard"])]
+    pub load: bool,
+    /// A mesh file `--load` also times (repeat for several).
+    #[arg(long = "load-mesh", value_name = "FILE", requires = "load")]
+    pub load_meshes: Vec<PathBuf>,
     /// Steps of `--soak` on the CPU kernel.
     #[arg(long, value_name = "N", default_value_t = 1_000_000, requires = "soak")]
     pub steps: u64,
@@ -149,6 +165,12 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     }
     if args.contact {
         return contact::run(args.quick);
+    }
+    if let Some(recorded) = &args.guard {
+        return guard::run(recorded);
+    }
+    if args.load {
+        return load::run(&models::meshes_dir(args.meshes.as_deref()), &args.load_meshes);
     }
     let started = Instant::now();
     for name in &args.models {

@@ -4,8 +4,7 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 
 // The golden-image helpers pelt-render's GPU tests use (limits, silhouette band, `PELT_UPDATE_GOLDEN=1`).
-#[path = "../../pelt-render/tests/common/mod.rs"]
-mod common;
+use crate::common;
 
 fn pelt(args: &[&str], dir: &Path) -> Output {
     Command::new(env!("CARGO_BIN_EXE_pelt")).args(args).current_dir(dir).output().expect("run pelt")

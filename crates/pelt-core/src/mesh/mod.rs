@@ -104,6 +104,17 @@ impl Mesh {
     /// A [`MeshError`] naming the file for missing files, unknown formats, parse errors and
     /// unrepairable content.
     pub fn load(path: &Path, options: &ImportOptions) -> Result<(Self, MeshReport), MeshError> {
+        let (raw, colour_sets) = Self::read_raw(path)?;
+        Self::repair(raw, &colour_sets, path, options).map(|(mesh, report, _)| (mesh, report))
+    }
+
+    /// The first half of [`Mesh::load`]: the file parsed, not yet repaired, with its vertex
+    /// colour sets (one colour per raw vertex each). [`Mesh::from_raw`] is the second half for
+    /// a file without colour sets.
+    ///
+    /// # Errors
+    /// As [`Mesh::load`], for the reading and parsing alone.
+    pub fn read_raw(path: &Path) -> Result<(RawMesh, Vec<ColourSet>), MeshError> {
         let extension = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).unwrap_or_default();
         if !path.exists() {
             return Err(MeshError::Io {
@@ -111,12 +122,11 @@ impl Mesh {
                 error: std::io::Error::new(std::io::ErrorKind::NotFound, "no such file"),
             });
         }
-        let (raw, colour_sets) = match extension.as_str() {
-            "obj" => (obj::load(path)?, Vec::new()),
-            "gltf" | "glb" => gltf::load(path)?,
-            _ => return Err(MeshError::UnknownFormat { file: path.to_path_buf(), extension }),
-        };
-        Self::repair(raw, &colour_sets, path, options).map(|(mesh, report, _)| (mesh, report))
+        match extension.as_str() {
+            "obj" => Ok((obj::load(path)?, Vec::new())),
+            "gltf" | "glb" => gltf::load(path),
+            _ => Err(MeshError::UnknownFormat { file: path.to_path_buf(), extension }),
+        }
     }
 
     /// Parses OBJ text held in memory (used for embedded meshes and tests).

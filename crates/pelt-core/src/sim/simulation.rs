@@ -15,7 +15,7 @@ use rayon::prelude::*;
 use super::contact::skin::skin_planes_of;
 use super::contact::{
     BatchPlanes, Collider, ContactStep, ContactStrands, Grasp, GraspParams, MAX_STEP_COLLIDERS, Resolve, SKIN_PLANES,
-    SkinSurface, skin_lanes, skin_surface,
+    SkinSurface, skin_lanes,
 };
 use super::dispatch::{self, CpuKernel};
 use super::field::{ForceField, Touch};
@@ -196,7 +196,8 @@ impl Simulation {
         debug_assert!(centre.is_finite());
         let nodes = v * (layers + 1);
         let batch_nodes = batches * (layers + 1);
-        let (skin_cell, skin) = skin_planes_of(fur, 0..v);
+        let setup = super::contact::skin_setup(fur);
+        let (skin_cell, skin) = (setup.cell, setup.planes.clone());
         let mut simulation = Self {
             params: params.clone(),
             layers: fur.layers,
@@ -234,7 +235,7 @@ impl Simulation {
             },
             roots_moved: false,
             touch_on_step_roots: false,
-            surface: skin_surface(fur, &skin),
+            surface: setup.surface.clone(),
             skin_lanes: skin_lanes(&skin),
             skin,
             skin_cell,

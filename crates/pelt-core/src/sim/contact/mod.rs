@@ -38,9 +38,11 @@
 //! [`ContactStep`] (what every strand shares) and [`ContactStrands`] (per strand) are the inputs
 //! every kernel reads, as [`StepInputs`](super::StepInputs) and [`StrandInputs`](super::StrandInputs).
 
+mod bvh;
 mod collider;
 mod grasp;
 pub(crate) mod screen;
+mod setup;
 pub mod skin;
 pub mod surface;
 
@@ -48,6 +50,7 @@ use glam::{Quat, Vec3, Vec4};
 
 pub use collider::{Collider, ColliderKey, ColliderMesh, SWEEP_RADII_PER_STEP, Shape, StepCollider};
 pub use grasp::{Grasp, GraspParams, HAND_PARTS};
+pub use setup::{SkinSetup, skin_setup};
 pub use skin::{SKIN_PLANES, skin_cone, skin_planes};
 pub use surface::{SURFACE_WORDS, SkinSurface, skin_surface};
 

@@ -13,10 +13,12 @@
 //! cross them, so the rest pose is never moved. Where the intersection of the planes still
 //! reaches below the surface (saddles, creases), [`surface`](super::surface) keeps triangles.
 
-use std::collections::HashMap;
+use std::collections::BinaryHeap;
 
 use glam::{Vec3, Vec4};
+use rayon::prelude::*;
 
+use super::bvh::{Bvh, box_may_reach};
 use crate::fur::FurStructure;
 
 /// Half-spaces per strand.
@@ -48,80 +50,214 @@ pub(crate) fn skin_planes_of(
         .map(|j| (0..layers).map(|k| positions[(k + 1) * v + j].distance(positions[k * v + j])).sum::<f32>())
         .collect();
     let cell = grid_cell(&mesh.positions, &reach);
-    let grid = Grid::new(&mesh.positions, &mesh.triangles, cell);
-    let mut stamp = vec![u32::MAX; mesh.triangles.len()];
-    let mut candidates: Vec<Vec4> = Vec::new();
-    let mut rising: Vec<[Vec3; 3]> = Vec::new();
+    let faces = Faces { bvh: Bvh::new(&mesh.positions, &mesh.triangles), cell };
+    let strands: Vec<usize> = strands.collect();
+    // Strands are independent: each thread keeps its own scratch, and the order of the result
+    // is the strands'.
     let planes = strands
-        .map(|j| {
-            let root = positions[j];
-            let nodes: Vec<Vec3> = (1..=layers).map(|k| positions[k * v + j] - root).collect();
-            let normal = mesh.normals[j].try_normalize().or_else(|| nodes.last().and_then(|t| t.try_normalize()));
-            let mut planes = [NO_PLANE; SKIN_PLANES];
-            let Some(n0) = normal else { return planes };
-            // Relaxed so the rest strand satisfies the plane.
-            let relax = |n: Vec3, h: f32| nodes.iter().map(|x| -n.dot(*x)).fold(h, f32::max);
-            planes[0] = n0.extend(relax(n0, 0.0));
-            let r = reach[j] * 1.05;
-            if r <= 0.0 {
-                return planes;
-            }
-            // The faces within reach that rise above the tangent plane, and the planes of those
-            // with the root on their upper side: cover the rising faces greedily, each plane
-            // taken for the most faces that lie on or below it.
-            rising.clear();
-            grid.near(root, r, |t| {
-                if stamp[t as usize] == j as u32 {
-                    return;
-                }
-                stamp[t as usize] = j as u32;
-                let corners = mesh.triangles[t as usize].map(|i| mesh.positions[i as usize]);
-                let [a, b, c] = corners;
-                if distance_to_triangle(root, a, b, c) > r {
-                    return;
-                }
-                let rise = corners.iter().map(|y| n0.dot(*y - root)).fold(f32::MIN, f32::max);
-                if rise > 1e-6 * r {
-                    rising.push(corners);
-                }
-            });
-            candidates.clear();
-            for [a, b, c] in &rising {
-                let Some(nf) = (*b - *a).cross(*c - *a).try_normalize() else { continue };
-                let d = nf.dot(root - *a);
-                if d >= -1e-6 * r {
-                    let h = relax(nf, d.max(0.0));
-                    // A plane the rest strand crosses covers nothing it was taken for.
-                    if h <= d.max(0.0) + 1e-4 * r {
-                        candidates.push(nf.extend(h));
-                    }
-                }
-            }
-            let covers = |plane: Vec4, corners: &[Vec3; 3]| {
-                corners.iter().all(|y| plane.truncate().dot(*y - root) <= -plane.w + 1e-5 * r)
-            };
-            let mut uncovered: Vec<bool> = rising.iter().map(|t| !covers(planes[0], t)).collect();
-            for slot in planes.iter_mut().skip(1) {
-                let best = candidates
-                    .iter()
-                    .map(|&plane| {
-                        let count = rising.iter().zip(&uncovered).filter(|(t, u)| **u && covers(plane, t)).count();
-                        (count, plane)
-                    })
-                    .max_by_key(|(count, _)| *count);
-                let Some((count, plane)) = best.filter(|(count, _)| *count > 0) else { break };
-                let _ = count;
-                *slot = plane;
-                for (t, u) in rising.iter().zip(uncovered.iter_mut()) {
-                    if *u && covers(plane, t) {
-                        *u = false;
-                    }
-                }
-            }
-            planes
-        })
+        .par_iter()
+        .with_min_len(64)
+        .map_init(Vec::new, |rising, &j| strand_planes(fur, &faces, reach[j], j, rising))
         .collect();
     (cell, planes)
+}
+
+/// The skin's triangles for the planes' queries, and the cell that orders them.
+struct Faces {
+    bvh: Bvh,
+    /// The cover's ties are decided by the order faces come in: that of a grid of this cell
+    /// walked x, y, z about the root, a face where the walk first meets it, then by index.
+    cell: f32,
+}
+
+impl Faces {
+    /// The order key of triangle `t` (lower corner `lo`) for a walk from `root` out to `r`.
+    fn key(&self, lo: Vec3, root: Vec3, r: f32, t: u32) -> ([i32; 3], u32) {
+        let cell = |p: Vec3| (p / self.cell).floor().as_ivec3();
+        (cell(lo).max(cell(root - Vec3::splat(r))).to_array(), t)
+    }
+}
+
+/// A rising face within reach: its order key, distance to the root and corners.
+type Rising = (([i32; 3], u32), f32, [Vec3; 3]);
+
+/// A found face by its distance, then its order key: the farthest on top of a heap.
+#[derive(Clone, Copy, PartialEq)]
+struct Nearest(f32, ([i32; 3], u32));
+
+impl Eq for Nearest {}
+
+impl PartialOrd for Nearest {
+    fn partial_cmp(&self, other: &Self) -> Option<std::cmp::Ordering> {
+        Some(self.cmp(other))
+    }
+}
+
+impl Ord for Nearest {
+    fn cmp(&self, other: &Self) -> std::cmp::Ordering {
+        self.0.total_cmp(&other.0).then(self.1.cmp(&other.1))
+    }
+}
+
+/// Most rising faces one strand's cover is counted over, and most candidate planes it chooses
+/// from, where it has more than [`EXACT_RISING`] rising faces or the whole cover would cost
+/// more than [`EXACT_COVER_WORK`]: the nearest faces, and one plane per direction bin (see
+/// [`thin_candidates`]). Dense meshes (a human's 37,000
+/// triangles under a coat as long as a hand) put thousands of faces within a strand's reach; a
+/// cover counted over all of them is quadratic in them. Faces the thinned cover leaves above
+/// the planes are caught by the skin's triangles (`surface`), as at any crease.
+const COVER_FACES: usize = 256;
+const COVER_CANDIDATES: usize = 48;
+/// Rising faces above which a strand's cover is thinned without looking for the rest.
+const EXACT_RISING: usize = 512;
+/// Candidate-face tests above which a strand's cover is thinned (above every strand of the
+/// built-ins, the Fox, Spot and Cesium Man, whose covers stay exact: at most 15,520 there).
+const EXACT_COVER_WORK: usize = 1 << 14;
+
+/// Strand `j`'s planes (see [`skin_planes`]).
+fn strand_planes(
+    fur: &FurStructure,
+    faces: &Faces,
+    reach: f32,
+    j: usize,
+    rising: &mut Vec<Rising>,
+) -> [Vec4; SKIN_PLANES] {
+    let v = fur.vertex_count();
+    let (positions, mesh) = (&fur.positions, &fur.mesh);
+    let root = positions[j];
+    let nodes: Vec<Vec3> = (1..=fur.layers as usize).map(|k| positions[k * v + j] - root).collect();
+    let normal = mesh.normals[j].try_normalize().or_else(|| nodes.last().and_then(|t| t.try_normalize()));
+    let mut planes = [NO_PLANE; SKIN_PLANES];
+    let Some(n0) = normal else { return planes };
+    // Relaxed so the rest strand satisfies the plane.
+    let relax = |n: Vec3, h: f32| nodes.iter().map(|x| -n.dot(*x)).fold(h, f32::max);
+    planes[0] = n0.extend(relax(n0, 0.0));
+    let r = reach * 1.05;
+    if r <= 0.0 {
+        return planes;
+    }
+    // The faces within reach that rise above the tangent plane, and the planes of those with
+    // the root on their upper side: cover the rising faces greedily, each plane taken for the
+    // most faces that lie on or below it.
+    rising.clear();
+    // Most faces within reach lie below the tangent plane: whole subtrees of them are skipped.
+    let threshold = 1e-6 * r;
+    let keep = |lo, hi| box_may_reach(lo, hi, root, r, n0, threshold);
+    let rising_face = |t: u32| {
+        let corners = mesh.triangles[t as usize].map(|i| mesh.positions[i as usize]);
+        let rise = corners.iter().map(|y| n0.dot(*y - root)).fold(f32::MIN, f32::max);
+        if rise <= threshold {
+            return None;
+        }
+        let [a, b, c] = corners;
+        let distance = distance_to_triangle(root, a, b, c);
+        (distance <= r).then(|| (faces.key(a.min(b).min(c), root, r, t), distance, corners))
+    };
+    // Nearest box first, all of them while the faces are few; past `EXACT_RISING` of them only
+    // the nearest `COVER_FACES` are wanted, and the walk stops once no nearer one can come.
+    // Both closures below read the heap of the nearest and the count (one writes, one reads):
+    // shared through cells.
+    let nearest = std::cell::RefCell::new(BinaryHeap::new());
+    let found = std::cell::Cell::new(0_usize);
+    faces.bvh.visit_nearest(
+        root,
+        keep,
+        |t| {
+            if let Some(face) = rising_face(t) {
+                let mut nearest = nearest.borrow_mut();
+                nearest.push(Nearest(face.1, face.0));
+                if nearest.len() > COVER_FACES {
+                    nearest.pop();
+                }
+                rising.push(face);
+                found.set(found.get() + 1);
+            }
+        },
+        |d| {
+            let nearest = nearest.borrow();
+            found.get() > EXACT_RISING && nearest.peek().is_some_and(|worst| d > worst.0)
+        },
+    );
+    let complete = rising.len() <= EXACT_RISING;
+    let candidate = |[a, b, c]: [Vec3; 3]| {
+        let nf = (b - a).cross(c - a).try_normalize()?;
+        let d = nf.dot(root - a);
+        if d < -1e-6 * r {
+            return None;
+        }
+        let h = relax(nf, d.max(0.0));
+        // A plane the rest strand crosses covers nothing it was taken for.
+        (h <= d.max(0.0) + 1e-4 * r).then(|| nf.extend(h))
+    };
+    let mut candidates = Vec::new();
+    if complete {
+        rising.sort_unstable_by_key(|(key, _, _)| *key);
+        candidates.extend(rising.iter().filter_map(|(_, _, t)| candidate(*t)));
+    }
+    if !complete || candidates.len() * rising.len() > EXACT_COVER_WORK {
+        // The nearest faces (ties in the walk's order), so the thinned cover keeps the faces a
+        // strand meets first.
+        rising.sort_by(|x, y| x.1.total_cmp(&y.1).then(x.0.cmp(&y.0)));
+        rising.truncate(COVER_FACES);
+        candidates = thin_candidates(rising.iter().filter_map(|(_, _, t)| candidate(*t)));
+    }
+    let covers = |plane: Vec4, corners: &[Vec3; 3]| {
+        corners.iter().all(|y| plane.truncate().dot(*y - root) <= -plane.w + 1e-5 * r)
+    };
+    // Which faces each candidate covers, one bit a face, counted once: the greedy rounds then
+    // count the still uncovered ones a word at a time.
+    let words = rising.len().div_ceil(64);
+    let bits = |plane: Vec4| {
+        let mut set = vec![0_u64; words];
+        for (f, (_, _, t)) in rising.iter().enumerate() {
+            if covers(plane, t) {
+                set[f / 64] |= 1 << (f % 64);
+            }
+        }
+        set
+    };
+    let mut uncovered: Vec<u64> = bits(planes[0]).iter().map(|w| !w).collect();
+    if let Some(last) = uncovered.last_mut()
+        && !rising.len().is_multiple_of(64)
+    {
+        *last &= (1 << (rising.len() % 64)) - 1;
+    }
+    let coverage: Vec<Vec<u64>> = candidates.iter().map(|&plane| bits(plane)).collect();
+    for slot in planes.iter_mut().skip(1) {
+        // The last of the candidates covering the most (as `max_by_key` breaks ties).
+        let best = coverage
+            .iter()
+            .enumerate()
+            .map(|(c, set)| (set.iter().zip(&uncovered).map(|(s, u)| (s & u).count_ones()).sum::<u32>(), c))
+            .max_by_key(|(count, _)| *count);
+        let Some((_, c)) = best.filter(|(count, _)| *count > 0) else { break };
+        *slot = candidates[c];
+        for (u, s) in uncovered.iter_mut().zip(&coverage[c]) {
+            *u &= !s;
+        }
+    }
+    planes
+}
+
+/// At most [`COVER_CANDIDATES`] of `candidates` (in their order): the first of each direction
+/// bin (the octahedral map of the normal on a 16 x 16 grid, about 8 degrees a bin), as faces of
+/// one smooth patch give near-equal planes and one of them covers what the others would.
+fn thin_candidates(candidates: impl Iterator<Item = Vec4>) -> Vec<Vec4> {
+    let mut seen = std::collections::HashSet::new();
+    candidates
+        .filter(|plane| {
+            let n = plane.truncate();
+            let p = n / (n.x.abs() + n.y.abs() + n.z.abs());
+            let (x, y) = if p.z >= 0.0 {
+                (p.x, p.y)
+            } else {
+                ((1.0 - p.y.abs()) * p.x.signum(), (1.0 - p.x.abs()) * p.y.signum())
+            };
+            let bin = |u: f32| ((u * 0.5 + 0.5) * 16.0).clamp(0.0, 15.0) as u32;
+            seen.insert(bin(x) * 16 + bin(y))
+        })
+        .take(COVER_CANDIDATES)
+        .collect()
 }
 
 /// Rounds of [`skin_cone`]'s search for its axis.
@@ -148,48 +284,8 @@ pub fn skin_cone(planes: &[Vec4; SKIN_PLANES]) -> Vec4 {
     axis.extend(spread * (1.0 + 1e-4) + 1e-5)
 }
 
-/// Triangles binned by the cells their boxes cover.
-pub(super) struct Grid {
-    cell: f32,
-    bins: HashMap<[i32; 3], Vec<u32>>,
-}
-
-impl Grid {
-    pub(super) fn new(points: &[Vec3], triangles: &[[u32; 3]], cell: f32) -> Self {
-        let mut bins: HashMap<[i32; 3], Vec<u32>> = HashMap::new();
-        let key = |p: Vec3| (p / cell).floor().as_ivec3().to_array();
-        for (t, tri) in triangles.iter().enumerate() {
-            let [a, b, c] = tri.map(|i| points[i as usize]);
-            let (lo, hi) = (key(a.min(b).min(c)), key(a.max(b).max(c)));
-            for x in lo[0]..=hi[0] {
-                for y in lo[1]..=hi[1] {
-                    for z in lo[2]..=hi[2] {
-                        bins.entry([x, y, z]).or_default().push(t as u32);
-                    }
-                }
-            }
-        }
-        Self { cell, bins }
-    }
-
-    pub(super) fn near(&self, p: Vec3, r: f32, mut visit: impl FnMut(u32)) {
-        let key = |p: Vec3| (p / self.cell).floor().as_ivec3().to_array();
-        let (lo, hi) = (key(p - Vec3::splat(r)), key(p + Vec3::splat(r)));
-        for x in lo[0]..=hi[0] {
-            for y in lo[1]..=hi[1] {
-                for z in lo[2]..=hi[2] {
-                    for &t in self.bins.get(&[x, y, z]).map_or(&[][..], Vec::as_slice) {
-                        visit(t);
-                    }
-                }
-            }
-        }
-    }
-}
-
-/// Distance from `p` to the triangle `abc` (Ericson, Real-Time Collision Detection 5.1.5).
-/// The triangle grid's cell for strands of `reach`: the longest reach, but no smaller than a
-/// 32nd of the mesh, so short or bald fur does not bin each triangle into millions of cells.
+/// The cell of the grid whose walk orders a strand's faces (`Faces`) for strands of `reach`: the
+/// longest reach, but no smaller than a 32nd of the mesh.
 pub(super) fn grid_cell(points: &[Vec3], reach: &[f32]) -> f32 {
     let (lo, hi) = points.iter().fold((Vec3::MAX, Vec3::MIN), |(l, h), p| (l.min(*p), h.max(*p)));
     let extent = (hi - lo).max_element();
@@ -197,6 +293,7 @@ pub(super) fn grid_cell(points: &[Vec3], reach: &[f32]) -> f32 {
     reach.iter().copied().fold(0.0_f32, f32::max).max(floor)
 }
 
+/// Distance from `p` to the triangle `abc` (Ericson, Real-Time Collision Detection 5.1.5).
 pub(super) fn distance_to_triangle(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> f32 {
     let (ab, ac, ap) = (b - a, c - a, p - a);
     let (d1, d2) = (ab.dot(ap), ac.dot(ap));

@@ -13,8 +13,10 @@
 use std::collections::HashMap;
 
 use glam::{Quat, Vec3, Vec4};
+use rayon::prelude::*;
 
-use super::skin::{Grid, SKIN_PLANES, distance_to_triangle, grid_cell};
+use super::bvh::{Bvh, box_may_reach_all};
+use super::skin::{SKIN_PLANES, distance_to_triangle};
 use crate::fur::FurStructure;
 
 /// Words per stored triangle: its corners `a`, `b`, `c`, its face normal, the pseudonormals of
@@ -146,8 +148,13 @@ pub(crate) fn closest_feature(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> (Vec3, usiz
 /// [`skin_planes`](super::skin_planes)).
 #[must_use]
 pub fn skin_surface(fur: &FurStructure, planes: &[[Vec4; SKIN_PLANES]]) -> SkinSurface {
-    let mut scan = Scan::new(fur);
-    let kept: Vec<Vec<u32>> = (0..fur.vertex_count()).map(|j| scan.strand(fur, planes, j)).collect();
+    let scan = Scan::new(fur);
+    // Strands are independent: each thread keeps its own stamps, and the order is the strands'.
+    let kept: Vec<Vec<u32>> = (0..fur.vertex_count())
+        .into_par_iter()
+        .with_min_len(64)
+        .map_init(|| Stamps::new(fur), |stamps, j| scan.strand(fur, planes, j, stamps))
+        .collect();
     pack(&scan.words, kept.iter().map(Vec::as_slice))
 }
 
@@ -160,12 +167,13 @@ pub(crate) fn skin_surface_of(
     planes: &[[Vec4; SKIN_PLANES]],
     strands: &[u32],
 ) -> SkinSurface {
-    let mut scan = Scan::new(fur);
+    let scan = Scan::new(fur);
+    let mut stamps = Stamps::new(fur);
     let mut kept: Vec<Vec<u32>> = (0..fur.vertex_count())
         .map(|j| surface.strand(j).iter().map(|&t| surface.mesh_triangles[t as usize]).collect())
         .collect();
     for &j in strands {
-        kept[j as usize] = scan.strand(fur, planes, j as usize);
+        kept[j as usize] = scan.strand(fur, planes, j as usize, &mut stamps);
     }
     pack(&scan.words, kept.iter().map(Vec::as_slice))
 }
@@ -198,10 +206,21 @@ fn pack<'a>(words: &[Option<[Vec4; SURFACE_WORDS]>], kept: impl Iterator<Item = 
 /// triangles meet at each corner.
 struct Scan {
     reach: Vec<f32>,
-    grid: Grid,
+    bvh: Bvh,
     words: Vec<Option<[Vec4; SURFACE_WORDS]>>,
     corner_triangles: Vec<Vec<u32>>,
-    stamp: Vec<u32>,
+}
+
+/// One thread's marks, per mesh triangle, of the last strand that kept it, so each strand
+/// keeps a triangle once in time linear in what it meets.
+struct Stamps {
+    kept: Vec<u32>,
+}
+
+impl Stamps {
+    fn new(fur: &FurStructure) -> Self {
+        Self { kept: vec![u32::MAX; fur.mesh.triangles.len()] }
+    }
 }
 
 impl Scan {
@@ -214,7 +233,7 @@ impl Scan {
         let reach: Vec<f32> = (0..v)
             .map(|j| (0..layers).map(|k| positions[(k + 1) * v + j].distance(positions[k * v + j])).sum::<f32>())
             .collect();
-        let grid = Grid::new(points, &mesh.triangles, grid_cell(points, &reach));
+        let bvh = Bvh::new(points, &mesh.triangles);
         let words = triangle_words(points, &mesh.triangles);
         let mut corner_triangles: Vec<Vec<u32>> = vec![Vec::new(); points.len()];
         for (t, tri) in mesh.triangles.iter().enumerate() {
@@ -224,11 +243,11 @@ impl Scan {
                 }
             }
         }
-        Self { reach, grid, words, corner_triangles, stamp: vec![u32::MAX; mesh.triangles.len()] }
+        Self { reach, bvh, words, corner_triangles }
     }
 
     /// Strand `j`'s triangles (mesh triangle indices), the nearest to its root first.
-    fn strand(&mut self, fur: &FurStructure, planes: &[[Vec4; SKIN_PLANES]], j: usize) -> Vec<u32> {
+    fn strand(&self, fur: &FurStructure, planes: &[[Vec4; SKIN_PLANES]], j: usize, stamps: &mut Stamps) -> Vec<u32> {
         let mesh = &fur.mesh;
         let points = &mesh.positions;
         let root = fur.positions[j];
@@ -238,12 +257,15 @@ impl Scan {
             let strand_planes: Vec<Vec4> = planes[j].iter().copied().filter(|p| p.truncate() != Vec3::ZERO).collect();
             let mut hits = Vec::new();
             let mut polygon = Vec::new();
-            let (stamp, words) = (&mut self.stamp, &self.words);
-            self.grid.near(root, r, |t| {
-                if stamp[t as usize] == j as u32 || words[t as usize].is_none() {
+            let words = &self.words;
+            // A face wholly below one of the planes is clipped away: whole subtrees of them
+            // (below the tangent plane, most of all) are skipped.
+            let shifted = |plane: &Vec4| (plane.truncate(), -(plane.w - KEEP_TOLERANCE * r));
+            let keep = |lo, hi| box_may_reach_all(lo, hi, root, r, strand_planes.iter().map(shifted));
+            self.bvh.visit(keep, |t| {
+                if words[t as usize].is_none() {
                     return;
                 }
-                stamp[t as usize] = j as u32;
                 let [a, b, c] = mesh.triangles[t as usize].map(|i| points[i as usize]);
                 if distance_to_triangle(root, a, b, c) > r {
                     return;
@@ -265,7 +287,8 @@ impl Scan {
             for &t in &hits {
                 for &i in &mesh.triangles[t as usize] {
                     for &n in &self.corner_triangles[i as usize] {
-                        if !kept.iter().any(|&(_, k)| k == n) {
+                        if stamps.kept[n as usize] != j as u32 {
+                            stamps.kept[n as usize] = j as u32;
                             let [a, b, c] = mesh.triangles[n as usize].map(|i| points[i as usize]);
                             kept.push((distance_to_triangle(root, a, b, c), n));
                         }
@@ -329,6 +352,15 @@ fn clip(polygon: &mut Vec<Vec3>, n: Vec3, h: f32, root: Vec3) {
         return;
     }
     let side = |x: Vec3| n.dot(x - root) + h;
+    // Wholly on one side (most planes and faces): kept or gone as the loop below would leave it.
+    let above = polygon.iter().filter(|x| side(**x) >= 0.0).count();
+    if above == polygon.len() {
+        return;
+    }
+    if above == 0 {
+        polygon.clear();
+        return;
+    }
     let mut out = Vec::with_capacity(polygon.len() + 1);
     for i in 0..polygon.len() {
         let (x, y) = (polygon[i], polygon[(i + 1) % polygon.len()]);

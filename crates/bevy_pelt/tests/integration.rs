@@ -1,0 +1,10 @@
+//! bevy_pelt's tests through Bevy on a real adapter in one binary
+//! (one link for all of them); each module is one file of tests beside this one.
+
+#[path = "common/mod.rs"]
+mod common;
+
+#[path = "interaction.rs"]
+mod interaction;
+#[path = "render.rs"]
+mod render;
