@@ -274,7 +274,9 @@ fn bad_curve_files_are_clear_errors_naming_the_file() {
     let folder = scratch("bad");
     let preset = Preset::load(assets().join("presets/fox.toml")).unwrap();
     let mesh = pelt_core::Builtin::Sphere.mesh().0;
-    let cases: [(&str, &[u8], &str); 9] = [
+    let deep = format!("#usda 1.0\ndef Xform \"A\" {{\n float3 x = {}\n}}\n", "(".repeat(100_000));
+    let cases: [(&str, &[u8], &str); 10] = [
+        ("deep.usda", deep.as_bytes(), "nested more than"),
         ("empty.usda", b"", "the file is empty"),
         ("crate.usd", b"PXR-USDC\0\0\0\0", "binary USD crate file"),
         ("archive.usdz", b"PK\x03\x04rest", ".usdz archive"),

@@ -63,7 +63,7 @@ pub fn read_curves_from(mut input: impl BufRead, file: &Path) -> Result<UsdCurve
         return Err(content("not a USD text file: it does not start with `#usda 1.0`"));
     }
     let mut parser =
-        Parser { lexer: Lexer::new(input, file), prims: Vec::new(), raw: Vec::new(), meta: Meta::default() };
+        Parser { lexer: Lexer::new(input, file), prims: Vec::new(), raw: Vec::new(), meta: Meta::default(), depth: 0 };
     parser.lexer.skip_line()?;
     parser.layer()?;
     parser.finish()
@@ -140,7 +140,13 @@ struct Parser<R: BufRead> {
     prims: Vec<PrimInfo>,
     raw: Vec<RawCurves>,
     meta: Meta,
+    /// Values and prims being read inside one another (bounded, so a crafted file cannot
+    /// exhaust the stack).
+    depth: usize,
 }
+
+/// The deepest nesting of prims and values read.
+const MAX_DEPTH: usize = 128;
 
 impl<R: BufRead> Parser<R> {
     fn layer(&mut self) -> Result<(), UsdError> {
@@ -203,6 +209,23 @@ impl<R: BufRead> Parser<R> {
     }
 
     fn value(&mut self) -> Result<Value, UsdError> {
+        self.enter()?;
+        let value = self.value_inside();
+        self.depth -= 1;
+        value
+    }
+
+    /// One level deeper, or an error past [`MAX_DEPTH`].
+    fn enter(&mut self) -> Result<(), UsdError> {
+        self.depth += 1;
+        if self.depth > MAX_DEPTH {
+            self.depth -= 1;
+            return Err(self.lexer.error(format!("prims or values nested more than {MAX_DEPTH} deep")));
+        }
+        Ok(())
+    }
+
+    fn value_inside(&mut self) -> Result<Value, UsdError> {
         match self.lexer.next()? {
             Tok::Num(x) => Ok(Value::Num(x)),
             Tok::Str(s) => Ok(Value::Text(s)),
@@ -332,6 +355,13 @@ impl<R: BufRead> Parser<R> {
 
     /// A prim after its specifier.
     fn prim(&mut self, parent: Option<usize>, parent_path: &str) -> Result<(), UsdError> {
+        self.enter()?;
+        let prim = self.prim_inside(parent, parent_path);
+        self.depth -= 1;
+        prim
+    }
+
+    fn prim_inside(&mut self, parent: Option<usize>, parent_path: &str) -> Result<(), UsdError> {
         let (type_name, name) = match self.lexer.next()? {
             Tok::Str(name) => (String::new(), name),
             Tok::Ident(type_name) => match self.lexer.next()? {
