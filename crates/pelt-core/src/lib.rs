@@ -6,8 +6,10 @@
 //! it) -> [`fur`] (the unified shell-and-fin structure) ->
 //! [`texture`] (seeded shell and fin textures) -> [`sim`] (gravity, wind, touch) -> the renderer
 //! in `pelt-render`. [`preset`] holds everything about one fur in one TOML file; [`stage`] loads
-//! the meshes of one scene (the furred one, its rig, the plain ones) for every host. [`rng`] and
-//! [`param`] (the range error every parameter check returns) sit below them all.
+//! the meshes of one scene (the furred one, its rig, the plain ones) for every host; [`export`]
+//! writes the fur as glTF and its strands as USD hair, through [`usd`] (USD's text format), which
+//! also reads a strand groom for [`groom`] to bake. [`rng`] and [`param`] (the range error every
+//! parameter check returns) sit below them all.
 
 #![warn(missing_docs)]
 
@@ -24,6 +26,7 @@ pub mod rng;
 pub mod sim;
 pub mod stage;
 pub mod texture;
+pub mod usd;
 pub mod wet;
 
 pub use fur::{FurParams, FurStructure, GrowthDirection, SeparatedStructure};

@@ -15,6 +15,10 @@
 //! [wet]                # what wetness does: clumps, darkening, shine, weight, drying (`wet::WetParams`)
 //! ```
 
+mod strands;
+
+pub use strands::ROOT_TOLERANCE_FRACTION;
+
 use std::path::{Path, PathBuf};
 
 use glam::Vec3;
@@ -466,9 +470,7 @@ impl Preset {
     /// # Errors
     /// [`PresetError::Groom`] naming the preset, the groom's file and key and the problem.
     pub fn groom(&self, mesh: &Mesh, mesh_name: &str) -> Result<Option<Groom>, PresetError> {
-        self.groom
-            .load(mesh, mesh_name, |path| self.resolve(path))
-            .map_err(|error| PresetError::Groom { file: self.file.clone(), error })
+        Ok(self.groom_with_report(mesh, mesh_name)?.0)
     }
 
     /// Grows the preset's fur on `mesh`, groomed: [`Preset::fur_params`] and [`Preset::groom`]

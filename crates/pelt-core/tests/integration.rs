@@ -40,5 +40,7 @@ mod sim_oracle;
 mod stepper;
 #[path = "textures.rs"]
 mod textures;
+#[path = "usd.rs"]
+mod usd;
 #[path = "wet.rs"]
 mod wet;

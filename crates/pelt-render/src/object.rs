@@ -59,7 +59,7 @@ impl Default for FurLook {
             root_occlusion: 0.3,
             fin_fade_cos: 0.1,
             shell_fade_cos: 0.25,
-            tiles_per_radius: 0.4,
+            tiles_per_radius: pelt_core::reference::STANDARD_TILES_PER_RADIUS,
             wet_darkening: 0.5,
             wet_shine: 0.6,
             clump_size: 12.0,

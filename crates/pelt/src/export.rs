@@ -1,5 +1,6 @@
 //! `pelt export`: the fur, settled, as a standard glTF file (`.glb`, or `.gltf` with a `.bin`)
-//! that glTF viewers and engines draw with their own materials.
+//! that glTF viewers and engines draw with their own materials, or its strands as USD hair
+//! curves (`.usda`, `export_usd`).
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -20,9 +21,9 @@ use crate::mesh_args::MeshArgs;
 use crate::render::{LIGHT_WIND, PLAIN_COLOUR};
 
 /// How long the fur settles under gravity before it is written (seconds of simulated time).
-const SETTLE_SECS: f64 = 1.5;
+pub(crate) const SETTLE_SECS: f64 = 1.5;
 /// Frame rate the simulation is driven at while a clip plays to `--time`.
-const DRIVE_FPS: f64 = 30.0;
+pub(crate) const DRIVE_FPS: f64 = 30.0;
 /// How long the wind blows before `--motion` samples it (the lean it starts with is not looped).
 const MOTION_WARM_SECS: f64 = 1.0;
 /// Sampled frames (morph targets) per second of `--motion`, and at most: each frame is a copy of
@@ -45,43 +46,73 @@ pub enum Alpha {
 The fur is settled under gravity (no wind) at the rest pose, or with --time at that time of an
 animation (--animation picks it; the first by default). A glTF source is copied whole (meshes,
 materials, skins, animations); on a skinned mesh every fur vertex follows its root's joints.
-Examples: `pelt export --builtin bunny -o bunny.glb`, `pelt export assets/meshes/Fox.glb
---preset assets/presets/fox.toml --time 0.5 --animation Walk -o fox.glb`.")]
+A .usda output holds the strands the shells stand for (where `pelt fidelity` places them) as
+USD BasisCurves on the base mesh; --motion there adds time samples (the clip plays on from
+--time, the fur sways in the wind). Examples: `pelt export --builtin bunny -o bunny.glb`,
+`pelt export assets/meshes/Fox.glb --preset assets/presets/fox.toml --time 0.5 --animation Walk
+-o fox.glb`, `pelt export assets/meshes/Fox.glb --preset assets/presets/fox_groomed.toml -o
+fox.usda`.")]
 pub struct Args {
     #[command(flatten)]
-    mesh: MeshArgs,
+    pub mesh: MeshArgs,
     /// The fur preset (TOML); the built-in default fur without one.
     #[arg(long, value_name = "P")]
-    preset: Option<PathBuf>,
+    pub preset: Option<PathBuf>,
     /// Shells to write (spread evenly up to the tips); default every layer of the preset.
     #[arg(long, value_name = "N", conflicts_with = "screen_size")]
-    layers: Option<u32>,
+    pub layers: Option<u32>,
     /// Shells for a fur this many pixels tall on screen: the level `pelt render` draws it at
     /// there (the preset's `[render.lod]`), in place of `--layers`.
     #[arg(long, value_name = "PIXELS")]
-    screen_size: Option<u32>,
+    pub screen_size: Option<u32>,
     /// Bake this many seconds of the fur swaying in the preset's wind (pelt render's light breeze
     /// if it has none) as morph targets with a looping weights animation ("pelt fur motion").
     #[arg(long, value_name = "SECONDS", allow_negative_numbers = true)]
-    motion: Option<f64>,
+    pub motion: Option<f64>,
     /// Settle the fur at this time (seconds) of the animation instead of the rest pose.
     #[arg(long, value_name = "T", allow_negative_numbers = true)]
-    time: Option<f64>,
+    pub time: Option<f64>,
     /// The animation `--time` refers to: its name or index (default: the first).
     #[arg(long, value_name = "NAME|INDEX")]
-    animation: Option<String>,
+    pub animation: Option<String>,
     /// How the fur's materials treat alpha. `mask` by default: in three.js it comes closer to
     /// `pelt render`'s picture than `blend` (web/export-test), and it needs no sorting.
     #[arg(long, value_enum, default_value_t = Alpha::Mask)]
-    alpha: Alpha,
-    /// Output: a .glb, or a .gltf (its buffer written beside it as a .bin).
+    pub alpha: Alpha,
+    /// .usda: the share of the strands written, above 0 and at most 1 (seeded per strand).
+    #[arg(long, value_name = "F")]
+    pub strand_fraction: Option<f32>,
+    /// .usda: how the curves run between their points.
+    #[arg(long, value_enum)]
+    pub curves: Option<crate::export_usd::Curves>,
+    /// .usda: a uniformly wet coat, 0 (dry) to 1 (soaked): the strands gather into the wet
+    /// clumps and droop under the water's weight (the preset's `[wet]`).
+    #[arg(long, value_name = "W", value_parser = crate::values::parse_wetness)]
+    pub wetness: Option<f32>,
+    /// .usda: metres per unit of the mesh (`metersPerUnit`; glTF's metres by default).
+    #[arg(long, value_name = "M", allow_negative_numbers = true)]
+    pub meters_per_unit: Option<f64>,
+    /// Output: a .glb, a .gltf (its buffer written beside it as a .bin), or a .usda (the strands
+    /// as USD hair curves on the base mesh; .usd writes the same text).
     #[arg(short, long, default_value = "pelt.glb")]
-    output: PathBuf,
+    pub output: PathBuf,
 }
 
 pub fn run(args: &Args) -> anyhow::Result<()> {
     let started = Instant::now();
     check_output(args)?;
+    if crate::export_usd::is_usda(&args.output) {
+        return crate::export_usd::run(args, started);
+    }
+    let usd_only = [
+        ("--strand-fraction", args.strand_fraction.is_some()),
+        ("--curves", args.curves.is_some()),
+        ("--wetness", args.wetness.is_some()),
+        ("--meters-per-unit", args.meters_per_unit.is_some()),
+    ];
+    if let Some((flag, _)) = usd_only.iter().find(|(_, given)| *given) {
+        bail!("{flag}: only a .usda export (the strands as curves) takes it");
+    }
     if args.layers == Some(0) {
         bail!("--layers must be at least 1, got 0");
     }
@@ -201,18 +232,18 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     Ok(())
 }
 
-fn is_gltf(path: &Path) -> bool {
+pub(crate) fn is_gltf(path: &Path) -> bool {
     matches!(path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref(), Some("gltf" | "glb"))
 }
 
 /// Fails early, before any work, on an output that cannot be written.
-fn check_output(args: &Args) -> anyhow::Result<()> {
+pub(crate) fn check_output(args: &Args) -> anyhow::Result<()> {
     let path = &args.output;
     if !matches!(
         path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase).as_deref(),
-        Some("glb" | "gltf")
+        Some("glb" | "gltf" | "usda" | "usd")
     ) {
-        bail!("{}: the output must end in .glb or .gltf", path.display());
+        bail!("{}: the output must end in .glb, .gltf or .usda (.usd)", path.display());
     }
     let folder = match path.parent() {
         Some(p) if !p.as_os_str().is_empty() => p,
@@ -229,7 +260,7 @@ fn check_output(args: &Args) -> anyhow::Result<()> {
 }
 
 /// The clip `--time` refers to: none without `--time` and `--animation` (the rest pose).
-fn choose_clip(args: &Args, rig: Option<&Rig>) -> anyhow::Result<Option<usize>> {
+pub(crate) fn choose_clip(args: &Args, rig: Option<&Rig>) -> anyhow::Result<Option<usize>> {
     let clips = rig.map_or(0, |r| r.animations().len());
     let clip = match (args.animation.as_deref(), rig) {
         (Some(name), Some(rig)) if clips > 0 => {
@@ -256,7 +287,7 @@ fn choose_clip(args: &Args, rig: Option<&Rig>) -> anyhow::Result<Option<usize>> 
 }
 
 /// Simulation frames of the settling (and of the clip up to `--time`).
-fn settle_frames(time: Option<f64>) -> u64 {
+pub(crate) fn settle_frames(time: Option<f64>) -> u64 {
     let settle = (SETTLE_SECS * DRIVE_FPS).round() as u64 + 1;
     settle + time.map_or(0, |t| (t * DRIVE_FPS).ceil() as u64)
 }
@@ -269,7 +300,7 @@ fn motion_steps(args: &Args, frames: u32) -> u64 {
 
 /// Settles the fur under gravity (no wind): at the rest pose, or in the clip's first pose and
 /// then through the clip to `time`. The stepper at the end (posed at the clip time).
-fn settle(
+pub(crate) fn settle(
     fur: &FurStructure,
     preset: &Preset,
     rig: Option<&Rig>,
@@ -277,9 +308,25 @@ fn settle(
     time: Option<f64>,
     progress: &Progress,
 ) -> anyhow::Result<FurStepper> {
+    settle_wet(fur, preset, rig, clip, time, None, progress)
+}
+
+/// [`settle`] with the coat held at `wetness` (the preset's `[wet]`) while it settles.
+pub(crate) fn settle_wet(
+    fur: &FurStructure,
+    preset: &Preset,
+    rig: Option<&Rig>,
+    clip: Option<usize>,
+    time: Option<f64>,
+    wetness: Option<f32>,
+    progress: &Progress,
+) -> anyhow::Result<FurStepper> {
     let mut params = preset.simulation.clone();
     params.wind = WindParams { strength: 0.0, ..params.wind };
     let mut stepper = FurStepper::new(fur, &params)?;
+    if wetness.is_some() {
+        stepper.set_wet(&crate::render::wet_params(preset, wetness))?;
+    }
     if let (Some(rig), Some(_)) = (rig, clip) {
         stepper.set_clip(rig.clone(), clip);
     }
@@ -449,10 +496,10 @@ fn shells_at_screen_size(preset: &Preset, fur: &FurStructure, pixels: u32) -> u3
 }
 
 /// A bar on stderr over the export's simulation frames, drawn only on a terminal.
-struct Progress(indicatif::ProgressBar);
+pub(crate) struct Progress(indicatif::ProgressBar);
 
 impl Progress {
-    fn new(steps: u64) -> Self {
+    pub(crate) fn new(steps: u64) -> Self {
         let bar = indicatif::ProgressBar::with_draw_target(Some(steps), indicatif::ProgressDrawTarget::stderr());
         bar.set_style(
             indicatif::ProgressStyle::with_template(
@@ -464,15 +511,15 @@ impl Progress {
         Self(bar)
     }
 
-    fn step(&self) {
+    pub(crate) fn step(&self) {
         self.0.inc(1);
     }
 
-    fn finish_simulation(&self) {
+    pub(crate) fn finish_simulation(&self) {
         self.0.set_message("writing");
     }
 
-    fn done(&self) {
+    pub(crate) fn done(&self) {
         self.0.finish_and_clear();
     }
 }

@@ -2,8 +2,10 @@
 
 mod bench;
 mod export;
+mod export_usd;
 mod fidelity;
 mod format;
+mod groom;
 mod lod;
 mod mesh_args;
 mod render;
@@ -35,8 +37,11 @@ enum Command {
     Textures(textures::Args),
     /// Measure how close shells and fins come to the explicit strands they stand for (SSIM).
     Fidelity(fidelity::Args),
-    /// Write the fur as a standard glTF file (.glb or .gltf) for other viewers and engines.
+    /// Write the fur as a standard glTF file (.glb or .gltf) for other viewers and engines, or
+    /// its strands as USD hair curves (.usda) for Blender, Houdini and path tracers.
     Export(export::Args),
+    /// Grooms as files: bake a strand groom (USD hair curves) into a per-vertex .groom.
+    Groom(groom::Args),
     /// Measure memory, frame time, simulation and texture generation side by side.
     Bench(bench::Args),
 }
@@ -48,6 +53,7 @@ fn main() -> anyhow::Result<()> {
         Command::Stats(args) => stats::run(&args),
         Command::Textures(args) => textures::run(&args),
         Command::Export(args) => export::run(&args),
+        Command::Groom(args) => groom::run(&args),
         Command::Bench(args) => bench::run(&args),
         Command::Fidelity(args) => fidelity::run(&args),
     }

@@ -12,6 +12,8 @@ mod cli_export;
 mod cli_fidelity;
 #[path = "cli_render.rs"]
 mod cli_render;
+#[path = "cli_usd.rs"]
+mod cli_usd;
 #[path = "cli_view.rs"]
 mod cli_view;
 #[path = "stats_cli.rs"]

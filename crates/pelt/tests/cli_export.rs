@@ -90,7 +90,12 @@ fn bad_input_fails_clearly_and_leaves_no_file() {
         &["note.txt"],
     );
     fails("is-folder", &["--builtin", "box", "-o", "FOLDER"], &["FOLDER"], &[]);
-    fails("not-gltf", &["--builtin", "box", "-o", "FOLDER/fur.obj"], &["FOLDER/fur.obj", ".glb or .gltf"], &[]);
+    fails(
+        "not-gltf",
+        &["--builtin", "box", "-o", "FOLDER/fur.obj"],
+        &["FOLDER/fur.obj", ".glb, .gltf or .usda (.usd)"],
+        &[],
+    );
 }
 
 /// The JSON chunk of a GLB.

@@ -15,6 +15,7 @@ mod document;
 mod geometry;
 mod images;
 mod morph;
+mod strands;
 
 use std::path::{Path, PathBuf};
 
@@ -24,6 +25,9 @@ use serde_json::{Value, json};
 use self::document::{CLAMP_TO_EDGE, Document, REPEAT};
 use self::geometry::{fins, shell_wedges, srgb_to_linear, surface_colours};
 pub use self::morph::{FurMorphs, MorphAnimation, carried_up};
+pub use self::strands::{
+    StrandBasis, StrandExportCounts, StrandExportInput, StrandFrame, kept_strands, write_strands_usda,
+};
 use crate::fur::FurStructure;
 use crate::mesh::Mesh;
 use crate::reference::TileMapping;

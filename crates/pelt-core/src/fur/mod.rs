@@ -9,11 +9,11 @@
 
 mod footprint;
 
-use glam::{Quat, Vec3};
+use glam::{Quat, Vec2, Vec3};
 
 pub use footprint::{Footprint, SeparatedStructure};
 
-use crate::groom::{Groom, tangent_frames};
+use crate::groom::{Groom, TangentFrame, tangent_frames};
 use crate::mesh::Mesh;
 use crate::rng;
 
@@ -107,6 +107,18 @@ impl GrowthDirection {
     }
 }
 
+impl GrowthDirection {
+    /// The growing vector of a groomed vertex: combed along the groom's `flow` in its tangent
+    /// `frame` (in place of [`GrowthDirection::comb`]), leaning by `comb_blend` times the flow's
+    /// length (at most 1), then tilted as [`GrowthDirection::apply`] tilts.
+    #[must_use]
+    pub fn groomed(&self, vertex: usize, normal: Vec3, frame: TangentFrame, flow: Vec2) -> Vec3 {
+        let comb = frame.to_surface(flow);
+        let comb_blend = self.comb_blend * flow.length().min(1.0);
+        GrowthDirection { comb, comb_blend, ..*self }.apply(vertex, normal)
+    }
+}
+
 /// The least cosine between a growing vector and its normal: fur always leaves the surface.
 const MIN_HEIGHT: f32 = 0.1;
 
@@ -188,13 +200,8 @@ impl FurStructure {
             None => mesh.normals.iter().enumerate().map(|(j, n)| params.direction.apply(j, *n)).collect(),
             Some(flows) => {
                 let frames = tangent_frames(&mesh);
-                let base = params.direction;
                 (mesh.normals.iter().zip(&frames).zip(flows).enumerate())
-                    .map(|(j, ((n, frame), flow))| {
-                        let comb = frame.to_surface(*flow);
-                        let comb_blend = base.comb_blend * flow.length().min(1.0);
-                        GrowthDirection { comb, comb_blend, ..base }.apply(j, *n)
-                    })
+                    .map(|(j, ((n, frame), flow))| params.direction.groomed(j, *n, *frame, *flow))
                     .collect()
             }
         };

@@ -11,7 +11,8 @@
 //!
 //! Sources are named in the preset's `[groom]` table ([`GroomParams`], `source`): images through
 //! the mesh's UVs, glTF vertex colour sets, or a per-vertex groom file (`file`, its format in
-//! `file.rs`). [`crate::fur::FurStructure::new_groomed`] grows the structure a groom describes.
+//! `file.rs`), or a strand groom of USD curves baked per vertex (`strands.rs`, [`bake_strands`]).
+//! [`crate::fur::FurStructure::new_groomed`] grows the structure a groom describes.
 //! [`GroomEditor`] paints a groom with [`Brush`]es (`brush.rs`, `edit.rs`).
 
 mod brush;
@@ -19,7 +20,10 @@ mod edit;
 mod file;
 mod frame;
 mod source;
+mod sparse;
+mod strands;
 mod strokes;
+mod surface_grid;
 
 use std::path::PathBuf;
 
@@ -32,6 +36,7 @@ pub use edit::{DAB_SPACING, GroomEditor, UNDO_DEPTH, rest_point};
 pub use file::{FILE_MAGIC, FILE_VERSION};
 pub use frame::{TangentFrame, tangent_frames};
 pub use source::GroomParams;
+pub use strands::{StrandBakeParams, StrandBakeReport, bake_strands};
 pub use strokes::StrokeList;
 
 /// The largest length factor a groom may hold (images reach 1; groom files may go beyond).
@@ -184,6 +189,17 @@ pub enum GroomError {
         expected: usize,
         /// Values in the map.
         got: usize,
+    },
+    /// A strand groom's file could not be read as USD (the message names it).
+    #[error("groom.strands: {0}")]
+    Usd(String),
+    /// A strand groom (USD curves) that cannot be baked.
+    #[error("{}: {problem}", file.display())]
+    Strands {
+        /// The curve file.
+        file: PathBuf,
+        /// What is wrong.
+        problem: String,
     },
     /// A value that is not finite or out of its range.
     #[error("{origin}: groom.{key}: vertex {vertex}: {problem}")]

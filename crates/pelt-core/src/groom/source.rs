@@ -18,6 +18,7 @@ const MAX_IMAGE_SIDE: u32 = 16_384;
 /// ```toml
 /// [groom]
 /// file = "fox.groom"          # per-vertex maps written by the viewer
+/// # strands = "groom.usda"    # or USD hair curves, baked per vertex (not with `file`)
 /// length = "fox_length.png"   # 0 = bald, 1 = the preset's length (grey, or the red channel)
 /// direction = "fox_flow.png"  # red = right, green = up in the image; 0.5 = no flow
 /// density = "COLOR_0"         # the red channel of the vertex colours
@@ -34,6 +35,10 @@ pub struct GroomParams {
     /// A per-vertex groom file.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub file: Option<PathBuf>,
+    /// A strand groom: USD curves (`.usda`) baked per vertex when the preset grows its fur
+    /// ([`crate::Preset::groom`]); a map key also given replaces the baked map.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub strands: Option<PathBuf>,
     /// Length factor map.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub length: Option<PathBuf>,
@@ -64,7 +69,7 @@ impl GroomParams {
     /// Whether the table names nothing (the uniform fur).
     #[must_use]
     pub fn is_empty(&self) -> bool {
-        self.file.is_none() && GroomMap::ALL.iter().all(|&map| self.map(map).is_none())
+        self.file.is_none() && self.strands.is_none() && GroomMap::ALL.iter().all(|&map| self.map(map).is_none())
     }
 
     /// The source the table names for `map`.
@@ -85,6 +90,9 @@ impl GroomParams {
     pub fn files(&self) -> Vec<(String, &Path)> {
         let mut files: Vec<(String, &Path)> =
             self.file.as_deref().map(|f| ("groom.file".to_owned(), f)).into_iter().collect();
+        if let Some(strands) = &self.strands {
+            files.push(("groom.strands".to_owned(), strands));
+        }
         for map in GroomMap::ALL {
             if let Some(Source::Image(path)) = self.map(map).map(source) {
                 files.push((format!("groom.{}", map.key()), path));
@@ -123,6 +131,14 @@ impl GroomParams {
     ) -> Result<Option<Groom>, GroomError> {
         if self.is_empty() {
             return Ok(None);
+        }
+        if let Some(strands) = &self.strands {
+            return Err(GroomError::Strands {
+                file: resolve(strands),
+                problem: "groom.strands: a strand groom is baked with the preset's fur (Preset::groom), \
+                          or into a .groom file by `pelt groom bake`, which groom.file then names"
+                    .to_owned(),
+            });
         }
         let mut groom = match &self.file {
             Some(file) => {

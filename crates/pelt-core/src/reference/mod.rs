@@ -27,6 +27,7 @@ use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 
 use crate::fur::FurStructure;
+use crate::mesh::Mesh;
 use crate::texture::{Strand, StrandField};
 
 pub use clumps::{CLUMP_PARTING, WetClumps, gather_amount, gathered, nearest_centre};
@@ -38,6 +39,49 @@ pub struct TileMapping {
     pub tiles_per_uv: f32,
     /// Meshes without uvs: tiles per model unit (triplanar projection).
     pub tiles_per_world: f32,
+}
+
+/// Shell texture tiles across a mesh's bounding radius in Pelt's standard look
+/// (`pelt_render::FurLook::default()`'s `tiles_per_radius`).
+pub const STANDARD_TILES_PER_RADIUS: f32 = 0.4;
+
+impl TileMapping {
+    /// The mapping the standard look lays on `mesh` (what `pelt_render::tile_mapping` gives for
+    /// the default look): `STANDARD_TILES_PER_RADIUS` tiles per bounding radius, and on a mesh
+    /// with uvs as many tiles per uv unit as keep the same tiles per area.
+    #[must_use]
+    pub fn standard(mesh: &Mesh) -> Self {
+        let tiles_per_world = STANDARD_TILES_PER_RADIUS / mesh.bounding_sphere().1.max(1e-6);
+        let world_per_uv = match &mesh.corner_uvs {
+            Some(uvs) => {
+                let uv_area: f32 = uvs.iter().map(|[a, b, c]| (*b - *a).perp_dot(*c - *a).abs() * 0.5).sum();
+                if uv_area > 1e-12 { (mesh.surface_area() / uv_area).sqrt() } else { 1.0 }
+            }
+            None => 1.0,
+        };
+        Self { tiles_per_uv: tiles_per_world * world_per_uv, tiles_per_world }
+    }
+
+    /// Strands a field of `strands_per_tile` places on each triangle of `mesh` through this
+    /// mapping (its uv area in tiles, or its triplanar projection's area in tiles, times the
+    /// strands a tile holds).
+    #[must_use]
+    pub fn expected_strands(&self, mesh: &Mesh, strands_per_tile: usize) -> Vec<f32> {
+        let n = strands_per_tile as f32;
+        (0..mesh.triangles.len())
+            .map(|t| match &mesh.corner_uvs {
+                Some(uvs) => {
+                    let [a, b, c] = uvs[t];
+                    (b - a).perp_dot(c - a).abs() * 0.5 * self.tiles_per_uv * self.tiles_per_uv * n
+                }
+                None => {
+                    let [a, b, c] = mesh.triangles[t].map(|j| mesh.positions[j as usize]);
+                    let cross = (b - a).cross(c - a);
+                    cross.abs().max_element() * 0.5 * self.tiles_per_world * self.tiles_per_world * n
+                }
+            })
+            .collect()
+    }
 }
 
 /// One strand placed on a triangle.

@@ -66,6 +66,13 @@ impl Strand {
         self.length
     }
 
+    /// The strand's seeded value for a groom's density, `0..1`: it is kept where this lies below
+    /// the density (as the shader keeps it).
+    #[must_use]
+    pub fn keep_value(&self) -> f32 {
+        (f32::from(self.keep) + 0.5) / 256.0
+    }
+
     /// Radius of the cross-section at height `t` (texels), tapering toward the strand's end by
     /// `taper` ([`TextureParams::taper`]); the texture's soft edge and root blur are left out.
     #[must_use]
