@@ -116,8 +116,8 @@ impl Bvh {
             (p.clamp(node.lo, node.hi).distance(p) - slack).max(0.0)
         };
         let mut queue = BinaryHeap::new();
-        queue.push(Reverse(Queued(distance(&self.nodes[0]), 0)));
-        while let Some(Reverse(Queued(d, n))) = queue.pop() {
+        queue.push(Reverse(ByDistance(distance(&self.nodes[0]), 0)));
+        while let Some(Reverse(ByDistance(d, n))) = queue.pop() {
             if enough(d) {
                 return;
             }
@@ -131,7 +131,7 @@ impl Bvh {
                 }
             } else {
                 for child in [node.first, node.first + 1] {
-                    queue.push(Reverse(Queued(distance(&self.nodes[child as usize]), child)));
+                    queue.push(Reverse(ByDistance(distance(&self.nodes[child as usize]), child)));
                 }
             }
         }
@@ -142,19 +142,20 @@ impl Bvh {
     }
 }
 
-/// A node waiting in [`Bvh::visit_nearest`]'s queue: its box's distance, then its index.
+/// A distance and a key, ordered by the distance and then the key (a total order: heaps of
+/// nearest things, here and in `skin`, pop the same element whatever the order of pushes).
 #[derive(Clone, Copy, PartialEq)]
-struct Queued(f32, u32);
+pub(super) struct ByDistance<K>(pub f32, pub K);
 
-impl Eq for Queued {}
+impl<K: Ord> Eq for ByDistance<K> {}
 
-impl PartialOrd for Queued {
+impl<K: Ord> PartialOrd for ByDistance<K> {
     fn partial_cmp(&self, other: &Self) -> Option<std::cmp::Ordering> {
         Some(self.cmp(other))
     }
 }
 
-impl Ord for Queued {
+impl<K: Ord> Ord for ByDistance<K> {
     fn cmp(&self, other: &Self) -> std::cmp::Ordering {
         self.0.total_cmp(&other.0).then(self.1.cmp(&other.1))
     }

@@ -18,7 +18,7 @@ use std::collections::BinaryHeap;
 use glam::{Vec3, Vec4};
 use rayon::prelude::*;
 
-use super::bvh::{Bvh, box_may_reach};
+use super::bvh::{Bvh, ByDistance, box_may_reach};
 use crate::fur::FurStructure;
 
 /// Half-spaces per strand.
@@ -80,24 +80,6 @@ impl Faces {
 
 /// A rising face within reach: its order key, distance to the root and corners.
 type Rising = (([i32; 3], u32), f32, [Vec3; 3]);
-
-/// A found face by its distance, then its order key: the farthest on top of a heap.
-#[derive(Clone, Copy, PartialEq)]
-struct Nearest(f32, ([i32; 3], u32));
-
-impl Eq for Nearest {}
-
-impl PartialOrd for Nearest {
-    fn partial_cmp(&self, other: &Self) -> Option<std::cmp::Ordering> {
-        Some(self.cmp(other))
-    }
-}
-
-impl Ord for Nearest {
-    fn cmp(&self, other: &Self) -> std::cmp::Ordering {
-        self.0.total_cmp(&other.0).then(self.1.cmp(&other.1))
-    }
-}
 
 /// Most rising faces one strand's cover is counted over, and most candidate planes it chooses
 /// from, where it has more than [`EXACT_RISING`] rising faces or the whole cover would cost
@@ -165,7 +147,7 @@ fn strand_planes(
         |t| {
             if let Some(face) = rising_face(t) {
                 let mut nearest = nearest.borrow_mut();
-                nearest.push(Nearest(face.1, face.0));
+                nearest.push(ByDistance(face.1, face.0));
                 if nearest.len() > COVER_FACES {
                     nearest.pop();
                 }
