@@ -116,16 +116,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     if args.layers == Some(0) {
         bail!("--layers must be at least 1, got 0");
     }
-    if let Some(time) = args.time
-        && !(time.is_finite() && time >= 0.0)
-    {
-        bail!("--time must be a number of seconds, 0 or more, got {time}");
-    }
-    if let Some(motion) = args.motion
-        && !(motion.is_finite() && motion > 0.0 && motion <= 60.0)
-    {
-        bail!("--motion must be a number of seconds above 0 and at most 60, got {motion}");
-    }
+    check_time_and_motion(args)?;
     if args.screen_size == Some(0) {
         bail!("--screen-size must be at least 1 pixel, got 0");
     }
@@ -522,4 +513,19 @@ impl Progress {
     pub(crate) fn done(&self) {
         self.0.finish_and_clear();
     }
+}
+
+/// `--time` and `--motion`, checked alike for every kind of export.
+pub fn check_time_and_motion(args: &Args) -> anyhow::Result<()> {
+    if let Some(time) = args.time
+        && !(time.is_finite() && time >= 0.0)
+    {
+        bail!("--time must be a number of seconds, 0 or more, got {time}");
+    }
+    if let Some(motion) = args.motion
+        && !(motion.is_finite() && motion > 0.0 && motion <= 60.0)
+    {
+        bail!("--motion must be a number of seconds above 0 and at most 60, got {motion}");
+    }
+    Ok(())
 }

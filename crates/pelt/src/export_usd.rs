@@ -54,16 +54,7 @@ pub fn run(args: &Args, started: Instant) -> anyhow::Result<()> {
     if !(meters_per_unit.is_finite() && meters_per_unit > 0.0) {
         bail!("--meters-per-unit must be a positive number, got {meters_per_unit}");
     }
-    if let Some(time) = args.time
-        && !(time.is_finite() && time >= 0.0)
-    {
-        bail!("--time must be a number of seconds, 0 or more, got {time}");
-    }
-    if let Some(motion) = args.motion
-        && !(motion.is_finite() && motion > 0.0 && motion <= 60.0)
-    {
-        bail!("--motion must be a number of seconds above 0 and at most 60, got {motion}");
-    }
+    crate::export::check_time_and_motion(args)?;
     let preset = match &args.preset {
         Some(path) => Preset::load(path)?,
         None => Preset::default(),
@@ -78,20 +69,8 @@ pub fn run(args: &Args, started: Instant) -> anyhow::Result<()> {
     let progress = Progress::new(settle_frames(args.time) + motion_steps);
     let mut stepper = settle_wet(&fur, &preset, rig.as_ref(), clip, args.time, args.wetness, &progress)?;
     let clip_secs = if clip.is_some() { args.time.unwrap_or(0.0) } else { 0.0 };
-    let mapping = tile_mapping(&fur.mesh, &FurLook::default());
-    // A wet coat's strands gather into the clumps the shells draw (as `pelt fidelity`'s).
-    let reference = if stepper.wetness().is_dry() {
-        StrandReference::new(&fur, field, mapping)?
-    } else {
-        let wet = stepper.wet();
-        let clumps = WetClumps {
-            wetness: stepper.wetness().values().to_vec(),
-            clump_size: wet.clump_size,
-            clump_strength: wet.clump_strength,
-            groom_clump: fur.groom.as_ref().and_then(|g| g.clump.clone()),
-        };
-        StrandReference::wet(&fur, field, mapping, &clumps)?
-    };
+    // The strands `pelt fidelity` compares with (a wet coat's gathered into its clumps).
+    let reference = crate::fidelity::strand_reference(&fur, field, &stepper)?;
     let frame = |stepper: &FurStepper, time_code: Option<f64>| StrandFrame {
         time_code,
         positions: stepper.simulation().positions().to_vec(),

@@ -166,20 +166,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let shell_side = Side::new(&shells, &fur, &textures, &mut stepper, &plain)?;
     let strand_side = Side::new(&strands, &fur, &textures, &mut stepper, &plain)?;
     let positions = stepper.simulation().positions();
-    let mapping = tile_mapping(&fur.mesh, &FurLook::default());
-    // The strands of a wet coat gather into the clumps the shells draw.
-    let reference = if stepper.wetness().is_dry() {
-        StrandReference::new(&fur, field, mapping)?
-    } else {
-        let wet = stepper.wet();
-        let clumps = WetClumps {
-            wetness: stepper.wetness().values().to_vec(),
-            clump_size: wet.clump_size,
-            clump_strength: wet.clump_strength,
-            groom_clump: fur.groom.as_ref().and_then(|g| g.clump.clone()),
-        };
-        StrandReference::wet(&fur, field, mapping, &clumps)?
-    };
+    let reference = strand_reference(&fur, field, &stepper)?;
     let strand_renderer = StrandRenderer::new(&strands.gpu.device, &strand_side.renderer)?;
     let normals = stepper.moved_pose().map_or(&fur.mesh.normals, |pose| &pose.normals);
     let ribbons = StrandRibbons::new(&strands.gpu.device, &reference, positions, normals, &fur.mesh.triangles)?;
@@ -370,4 +357,26 @@ impl Side {
             },
         )?)
     }
+}
+
+/// Every strand `fur`'s shells stand for, placed on the mesh as `stepper` leaves the coat: a wet
+/// coat's strands gather into the clumps the shells draw. `pelt fidelity` compares with them and
+/// `pelt export -o *.usda` writes them.
+pub fn strand_reference(
+    fur: &FurStructure,
+    field: texture::StrandField,
+    stepper: &FurStepper,
+) -> anyhow::Result<StrandReference> {
+    let mapping = tile_mapping(&fur.mesh, &FurLook::default());
+    if stepper.wetness().is_dry() {
+        return Ok(StrandReference::new(fur, field, mapping)?);
+    }
+    let wet = stepper.wet();
+    let clumps = WetClumps {
+        wetness: stepper.wetness().values().to_vec(),
+        clump_size: wet.clump_size,
+        clump_strength: wet.clump_strength,
+        groom_clump: fur.groom.as_ref().and_then(|g| g.clump.clone()),
+    };
+    Ok(StrandReference::wet(fur, field, mapping, &clumps)?)
 }
