@@ -8,10 +8,8 @@ use std::time::Instant;
 use anyhow::bail;
 use glam::Vec3;
 use pelt_core::export::{StrandBasis, StrandExportCounts, StrandExportInput, StrandFrame, write_strands_usda};
-use pelt_core::reference::{StrandReference, WetClumps};
 use pelt_core::sim::{FurStepper, WindParams};
 use pelt_core::{Builtin, Preset, Stage};
-use pelt_render::{FurLook, tile_mapping};
 
 use crate::export::{Args, DRIVE_FPS, Progress, SETTLE_SECS, choose_clip, settle_frames, settle_wet};
 use crate::render::LIGHT_WIND;
