@@ -1,7 +1,8 @@
 """Checks a `pelt export ... -o FILE.usda` with Pixar's USD library (PyPI usd-core): the stage
-opens with its metadata, the curves and mesh prims are valid, their counts and extents are what
-Pelt printed (its `usd:` line), and USD's checker reports no error: UsdUtils.ComplianceChecker
-where the library has it, else every validator of UsdValidation (which replaced it in USD 26).
+opens with its metadata, the curves and mesh prims are valid (Pelt's texture offsets one vector
+per point), their counts and extents are what Pelt printed (its `usd:` line), and USD's checker
+reports no error: UsdUtils.ComplianceChecker where the library has it, else every validator of
+UsdValidation (which replaced it in USD 26).
 Usage: python check.py FILE.usda "usd: curves N points N ..." (the line `pelt export` printed)."""
 
 import sys
@@ -70,6 +71,22 @@ def main(path, line):
     colours = UsdGeom.PrimvarsAPI(curves.GetPrim()).GetPrimvar("displayColor")
     if colours.GetInterpolation() != UsdGeom.Tokens.uniform or len(colours.Get(time)) != len(counts):
         fail(path, "displayColor is not one colour per curve")
+
+    # Pelt's texture offsets: one vector per point, sampled with the points.
+    offsets = UsdGeom.PrimvarsAPI(curves.GetPrim()).GetPrimvar("pelt:textureOffset")
+    if not offsets or offsets.GetInterpolation() != UsdGeom.Tokens.vertex:
+        fail(path, "primvars:pelt:textureOffset is not a per-vertex primvar")
+    offset_values = offsets.Get(time)
+    if offsets.GetTypeName() != "vector3f[]" or len(offset_values) != len(points):
+        fail(path, f"primvars:pelt:textureOffset has {len(offset_values)} values for {len(points)} points")
+    if len(offsets.GetAttr().GetTimeSamples()) != len(samples):
+        fail(path, "primvars:pelt:textureOffset is not sampled with the points")
+    # A curve's root stands on its column: no offset.
+    first = 0
+    for count in counts:
+        if any(abs(c) > 0 for c in offset_values[first]):
+            fail(path, f"the texture offset at the root point {first} is not zero")
+        first += count
 
     face_counts = mesh.GetFaceVertexCountsAttr().Get(time)
     indices = mesh.GetFaceVertexIndicesAttr().Get(time)

@@ -15,6 +15,12 @@
 //!   seeded share of the rest.
 //! - `primvars:pelt:lengthFactor` per strand: its seeded length over its column's (strands end
 //!   at seeded heights), so a bake of the file finds the columns' lengths exactly.
+//! - `primvars:pelt:textureOffset` per point (`vector3f`, vertex interpolation, model units in
+//!   the curves' space): what the shell texture adds to the strand there, its offset from the
+//!   strand's straight column at that height (the texture's lean, clumps and curl, a wet coat's
+//!   gathering). The groom shapes the column alone, so a bake subtracts the offsets and measures
+//!   the groom without counting the texture's lean twice when the same preset grows it again;
+//!   a tool that moves the points but keeps the primvar (Houdini) still has its edit baked.
 //! - Several frames become time samples on the points and extents (the mesh's too).
 //!
 //! The file is written through a temporary file and a rename: a failed write leaves nothing.
@@ -262,28 +268,45 @@ fn write_layer<W: Write>(out: W, input: &StrandExportInput<'_>, kept: &[usize]) 
         Some("uniform"),
         |w, x| w.write_all(format_f32(x).as_bytes()),
     )?;
-    let points = |frame: &StrandFrame| -> std::io::Result<Vec<Vec3>> {
-        let nodes = reference
-            .node_positions(&frame.positions)
+    // Each frame's points and their texture offsets (see the module docs), curve after curve.
+    let points = |frame: &StrandFrame| -> std::io::Result<(Vec<Vec3>, Vec<Vec3>)> {
+        let (nodes, offsets) = reference
+            .node_positions_and_offsets(&frame.positions)
             .map_err(|e| std::io::Error::new(std::io::ErrorKind::InvalidInput, e.to_string()))?;
-        Ok(strands
-            .iter()
-            .flat_map(|placed| {
-                let first = placed.first_node as usize;
-                nodes[first..first + placed.node_count as usize].iter().copied()
-            })
-            .collect())
+        let gather = |all: &[Vec3]| -> Vec<Vec3> {
+            strands
+                .iter()
+                .flat_map(|placed| {
+                    let first = placed.first_node as usize;
+                    all[first..first + placed.node_count as usize].iter().copied()
+                })
+                .collect()
+        };
+        Ok((gather(&nodes), gather(&offsets)))
     };
-    let first = points(&input.frames[0])?;
+    let (first, first_offsets) = points(&input.frames[0])?;
     let point_count = first.len();
     let curves_extent = bounds(first.iter().copied(), widest * 0.5);
     if timed {
+        // The offsets follow the pose (the columns bend with it): one sample per frame, computed
+        // again rather than held for every frame.
+        usd.declare("vector3f[]", "primvars:pelt:textureOffset", Some("vertex"))?;
+        usd.time_sampled_array(
+            "vector3f[]",
+            "primvars:pelt:textureOffset",
+            input.frames.iter().enumerate().map(|(k, f)| {
+                let offsets = if k == 0 { first_offsets.clone() } else { points(f)?.1 };
+                Ok((f.time_code.unwrap_or(0.0), offsets))
+            }),
+            vec3,
+        )?;
+        drop(first_offsets);
         let mut extents = Vec::with_capacity(input.frames.len());
         usd.time_sampled_array(
             "point3f[]",
             "points",
             input.frames.iter().enumerate().map(|(k, f)| {
-                let frame_points = if k == 0 { first.clone() } else { points(f)? };
+                let frame_points = if k == 0 { first.clone() } else { points(f)?.0 };
                 extents.push((f.time_code.unwrap_or(0.0), bounds(frame_points.iter().copied(), widest * 0.5)));
                 Ok((f.time_code.unwrap_or(0.0), frame_points))
             }),
@@ -291,6 +314,7 @@ fn write_layer<W: Write>(out: W, input: &StrandExportInput<'_>, kept: &[usize]) 
         )?;
         usd.time_sampled_array("float3[]", "extent", extents.into_iter().map(|(t, e)| Ok((t, e))), vec3)?;
     } else {
+        usd.array("vector3f[]", "primvars:pelt:textureOffset", first_offsets, Some("vertex"), vec3)?;
         usd.array("point3f[]", "points", first.iter().copied(), None, vec3)?;
         usd.array("float3[]", "extent", curves_extent, None, vec3)?;
     }

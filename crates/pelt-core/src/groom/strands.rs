@@ -9,6 +9,11 @@
 //! decide it): a vertex whose own curves are short stays short even beside long ones, and bald
 //! stays bald.
 //!
+//! Curves Pelt exported carry `primvars:pelt:textureOffset`, what the shell texture added to
+//! each point (its lean, clumps and curl): the bake takes it off first, so it measures the groom
+//! alone and the preset's texture, growing the coat again, does not add its lean twice. Curves
+//! without it (Blender, other tools) are measured as they are.
+//!
 //! - **length**: the curves' arc lengths over their strand length factor (Pelt's own
 //!   `primvars:pelt:lengthFactor`, else the field's mean: a coat's strands end at seeded heights
 //!   below its tip), over the preset's length; a vertex shorter than one layer's height of the
@@ -180,10 +185,21 @@ pub fn bake_strands(
     let mean_factor = params.mean_length_factor.max(1e-3);
     let mut distance_sum = 0.0f64;
     let mut nearest_off = f32::INFINITY;
+    let mut straightened = 0usize;
     for set in &curves.curves {
-        let offsets = set.offsets();
+        let starts = set.offsets();
         for k in 0..set.counts.len() {
-            let points: Vec<Vec3> = set.curve(&offsets, k).iter().map(|&p| to_mesh(p)).collect();
+            let curve = set.curve(&starts, k);
+            // Pelt's own curves say what the shell texture added to each point: the groom is
+            // measured on what is left (the preset's texture adds its lean again when it grows).
+            let points: Vec<Vec3> = match &set.texture_offsets {
+                Some(texture) => {
+                    straightened += 1;
+                    let texture = &texture[starts[k]..starts[k] + curve.len()];
+                    curve.iter().zip(texture).map(|(&p, &o)| to_mesh(p - o)).collect()
+                }
+                None => curve.iter().map(|&p| to_mesh(p)).collect(),
+            };
             let line = set.polyline(&points, SAMPLES_PER_SEGMENT);
             let length: f32 = line.windows(2).map(|w| w[0].distance(w[1])).sum();
             let first = line.windows(2).map(|w| w[1] - w[0]).find(|d| d.length() > length * 1e-4);
@@ -220,6 +236,11 @@ pub fn bake_strands(
              (after the stage's {axis} and {} m per unit; the mesh is Y up at {} m per unit)",
             params.tolerance, curves.meters_per_unit, params.mesh_meters_per_unit
         )));
+    }
+    if straightened > 0 {
+        report
+            .notes
+            .push(format!("the shell texture's offsets (primvars:pelt:textureOffset) taken off {straightened} curves"));
     }
     report.root_distance_mean = (distance_sum / report.on_surface as f64) as f32;
     let groom = sums.solve(mesh, params, &mut report);

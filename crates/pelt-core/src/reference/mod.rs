@@ -316,28 +316,56 @@ impl StrandReference {
     /// # Errors
     /// [`ReferenceError::Positions`] for an array of another size.
     pub fn node_positions(&self, positions: &[Vec3]) -> Result<Vec<Vec3>, ReferenceError> {
+        Ok(self.evaluate(positions, false)?.0)
+    }
+
+    /// Every node's model-space position, as [`Self::node_positions`], and what the shell
+    /// texture adds to it: its offset from the strand's straight column at its height (the
+    /// blend of the triangle's columns at the root's weights), the texture's lean, clumps and
+    /// curl (and a wet coat's gathering). A position less its offset lies on the column, which
+    /// the groom alone shapes.
+    ///
+    /// # Errors
+    /// [`ReferenceError::Positions`] for an array of another size.
+    pub fn node_positions_and_offsets(&self, positions: &[Vec3]) -> Result<(Vec<Vec3>, Vec<Vec3>), ReferenceError> {
+        self.evaluate(positions, true)
+    }
+
+    /// Node positions, and their texture offsets when `offsets` (else an empty second list).
+    fn evaluate(&self, positions: &[Vec3], offsets: bool) -> Result<(Vec<Vec3>, Vec<Vec3>), ReferenceError> {
         let expected = (self.layers as usize + 1) * self.vertex_count;
         if positions.len() != expected {
             return Err(ReferenceError::Positions { expected, got: positions.len() });
         }
         let columns = Columns { positions, vertex_count: self.vertex_count, layers: self.layers };
         let mut out = vec![Vec3::ZERO; self.nodes.len()];
-        let chunks: Vec<(&PlacedStrand, &mut [Vec3])> = {
+        let mut out_offsets = vec![Vec3::ZERO; if offsets { self.nodes.len() } else { 0 }];
+        type Chunk<'a> = (&'a PlacedStrand, &'a mut [Vec3], Option<&'a mut [Vec3]>);
+        let chunks: Vec<Chunk<'_>> = {
             let mut rest = out.as_mut_slice();
+            let mut rest_offsets = out_offsets.as_mut_slice();
             let mut chunks = Vec::with_capacity(self.strands.len());
             for strand in &self.strands {
-                let (head, tail) = rest.split_at_mut(strand.node_count as usize);
-                chunks.push((strand, head));
+                let n = strand.node_count as usize;
+                let (head, tail) = rest.split_at_mut(n);
                 rest = tail;
+                let offsets_head = if offsets {
+                    let (head, tail) = std::mem::take(&mut rest_offsets).split_at_mut(n);
+                    rest_offsets = tail;
+                    Some(head)
+                } else {
+                    None
+                };
+                chunks.push((strand, head, offsets_head));
             }
             chunks
         };
-        chunks.into_par_iter().for_each(|(strand, out)| {
+        chunks.into_par_iter().for_each(|(strand, out, mut offsets)| {
             let triangle = self.triangles[strand.triangle as usize];
             let nodes = self.strand_nodes(strand);
             // The root node has no lean: its weights are the root's.
             let root_weights = nodes[0].barycentric;
-            for (node, position) in nodes.iter().zip(out.iter_mut()) {
+            for (k, (node, position)) in nodes.iter().zip(out.iter_mut()).enumerate() {
                 let at = |b: Vec3| {
                     columns.at(triangle[0], node.height) * b.x
                         + columns.at(triangle[1], node.height) * b.y
@@ -346,11 +374,14 @@ impl StrandReference {
                 let column = at(root_weights);
                 let sideways = at(node.barycentric) - column;
                 let length = sideways.length();
-                *position =
-                    if length > node.reach { column + sideways * (node.reach / length) } else { column + sideways };
+                let offset = if length > node.reach { sideways * (node.reach / length) } else { sideways };
+                *position = column + offset;
+                if let Some(offsets) = offsets.as_deref_mut() {
+                    offsets[k] = offset;
+                }
             }
         });
-        Ok(out)
+        Ok((out, out_offsets))
     }
 }
 

@@ -55,6 +55,10 @@ pub struct Curves {
     /// Each curve's length over its column's (`primvars:pelt:lengthFactor`, uniform), as Pelt
     /// writes it: a coat's strands end at seeded heights, and this says where.
     pub length_factors: Option<Vec<f32>>,
+    /// What Pelt's shell texture added to each point (`primvars:pelt:textureOffset`, vertex),
+    /// in the stage's space like the points: a point less its offset lies on the strand's
+    /// column, which the groom alone shapes.
+    pub texture_offsets: Option<Vec<Vec3>>,
 }
 
 impl Curves {

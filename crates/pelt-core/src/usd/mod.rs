@@ -11,7 +11,8 @@
 //! - [`read_curves`] (`read`, over the tokens of `lex`) reads a layer from a `BufRead` in one pass and keeps only what a
 //!   strand groom needs: the stage's `upAxis` and `metersPerUnit`, every `BasisCurves` prim's
 //!   counts, points (the default value, else the earliest time sample), basis, type, wrap and
-//!   `primvars:displayColor`, each placed by its prims' `xformOp`s (`xform`); `curves` evaluates
+//!   `primvars:displayColor` (and Pelt's own `primvars:pelt:lengthFactor` and
+//!   `primvars:pelt:textureOffset`), each placed by its prims' `xformOp`s (`xform`); `curves` evaluates
 //!   each basis. Other values are parsed and
 //!   dropped; a curve set's points are held once, as `f32`.
 //!

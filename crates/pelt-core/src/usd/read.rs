@@ -133,6 +133,7 @@ struct RawCurves {
     wrap: Option<String>,
     colour: Option<(Vec<Vec3>, String)>,
     length_factors: Option<Vec<f32>>,
+    texture_offsets: Option<Vec<Vec3>>,
 }
 
 struct Parser<R: BufRead> {
@@ -389,6 +390,7 @@ impl<R: BufRead> Parser<R> {
                     wrap: None,
                     colour: None,
                     length_factors: None,
+                    texture_offsets: None,
                 });
                 Some(self.raw.len() - 1)
             }
@@ -502,6 +504,7 @@ impl<R: BufRead> Parser<R> {
                 "basis" => raw.basis = text(value),
                 "wrap" => raw.wrap = text(value),
                 "primvars:pelt:lengthFactor" => raw.length_factors = floats(value),
+                "primvars:pelt:textureOffset" => raw.texture_offsets = triples(value),
                 "primvars:displayColor" => {
                     raw.colour = triples(value).map(|c| (c, interpolation.unwrap_or_else(|| "constant".to_owned())));
                 }
@@ -609,6 +612,21 @@ impl<R: BufRead> Parser<R> {
                 }
                 other => other,
             };
+            let texture_offsets = match raw.texture_offsets {
+                Some(offsets) if offsets.len() != points.len() => {
+                    return Err(problem(format!(
+                        "primvars:pelt:textureOffset has {} offsets for {} points (one per point)",
+                        offsets.len(),
+                        points.len()
+                    )));
+                }
+                Some(offsets) if offsets.iter().any(|o| !o.is_finite()) => {
+                    return Err(problem("primvars:pelt:textureOffset must be finite (x, y, z) triples".to_owned()));
+                }
+                // Offsets are vectors: the prims' transforms turn and scale them, never move them.
+                Some(offsets) => Some(offsets.into_iter().map(|o| matrix.transform_vector3(o)).collect()),
+                None => None,
+            };
             curves.push(Curves {
                 path,
                 counts: integer_counts,
@@ -618,6 +636,7 @@ impl<R: BufRead> Parser<R> {
                 wrap,
                 colours,
                 length_factors,
+                texture_offsets,
             });
         }
         let mut notes = Vec::new();
