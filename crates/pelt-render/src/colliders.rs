@@ -61,6 +61,13 @@ fn placement(collider: &StepCollider, plane_half_size: f32) -> (MeshShape, Vec3,
     }
 }
 
+/// A ground: the square from -1 to 1 in x and z at y = 0, facing +y (place and scale it with
+/// [`PlainMesh::prepare`]).
+#[must_use]
+pub fn ground_mesh() -> Mesh {
+    shape_mesh(&MeshShape::Plane)
+}
+
 /// A triangle mesh of `shape` (counter-clockwise from outside, unit normals).
 fn shape_mesh(shape: &MeshShape) -> Mesh {
     let raw = match shape {

@@ -38,18 +38,29 @@ pub(crate) struct Coat {
     pub groomed: bool,
     /// Some strand is wet.
     pub wet: bool,
+    /// The view it is drawn through reads the key light's shadow maps (`SHADOWS` in
+    /// `shadows.wgsl`): a coat seen without shadows runs none of their lookups.
+    pub shadowed: bool,
 }
 
 impl Coat {
-    /// Dry and ungroomed: the lean entry points.
-    pub const PLAIN: Self = Self { groomed: false, wet: false };
+    /// Dry and ungroomed, without shadows: the lean entry points.
+    pub const PLAIN: Self = Self { groomed: false, wet: false, shadowed: false };
+    /// Every coat, by [`Coat::index`].
+    pub const COUNT: usize = 8;
+
     pub fn index(self) -> usize {
-        usize::from(self.groomed) | usize::from(self.wet) << 1
+        usize::from(self.groomed) | usize::from(self.wet) << 1 | usize::from(self.shadowed) << 2
     }
 
     /// The entry point of `name`'s kind for this coat: the lean one, or its `_groomed` twin.
     pub fn entry(self, name: &str) -> String {
-        if self == Self::PLAIN { name.to_owned() } else { format!("{name}_groomed") }
+        if self.groomed || self.wet { format!("{name}_groomed") } else { name.to_owned() }
+    }
+
+    /// The same coat, seen with shadows or without.
+    pub fn shadowed(self, shadowed: bool) -> Self {
+        Self { shadowed, ..self }
     }
 }
 
@@ -334,7 +345,7 @@ impl GpuFur {
 
     /// The coat the last `prepare` left the fur drawing with.
     pub(crate) fn coat(&self) -> Coat {
-        Coat { groomed: self.geometry.shape.groom_shading, wet: self.wet.load(Ordering::Relaxed) }
+        Coat { groomed: self.geometry.shape.groom_shading, wet: self.wet.load(Ordering::Relaxed), shadowed: false }
     }
 
     pub(crate) fn textures_bind_group(&self) -> &wgpu::BindGroup {

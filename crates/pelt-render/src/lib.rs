@@ -123,6 +123,7 @@ mod plain;
 mod renderer;
 mod requirements;
 mod shaders;
+mod shadows;
 mod simulation;
 mod studio;
 mod targets;
@@ -130,7 +131,7 @@ mod textures;
 mod view;
 
 pub use camera::Camera;
-pub use colliders::{COLLIDER_COLOUR, ColliderMeshes, HAND_COLOUR};
+pub use colliders::{COLLIDER_COLOUR, ColliderMeshes, HAND_COLOUR, ground_mesh};
 pub use driver::{FurDriver, KernelChoice, SimKernel, cpu_secs_per_step, gpu_secs_per_step, gpu_secs_per_step_of};
 pub use error::RenderError;
 pub use fur::{FurStates, GpuFur};
@@ -149,6 +150,7 @@ pub use requirements::{check_adapter, required_downlevel_flags, required_feature
 #[cfg(feature = "lab")]
 pub use shaders::{separated_shader_source, strands_shader_source};
 pub use shaders::{silhouette_shader_source, simulation_shader_source, unified_shader_source, view_lod_shader_source};
+pub use shadows::{ShadowCaster, ShadowMap, ShadowSettings};
 pub use simulation::GpuSimulation;
 pub use studio::Studio;
 pub use targets::{DEFAULT_BACKGROUND, DEPTH_FORMAT, FurTarget, RenderTargets, SAMPLE_COUNT, default_sample_count};

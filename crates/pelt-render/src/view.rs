@@ -5,6 +5,7 @@
 use glam::{Mat4, Vec3};
 
 use crate::shaders::{Layouts, ViewUniform};
+use crate::shadows::ShadowMap;
 
 /// Where the key light comes from.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -80,6 +81,31 @@ impl ViewData {
 pub struct FurView {
     buffer: wgpu::Buffer,
     bind_group: wgpu::BindGroup,
+    /// Group 3: the shadow maps this view's draws read (or stand-ins).
+    shadow_group: wgpu::BindGroup,
+    /// Kept to drop the shadow maps again.
+    no_shadows: wgpu::BindGroup,
+    role: ViewRole,
+}
+
+/// What draws through a view record.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum ViewRole {
+    /// The host's picture, lit with the shadow maps or without.
+    Camera { shadowed: bool },
+    /// One pass of a shadow map, seen from the light.
+    Shadow(ShadowPass),
+}
+
+/// The passes of a [`ShadowMap`], in order.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum ShadowPass {
+    /// Everything opaque (skin, plain meshes, colliders, ground), depth only.
+    Opaque,
+    /// The fur's first surface (its outermost shell), depth only.
+    FurDepth,
+    /// The shells and fins' opacity, added into the layers beyond the first surface.
+    Opacity,
 }
 
 impl FurView {
@@ -96,7 +122,45 @@ impl FurView {
             layout: &layouts.view,
             entries: &[wgpu::BindGroupEntry { binding: 0, resource: buffer.as_entire_binding() }],
         });
-        Self { buffer, bind_group }
+        let no_shadows = layouts.no_shadows.clone();
+        Self {
+            buffer,
+            bind_group,
+            shadow_group: no_shadows.clone(),
+            no_shadows,
+            role: ViewRole::Camera { shadowed: false },
+        }
+    }
+
+    /// A view of one of a shadow map's passes, reading `shadow_group`.
+    pub(crate) fn shadow_pass(
+        device: &wgpu::Device,
+        layouts: &Layouts,
+        pass: ShadowPass,
+        shadow_group: wgpu::BindGroup,
+    ) -> Self {
+        Self { shadow_group, role: ViewRole::Shadow(pass), ..Self::create(device, layouts) }
+    }
+
+    /// Lights the draws through this view with `shadows` (the key light's shadow map, recorded
+    /// with [`ShadowMap::record`] before this view's pass), or without shadows (`None`).
+    pub fn set_shadows(&mut self, shadows: Option<&ShadowMap>) {
+        self.shadow_group = shadows.map_or_else(|| self.no_shadows.clone(), |map| map.receiver_group().clone());
+        self.role = ViewRole::Camera { shadowed: shadows.is_some() };
+    }
+
+    /// Whether draws through this view read a shadow map.
+    #[must_use]
+    pub fn has_shadows(&self) -> bool {
+        self.role == ViewRole::Camera { shadowed: true }
+    }
+
+    pub(crate) fn role(&self) -> ViewRole {
+        self.role
+    }
+
+    pub(crate) fn shadow_group(&self) -> &wgpu::BindGroup {
+        &self.shadow_group
     }
 
     /// Writes this frame's view (takes effect at the next submission).

@@ -24,6 +24,8 @@ mod host;
 mod lean;
 #[path = "lod.rs"]
 mod lod;
+#[path = "shadows.rs"]
+mod shadows;
 #[path = "simulation.rs"]
 mod simulation;
 #[path = "simulation_inputs.rs"]

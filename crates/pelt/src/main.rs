@@ -9,6 +9,7 @@ mod groom;
 mod lod;
 mod mesh_args;
 mod render;
+mod shadows;
 mod sim_kernel;
 mod stats;
 mod textures;

@@ -17,6 +17,7 @@ use pelt_render::{
 
 use crate::lod;
 use crate::mesh_args::MeshArgs;
+use crate::shadows::Surroundings;
 use crate::sim_kernel::SimChoice;
 
 /// Skin tone of plain meshes (linear RGB).
@@ -91,6 +92,8 @@ pub struct Args {
     /// says what wetness does. A script's `[[rain]]` and `[[water]]` add to it.
     #[arg(long, value_name = "W", value_parser = crate::values::parse_wetness)]
     wetness: Option<f32>,
+    #[command(flatten)]
+    shadows: crate::shadows::ShadowArgs,
     /// Output: a .png (one frame), a .gif (animated) or a folder (numbered PNGs).
     #[arg(short, long, default_value = "pelt.png")]
     output: PathBuf,
@@ -206,8 +209,12 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let scene_camera = stepper.scene().and_then(|s| s.camera.as_ref());
     let camera = camera(args, &preset, &fur, &plain, (motion_keys, scene_camera), frames, headless.aspect_ratio());
     let studio = Studio::default();
-    let view = FurView::new(device, &renderer);
-    view.prepare(queue, &studio.view_data(&camera, headless.aspect_ratio()));
+    let mut view = FurView::new(device, &renderer);
+    let view_data = studio.view_data(&camera, headless.aspect_ratio());
+    view.prepare(queue, &view_data);
+    let scene_ground = stepper.scene().and_then(|s| s.ground.as_ref());
+    let surroundings = Surroundings::new(device, queue, &renderer, &args.shadows, scene_ground, (&fur, &plain))?;
+    surroundings.prepare(queue, &view_data, &mut view);
     // The camera stays put, so one level serves every frame.
     let level = lod::level(&lod::settings(&preset.render.lod, args.no_lod), &fur, camera.eye, camera.fov_y_rad, height);
     driver.set_level(level);
@@ -268,8 +275,19 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         colliders.update(device, queue, &renderer, &shown, Mat4::IDENTITY, plane_half_size)?;
         let image = headless.render_with(
             studio.background,
-            |encoder| driver.record_view(encoder, &renderer, &view),
+            |encoder| {
+                driver.record_view(encoder, &renderer, &view);
+                surroundings.record(encoder, |pass, light| {
+                    surroundings.draw_ground(pass, &renderer, light);
+                    for mesh in &plain_meshes {
+                        renderer.draw_plain(pass, light, mesh);
+                    }
+                    colliders.draw(pass, &renderer, light);
+                    driver.draw(pass, &renderer, light, &FurDrawSettings::ALL);
+                });
+            },
             |pass| {
+                surroundings.draw_ground(pass, &renderer, &view);
                 for mesh in &plain_meshes {
                     renderer.draw_plain(pass, &view, mesh);
                 }

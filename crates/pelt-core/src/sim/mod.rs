@@ -59,7 +59,7 @@ pub use inputs::{InputVersions, StepInputs, StrandInputs};
 pub use kernel::{KernelRest, kernel_rest};
 pub use motion::{Ease, MotionKey};
 pub use pick::{Hit, pick};
-pub use scene::{Scene, SceneCamera, SceneCollider, SceneError, SceneShape, Stroke, WindKey};
+pub use scene::{Scene, SceneCamera, SceneCollider, SceneError, SceneGround, SceneShape, Stroke, WindKey};
 pub use simulation::{SimError, Simulation};
 #[cfg(feature = "lab")]
 pub use soak::{SoakReport, SoakStep, SoakSubject, soak};

@@ -57,6 +57,11 @@
 //! azimuth_deg = 60.0               # around +Y from +Z toward +X
 //! elevation_deg = 35.0
 //! distance = 8.0                   # optional: default the meshes framed
+//!
+//! [ground]                         # optional: a plane under the meshes that takes their shadow
+//! height = -1.0                    # optional: default just under the meshes
+//! size = 6.0                       # optional: side length; default 4 times the meshes' radius
+//! colour = [0.35, 0.33, 0.3]       # optional: linear RGB
 //! ```
 //!
 //! Stroke points are world positions, on or near the base surface, which keeps a script
@@ -394,6 +399,21 @@ pub struct SceneCamera {
     pub distance: Option<f32>,
 }
 
+/// The ground of a scene (`[ground]`): a square plane, level in y, under the meshes.
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SceneGround {
+    /// Its y; default just under the meshes.
+    #[serde(default)]
+    pub height: Option<f32>,
+    /// Its side length; default four times the meshes' bounding radius.
+    #[serde(default)]
+    pub size: Option<f32>,
+    /// Linear RGB, each 0 to 1; default a warm grey.
+    #[serde(default)]
+    pub colour: Option<Vec3>,
+}
+
 /// A parsed, validated scene script.
 #[derive(Clone, Debug, Default, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -425,6 +445,9 @@ pub struct Scene {
     /// The camera; default: the host's own.
     #[serde(default)]
     pub camera: Option<SceneCamera>,
+    /// A ground under the meshes; default none (unless the host draws one).
+    #[serde(default)]
+    pub ground: Option<SceneGround>,
 }
 
 impl Scene {
@@ -544,6 +567,19 @@ impl Scene {
             range("camera.elevation_deg".into(), camera.elevation_deg, -89.0, 89.0)?;
             if let Some(distance) = camera.distance {
                 range("camera.distance".into(), distance, f32::MIN_POSITIVE, f32::MAX)?;
+            }
+        }
+        if let Some(ground) = &self.ground {
+            if ground.height.is_some_and(|h| !h.is_finite()) {
+                return Err(("ground.height".into(), "must be finite".into()));
+            }
+            if let Some(size) = ground.size {
+                range("ground.size".into(), size, f32::MIN_POSITIVE, f32::MAX)?;
+            }
+            if let Some(colour) = ground.colour {
+                for (k, c) in colour.to_array().into_iter().enumerate() {
+                    range(format!("ground.colour[{k}]"), c, 0.0, 1.0)?;
+                }
             }
         }
         Ok(())
@@ -681,6 +717,27 @@ impl Scene {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_ground_is_read_and_checked() {
+        let text = "[ground]\nheight = -1.5\ncolour = [0.2, 0.3, 0.4]\n";
+        let scene = Scene::from_toml_str(text, Path::new("a.toml")).expect("a valid ground");
+        let ground = scene.ground.expect("the ground is kept");
+        assert_eq!((ground.height, ground.size, ground.colour), (Some(-1.5), None, Some(Vec3::new(0.2, 0.3, 0.4))));
+        assert_eq!(
+            Scene::from_toml_str("[ground]\n", Path::new("a.toml")).expect("all optional").ground,
+            Some(SceneGround::default())
+        );
+        for (bad, key) in [
+            ("size = 0.0", "ground.size"),
+            ("colour = [0.2, 1.5, 0.1]", "ground.colour[1]"),
+            ("height = nan", "ground.height"),
+        ] {
+            let error =
+                Scene::from_toml_str(&format!("[ground]\n{bad}\n"), Path::new("g.toml")).expect_err(bad).to_string();
+            assert!(error.contains("g.toml") && error.contains(key), "{error}");
+        }
+    }
 
     #[test]
     fn a_camera_is_read_and_checked() {

@@ -42,6 +42,8 @@ const VERTEX_ATTRIBUTES: [wgpu::VertexAttribute; 6] = wgpu::vertex_attr_array![
 #[derive(Debug)]
 pub struct StrandRenderer {
     pipeline: wgpu::RenderPipeline,
+    /// Group 2 (the strands read no fur textures).
+    empty: wgpu::BindGroup,
 }
 
 impl StrandRenderer {
@@ -105,7 +107,7 @@ impl StrandRenderer {
             cache: None,
         });
         scope.pop("building the strand pipeline")?;
-        Ok(Self { pipeline })
+        Ok(Self { pipeline, empty: layouts.empty_group.clone() })
     }
 
     /// Records `ribbons` as seen from `view`, with `fur`'s object uniform (model transform and
@@ -118,6 +120,8 @@ impl StrandRenderer {
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, view.bind_group(), &[]);
         pass.set_bind_group(1, fur.geometry().bind_group(), &[]);
+        pass.set_bind_group(2, &self.empty, &[]);
+        pass.set_bind_group(3, view.shadow_group(), &[]);
         pass.set_vertex_buffer(0, ribbons.vertices.slice(..));
         pass.set_index_buffer(ribbons.indices.slice(..), wgpu::IndexFormat::Uint32);
         pass.draw_indexed(0..ribbons.index_count, 0, 0..1);

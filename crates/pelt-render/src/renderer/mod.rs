@@ -12,6 +12,7 @@
 
 mod objects;
 mod pipeline;
+mod shadow;
 
 pub(crate) use pipeline::{PassKind, PipelineSource, Transparency, create_pipeline};
 
@@ -24,7 +25,7 @@ use crate::plain::PlainMesh;
 use crate::requirements::{ErrorScope, check_features_and_limits};
 use crate::shaders::{Layouts, unified_shader_source};
 use crate::targets::FurTarget;
-use crate::view::FurView;
+use crate::view::{FurView, ViewRole};
 
 /// Which parts of a fur a draw records; everything here can change every draw.
 ///
@@ -98,9 +99,32 @@ struct CoatBuilder {
     device: wgpu::Device,
     module: wgpu::ShaderModule,
     layout: wgpu::PipelineLayout,
+    /// Plain meshes' (no fur textures).
+    plain_layout: wgpu::PipelineLayout,
 }
 
 impl CoatBuilder {
+    /// The plain and skin pipelines of one walk, seen with shadows or without.
+    fn surface(&self, target: &FurTarget, mesh_uvs: bool, shadowed: bool) -> SurfacePipelines {
+        let skin = format!("vs_skin_{}", if mesh_uvs { "wedges" } else { "indexed" });
+        let build = |label, layout, fragment_entry| {
+            let source = PipelineSource {
+                mesh_uvs: Some(mesh_uvs),
+                coat: Some(Coat::PLAIN.shadowed(shadowed)),
+                layout,
+                module: &self.module,
+                vertex_entry: &skin,
+                fragment_entry,
+                buffers: &[],
+            };
+            create_pipeline(&self.device, target, label, &source, PassKind::Opaque)
+        };
+        SurfacePipelines {
+            plain: build("pelt plain", &self.plain_layout, "fs_plain"),
+            skin: build("pelt skin", &self.layout, "fs_skin"),
+        }
+    }
+
     fn build(&self, target: &FurTarget, coat: Coat) -> CoatPipelines {
         let build = |label: &str, vertex: &str, fragment: &str, kind: PassKind, (buffers, mesh_uvs)| {
             let (vertex_entry, fragment_entry) = (coat.entry(vertex), coat.entry(fragment));
@@ -148,13 +172,15 @@ impl CoatBuilder {
 pub struct FurRenderer {
     target: FurTarget,
     layouts: Layouts,
-    /// Meshes with uvs: indexed by the corners' wedges (base vertex and uv).
-    wedges: SurfacePipelines,
-    /// Meshes without uvs: indexed by the base triangles.
-    indexed: SurfacePipelines,
+    /// The skin and plain meshes, without shadows and with them: meshes with uvs (indexed by
+    /// the corners' wedges), then meshes without (by the base triangles). Those without shadows
+    /// are built with the rest.
+    surfaces: [[OnceLock<SurfacePipelines>; 2]; 2],
     /// Shells and fins per [`Coat`] (by [`Coat::index`]); the plain coat's built with the rest.
-    coats: [OnceLock<CoatPipelines>; 4],
+    coats: [OnceLock<CoatPipelines>; Coat::COUNT],
     coat_builder: CoatBuilder,
+    /// The shadow maps' pipelines, built when one first draws.
+    shadows: shadow::ShadowSet,
     /// The silhouette and view-angle passes.
     listing: ListingPasses,
 }
@@ -179,33 +205,16 @@ impl FurRenderer {
         });
         let fur_layout = layouts.pipeline_layout(device, "pelt unified", &layouts.unified_object, true);
         let plain_layout = layouts.pipeline_layout(device, "pelt plain", &layouts.unified_object, false);
-        let surface = |walk: &str, mesh_uvs: bool| {
-            let skin = format!("vs_skin_{walk}");
-            let build = |label, layout, fragment_entry| {
-                let source = PipelineSource {
-                    mesh_uvs: Some(mesh_uvs),
-                    coat: Some(Coat::PLAIN),
-                    layout,
-                    module: &module,
-                    vertex_entry: &skin,
-                    fragment_entry,
-                    buffers: &[],
-                };
-                create_pipeline(device, &target, label, &source, PassKind::Opaque)
-            };
-            SurfacePipelines {
-                plain: build("pelt plain", &plain_layout, "fs_plain"),
-                skin: build("pelt skin", &fur_layout, "fs_skin"),
-            }
-        };
-        let wedges = surface("wedges", true);
-        let indexed = surface("indexed", false);
-        let coat_builder = CoatBuilder { device: device.clone(), module, layout: fur_layout };
-        let coats = [(); 4].map(|()| OnceLock::new());
+        let coat_builder = CoatBuilder { device: device.clone(), module, layout: fur_layout, plain_layout };
+        let surfaces = [(); 2].map(|()| [(); 2].map(|()| OnceLock::new()));
+        for (walk, mesh_uvs) in [true, false].into_iter().enumerate() {
+            let _ = surfaces[0][walk].set(coat_builder.surface(&target, mesh_uvs, false));
+        }
+        let coats = [(); Coat::COUNT].map(|()| OnceLock::new());
         let _ = coats[Coat::PLAIN.index()].set(coat_builder.build(&target, Coat::PLAIN));
         let listing = ListingPasses::new(device, &layouts);
         scope.pop("building the fur pipelines")?;
-        Ok(Self { target, layouts, wedges, indexed, coats, coat_builder, listing })
+        Ok(Self { target, layouts, surfaces, coats, coat_builder, shadows: shadow::ShadowSet::default(), listing })
     }
 
     /// The target description the pipelines were built for.
@@ -218,22 +227,30 @@ impl FurRenderer {
     /// target). Call [`FurView::prepare`] and [`GpuFur::prepare`] before submitting.
     ///
     /// With blending, draw opaque geometry first and furs after it, farthest first.
+    ///
+    /// Through one of a [`crate::ShadowMap`]'s views (its `record`), the fur draws itself into
+    /// that shadow pass instead: its skin as an opaque caster, its shells and fins as opacity.
     pub fn draw(&self, pass: &mut wgpu::RenderPass<'_>, view: &FurView, fur: &GpuFur, settings: &FurDrawSettings) {
+        let shadowed = match view.role() {
+            ViewRole::Camera { shadowed } => shadowed,
+            ViewRole::Shadow(shadow_pass) => return self.draw_shadow(pass, (view, shadow_pass), fur, settings),
+        };
         let geometry = fur.geometry();
         let walk = usize::from(!geometry.shape.has_uvs);
         let which = Transparency::index(settings.alpha_to_coverage);
         pass.set_bind_group(0, view.bind_group(), &[]);
         pass.set_bind_group(1, geometry.bind_group(), &[]);
         pass.set_bind_group(2, fur.textures_bind_group(), &[]);
+        pass.set_bind_group(3, view.shadow_group(), &[]);
         if settings.skin {
-            pass.set_pipeline(&self.surface(geometry.shape.has_uvs).skin);
+            pass.set_pipeline(&self.surface(geometry.shape.has_uvs, shadowed).skin);
             geometry.draw_skin(pass);
         }
         let layers = geometry.shape.layers;
         if layers == 0 || !(settings.shells || settings.fins) {
             return;
         }
-        let coat = self.coat(fur.coat());
+        let coat = self.coat(fur.coat().shadowed(shadowed));
         if settings.shells {
             let shells = &coat.shells[walk][which];
             match fur.shell_list() {
@@ -285,15 +302,23 @@ impl FurRenderer {
     /// Records a plain mesh as seen from `view` (opaque: draw it before the furs). Call
     /// [`PlainMesh::prepare`] before submitting.
     pub fn draw_plain(&self, pass: &mut wgpu::RenderPass<'_>, view: &FurView, mesh: &PlainMesh) {
+        let shadowed = match view.role() {
+            ViewRole::Camera { shadowed } => shadowed,
+            ViewRole::Shadow(shadow_pass) => return self.draw_plain_shadow(pass, (view, shadow_pass), mesh),
+        };
         let geometry = mesh.geometry();
         pass.set_bind_group(0, view.bind_group(), &[]);
         pass.set_bind_group(1, geometry.bind_group(), &[]);
-        pass.set_pipeline(&self.surface(geometry.shape.has_uvs).plain);
+        pass.set_bind_group(2, &self.layouts.empty_group, &[]);
+        pass.set_bind_group(3, view.shadow_group(), &[]);
+        pass.set_pipeline(&self.surface(geometry.shape.has_uvs, shadowed).plain);
         geometry.draw_skin(pass);
     }
 
-    fn surface(&self, has_uvs: bool) -> &SurfacePipelines {
-        if has_uvs { &self.wedges } else { &self.indexed }
+    fn surface(&self, has_uvs: bool, shadowed: bool) -> &SurfacePipelines {
+        let walk = usize::from(!has_uvs);
+        self.surfaces[usize::from(shadowed)][walk]
+            .get_or_init(|| self.coat_builder.surface(&self.target, has_uvs, shadowed))
     }
 
     /// `coat`'s shell and fin pipelines, built on first use.

@@ -82,6 +82,7 @@ pub(crate) fn create_pipeline(
         ("MESH_UVS", mesh_uvs),
         ("GROOM", switch(source.coat.map(|c| c.groomed))),
         ("WET", switch(source.coat.map(|c| c.wet))),
+        ("SHADOWS", if source.coat.is_some_and(|c| c.shadowed) { 1.0 } else { 0.0 }),
     ];
     let compilation_options = wgpu::PipelineCompilationOptions { constants: &constants, ..Default::default() };
     device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {

@@ -20,6 +20,16 @@ pub(crate) struct Layouts {
     pub shell_list: wgpu::BindGroupLayout,
     pub shell_sampler: wgpu::Sampler,
     pub fin_sampler: wgpu::Sampler,
+    /// Group 3 of every drawing pipeline: the key light's shadow maps (`shadows.wgsl`).
+    pub shadow: wgpu::BindGroupLayout,
+    /// Group 2 of plain meshes: nothing.
+    pub empty: wgpu::BindGroupLayout,
+    pub empty_group: wgpu::BindGroup,
+    /// Group 3 of views without shadow maps: 1x1 stand-ins, read by no pipeline they draw with.
+    pub no_shadows: wgpu::BindGroup,
+    /// The opaque shadow map's filtered comparison and the opacity layers' filtering.
+    pub shadow_compare: wgpu::Sampler,
+    pub shadow_linear: wgpu::Sampler,
 }
 
 impl Layouts {
@@ -78,6 +88,13 @@ impl Layouts {
         };
         let filtering = wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering);
         let fragment = wgpu::ShaderStages::FRAGMENT;
+        // Shells and fins look their shadows up per vertex, the skin and plain meshes per fragment.
+        let render = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT;
+        let depth_texture = wgpu::BindingType::Texture {
+            sample_type: wgpu::TextureSampleType::Depth,
+            view_dimension: wgpu::TextureViewDimension::D2,
+            multisampled: false,
+        };
         let textures = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("pelt fur textures"),
             entries: &[
@@ -90,6 +107,36 @@ impl Layouts {
                 entry(5, fragment, texture(wgpu::TextureViewDimension::D2Array)),
             ],
         });
+        let shadow = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("pelt shadows"),
+            entries: &[
+                entry(0, render, uniform),
+                entry(1, render, depth_texture),
+                entry(2, render, wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Comparison)),
+                entry(3, render, depth_texture),
+                entry(4, render, texture(wgpu::TextureViewDimension::D2)),
+                entry(5, render, filtering),
+            ],
+        });
+        let empty = device
+            .create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some("pelt empty"), entries: &[] });
+        let empty_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("pelt empty"),
+            layout: &empty,
+            entries: &[],
+        });
+        let clamped = |label, compare| {
+            device.create_sampler(&wgpu::SamplerDescriptor {
+                label: Some(label),
+                mag_filter: wgpu::FilterMode::Linear,
+                min_filter: wgpu::FilterMode::Linear,
+                compare,
+                ..wgpu::SamplerDescriptor::default()
+            })
+        };
+        let shadow_compare = clamped("pelt shadow compare", Some(wgpu::CompareFunction::LessEqual));
+        let shadow_linear = clamped("pelt shadow linear", None);
+        let no_shadows = stand_in_shadows(device, &shadow, (&shadow_compare, &shadow_linear));
         let sampler = |label, v_mode| {
             device.create_sampler(&wgpu::SamplerDescriptor {
                 label: Some(label),
@@ -114,10 +161,17 @@ impl Layouts {
             shell_sampler: sampler("pelt shell sampler", wgpu::AddressMode::Repeat),
             // Fin rows run root to tip: clamp so the tips do not bleed into the roots.
             fin_sampler: sampler("pelt fin sampler", wgpu::AddressMode::ClampToEdge),
+            shadow,
+            empty,
+            empty_group,
+            no_shadows,
+            shadow_compare,
+            shadow_linear,
         }
     }
 
-    /// The layout of pipelines that draw with `object` in group 1, with or without textures.
+    /// The layout of pipelines that draw with `object` in group 1, with textures or the empty
+    /// group in group 2, and the shadows in group 3.
     pub fn pipeline_layout(
         &self,
         device: &wgpu::Device,
@@ -125,12 +179,28 @@ impl Layouts {
         object: &wgpu::BindGroupLayout,
         with_textures: bool,
     ) -> wgpu::PipelineLayout {
-        let with = [Some(&self.view), Some(object), Some(&self.textures)];
+        let textures = if with_textures { &self.textures } else { &self.empty };
         device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some(label),
-            bind_group_layouts: if with_textures { &with } else { &with[..2] },
+            bind_group_layouts: &[Some(&self.view), Some(object), Some(textures), Some(&self.shadow)],
             immediate_size: 0,
         })
+    }
+
+    /// Group 3 over a shadow uniform and the three maps.
+    pub fn shadow_group(
+        &self,
+        device: &wgpu::Device,
+        uniform: &wgpu::Buffer,
+        (depth, fur_depth, opacity): (&wgpu::TextureView, &wgpu::TextureView, &wgpu::TextureView),
+    ) -> wgpu::BindGroup {
+        shadow_group(
+            device,
+            &self.shadow,
+            uniform,
+            (depth, fur_depth, opacity),
+            (&self.shadow_compare, &self.shadow_linear),
+        )
     }
 }
 
@@ -150,4 +220,69 @@ fn list_layout(device: &wgpu::Device, label: &str, buffers: u32) -> wgpu::BindGr
         })
         .collect();
     device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(label), entries: &entries })
+}
+
+fn shadow_group(
+    device: &wgpu::Device,
+    layout: &wgpu::BindGroupLayout,
+    uniform: &wgpu::Buffer,
+    (depth, fur_depth, opacity): (&wgpu::TextureView, &wgpu::TextureView, &wgpu::TextureView),
+    (compare, linear): (&wgpu::Sampler, &wgpu::Sampler),
+) -> wgpu::BindGroup {
+    let entry = |binding, resource| wgpu::BindGroupEntry { binding, resource };
+    device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("pelt shadows"),
+        layout,
+        entries: &[
+            entry(0, uniform.as_entire_binding()),
+            entry(1, wgpu::BindingResource::TextureView(depth)),
+            entry(2, wgpu::BindingResource::Sampler(compare)),
+            entry(3, wgpu::BindingResource::TextureView(fur_depth)),
+            entry(4, wgpu::BindingResource::TextureView(opacity)),
+            entry(5, wgpu::BindingResource::Sampler(linear)),
+        ],
+    })
+}
+
+/// A 1x1 texture of `format` for the shadow stand-ins.
+pub(crate) fn shadow_texture(
+    device: &wgpu::Device,
+    format: wgpu::TextureFormat,
+    size: u32,
+    attachment: bool,
+) -> wgpu::TextureView {
+    let usage = if attachment {
+        wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::RENDER_ATTACHMENT
+    } else {
+        wgpu::TextureUsages::TEXTURE_BINDING
+    };
+    device
+        .create_texture(&wgpu::TextureDescriptor {
+            label: Some("pelt shadow map"),
+            size: wgpu::Extent3d { width: size, height: size, depth_or_array_layers: 1 },
+            mip_level_count: 1,
+            sample_count: 1,
+            dimension: wgpu::TextureDimension::D2,
+            format,
+            usage,
+            view_formats: &[],
+        })
+        .create_view(&wgpu::TextureViewDescriptor::default())
+}
+
+/// The shadows' group for views without a shadow map: nothing in it is read.
+fn stand_in_shadows(
+    device: &wgpu::Device,
+    layout: &wgpu::BindGroupLayout,
+    samplers: (&wgpu::Sampler, &wgpu::Sampler),
+) -> wgpu::BindGroup {
+    let uniform = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("pelt no shadows"),
+        size: size_of::<super::ShadowUniform>() as u64,
+        usage: wgpu::BufferUsages::UNIFORM,
+        mapped_at_creation: false,
+    });
+    let depth = shadow_texture(device, wgpu::TextureFormat::Depth32Float, 1, false);
+    let opacity = shadow_texture(device, wgpu::TextureFormat::Rgba16Float, 1, false);
+    shadow_group(device, layout, &uniform, (&depth, &depth, &opacity), samplers)
 }

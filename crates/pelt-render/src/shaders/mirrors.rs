@@ -59,6 +59,22 @@ pub(crate) struct ObjectUniform {
     pub _padding_2: u32,
 }
 
+/// The key light's shadow maps; the layout of `Shadow` in `shadows.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+pub(crate) struct ShadowUniform {
+    pub light_clip_from_world: Mat4,
+    pub texel_world: f32,
+    pub bias_world: f32,
+    pub extinction: f32,
+    pub perspective: f32,
+    pub near: f32,
+    pub far: f32,
+    pub texel: f32,
+    pub _padding: f32,
+    pub layer_ends: Vec4,
+}
+
 pub(crate) const OBJECT_UNIFORM_BYTES: u64 = size_of::<ObjectUniform>() as u64;
 
 /// A Rust struct's fields as `offset_of!` and `size_of` see them, for [`assert_mirrors`].
@@ -196,6 +212,23 @@ mod tests {
 
     use crate::shaders::{silhouette_shader_source, unified_shader_source, view_lod_shader_source};
     use wgpu::util::DrawIndexedIndirectArgs;
+
+    #[test]
+    fn shadow_uniform_mirrors_shadow() {
+        let rust = rust_layout!(ShadowUniform {
+            light_clip_from_world,
+            texel_world,
+            bias_world,
+            extinction,
+            perspective,
+            near,
+            far,
+            texel,
+            _padding,
+            layer_ends
+        });
+        assert_mirrors(&unified_shader_source(), "Shadow", &rust);
+    }
 
     #[test]
     fn view_uniform_mirrors_view() {

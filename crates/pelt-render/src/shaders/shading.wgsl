@@ -2,7 +2,7 @@
 // lighting. `unified.wgsl` and `separated.wgsl` are appended to this file to make one module each.
 //
 // Bind groups: 0 = one view (`FurView`), 1 = one object (a fur or a plain mesh), 2 = the fur's
-// textures (fur pipelines only).
+// textures (fur pipelines; empty for plain meshes), 3 = the key light's shadows (`shadows.wgsl`).
 
 // One view, written by the host every frame (`ViewData`).
 struct View {
@@ -406,7 +406,9 @@ fn hair_terms(tangent: vec3<f32>, normal: vec3<f32>, world_position: vec3<f32>, 
     let t_dot_l = dot(tangent, to_light);
     let t_dot_h = dot(tangent, half_vector);
     let diffuse = sqrt(max(1.0 - t_dot_l * t_dot_l, 0.0));
-    let lit_side = smoothstep(-0.25, 0.6, dot(normal, to_light));
+    // The key light's shadow at the vertex: the fur's transmittance is smooth, and a shell
+    // fragment then pays for no lookup.
+    let lit_side = smoothstep(-0.25, 0.6, dot(normal, to_light)) * light_visibility(0u, world_position, normal);
     return vec4<f32>(diffuse, max(1.0 - t_dot_h * t_dot_h, 0.0), lit_side, occlusion(height));
 }
 
@@ -423,9 +425,10 @@ fn hair_colour(albedo: vec3<f32>, terms: vec4<f32>, height: f32) -> vec3<f32> {
 }
 
 // Lambert with a soft terminator for surfaces without fur (the skin, plain meshes).
-fn surface_lighting(albedo: vec3<f32>, normal: vec3<f32>) -> vec3<f32> {
+fn surface_lighting(albedo: vec3<f32>, normal: vec3<f32>, world_position: vec3<f32>) -> vec3<f32> {
     let wrapped = max(dot(normal, view.light_direction) * 0.7 + 0.3, 0.0);
-    return albedo * (view.ambient + view.light_colour * wrapped);
+    let visibility = light_visibility(0u, world_position, normal);
+    return albedo * (view.ambient + view.light_colour * wrapped * visibility);
 }
 
 // Shell slices are sampled half a mip level sharper than the hardware's choice: trilinear
@@ -579,7 +582,7 @@ fn fur_output(colour: vec3<f32>, alpha: f32) -> vec4<f32> {
 // Plain meshes (no fur, e.g. the body under a furry garment): lit in the object's colour.
 @fragment
 fn fs_plain(in: Varyings) -> @location(0) vec4<f32> {
-    return vec4<f32>(surface_lighting(object.colour.rgb, normalize(in.normal)), 1.0);
+    return vec4<f32>(surface_lighting(object.colour.rgb, normalize(in.normal), in.world_position), 1.0);
 }
 
 // The opaque skin under the fur, in the colour of the roots.
@@ -587,7 +590,7 @@ fn fs_plain(in: Varyings) -> @location(0) vec4<f32> {
 fn fs_skin(in: Varyings) -> @location(0) vec4<f32> {
     let normal = normalize(in.normal);
     let albedo = object.colour.rgb * surface_tint(root_surface_uv(in));
-    let colour = surface_lighting(albedo, normal) * object.root_occlusion;
+    let colour = surface_lighting(albedo, normal, in.world_position) * object.root_occlusion;
     return vec4<f32>(colour, 1.0);
 }
 

@@ -1,0 +1,248 @@
+//! The shadow views' pipelines: the same vertex shaders as the picture's, drawn from the light
+//! into a [`ShadowMap`](crate::ShadowMap)'s depth and opacity maps (`shadows.wgsl`).
+
+use std::sync::OnceLock;
+
+use super::{CoatBuilder, FurRenderer, PipelineSource};
+use crate::fur::{Coat, GpuFur};
+use crate::plain::PlainMesh;
+use crate::renderer::FurDrawSettings;
+use crate::shadows::{DEPTH_FORMAT, OPACITY_FORMAT};
+use crate::view::{FurView, ShadowPass};
+
+/// What a shadow pipeline writes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum ShadowKind {
+    /// Depth only, biased against acne (the opaque map).
+    Opaque,
+    /// Depth only (the fur's first surface).
+    FurDepth,
+    /// Opacity added into the layers, tested against the opaque map; `cull` for shells.
+    Opacity { cull: bool },
+}
+
+/// The depth-only pipelines every fur shares: walk by walk (wedges, then indexed).
+#[derive(Debug)]
+pub(super) struct ShadowPipelines {
+    plain: [wgpu::RenderPipeline; 2],
+    skin: [wgpu::RenderPipeline; 2],
+    fur_depth: [wgpu::RenderPipeline; 2],
+}
+
+/// One coat's opacity pipelines.
+#[derive(Debug)]
+pub(super) struct OpacityPipelines {
+    shells: [wgpu::RenderPipeline; 2],
+    fins: wgpu::RenderPipeline,
+}
+
+/// The shadow pipelines, each built the first time a shadow map draws with it.
+#[derive(Debug, Default)]
+pub(super) struct ShadowSet {
+    depth: OnceLock<ShadowPipelines>,
+    /// By the coat's index without shadows (groomed, wet).
+    opacity: [OnceLock<OpacityPipelines>; 4],
+}
+
+const WALKS: [(&str, bool); 2] = [("wedges", true), ("indexed", false)];
+
+impl CoatBuilder {
+    fn shadow_pipeline(
+        &self,
+        label: &str,
+        (vertex, fragment): (&str, Option<&str>),
+        (layout, mesh_uvs, coat): (&wgpu::PipelineLayout, Option<bool>, Coat),
+        kind: ShadowKind,
+    ) -> wgpu::RenderPipeline {
+        let source = PipelineSource {
+            mesh_uvs,
+            coat: Some(coat),
+            layout,
+            module: &self.module,
+            vertex_entry: vertex,
+            fragment_entry: "",
+            buffers: &[],
+        };
+        create_shadow_pipeline(&self.device, label, &source, fragment, kind)
+    }
+
+    fn shadow_depth(&self) -> ShadowPipelines {
+        let depth = |label, vertex: &str, layout, mesh_uvs, kind| {
+            self.shadow_pipeline(label, (vertex, None), (layout, Some(mesh_uvs), Coat::PLAIN), kind)
+        };
+        ShadowPipelines {
+            plain: WALKS.map(|(walk, uvs)| {
+                depth("pelt shadow plain", &format!("vs_skin_{walk}"), &self.plain_layout, uvs, ShadowKind::Opaque)
+            }),
+            skin: WALKS.map(|(walk, uvs)| {
+                depth("pelt shadow skin", &format!("vs_skin_{walk}"), &self.layout, uvs, ShadowKind::Opaque)
+            }),
+            fur_depth: WALKS.map(|(walk, uvs)| {
+                depth("pelt shadow fur depth", &format!("vs_shell_{walk}"), &self.layout, uvs, ShadowKind::FurDepth)
+            }),
+        }
+    }
+
+    fn opacity(&self, coat: Coat) -> OpacityPipelines {
+        OpacityPipelines {
+            shells: WALKS.map(|(walk, uvs)| {
+                let fragment = coat.entry(if uvs { "fs_opacity_uvs" } else { "fs_opacity_tiles" });
+                self.shadow_pipeline(
+                    "pelt shadow shells",
+                    (&coat.entry(&format!("vs_shell_{walk}")), Some(&fragment)),
+                    (&self.layout, Some(uvs), coat),
+                    ShadowKind::Opacity { cull: true },
+                )
+            }),
+            fins: self.shadow_pipeline(
+                "pelt shadow fins",
+                (&coat.entry("vs_fin"), Some(&coat.entry("fs_opacity_fin"))),
+                (&self.layout, None, coat),
+                ShadowKind::Opacity { cull: false },
+            ),
+        }
+    }
+}
+
+impl FurRenderer {
+    fn shadow_depth(&self) -> &ShadowPipelines {
+        self.shadows.depth.get_or_init(|| self.coat_builder.shadow_depth())
+    }
+
+    fn opacity(&self, coat: Coat) -> &OpacityPipelines {
+        let coat = coat.shadowed(false);
+        self.shadows.opacity[coat.index()].get_or_init(|| self.coat_builder.opacity(coat))
+    }
+
+    /// `fur` in one pass of a shadow map.
+    pub(super) fn draw_shadow(
+        &self,
+        pass: &mut wgpu::RenderPass<'_>,
+        (view, shadow_pass): (&FurView, ShadowPass),
+        fur: &GpuFur,
+        settings: &FurDrawSettings,
+    ) {
+        let geometry = fur.geometry();
+        let walk = usize::from(!geometry.shape.has_uvs);
+        pass.set_bind_group(0, view.bind_group(), &[]);
+        pass.set_bind_group(1, geometry.bind_group(), &[]);
+        pass.set_bind_group(2, fur.textures_bind_group(), &[]);
+        pass.set_bind_group(3, view.shadow_group(), &[]);
+        let shells = fur.drawn_shells();
+        let furred = geometry.shape.layers > 0 && shells > 0 && (settings.shells || settings.fins);
+        match shadow_pass {
+            ShadowPass::Opaque if settings.skin => {
+                pass.set_pipeline(&self.shadow_depth().skin[walk]);
+                geometry.draw_skin(pass);
+            }
+            ShadowPass::FurDepth if furred => {
+                // The outermost shell is the fur's first surface wherever it grows.
+                pass.set_pipeline(&self.shadow_depth().fur_depth[walk]);
+                geometry.draw_shells(pass, shells - 1..shells);
+            }
+            ShadowPass::Opacity if furred => {
+                let opacity = self.opacity(fur.coat());
+                if settings.shells {
+                    pass.set_pipeline(&opacity.shells[walk]);
+                    geometry.draw_shells(pass, 0..shells);
+                }
+                if settings.fins {
+                    pass.set_pipeline(&opacity.fins);
+                    geometry.draw_fins(pass, shells);
+                }
+            }
+            _ => {}
+        }
+    }
+
+    /// A plain mesh in one pass of a shadow map: it casts in the opaque one only.
+    pub(super) fn draw_plain_shadow(
+        &self,
+        pass: &mut wgpu::RenderPass<'_>,
+        (view, shadow_pass): (&FurView, ShadowPass),
+        mesh: &PlainMesh,
+    ) {
+        if shadow_pass != ShadowPass::Opaque {
+            return;
+        }
+        let geometry = mesh.geometry();
+        pass.set_bind_group(0, view.bind_group(), &[]);
+        pass.set_bind_group(1, geometry.bind_group(), &[]);
+        pass.set_bind_group(2, &self.layouts.empty_group, &[]);
+        pass.set_bind_group(3, view.shadow_group(), &[]);
+        pass.set_pipeline(&self.shadow_depth().plain[usize::from(!geometry.shape.has_uvs)]);
+        geometry.draw_skin(pass);
+    }
+}
+
+fn create_shadow_pipeline(
+    device: &wgpu::Device,
+    label: &str,
+    source: &PipelineSource<'_>,
+    fragment_entry: Option<&str>,
+    kind: ShadowKind,
+) -> wgpu::RenderPipeline {
+    let switch = |on: bool| if on { 2.0 } else { 1.0 };
+    let coat = source.coat.unwrap_or(Coat::PLAIN);
+    let mesh_uvs = match source.mesh_uvs {
+        None => 0.0,
+        Some(true) => 1.0,
+        Some(false) => 2.0,
+    };
+    let constants = [
+        ("ALPHA_TO_COVERAGE", 0.0),
+        ("MESH_UVS", mesh_uvs),
+        ("GROOM", switch(coat.groomed)),
+        ("WET", switch(coat.wet)),
+        ("SHADOWS", 0.0),
+    ];
+    let compilation_options = wgpu::PipelineCompilationOptions { constants: &constants, ..Default::default() };
+    let (depth_write, bias, cull_mode) = match kind {
+        // A texel's worth of slope keeps lit surfaces off their own shadow.
+        ShadowKind::Opaque => (true, wgpu::DepthBiasState { constant: 2, slope_scale: 2.0, clamp: 0.0 }, None),
+        ShadowKind::FurDepth => (true, wgpu::DepthBiasState::default(), None),
+        ShadowKind::Opacity { cull } => (false, wgpu::DepthBiasState::default(), cull.then_some(wgpu::Face::Back)),
+    };
+    let additive = wgpu::BlendComponent {
+        src_factor: wgpu::BlendFactor::One,
+        dst_factor: wgpu::BlendFactor::One,
+        operation: wgpu::BlendOperation::Add,
+    };
+    let targets = [Some(wgpu::ColorTargetState {
+        format: OPACITY_FORMAT,
+        blend: Some(wgpu::BlendState { color: additive, alpha: additive }),
+        write_mask: wgpu::ColorWrites::ALL,
+    })];
+    device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
+        label: Some(label),
+        layout: Some(source.layout),
+        vertex: wgpu::VertexState {
+            module: source.module,
+            entry_point: Some(source.vertex_entry),
+            compilation_options: compilation_options.clone(),
+            buffers: source.buffers,
+        },
+        primitive: wgpu::PrimitiveState {
+            topology: wgpu::PrimitiveTopology::TriangleList,
+            front_face: wgpu::FrontFace::Ccw,
+            cull_mode,
+            ..wgpu::PrimitiveState::default()
+        },
+        depth_stencil: Some(wgpu::DepthStencilState {
+            format: DEPTH_FORMAT,
+            depth_write_enabled: Some(depth_write),
+            depth_compare: Some(wgpu::CompareFunction::LessEqual),
+            stencil: wgpu::StencilState::default(),
+            bias,
+        }),
+        multisample: wgpu::MultisampleState::default(),
+        fragment: fragment_entry.map(|entry| wgpu::FragmentState {
+            module: source.module,
+            entry_point: Some(entry),
+            compilation_options,
+            targets: &targets,
+        }),
+        multiview_mask: None,
+        cache: None,
+    })
+}

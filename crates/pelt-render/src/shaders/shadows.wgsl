@@ -1,0 +1,146 @@
+// The key light's shadows (group 3, `ShadowMap`): an opaque shadow map of the skin, plain
+// meshes, colliders and ground, sampled with a few filtered taps, and a deep opacity map of the
+// fur (Yuksel & Keyser 2008): the depth of the fur's first surface seen from the light (z0) and
+// four cumulative opacity layers beyond it, from which a point's transmittance follows.
+// Appended to `shading.wgsl`; the shadow views' own fragments are here too.
+
+struct Shadow {
+    light_clip_from_world: mat4x4<f32>,
+    // World units a shadow texel spans (the normal offset) and the depth bias (world units).
+    texel_world: f32,
+    bias_world: f32,
+    // How fast light dies in the fur: transmittance exp(-extinction * opacity).
+    extinction: f32,
+    // 1 for a perspective (spot) light, 0 for an orthographic (directional) one.
+    perspective: f32,
+    // The light view's near and far planes (linear depth along the light, world units).
+    near: f32,
+    far: f32,
+    // 1 / the map's size in texels.
+    texel: f32,
+    padding: f32,
+    // Where each opacity layer ends beyond z0 (world units); the last one's end is where the
+    // interpolation stops (fur deeper still counts in full).
+    layer_ends: vec4<f32>,
+}
+
+@group(3) @binding(0) var<uniform> shadow: Shadow;
+@group(3) @binding(1) var shadow_depth: texture_depth_2d;
+@group(3) @binding(2) var shadow_compare: sampler_comparison;
+@group(3) @binding(3) var fur_depth: texture_depth_2d;
+@group(3) @binding(4) var fur_opacity: texture_2d<f32>;
+@group(3) @binding(5) var shadow_linear: sampler;
+
+// Set per pipeline: only views with a shadow map compile the lookups (a software rasteriser runs
+// every branch, taken or not).
+override SHADOWS: bool = false;
+
+// Light-space depth in world units from a depth-buffer value.
+fn shadow_linear_depth(z: f32) -> f32 {
+    if shadow.perspective > 0.5 {
+        return shadow.near * shadow.far / (shadow.far - z * (shadow.far - shadow.near));
+    }
+    return shadow.near + z * (shadow.far - shadow.near);
+}
+
+// The fur's opacity at `beyond` world units past its first surface: the four cumulative layers
+// interpolated linearly, 0 at z0.
+fn deep_opacity(layers: vec4<f32>, beyond: f32) -> f32 {
+    let e = shadow.layer_ends;
+    let o = max(layers, vec4<f32>(0.0));
+    var opacity = o.x * clamp(beyond / e.x, 0.0, 1.0);
+    opacity += (o.y - o.x) * clamp((beyond - e.x) / (e.y - e.x), 0.0, 1.0);
+    opacity += (o.z - o.y) * clamp((beyond - e.y) / (e.z - e.y), 0.0, 1.0);
+    opacity += (o.w - o.z) * clamp((beyond - e.z) / (e.w - e.z), 0.0, 1.0);
+    return max(opacity, 0.0);
+}
+
+// How much of light `light_index` reaches `world_position` (surface normal `world_normal`):
+// 1 = unshadowed. The opaque map's filtered taps times the fur's transmittance. Only the key
+// light (index 0) has shadow maps.
+fn light_visibility(light_index: u32, world_position: vec3<f32>, world_normal: vec3<f32>) -> f32 {
+    if !SHADOWS || light_index != 0u {
+        return 1.0;
+    }
+    let to_light = view.light_direction;
+    // Slope-scaled: surfaces turning from the light move further off themselves.
+    let n_dot_l = clamp(dot(world_normal, to_light), -1.0, 1.0);
+    let slope = sqrt(max(1.0 - n_dot_l * n_dot_l, 0.0));
+    let p = world_position + world_normal * (shadow.texel_world * (0.5 + 1.5 * slope)) + to_light * shadow.bias_world;
+    let clip = shadow.light_clip_from_world * vec4<f32>(p, 1.0);
+    if clip.w <= 0.0 {
+        return 1.0;
+    }
+    let ndc = clip.xyz / clip.w;
+    let uv = vec2<f32>(ndc.x * 0.5 + 0.5, 0.5 - ndc.y * 0.5);
+    if any(uv < vec2<f32>(0.0)) || any(uv > vec2<f32>(1.0)) {
+        return 1.0;
+    }
+    // Receivers past the far plane (the ground below the casters) compare as at it.
+    let z = clamp(ndc.z, 0.0, 1.0);
+    let t = 0.75 * shadow.texel;
+    var lit = textureSampleCompareLevel(shadow_depth, shadow_compare, uv + vec2<f32>(-t, -t), z);
+    lit += textureSampleCompareLevel(shadow_depth, shadow_compare, uv + vec2<f32>(t, -t), z);
+    lit += textureSampleCompareLevel(shadow_depth, shadow_compare, uv + vec2<f32>(-t, t), z);
+    lit += textureSampleCompareLevel(shadow_depth, shadow_compare, uv + vec2<f32>(t, t), z);
+    let size = vec2<f32>(textureDimensions(fur_depth));
+    let texel = clamp(vec2<i32>(uv * size), vec2<i32>(0), vec2<i32>(size) - 1);
+    let z0 = textureLoad(fur_depth, texel, 0);
+    let beyond = shadow_linear_depth(z) - shadow_linear_depth(z0);
+    let layers = textureSampleLevel(fur_opacity, shadow_linear, uv, 0.0);
+    return 0.25 * lit * exp(-shadow.extinction * deep_opacity(layers, beyond));
+}
+
+// A shadow view's opacity fragment: `alpha` added to every layer that ends at or past the
+// fragment's depth beyond z0 (the last layer takes every fragment), so each layer holds the
+// opacity in front of its end.
+fn opacity_layers(position: vec4<f32>, alpha: f32) -> vec4<f32> {
+    let z0 = textureLoad(fur_depth, vec2<i32>(position.xy), 0);
+    let beyond = shadow_linear_depth(position.z) - shadow_linear_depth(z0);
+    let e = shadow.layer_ends;
+    let inside = vec4<f32>(select(0.0, 1.0, beyond <= e.x), select(0.0, 1.0, beyond <= e.y), select(0.0, 1.0, beyond <= e.z), 1.0);
+    return inside * clamp(alpha, 0.0, 1.0);
+}
+
+@fragment
+fn fs_opacity_tiles(in: ShellTileVaryings) -> @location(0) vec4<f32> {
+    let layer = varying_layer(in.fade_blend_layer.z);
+    let texel = tile_texel(in.tile_position, in.tile_normal, layer);
+    return opacity_layers(in.clip_position, lod_alpha(texel.a * in.fade_blend_layer.x, layer, in.fade_blend_layer.y));
+}
+
+@fragment
+fn fs_opacity_uvs(in: ShellUvVaryings) -> @location(0) vec4<f32> {
+    let layer = varying_layer(in.fade_blend_layer.z);
+    let texel = sample_shell(in.uvs.xy, shell_slice(layer));
+    return opacity_layers(in.clip_position, lod_alpha(texel.a * in.fade_blend_layer.x, layer, in.fade_blend_layer.y));
+}
+
+@fragment
+fn fs_opacity_tiles_groomed(in: GroomedShellTileVaryings) -> @location(0) vec4<f32> {
+    let layer = varying_layer(in.fade_blend_layer.z);
+    let groom = shell_groom(in.fade_blend_layer, in.tint_density);
+    let texel = coat_shell_texel(tile_uv(in.tile_position, in.tile_normal), layer, groom);
+    return opacity_layers(in.clip_position, lod_alpha(texel.a * in.fade_blend_layer.x, layer, in.fade_blend_layer.y));
+}
+
+@fragment
+fn fs_opacity_uvs_groomed(in: GroomedShellUvVaryings) -> @location(0) vec4<f32> {
+    let layer = varying_layer(in.fade_blend_layer.z);
+    let groom = shell_groom(in.fade_blend_layer, in.tint_density);
+    let texel = coat_shell_texel(in.uvs.xy, layer, groom);
+    return opacity_layers(in.clip_position, lod_alpha(texel.a * in.fade_blend_layer.x, layer, in.fade_blend_layer.y));
+}
+
+@fragment
+fn fs_opacity_fin(in: FinVaryings) -> @location(0) vec4<f32> {
+    let texel = textureSample(fin_texture, fin_sampler, fin_texture_uv(in.uvs));
+    return opacity_layers(in.clip_position, texel.a * in.lighting_fade.w * mix(0.15, 0.6, in.uvs.y));
+}
+
+@fragment
+fn fs_opacity_fin_groomed(in: GroomedFinVaryings) -> @location(0) vec4<f32> {
+    let texel = textureSample(fin_texture, fin_sampler, fin_texture_uv(in.uvs));
+    let density = clamp(in.tint_density.a, 0.0, 1.0);
+    return opacity_layers(in.clip_position, texel.a * in.lighting_fade.w * mix(0.15, 0.6, in.uvs.y) * density);
+}

@@ -1,0 +1,239 @@
+//! The key light's shadows: [`ShadowMap`], three views of the same renderer from the light.
+//!
+//! 1. Everything opaque (the furs' skin, plain meshes, colliders, a ground) draws depth only: the
+//!    opaque shadow map, sampled with a few filtered taps.
+//! 2. The furs' outermost shells draw depth only: the fur's first surface from the light (z0).
+//! 3. The shells and fins draw their opacity, added into four cumulative layers by depth past z0
+//!    (a deep opacity map, Yuksel & Keyser 2008), tested against the opaque map.
+//!
+//! A view lit with the map ([`FurView::set_shadows`]) reads a point's visibility as the opaque
+//! taps times the fur's transmittance `exp(-extinction * opacity)` at its depth (`shadows.wgsl`).
+
+use glam::{Vec3, Vec4};
+
+use crate::RenderError;
+use crate::renderer::FurRenderer;
+use crate::shaders::{ShadowUniform, shadow_texture};
+use crate::view::{FurView, ShadowPass, ViewData};
+
+/// The shadow maps' depth format.
+pub(crate) const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+/// The opacity layers' format: four layers, blended additively.
+pub(crate) const OPACITY_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
+
+/// The light that casts the shadows.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ShadowCaster {
+    /// A sun toward `toward_light` (world space): an orthographic view fitted to the scene.
+    Directional {
+        /// Toward the light.
+        toward_light: Vec3,
+    },
+    /// A spot light at `position` shining along `direction` in a cone of half-angle `cone_rad`:
+    /// a perspective view.
+    Spot {
+        /// World space.
+        position: Vec3,
+        /// Where the light points.
+        direction: Vec3,
+        /// Half the cone's opening, radians (`0 < cone_rad < pi / 2`).
+        cone_rad: f32,
+    },
+}
+
+/// A shadow map's resolution and how the fur takes light.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ShadowSettings {
+    /// Texels along each side of the maps.
+    pub size: u32,
+    /// How deep (world units) below the fur's first surface the opacity layers reach: about
+    /// the fur's length.
+    pub fur_depth: f32,
+    /// How fast light dies in fur: the transmittance is `exp(-extinction * opacity)`, the
+    /// opacity the sum of the strands' alpha in front.
+    pub extinction: f32,
+}
+
+impl ShadowSettings {
+    /// Pelt's default map (512 texels a side) for fur `fur_length` long.
+    #[must_use]
+    pub fn for_fur(fur_length: f32) -> Self {
+        Self { size: 512, fur_depth: fur_length, extinction: 0.6 }
+    }
+}
+
+/// The key light's shadow maps: an opaque depth map, the fur's first surface and its opacity
+/// layers, each `size` squared. Make one per light and renderer; each frame
+/// [`ShadowMap::prepare`] it, [`ShadowMap::record`] it before the picture's pass, and draw the
+/// picture through a view lit with it ([`FurView::set_shadows`]).
+#[derive(Debug)]
+pub struct ShadowMap {
+    settings: ShadowSettings,
+    uniform: wgpu::Buffer,
+    depth: wgpu::TextureView,
+    fur_depth: wgpu::TextureView,
+    opacity: wgpu::TextureView,
+    /// The three passes' views (`ShadowPass` order).
+    views: [FurView; 3],
+    receiver: wgpu::BindGroup,
+}
+
+impl ShadowMap {
+    /// The maps for drawing with `renderer`.
+    ///
+    /// # Errors
+    /// [`RenderError::Target`] for a size of 0 or past the device's texture limit, or a fur depth
+    /// or extinction that is not a positive (or zero extinction) finite number.
+    pub fn new(device: &wgpu::Device, renderer: &FurRenderer, settings: ShadowSettings) -> Result<Self, RenderError> {
+        let max = device.limits().max_texture_dimension_2d;
+        if settings.size == 0 || settings.size > max {
+            return Err(RenderError::Target(format!("a shadow map of {} texels a side (1 to {max})", settings.size)));
+        }
+        if !(settings.fur_depth.is_finite() && settings.fur_depth > 0.0) {
+            return Err(RenderError::Target(format!(
+                "a shadow fur depth of {} (a positive length)",
+                settings.fur_depth
+            )));
+        }
+        if !(settings.extinction.is_finite() && settings.extinction >= 0.0) {
+            return Err(RenderError::Target(format!("a shadow extinction of {} (0 or more)", settings.extinction)));
+        }
+        let layouts = renderer.layouts();
+        let uniform = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("pelt shadow"),
+            size: size_of::<ShadowUniform>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let size = settings.size;
+        let depth = shadow_texture(device, DEPTH_FORMAT, size, true);
+        let fur_depth = shadow_texture(device, DEPTH_FORMAT, size, true);
+        let opacity = shadow_texture(device, OPACITY_FORMAT, size, true);
+        // The opacity pass reads z0; what it draws into stands in as 1x1 textures.
+        let stand_in_depth = shadow_texture(device, DEPTH_FORMAT, 1, false);
+        let stand_in_opacity = shadow_texture(device, OPACITY_FORMAT, 1, false);
+        let caster = layouts.shadow_group(device, &uniform, (&stand_in_depth, &fur_depth, &stand_in_opacity));
+        let receiver = layouts.shadow_group(device, &uniform, (&depth, &fur_depth, &opacity));
+        let views = [
+            FurView::shadow_pass(device, layouts, ShadowPass::Opaque, layouts.no_shadows.clone()),
+            FurView::shadow_pass(device, layouts, ShadowPass::FurDepth, layouts.no_shadows.clone()),
+            FurView::shadow_pass(device, layouts, ShadowPass::Opacity, caster),
+        ];
+        Ok(Self { settings, uniform, depth, fur_depth, opacity, views, receiver })
+    }
+
+    /// The settings the maps were made with.
+    #[must_use]
+    pub fn settings(&self) -> ShadowSettings {
+        self.settings
+    }
+
+    /// Aims the light's views at the scene: everything that casts lies within `radius` of
+    /// `centre` (world space). Receivers further from the light than that compare as at the far
+    /// edge, so a ground below the casters takes their shadow without being inside.
+    pub fn prepare(&self, queue: &wgpu::Queue, caster: &ShadowCaster, (centre, radius): (Vec3, f32)) {
+        let radius = if radius.is_finite() && radius > 0.0 { radius } else { 1.0 };
+        let size = self.settings.size as f32;
+        let (eye, forward, projection, near, far, texel_world, perspective) = match *caster {
+            ShadowCaster::Directional { toward_light } => {
+                let toward = toward_light.normalize_or(Vec3::Y);
+                let eye = centre + toward * (2.0 * radius);
+                let (near, far) = (radius, 3.0 * radius);
+                let projection =
+                    glam::camera::rh::proj::directx::orthographic(-radius, radius, -radius, radius, near, far);
+                (eye, -toward, projection, near, far, 2.0 * radius / size, 0.0)
+            }
+            ShadowCaster::Spot { position, direction, cone_rad } => {
+                let forward = direction.normalize_or(-Vec3::Y);
+                let cone = cone_rad.clamp(0.01, 1.5);
+                let distance = (centre - position).length().max(1e-3);
+                let far = distance + radius;
+                let near = (distance - radius).max(far * 1e-3);
+                let projection = glam::camera::rh::proj::directx::perspective(2.0 * cone, 1.0, near, far);
+                (position, forward, projection, near, far, 2.0 * distance * cone.tan() / size, 1.0)
+            }
+        };
+        let up = if forward.y.abs() > 0.99 { Vec3::Z } else { Vec3::Y };
+        let light_clip_from_world = projection * glam::camera::rh::view::look_to_mat4(eye, forward, up);
+        let d = self.settings.fur_depth;
+        let uniform = ShadowUniform {
+            light_clip_from_world,
+            texel_world,
+            bias_world: texel_world,
+            extinction: self.settings.extinction,
+            perspective,
+            near,
+            far,
+            texel: 1.0 / size,
+            _padding: 0.0,
+            layer_ends: Vec4::new(0.2 * d, 0.5 * d, 1.0 * d, 2.0 * d),
+        };
+        queue.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&uniform));
+        let data = ViewData {
+            clip_from_world: light_clip_from_world,
+            camera_position_world: eye,
+            light_direction_world: -forward,
+            light_colour: Vec3::ONE,
+            ambient: 0.0,
+        };
+        for view in &self.views {
+            view.prepare(queue, &data);
+        }
+    }
+
+    /// Records the three passes into `encoder`; `draw` records the scene into each through the
+    /// view it is given, with the same [`FurRenderer::draw`] and
+    /// [`FurRenderer::draw_plain`] calls as the picture (each draws what that pass needs).
+    pub fn record(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        mut draw: impl FnMut(&mut wgpu::RenderPass<'_>, &FurView),
+    ) {
+        let clear_depth = |view| wgpu::RenderPassDepthStencilAttachment {
+            view,
+            depth_ops: Some(wgpu::Operations { load: wgpu::LoadOp::Clear(1.0), store: wgpu::StoreOp::Store }),
+            stencil_ops: None,
+        };
+        for (label, depth, view) in [
+            ("pelt shadow opaque", &self.depth, &self.views[0]),
+            ("pelt shadow fur depth", &self.fur_depth, &self.views[1]),
+        ] {
+            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some(label),
+                color_attachments: &[],
+                depth_stencil_attachment: Some(clear_depth(depth)),
+                timestamp_writes: None,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            draw(&mut pass, view);
+        }
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("pelt shadow opacity"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: &self.opacity,
+                depth_slice: None,
+                resolve_target: None,
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(wgpu::Color::TRANSPARENT),
+                    store: wgpu::StoreOp::Store,
+                },
+            })],
+            // Fur behind the opaque casters is in their shadow already.
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: &self.depth,
+                depth_ops: None,
+                stencil_ops: None,
+            }),
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        draw(&mut pass, &self.views[2]);
+    }
+
+    /// Group 3 of the views lit with these maps.
+    pub(crate) fn receiver_group(&self) -> &wgpu::BindGroup {
+        &self.receiver
+    }
+}

@@ -1,0 +1,272 @@
+//! The key light's shadows: a furred mesh over a ground, drawn with its `ShadowMap` and without.
+//! The oracles are geometric (rays against the ground plane, the mesh's vertices projected along
+//! the light) and photometric (linear light of the same pixels with shadows on and off); they
+//! share nothing with the shadow maps they check.
+
+use crate::common;
+
+use common::{BROWN_ROOT, BROWN_TIP, Rig, strand_textures};
+use glam::{Mat4, Vec3, Vec4Swizzles as _};
+use pelt_core::groom::Groom;
+use pelt_core::{Builtin, FurParams, FurStructure, GrowthDirection, fur::FurLength};
+use pelt_render::{
+    Camera, DEFAULT_BACKGROUND, FurDrawSettings, FurView, GpuFur, Light, LightDirection, PlainMesh, ShadowCaster,
+    ShadowMap, ShadowSettings, ground_mesh,
+};
+
+const SIZE_PX: u32 = 256;
+const GROUND_Y: f32 = -1.05;
+const GROUND_COLOUR: Vec3 = Vec3::new(0.5, 0.5, 0.5);
+
+/// A sphere of radius 1 with fur `length` long, groomed by `groom`.
+fn sphere_fur(layers: u32, length: f32, groom: Option<Groom>) -> FurStructure {
+    let (mesh, _) = Builtin::Sphere.mesh();
+    let params = FurParams { layers, length: FurLength::Constant(length), direction: GrowthDirection::default() };
+    FurStructure::new_groomed(mesh, &params, groom).expect("groomed sphere")
+}
+
+struct Stage {
+    rig: Rig,
+    view: FurView,
+    ground: PlainMesh,
+}
+
+impl Stage {
+    fn new() -> Self {
+        let rig = Rig::new(SIZE_PX, SIZE_PX);
+        let view = FurView::new(rig.device(), &rig.renderer);
+        let ground = rig.plain(&ground_mesh(), GROUND_COLOUR);
+        ground.prepare(
+            rig.queue(),
+            Mat4::from_translation(Vec3::Y * GROUND_Y) * Mat4::from_scale(Vec3::new(4.0, 1.0, 4.0)),
+        );
+        Self { rig, view, ground }
+    }
+
+    fn fur(&self, structure: &FurStructure) -> GpuFur {
+        self.rig.fur(structure, &strand_textures(128, structure.layers, BROWN_ROOT, BROWN_TIP))
+    }
+
+    /// One frame from `camera` lit from `toward_light`, with the ground if `ground`, the fur if
+    /// any, and a shadow map of `fur_depth` if `shadows`; in linear RGB per pixel.
+    fn render(
+        &mut self,
+        camera: &Camera,
+        toward_light: Vec3,
+        (fur, ground): (Option<&GpuFur>, bool),
+        shadows: Option<f32>,
+        name: &str,
+    ) -> Vec<Vec3> {
+        let rig = &self.rig;
+        let light =
+            Light { direction: LightDirection::World(toward_light.normalize()), colour: Vec3::ONE, ambient: 0.2 };
+        self.view.prepare(rig.queue(), &camera.view_data(1.0, &light));
+        let map = shadows.map(|fur_depth| {
+            let settings = ShadowSettings { size: 512, fur_depth, extinction: 0.6 };
+            let map = ShadowMap::new(rig.device(), &rig.renderer, settings).expect("shadow map");
+            map.prepare(rig.queue(), &ShadowCaster::Directional { toward_light }, (Vec3::ZERO, 1.6));
+            map
+        });
+        self.view.set_shadows(map.as_ref());
+        let (view, plane) = (&self.view, &self.ground);
+        let draw = |pass: &mut wgpu::RenderPass<'_>, view: &FurView| {
+            if ground {
+                rig.renderer.draw_plain(pass, view, plane);
+            }
+            if let Some(fur) = fur {
+                rig.renderer.draw(pass, view, fur, &FurDrawSettings::ALL);
+            }
+        };
+        let image = rig
+            .headless
+            .render_with(
+                DEFAULT_BACKGROUND,
+                |encoder| {
+                    if let Some(map) = &map {
+                        map.record(encoder, draw);
+                    }
+                },
+                |pass| draw(pass, view),
+            )
+            .expect("frame");
+        image.save(common::out_dir().join(format!("shadows-{name}.png"))).expect("save");
+        let linear = |c: u8| {
+            let c = f32::from(c) / 255.0;
+            if c <= 0.04045 { c / 12.92 } else { ((c + 0.055) / 1.055).powf(2.4) }
+        };
+        image.pixels().map(|p| Vec3::new(linear(p[0]), linear(p[1]), linear(p[2]))).collect()
+    }
+}
+
+fn luminance(c: Vec3) -> f32 {
+    c.dot(Vec3::new(0.2126, 0.7152, 0.0722))
+}
+
+/// Where each pixel's ray meets the ground plane (`None` off it).
+fn ground_hits(camera: &Camera) -> Vec<Option<Vec3>> {
+    let world_from_clip = camera.clip_from_world(1.0).inverse();
+    (0..SIZE_PX * SIZE_PX)
+        .map(|k| {
+            let (x, y) = (k % SIZE_PX, k / SIZE_PX);
+            let point = |z: f32| {
+                let x_ndc = (x as f32 + 0.5) / SIZE_PX as f32 * 2.0 - 1.0;
+                let y_ndc = 1.0 - (y as f32 + 0.5) / SIZE_PX as f32 * 2.0;
+                let world = world_from_clip * glam::Vec4::new(x_ndc, y_ndc, z, 1.0);
+                world.xyz() / world.w
+            };
+            let (near, far) = (point(0.0), point(1.0));
+            let t = (near.y - GROUND_Y) / (near.y - far.y);
+            let hit = near + (far - near) * t;
+            (t > 0.0 && hit.x.abs() < 3.8 && hit.z.abs() < 3.8).then_some(hit)
+        })
+        .collect()
+}
+
+/// How far a ground point lies from the unit sphere's shadow along `toward_light` (0 inside
+/// it): the distance from the sphere's centre to the ray from the point toward the light,
+/// less the radius.
+fn outside_sphere_shadow(point: Vec3, toward_light: Vec3) -> f32 {
+    let l = toward_light.normalize();
+    let along = (-point).dot(l);
+    (-point - l * along).length() - 1.0
+}
+
+const SLANTED: Vec3 = Vec3::new(0.6, 1.0, 0.25);
+
+fn ground_camera() -> Camera {
+    Camera::orbit(Vec3::new(-0.6, GROUND_Y, 0.0), 200.0, 55.0, 7.0)
+}
+
+/// The ground's shade with shadows over without, at the visible ground pixels (the fur and
+/// sphere cover none of them: the frame with them and without shadows matches the bare ground).
+fn ground_shade(stage: &mut Stage, fur: &GpuFur, fur_depth: f32, name: &str) -> Vec<(Vec3, f32)> {
+    let camera = ground_camera();
+    let bare = stage.render(&camera, SLANTED, (None, true), None, &format!("{name}-bare"));
+    let off = stage.render(&camera, SLANTED, (Some(fur), true), None, &format!("{name}-off"));
+    let on = stage.render(&camera, SLANTED, (Some(fur), true), Some(fur_depth), &format!("{name}-on"));
+    ground_hits(&camera)
+        .into_iter()
+        .enumerate()
+        .filter_map(|(k, hit)| {
+            let hit = hit?;
+            let visible = (off[k] - bare[k]).abs().max_element() < 1e-3 && luminance(bare[k]) > 1e-3;
+            visible.then(|| (hit, luminance(on[k]) / luminance(off[k])))
+        })
+        .collect()
+}
+
+#[test]
+fn the_ground_under_a_furred_sphere_is_darker_with_shadows() {
+    let mut stage = Stage::new();
+    let structure = sphere_fur(16, 0.15, None);
+    let fur = stage.fur(&structure);
+    let shade = ground_shade(&mut stage, &fur, 0.15, "ground");
+    let inside: Vec<f32> =
+        shade.iter().filter(|(hit, _)| outside_sphere_shadow(*hit, SLANTED) < -0.3).map(|&(_, s)| s).collect();
+    let far: Vec<f32> =
+        shade.iter().filter(|(hit, _)| outside_sphere_shadow(*hit, SLANTED) > 0.8).map(|&(_, s)| s).collect();
+    assert!(
+        inside.len() > 200 && far.len() > 2000,
+        "{} shadowed and {} far ground pixels in view",
+        inside.len(),
+        far.len()
+    );
+    let mean = |v: &[f32]| v.iter().sum::<f32>() / v.len() as f32;
+    assert!(mean(&inside) < 0.5, "the ground in the sphere's shadow keeps {:.2} of its light", mean(&inside));
+    assert!(mean(&far) > 0.97, "the ground far from the sphere keeps only {:.2} of its light", mean(&far));
+}
+
+#[test]
+fn a_furred_shadow_is_larger_and_softer_than_a_bald_one() {
+    let mut stage = Stage::new();
+    let length = 0.3;
+    let furred = sphere_fur(16, length, None);
+    let bald_groom = Groom { length: Some(vec![0.0; furred.mesh.positions.len()]), ..Groom::default() };
+    let bald = sphere_fur(16, length, Some(bald_groom));
+    let (furred_fur, bald_fur) = (stage.fur(&furred), stage.fur(&bald));
+    let furred_shade = ground_shade(&mut stage, &furred_fur, length, "furred");
+    let bald_shade = ground_shade(&mut stage, &bald_fur, length, "bald");
+    assert_eq!(furred_shade.len(), bald_shade.len().min(furred_shade.len()), "the same ground pixels in view");
+    // The ground past the sphere's own shadow, where only the fur can shade it.
+    let ring = |shade: &[(Vec3, f32)]| -> Vec<f32> {
+        shade
+            .iter()
+            .filter(|(hit, _)| (0.05..0.35).contains(&outside_sphere_shadow(*hit, SLANTED)))
+            .map(|&(_, s)| s)
+            .collect()
+    };
+    let (furred_ring, bald_ring) = (ring(&furred_shade), ring(&bald_shade));
+    let shaded = |v: &[f32]| v.iter().filter(|&&s| s < 0.95).count();
+    assert!(
+        shaded(&furred_ring) > 2 * shaded(&bald_ring) + 50,
+        "ground shaded just outside the sphere's shadow: {} pixels furred, {} bald (of {})",
+        shaded(&furred_ring),
+        shaded(&bald_ring),
+        furred_ring.len()
+    );
+    // Softer: the furred shadow's edge is partly lit (neither full light nor the core's dark).
+    let penumbra = |shade: &[(Vec3, f32)]| shade.iter().filter(|&&(_, s)| (0.6..0.95).contains(&s)).count() as f32;
+    let umbra = |shade: &[(Vec3, f32)]| shade.iter().filter(|&&(_, s)| s < 0.6).count().max(1) as f32;
+    let (furred_soft, bald_soft) =
+        (penumbra(&furred_shade) / umbra(&furred_shade), penumbra(&bald_shade) / umbra(&bald_shade));
+    assert!(furred_soft > 1.5 * bald_soft, "penumbra over umbra: furred {furred_soft:.2}, bald {bald_soft:.2}");
+}
+
+/// The fur's pixels in the lower half of the sphere's image, seen from the side and lit from
+/// above: their summed light with shadows over without.
+#[test]
+fn fur_on_the_underside_is_darker_with_shadows_from_above() {
+    let mut stage = Stage::new();
+    let structure = sphere_fur(16, 0.2, None);
+    let fur = stage.fur(&structure);
+    let camera = Camera::orbit(Vec3::ZERO, 0.0, 0.0, 6.0);
+    let off = stage.render(&camera, Vec3::Y, (Some(&fur), false), None, "underside-off");
+    let on = stage.render(&camera, Vec3::Y, (Some(&fur), false), Some(0.2), "underside-on");
+    let background = luminance(off[0]);
+    let lower = |image: &[Vec3]| -> f32 {
+        image
+            .iter()
+            .enumerate()
+            .filter(|&(k, c)| k as u32 / SIZE_PX > SIZE_PX / 2 + 8 && (luminance(*c) - background).abs() > 1e-3)
+            .map(|(_, c)| luminance(*c))
+            .sum()
+    };
+    let (lit, shadowed) = (lower(&off), lower(&on));
+    assert!(lit > 0.0, "the lower half shows fur");
+    assert!(shadowed < 0.85 * lit, "the underside's light: {shadowed:.1} with shadows, {lit:.1} without");
+}
+
+/// The skin and roots of a plane of fur seen from above, lit from above: the shadows darken
+/// them by the fur above them, less where the fur is sparse.
+#[test]
+fn the_root_darkening_falls_when_the_fur_is_sparse() {
+    let mut stage = Stage::new();
+    let (mesh, _) = Builtin::Plane.mesh();
+    let params = FurParams { layers: 16, length: FurLength::Constant(0.15), direction: GrowthDirection::default() };
+    let groom = |density: f32| Groom { density: Some(vec![density; mesh.positions.len()]), ..Groom::default() };
+    let dense = FurStructure::new_groomed(mesh.clone(), &params, Some(groom(1.0))).expect("dense");
+    let sparse = FurStructure::new_groomed(mesh.clone(), &params, Some(groom(0.25))).expect("sparse");
+    let camera = Camera::orbit(Vec3::ZERO, 0.0, 89.0, 3.5);
+    let toward_light = Vec3::new(0.3, 1.0, 0.2);
+    let mut darkening = |structure: &FurStructure, name: &str| {
+        let fur = stage.fur(structure);
+        let off = stage.render(&camera, toward_light, (Some(&fur), false), None, &format!("roots-{name}-off"));
+        let on = stage.render(&camera, toward_light, (Some(&fur), false), Some(0.15), &format!("roots-{name}-on"));
+        // The middle of the plane, well inside its edges.
+        let centre = |image: &[Vec3]| -> f32 {
+            image
+                .iter()
+                .enumerate()
+                .filter(|&(k, _)| {
+                    let (x, y) = (k as u32 % SIZE_PX, k as u32 / SIZE_PX);
+                    x.abs_diff(SIZE_PX / 2) < SIZE_PX / 6 && y.abs_diff(SIZE_PX / 2) < SIZE_PX / 6
+                })
+                .map(|(_, c)| luminance(*c))
+                .sum()
+        };
+        1.0 - centre(&on) / centre(&off)
+    };
+    let (dense_dark, sparse_dark) = (darkening(&dense, "dense"), darkening(&sparse, "sparse"));
+    assert!(dense_dark > 0.05, "dense fur darkens its own roots by {dense_dark:.3}");
+    assert!(sparse_dark < 0.7 * dense_dark, "darkening: sparse {sparse_dark:.3}, dense {dense_dark:.3}");
+}
