@@ -81,6 +81,10 @@ pub struct Args {
     /// MSAA samples: 1, 2, 4 or 8. Default: 1 on a CPU rasteriser (lavapipe), 4 on a GPU.
     #[arg(long, value_name = "N", value_parser = crate::values::parse_msaa)]
     msaa: Option<u32>,
+    /// Draw a body's collision capsules over it (the walking try-on's); colliders a script
+    /// places are drawn either way.
+    #[arg(long)]
+    show_colliders: bool,
     /// Leave out the fins (shells only).
     #[arg(long)]
     no_fins: bool,
@@ -269,7 +273,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             }
         }
         let simulation = stepper.simulation();
-        let shown = simulation.shown_colliders(time_secs);
+        let shown = stepper.shown_colliders(time_secs, args.show_colliders);
         let plane_half_size = 1.5 * simulation.bounding_radius();
         // The simulation runs in the world (the base is posed with the script's motion).
         colliders.update(device, queue, &renderer, &shown, Mat4::IDENTITY, plane_half_size)?;

@@ -264,6 +264,28 @@ fn the_try_on_body_walks_and_the_skirt_goes_with_it() {
     assert!(walk > 0.02 && walk > 4.0 * rest, "walking changes {walk} of the image, standing still {rest}");
 }
 
+/// The walking try-on's body collides with the skirt through capsules, drawn over the body only
+/// with `--show-colliders`: the default frame differs from the one that draws them.
+#[test]
+fn the_body_capsules_are_drawn_only_when_asked() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");
+    let script = root.join("assets/scenes/catwalk.toml");
+    let dir = temp_dir("show-colliders");
+    // The second frame, half a second in: the capsules are posed from the first step on.
+    let script = script.to_str().unwrap();
+    let args = ["render", "--builtin", "tryon", "--script", script, "--size", "120x160", "--fps", "2", "--frames", "2"];
+    // One kernel for both, so only the capsules can tell the frames apart.
+    let args = [&args[..], &["--sim", "cpu"]].concat();
+    let plain = pelt(&[&args[..], &["-o", "plain"]].concat(), &dir);
+    assert!(plain.status.success(), "{}", text(&plain));
+    let shown = pelt(&[&args[..], &["--show-colliders", "-o", "shown"]].concat(), &dir);
+    assert!(shown.status.success(), "{}", text(&shown));
+    let (plain, shown) = (png(&dir, "plain/frame_0002.png"), png(&dir, "shown/frame_0002.png"));
+    let differ = differing_fraction(&plain, &shown);
+    // The capsules cover part of the body (1.4% of this frame), not the frame.
+    assert!(differ > 0.005 && differ < 0.5, "the capsules change {differ} of the frame: drawn by default, or never");
+}
+
 #[test]
 fn the_catwalk_script_moves_the_body_and_the_skirt_together() {
     let root = Path::new(env!("CARGO_MANIFEST_DIR")).join("../..");

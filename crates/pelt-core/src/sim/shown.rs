@@ -1,6 +1,6 @@
 //! What a host draws of the colliders: each one once, where and as large as it is at a time.
 
-use super::contact::StepCollider;
+use super::contact::{Collider, StepCollider};
 use super::simulation::Simulation;
 
 impl Simulation {
@@ -11,13 +11,19 @@ impl Simulation {
     /// pushed out of (the step's own pose, without the samples along its path).
     #[must_use]
     pub fn shown_colliders(&self, time_secs: f64) -> Vec<StepCollider> {
+        self.shown_colliders_where(time_secs, |_| true)
+    }
+
+    /// [`Self::shown_colliders`], of the colliders `keep` takes (the grasp's hand always).
+    #[must_use]
+    pub fn shown_colliders_where(&self, time_secs: f64, keep: impl Fn(&Collider) -> bool) -> Vec<StepCollider> {
         let step_secs = 1.0 / f64::from(self.params().rate_hz);
         let mut shown = Vec::new();
         if let Some(grasp) = self.grasp() {
             shown.extend(grasp.hand(time_secs));
         }
         let mut samples = Vec::new();
-        for collider in self.colliders() {
+        for collider in self.colliders().iter().filter(|c| keep(c)) {
             samples.clear();
             collider.push_step(time_secs, step_secs, self.bounding_radius(), &mut samples);
             // The step's own pose comes last, after the samples along the way.

@@ -5,7 +5,7 @@
 use glam::{Mat4, Quat, Vec3};
 
 use super::SimParams;
-use super::contact::{Collider, Shape};
+use super::contact::{Collider, Shape, StepCollider};
 use super::scene::Scene;
 use super::simulation::{SimError, Simulation};
 use crate::anim::{Pose, Rig};
@@ -335,6 +335,15 @@ impl FurStepper {
     #[must_use]
     pub fn simulation(&self) -> &Simulation {
         &self.simulation
+    }
+
+    /// The colliders a host draws at `time_secs` ([`Simulation::shown_colliders`]); the body's
+    /// capsules only with `body`: the body is drawn as its mesh, and its capsules are a
+    /// collision proxy that would hide it.
+    #[must_use]
+    pub fn shown_colliders(&self, time_secs: f64, body: bool) -> Vec<StepCollider> {
+        let capsules = self.body.as_ref().map_or(0, |b| b.capsules.bones.len()) as u32;
+        self.simulation.shown_colliders_where(time_secs, |c| body || c.id.wrapping_sub(BODY_COLLIDER_IDS) >= capsules)
     }
 
     /// The simulation, to change its parameters, wind or touch.

@@ -183,6 +183,7 @@ impl App {
         if let Some(textures) = model.poll_textures() {
             running.fur.set_textures(&running.gpu, &textures)?;
         }
+        running.fur.body_colliders = model.settings.draw.body_colliders;
         if let Some((time_secs, clip_secs)) = model.simulate(frame_secs) {
             let started = std::time::Instant::now();
             running.fur.advance(&running.gpu, &mut model.stepper, time_secs, clip_secs)?;

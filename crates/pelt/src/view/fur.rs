@@ -35,6 +35,8 @@ pub struct FurScene {
     view: FurView,
     textures: FurTextures,
     pub settings: FurDrawSettings,
+    /// Whether a body's collision capsules are drawn (they would hide the body they stand for).
+    pub body_colliders: bool,
     /// The view-angle pass's count, read back for the overlay.
     shell_share: ShellShare,
 }
@@ -60,6 +62,7 @@ impl FurScene {
             view,
             textures: textures.clone(),
             settings: FurDrawSettings::SILHOUETTE,
+            body_colliders: false,
             shell_share: ShellShare::new(&gpu.device),
         })
     }
@@ -131,7 +134,7 @@ impl FurScene {
         time_secs: f64,
     ) -> anyhow::Result<()> {
         let simulation = stepper.simulation();
-        let shown = simulation.shown_colliders(time_secs);
+        let shown = stepper.shown_colliders(time_secs, self.body_colliders);
         let plane_half_size = 1.5 * simulation.bounding_radius();
         // The simulation runs in the world (the stepper poses the base with the script's
         // motion), so its colliders are drawn where they are.

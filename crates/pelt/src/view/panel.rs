@@ -59,11 +59,13 @@ pub struct DrawToggles {
     pub fins: bool,
     /// The unified structure (true) or the separated one of Lengyel et al. (false).
     pub unified: bool,
+    /// A body's collision capsules over the body (a script's colliders are always drawn).
+    pub body_colliders: bool,
 }
 
 impl Default for DrawToggles {
     fn default() -> Self {
-        Self { skin: true, shells: true, fins: true, unified: true }
+        Self { skin: true, shells: true, fins: true, unified: true, body_colliders: false }
     }
 }
 
@@ -363,6 +365,7 @@ pub fn show(
                 ui.radio_value(&mut draw.unified, true, "unified");
                 ui.radio_value(&mut draw.unified, false, "separated (U)");
             });
+            ui.checkbox(&mut draw.body_colliders, "the body's collision capsules");
             ui.checkbox(&mut settings.overlay, "overlay (O)");
         });
         section(ui, "Shortcuts", false, |ui| {
