@@ -95,6 +95,11 @@ impl Layouts {
             view_dimension: wgpu::TextureViewDimension::D2,
             multisampled: false,
         };
+        let unfilterable = wgpu::BindingType::Texture {
+            sample_type: wgpu::TextureSampleType::Float { filterable: false },
+            view_dimension: wgpu::TextureViewDimension::D2,
+            multisampled: false,
+        };
         let textures = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("pelt fur textures"),
             entries: &[
@@ -113,7 +118,9 @@ impl Layouts {
                 entry(0, render, uniform),
                 entry(1, render, depth_texture),
                 entry(2, render, wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Comparison)),
-                entry(3, render, depth_texture),
+                // The fur's first-surface depth, fetched by texel as a float texture (GLSL
+                // cannot fetch from a depth texture).
+                entry(3, render, unfilterable),
                 entry(4, render, texture(wgpu::TextureViewDimension::D2)),
                 entry(5, render, filtering),
             ],

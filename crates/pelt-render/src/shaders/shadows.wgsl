@@ -27,7 +27,7 @@ struct Shadow {
 @group(3) @binding(0) var<uniform> shadow: Shadow;
 @group(3) @binding(1) var shadow_depth: texture_depth_2d;
 @group(3) @binding(2) var shadow_compare: sampler_comparison;
-@group(3) @binding(3) var fur_depth: texture_depth_2d;
+@group(3) @binding(3) var fur_depth: texture_2d<f32>;
 @group(3) @binding(4) var fur_opacity: texture_2d<f32>;
 @group(3) @binding(5) var shadow_linear: sampler;
 
@@ -85,7 +85,7 @@ fn light_visibility(light_index: u32, world_position: vec3<f32>, world_normal: v
     lit += textureSampleCompareLevel(shadow_depth, shadow_compare, uv + vec2<f32>(t, t), z);
     let size = vec2<f32>(textureDimensions(fur_depth));
     let texel = clamp(vec2<i32>(uv * size), vec2<i32>(0), vec2<i32>(size) - 1);
-    let z0 = textureLoad(fur_depth, texel, 0);
+    let z0 = textureLoad(fur_depth, texel, 0).x;
     let beyond = shadow_linear_depth(z) - shadow_linear_depth(z0);
     let layers = textureSampleLevel(fur_opacity, shadow_linear, uv, 0.0);
     return 0.25 * lit * exp(-shadow.extinction * deep_opacity(layers, beyond));
@@ -95,7 +95,7 @@ fn light_visibility(light_index: u32, world_position: vec3<f32>, world_normal: v
 // fragment's depth beyond z0 (the last layer takes every fragment), so each layer holds the
 // opacity in front of its end.
 fn opacity_layers(position: vec4<f32>, alpha: f32) -> vec4<f32> {
-    let z0 = textureLoad(fur_depth, vec2<i32>(position.xy), 0);
+    let z0 = textureLoad(fur_depth, vec2<i32>(position.xy), 0).x;
     let beyond = shadow_linear_depth(position.z) - shadow_linear_depth(z0);
     let e = shadow.layer_ends;
     let inside = vec4<f32>(select(0.0, 1.0, beyond <= e.x), select(0.0, 1.0, beyond <= e.y), select(0.0, 1.0, beyond <= e.z), 1.0);
