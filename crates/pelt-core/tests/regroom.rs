@@ -83,3 +83,40 @@ fn regroom_refuses_another_structure() {
     assert!(simulation.regroom(&other, &[0]).is_err());
     assert!(simulation.regroom(&structure, &[mesh.vertex_count() as u32]).is_err());
 }
+
+/// A simulation made with skin contact off finds no skin planes (most of a dense mesh's setup);
+/// turned on later, after a dab reshaped strands, it finds the planes and triangles a simulation
+/// made with skin contact on from the regrown structure has, and steps as it does, to the bit.
+#[test]
+fn skin_contact_turned_on_late_equals_it_on_from_the_start() {
+    let preset = Preset::default();
+    let (mesh, _) = Builtin::Bunny.mesh();
+    let params = preset.fur_params(&mesh);
+    let radius = mesh.bounding_sphere().1;
+    let mut off = preset.simulation.clone();
+    off.contact.skin = false;
+    off.wind = WindParams { direction: Vec3::X, strength: 0.8, ..off.wind.clone() };
+    let on = pelt_core::sim::SimParams { contact: pelt_core::sim::ContactParams { skin: true }, ..off.clone() };
+    let structure = FurStructure::new_groomed(mesh.clone(), &params, None).unwrap();
+    let mut late = Simulation::new(&structure, &off).unwrap();
+    assert!(!late.has_skin_setup(), "skin contact off finds no planes");
+    let mut editor = GroomEditor::new(&mesh, None, preset.direction.comb).unwrap();
+    let brush = Brush { kind: BrushKind::Cut, radius: 0.15 * radius, strength: 0.6, ..Brush::default() };
+    editor.begin_stroke();
+    editor.stroke_to(&brush, mesh.positions[900]);
+    editor.end_stroke();
+    let regrown = FurStructure::new_groomed(mesh.clone(), &params, Some(editor.groom().clone())).unwrap();
+    late.regroom(&regrown, &structure.changed_strands(&regrown)).unwrap();
+    late.set_params(&on).unwrap();
+    assert!(late.has_skin_setup());
+    let mut early = Simulation::new(&regrown, &on).unwrap();
+    assert!(skin_bits(&late) == skin_bits(&early), "skin planes");
+    assert!(late.contact_strands().surface == early.contact_strands().surface, "skin triangles");
+    let mut time_secs = 0.0;
+    for _ in 0..8 {
+        time_secs += 1.0 / 30.0;
+        late.advance_to(time_secs);
+        early.advance_to(time_secs);
+        assert!(position_bits(&late) == position_bits(&early), "state at {time_secs} s");
+    }
+}

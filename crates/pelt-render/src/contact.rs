@@ -88,10 +88,15 @@ pub(crate) struct Skin {
 }
 
 impl Skin {
-    /// `structure`'s skin planes and triangles (`pelt_core::sim::contact`).
-    pub fn new(structure: &FurStructure) -> Self {
-        let setup = pelt_core::sim::contact::skin_setup(structure);
-        Self { planes: setup.planes.clone(), surface: setup.surface.clone() }
+    /// No planes and no triangles for `v` strands: what the buffer holds until the simulation
+    /// has found its skin setup (skin contact off reads none of it).
+    pub fn none(v: usize) -> Self {
+        Self { planes: vec![[glam::Vec4::ZERO; SKIN_PLANES]; v], surface: SkinSurface::default() }
+    }
+
+    /// The simulation's skin planes and triangles (`pelt_core::sim::contact`).
+    pub fn of(strands: &ContactStrands<'_>) -> Self {
+        Self { planes: strands.skin.to_vec(), surface: strands.surface.clone() }
     }
 
     /// Each strand's cone (`skin_cone`), for the screen.
@@ -118,42 +123,11 @@ impl GpuContact {
         16 + 8 * v.max(1) as u64
     }
 
-    /// The buffer with `structure`'s skin planes and triangles and no collider or grasp.
+    /// The buffer with `skin` (planes and triangles) for `structure`'s strands and no collider
+    /// or grasp.
     pub fn new(device: &wgpu::Device, structure: &FurStructure, skin: &Skin) -> Self {
         let v = structure.vertex_count();
-        let mut words = vec![[0.0_f32; 4]; colliders_first(v, CONTACT_SLOTS)];
-        for (j, planes) in skin.planes.iter().enumerate() {
-            for (p, plane) in planes.iter().enumerate() {
-                words[SKIN_FIRST + j * SKIN_PLANES + p] = plane.to_array();
-            }
-        }
-        for (j, cone) in skin.cones().enumerate() {
-            words[cones_first(v) + j] = cone.to_array();
-        }
-        // The triangles (`simulation_contact.wgsl`'s `surface_closest`).
-        let surface = &skin.surface;
-        for (j, [first, count]) in surface.strands.iter().enumerate() {
-            let root = structure.positions[j];
-            words.push(root.extend(f32::from_bits((first << 6) | count)).to_array());
-        }
-        // Each list entry is its triangle's first vec4, counted from the strands' headers.
-        let triangles_first = (v + surface.lists.len().div_ceil(4)) as u32;
-        words.extend(surface.lists.chunks(4).map(|c| {
-            let mut w = [0.0_f32; 4];
-            for (slot, index) in w.iter_mut().zip(c) {
-                *slot = f32::from_bits(triangles_first + index * SURFACE_WORDS as u32);
-            }
-            w
-        }));
-        words.extend(surface.triangles.iter().flat_map(|t| t.map(|w| w.to_array())));
-        let buffer = wgpu::util::DeviceExt::create_buffer_init(
-            device,
-            &wgpu::util::BufferInitDescriptor {
-                label: Some("pelt simulation contact"),
-                contents: bytemuck::cast_slice(&words),
-                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
-            },
-        );
+        let buffer = skin_buffer(device, &structure.positions[..v], skin);
         let fields_buffer = fields_buffer(device, &[0.0; 4]);
         let work = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("pelt simulation contact list"),
@@ -183,6 +157,14 @@ impl GpuContact {
             work_groups,
             fields: Vec::new(),
         }
+    }
+
+    /// Puts `skin` in a new buffer (its size follows the triangles); the grasp's weights are
+    /// written again at the next step, the slots are written every step. `roots`: the strands'
+    /// rest roots.
+    pub fn set_skin(&mut self, device: &wgpu::Device, roots: &[glam::Vec3], skin: &Skin) {
+        self.buffer = skin_buffer(device, roots, skin);
+        self.weights.clear();
     }
 
     /// Empties the list before a step's screen.
@@ -288,6 +270,45 @@ impl GpuContact {
         }
         self.weights = strands.grasp_weights.to_vec();
     }
+}
+
+/// The contact buffer for `roots.len()` strands: the slots' headers (zero), `skin`'s planes and
+/// cones, the collider and weight slots (zero), then the skin triangles.
+fn skin_buffer(device: &wgpu::Device, roots: &[glam::Vec3], skin: &Skin) -> wgpu::Buffer {
+    let v = roots.len();
+    let mut words = vec![[0.0_f32; 4]; colliders_first(v, CONTACT_SLOTS)];
+    for (j, planes) in skin.planes.iter().enumerate() {
+        for (p, plane) in planes.iter().enumerate() {
+            words[SKIN_FIRST + j * SKIN_PLANES + p] = plane.to_array();
+        }
+    }
+    for (j, cone) in skin.cones().enumerate() {
+        words[cones_first(v) + j] = cone.to_array();
+    }
+    // The triangles (`simulation_contact.wgsl`'s `surface_closest`).
+    let surface = &skin.surface;
+    for (j, [first, count]) in surface.strands.iter().enumerate() {
+        let root = roots[j];
+        words.push(root.extend(f32::from_bits((first << 6) | count)).to_array());
+    }
+    // Each list entry is its triangle's first vec4, counted from the strands' headers.
+    let triangles_first = (v + surface.lists.len().div_ceil(4)) as u32;
+    words.extend(surface.lists.chunks(4).map(|c| {
+        let mut w = [0.0_f32; 4];
+        for (slot, index) in w.iter_mut().zip(c) {
+            *slot = f32::from_bits(triangles_first + index * SURFACE_WORDS as u32);
+        }
+        w
+    }));
+    words.extend(surface.triangles.iter().flat_map(|t| t.map(|w| w.to_array())));
+    wgpu::util::DeviceExt::create_buffer_init(
+        device,
+        &wgpu::util::BufferInitDescriptor {
+            label: Some("pelt simulation contact"),
+            contents: bytemuck::cast_slice(&words),
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+        },
+    )
 }
 
 #[cfg(test)]

@@ -161,10 +161,28 @@ pub struct Simulation {
     surface: SkinSurface,
     /// The grid cell the skin planes were found in (the longest strand's reach).
     skin_cell: f32,
+    /// While skin contact has been off since the start: the rest shape the skin planes and
+    /// triangles are found from when it turns on (`skin`, `skin_lanes` and `surface` hold none
+    /// until then). Finding them is most of the setup on a dense mesh, so a coat that never
+    /// touches its skin never pays for it.
+    skin_source: Option<Box<FurStructure>>,
     /// Colliders the host or a script placed.
     colliders: Vec<Collider>,
     /// The grasp holding (or springing back), if any.
     grasp: Option<Grasp>,
+}
+
+/// What the skin setup reads of `fur` (`contact::skin`, `contact::surface`): its mesh, layers and
+/// rest shape, kept while skin contact is off.
+fn skin_source_of(fur: &FurStructure) -> FurStructure {
+    FurStructure {
+        mesh: fur.mesh.clone(),
+        layers: fur.layers,
+        directions: Vec::new(),
+        lengths: Vec::new(),
+        positions: fur.positions.clone(),
+        groom: None,
+    }
 }
 
 /// Simulations made so far: each one's [`InputVersions::id`].
@@ -196,8 +214,12 @@ impl Simulation {
         debug_assert!(centre.is_finite());
         let nodes = v * (layers + 1);
         let batch_nodes = batches * (layers + 1);
-        let setup = super::contact::skin_setup(fur);
-        let (skin_cell, skin) = (setup.cell, setup.planes.clone());
+        let (skin_cell, skin, surface, skin_source) = if params.contact.skin {
+            let setup = super::contact::skin_setup(fur);
+            (setup.cell, setup.planes.clone(), setup.surface.clone(), None)
+        } else {
+            (0.0, vec![[Vec4::ZERO; SKIN_PLANES]; v], SkinSurface::default(), Some(Box::new(skin_source_of(fur))))
+        };
         let mut simulation = Self {
             params: params.clone(),
             layers: fur.layers,
@@ -235,10 +257,11 @@ impl Simulation {
             },
             roots_moved: false,
             touch_on_step_roots: false,
-            surface: setup.surface.clone(),
+            surface,
             skin_lanes: skin_lanes(&skin),
             skin,
             skin_cell,
+            skin_source,
             colliders: Vec::new(),
             grasp: None,
         };
@@ -267,8 +290,30 @@ impl Simulation {
         if params.stability != self.params.stability {
             self.versions.stability += 1;
         }
+        if params.contact.skin {
+            self.find_skin_setup();
+        }
         self.params = params.clone();
         Ok(())
+    }
+
+    /// Finds the skin planes and triangles if skin contact has been off until now.
+    fn find_skin_setup(&mut self) {
+        if let Some(fur) = self.skin_source.take() {
+            let setup = super::contact::skin_setup(&fur);
+            self.skin_cell = setup.cell;
+            self.skin.clone_from(&setup.planes);
+            self.surface.clone_from(&setup.surface);
+            self.skin_lanes = skin_lanes(&self.skin);
+        }
+    }
+
+    /// Whether the skin planes and triangles are found ([`Simulation::contact_strands`] holds
+    /// them): from the start with skin contact on, else from the first
+    /// [`Simulation::set_params`] that turns it on.
+    #[must_use]
+    pub fn has_skin_setup(&self) -> bool {
+        self.skin_source.is_none()
     }
 
     /// Sets the wind from the next step on.

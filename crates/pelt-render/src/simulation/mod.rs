@@ -92,6 +92,8 @@ pub struct GpuSimulation {
     touch_uploaded: bool,
     /// `Simulation::steps_taken` at the last prepare (`None`: replay the last two steps).
     seen_steps: Option<u64>,
+    /// Whether the contact buffer holds the simulation's skin planes and triangles.
+    skin_found: bool,
     /// Steps prepared and not yet dispatched (at most [`STEP_SLOTS`], in slot order).
     pending: Vec<StepUniform>,
     /// The ring slot of the first pending step.
@@ -271,7 +273,9 @@ impl GpuSimulation {
             v.max(1) as u64 * STATE_BYTES,
             storage_usage | wgpu::BufferUsages::COPY_SRC,
         );
-        let skin = Skin::new(structure);
+        // The skin's planes and triangles come from the CPU simulation once it has found them
+        // (skin contact on): a coat that never touches its skin never finds them.
+        let skin = Skin::none(v);
         check_size(device, "simulation contact", GpuContact::bytes(&skin))?;
         check_size(device, "simulation contact list", GpuContact::work_bytes(v))?;
         let contact = GpuContact::new(device, structure, &skin);
@@ -298,6 +302,7 @@ impl GpuSimulation {
             weigh_touch: false,
             touch_uploaded: false,
             seen_steps: None,
+            skin_found: false,
             pending: Vec::with_capacity(STEP_SLOTS + 2),
             ring: 0,
             dispatched_history: 0,
@@ -380,9 +385,18 @@ impl GpuSimulation {
         }
         let history = if start_over { 0 } else { self.dispatched_history };
         self.pending_history = settle_inertia(&mut self.pending, history);
-        self.contact.write_strands(queue, &simulation.contact_strands());
-        if self.contact.upload_fields(device, &self.pending_contact)? {
-            // The fields buffer is new: bind it.
+        let strands = simulation.contact_strands();
+        let mut rebind = false;
+        if !self.skin_found && simulation.has_skin_setup() {
+            let skin = Skin::of(&strands);
+            check_size(device, "simulation contact", GpuContact::bytes(&skin))?;
+            self.contact.set_skin(device, strands.rest_roots, &skin);
+            self.skin_found = true;
+            rebind = true;
+        }
+        self.contact.write_strands(queue, &strands);
+        if self.contact.upload_fields(device, &self.pending_contact)? || rebind {
+            // The fields or the contact buffer is new: bind it.
             self.bind_groups.clear();
             for buffer in [fur.current_positions(), fur.previous_positions()] {
                 self.bind_group_for(device, buffer)?;

@@ -33,6 +33,12 @@ impl Simulation {
             return Ok(());
         }
         self.rest.update(&fur.positions, v, layers, strands);
+        if let Some(source) = &mut self.skin_source {
+            // Skin contact is off: only the rest shape its setup will be found from changes.
+            source.positions.clone_from(&fur.positions);
+            self.restart();
+            return Ok(());
+        }
         let (cell, planes) = skin_planes_of(fur, strands.iter().map(|&j| j as usize));
         if cell.to_bits() == self.skin_cell.to_bits() {
             for (&j, planes) in strands.iter().zip(planes) {
