@@ -13,13 +13,10 @@ use glam::{Vec3, Vec4};
 
 use crate::RenderError;
 use crate::renderer::FurRenderer;
-use crate::shaders::{ShadowUniform, shadow_texture};
+use crate::shaders::{
+    SHADOW_DEPTH_FORMAT as DEPTH_FORMAT, SHADOW_OPACITY_FORMAT as OPACITY_FORMAT, ShadowUniform, shadow_texture,
+};
 use crate::view::{FurView, ShadowPass, ViewData};
-
-/// The shadow maps' depth format.
-pub(crate) const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
-/// The opacity layers' format: four layers, blended additively.
-pub(crate) const OPACITY_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;
 
 /// The light that casts the shadows.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -235,5 +232,13 @@ impl ShadowMap {
     /// Group 3 of the views lit with these maps.
     pub(crate) fn receiver_group(&self) -> &wgpu::BindGroup {
         &self.receiver
+    }
+}
+
+impl FurView {
+    /// Lights the draws through this view with `shadows` (the key light's shadow map, recorded
+    /// with [`ShadowMap::record`] before this view's pass), or without shadows (`None`).
+    pub fn set_shadows(&mut self, shadows: Option<&ShadowMap>) {
+        self.set_shadow_group(shadows.map(ShadowMap::receiver_group));
     }
 }

@@ -5,7 +5,6 @@
 use glam::{Mat4, Vec3};
 
 use crate::shaders::{Layouts, ViewUniform};
-use crate::shadows::ShadowMap;
 
 /// Where the key light comes from.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -142,11 +141,11 @@ impl FurView {
         Self { shadow_group, role: ViewRole::Shadow(pass), ..Self::create(device, layouts) }
     }
 
-    /// Lights the draws through this view with `shadows` (the key light's shadow map, recorded
-    /// with [`ShadowMap::record`] before this view's pass), or without shadows (`None`).
-    pub fn set_shadows(&mut self, shadows: Option<&ShadowMap>) {
-        self.shadow_group = shadows.map_or_else(|| self.no_shadows.clone(), |map| map.receiver_group().clone());
-        self.role = ViewRole::Camera { shadowed: shadows.is_some() };
+    /// Binds a shadow map's receiver group (`None`: the stand-ins, no shadows); hosts call
+    /// `FurView::set_shadows` (`shadows.rs`).
+    pub(crate) fn set_shadow_group(&mut self, group: Option<&wgpu::BindGroup>) {
+        self.shadow_group = group.map_or_else(|| self.no_shadows.clone(), Clone::clone);
+        self.role = ViewRole::Camera { shadowed: group.is_some() };
     }
 
     /// Whether draws through this view read a shadow map.

@@ -147,37 +147,4 @@ mod tests {
             assert!(farthest < 0.08 * height, "at {t} s a skirt vertex is {farthest} from the body");
         }
     }
-
-    /// The body's capsules collide with the skirt's fur but are drawn only when asked; a ball a
-    /// script places is drawn either way.
-    #[test]
-    fn the_body_capsules_are_shown_only_when_asked() {
-        use crate::fur::{FurLength, FurParams, FurStructure};
-        use crate::sim::stepper::BODY_COLLIDER_IDS;
-        use crate::sim::{FurStepper, Scene, SimParams};
-        let scene = walking_try_on(&ImportOptions::default()).expect("walking try-on");
-        let fur = FurStructure::new(
-            scene.garment.clone(),
-            &FurParams { layers: 4, length: FurLength::Constant(0.02), direction: Default::default() },
-        )
-        .expect("fur on the skirt");
-        let mut stepper = FurStepper::new(&fur, &SimParams::default()).expect("stepper");
-        stepper.set_clip(scene.garment_rig.clone(), Some(0));
-        let capsules = scene.capsules.bones.len();
-        stepper.set_body(Some((scene.body.clone(), scene.body_rig.clone(), scene.capsules.clone())));
-        let script = "[[collider]]\nshape = { kind = \"sphere\", radius = 0.1 }\n\
-                      keys = [{ time_secs = 0.0, position = [0.0, 3.0, 0.0] }]\n";
-        stepper.set_scene(Some(Scene::from_toml_str(script, Path::new("ball.toml")).expect("script")));
-        stepper.advance_to(0.5).expect("steps");
-        let colliding = stepper.simulation().colliders();
-        let body_ids = colliding.iter().filter(|c| c.id.wrapping_sub(BODY_COLLIDER_IDS) < capsules as u32).count();
-        assert!(capsules >= 10 && body_ids == capsules, "{body_ids} of {capsules} capsules collide");
-        let balls = |shown: &[crate::sim::StepCollider]| {
-            shown.iter().filter(|c| c.kind == crate::sim::StepCollider::SPHERE && (c.radius - 0.1).abs() < 1e-6).count()
-        };
-        let hidden = stepper.shown_colliders(0.5, false);
-        assert_eq!((hidden.len(), balls(&hidden)), (1, 1), "only the script's ball is drawn by default");
-        let shown = stepper.shown_colliders(0.5, true);
-        assert_eq!((shown.len(), balls(&shown)), (1 + capsules, 1), "asked, the capsules are drawn too");
-    }
 }

@@ -7,7 +7,7 @@ use super::{CoatBuilder, FurRenderer, PipelineSource};
 use crate::fur::{Coat, GpuFur};
 use crate::plain::PlainMesh;
 use crate::renderer::FurDrawSettings;
-use crate::shadows::{DEPTH_FORMAT, OPACITY_FORMAT};
+use crate::shaders::{SHADOW_DEPTH_FORMAT as DEPTH_FORMAT, SHADOW_OPACITY_FORMAT as OPACITY_FORMAT};
 use crate::view::{FurView, ShadowPass};
 
 /// What a shadow pipeline writes.

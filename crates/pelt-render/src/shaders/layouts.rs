@@ -293,3 +293,8 @@ fn stand_in_shadows(
     let opacity = shadow_texture(device, wgpu::TextureFormat::Rgba16Float, 1, false);
     shadow_group(device, layout, &uniform, (&depth, &depth, &opacity), samplers)
 }
+
+/// The shadow maps' depth format.
+pub(crate) const SHADOW_DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
+/// The opacity layers' format: four layers, blended additively.
+pub(crate) const SHADOW_OPACITY_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Rgba16Float;

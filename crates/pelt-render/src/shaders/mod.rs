@@ -10,7 +10,7 @@ mod layouts;
 mod mirrors;
 
 pub(crate) use layouts::Layouts;
-pub(crate) use layouts::shadow_texture;
+pub(crate) use layouts::{SHADOW_DEPTH_FORMAT, SHADOW_OPACITY_FORMAT, shadow_texture};
 #[cfg(all(test, feature = "lab"))]
 pub(crate) use mirrors::assert_vertex_mirrors;
 pub(crate) use mirrors::{OBJECT_UNIFORM_BYTES, ObjectUniform, ShadowUniform, ViewUniform};
