@@ -96,7 +96,7 @@ pub(crate) enum ViewRole {
     Shadow(ShadowPass),
 }
 
-/// The passes of a [`ShadowMap`], in order.
+/// The passes of a [`ShadowMap`](crate::ShadowMap), in order.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) enum ShadowPass {
     /// Everything opaque (skin, plain meshes, colliders, ground), depth only.
