@@ -1,7 +1,8 @@
 //! `pelt bench --load`: where the time to a mesh's first frame goes, phase by phase, in the
 //! order every host runs them: the file read and parsed, the mesh repaired (welding, normals,
 //! winding), the unified structure grown, the shell and fin textures made, the skin contact's
-//! planes and triangles found, and the fur uploaded to the GPU.
+//! planes and triangles found (only by a coat with skin contact on, `[simulation.contact] skin`),
+//! and the fur uploaded to the GPU.
 
 use std::path::{Path, PathBuf};
 use std::time::Instant;
@@ -25,7 +26,11 @@ pub fn run(meshes_dir: &Path, extra: &[PathBuf]) -> anyhow::Result<()> {
     let gpu = Gpu::new(Backend::Auto).context("opening a GPU for the upload phase")?;
     let renderer = FurRenderer::new(&gpu.device, FurTarget::new(HEADLESS_FORMAT))?;
     let preset = Preset::default();
-    println!("Load phases (ms) with the default preset (L = {}), on {}:\n", preset.layers, gpu.summary());
+    println!(
+        "Load phases (ms) with the default preset (L = {}), on {}; skin setup is paid only with skin contact on:\n",
+        preset.layers,
+        gpu.summary()
+    );
     println!("| mesh | triangles | parse | repair | structure | textures | skin setup | GPU upload | total |");
     println!("|---|---:|---:|---:|---:|---:|---:|---:|---:|");
     for path in &files {
