@@ -67,8 +67,8 @@ fn every_wgsl_file_is_part_of_a_validated_module() {
         }
     }
     assert_eq!(
-        checked, 12,
-        "shading, wet, unified, separated, scan, silhouette, view_lod, simulation_wind, simulation, \
-         simulation_inputs, simulation_contact and strands"
+        checked, 13,
+        "shading, wet, shadows, unified, separated, scan, silhouette, view_lod, simulation_wind, \
+         simulation, simulation_inputs, simulation_contact and strands"
     );
 }
