@@ -99,8 +99,8 @@ fn skin_contact_turned_on_late_equals_it_on_from_the_start() {
     off.wind = WindParams { direction: Vec3::X, strength: 0.8, ..off.wind.clone() };
     let on = pelt_core::sim::SimParams { contact: pelt_core::sim::ContactParams { skin: true }, ..off.clone() };
     let mut editor = GroomEditor::new(&mesh, None, preset.direction.comb).unwrap();
-    let mut dab = |at: usize| {
-        let brush = Brush { kind: BrushKind::Cut, radius: 0.15 * radius, strength: 0.6, ..Brush::default() };
+    let mut dab = |kind: BrushKind, at: usize| {
+        let brush = Brush { kind, radius: 0.15 * radius, strength: 0.6, ..Brush::default() };
         editor.begin_stroke();
         editor.stroke_to(&brush, mesh.positions[at]);
         editor.end_stroke();
@@ -111,7 +111,8 @@ fn skin_contact_turned_on_late_equals_it_on_from_the_start() {
     assert!(!late.has_skin_setup(), "skin contact off finds no planes");
     let mut time_secs = 0.5;
     late.advance_to(time_secs);
-    let regrown = dab(900);
+    // Grow lengthens the longest strands: every strand's skin planes change with their reach.
+    let regrown = dab(BrushKind::Grow, 100);
     late.regroom(&regrown, &structure.changed_strands(&regrown)).unwrap();
     late.set_params(&on).unwrap();
     assert!(late.has_skin_setup());
@@ -119,7 +120,7 @@ fn skin_contact_turned_on_late_equals_it_on_from_the_start() {
     early.advance_to(time_secs);
     assert!(skin_bits(&late) == skin_bits(&early), "skin planes");
     assert!(late.contact_strands().surface == early.contact_strands().surface, "skin triangles");
-    let again = dab(60);
+    let again = dab(BrushKind::Cut, 60);
     let strands = regrown.changed_strands(&again);
     late.regroom(&again, &strands).unwrap();
     early.regroom(&again, &strands).unwrap();
