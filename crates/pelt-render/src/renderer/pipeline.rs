@@ -31,6 +31,7 @@ pub(crate) enum PassKind {
 }
 
 /// One pipeline's shader and vertex input.
+#[derive(Clone, Copy)]
 pub(crate) struct PipelineSource<'a> {
     /// Whether every mesh the pipeline draws has uvs, where that is known (the unified
     /// renderer walks meshes with and without them through separate pipelines): the shaders
@@ -44,6 +45,31 @@ pub(crate) struct PipelineSource<'a> {
     pub vertex_entry: &'a str,
     pub fragment_entry: &'a str,
     pub buffers: &'a [Option<wgpu::VertexBufferLayout<'a>>],
+}
+
+impl PipelineSource<'_> {
+    /// The shaders' override constants for this source (`shading.wgsl`, `unified.wgsl`,
+    /// `shadows.wgsl`); `coverage` sets `ALPHA_TO_COVERAGE`.
+    pub(crate) fn constants(&self, coverage: bool) -> [(&'static str, f64); 5] {
+        let mesh_uvs = match self.mesh_uvs {
+            None => 0.0,
+            Some(true) => 1.0,
+            Some(false) => 2.0,
+        };
+        // 0 reads the object's flag, 1 is off, 2 on.
+        let switch = |on: Option<bool>| match on {
+            None => 0.0,
+            Some(false) => 1.0,
+            Some(true) => 2.0,
+        };
+        [
+            ("ALPHA_TO_COVERAGE", if coverage { 1.0 } else { 0.0 }),
+            ("MESH_UVS", mesh_uvs),
+            ("GROOM", switch(self.coat.map(|c| c.groomed))),
+            ("WET", switch(self.coat.map(|c| c.wet))),
+            ("SHADOWS", if self.coat.is_some_and(|c| c.shadowed) { 1.0 } else { 0.0 }),
+        ]
+    }
 }
 
 /// Builds one Pelt pipeline for `target`.
@@ -66,24 +92,7 @@ pub(crate) fn create_pipeline(
         PassKind::Fins(_) => None,
         PassKind::Opaque | PassKind::Shells(_) => Some(wgpu::Face::Back),
     };
-    let mesh_uvs = match source.mesh_uvs {
-        None => 0.0,
-        Some(true) => 1.0,
-        Some(false) => 2.0,
-    };
-    // 0 reads the object's flag, 1 is off, 2 on.
-    let switch = |on: Option<bool>| match on {
-        None => 0.0,
-        Some(false) => 1.0,
-        Some(true) => 2.0,
-    };
-    let constants = [
-        ("ALPHA_TO_COVERAGE", if coverage { 1.0 } else { 0.0 }),
-        ("MESH_UVS", mesh_uvs),
-        ("GROOM", switch(source.coat.map(|c| c.groomed))),
-        ("WET", switch(source.coat.map(|c| c.wet))),
-        ("SHADOWS", if source.coat.is_some_and(|c| c.shadowed) { 1.0 } else { 0.0 }),
-    ];
+    let constants = source.constants(coverage);
     let compilation_options = wgpu::PipelineCompilationOptions { constants: &constants, ..Default::default() };
     device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
         label: Some(label),

@@ -182,20 +182,9 @@ fn create_shadow_pipeline(
     fragment_entry: Option<&str>,
     kind: ShadowKind,
 ) -> wgpu::RenderPipeline {
-    let switch = |on: bool| if on { 2.0 } else { 1.0 };
-    let coat = source.coat.unwrap_or(Coat::PLAIN);
-    let mesh_uvs = match source.mesh_uvs {
-        None => 0.0,
-        Some(true) => 1.0,
-        Some(false) => 2.0,
-    };
-    let constants = [
-        ("ALPHA_TO_COVERAGE", 0.0),
-        ("MESH_UVS", mesh_uvs),
-        ("GROOM", switch(coat.groomed)),
-        ("WET", switch(coat.wet)),
-        ("SHADOWS", 0.0),
-    ];
+    // The shadow views draw a coat's own shapes without reading shadows themselves.
+    let coat = source.coat.unwrap_or(Coat::PLAIN).shadowed(false);
+    let constants = PipelineSource { coat: Some(coat), ..*source }.constants(false);
     let compilation_options = wgpu::PipelineCompilationOptions { constants: &constants, ..Default::default() };
     let (depth_write, bias, cull_mode) = match kind {
         // A texel's worth of slope keeps lit surfaces off their own shadow.
