@@ -12,8 +12,10 @@
 
 mod objects;
 mod pipeline;
+mod prepass;
 
 pub(crate) use pipeline::{PassKind, PipelineSource, Transparency, create_pipeline};
+pub use prepass::{FurMotion, FurPrepass, MotionData, PrepassTarget};
 
 use std::sync::OnceLock;
 
