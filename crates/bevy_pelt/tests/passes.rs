@@ -22,8 +22,9 @@ use bevy_pelt::{Fur, FurState};
 use crate::common::{self, test_assets as assets, update};
 use crate::render::{SIZE, capture, cuboid, preset};
 
-/// The skinless furred cube over a lit ground, the sun straight above; `caster` leaves the fur
-/// casting (else `NotShadowCaster`).
+/// The skinless furred cube over a lit ground, the sun almost straight above (slightly behind it,
+/// so the shadow falls toward the camera); `caster` leaves the fur casting (else
+/// `NotShadowCaster`).
 fn shadow_scene(caster: bool) -> image::RgbaImage {
     let images = capture(1, |world, targets| {
         let ground = world.resource_mut::<Assets<StandardMaterial>>().add(StandardMaterial::from(Color::WHITE));
@@ -37,7 +38,7 @@ fn shadow_scene(caster: bool) -> image::RgbaImage {
         }
         world.spawn((
             DirectionalLight { illuminance: 4000.0, shadow_maps_enabled: true, ..default() },
-            Transform::from_xyz(0.3, 6.0, 0.2).looking_at(Vec3::ZERO, Vec3::Y),
+            Transform::from_xyz(0.3, 6.0, -1.0).looking_at(Vec3::ZERO, Vec3::Y),
         ));
         world.spawn((
             Camera3d::default(),
@@ -62,7 +63,7 @@ fn the_fur_casts_into_bevys_shadow_maps() {
     // The fur draws the same either way; only the ground under it darkens.
     let darker = cast.pixels().zip(not_cast.pixels()).filter(|(a, b)| luma(a) + 20.0 < luma(b)).count();
     let brighter = cast.pixels().zip(not_cast.pixels()).filter(|(a, b)| luma(a) > luma(b) + 20.0).count();
-    assert!(darker > 400, "{darker} pixels darker with the fur casting");
+    assert!(darker > 250, "{darker} pixels darker with the fur casting");
     assert!(brighter < darker / 10, "{brighter} pixels brighter, {darker} darker");
 }
 
