@@ -2,11 +2,15 @@
 //! with its own `AnimationPlayer`; bevy_pelt takes Bevy's joints each frame, skins the fur's base
 //! with pelt-core and simulates it (the fur swings as the Fox moves).
 //!
-//! `cargo run --release -p bevy_pelt --example fox [--ignore-rust-version] -- [PRESET] [--screenshot PNG]`
+//! `cargo run --release -p bevy_pelt --example fox [--ignore-rust-version] -- [PRESET] [--screenshot PNG]
+//! [--no-taa] [--no-shadows] [--no-fur]`
 //! (PRESET is relative to the repository's `assets/`, default `presets/fox_groomed.toml`: the
 //! Fox's own texture carried into its fur, groomed by `fox_groomed.groom`: bald eyes, nose and
 //! inner ears, a short face and legs, a long tail and a chest ruff; editing the preset or the
 //! groom file while the example runs regrows the fur).
+//!
+//! The fur casts the Fox's shadow on the ground and writes its depth and motion vectors in
+//! Bevy's prepass, so the camera's TAA keeps it sharp as it walks.
 //!
 //! Right-drag orbits, the wheel zooms. 1, 2 and 3 play Survey, Walk and Run; Space pauses.
 //! `--screenshot PNG` saves a frame and exits.

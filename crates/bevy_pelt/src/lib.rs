@@ -39,6 +39,10 @@
 //!   `DirectionalLight` (its direction and colour, its illuminance times the camera's exposure
 //!   over pi, as Bevy lights a white diffuse surface facing it), or by [`FurLight`]'s light when
 //!   there is none; [`FurLight`]'s ambient applies either way.
+//! - Fur casts into Bevy's shadow maps (directional cascades, point and spot lights) unless its
+//!   entity has `NotShadowCaster`, and on a camera with `DepthPrepass` (and
+//!   `MotionVectorPrepass`, as TAA and motion blur need) writes its depth (and motion vectors)
+//!   into Bevy's prepass textures; under TAA it is drawn with the camera's jitter.
 
 #![warn(missing_docs)]
 // Bevy systems take their queries and resources as parameters; splitting them up to please these
@@ -50,6 +54,7 @@ mod contact;
 mod convert;
 mod fur;
 mod mesh;
+mod passes;
 mod preset;
 mod render;
 mod wet;
@@ -57,8 +62,10 @@ mod wet;
 use bevy::app::{App, Plugin, PostUpdate};
 use bevy::asset::AssetApp;
 use bevy::core_pipeline::core_3d::{main_opaque_pass_3d, main_transparent_pass_3d};
+use bevy::core_pipeline::prepass::node::late_prepass;
 use bevy::core_pipeline::{Core3dSystems, schedule::Core3d};
 use bevy::ecs::schedule::IntoScheduleConfigs;
+use bevy::pbr::{LATE_SHADOW_PASS, per_view_shadow_pass, shared_shadow_pass};
 use bevy::render::{ExtractSchedule, Render, RenderApp, RenderSystems};
 use bevy::transform::TransformSystems;
 
@@ -89,14 +96,30 @@ impl Plugin for PeltPlugin {
         render_app
             .init_resource::<render::ExtractedFurs>()
             .init_resource::<render::FurGpu>()
+            .init_resource::<passes::FurPasses>()
             .add_systems(ExtractSchedule, render::extract_furs)
-            .add_systems(Render, render::prepare_furs.in_set(RenderSystems::PrepareResources))
+            .add_systems(
+                Render,
+                (render::prepare_furs, passes::prepare_fur_passes).chain().in_set(RenderSystems::PrepareResources),
+            )
             .add_systems(
                 Core3d,
                 render::draw_furs
                     .after(main_opaque_pass_3d)
                     .before(main_transparent_pass_3d)
                     .in_set(Core3dSystems::MainPass),
+            )
+            .add_systems(
+                Core3d,
+                (
+                    passes::draw_fur_prepass.after(late_prepass).in_set(Core3dSystems::Prepass),
+                    passes::draw_fur_cascades
+                        .after(per_view_shadow_pass::<LATE_SHADOW_PASS>)
+                        .before(Core3dSystems::MainPass),
+                    passes::draw_fur_shared_shadows
+                        .after(shared_shadow_pass::<LATE_SHADOW_PASS>)
+                        .before(Core3dSystems::MainPass),
+                ),
             );
     }
 }

@@ -7,11 +7,11 @@ use std::sync::Arc;
 
 use bevy::camera::{Camera3d, CompositingSpace, Exposure};
 use bevy::ecs::prelude::*;
-use bevy::light::DirectionalLight;
+use bevy::light::{DirectionalLight, NotShadowCaster};
 use bevy::log::error;
 use bevy::prelude::{GlobalTransform, InheritedVisibility};
 use bevy::render::Extract;
-use bevy::render::camera::ExtractedCamera;
+use bevy::render::camera::{ExtractedCamera, TemporalJitter};
 use bevy::render::renderer::{RenderContext, RenderDevice, RenderQueue, ViewQuery};
 use bevy::render::view::{ExtractedView, Msaa, ResolvedCompositingSpace, ViewDepthStencilTexture, ViewTarget};
 use pelt_core::FurStructure;
@@ -38,7 +38,7 @@ use crate::fur::{Fur, FurState};
 pub struct FurLight(pub Light);
 
 /// The depth format of Bevy's 3D views.
-const DEPTH_FORMAT: wgpu::TextureFormat = bevy::core_pipeline::core_3d::CORE_3D_DEPTH_FORMAT;
+pub(crate) const DEPTH_FORMAT: wgpu::TextureFormat = bevy::core_pipeline::core_3d::CORE_3D_DEPTH_FORMAT;
 
 /// This frame's furs, copied out of the main world.
 #[derive(Resource, Default)]
@@ -68,16 +68,18 @@ impl Sun {
     }
 }
 
-struct ExtractedFur {
-    entity: Entity,
-    revision: u64,
+pub(crate) struct ExtractedFur {
+    pub(crate) entity: Entity,
+    pub(crate) revision: u64,
     structure: Arc<FurStructure>,
     textures: Arc<FurTextures>,
     positions: Arc<Vec<glam::Vec3>>,
     normals: Arc<Vec<glam::Vec3>>,
-    world_from_simulation: glam::Mat4,
+    pub(crate) world_from_simulation: glam::Mat4,
     centre_world: glam::Vec3,
-    skin: bool,
+    pub(crate) skin: bool,
+    /// Drawn into Bevy's shadow maps (no `NotShadowCaster`).
+    pub(crate) casts_shadows: bool,
     wetness: Option<Arc<Vec<f32>>>,
     wet: WetParams,
 }
@@ -85,7 +87,7 @@ struct ExtractedFur {
 pub(crate) fn extract_furs(
     mut extracted: ResMut<ExtractedFurs>,
     light: Extract<Res<FurLight>>,
-    furs: Extract<Query<(Entity, &Fur, &FurState, Option<&InheritedVisibility>)>>,
+    furs: Extract<Query<(Entity, &Fur, &FurState, Option<&InheritedVisibility>, Has<NotShadowCaster>)>>,
     suns: Extract<Query<(Entity, &DirectionalLight, &GlobalTransform, Option<&InheritedVisibility>)>>,
 ) {
     extracted.light = light.0;
@@ -101,7 +103,7 @@ pub(crate) fn extract_furs(
             colour_lux.is_finite().then_some(Sun { toward_light, colour_lux })
         });
     extracted.furs.clear();
-    for (entity, fur, state, visibility) in &furs {
+    for (entity, fur, state, visibility, not_caster) in &furs {
         if visibility.is_some_and(|v| !v.get()) {
             continue;
         }
@@ -115,9 +117,43 @@ pub(crate) fn extract_furs(
             world_from_simulation: state.world_from_simulation,
             centre_world: state.centre_world,
             skin: fur.skin,
+            casts_shadows: !not_caster,
             wetness: state.wetness.clone(),
             wet: state.wet.clone(),
         });
+    }
+}
+
+impl ExtractedFurs {
+    pub(crate) fn furs(&self) -> &[ExtractedFur] {
+        &self.furs
+    }
+}
+
+/// A view's projection times view, as Bevy's shaders see it without the TAA jitter.
+pub(crate) fn clip_from_world(view: &ExtractedView) -> glam::Mat4 {
+    match view.clip_from_world {
+        Some(clip_from_world) => to_pelt_mat4(&clip_from_world),
+        None => to_pelt_mat4(&view.clip_from_view) * to_pelt_mat4(&view.world_from_view.to_matrix()).inverse(),
+    }
+}
+
+/// The projection Bevy draws a camera's geometry with: jittered under TAA, so the fur's samples
+/// move with the rest of the picture's.
+fn jittered_clip_from_world(view: &ExtractedView, jitter: Option<&TemporalJitter>) -> glam::Mat4 {
+    let Some(jitter) = jitter.filter(|_| view.clip_from_world.is_none()) else { return clip_from_world(view) };
+    let mut clip_from_view = view.clip_from_view;
+    jitter.jitter_projection(&mut clip_from_view, bevy::math::UVec2::new(view.viewport.z, view.viewport.w).as_vec2());
+    to_pelt_mat4(&clip_from_view) * to_pelt_mat4(&view.world_from_view.to_matrix()).inverse()
+}
+
+impl ViewEntry {
+    pub(crate) fn target(&self) -> FurTarget {
+        self.target
+    }
+
+    pub(crate) fn fur_view(&self) -> &FurView {
+        &self.view
     }
 }
 
@@ -138,9 +174,12 @@ struct GpuFurEntry {
     /// Draws the states the main world's `FurStepper` simulates (the CPU kernel).
     fur: FurDriver,
     revision: u64,
+    /// The positions and model transform drawn this frame and the last (motion vectors).
+    current: Option<(Arc<Vec<glam::Vec3>>, glam::Mat4)>,
+    previous: Option<(Arc<Vec<glam::Vec3>>, glam::Mat4)>,
 }
 
-struct ViewEntry {
+pub(crate) struct ViewEntry {
     target: FurTarget,
     view: FurView,
     /// Draw through an sRGB view of Bevy's `Rgba8Unorm` target, which holds sRGB-encoded colour
@@ -160,6 +199,32 @@ fn colour_format(target_format: wgpu::TextureFormat, space: Option<CompositingSp
     }
 }
 
+impl FurGpu {
+    pub(crate) fn view(&self, entity: Entity) -> Option<&ViewEntry> {
+        self.views.get(&entity)
+    }
+
+    /// The renderer of a target some view has.
+    pub(crate) fn renderer(&self, target: FurTarget) -> &FurRenderer {
+        &self.renderers[&target]
+    }
+
+    /// A target some view draws into, the same every frame while the views stay.
+    pub(crate) fn first_target(&self) -> Option<FurTarget> {
+        self.views.values().map(|view| view.target).min_by_key(|target| format!("{target:?}"))
+    }
+
+    pub(crate) fn fur(&self, entity: Entity, target: FurTarget) -> Option<&FurDriver> {
+        self.furs.get(&(entity, target)).map(|entry| &entry.fur)
+    }
+
+    /// Last frame's positions and model transform of a fur (none on its first frame).
+    pub(crate) fn previous(&self, entity: Entity, target: FurTarget) -> Option<(&[glam::Vec3], glam::Mat4)> {
+        let (positions, transform) = self.furs.get(&(entity, target))?.previous.as_ref()?;
+        Some((&positions[..], *transform))
+    }
+}
+
 /// Pipelines per target, a view uniform per camera, and each fur's upload and transform.
 pub(crate) fn prepare_furs(
     device: Res<RenderDevice>,
@@ -167,7 +232,14 @@ pub(crate) fn prepare_furs(
     extracted: Res<ExtractedFurs>,
     mut gpu: ResMut<FurGpu>,
     views: Query<
-        (Entity, &ExtractedView, &Msaa, Option<&ResolvedCompositingSpace>, Option<&ExtractedCamera>),
+        (
+            Entity,
+            &ExtractedView,
+            &Msaa,
+            Option<&ResolvedCompositingSpace>,
+            Option<&ExtractedCamera>,
+            Option<&TemporalJitter>,
+        ),
         (With<ViewTarget>, With<Camera3d>),
     >,
 ) {
@@ -176,7 +248,7 @@ pub(crate) fn prepare_furs(
     let gpu = &mut *gpu;
     let mut seen_views = HashSet::new();
     let mut targets = HashSet::new();
-    for (entity, view, msaa, space, camera) in &views {
+    for (entity, view, msaa, space, camera, jitter) in &views {
         let (colour, srgb_view) = colour_format(view.target_format, ResolvedCompositingSpace::space(space));
         let target = FurTarget::new(colour)
             .with_depth(DEPTH_FORMAT, wgpu::CompareFunction::GreaterEqual)
@@ -207,10 +279,7 @@ pub(crate) fn prepare_furs(
         };
         entry.srgb_view = srgb_view;
         let world_from_view = to_pelt_mat4(&view.world_from_view.to_matrix());
-        let clip_from_world = match view.clip_from_world {
-            Some(clip_from_world) => to_pelt_mat4(&clip_from_world),
-            None => to_pelt_mat4(&view.clip_from_view) * world_from_view.inverse(),
-        };
+        let clip_from_world = jittered_clip_from_world(view, jitter);
         entry.camera_position = world_from_view.w_axis.truncate();
         let exposure = camera.map_or_else(|| Exposure::default().exposure(), |camera| camera.exposure);
         let light = extracted.sun.map_or(extracted.light, |sun| sun.light(exposure, extracted.light.ambient));
@@ -234,7 +303,10 @@ pub(crate) fn prepare_furs(
                 match FurDriver::new(device, queue, renderer, &fur.structure, &fur.textures, &params, KernelChoice::Cpu)
                 {
                     Ok(gpu_fur) => {
-                        gpu.furs.insert(key, GpuFurEntry { fur: gpu_fur, revision: fur.revision });
+                        gpu.furs.insert(
+                            key,
+                            GpuFurEntry { fur: gpu_fur, revision: fur.revision, current: None, previous: None },
+                        );
                     }
                     Err(problem) => {
                         error!("Pelt cannot upload the fur of {}: {problem}", fur.entity);
@@ -255,6 +327,8 @@ pub(crate) fn prepare_furs(
                 error!("Pelt cannot update the fur of {}: {problem}", fur.entity);
                 continue;
             }
+            let now = (Arc::clone(&fur.positions), fur.world_from_simulation);
+            entry.previous = entry.current.replace(now);
             seen_furs.insert(key);
         }
     }

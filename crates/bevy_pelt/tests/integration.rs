@@ -6,5 +6,7 @@ mod common;
 
 #[path = "interaction.rs"]
 mod interaction;
+#[path = "passes.rs"]
+mod passes;
 #[path = "render.rs"]
 mod render;

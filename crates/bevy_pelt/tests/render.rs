@@ -17,7 +17,7 @@ use bevy::render::render_resource::TextureFormat;
 use bevy::render::view::screenshot::{Screenshot, ScreenshotCaptured};
 use bevy_pelt::{Fur, FurPreset, FurState};
 
-const SIZE: u32 = 160;
+pub(crate) const SIZE: u32 = 160;
 const BACKDROP: Color = Color::srgb(0.1, 0.2, 0.6);
 const CUBE: Color = Color::srgb(0.5, 0.5, 0.5);
 const WALL: Color = Color::srgb(0.8, 0.1, 0.1);
@@ -31,7 +31,7 @@ fn headless_app(assets: &Path) -> App {
 
 /// Runs a headless app with `targets` image targets (`SIZE` square, sRGB) until every furred
 /// entity `setup` spawns is built, then captures each target.
-fn capture(targets: usize, setup: impl FnOnce(&mut World, &[Handle<Image>])) -> Vec<image::RgbaImage> {
+pub(crate) fn capture(targets: usize, setup: impl FnOnce(&mut World, &[Handle<Image>])) -> Vec<image::RgbaImage> {
     let mut app = headless_app(&assets());
     let world = app.world_mut();
     let handles: Vec<Handle<Image>> = (0..targets)
@@ -83,7 +83,7 @@ fn capture(targets: usize, setup: impl FnOnce(&mut World, &[Handle<Image>])) -> 
         .collect()
 }
 
-fn unlit(world: &mut World, color: Color) -> Handle<StandardMaterial> {
+pub(crate) fn unlit(world: &mut World, color: Color) -> Handle<StandardMaterial> {
     world.resource_mut::<Assets<StandardMaterial>>().add(StandardMaterial {
         base_color: color,
         unlit: true,
@@ -91,11 +91,11 @@ fn unlit(world: &mut World, color: Color) -> Handle<StandardMaterial> {
     })
 }
 
-fn cuboid(world: &mut World, size: Vec3) -> Handle<Mesh> {
+pub(crate) fn cuboid(world: &mut World, size: Vec3) -> Handle<Mesh> {
     world.resource_mut::<Assets<Mesh>>().add(Cuboid::from_size(size))
 }
 
-fn preset(world: &mut World, path: &'static str) -> Handle<FurPreset> {
+pub(crate) fn preset(world: &mut World, path: &'static str) -> Handle<FurPreset> {
     world.resource::<AssetServer>().load(path)
 }
 
@@ -288,7 +288,7 @@ fn out_dir() -> PathBuf {
     dir
 }
 
-fn save(image: &image::RgbaImage, name: &str) {
+pub(crate) fn save(image: &image::RgbaImage, name: &str) {
     image.save(out_dir().join(format!("{name}.png"))).unwrap();
 }
 

@@ -145,11 +145,14 @@ pub use lab::{CpuSilhouette, SeparatedFur, SeparatedRenderer, StrandRenderer, St
 pub use lod::{FurLevel, LodSettings, strand_pixels, strand_pixels_in_view};
 pub use object::{FurFrame, FurLook, GpuBytes, tile_mapping};
 pub use plain::PlainMesh;
-pub use renderer::{FurDrawSettings, FurRenderer};
+pub use renderer::{FurDrawSettings, FurMotion, FurPrepass, FurRenderer, MotionData, PrepassTarget};
 pub use requirements::{check_adapter, required_downlevel_flags, required_features, required_limits};
+pub use shaders::{
+    prepass_shader_source, silhouette_shader_source, simulation_shader_source, unified_shader_source,
+    view_lod_shader_source,
+};
 #[cfg(feature = "lab")]
 pub use shaders::{separated_shader_source, strands_shader_source};
-pub use shaders::{silhouette_shader_source, simulation_shader_source, unified_shader_source, view_lod_shader_source};
 pub use shadows::{ShadowCaster, ShadowMap, ShadowSettings};
 pub use simulation::GpuSimulation;
 pub use studio::Studio;

@@ -37,6 +37,11 @@ fn view_lod_module_validates() {
 }
 
 #[test]
+fn prepass_module_validates() {
+    validate("shading.wgsl + unified.wgsl + prepass.wgsl", &pelt_render::prepass_shader_source());
+}
+
+#[test]
 fn strands_module_validates() {
     validate("shading.wgsl + strands.wgsl", &pelt_render::strands_shader_source());
 }
@@ -49,6 +54,7 @@ fn every_wgsl_file_is_part_of_a_validated_module() {
         pelt_render::simulation_shader_source(),
         pelt_render::silhouette_shader_source(),
         pelt_render::view_lod_shader_source(),
+        pelt_render::prepass_shader_source(),
         pelt_render::strands_shader_source(),
     ];
     // Every .wgsl under src/, wherever it lies.
@@ -67,8 +73,8 @@ fn every_wgsl_file_is_part_of_a_validated_module() {
         }
     }
     assert_eq!(
-        checked, 13,
-        "shading, wet, shadows, unified, separated, scan, silhouette, view_lod, simulation_wind, \
+        checked, 14,
+        "shading, wet, shadows, unified, prepass, separated, scan, silhouette, view_lod, simulation_wind, \
          simulation, simulation_inputs, simulation_contact and strands"
     );
 }

@@ -1,22 +1,32 @@
 //! What the `bunny` and `fox` examples share: their command line, Bevy's plugins pointed at the
-//! repository's `assets/`, the scenery (ground, sun, camera), the orbit camera, a frame-time log
-//! and `--screenshot`.
+//! repository's `assets/`, the scenery (ground, sun with shadows, camera with TAA), the orbit
+//! camera, a frame-time log and `--screenshot`.
 
 use std::path::Path;
 
+use bevy::anti_alias::taa::TemporalAntiAliasing;
 use bevy::app::PluginGroupBuilder;
+use bevy::core_pipeline::prepass::{DepthPrepass, MotionVectorPrepass};
 use bevy::core_pipeline::tonemapping::Tonemapping;
 use bevy::input::mouse::{AccumulatedMouseMotion, AccumulatedMouseScroll};
 use bevy::prelude::*;
 use bevy::render::view::screenshot::{Screenshot, save_to_disk};
+use bevy::transform::TransformSystems;
+use bevy_pelt::Fur;
 
-/// The command line: `[PRESET] [--screenshot PNG]`.
+/// The command line: `[PRESET] [--screenshot PNG] [--no-taa] [--no-shadows] [--no-fur]`.
 #[derive(Resource)]
 pub struct Args {
     /// The fur preset, relative to the repository's `assets/`.
     pub preset: String,
     /// Save a frame to this PNG and exit.
     pub screenshot: Option<String>,
+    /// TAA on the camera (with the depth and motion-vector prepasses it needs).
+    pub taa: bool,
+    /// The sun casts shadows.
+    pub shadows: bool,
+    /// Grow the fur (off: the same scene bare, for comparing frame times).
+    pub fur: bool,
 }
 
 impl Args {
@@ -25,7 +35,8 @@ impl Args {
         let args: Vec<String> = std::env::args().skip(1).collect();
         let screenshot = args.iter().position(|a| a == "--screenshot").and_then(|i| args.get(i + 1)).cloned();
         let preset = args.iter().find(|a| a.ends_with(".toml")).cloned().unwrap_or_else(|| default_preset.to_owned());
-        Self { preset, screenshot }
+        let off = |flag: &str| args.iter().any(|a| a == flag);
+        Self { preset, screenshot, taa: !off("--no-taa"), shadows: !off("--no-shadows"), fur: !off("--no-fur") }
     }
 }
 
@@ -75,7 +86,8 @@ impl Plugin for ExamplePlugin {
         app.insert_resource(self.orbit.clone())
             .insert_resource(SceneSettings { sun_lux: self.sun_lux, screenshot_frame: self.screenshot_frame })
             .add_systems(Startup, scenery)
-            .add_systems(Update, (orbit, log_frame_time, screenshot_then_exit));
+            .add_systems(Update, (orbit, log_frame_time, screenshot_then_exit))
+            .add_systems(PostUpdate, drop_fur.before(TransformSystems::Propagate));
     }
 }
 
@@ -84,17 +96,32 @@ fn scenery(
     mut meshes: ResMut<Assets<Mesh>>,
     mut materials: ResMut<Assets<StandardMaterial>>,
     settings: Res<SceneSettings>,
+    args: Option<Res<Args>>,
 ) {
+    let (taa, shadows) = args.map_or((true, true), |args| (args.taa, args.shadows));
     commands.spawn((
         Mesh3d(meshes.add(Plane3d::default().mesh().size(8.0, 8.0))),
         MeshMaterial3d(materials.add(Color::srgb(0.35, 0.42, 0.3))),
     ));
     commands.spawn((
-        DirectionalLight { illuminance: settings.sun_lux, shadow_maps_enabled: true, ..default() },
+        DirectionalLight { illuminance: settings.sun_lux, shadow_maps_enabled: shadows, ..default() },
         Transform::from_xyz(3.0, 6.0, 2.0).looking_at(Vec3::ZERO, Vec3::Y),
     ));
     // ACES needs no lookup tables (the crate leaves Bevy's `tonemapping_luts` feature off).
-    commands.spawn((Camera3d::default(), Tonemapping::AcesFitted, Transform::default()));
+    let mut camera = commands.spawn((Camera3d::default(), Tonemapping::AcesFitted, Transform::default()));
+    if taa {
+        // TAA reads the fur's depth and motion vectors from Bevy's prepasses.
+        camera.insert((Msaa::Off, DepthPrepass, MotionVectorPrepass, TemporalAntiAliasing::default()));
+    }
+}
+
+/// `--no-fur`: the scene without the fur its example grows, for comparing frame times.
+fn drop_fur(mut commands: Commands, args: Option<Res<Args>>, added: Query<Entity, Added<Fur>>) {
+    if args.is_some_and(|args| !args.fur) {
+        for entity in &added {
+            commands.entity(entity).remove::<Fur>();
+        }
+    }
 }
 
 fn orbit(

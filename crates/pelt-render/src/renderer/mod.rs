@@ -12,9 +12,11 @@
 
 mod objects;
 mod pipeline;
+mod prepass;
 mod shadow;
 
 pub(crate) use pipeline::{PassKind, PipelineSource, Transparency, create_pipeline};
+pub use prepass::{FurMotion, FurPrepass, MotionData, PrepassTarget};
 
 use std::sync::OnceLock;
 

@@ -32,6 +32,8 @@ const SCAN_WGSL: &str = include_str!("scan.wgsl");
 const SILHOUETTE_WGSL: &str = include_str!("silhouette.wgsl");
 /// The view-angle pass: which triangles the thinned shells still need.
 const VIEW_LOD_WGSL: &str = include_str!("view_lod.wgsl");
+/// Depth-only and motion-vector draws (prepasses, shadow maps).
+const PREPASS_WGSL: &str = include_str!("prepass.wgsl");
 /// The wind's noise, shared by the simulation's step.
 const SIMULATION_WIND_WGSL: &str = include_str!("simulation_wind.wgsl");
 /// One simulation step, one invocation a strand.
@@ -51,6 +53,13 @@ const STRANDS_WGSL: &str = include_str!("strands.wgsl");
 #[must_use]
 pub fn unified_shader_source() -> String {
     format!("{SHADING_WGSL}\n{WET_WGSL}\n{SHADOWS_WGSL}\n{UNIFIED_WGSL}")
+}
+
+/// The WGSL module of the prepass and shadow draws (the shared shading, `unified.wgsl` and
+/// `prepass.wgsl`).
+#[must_use]
+pub fn prepass_shader_source() -> String {
+    format!("{SHADING_WGSL}\n{WET_WGSL}\n{UNIFIED_WGSL}\n{PREPASS_WGSL}")
 }
 
 /// The WGSL module of the silhouette pass (the shared shading, `unified.wgsl`, `scan.wgsl` and
