@@ -38,18 +38,22 @@ pub(crate) struct Coat {
     pub groomed: bool,
     /// Some strand is wet.
     pub wet: bool,
+    /// The fur model lights it (else Kajiya-Kay).
+    pub fur_model: bool,
 }
 
 impl Coat {
     /// Dry and ungroomed: the lean entry points.
-    pub const PLAIN: Self = Self { groomed: false, wet: false };
+    pub const PLAIN: Self = Self { groomed: false, wet: false, fur_model: false };
+    /// Every coat, by [`Coat::index`].
+    pub const COUNT: usize = 8;
     pub fn index(self) -> usize {
-        usize::from(self.groomed) | usize::from(self.wet) << 1
+        usize::from(self.groomed) | usize::from(self.wet) << 1 | usize::from(self.fur_model) << 2
     }
 
     /// The entry point of `name`'s kind for this coat: the lean one, or its `_groomed` twin.
     pub fn entry(self, name: &str) -> String {
-        if self == Self::PLAIN { name.to_owned() } else { format!("{name}_groomed") }
+        if !self.groomed && !self.wet { name.to_owned() } else { format!("{name}_groomed") }
     }
 }
 
@@ -77,6 +81,8 @@ pub struct GpuFur {
     shells: Option<ShellList>,
     /// Whether the last `prepare`'s frame was wet (its coat's pipelines read the wetness).
     wet: AtomicBool,
+    /// Whether the last `prepare`'s look was the fur model.
+    fur_model: AtomicBool,
 }
 
 impl GpuFur {
@@ -104,6 +110,7 @@ impl GpuFur {
             level: PreparedLevel::new(),
             shells: shells?,
             wet: AtomicBool::new(false),
+            fur_model: AtomicBool::new(false),
         })
     }
 
@@ -177,6 +184,7 @@ impl GpuFur {
         self.geometry.write_uniform(queue, &self.geometry.shape.uniform(&frame, self.textures.root_colour, textures));
         self.level.set(frame.level, self.geometry.shape.layers);
         self.wet.store(frame.wet, Ordering::Relaxed);
+        self.fur_model.store(frame.look.shading.fur_model, Ordering::Relaxed);
         if let Some(list) = &self.shells {
             list.invalidate();
         }
@@ -334,7 +342,11 @@ impl GpuFur {
 
     /// The coat the last `prepare` left the fur drawing with.
     pub(crate) fn coat(&self) -> Coat {
-        Coat { groomed: self.geometry.shape.groom_shading, wet: self.wet.load(Ordering::Relaxed) }
+        Coat {
+            groomed: self.geometry.shape.groom_shading,
+            wet: self.wet.load(Ordering::Relaxed),
+            fur_model: self.fur_model.load(Ordering::Relaxed),
+        }
     }
 
     pub(crate) fn textures_bind_group(&self) -> &wgpu::BindGroup {

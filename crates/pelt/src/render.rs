@@ -12,9 +12,10 @@ use pelt_core::sim::{FurStepper, Scene, SceneCamera, WindParams};
 use pelt_core::{Builtin, FurStructure, Mesh, Preset, Stage};
 use pelt_render::{
     Backend, Camera, ColliderMeshes, FurDrawSettings, FurDriver, FurTarget, FurView, Gpu, HEADLESS_FORMAT, Headless,
-    PlainMesh, SAMPLE_COUNT, Studio, default_sample_count,
+    PlainMesh, SAMPLE_COUNT, default_sample_count,
 };
 
+use crate::light_args::{LightArgs, preset_look};
 use crate::lod;
 use crate::mesh_args::MeshArgs;
 use crate::sim_kernel::SimChoice;
@@ -94,6 +95,8 @@ pub struct Args {
     /// Output: a .png (one frame), a .gif (animated) or a folder (numbered PNGs).
     #[arg(short, long, default_value = "pelt.png")]
     output: PathBuf,
+    #[command(flatten)]
+    lights: LightArgs,
 }
 
 /// The preset's `[wet]`, with `--wetness` as the whole coat's wetness, held.
@@ -205,9 +208,11 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let motion_keys = stepper.scene().map_or(&[][..], |s| &s.motion[..]);
     let scene_camera = stepper.scene().and_then(|s| s.camera.as_ref());
     let camera = camera(args, &preset, &fur, &plain, (motion_keys, scene_camera), frames, headless.aspect_ratio());
-    let studio = Studio::default();
+    let environment = args.lights.environment(stepper.scene())?;
+    let studio = args.lights.studio(stepper.scene(), environment, 0.0);
     let view = FurView::new(device, &renderer);
     view.prepare(queue, &studio.view_data(&camera, headless.aspect_ratio()));
+    driver.set_look(preset_look(&preset));
     // The camera stays put, so one level serves every frame.
     let level = lod::level(&lod::settings(&preset.render.lod, args.no_lod), &fur, camera.eye, camera.fov_y_rad, height);
     driver.set_level(level);
@@ -246,6 +251,11 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         driver.advance_to(device, queue, &mut stepper, time_secs)?;
         simulation_time += sim_started.elapsed();
         let render_started = Instant::now();
+        // A script's lights may move.
+        if frame > 0 && args.lights.light.is_none() && stepper.scene().is_some_and(|s| !s.light.is_empty()) {
+            let studio = args.lights.studio(stepper.scene(), environment, time_secs);
+            view.prepare(queue, &studio.view_data(&camera, headless.aspect_ratio()));
+        }
         // The walking try-on body takes the fur's clip at the same time.
         if let (Some(body), Some(body_mesh), Some(plain_mesh)) = (&body, plain.first(), plain_meshes.first()) {
             body.rig.pose(body_mesh, clip, time_secs, &mut body_pose);

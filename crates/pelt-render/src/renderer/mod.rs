@@ -153,7 +153,7 @@ pub struct FurRenderer {
     /// Meshes without uvs: indexed by the base triangles.
     indexed: SurfacePipelines,
     /// Shells and fins per [`Coat`] (by [`Coat::index`]); the plain coat's built with the rest.
-    coats: [OnceLock<CoatPipelines>; 4],
+    coats: [OnceLock<CoatPipelines>; Coat::COUNT],
     coat_builder: CoatBuilder,
     /// The silhouette and view-angle passes.
     listing: ListingPasses,
@@ -201,7 +201,7 @@ impl FurRenderer {
         let wedges = surface("wedges", true);
         let indexed = surface("indexed", false);
         let coat_builder = CoatBuilder { device: device.clone(), module, layout: fur_layout };
-        let coats = [(); 4].map(|()| OnceLock::new());
+        let coats = [(); Coat::COUNT].map(|()| OnceLock::new());
         let _ = coats[Coat::PLAIN.index()].set(coat_builder.build(&target, Coat::PLAIN));
         let listing = ListingPasses::new(device, &layouts);
         scope.pop("building the fur pipelines")?;

@@ -82,6 +82,7 @@ pub(crate) fn create_pipeline(
         ("MESH_UVS", mesh_uvs),
         ("GROOM", switch(source.coat.map(|c| c.groomed))),
         ("WET", switch(source.coat.map(|c| c.wet))),
+        ("SHADING", switch(source.coat.map(|c| c.fur_model))),
     ];
     let compilation_options = wgpu::PipelineCompilationOptions { constants: &constants, ..Default::default() };
     device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
