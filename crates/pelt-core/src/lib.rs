@@ -18,6 +18,7 @@ pub mod body;
 pub mod export;
 pub mod fur;
 pub mod groom;
+pub mod light;
 pub mod mesh;
 pub mod param;
 pub mod preset;

@@ -12,10 +12,14 @@
 //! [simulation]         # `sim::SimParams`; equation = "pelt" | "paper" (`sim::Equation`)
 //! [render]             # how Pelt's commands show it (see `RenderParams`)
 //! [groom]              # per-vertex maps: length, density, direction, clump, tint (`groom::GroomParams`)
+//! [shading]            # how strands reflect light: model, roughness, pigments (`ShadingParams`)
 //! [wet]                # what wetness does: clumps, darkening, shine, weight, drying (`wet::WetParams`)
 //! ```
 
+mod shading;
 mod strands;
+
+pub use shading::{ShadingModel, ShadingParams};
 
 pub use strands::ROOT_TOLERANCE_FRACTION;
 
@@ -176,6 +180,9 @@ pub struct Preset {
     /// defaults.
     #[serde(skip_serializing_if = "WetParams::is_default")]
     pub wet: WetParams,
+    /// How the strands reflect light; left out of the TOML at its defaults.
+    #[serde(skip_serializing_if = "ShadingParams::is_default")]
+    pub shading: ShadingParams,
     /// The preset file (for messages) and its folder (for relative image paths); not in TOML.
     #[serde(skip)]
     file: PathBuf,
@@ -193,6 +200,7 @@ impl Default for Preset {
             render: RenderParams::default(),
             groom: GroomParams::default(),
             wet: WetParams::default(),
+            shading: ShadingParams::default(),
             file: PathBuf::from("<default preset>"),
         }
     }
@@ -210,6 +218,7 @@ impl PartialEq for Preset {
             && self.render == other.render
             && self.groom == other.groom
             && self.wet == other.wet
+            && self.shading == other.shading
     }
 }
 
@@ -369,6 +378,7 @@ impl Preset {
         self.texture.validate().map_err(invalid)?;
         self.colour.validate().map_err(invalid)?;
         self.wet.validate().map_err(invalid)?;
+        self.shading.validate().map_err(invalid)?;
         self.simulation.validate().map_err(invalid)
     }
 

@@ -18,6 +18,8 @@ mod grasp_hand;
 mod groom;
 #[path = "import.rs"]
 mod import;
+#[path = "lights.rs"]
+mod lights;
 #[path = "module_order.rs"]
 mod module_order;
 #[path = "presets.rs"]

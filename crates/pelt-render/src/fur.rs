@@ -41,16 +41,21 @@ pub(crate) struct Coat {
     /// The view it is drawn through reads the key light's shadow maps (`SHADOWS` in
     /// `shadows.wgsl`): a coat seen without shadows runs none of their lookups.
     pub shadowed: bool,
+    /// The fur model lights it (else Kajiya-Kay).
+    pub fur_model: bool,
 }
 
 impl Coat {
-    /// Dry and ungroomed, without shadows: the lean entry points.
-    pub const PLAIN: Self = Self { groomed: false, wet: false, shadowed: false };
+    /// Dry and ungroomed, Kajiya-Kay, without shadows: the lean entry points.
+    pub const PLAIN: Self = Self { groomed: false, wet: false, shadowed: false, fur_model: false };
     /// Every coat, by [`Coat::index`].
-    pub const COUNT: usize = 8;
+    pub const COUNT: usize = 16;
 
     pub fn index(self) -> usize {
-        usize::from(self.groomed) | usize::from(self.wet) << 1 | usize::from(self.shadowed) << 2
+        usize::from(self.groomed)
+            | usize::from(self.wet) << 1
+            | usize::from(self.shadowed) << 2
+            | usize::from(self.fur_model) << 3
     }
 
     /// The entry point of `name`'s kind for this coat: the lean one, or its `_groomed` twin.
@@ -88,6 +93,8 @@ pub struct GpuFur {
     shells: Option<ShellList>,
     /// Whether the last `prepare`'s frame was wet (its coat's pipelines read the wetness).
     wet: AtomicBool,
+    /// Whether the last `prepare`'s look was the fur model.
+    fur_model: AtomicBool,
 }
 
 impl GpuFur {
@@ -115,6 +122,7 @@ impl GpuFur {
             level: PreparedLevel::new(),
             shells: shells?,
             wet: AtomicBool::new(false),
+            fur_model: AtomicBool::new(false),
         })
     }
 
@@ -188,6 +196,7 @@ impl GpuFur {
         self.geometry.write_uniform(queue, &self.geometry.shape.uniform(&frame, self.textures.root_colour, textures));
         self.level.set(frame.level, self.geometry.shape.layers);
         self.wet.store(frame.wet, Ordering::Relaxed);
+        self.fur_model.store(frame.look.shading.fur_model, Ordering::Relaxed);
         if let Some(list) = &self.shells {
             list.invalidate();
         }
@@ -345,7 +354,12 @@ impl GpuFur {
 
     /// The coat the last `prepare` left the fur drawing with.
     pub(crate) fn coat(&self) -> Coat {
-        Coat { groomed: self.geometry.shape.groom_shading, wet: self.wet.load(Ordering::Relaxed), shadowed: false }
+        Coat {
+            groomed: self.geometry.shape.groom_shading,
+            wet: self.wet.load(Ordering::Relaxed),
+            shadowed: false,
+            fur_model: self.fur_model.load(Ordering::Relaxed),
+        }
     }
 
     pub(crate) fn textures_bind_group(&self) -> &wgpu::BindGroup {

@@ -109,6 +109,7 @@ mod contact;
 mod driver;
 mod error;
 mod fur;
+pub mod fur_bsdf;
 mod geometry;
 #[cfg(feature = "headless")]
 mod gpu;
@@ -143,6 +144,7 @@ pub use headless::{HEADLESS_FORMAT, Headless};
 #[cfg(feature = "lab")]
 pub use lab::{CpuSilhouette, SeparatedFur, SeparatedRenderer, StrandRenderer, StrandRibbons};
 pub use lod::{FurLevel, LodSettings, strand_pixels, strand_pixels_in_view};
+pub use object::FurShading;
 pub use object::{FurFrame, FurLook, GpuBytes, tile_mapping};
 pub use plain::PlainMesh;
 pub use renderer::{FurDrawSettings, FurMotion, FurPrepass, FurRenderer, MotionData, PrepassTarget};
@@ -157,4 +159,4 @@ pub use shadows::{ShadowCaster, ShadowMap, ShadowSettings};
 pub use simulation::GpuSimulation;
 pub use studio::Studio;
 pub use targets::{DEFAULT_BACKGROUND, DEPTH_FORMAT, FurTarget, RenderTargets, SAMPLE_COUNT, default_sample_count};
-pub use view::{FurView, Light, LightDirection, ViewData};
+pub use view::{FurView, Light, LightDirection, LightSet, ViewData};

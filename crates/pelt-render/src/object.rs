@@ -35,6 +35,45 @@ pub struct FurLook {
     pub clump_size: f32,
     /// How strongly a soaked strand clumps, 0..1 (`[wet] clump_strength`).
     pub clump_strength: f32,
+    /// The reflectance model and its parameters (`[shading]`).
+    pub shading: FurShading,
+}
+
+/// The reflectance model a fur is lit with and the fur model's parameters (`[shading]`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct FurShading {
+    /// The fur model (R, TT, TRT and medulla lobes, every light and the environment), else
+    /// Kajiya-Kay with the key light and the ambient.
+    pub fur_model: bool,
+    /// The pigments' colour, multiplying the texture's (white: the texture's alone).
+    pub pigment: Vec3,
+    /// Longitudinal roughness of the lobes.
+    pub roughness: f32,
+    /// Cuticle tilt, radians.
+    pub cuticle_tilt: f32,
+    /// Share of the entering light the medulla scatters.
+    pub medulla: f32,
+}
+
+impl Default for FurShading {
+    /// Kajiya-Kay; the fur model's parameters at the `[shading]` defaults.
+    fn default() -> Self {
+        Self::from_params(&pelt_core::preset::ShadingParams::default())
+    }
+}
+
+impl FurShading {
+    /// The shading a preset's `[shading]` table describes.
+    #[must_use]
+    pub fn from_params(params: &pelt_core::preset::ShadingParams) -> Self {
+        Self {
+            fur_model: params.model == pelt_core::preset::ShadingModel::Fur,
+            pigment: params.pigment_colour(),
+            roughness: params.roughness,
+            cuticle_tilt: params.cuticle_tilt_deg.to_radians(),
+            medulla: params.medulla,
+        }
+    }
 }
 
 impl FurLook {
@@ -64,6 +103,7 @@ impl Default for FurLook {
             wet_shine: 0.6,
             clump_size: 12.0,
             clump_strength: 0.8,
+            shading: FurShading::default(),
         }
     }
 }
@@ -223,7 +263,12 @@ impl ObjectShape {
             wet_clump: look.clump_strength.clamp(0.0, 1.0),
             clump_cell_texels: look.clump_size.clamp(2.0, 128.0),
             wet_any: u32::from(frame.wet),
-            _padding_2: 0,
+            shading_model: u32::from(look.shading.fur_model),
+            fur_pigment: look.shading.pigment,
+            fur_roughness: look.shading.roughness.clamp(0.05, 1.0),
+            fur_cuticle_tilt: look.shading.cuticle_tilt,
+            fur_medulla: look.shading.medulla.clamp(0.0, 1.0),
+            _padding_2: [0; 2],
         }
     }
 }

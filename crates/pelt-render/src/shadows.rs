@@ -172,6 +172,8 @@ impl ShadowMap {
             light_direction_world: -forward,
             light_colour: Vec3::ONE,
             ambient: 0.0,
+            lights: crate::view::LightSet::default(),
+            environment: pelt_core::light::Environment::default(),
         };
         for view in &self.views {
             view.prepare(queue, &data);

@@ -3,10 +3,11 @@
 //! examples) draws with [`Studio::default`], so a preset seen from one camera looks the same in each.
 
 use glam::Vec3;
+use pelt_core::light::{Environment, LightSource};
 
 use crate::camera::Camera;
 use crate::targets::DEFAULT_BACKGROUND;
-use crate::view::{Light, ViewData};
+use crate::view::{Light, LightSet, ViewData};
 
 /// The light, exposure and background a fur is shown with. Colours are linear RGB: a host
 /// resolves into an sRGB target (or an sRGB view of its canvas or swap chain) so that the
@@ -19,12 +20,22 @@ pub struct Studio {
     pub exposure: f32,
     /// The clear colour.
     pub background: Vec3,
+    /// Lights in physical units replacing `light` (empty: `light` is the key light).
+    pub lights: LightSet,
+    /// The environment replacing `light`'s ambient (none: the ambient).
+    pub environment: Option<Environment>,
 }
 
 impl Default for Studio {
     /// Pelt's look: [`Light::default`], exposure 1 and [`DEFAULT_BACKGROUND`].
     fn default() -> Self {
-        Self { light: Light::default(), exposure: 1.0, background: DEFAULT_BACKGROUND }
+        Self {
+            light: Light::default(),
+            exposure: 1.0,
+            background: DEFAULT_BACKGROUND,
+            lights: LightSet::default(),
+            environment: None,
+        }
     }
 }
 
@@ -37,7 +48,19 @@ impl Studio {
             ambient: self.light.ambient * self.exposure,
             ..self.light
         };
-        camera.view_data(aspect_ratio, &light)
+        let view = camera.view_data(aspect_ratio, &light);
+        if self.lights.is_empty() && self.environment.is_none() {
+            return view;
+        }
+        let environment = self.environment.unwrap_or_else(|| Environment::uniform(Vec3::splat(self.light.ambient)));
+        let environment = Environment { sh: environment.sh.scaled(self.exposure) };
+        view.with_lights(self.lights.scaled(self.exposure).as_slice(), Some(environment))
+    }
+
+    /// This studio with `lights` (at most [`pelt_core::light::MAX_LIGHTS`]) and `environment`.
+    #[must_use]
+    pub fn with_lights(self, lights: &[LightSource], environment: Option<Environment>) -> Self {
+        Self { lights: LightSet::new(lights), environment, ..self }
     }
 }
 

@@ -1,10 +1,11 @@
-//! Per-view data supplied by the host: the camera's transform and position and the light.
-//! Each view has its own uniform buffer ([`FurView`]), so several views drawn in one submission
-//! do not overwrite each other.
+//! Per-view data supplied by the host: the camera's transform and position, the key light, and
+//! the lights and environment the fur model loops over. Each view has its own uniform buffers
+//! ([`FurView`]), so several views drawn in one submission do not overwrite each other.
 
 use glam::{Mat4, Vec3};
+use pelt_core::light::{Environment, LightKind, LightSource, MAX_LIGHTS};
 
-use crate::shaders::{Layouts, ViewUniform};
+use crate::shaders::{GpuLight, Layouts, LightsUniform, ViewUniform};
 
 /// Where the key light comes from.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -38,6 +39,52 @@ impl Default for Light {
     }
 }
 
+/// Up to [`MAX_LIGHTS`] lights, in a fixed array so a view stays `Copy`.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct LightSet {
+    lights: [LightSource; MAX_LIGHTS],
+    count: usize,
+}
+
+impl Default for LightSet {
+    fn default() -> Self {
+        Self { lights: [LightSource::directional(Vec3::Y, Vec3::ZERO, 0.0); MAX_LIGHTS], count: 0 }
+    }
+}
+
+impl LightSet {
+    /// The first [`MAX_LIGHTS`] of `lights`.
+    #[must_use]
+    pub fn new(lights: &[LightSource]) -> Self {
+        let mut set = Self::default();
+        set.count = lights.len().min(MAX_LIGHTS);
+        set.lights[..set.count].copy_from_slice(&lights[..set.count]);
+        set
+    }
+
+    /// The lights.
+    #[must_use]
+    pub fn as_slice(&self) -> &[LightSource] {
+        &self.lights[..self.count]
+    }
+
+    /// Whether there are none.
+    #[must_use]
+    pub fn is_empty(&self) -> bool {
+        self.count == 0
+    }
+
+    /// Every light's intensity times `scale`.
+    #[must_use]
+    pub fn scaled(&self, scale: f32) -> Self {
+        let mut set = *self;
+        for light in &mut set.lights[..set.count] {
+            light.intensity *= scale;
+        }
+        set
+    }
+}
+
 /// One view as the shaders see it; build it from the host's camera with [`ViewData::new`] or
 /// fill the fields directly.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -52,6 +99,10 @@ pub struct ViewData {
     pub light_colour: Vec3,
     /// Light everywhere, as a fraction of the surface colour.
     pub ambient: f32,
+    /// The lights the fur model loops over (light 0 is the key light).
+    pub lights: LightSet,
+    /// The fur model's environment.
+    pub environment: Environment,
 }
 
 impl ViewData {
@@ -63,14 +114,93 @@ impl ViewData {
             LightDirection::World(direction) => direction,
             LightDirection::View(direction) => world_from_view.transform_vector3(direction),
         };
+        let light_direction_world = light_direction_world.normalize_or(Vec3::Y);
+        // The key light as the fur model's light 0 and the ambient as a uniform environment: a
+        // colour of 1 is pi lux, which shows a white Lambertian surface as white.
+        let key = LightSource::directional(light_direction_world, light.colour, std::f32::consts::PI);
         Self {
             clip_from_world,
             camera_position_world: world_from_view.w_axis.truncate(),
-            light_direction_world: light_direction_world.normalize_or(Vec3::Y),
+            light_direction_world,
             light_colour: light.colour,
             ambient: light.ambient,
+            lights: LightSet::new(&[key]),
+            environment: Environment::uniform(Vec3::splat(light.ambient)),
         }
     }
+
+    /// This view lit by `lights` and `environment` (none: no environment light) instead: the
+    /// fur model takes them all; Kajiya-Kay takes light 0 as its key light (a point or spot
+    /// light by its direction from the world origin) and the environment's mean as its ambient.
+    #[must_use]
+    pub fn with_lights(self, lights: &[LightSource], environment: Option<Environment>) -> Self {
+        let environment = environment.unwrap_or_default();
+        let (light_direction_world, light_colour) = match lights.first() {
+            None => (self.light_direction_world, Vec3::ZERO),
+            Some(key) => {
+                let direction = match key.kind {
+                    LightKind::Directional => key.direction,
+                    LightKind::Point | LightKind::Spot => key.position.normalize_or(Vec3::Y),
+                };
+                (direction, key.intensity / std::f32::consts::PI)
+            }
+        };
+        Self {
+            light_direction_world,
+            light_colour,
+            ambient: luminance(environment.sh.mean()),
+            lights: LightSet::new(lights),
+            environment,
+            ..self
+        }
+    }
+
+    /// The lights' uniform (`Lights` in `fur_bsdf.wgsl`).
+    pub(crate) fn lights_uniform(&self) -> LightsUniform {
+        let lights = self.lights.as_slice();
+        let mut light = [GpuLight::default(); MAX_LIGHTS];
+        for (gpu, l) in light.iter_mut().zip(lights) {
+            let (position_or_direction, cos_outer, cos_inner) = match l.kind {
+                LightKind::Directional => (l.direction.extend(0.0), -2.0, -1.0),
+                LightKind::Point => (l.position.extend(1.0), -2.0, -1.0),
+                LightKind::Spot => (l.position.extend(1.0), l.cos_outer, l.cos_inner),
+            };
+            let kind = match l.kind {
+                LightKind::Directional => 0,
+                LightKind::Point => 1,
+                LightKind::Spot => 2,
+            };
+            *gpu = GpuLight {
+                position_or_direction,
+                spot_axis_cos_outer: l.direction.extend(cos_outer),
+                intensity_cos_inner: l.intensity.extend(cos_inner),
+                flags: [u32::from(l.casts_shadows), kind, 0, 0],
+            };
+        }
+        let environment_tint = tint(self.environment.sh.mean());
+        let light_sum = lights.iter().fold(Vec3::ZERO, |sum, l| sum + l.intensity);
+        let light_tint = if luminance(light_sum) > 0.0 { tint(light_sum) } else { environment_tint };
+        LightsUniform {
+            count: lights.len() as u32,
+            padding_0: 0,
+            padding_1: 0,
+            padding_2: 0,
+            light_tint: light_tint.extend(1.0),
+            environment_tint: environment_tint.extend(1.0),
+            environment_sh: self.environment.sh.coefficients.map(|c| c.extend(luminance(c))),
+            light,
+        }
+    }
+}
+
+fn luminance(c: Vec3) -> f32 {
+    c.dot(Vec3::new(0.2126, 0.7152, 0.0722))
+}
+
+/// `c` scaled to luminance 1 (white where it has none).
+fn tint(c: Vec3) -> Vec3 {
+    let l = luminance(c);
+    if l > 1e-12 && c.is_finite() { c / l } else { Vec3::ONE }
 }
 
 /// One view's uniform buffer and bind group (group 0 of every Pelt pipeline). Make one per
@@ -79,6 +209,7 @@ impl ViewData {
 #[derive(Debug)]
 pub struct FurView {
     buffer: wgpu::Buffer,
+    lights: wgpu::Buffer,
     bind_group: wgpu::BindGroup,
     /// Group 3: the shadow maps this view's draws read (or stand-ins).
     shadow_group: wgpu::BindGroup,
@@ -116,14 +247,24 @@ impl FurView {
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
+        let lights = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("pelt lights"),
+            size: size_of::<LightsUniform>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
         let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("pelt view"),
             layout: &layouts.view,
-            entries: &[wgpu::BindGroupEntry { binding: 0, resource: buffer.as_entire_binding() }],
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: buffer.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 1, resource: lights.as_entire_binding() },
+            ],
         });
         let no_shadows = layouts.no_shadows.clone();
         Self {
             buffer,
+            lights,
             bind_group,
             shadow_group: no_shadows.clone(),
             no_shadows,
@@ -174,6 +315,7 @@ impl FurView {
             _padding_1: 0.0,
         };
         queue.write_buffer(&self.buffer, 0, bytemuck::bytes_of(&uniform));
+        queue.write_buffer(&self.lights, 0, bytemuck::bytes_of(&data.lights_uniform()));
     }
 
     pub(crate) fn bind_group(&self) -> &wgpu::BindGroup {

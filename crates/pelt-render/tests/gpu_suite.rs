@@ -12,6 +12,8 @@ mod colliders;
 mod driver;
 #[path = "embed.rs"]
 mod embed;
+#[path = "fur_lights.rs"]
+mod fur_lights;
 #[path = "gpu.rs"]
 mod gpu;
 #[path = "groom.rs"]

@@ -78,6 +78,8 @@ pub struct Args {
     /// (BENCHMARKS.md's "CI speed guard" table).
     #[arg(long, value_name = "FILE", conflicts_with_all = ["soak", "contact"])]
     pub guard: Option<PathBuf>,
+    #[command(flatten)]
+    pub lights: crate::light_args::LightArgs,
     /// Instead of the report: the time to a first frame phase by phase (parse, repair,
     /// structure, textures, skin setup, GPU upload) for every mesh in the meshes folder and
     /// each `--load-mesh`.
@@ -185,7 +187,8 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let meshes_dir = models::meshes_dir(args.meshes.as_deref());
 
     // One GPU for the whole run; without one the frame times are null with the reason.
-    let gpu = match render::Bench::open() {
+    let environment = args.lights.environment(None)?;
+    let gpu = match render::Bench::open(args.lights.studio(None, environment, 0.0)) {
         Ok(gpu) => {
             eprintln!("pelt bench: adapter {}", gpu.adapter().name);
             Ok(gpu)

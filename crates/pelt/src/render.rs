@@ -12,9 +12,10 @@ use pelt_core::sim::{FurStepper, Scene, SceneCamera, WindParams};
 use pelt_core::{Builtin, FurStructure, Mesh, Preset, Stage};
 use pelt_render::{
     Backend, Camera, ColliderMeshes, FurDrawSettings, FurDriver, FurTarget, FurView, Gpu, HEADLESS_FORMAT, Headless,
-    PlainMesh, SAMPLE_COUNT, Studio, default_sample_count,
+    PlainMesh, SAMPLE_COUNT, default_sample_count,
 };
 
+use crate::light_args::{LightArgs, preset_look};
 use crate::lod;
 use crate::mesh_args::MeshArgs;
 use crate::shadows::Surroundings;
@@ -101,6 +102,8 @@ pub struct Args {
     /// Output: a .png (one frame), a .gif (animated) or a folder (numbered PNGs).
     #[arg(short, long, default_value = "pelt.png")]
     output: PathBuf,
+    #[command(flatten)]
+    lights: LightArgs,
 }
 
 /// The preset's `[wet]`, with `--wetness` as the whole coat's wetness, held.
@@ -212,10 +215,12 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let motion_keys = stepper.scene().map_or(&[][..], |s| &s.motion[..]);
     let scene_camera = stepper.scene().and_then(|s| s.camera.as_ref());
     let camera = camera(args, &preset, &fur, &plain, (motion_keys, scene_camera), frames, headless.aspect_ratio());
-    let studio = Studio::default();
+    let environment = args.lights.environment(stepper.scene())?;
+    let studio = args.lights.studio(stepper.scene(), environment, 0.0);
     let mut view = FurView::new(device, &renderer);
     let view_data = studio.view_data(&camera, headless.aspect_ratio());
     view.prepare(queue, &view_data);
+    driver.set_look(preset_look(&preset));
     let scene_ground = stepper.scene().and_then(|s| s.ground.as_ref());
     let surroundings = Surroundings::new(device, queue, &renderer, &args.shadows, scene_ground, (&fur, &plain))?;
     surroundings.prepare(queue, &view_data, &mut view);
@@ -257,6 +262,11 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         driver.advance_to(device, queue, &mut stepper, time_secs)?;
         simulation_time += sim_started.elapsed();
         let render_started = Instant::now();
+        // A script's lights may move.
+        if frame > 0 && args.lights.light.is_none() && stepper.scene().is_some_and(|s| !s.light.is_empty()) {
+            let studio = args.lights.studio(stepper.scene(), environment, time_secs);
+            view.prepare(queue, &studio.view_data(&camera, headless.aspect_ratio()));
+        }
         // The walking try-on body takes the fur's clip at the same time.
         if let (Some(body), Some(body_mesh), Some(plain_mesh)) = (&body, plain.first(), plain_meshes.first()) {
             body.rig.pose(body_mesh, clip, time_secs, &mut body_pose);

@@ -52,6 +52,18 @@
 //! point = [0.0, -1.0, 0.0]
 //! normal = [0.0, 1.0, 0.0]
 //!
+//! [[light]]                        # lights, keyed over time by name (see `light::LightSpec`)
+//! name = "key"
+//! time_secs = 0.0
+//! kind = "directional"             # or "point", "spot"
+//! azimuth_deg = 30.0
+//! elevation_deg = 40.0
+//! lux = 1.0
+//!
+//! [environment]                    # light from every direction (see `light::EnvironmentSpec`)
+//! sky = [0.4, 0.45, 0.5]
+//! ground = [0.15, 0.13, 0.1]       # or image = "studio.hdr"
+//!
 //! [camera]                         # optional: where `pelt render` looks from (unless --camera)
 //! target = [2.8, 5.9, 0.2]         # optional: default the meshes' centre
 //! azimuth_deg = 60.0               # around +Y from +Z toward +X
@@ -83,6 +95,7 @@ use super::MAX_FORCE;
 use super::contact::{Collider, ColliderKey, ColliderMesh, GraspParams, Shape};
 use super::motion::{self, MotionKey};
 use super::simulation::{SimError, Simulation};
+use crate::light::{self, Environment, EnvironmentError, EnvironmentSpec, LightSource, LightSpec};
 use crate::mesh::{ImportOptions, Mesh};
 use crate::wet::{self, RainKey, WaterKey, WetSources};
 
@@ -448,6 +461,15 @@ pub struct Scene {
     /// A ground under the meshes; default none (unless the host draws one).
     #[serde(default)]
     pub ground: Option<SceneGround>,
+    /// Light keys: each unnamed table a light, each name's tables one light over time.
+    #[serde(default)]
+    pub light: Vec<LightSpec>,
+    /// The environment's table; default: the host's own.
+    #[serde(default)]
+    pub environment: Option<EnvironmentSpec>,
+    /// The environment the table describes, loaded with the script.
+    #[serde(skip)]
+    pub environment_light: Option<Environment>,
 }
 
 impl Scene {
@@ -480,6 +502,19 @@ impl Scene {
             })?;
         }
         scene.validate().map_err(|(key, problem)| SceneError::Invalid { file: name.to_path_buf(), key, problem })?;
+        if let Some(spec) = &scene.environment {
+            let environment = Environment::from_spec(spec, folder).map_err(|error| match error {
+                EnvironmentError::Invalid { key, problem } => {
+                    SceneError::Invalid { file: name.to_path_buf(), key, problem }
+                }
+                image @ EnvironmentError::Image { .. } => SceneError::Invalid {
+                    file: name.to_path_buf(),
+                    key: "environment.image".into(),
+                    problem: image.to_string(),
+                },
+            })?;
+            scene.environment_light = Some(environment);
+        }
         Ok(scene)
     }
 
@@ -517,6 +552,7 @@ impl Scene {
             range(format!("wind[{i}].jitter"), key.jitter, 0.0, 1.0)?;
         }
         motion::validate(&self.motion)?;
+        light::validate_keys(&self.light)?;
         wet::validate(&self.rain, &self.water)?;
         for (i, stroke) in self.strokes.iter().enumerate() {
             finite_time(format!("stroke[{i}].start_secs"), stroke.start_secs)?;
@@ -593,6 +629,7 @@ impl Scene {
             let motion = self.motion.last().map_or(0.0, |k| k.time_secs);
             let water = self.water.last().map_or(0.0, |k| k.time_secs);
             let rain = self.rain.iter().map(|r| r.end_secs).fold(0.0, f64::max);
+            let lights = self.light.iter().map(|k| k.time_secs).fold(0.0, f64::max);
             let keys = self.colliders.iter().filter_map(|c| c.keys.last()).map(|k| k.time_secs);
             let grasps = self.grasps.iter().map(|g| g.end_secs);
             self.strokes
@@ -600,7 +637,7 @@ impl Scene {
                 .map(|s| s.end_secs)
                 .chain(keys)
                 .chain(grasps)
-                .fold(wind.max(motion).max(water).max(rain), f64::max)
+                .fold(wind.max(motion).max(water).max(rain).max(lights), f64::max)
         })
     }
 
@@ -644,6 +681,12 @@ impl Scene {
     #[must_use]
     pub fn stroke_at(&self, time_secs: f64) -> Option<&Stroke> {
         self.strokes.iter().rev().find(|s| (s.start_secs..s.end_secs).contains(&time_secs))
+    }
+
+    /// The script's lights at `time_secs` (none when it has no `[[light]]`).
+    #[must_use]
+    pub fn lights_at(&self, time_secs: f64) -> Vec<LightSource> {
+        light::lights_at(&self.light, time_secs)
     }
 
     /// Sets the simulation's wind and touch for `time_secs`: begins, drags and ends touches as

@@ -4,7 +4,7 @@
 /// The bind group layouts and samplers of one renderer, shared by everything it draws.
 #[derive(Debug, Clone)]
 pub(crate) struct Layouts {
-    /// Group 0: the view uniform.
+    /// Group 0: the view uniform and the lights.
     pub view: wgpu::BindGroupLayout,
     /// Group 1 of the unified structure and plain meshes: the object uniform and the storage
     /// buffers (positions twice, base normals, wedge uvs, topology, groom attributes, wetness).
@@ -49,7 +49,8 @@ impl Layouts {
         let entry = |binding, visibility, ty| wgpu::BindGroupLayoutEntry { binding, visibility, ty, count: None };
         let view = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("pelt view"),
-            entries: &[entry(0, both, uniform)],
+            // The view, then the fur model's lights and environment.
+            entries: &[entry(0, both, uniform), entry(1, both, uniform)],
         });
         // Storage buffers are read by vertex shaders and the silhouette pass only, so fragment
         // stages need no storage.

@@ -55,8 +55,37 @@ pub(crate) struct ObjectUniform {
     pub wet_clump: f32,
     pub clump_cell_texels: f32,
     pub wet_any: u32,
+    pub shading_model: u32,
+    pub fur_pigment: Vec3,
+    pub fur_roughness: f32,
+    pub fur_cuticle_tilt: f32,
+    pub fur_medulla: f32,
     /// WGSL rounds the struct up to its 16-byte alignment.
-    pub _padding_2: u32,
+    pub _padding_2: [u32; 2],
+}
+
+/// One light; the layout of `Light` in `fur_bsdf.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, bytemuck::Pod, bytemuck::Zeroable)]
+pub(crate) struct GpuLight {
+    pub position_or_direction: Vec4,
+    pub spot_axis_cos_outer: Vec4,
+    pub intensity_cos_inner: Vec4,
+    pub flags: [u32; 4],
+}
+
+/// A view's lights and environment; the layout of `Lights` in `fur_bsdf.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+pub(crate) struct LightsUniform {
+    pub count: u32,
+    pub padding_0: u32,
+    pub padding_1: u32,
+    pub padding_2: u32,
+    pub light_tint: Vec4,
+    pub environment_tint: Vec4,
+    pub environment_sh: [Vec4; 9],
+    pub light: [GpuLight; 8],
 }
 
 /// The key light's shadow maps; the layout of `Shadow` in `shadows.wgsl`.
@@ -281,9 +310,31 @@ mod tests {
             wet_clump,
             clump_cell_texels,
             wet_any,
+            shading_model,
+            fur_pigment,
+            fur_roughness,
+            fur_cuticle_tilt,
+            fur_medulla,
             _padding_2
         });
         assert_mirrors(&unified_shader_source(), "Object", &rust);
+    }
+
+    #[test]
+    fn lights_uniform_mirrors_lights() {
+        let rust = rust_layout!(LightsUniform {
+            count,
+            padding_0,
+            padding_1,
+            padding_2,
+            light_tint,
+            environment_tint,
+            environment_sh,
+            light
+        });
+        assert_mirrors(&unified_shader_source(), "Lights", &rust);
+        let rust = rust_layout!(GpuLight { position_or_direction, spot_axis_cos_outer, intensity_cos_inner, flags });
+        assert_mirrors(&unified_shader_source(), "Light", &rust);
     }
 
     #[test]

@@ -13,7 +13,7 @@ pub(crate) use layouts::Layouts;
 pub(crate) use layouts::{SHADOW_DEPTH_FORMAT, SHADOW_OPACITY_FORMAT, shadow_texture};
 #[cfg(all(test, feature = "lab"))]
 pub(crate) use mirrors::assert_vertex_mirrors;
-pub(crate) use mirrors::{OBJECT_UNIFORM_BYTES, ObjectUniform, ShadowUniform, ViewUniform};
+pub(crate) use mirrors::{GpuLight, LightsUniform, OBJECT_UNIFORM_BYTES, ObjectUniform, ShadowUniform, ViewUniform};
 #[cfg(test)]
 pub(crate) use mirrors::{RustLayout, assert_mirrors, rust_layout};
 
@@ -21,6 +21,8 @@ pub(crate) use mirrors::{RustLayout, assert_mirrors, rust_layout};
 pub(crate) const SHADING_WGSL: &str = include_str!("shading.wgsl");
 /// The wet look and the clumps, appended to the shading wherever it goes.
 const WET_WGSL: &str = include_str!("wet.wgsl");
+/// The fur model's lights, environment and BSDF, likewise appended.
+const FUR_BSDF_WGSL: &str = include_str!("fur_bsdf.wgsl");
 /// The key light's visibility (shadow map and deep opacity map) and the shadow views' opacity
 /// fragments, appended to the shading wherever it goes.
 const SHADOWS_WGSL: &str = include_str!("shadows.wgsl");
@@ -52,28 +54,30 @@ const STRANDS_WGSL: &str = include_str!("strands.wgsl");
 /// The WGSL module of the unified renderer (the shared shading plus `unified.wgsl`).
 #[must_use]
 pub fn unified_shader_source() -> String {
-    format!("{SHADING_WGSL}\n{WET_WGSL}\n{SHADOWS_WGSL}\n{UNIFIED_WGSL}")
+    format!("{SHADING_WGSL}\n{WET_WGSL}\n{FUR_BSDF_WGSL}\n{SHADOWS_WGSL}\n{UNIFIED_WGSL}")
 }
 
 /// The WGSL module of the prepass and shadow draws (the shared shading, `unified.wgsl` and
 /// `prepass.wgsl`).
 #[must_use]
 pub fn prepass_shader_source() -> String {
-    format!("{SHADING_WGSL}\n{WET_WGSL}\n{UNIFIED_WGSL}\n{PREPASS_WGSL}")
+    format!("{SHADING_WGSL}\n{WET_WGSL}\n{FUR_BSDF_WGSL}\n{SHADOWS_WGSL}\n{UNIFIED_WGSL}\n{PREPASS_WGSL}")
 }
 
 /// The WGSL module of the silhouette pass (the shared shading, `unified.wgsl`, `scan.wgsl` and
 /// `silhouette.wgsl`).
 #[must_use]
 pub fn silhouette_shader_source() -> String {
-    format!("{SHADING_WGSL}\n{WET_WGSL}\n{SHADOWS_WGSL}\n{UNIFIED_WGSL}\n{SCAN_WGSL}\n{SILHOUETTE_WGSL}")
+    format!(
+        "{SHADING_WGSL}\n{WET_WGSL}\n{FUR_BSDF_WGSL}\n{SHADOWS_WGSL}\n{UNIFIED_WGSL}\n{SCAN_WGSL}\n{SILHOUETTE_WGSL}"
+    )
 }
 
 /// The WGSL module of the view-angle pass (the shared shading, `unified.wgsl`, `scan.wgsl` and
 /// `view_lod.wgsl`).
 #[must_use]
 pub fn view_lod_shader_source() -> String {
-    format!("{SHADING_WGSL}\n{WET_WGSL}\n{SHADOWS_WGSL}\n{UNIFIED_WGSL}\n{SCAN_WGSL}\n{VIEW_LOD_WGSL}")
+    format!("{SHADING_WGSL}\n{WET_WGSL}\n{FUR_BSDF_WGSL}\n{SHADOWS_WGSL}\n{UNIFIED_WGSL}\n{SCAN_WGSL}\n{VIEW_LOD_WGSL}")
 }
 
 /// The WGSL module of the GPU simulation (`simulation_wind.wgsl`, `simulation.wgsl` and
@@ -87,12 +91,12 @@ pub fn simulation_shader_source() -> String {
 #[must_use]
 #[cfg(feature = "lab")]
 pub fn separated_shader_source() -> String {
-    format!("{SHADING_WGSL}\n{WET_WGSL}\n{SHADOWS_WGSL}\n{SEPARATED_WGSL}")
+    format!("{SHADING_WGSL}\n{WET_WGSL}\n{FUR_BSDF_WGSL}\n{SHADOWS_WGSL}\n{SEPARATED_WGSL}")
 }
 
 /// The WGSL module of the strand renderer (the shared shading plus `strands.wgsl`).
 #[must_use]
 #[cfg(feature = "lab")]
 pub fn strands_shader_source() -> String {
-    format!("{SHADING_WGSL}\n{WET_WGSL}\n{SHADOWS_WGSL}\n{STRANDS_WGSL}")
+    format!("{SHADING_WGSL}\n{WET_WGSL}\n{FUR_BSDF_WGSL}\n{SHADOWS_WGSL}\n{STRANDS_WGSL}")
 }

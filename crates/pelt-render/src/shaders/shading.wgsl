@@ -80,6 +80,14 @@ struct Object {
     wet_clump: f32,
     clump_cell_texels: f32,
     wet_any: u32,
+    // 1 for the fur model (`fur_bsdf.wgsl`), 0 for Kajiya-Kay.
+    shading_model: u32,
+    // The fur model: the pigments' colour (multiplying the texel's), the lobes' longitudinal
+    // roughness, the cuticle tilt (radians) and the medulla's share.
+    fur_pigment: vec3<f32>,
+    fur_roughness: f32,
+    fur_cuticle_tilt: f32,
+    fur_medulla: f32,
 }
 
 // Set per pipeline: shells and fins with alpha-to-coverage output straight colour, blended ones
@@ -91,6 +99,16 @@ override ALPHA_TO_COVERAGE: bool = false;
 // every branch of a fragment, taken or not); 0 reads the object's flags instead.
 override GROOM: u32 = 0u;
 override WET: u32 = 0u;
+// The same for the reflectance model: 1 Kajiya-Kay, 2 the fur model; 0 reads the object's.
+override SHADING: u32 = 0u;
+
+// Whether the fur model lights the strands (else Kajiya-Kay). Uniform.
+fn fur_model() -> bool {
+    if SHADING == 0u {
+        return object.shading_model != 0u;
+    }
+    return SHADING == 2u;
+}
 
 // Whether the groom's density, clump or tint reach the shading. Uniform.
 fn groom_on() -> bool {
@@ -235,14 +253,14 @@ fn shell_uv_varyings(v: Varyings, fade: f32, lod_blend: f32) -> ShellUvVaryings 
 fn groomed_shell_tile_varyings(v: Varyings, fade: f32, lod_blend: f32, groom: GroomShade) -> GroomedShellTileVaryings {
     let fade_blend_layer = vec4<f32>(fade, lod_blend, f32(v.layer), groom.clump);
     let tint_density = vec4<f32>(groom.tint, groom.density);
-    let lighting = wet_terms(shell_lighting(v), groom.wetness);
+    let lighting = coat_terms(v.tangent, v.normal, v.world_position, layer_height(v.layer), groom.wetness);
     return GroomedShellTileVaryings(v.clip_position, lighting, fade_blend_layer, v.tile_position, v.tile_normal, tint_density);
 }
 
 fn groomed_shell_uv_varyings(v: Varyings, fade: f32, lod_blend: f32, groom: GroomShade) -> GroomedShellUvVaryings {
     let fade_blend_layer = vec4<f32>(fade, lod_blend, f32(v.layer), groom.clump);
     let tint_density = vec4<f32>(groom.tint, groom.density);
-    let lighting = wet_terms(shell_lighting(v), groom.wetness);
+    let lighting = coat_terms(v.tangent, v.normal, v.world_position, layer_height(v.layer), groom.wetness);
     return GroomedShellUvVaryings(v.clip_position, lighting, fade_blend_layer, vec4<f32>(v.uv, v.surface_uv), tint_density);
 }
 
@@ -400,6 +418,22 @@ fn hair_lighting(albedo: vec3<f32>, tangent: vec3<f32>, normal: vec3<f32>, world
 // and brightens the fur). The fragment is left two square roots, a normalisation, a power and a
 // smoothstep fewer (BENCHMARKS.md: a quarter of the shells' frame at 1280x720 on lavapipe).
 fn hair_terms(tangent: vec3<f32>, normal: vec3<f32>, world_position: vec3<f32>, height: f32) -> vec4<f32> {
+    if fur_model() {
+        return fur_terms(tangent, normal, world_position, height, 0.0);
+    }
+    return kajiya_kay_terms(tangent, normal, world_position, height);
+}
+
+// The terms of a strand of wetness `wetness`: the fur model's with its wet parameters, or the
+// Kajiya-Kay terms with the wet highlight (`wet_terms`).
+fn coat_terms(tangent: vec3<f32>, normal: vec3<f32>, world_position: vec3<f32>, height: f32, wetness: f32) -> vec4<f32> {
+    if fur_model() {
+        return fur_terms(tangent, normal, world_position, height, select(0.0, wetness, wet_on()));
+    }
+    return wet_terms(kajiya_kay_terms(tangent, normal, world_position, height), wetness);
+}
+
+fn kajiya_kay_terms(tangent: vec3<f32>, normal: vec3<f32>, world_position: vec3<f32>, height: f32) -> vec4<f32> {
     let to_light = view.light_direction;
     let to_camera = safe_normalize(view.camera_position - world_position, normal);
     let half_vector = safe_normalize(to_light + to_camera, to_light);
@@ -413,6 +447,9 @@ fn hair_terms(tangent: vec3<f32>, normal: vec3<f32>, world_position: vec3<f32>, 
 }
 
 fn hair_colour(albedo: vec3<f32>, terms: vec4<f32>, height: f32) -> vec3<f32> {
+    if fur_model() {
+        return fur_colour(albedo, terms);
+    }
     let diffuse = terms.x;
     // sin^shininess of the angle to the half vector, as (sin^2)^(shininess / 2).
     let specular = pow(max(terms.y, 0.0), 0.5 * object.shininess);

@@ -281,6 +281,11 @@ fn fin_vertex(index: u32, edge: u32) -> u32 {
 
 // The fin vertex `index` of a shown `edge` (fade > 0): node `index / 2` of the level of detail.
 fn fin_varyings(index: u32, edge: u32, fade: f32) -> FinVaryings {
+    return wet_fin_varyings(index, edge, fade, 0.0);
+}
+
+// `fin_varyings` for a strand of wetness `wetness`.
+fn wet_fin_varyings(index: u32, edge: u32, fade: f32, wetness: f32) -> FinVaryings {
     let side = index % 2u;
     let layer = lod_fin_layer(index / 2u);
     let edges_start = 3u * object.triangle_count;
@@ -296,7 +301,7 @@ fn fin_varyings(index: u32, edge: u32, fade: f32) -> FinVaryings {
     let normal = safe_normalize(normal_a + world_from_model_normal(model_normal(b)), normal_a);
     let tangent = strand_tangent(layer, vertex, here, normal);
     // The occlusion (`w`) is the fragment's, from the interpolated height.
-    out.lighting_fade = vec4<f32>(hair_terms(tangent, normal, position, 0.0).xyz, fade);
+    out.lighting_fade = vec4<f32>(coat_terms(tangent, normal, position, 0.0, wetness).xyz, fade);
     let offset = f32(hash(edge) & 0xffffu) / 65536.0;
     let along = f32(side) * distance(model_vertex(0u, a), model_vertex(0u, b)) * object.tiles_per_world;
     // The surface uv of this end of the edge, from its corner in the first face.
@@ -315,9 +320,9 @@ fn fin_varyings(index: u32, edge: u32, fade: f32) -> FinVaryings {
 
 // A groomed or wet coat's fin vertex: the lean one's, its highlight wet, and the groom's terms.
 fn groomed_fin_varyings(index: u32, edge: u32, fade: f32) -> GroomedFinVaryings {
-    let lean = fin_varyings(index, edge, fade);
     let groom = vertex_groom(fin_vertex(index, edge));
-    let lighting = wet_terms(vec4<f32>(lean.lighting_fade.xyz, 0.0), groom.wetness).xyz;
+    let lean = wet_fin_varyings(index, edge, fade, groom.wetness);
+    let lighting = lean.lighting_fade.xyz;
     let tint_density = vec4<f32>(groom.tint, groom.density);
     return GroomedFinVaryings(lean.clip_position, vec4<f32>(lighting, fade), lean.uvs, tint_density, groom.clump);
 }

@@ -7,7 +7,8 @@
 // A strand's groom terms with its wetness `w`: the tint darkened, the clump amount raised.
 fn wet_groom(groom: GroomShade, wetness: f32) -> GroomShade {
     let w = clamp(wetness, 0.0, 1.0);
-    let tint = groom.tint * (1.0 - object.wet_darkening * w);
+    // The fur model darkens through its BSDF's parameters instead (`fur_bsdf`).
+    let tint = groom.tint * (1.0 - select(object.wet_darkening * w, 0.0, fur_model()));
     let clump = min(groom.clump + object.wet_clump * w, 1.0);
     return GroomShade(tint, groom.density, clump, w);
 }

@@ -8,7 +8,7 @@ use pelt_core::texture::FurTextures;
 use pelt_core::{FurStructure, Mesh};
 use pelt_render::{
     Backend, Camera, DEFAULT_BACKGROUND, FurDrawSettings, FurFrame, FurRenderer, FurStates, FurTarget, FurView, Gpu,
-    GpuFur, HEADLESS_FORMAT, Light, PlainMesh, RenderTargets, SeparatedFur, SeparatedRenderer, default_sample_count,
+    GpuFur, HEADLESS_FORMAT, PlainMesh, RenderTargets, SeparatedFur, SeparatedRenderer, default_sample_count,
 };
 
 use super::report::{Adapter, GpuSimFigures, LodFigures, RenderFigures, SizeFigures};
@@ -42,12 +42,14 @@ pub struct RenderBudget {
 #[derive(Debug)]
 pub struct Bench {
     gpu: Gpu,
+    /// The lights every timed frame is drawn with (`--light`, `--environment`).
+    studio: pelt_render::Studio,
 }
 
 impl Bench {
     /// Opens the best adapter (`WGPU_BACKEND` chooses the API when set).
-    pub fn open() -> anyhow::Result<Self> {
-        Ok(Self { gpu: Gpu::new(Backend::Auto)? })
+    pub fn open(studio: pelt_render::Studio) -> anyhow::Result<Self> {
+        Ok(Self { gpu: Gpu::new(Backend::Auto)?, studio })
     }
 
     pub fn adapter(&self) -> Adapter {
@@ -167,7 +169,7 @@ impl Bench {
             let output = device.create_texture(&wgpu_output_descriptor(width, height));
             let output_view = output.create_view(&Default::default());
             let camera = Camera::framing(centre, radius, 35.0, 20.0, targets.aspect_ratio());
-            let view_data = camera.view_data(targets.aspect_ratio(), &Light::default());
+            let view_data = self.studio.view_data(&camera, targets.aspect_ratio());
             // Every structure draws the same scene the same way: the view written, the body
             // (if any), then the fur, in one pass.
             let frame = |encoder: &mut wgpu::CommandEncoder,
@@ -237,7 +239,7 @@ impl Bench {
                 // The unified fur alone (as above) at its level of detail, near and at 4x the
                 // distance, then far with every shell; the counts from the silhouette pass.
                 let far_camera = Camera { eye: centre + (camera.eye - centre) * 4.0, ..camera };
-                let far_view = far_camera.view_data(targets.aspect_ratio(), &Light::default());
+                let far_view = self.studio.view_data(&far_camera, targets.aspect_ratio());
                 let level = |camera: &Camera| crate::lod::level(&lod, fur, camera.eye, camera.fov_y_rad, height);
                 let (near_level, far_level) = (level(&camera), level(&far_camera));
                 let timed = |view_data: &pelt_render::ViewData, level: pelt_render::FurLevel| {

@@ -15,7 +15,7 @@ use pelt_core::sim::{FurStepper, SimParams, WindParams};
 use pelt_core::{Builtin, FurStructure, Mesh, Preset, Stage, texture};
 use pelt_render::{
     Backend, Camera, DEFAULT_BACKGROUND, FurDrawSettings, FurDriver, FurLook, FurRenderer, FurTarget, FurView, Gpu,
-    HEADLESS_FORMAT, Headless, KernelChoice, Light, PlainMesh, StrandRenderer, StrandRibbons, default_sample_count,
+    HEADLESS_FORMAT, Headless, KernelChoice, PlainMesh, StrandRenderer, StrandRibbons, default_sample_count,
     tile_mapping,
 };
 
@@ -57,6 +57,8 @@ pub struct Args {
     /// Write the results as JSON here.
     #[arg(long, value_name = "FILE")]
     json: Option<PathBuf>,
+    #[command(flatten)]
+    lights: crate::light_args::LightArgs,
     /// Folder for the side-by-side images.
     #[arg(long, default_value = "fidelity", value_name = "DIR")]
     out: PathBuf,
@@ -188,11 +190,13 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     if wetness > 0.0 {
         tag += &format!("-wet{wetness}");
     }
+    let environment = args.lights.environment(None)?;
+    let studio = args.lights.studio(None, environment, 0.0);
     let mut results = Vec::new();
     for (name, azimuth) in &views {
         let camera =
             Camera::framing_points(centre, points.iter().copied(), fur_length, front + azimuth, elevation, aspect);
-        let view_data = camera.view_data(aspect, &Light::default());
+        let view_data = studio.view_data(&camera, aspect);
         shell_side.view.prepare(&shells.gpu.queue, &view_data);
         strand_side.view.prepare(&strands.gpu.queue, &view_data);
         let empty = shells.render(DEFAULT_BACKGROUND, |_| {})?;
