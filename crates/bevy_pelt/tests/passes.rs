@@ -138,7 +138,7 @@ fn copy_motion_vectors(
 }
 
 fn read_motion(app: &App) -> Vec<[f32; 2]> {
-    let buffer = app.sub_app(RenderApp).world().resource::<MotionReadback>().0.lock().unwrap().take();
+    let buffer = app.world().resource::<MotionReadback>().0.lock().unwrap().take();
     let buffer = buffer.expect("the motion vectors were copied");
     buffer.slice(..).map_async(wgpu::MapMode::Read, |result| result.expect("mapped"));
     app.world()
@@ -173,11 +173,14 @@ fn slide(moving: Res<Moving>, mut furred: Query<&mut Transform, With<Furred>>) {
 /// with `taa`, TAA; `step` is its motion along +X per frame. Returns the app after `frames`
 /// frames with the fur built.
 fn prepass_app(taa: bool, step: f32, frames: u32) -> (App, Handle<Image>) {
-    let mut app = common::headless_app(&assets(), false, None);
     let readback = MotionReadback::default();
-    app.sub_app_mut(RenderApp)
-        .insert_resource(readback)
-        .add_systems(Core3d, copy_motion_vectors.after(Core3dSystems::Prepass).before(Core3dSystems::MainPass));
+    let mut app = common::headless_app_with(&assets(), false, None, |app| {
+        app.sub_app_mut(RenderApp)
+            .insert_resource(readback.clone())
+            .add_systems(Core3d, copy_motion_vectors.after(Core3dSystems::Prepass).before(Core3dSystems::MainPass));
+    });
+    // The same buffer slot, read from the main world.
+    app.insert_resource(readback);
     app.insert_resource(Moving(0.0)).add_systems(Update, slide);
     let world = app.world_mut();
     let mut image = Image::new_target_texture(SIZE, SIZE, TextureFormat::Rgba8UnormSrgb, None);

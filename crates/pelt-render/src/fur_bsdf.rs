@@ -29,6 +29,12 @@ fn hair_fresnel(cos_theta: f32) -> f32 {
     f0 + (1.0 - f0) * m.powi(5)
 }
 
+fn hair_r_albedo(cos_v: f32) -> f32 {
+    let c = cos_v;
+    0.173_927_42 * (hair_fresnel(c * 0.99759) + hair_fresnel(c * 0.36612))
+        + 0.326_072_58 * (hair_fresnel(c * 0.94398) + hair_fresnel(c * 0.74237))
+}
+
 /// (white R lobe, albedo-tinted lobes) per unit irradiance from `l`, for unit strand tangent
 /// `t`, toward-eye `v`, toward-light `l` and surface normal `n`, at wetness `wet`.
 #[must_use]
@@ -68,7 +74,8 @@ pub fn mirror(t: Vec3, v: Vec3, l: Vec3, n: Vec3, wet: f32, shading: &FurShading
         * lit_side;
     let m = shading.medulla.clamp(0.0, 1.0);
     let scattered = hair_gaussian(b + 0.6, s) * (1.0 - 0.4 * cos_phi) * 0.159_154_94 * (1.0 - f_tt) * lit_side;
-    let tinted = ((1.0 - m) * (tt + trt) + m * scattered) * (1.0 - wet_look.darkening * wet);
+    let tinted =
+        ((1.0 - m) * (tt + trt) + m * scattered) * (1.0 - hair_r_albedo(cos_v)) * (1.0 - wet_look.darkening * wet);
     (r, tinted)
 }
 
@@ -76,16 +83,22 @@ pub fn mirror(t: Vec3, v: Vec3, l: Vec3, n: Vec3, wet: f32, shading: &FurShading
 mod tests {
     use super::*;
 
-    /// `n` directions spread evenly over the sphere (a Fibonacci lattice), `4 pi / n` sr each.
-    fn sphere(n: usize) -> Vec<Vec3> {
-        let golden = std::f32::consts::PI * (3.0 - 5f32.sqrt());
-        (0..n)
-            .map(|i| {
-                let y = 1.0 - 2.0 * (i as f32 + 0.5) / n as f32;
-                let r = (1.0 - y * y).max(0.0).sqrt();
-                Vec3::new(r * (golden * i as f32).cos(), y, r * (golden * i as f32).sin())
-            })
-            .collect()
+    /// Directions around the unit strand tangent `t` on an even grid in (sin theta, phi), each
+    /// `4 pi / count` sr: the lobes are narrow in sin theta (Marschner's longitudinal Gaussians), so
+    /// a grid along the strand integrates them far better than a lattice over the sphere.
+    fn around(t: Vec3, rows: usize, columns: usize) -> Vec<Vec3> {
+        let a = t.any_orthonormal_vector();
+        let b = t.cross(a);
+        let mut out = Vec::with_capacity(rows * columns);
+        for i in 0..rows {
+            let sin = -1.0 + 2.0 * (i as f32 + 0.5) / rows as f32;
+            let cos = (1.0 - sin * sin).max(0.0).sqrt();
+            for j in 0..columns {
+                let phi = std::f32::consts::TAU * (j as f32 + 0.5) / columns as f32;
+                out.push(t * sin + (a * phi.cos() + b * phi.sin()) * cos);
+            }
+        }
+        out
     }
 
     const DRY: WetLook = WetLook { shine: 0.6, darkening: 0.5 };
@@ -95,16 +108,25 @@ mod tests {
     /// most 1 toward every eye, for rough and smooth strands, with and without a medulla.
     #[test]
     fn a_white_strand_returns_at_most_the_light_it_gets() {
-        let directions = sphere(40_000);
-        let weight = 4.0 * std::f32::consts::PI / directions.len() as f32;
         let t = Vec3::new(0.2, -0.9, 0.3).normalize();
+        let directions = around(t, 1500, 240);
+        let weight = 4.0 * std::f32::consts::PI / directions.len() as f32;
+        // Views from along the strand to across it, on both sides: the grazing ones are where
+        // the R lobe's Fresnel grows.
+        let views: Vec<Vec3> = (0..=40)
+            .map(|k| {
+                let sin = -0.98 + 1.96 * k as f32 / 40.0;
+                t * sin + t.any_orthonormal_vector() * (1.0 - sin * sin).sqrt()
+            })
+            .collect();
         let mut most: f32 = 0.0;
         for shading in [
             FurShading { roughness: 0.35, medulla: 0.3, ..FurShading::default() },
             FurShading { roughness: 0.1, medulla: 0.0, ..FurShading::default() },
             FurShading { roughness: 0.8, medulla: 1.0, ..FurShading::default() },
+            FurShading { roughness: 0.05, medulla: 0.0, cuticle_tilt: 10f32.to_radians(), ..FurShading::default() },
         ] {
-            for v in directions.iter().step_by(997) {
+            for v in &views {
                 let returned: f32 = directions
                     .iter()
                     .map(|&l| {

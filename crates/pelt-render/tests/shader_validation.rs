@@ -73,8 +73,8 @@ fn every_wgsl_file_is_part_of_a_validated_module() {
         }
     }
     assert_eq!(
-        checked, 14,
-        "shading, wet, shadows, unified, prepass, separated, scan, silhouette, view_lod, simulation_wind, \
+        checked, 15,
+        "shading, wet, fur_bsdf, shadows, unified, prepass, separated, scan, silhouette, view_lod, simulation_wind, \
          simulation, simulation_inputs, simulation_contact and strands"
     );
 }

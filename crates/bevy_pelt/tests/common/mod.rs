@@ -20,6 +20,12 @@ pub fn test_assets() -> PathBuf {
 /// A windowless app with Pelt on `assets`; `watch` turns on Bevy's file watcher, and `frame`
 /// makes every frame that long, however fast the machine draws.
 pub fn headless_app(assets: &Path, watch: bool, frame: Option<Duration>) -> App {
+    headless_app_with(assets, watch, frame, |_| {})
+}
+
+/// `headless_app` with `configure` run before the plugins finish: the last moment the render
+/// world is reachable as a sub-app (pipelined rendering moves it to its own thread at cleanup).
+pub fn headless_app_with(assets: &Path, watch: bool, frame: Option<Duration>, configure: impl FnOnce(&mut App)) -> App {
     let mut app = App::new();
     app.add_plugins((
         DefaultPlugins
@@ -36,6 +42,7 @@ pub fn headless_app(assets: &Path, watch: bool, frame: Option<Duration>) -> App 
     if let Some(frame) = frame {
         app.insert_resource(TimeUpdateStrategy::ManualDuration(frame));
     }
+    configure(&mut app);
     app.finish();
     app.cleanup();
     app

@@ -54,6 +54,16 @@ fn hair_fresnel(cos_theta: f32) -> f32 {
     return f0 + (1.0 - f0) * m2 * m2 * m;
 }
 
+// The R lobe's albedo toward a view at `cos_v` from the normal plane: Fresnel averaged over the
+// strand's width, the integral over h in 0..1 of F(cos_v sqrt(1 - h^2)) by 4-point Gauss-Legendre.
+// The tinted lobes take only what R leaves, so a white strand never returns more than it gets
+// (Karis' lobes as published reach 1.11 at grazing views).
+fn hair_r_albedo(cos_v: f32) -> f32 {
+    let c = cos_v;
+    return 0.17392742 * (hair_fresnel(c * 0.99759) + hair_fresnel(c * 0.36612))
+        + 0.32607258 * (hair_fresnel(c * 0.94398) + hair_fresnel(c * 0.74237));
+}
+
 // The BSDF times the cosine for one light: (white R lobe, albedo-tinted lobes), per unit
 // irradiance from `l`. `t` strand tangent, `v` toward the eye, `n` surface normal, all unit.
 // `wet` (0..1) makes it smoother (narrower lobes), shinier and darker.
@@ -93,7 +103,7 @@ fn fur_bsdf(t: vec3<f32>, v: vec3<f32>, l: vec3<f32>, n: vec3<f32>, wet: f32) ->
     // (normalised over phi), taking the entering light's medulla share.
     let m = object.fur_medulla;
     let scattered = hair_gaussian(b + 0.6, s) * (1.0 - 0.4 * cos_phi) * 0.15915494 * (1.0 - f_tt) * lit_side;
-    let tinted = ((1.0 - m) * (tt + trt) + m * scattered) * (1.0 - object.wet_darkening * wet);
+    let tinted = ((1.0 - m) * (tt + trt) + m * scattered) * (1.0 - hair_r_albedo(cos_v)) * (1.0 - object.wet_darkening * wet);
     return vec2<f32>(r, tinted);
 }
 

@@ -126,13 +126,13 @@ fn vs_prepass_fin(@builtin(vertex_index) index: u32, @builtin(instance_index) ed
         out.clip_position = HIDDEN_FIN_CORNER;
         return out;
     }
-    let v = fin_varyings(index, edge, fade);
+    // The fin's geometry only: its lighting would read the colour pass's shadow maps (group 3).
+    let g = fin_geometry(index, edge);
     let layer = lod_fin_layer(index / 2u);
     let vertex = fin_vertex(index, edge);
-    out.clip_position = prepass_clip(v.clip_position);
-    out.along_height_fade = vec3<f32>(v.uvs.xy, fade);
-    let world = world_from_model_point(fin_node(layer, vertex));
-    out.current = motion.unjittered_clip_from_world * vec4<f32>(world, 1.0);
+    out.clip_position = prepass_clip(g.clip_position);
+    out.along_height_fade = vec3<f32>(g.uvs.xy, fade);
+    out.current = motion.unjittered_clip_from_world * vec4<f32>(g.world_position, 1.0);
     out.previous = motion.previous_clip_from_model * vec4<f32>(previous_model_vertex(layer, vertex), 1.0);
     return out;
 }

@@ -284,8 +284,18 @@ fn fin_varyings(index: u32, edge: u32, fade: f32) -> FinVaryings {
     return wet_fin_varyings(index, edge, fade, 0.0);
 }
 
-// `fin_varyings` for a strand of wetness `wetness`.
-fn wet_fin_varyings(index: u32, edge: u32, fade: f32, wetness: f32) -> FinVaryings {
+// Where a fin vertex lies and how its strand runs, without its lighting: the colour pass lights
+// it (`wet_fin_varyings`), the prepass and shadow views only place it.
+struct FinGeometry {
+    world_position: vec3<f32>,
+    clip_position: vec4<f32>,
+    normal: vec3<f32>,
+    tangent: vec3<f32>,
+    // Along the edge in tiles, the height, the surface uv.
+    uvs: vec4<f32>,
+}
+
+fn fin_geometry(index: u32, edge: u32) -> FinGeometry {
     let side = index % 2u;
     let layer = lod_fin_layer(index / 2u);
     let edges_start = 3u * object.triangle_count;
@@ -293,15 +303,13 @@ fn wet_fin_varyings(index: u32, edge: u32, fade: f32, wetness: f32) -> FinVaryin
     let b = topology[edges_start + 2u * edge + 1u];
     let vertex = select(a, b, side == 1u);
 
-    var out: FinVaryings;
+    var out: FinGeometry;
     let here = fin_node(layer, vertex);
-    let position = world_from_model_point(here);
-    out.clip_position = view.clip_from_world * vec4<f32>(position, 1.0);
+    out.world_position = world_from_model_point(here);
+    out.clip_position = view.clip_from_world * vec4<f32>(out.world_position, 1.0);
     let normal_a = world_from_model_normal(model_normal(a));
-    let normal = safe_normalize(normal_a + world_from_model_normal(model_normal(b)), normal_a);
-    let tangent = strand_tangent(layer, vertex, here, normal);
-    // The occlusion (`w`) is the fragment's, from the interpolated height.
-    out.lighting_fade = vec4<f32>(coat_terms(tangent, normal, position, 0.0, wetness).xyz, fade);
+    out.normal = safe_normalize(normal_a + world_from_model_normal(model_normal(b)), normal_a);
+    out.tangent = strand_tangent(layer, vertex, here, out.normal);
     let offset = f32(hash(edge) & 0xffffu) / 65536.0;
     let along = f32(side) * distance(model_vertex(0u, a), model_vertex(0u, b)) * object.tiles_per_world;
     // The surface uv of this end of the edge, from its corner in the first face.
@@ -315,6 +323,17 @@ fn wet_fin_varyings(index: u32, edge: u32, fade: f32, wetness: f32) -> FinVaryin
         }
     }
     out.uvs = vec4<f32>(offset + along, layer_height(layer), surface_uv);
+    return out;
+}
+
+// `fin_varyings` for a strand of wetness `wetness`.
+fn wet_fin_varyings(index: u32, edge: u32, fade: f32, wetness: f32) -> FinVaryings {
+    let g = fin_geometry(index, edge);
+    var out: FinVaryings;
+    out.clip_position = g.clip_position;
+    // The occlusion (`w`) is the fragment's, from the interpolated height.
+    out.lighting_fade = vec4<f32>(coat_terms(g.tangent, g.normal, g.world_position, 0.0, wetness).xyz, fade);
+    out.uvs = g.uvs;
     return out;
 }
 
