@@ -56,8 +56,7 @@ impl LightSet {
     /// The first [`MAX_LIGHTS`] of `lights`.
     #[must_use]
     pub fn new(lights: &[LightSource]) -> Self {
-        let mut set = Self::default();
-        set.count = lights.len().min(MAX_LIGHTS);
+        let mut set = Self { count: lights.len().min(MAX_LIGHTS), ..Self::default() };
         set.lights[..set.count].copy_from_slice(&lights[..set.count]);
         set
     }
