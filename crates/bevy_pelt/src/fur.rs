@@ -140,6 +140,8 @@ pub struct FurState {
     pub(crate) wetness: Option<Arc<Vec<f32>>>,
     /// The preset's `[wet]`: what wetness does to the look.
     pub(crate) wet: WetParams,
+    /// The preset's `[shading]`: Kajiya-Kay or the fur model.
+    pub(crate) shading: pelt_core::preset::ShadingParams,
 }
 
 impl FurState {
@@ -264,6 +266,7 @@ fn build(
         holding: None,
         wetness: None,
         wet: preset.preset.wet.clone(),
+        shading: preset.preset.shading.clone(),
     })
 }
 

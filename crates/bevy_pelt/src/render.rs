@@ -7,19 +7,21 @@ use std::sync::Arc;
 
 use bevy::camera::{Camera3d, CompositingSpace, Exposure};
 use bevy::ecs::prelude::*;
-use bevy::light::{DirectionalLight, NotShadowCaster};
+use bevy::light::{DirectionalLight, NotShadowCaster, PointLight, SpotLight};
 use bevy::log::error;
-use bevy::prelude::{GlobalTransform, InheritedVisibility};
+use bevy::prelude::{Color, GlobalTransform, InheritedVisibility};
 use bevy::render::Extract;
 use bevy::render::camera::{ExtractedCamera, TemporalJitter};
 use bevy::render::renderer::{RenderContext, RenderDevice, RenderQueue, ViewQuery};
 use bevy::render::view::{ExtractedView, Msaa, ResolvedCompositingSpace, ViewDepthStencilTexture, ViewTarget};
 use pelt_core::FurStructure;
+use pelt_core::light::{Environment, LightKind, LightSource, MAX_LIGHTS};
 use pelt_core::sim::SimParams;
 use pelt_core::texture::FurTextures;
 use pelt_core::wet::WetParams;
 use pelt_render::{
-    FurDrawSettings, FurDriver, FurRenderer, FurTarget, FurView, KernelChoice, Light, LightDirection, ViewData,
+    FurDrawSettings, FurDriver, FurLook, FurRenderer, FurShading, FurTarget, FurView, KernelChoice, Light,
+    LightDirection, ViewData,
 };
 
 use crate::convert::{to_pelt, to_pelt_mat4};
@@ -32,8 +34,10 @@ use crate::fur::{Fur, FurState};
 /// With a directional light in the scene (the first one by entity, among the visible), the fur
 /// takes its direction and its colour times `illuminance * exposure / pi`, the camera's exposure
 /// (Bevy's `Exposure`) included: the brightness Bevy gives a white diffuse surface facing the
-/// light, so fur and Bevy's materials agree. Other lights (point, spot, more directional
-/// lights, environment maps) do not reach the fur.
+/// light, so fur and Bevy's materials agree. Every other visible light (point and spot lights,
+/// more directional lights; up to 8 in all) reaches a coat shaded with the fur model
+/// (`[shading] model = "fur"`), in the same units; Kajiya-Kay takes the first. Environment maps
+/// do not reach the fur: `FurLight`'s ambient stands for them.
 #[derive(Resource, Clone, Copy, Debug, Default, PartialEq)]
 pub struct FurLight(pub Light);
 
@@ -46,6 +50,8 @@ pub(crate) struct ExtractedFurs {
     furs: Vec<ExtractedFur>,
     light: Light,
     sun: Option<Sun>,
+    /// The scene's other lights (point, spot, more directional), world space, before exposure.
+    others: Vec<pelt_core::light::LightSource>,
 }
 
 /// The scene's first directional light.
@@ -68,6 +74,12 @@ impl Sun {
     }
 }
 
+/// A Bevy colour as linear RGB.
+fn linear(colour: Color) -> glam::Vec3 {
+    let c = colour.to_linear();
+    glam::Vec3::new(c.red, c.green, c.blue)
+}
+
 pub(crate) struct ExtractedFur {
     pub(crate) entity: Entity,
     pub(crate) revision: u64,
@@ -82,6 +94,7 @@ pub(crate) struct ExtractedFur {
     pub(crate) casts_shadows: bool,
     wetness: Option<Arc<Vec<f32>>>,
     wet: WetParams,
+    shading: FurShading,
 }
 
 pub(crate) fn extract_furs(
@@ -89,19 +102,59 @@ pub(crate) fn extract_furs(
     light: Extract<Res<FurLight>>,
     furs: Extract<Query<(Entity, &Fur, &FurState, Option<&InheritedVisibility>, Has<NotShadowCaster>)>>,
     suns: Extract<Query<(Entity, &DirectionalLight, &GlobalTransform, Option<&InheritedVisibility>)>>,
+    bulbs: Extract<Query<(Entity, &PointLight, &GlobalTransform, Option<&InheritedVisibility>)>>,
+    spots: Extract<Query<(Entity, &SpotLight, &GlobalTransform, Option<&InheritedVisibility>)>>,
 ) {
     extracted.light = light.0;
-    extracted.sun = suns
+    let visible = |visibility: Option<&InheritedVisibility>| visibility.is_none_or(|v| v.get());
+    let mut suns: Vec<_> = suns.iter().filter(|(.., v)| visible(*v)).collect();
+    suns.sort_by_key(|(entity, ..)| *entity);
+    let sun = |(_, sun, transform, _): &(Entity, &DirectionalLight, &GlobalTransform, _)| {
+        // A directional light shines along its forward (-Z) axis.
+        let toward_light = to_pelt(transform.back().as_vec3()).try_normalize()?;
+        let colour_lux = linear(sun.color) * sun.illuminance;
+        colour_lux.is_finite().then_some(Sun { toward_light, colour_lux })
+    };
+    extracted.sun = suns.first().and_then(sun);
+    let mut others: Vec<LightSource> = suns
         .iter()
-        .filter(|(.., visibility)| visibility.is_none_or(|v| v.get()))
-        .min_by_key(|(entity, ..)| *entity)
-        .and_then(|(_, sun, transform, _)| {
-            // A directional light shines along its forward (-Z) axis.
-            let toward_light = to_pelt(transform.back().as_vec3()).try_normalize()?;
-            let colour = sun.color.to_linear();
-            let colour_lux = glam::Vec3::new(colour.red, colour.green, colour.blue) * sun.illuminance;
-            colour_lux.is_finite().then_some(Sun { toward_light, colour_lux })
+        .skip(1)
+        .filter_map(sun)
+        .map(|s| LightSource::directional(s.toward_light, s.colour_lux, 1.0))
+        .collect();
+    // Bevy gives point and spot lights in lumens over the whole sphere (a spot is a point light
+    // masked by its cone): candela = lumens / 4 pi.
+    let candela = |lumens: f32| lumens / (4.0 * std::f32::consts::PI);
+    let mut bulbs: Vec<_> = bulbs.iter().filter(|(.., v)| visible(*v)).collect();
+    bulbs.sort_by_key(|(entity, ..)| *entity);
+    for (_, bulb, transform, _) in bulbs {
+        others.push(LightSource {
+            kind: LightKind::Point,
+            position: to_pelt(transform.translation()),
+            direction: glam::Vec3::ZERO,
+            intensity: linear(bulb.color) * candela(bulb.intensity),
+            cos_inner: -1.0,
+            cos_outer: -1.0,
+            casts_shadows: false,
         });
+    }
+    let mut spots: Vec<_> = spots.iter().filter(|(.., v)| visible(*v)).collect();
+    spots.sort_by_key(|(entity, ..)| *entity);
+    for (_, spot, transform, _) in spots {
+        others.push(LightSource {
+            kind: LightKind::Spot,
+            position: to_pelt(transform.translation()),
+            direction: to_pelt(transform.forward().as_vec3()).normalize_or(glam::Vec3::NEG_Y),
+            intensity: linear(spot.color) * candela(spot.intensity),
+            // Bevy's angles are half angles.
+            cos_inner: spot.inner_angle.cos(),
+            cos_outer: spot.outer_angle.cos(),
+            casts_shadows: false,
+        });
+    }
+    others.retain(|l| l.intensity.is_finite() && l.position.is_finite() && l.direction.is_finite());
+    others.truncate(MAX_LIGHTS - 1);
+    extracted.others = others;
     extracted.furs.clear();
     for (entity, fur, state, visibility, not_caster) in &furs {
         if visibility.is_some_and(|v| !v.get()) {
@@ -120,6 +173,7 @@ pub(crate) fn extract_furs(
             casts_shadows: !not_caster,
             wetness: state.wetness.clone(),
             wet: state.wet.clone(),
+            shading: FurShading::from_params(&state.shading),
         });
     }
 }
@@ -283,7 +337,20 @@ pub(crate) fn prepare_furs(
         entry.camera_position = world_from_view.w_axis.truncate();
         let exposure = camera.map_or_else(|| Exposure::default().exposure(), |camera| camera.exposure);
         let light = extracted.sun.map_or(extracted.light, |sun| sun.light(exposure, extracted.light.ambient));
-        entry.view.prepare(queue, &ViewData::new(clip_from_world, world_from_view, &light));
+        let mut data = ViewData::new(clip_from_world, world_from_view, &light);
+        // The fur model sums the lights it is given; Kajiya-Kay alone needs only the key light.
+        if !extracted.others.is_empty() || extracted.furs.iter().any(|f| f.shading.fur_model) {
+            // The sun (if any) first: Kajiya-Kay keeps it as its key light.
+            let sun = extracted.sun.map(|s| LightSource::directional(s.toward_light, s.colour_lux, 1.0));
+            let lights: Vec<LightSource> = sun
+                .into_iter()
+                .chain(extracted.others.iter().copied())
+                .map(|l| LightSource { intensity: l.intensity * exposure, ..l })
+                .collect();
+            let ambient = Environment::uniform(glam::Vec3::splat(extracted.light.ambient));
+            data = data.with_lights(&lights, Some(ambient));
+        }
+        entry.view.prepare(queue, &data);
         seen_views.insert(entity);
         targets.insert(target);
     }
@@ -318,6 +385,7 @@ pub(crate) fn prepare_furs(
             }
             let Some(entry) = gpu.furs.get_mut(&key) else { continue };
             entry.fur.set_world_from_model(fur.world_from_simulation);
+            entry.fur.set_look(FurLook { shading: fur.shading, ..FurLook::default() });
             if let Err(problem) = entry.fur.show_wet(queue, fur.wetness.as_deref().map(Vec::as_slice), &fur.wet) {
                 error!("Pelt cannot show the wetness of {}: {problem}", fur.entity);
             }

@@ -6,6 +6,8 @@ mod common;
 
 #[path = "interaction.rs"]
 mod interaction;
+#[path = "lights.rs"]
+mod lights;
 #[path = "passes.rs"]
 mod passes;
 #[path = "render.rs"]
