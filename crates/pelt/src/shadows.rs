@@ -1,5 +1,6 @@
-//! The shadows and the ground of Pelt's own pictures (`--shadows`, `--no-shadows`, `--ground`,
-//! a script's `[ground]`): the key light's [`ShadowMap`] and the plane under the meshes.
+//! The shadows and the ground of Pelt's own pictures and viewer (`--shadows`, `--no-shadows`,
+//! `--ground`, a script's `[ground]`): the key light's [`ShadowMap`] and the plane under the
+//! meshes.
 
 use anyhow::Context as _;
 use glam::{Mat4, Vec3};

@@ -53,6 +53,8 @@ pub struct Args {
     /// `[render.lod]` is on by default; the overlay shows the level in use).
     #[arg(long)]
     pub no_lod: bool,
+    #[command(flatten)]
+    pub shadows: crate::shadows::ShadowArgs,
     /// Window size in logical pixels, `WIDTHxHEIGHT`.
     #[arg(long, value_name = "WxH", default_value = "1280x800", value_parser = crate::values::parse_size)]
     pub size: (u32, u32),

@@ -161,3 +161,27 @@ fn an_animated_file_moves_in_the_window() {
     let moved = mean_difference(&early, &later, view);
     assert!(moved > 0.5, "the animation moves the fox: mean difference {moved}");
 }
+
+/// `--ground` and the Drawing section's switches: the ground under the bunny, and with shadows
+/// (on with the ground unless `--no-shadows`) the fur's shadow on it and on itself.
+#[test]
+fn the_window_draws_the_ground_and_the_furs_shadow() {
+    let common = ["--builtin", "bunny", "--sim", "cpu", "--no-overlay"];
+    let with = |extra: &[&'static str]| common.iter().copied().chain(extra.iter().copied()).collect::<Vec<_>>();
+    let shadowed = screenshot("ground_shadows", 4, &with(&["--ground"]));
+    let unshadowed = screenshot("ground_no_shadows", 4, &with(&["--ground", "--no-shadows"]));
+    let bare = screenshot("no_ground", 4, &common);
+    let view = 0..WIDTH_PX - PANEL_PX;
+    let count = |a: &image::RgbaImage, b: &image::RgbaImage, by: f64| {
+        view.clone()
+            .flat_map(|x| (0..HEIGHT_PX).map(move |y| (x, y)))
+            .filter(|&(x, y)| luminance(a.get_pixel(x, y)) + by < luminance(b.get_pixel(x, y)))
+            .count()
+    };
+    let ground = count(&bare, &unshadowed, 10.0) + count(&unshadowed, &bare, 10.0);
+    assert!(ground > 20_000, "the ground changed {ground} pixels");
+    let darker = count(&shadowed, &unshadowed, 20.0);
+    let brighter = count(&unshadowed, &shadowed, 20.0);
+    assert!(darker > 2_000, "{darker} pixels darker with shadows");
+    assert!(brighter < darker / 10, "{brighter} pixels brighter, {darker} darker");
+}

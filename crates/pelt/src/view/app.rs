@@ -184,6 +184,8 @@ impl App {
             running.fur.set_textures(&running.gpu, &textures)?;
         }
         running.fur.body_colliders = model.settings.draw.body_colliders;
+        let draw = model.settings.draw;
+        running.fur.set_surroundings(&running.gpu, &model.structure, model.body.as_ref(), draw.shadows, draw.ground)?;
         if let Some((time_secs, clip_secs)) = model.simulate(frame_secs) {
             let started = std::time::Instant::now();
             running.fur.advance(&running.gpu, &mut model.stepper, time_secs, clip_secs)?;

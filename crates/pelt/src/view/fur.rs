@@ -13,6 +13,7 @@ use pelt_render::{
 use super::camera::OrbitCamera;
 use super::shell_share::ShellShare;
 use super::viewport::{Viewport, target};
+use crate::shadows::{ShadowArgs, Surroundings};
 
 /// Colour of a plain (furless) body, linear RGB.
 const BODY_COLOUR: Vec3 = Vec3::new(0.6, 0.45, 0.38);
@@ -39,6 +40,9 @@ pub struct FurScene {
     pub body_colliders: bool,
     /// The view-angle pass's count, read back for the overlay.
     shell_share: ShellShare,
+    /// The shadow maps and the ground, with the (shadows, ground) switches they were made for;
+    /// `None` until asked for, and again after a new structure or body.
+    surroundings: Option<((bool, bool), Surroundings)>,
 }
 
 impl FurScene {
@@ -64,6 +68,7 @@ impl FurScene {
             settings: FurDrawSettings::SILHOUETTE,
             body_colliders: false,
             shell_share: ShellShare::new(&gpu.device),
+            surroundings: None,
         })
     }
 
@@ -74,6 +79,7 @@ impl FurScene {
 
     pub fn set_structure(&mut self, gpu: &pelt_render::Gpu, structure: &FurStructure) -> anyhow::Result<()> {
         self.separated = None;
+        self.surroundings = None;
         self.driver.set_structure(&gpu.device, &gpu.queue, &self.renderer, structure)?;
         Ok(())
     }
@@ -150,7 +156,29 @@ impl FurScene {
     }
 
     /// Replaces the furless body drawn with the fur (the try-on scene's), if any.
+    /// The shadow maps and ground the switches ask for, around `structure` and `body` (made again
+    /// when a switch changes or after a new structure or body).
+    pub fn set_surroundings(
+        &mut self,
+        gpu: &pelt_render::Gpu,
+        structure: &FurStructure,
+        body: Option<&Mesh>,
+        shadows: bool,
+        ground: bool,
+    ) -> anyhow::Result<()> {
+        if self.surroundings.as_ref().is_some_and(|(made_for, _)| *made_for == (shadows, ground)) {
+            return Ok(());
+        }
+        let args = ShadowArgs { shadows, no_shadows: !shadows, ground };
+        let plain: Vec<Mesh> = body.into_iter().cloned().collect();
+        let surroundings =
+            Surroundings::new(&gpu.device, &gpu.queue, &self.renderer, &args, None, (structure, &plain))?;
+        self.surroundings = Some(((shadows, ground), surroundings));
+        Ok(())
+    }
+
     pub fn set_body(&mut self, gpu: &pelt_render::Gpu, body: Option<&Mesh>) -> anyhow::Result<()> {
+        self.surroundings = None;
         self.body = match body {
             Some(mesh) => {
                 let body = PlainMesh::new(&gpu.device, &self.renderer, mesh, BODY_COLOUR)?;
@@ -220,8 +248,15 @@ impl FurScene {
         let camera =
             Camera { eye: camera.eye(), target: camera.target, up: Vec3::Y, fov_y_rad: camera.fov_y_rad, near, far };
         let studio = Studio::default();
-        self.view.prepare(&gpu.queue, &studio.view_data(&camera, viewport.targets.aspect_ratio()));
+        let view_data = studio.view_data(&camera, viewport.targets.aspect_ratio());
+        self.view.prepare(&gpu.queue, &view_data);
         let separated = self.separated.as_ref().filter(|_| separated);
+        // The separated structure draws with pipelines of its own, which read no shadow maps.
+        let surroundings = self.surroundings.as_ref().map(|(_, s)| s).filter(|_| separated.is_none());
+        match surroundings {
+            Some(s) => s.prepare(&gpu.queue, &view_data, &mut self.view),
+            None => self.view.set_shadows(None),
+        }
         match separated {
             Some((_, fur)) => fur.prepare(&gpu.queue, &FurFrame { level, ..*self.driver.frame() }),
             None => {
@@ -230,8 +265,21 @@ impl FurScene {
                 self.driver.record_view(encoder, &self.renderer, &self.view);
             }
         }
+        if let Some(s) = surroundings {
+            s.record(encoder, |pass, light| {
+                s.draw_ground(pass, &self.renderer, light);
+                if let Some(body) = &self.body {
+                    self.renderer.draw_plain(pass, light, body);
+                }
+                self.colliders.draw(pass, &self.renderer, light);
+                self.driver.draw(pass, &self.renderer, light, &FurDrawSettings::ALL);
+            });
+        }
         {
             let mut pass = viewport.targets.begin_pass(encoder, &viewport.colour_view, studio.background);
+            if let Some(s) = surroundings {
+                s.draw_ground(&mut pass, &self.renderer, &self.view);
+            }
             if let Some(body) = &self.body {
                 self.renderer.draw_plain(&mut pass, &self.view, body);
             }

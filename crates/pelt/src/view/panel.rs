@@ -61,11 +61,23 @@ pub struct DrawToggles {
     pub unified: bool,
     /// A body's collision capsules over the body (a script's colliders are always drawn).
     pub body_colliders: bool,
+    /// The key light's shadow maps (the fur's deep opacity map included).
+    pub shadows: bool,
+    /// A ground under the meshes, taking their shadow.
+    pub ground: bool,
 }
 
 impl Default for DrawToggles {
     fn default() -> Self {
-        Self { skin: true, shells: true, fins: true, unified: true, body_colliders: false }
+        Self {
+            skin: true,
+            shells: true,
+            fins: true,
+            unified: true,
+            body_colliders: false,
+            shadows: false,
+            ground: false,
+        }
     }
 }
 
@@ -366,6 +378,10 @@ pub fn show(
                 ui.radio_value(&mut draw.unified, false, "separated (U)");
             });
             ui.checkbox(&mut draw.body_colliders, "the body's collision capsules");
+            ui.horizontal(|ui| {
+                ui.checkbox(&mut draw.shadows, "shadows").on_hover_text("the key light's, the fur's own included");
+                ui.checkbox(&mut draw.ground, "ground");
+            });
             ui.checkbox(&mut settings.overlay, "overlay (O)");
         });
         section(ui, "Shortcuts", false, |ui| {
