@@ -22,7 +22,7 @@ use pelt_render::{
 };
 
 use crate::convert::to_pelt_mat4;
-use crate::render::{DEPTH_FORMAT, ExtractedFurs, FurGpu, clip_from_world};
+use crate::render::{DEPTH_FORMAT, ExtractedFurs, FurGpu, clip_from_world, set_camera_viewport};
 
 /// Bevy's motion-vector format (`MOTION_VECTOR_PREPASS_FORMAT`).
 const MOTION_FORMAT: wgpu::TextureFormat = bevy::core_pipeline::prepass::MOTION_VECTOR_PREPASS_FORMAT;
@@ -223,10 +223,7 @@ pub(crate) fn draw_fur_prepass(
         occlusion_query_set: None,
         multiview_mask: None,
     });
-    if let Some(viewport) = &camera.viewport {
-        let (position, size) = (viewport.physical_position.as_vec2(), viewport.physical_size.as_vec2());
-        pass.set_viewport(position.x, position.y, size.x, size.y, viewport.depth.start, viewport.depth.end);
-    }
+    set_camera_viewport(&mut pass, camera);
     for (fur, motion, skin) in furs {
         prepass.draw(&mut pass, entry.fur_view(), fur, motion, skin);
     }

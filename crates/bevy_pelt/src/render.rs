@@ -72,6 +72,19 @@ impl Sun {
             ambient,
         }
     }
+
+    /// The sun as one of the fur model's lights (before exposure).
+    fn source(&self) -> LightSource {
+        LightSource::directional(self.toward_light, self.colour_lux, 1.0)
+    }
+}
+
+/// Limits `pass` to the camera's viewport, if it has one.
+pub(crate) fn set_camera_viewport(pass: &mut wgpu::RenderPass<'_>, camera: &ExtractedCamera) {
+    if let Some(viewport) = &camera.viewport {
+        let (position, size) = (viewport.physical_position.as_vec2(), viewport.physical_size.as_vec2());
+        pass.set_viewport(position.x, position.y, size.x, size.y, viewport.depth.start, viewport.depth.end);
+    }
 }
 
 /// A Bevy colour as linear RGB.
@@ -116,12 +129,7 @@ pub(crate) fn extract_furs(
         colour_lux.is_finite().then_some(Sun { toward_light, colour_lux })
     };
     extracted.sun = suns.first().and_then(sun);
-    let mut others: Vec<LightSource> = suns
-        .iter()
-        .skip(1)
-        .filter_map(sun)
-        .map(|s| LightSource::directional(s.toward_light, s.colour_lux, 1.0))
-        .collect();
+    let mut others: Vec<LightSource> = suns.iter().skip(1).filter_map(sun).map(|s| s.source()).collect();
     // Bevy gives point and spot lights in lumens over the whole sphere (a spot is a point light
     // masked by its cone): candela = lumens / 4 pi.
     let candela = |lumens: f32| lumens / (4.0 * std::f32::consts::PI);
@@ -341,7 +349,7 @@ pub(crate) fn prepare_furs(
         // The fur model sums the lights it is given; Kajiya-Kay alone needs only the key light.
         if !extracted.others.is_empty() || extracted.furs.iter().any(|f| f.shading.fur_model) {
             // The sun (if any) first: Kajiya-Kay keeps it as its key light.
-            let sun = extracted.sun.map(|s| LightSource::directional(s.toward_light, s.colour_lux, 1.0));
+            let sun = extracted.sun.as_ref().map(Sun::source);
             let lights: Vec<LightSource> = sun
                 .into_iter()
                 .chain(extracted.others.iter().copied())
@@ -453,10 +461,7 @@ pub(crate) fn draw_furs(
         occlusion_query_set: None,
         multiview_mask: None,
     });
-    if let Some(viewport) = &camera.viewport {
-        let (position, size) = (viewport.physical_position.as_vec2(), viewport.physical_size.as_vec2());
-        pass.set_viewport(position.x, position.y, size.x, size.y, viewport.depth.start, viewport.depth.end);
-    }
+    set_camera_viewport(&mut pass, camera);
     for (fur, driver) in furs {
         let settings = FurDrawSettings { skin: fur.skin, ..FurDrawSettings::ALL };
         driver.draw(&mut pass, renderer, &entry.view, &settings);

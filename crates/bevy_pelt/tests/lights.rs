@@ -6,11 +6,8 @@ use bevy::core_pipeline::tonemapping::Tonemapping;
 use bevy::prelude::*;
 use bevy_pelt::Fur;
 
+use crate::common::luma;
 use crate::render::{capture, cuboid, preset, save};
-
-fn luma(p: &image::Rgba<u8>) -> f32 {
-    0.2126 * f32::from(p[0]) + 0.7152 * f32::from(p[1]) + 0.0722 * f32::from(p[2])
-}
 
 /// The skinless furred cube (fur model) before a camera, with a point light in front of it and
 /// to the upper right, or without one.

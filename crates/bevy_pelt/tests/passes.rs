@@ -16,11 +16,10 @@ use bevy::prelude::*;
 use bevy::render::RenderApp;
 use bevy::render::render_resource::TextureFormat;
 use bevy::render::renderer::{RenderContext, RenderDevice, ViewQuery};
-use bevy::render::view::screenshot::{Screenshot, ScreenshotCaptured};
 use bevy_pelt::{Fur, FurState};
 
-use crate::common::{self, test_assets as assets, update};
-use crate::render::{SIZE, capture, cuboid, preset};
+use crate::common::{self, luma, test_assets as assets, update};
+use crate::render::{SIZE, capture, capture_now, cuboid, preset};
 
 /// The skinless furred cube over a lit ground, the sun almost straight above (slightly behind it,
 /// so the shadow falls toward the camera); `caster` leaves the fur casting (else
@@ -48,10 +47,6 @@ fn shadow_scene(caster: bool) -> image::RgbaImage {
         ));
     });
     images.into_iter().next().unwrap()
-}
-
-fn luma(p: &image::Rgba<u8>) -> f32 {
-    0.2126 * f32::from(p[0]) + 0.7152 * f32::from(p[1]) + 0.0722 * f32::from(p[2])
 }
 
 #[test]
@@ -216,22 +211,6 @@ fn prepass_app(taa: bool, step: f32, frames: u32) -> (App, Handle<Image>) {
     (app, target)
 }
 
-fn screenshot(app: &mut App, target: &Handle<Image>) -> image::RgbaImage {
-    let captured: Arc<Mutex<Option<Image>>> = Arc::new(Mutex::new(None));
-    let sink = Arc::clone(&captured);
-    app.world_mut().spawn(Screenshot::image(target.clone())).observe(move |shot: On<ScreenshotCaptured>| {
-        *sink.lock().unwrap() = Some(shot.image.clone());
-    });
-    for _ in 0..10 {
-        update(app);
-        if captured.lock().unwrap().is_some() {
-            break;
-        }
-    }
-    let image = captured.lock().unwrap().take().expect("the screenshot arrived");
-    image.try_into_dynamic().expect("an RGBA8 image").to_rgba8()
-}
-
 #[test]
 fn moving_fur_writes_motion_vectors_under_taa() {
     // 0.02 a frame along +X: about 0.02 / (2 * 4 * tan(fov / 2)) of the width, ~0.006 in uv.
@@ -254,9 +233,9 @@ fn moving_fur_writes_motion_vectors_under_taa() {
 #[test]
 fn a_still_fur_under_taa_converges_to_the_picture_without_it() {
     let (mut app, target) = prepass_app(true, 0.0, 40);
-    let with_taa = screenshot(&mut app, &target);
+    let with_taa = capture_now(&mut app, &target);
     let (mut app, target) = prepass_app(false, 0.0, 4);
-    let without = screenshot(&mut app, &target);
+    let without = capture_now(&mut app, &target);
     crate::render::save(&with_taa, "taa_still");
     crate::render::save(&without, "taa_off_still");
     let differences: Vec<f32> =

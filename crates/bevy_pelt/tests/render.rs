@@ -484,7 +484,7 @@ fn the_foxs_fur_follows_bevys_animation() {
 }
 
 /// Captures `target` now (a few frames).
-fn capture_now(app: &mut App, target: &Handle<Image>) -> image::RgbaImage {
+pub(crate) fn capture_now(app: &mut App, target: &Handle<Image>) -> image::RgbaImage {
     let captured: Arc<Mutex<Option<Image>>> = Arc::new(Mutex::new(None));
     let sink = Arc::clone(&captured);
     app.world_mut().spawn(Screenshot::image(target.clone())).observe(move |shot: On<ScreenshotCaptured>| {

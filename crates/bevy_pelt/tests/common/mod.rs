@@ -48,6 +48,11 @@ pub fn headless_app_with(assets: &Path, watch: bool, frame: Option<Duration>, co
     app
 }
 
+/// A pixel's luma (Rec. 709 weights on the stored sRGB values).
+pub fn luma(p: &image::Rgba<u8>) -> f32 {
+    0.2126 * f32::from(p[0]) + 0.7152 * f32::from(p[1]) + 0.0722 * f32::from(p[2])
+}
+
 /// One frame, waited for on the GPU.
 pub fn update(app: &mut App) {
     app.update();
