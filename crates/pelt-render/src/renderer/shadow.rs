@@ -17,8 +17,8 @@ enum ShadowKind {
     Opaque,
     /// Depth only (the fur's first surface).
     FurDepth,
-    /// Opacity added into the layers, tested against the opaque map; `cull` for shells.
-    Opacity { cull: bool },
+    /// Opacity added into the layers, tested against the opaque map.
+    Opacity,
 }
 
 /// The depth-only pipelines every fur shares: walk by walk (wedges, then indexed).
@@ -29,12 +29,16 @@ pub(super) struct ShadowPipelines {
     fur_depth: [wgpu::RenderPipeline; 2],
 }
 
-/// One coat's opacity pipelines.
+/// One coat's opacity pipelines (shells only: seen from the light, a coat's fins stand edge-on
+/// where its shells do not, and would cost more than every shell together).
 #[derive(Debug)]
 pub(super) struct OpacityPipelines {
     shells: [wgpu::RenderPipeline; 2],
-    fins: wgpu::RenderPipeline,
 }
+
+/// The opacity pass draws at most this many shells (`OPACITY_SHELLS` in `unified.wgsl`): one
+/// for each of the map's opacity layers.
+const OPACITY_SHELLS: u32 = 4;
 
 /// The shadow pipelines, each built the first time a shadow map draws with it.
 #[derive(Debug, Default)]
@@ -89,17 +93,11 @@ impl CoatBuilder {
                 let fragment = coat.entry(if uvs { "fs_opacity_uvs" } else { "fs_opacity_tiles" });
                 self.shadow_pipeline(
                     "pelt shadow shells",
-                    (&coat.entry(&format!("vs_shell_{walk}")), Some(&fragment)),
+                    (&coat.entry(&format!("vs_opacity_shell_{walk}")), Some(&fragment)),
                     (&self.layout, Some(uvs), coat),
-                    ShadowKind::Opacity { cull: true },
+                    ShadowKind::Opacity,
                 )
             }),
-            fins: self.shadow_pipeline(
-                "pelt shadow fins",
-                (&coat.entry("vs_fin"), Some(&coat.entry("fs_opacity_fin"))),
-                (&self.layout, None, coat),
-                ShadowKind::Opacity { cull: false },
-            ),
         }
     }
 }
@@ -141,15 +139,8 @@ impl FurRenderer {
                 geometry.draw_shells(pass, shells - 1..shells);
             }
             ShadowPass::Opacity if furred => {
-                let opacity = self.opacity(fur.coat());
-                if settings.shells {
-                    pass.set_pipeline(&opacity.shells[walk]);
-                    geometry.draw_shells(pass, 0..shells);
-                }
-                if settings.fins {
-                    pass.set_pipeline(&opacity.fins);
-                    geometry.draw_fins(pass, shells);
-                }
+                pass.set_pipeline(&self.opacity(fur.coat()).shells[walk]);
+                geometry.draw_shells(pass, 0..shells.div_ceil(shells.div_ceil(OPACITY_SHELLS)));
             }
             _ => {}
         }
@@ -190,7 +181,7 @@ fn create_shadow_pipeline(
         // A texel's worth of slope keeps lit surfaces off their own shadow.
         ShadowKind::Opaque => (true, wgpu::DepthBiasState { constant: 2, slope_scale: 2.0, clamp: 0.0 }, None),
         ShadowKind::FurDepth => (true, wgpu::DepthBiasState::default(), None),
-        ShadowKind::Opacity { cull } => (false, wgpu::DepthBiasState::default(), cull.then_some(wgpu::Face::Back)),
+        ShadowKind::Opacity => (false, wgpu::DepthBiasState::default(), Some(wgpu::Face::Back)),
     };
     let additive = wgpu::BlendComponent {
         src_factor: wgpu::BlendFactor::One,

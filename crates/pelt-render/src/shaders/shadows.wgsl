@@ -91,15 +91,26 @@ fn light_visibility(light_index: u32, world_position: vec3<f32>, world_normal: v
     return 0.25 * lit * exp(-shadow.extinction * deep_opacity(layers, beyond));
 }
 
-// A shadow view's opacity fragment: `alpha` added to every layer that ends at or past the
-// fragment's depth beyond z0 (the last layer takes every fragment), so each layer holds the
-// opacity in front of its end.
-fn opacity_layers(position: vec4<f32>, alpha: f32) -> vec4<f32> {
+// The deep opacity pass draws at most OPACITY_SHELLS shells, evenly spaced, each the middle of
+// a run of `opacity_stride()` shells and adding the opacity of the whole run (opacity adds up:
+// the transmittance is exp(-extinction * the sum)). The map holds four opacity layers, so four shells fill them: a shadow needs the
+// coat's density, not each shell.
+const OPACITY_SHELLS = 4u;
+
+fn opacity_stride() -> u32 {
+    return (object.lod_shells + OPACITY_SHELLS - 1u) / OPACITY_SHELLS;
+}
+
+// A shadow view's opacity fragment of a shell that stands for `opacity_stride()` shells
+// (`vs_opacity_shell_*`): their alpha, added to every layer that ends at or past the fragment's depth beyond z0 (the
+// last layer takes every fragment), so each layer holds the opacity in front of its end.
+fn opacity_layers(position: vec4<f32>, shell_alpha: f32) -> vec4<f32> {
+    let alpha = clamp(shell_alpha, 0.0, 1.0) * f32(opacity_stride());
     let z0 = textureLoad(fur_depth, vec2<i32>(position.xy), 0).x;
     let beyond = shadow_linear_depth(position.z) - shadow_linear_depth(z0);
     let e = shadow.layer_ends;
     let inside = vec4<f32>(select(0.0, 1.0, beyond <= e.x), select(0.0, 1.0, beyond <= e.y), select(0.0, 1.0, beyond <= e.z), 1.0);
-    return inside * clamp(alpha, 0.0, 1.0);
+    return inside * alpha;
 }
 
 @fragment
@@ -130,17 +141,4 @@ fn fs_opacity_uvs_groomed(in: GroomedShellUvVaryings) -> @location(0) vec4<f32> 
     let groom = shell_groom(in.fade_blend_layer, in.tint_density);
     let texel = coat_shell_texel(in.uvs.xy, layer, groom);
     return opacity_layers(in.clip_position, lod_alpha(texel.a * in.fade_blend_layer.x, layer, in.fade_blend_layer.y));
-}
-
-@fragment
-fn fs_opacity_fin(in: FinVaryings) -> @location(0) vec4<f32> {
-    let texel = textureSample(fin_texture, fin_sampler, fin_texture_uv(in.uvs));
-    return opacity_layers(in.clip_position, texel.a * in.lighting_fade.w * mix(0.15, 0.6, in.uvs.y));
-}
-
-@fragment
-fn fs_opacity_fin_groomed(in: GroomedFinVaryings) -> @location(0) vec4<f32> {
-    let texel = textureSample(fin_texture, fin_sampler, fin_texture_uv(in.uvs));
-    let density = clamp(in.tint_density.a, 0.0, 1.0);
-    return opacity_layers(in.clip_position, texel.a * in.lighting_fade.w * mix(0.15, 0.6, in.uvs.y) * density);
 }

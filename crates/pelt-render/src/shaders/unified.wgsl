@@ -194,6 +194,32 @@ fn vs_shell_indexed_listed_groomed(@builtin(vertex_index) index: u32) -> Groomed
     return groomed_shell_vertex(index % object.vertex_count, index / object.vertex_count);
 }
 
+// The deep opacity pass's shell `instance` (`opacity_stride` in `shadows.wgsl`).
+fn opacity_shell(instance: u32) -> u32 {
+    let stride = opacity_stride();
+    return min(stride * instance + stride / 2u, object.lod_shells - 1u);
+}
+
+@vertex
+fn vs_opacity_shell_wedges(@builtin(vertex_index) wedge: u32, @builtin(instance_index) instance: u32) -> ShellUvVaryings {
+    return shell_wedge(wedge, opacity_shell(instance));
+}
+
+@vertex
+fn vs_opacity_shell_indexed(@builtin(vertex_index) vertex: u32, @builtin(instance_index) instance: u32) -> ShellTileVaryings {
+    return shell_vertex(vertex, opacity_shell(instance));
+}
+
+@vertex
+fn vs_opacity_shell_wedges_groomed(@builtin(vertex_index) wedge: u32, @builtin(instance_index) instance: u32) -> GroomedShellUvVaryings {
+    return groomed_shell_wedge(wedge, opacity_shell(instance));
+}
+
+@vertex
+fn vs_opacity_shell_indexed_groomed(@builtin(vertex_index) vertex: u32, @builtin(instance_index) instance: u32) -> GroomedShellTileVaryings {
+    return groomed_shell_vertex(vertex, opacity_shell(instance));
+}
+
 fn shell_wedge(wedge: u32, shell: u32) -> ShellUvVaryings {
     let vertex = wedge_vertex(wedge);
     let v = surface_varyings(vertex, wedge, lod_shell_layer(shell));
