@@ -80,6 +80,10 @@ pub struct Args {
     pub guard: Option<PathBuf>,
     #[command(flatten)]
     pub lights: crate::light_args::LightArgs,
+    /// Also time the unified fur with the key light's shadows (its shadow maps and deep opacity
+    /// map, as `pelt render --shadows` draws them), in turn with the frame-time table's cases.
+    #[arg(long)]
+    pub shadows: bool,
     /// Instead of the report: the time to a first frame phase by phase (parse, repair,
     /// structure, textures, skin setup, GPU upload) for every mesh in the meshes folder and
     /// each `--load-mesh`.
@@ -110,6 +114,8 @@ struct Plan<'a> {
     extra_sizes: &'a [(u32, u32)],
     /// `--preset`: the preset timed in place of the default one.
     preset: Option<&'a Preset>,
+    /// `--shadows`.
+    shadows: bool,
 }
 
 impl Plan<'_> {
@@ -183,7 +189,13 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         );
     }
     let preset = args.preset.as_deref().map(Preset::load).transpose()?;
-    let plan = Plan { quick: args.quick, no_lod: args.no_lod, extra_sizes: &args.sizes, preset: preset.as_ref() };
+    let plan = Plan {
+        quick: args.quick,
+        no_lod: args.no_lod,
+        extra_sizes: &args.sizes,
+        preset: preset.as_ref(),
+        shadows: args.shadows,
+    };
     let meshes_dir = models::meshes_dir(args.meshes.as_deref());
 
     // One GPU for the whole run; without one the frame times are null with the reason.
@@ -318,7 +330,15 @@ fn measure(
         Ok(gpu) => {
             eprintln!("pelt bench:   {key} L={layers}: frame time");
             let lod = crate::lod::settings(&preset.render.lod, plan.no_lod);
-            gpu.measure(&fur, model.body.as_ref(), &textures, plan.render_budget(), lod, plan.extra_sizes)?
+            gpu.measure(
+                &fur,
+                model.body.as_ref(),
+                &textures,
+                plan.render_budget(),
+                lod,
+                plan.extra_sizes,
+                plan.shadows,
+            )?
         }
         Err(reason) => RenderFigures { render_unavailable_reason: Some(reason.clone()), ..RenderFigures::default() },
     };

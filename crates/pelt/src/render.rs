@@ -18,7 +18,6 @@ use pelt_render::{
 use crate::light_args::{LightArgs, preset_look};
 use crate::lod;
 use crate::mesh_args::MeshArgs;
-use crate::shadows::Surroundings;
 use crate::sim_kernel::SimChoice;
 
 /// Skin tone of plain meshes (linear RGB).
@@ -222,7 +221,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     view.prepare(queue, &view_data);
     driver.set_look(preset_look(&preset));
     let scene_ground = stepper.scene().and_then(|s| s.ground.as_ref());
-    let surroundings = Surroundings::new(device, queue, &renderer, &args.shadows, scene_ground, (&fur, &plain))?;
+    let surroundings = args.shadows.surroundings((device, queue, &renderer), scene_ground, (&fur, &plain))?;
     surroundings.prepare(queue, &view_data, &mut view);
     // The camera stays put, so one level serves every frame.
     let level = lod::level(&lod::settings(&preset.render.lod, args.no_lod), &fur, camera.eye, camera.fov_y_rad, height);

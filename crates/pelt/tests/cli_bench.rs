@@ -56,6 +56,8 @@ const MEASURED_KEYS: [(&str, &[&str]); 5] = [
             "frame_ms_unified_256x256",
             "frame_ms_separated2_256x256",
             "frame_ms_separated30_256x256",
+            "frame_ms_unified_shadows_1280x720",
+            "frame_ms_unified_shadows_256x256",
             "render_frames",
             "upload_ms_per_frame",
             "fin_edges_drawn",
@@ -88,7 +90,7 @@ fn quick_bench_writes_every_key_with_sane_values() {
     let json_path = dir.join(format!("bench-quick-{}.json", std::process::id()));
     let md_path = dir.join(format!("bench-quick-{}.md", std::process::id()));
     let output = Command::new(env!("CARGO_BIN_EXE_pelt"))
-        .args(["bench", "--quick", "--size", "96x64", "--json"])
+        .args(["bench", "--quick", "--shadows", "--size", "96x64", "--json"])
         .arg(&json_path)
         .arg("--md")
         .arg(&md_path)
@@ -98,6 +100,7 @@ fn quick_bench_writes_every_key_with_sane_values() {
     let report: Value = serde_json::from_str(&std::fs::read_to_string(&json_path).unwrap()).unwrap();
     let markdown = std::fs::read_to_string(&md_path).unwrap();
     assert!(markdown.contains("Table 2"), "{markdown}");
+    assert!(markdown.contains("### Shadows"), "--shadows adds the shadowed frame's table: {markdown}");
 
     for key in TOP_LEVEL_KEYS {
         assert!(report.get(key).is_some(), "missing top-level key {key}");

@@ -8,7 +8,8 @@ use pelt_core::texture::FurTextures;
 use pelt_core::{FurStructure, Mesh};
 use pelt_render::{
     Backend, Camera, DEFAULT_BACKGROUND, FurDrawSettings, FurFrame, FurRenderer, FurStates, FurTarget, FurView, Gpu,
-    GpuFur, HEADLESS_FORMAT, PlainMesh, RenderTargets, SeparatedFur, SeparatedRenderer, default_sample_count,
+    GpuFur, HEADLESS_FORMAT, PlainMesh, RenderTargets, SeparatedFur, SeparatedRenderer, Surroundings,
+    default_sample_count,
 };
 
 use super::report::{Adapter, GpuSimFigures, LodFigures, RenderFigures, SizeFigures};
@@ -120,7 +121,9 @@ impl Bench {
 
     /// Median frame times of the three structures at both sizes, each drawing the same scene:
     /// the fur and, for the try-on model, the plain `body` under it; at `extra_sizes` also
-    /// frames per second (`SizeFigures`).
+    /// frames per second (`SizeFigures`). With `shadows`, the unified fur is also timed with the
+    /// key light's shadow maps (interleaved with the rest, at the two standard sizes).
+    #[allow(clippy::too_many_arguments)]
     pub fn measure(
         &self,
         fur: &FurStructure,
@@ -129,6 +132,7 @@ impl Bench {
         budget: RenderBudget,
         lod: pelt_render::LodSettings,
         extra_sizes: &[(u32, u32)],
+        shadows: bool,
     ) -> anyhow::Result<RenderFigures> {
         let (device, queue) = (&self.gpu.device, &self.gpu.queue);
         // The samples `pelt render` and the viewer use on this adapter.
@@ -158,8 +162,16 @@ impl Bench {
         // Frame the whole scene: the body where there is one (the garment sits on it).
         let (centre, radius) = body_mesh.map_or_else(|| fur.mesh.bounding_sphere(), Mesh::bounding_sphere);
         let radius = radius + fur.lengths.iter().copied().fold(0.0, f32::max);
+        // The shadowed case: the key light's maps as `pelt render --shadows` draws them.
+        let plain: Vec<Mesh> = body_mesh.into_iter().cloned().collect();
+        let surroundings = shadows
+            .then(|| Surroundings::new(device, queue, &renderer, true, None, (fur, &plain)))
+            .transpose()
+            .context("making the shadow maps")?;
+        let mut shadowed_view = FurView::new(device, &renderer);
 
         let mut medians = [[0.0; 3]; SIZES.len()];
+        let mut shadowed_medians = [None; SIZES.len()];
         let mut frames_measured = u32::MAX;
         let mut fin_edges_drawn = None;
         let mut lod_figures = Vec::new();
@@ -170,6 +182,9 @@ impl Bench {
             let output_view = output.create_view(&Default::default());
             let camera = Camera::framing(centre, radius, 35.0, 20.0, targets.aspect_ratio());
             let view_data = self.studio.view_data(&camera, targets.aspect_ratio());
+            if let Some(surroundings) = &surroundings {
+                surroundings.prepare(queue, &view_data, &mut shadowed_view);
+            }
             // Every structure draws the same scene the same way: the view written, the body
             // (if any), then the fur, in one pass.
             let frame = |encoder: &mut wgpu::CommandEncoder,
@@ -183,7 +198,23 @@ impl Bench {
                 }
                 draw_fur(&mut pass);
             };
-            let cases: [&dyn Fn(&mut wgpu::CommandEncoder); 3] = [
+            let shadowed = |encoder: &mut wgpu::CommandEncoder| {
+                let Some(surroundings) = &surroundings else { return };
+                shadowed_view.prepare(queue, &view_data);
+                surroundings.record(encoder, |pass, light| {
+                    if let Some(body) = &body {
+                        renderer.draw_plain(pass, light, body);
+                    }
+                    renderer.draw(pass, light, &unified, &settings);
+                });
+                renderer.prepare_fins(encoder, &shadowed_view, &unified);
+                let mut pass = targets.begin_pass(encoder, &output_view, DEFAULT_BACKGROUND);
+                if let Some(body) = &body {
+                    renderer.draw_plain(&mut pass, &shadowed_view, body);
+                }
+                renderer.draw(&mut pass, &shadowed_view, &unified, &settings);
+            };
+            let cases: [&dyn Fn(&mut wgpu::CommandEncoder); 4] = [
                 &|encoder| {
                     let silhouette =
                         |encoder: &mut wgpu::CommandEncoder| renderer.prepare_fins(encoder, &view, &unified);
@@ -195,10 +226,13 @@ impl Bench {
                 &|encoder| {
                     frame(encoder, &|_| {}, &|pass| separated_renderer.draw(pass, &view, &separated30, &settings))
                 },
+                &shadowed,
             ];
             // Frame by frame in turn, so the machine's slow spells (10-20% on a shared VM) fall
-            // on the three structures alike and their ratios hold.
-            let times = self.time_interleaved(&cases, budget)?;
+            // on the three structures (and the shadowed fur) alike and their ratios hold.
+            let timed_cases = if surroundings.is_some() && index < SIZES.len() { &cases[..] } else { &cases[..3] };
+            let times = self.time_interleaved(timed_cases, budget)?;
+            let cases = &cases[..3];
             let Some(row) = medians.get_mut(index) else {
                 // A `--size`: the medians, then frames per second, the unified fur also at its
                 // level of detail for this framing (as `pelt render` and the viewer draw it).
@@ -207,7 +241,7 @@ impl Bench {
                 let frames =
                     ((FPS_RUN_SECS * 1000.0 / slowest_ms).ceil() as u32).clamp(*FPS_FRAMES.start(), *FPS_FRAMES.end());
                 let [fps_unified, fps_separated2, fps_separated30] =
-                    <[f64; 3]>::try_from(self.frames_per_second(&cases, frames)?).expect("one rate per case");
+                    <[f64; 3]>::try_from(self.frames_per_second(cases, frames)?).expect("one rate per case");
                 let (level, fps_unified_lod) = if lod.enabled {
                     let level = crate::lod::level(&lod, fur, camera.eye, camera.fov_y_rad, height);
                     unified.prepare(queue, &FurFrame { level, ..FurFrame::default() });
@@ -235,6 +269,7 @@ impl Bench {
                 frames_measured = frames_measured.min(times.len() as u32);
                 *median = median_ms(times);
             }
+            shadowed_medians[index] = times.get(3).map(|times| median_ms(times));
             if lod.enabled {
                 // The unified fur alone (as above) at its level of detail, near and at 4x the
                 // distance, then far with every shell; the counts from the silhouette pass.
@@ -292,6 +327,7 @@ impl Bench {
         let upload_times =
             self.time_frames(&|_| unified.set_positions(queue, &fur.positions).expect("checked just above"), budget)?;
         let [[u_large, s2_large, s30_large], [u_small, s2_small, s30_small]] = medians;
+        let [shadowed_large, shadowed_small] = shadowed_medians;
         Ok(RenderFigures {
             frame_ms_unified_1280x720: Some(u_large),
             frame_ms_separated2_1280x720: Some(s2_large),
@@ -299,6 +335,8 @@ impl Bench {
             frame_ms_unified_256x256: Some(u_small),
             frame_ms_separated2_256x256: Some(s2_small),
             frame_ms_separated30_256x256: Some(s30_small),
+            frame_ms_unified_shadows_1280x720: shadowed_large,
+            frame_ms_unified_shadows_256x256: shadowed_small,
             render_frames: Some(frames_measured),
             fin_edges_drawn,
             upload_ms_per_frame: Some(median_ms(&upload_times)),

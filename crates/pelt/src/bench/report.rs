@@ -144,6 +144,10 @@ pub struct RenderFigures {
     pub frame_ms_unified_256x256: Option<f64>,
     pub frame_ms_separated2_256x256: Option<f64>,
     pub frame_ms_separated30_256x256: Option<f64>,
+    /// `--shadows`: the unified fur with the key light's shadow maps (the shadow passes and the
+    /// picture), timed in turn with the three above.
+    pub frame_ms_unified_shadows_1280x720: Option<f64>,
+    pub frame_ms_unified_shadows_256x256: Option<f64>,
     /// Frames each median was taken over.
     pub render_frames: Option<u32>,
     /// Fins the unified structure drew at 1280x720: the edges the silhouette pass kept, of
@@ -382,6 +386,31 @@ impl Report {
             );
         }
         notes(&mut md, self.results.iter().map(|r| (r, r.render.render_unavailable_reason.as_deref())));
+
+        if self.results.iter().any(|r| r.render.frame_ms_unified_shadows_1280x720.is_some()) {
+            let _ = writeln!(md, "\n### Shadows (unified, median ms, timed in turn with the table above)\n");
+            let _ = writeln!(md, "| model | L | 1280x720 | with shadows | ratio | 256x256 | with shadows | ratio |");
+            let _ = writeln!(md, "|---|---:|---:|---:|---:|---:|---:|---:|");
+            let ratio = |with: Option<f64>, without: Option<f64>| match (with, without) {
+                (Some(with), Some(without)) if without > 0.0 => format!("{:.2}x", with / without),
+                _ => "-".to_owned(),
+            };
+            for r in &self.results {
+                let f = &r.render;
+                let _ = writeln!(
+                    md,
+                    "| {} | {} | {} | {} | {} | {} | {} | {} |",
+                    r.model,
+                    r.layers,
+                    ms(f.frame_ms_unified_1280x720),
+                    ms(f.frame_ms_unified_shadows_1280x720),
+                    ratio(f.frame_ms_unified_shadows_1280x720, f.frame_ms_unified_1280x720),
+                    ms(f.frame_ms_unified_256x256),
+                    ms(f.frame_ms_unified_shadows_256x256),
+                    ratio(f.frame_ms_unified_shadows_256x256, f.frame_ms_unified_256x256),
+                );
+            }
+        }
 
         if self.results.iter().any(|r| !r.render.lod.is_empty()) {
             let _ = writeln!(md, "\n### Level of detail (unified, median ms; the table above draws every shell)\n");

@@ -7,13 +7,13 @@ use pelt_core::texture::FurTextures;
 use pelt_core::{FurStructure, Mesh};
 use pelt_render::{
     Camera, ColliderMeshes, FurDrawSettings, FurDriver, FurFrame, FurLevel, FurRenderer, FurView, KernelChoice,
-    PlainMesh, SeparatedFur, SeparatedRenderer, SimKernel, Studio,
+    PlainMesh, SeparatedFur, SeparatedRenderer, SimKernel, Studio, Surroundings,
 };
 
 use super::camera::OrbitCamera;
 use super::shell_share::ShellShare;
 use super::viewport::{Viewport, target};
-use crate::shadows::{ShadowArgs, Surroundings};
+use crate::shadows::ShadowArgs;
 
 /// Colour of a plain (furless) body, linear RGB.
 const BODY_COLOUR: Vec3 = Vec3::new(0.6, 0.45, 0.38);
@@ -171,8 +171,7 @@ impl FurScene {
         }
         let args = ShadowArgs { shadows, no_shadows: !shadows, ground };
         let plain: Vec<Mesh> = body.into_iter().cloned().collect();
-        let surroundings =
-            Surroundings::new(&gpu.device, &gpu.queue, &self.renderer, &args, None, (structure, &plain))?;
+        let surroundings = args.surroundings((&gpu.device, &gpu.queue, &self.renderer), None, (structure, &plain))?;
         self.surroundings = Some(((shadows, ground), surroundings));
         Ok(())
     }

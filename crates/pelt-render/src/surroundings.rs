@@ -1,0 +1,107 @@
+//! What surrounds a fur in Pelt's own hosts (`pelt render`, the viewer, the web page): the key
+//! light's [`ShadowMap`] and a ground plane under the meshes, each where asked for.
+
+use glam::{Mat4, Vec3};
+use pelt_core::sim::SceneGround;
+use pelt_core::{FurStructure, Mesh};
+
+use crate::RenderError;
+use crate::colliders::ground_mesh;
+use crate::plain::PlainMesh;
+use crate::renderer::FurRenderer;
+use crate::shadows::{ShadowCaster, ShadowMap, ShadowSettings};
+use crate::view::{FurView, ViewData};
+
+/// The ground's colour without a script's (linear RGB): a warm mid grey.
+pub const GROUND_COLOUR: Vec3 = Vec3::new(0.34, 0.32, 0.3);
+
+/// The key light's shadow map and the ground, around one fur and its plain meshes.
+#[derive(Debug)]
+pub struct Surroundings {
+    shadows: Option<ShadowMap>,
+    ground: Option<PlainMesh>,
+    /// Every caster lies within this sphere.
+    bounds: (Vec3, f32),
+}
+
+impl Surroundings {
+    /// Shadows where `shadows`, and a ground where `ground` is given (its unset fields: just
+    /// under the meshes, four times their radius wide, [`GROUND_COLOUR`]), around `fur` and
+    /// `plain`.
+    ///
+    /// # Errors
+    /// The ground's upload or the shadow maps' [`RenderError`].
+    pub fn new(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        renderer: &FurRenderer,
+        shadows: bool,
+        ground: Option<&SceneGround>,
+        (fur, plain): (&FurStructure, &[Mesh]),
+    ) -> Result<Self, RenderError> {
+        let (centre, radius, bottom) = bounds(fur, plain);
+        let ground = ground
+            .map(|ground| {
+                let size = ground.size.unwrap_or(4.0 * radius);
+                let height = ground.height.unwrap_or(bottom - 0.01 * radius);
+                let mesh = PlainMesh::new(device, renderer, &ground_mesh(), ground.colour.unwrap_or(GROUND_COLOUR))?;
+                let world_from_ground = Mat4::from_translation(Vec3::new(centre.x, height, centre.z))
+                    * Mat4::from_scale(Vec3::new(0.5 * size, 1.0, 0.5 * size));
+                mesh.prepare(queue, world_from_ground);
+                Ok::<_, RenderError>(mesh)
+            })
+            .transpose()?;
+        let fur_length = fur.lengths.iter().copied().fold(0.0f32, f32::max).max(1e-3 * radius);
+        let shadows =
+            shadows.then(|| ShadowMap::new(device, renderer, ShadowSettings::for_fur(fur_length))).transpose()?;
+        // Room for the meshes to move a little (a script's motion, the wind).
+        Ok(Self { shadows, ground, bounds: (centre, 1.25 * radius) })
+    }
+
+    /// Whether the key light casts shadows.
+    #[must_use]
+    pub fn has_shadows(&self) -> bool {
+        self.shadows.is_some()
+    }
+
+    /// Whether there is a ground.
+    #[must_use]
+    pub fn has_ground(&self) -> bool {
+        self.ground.is_some()
+    }
+
+    /// Aims the shadow map at the key light of `view` (the picture's view data), and lights
+    /// `picture` with it.
+    pub fn prepare(&self, queue: &wgpu::Queue, view: &ViewData, picture: &mut FurView) {
+        if let Some(map) = &self.shadows {
+            map.prepare(queue, &ShadowCaster::Directional { toward_light: view.light_direction_world }, self.bounds);
+        }
+        picture.set_shadows(self.shadows.as_ref());
+    }
+
+    /// Records the shadow map (if any): `draw` draws the scene through the view it is given.
+    pub fn record(&self, encoder: &mut wgpu::CommandEncoder, draw: impl FnMut(&mut wgpu::RenderPass<'_>, &FurView)) {
+        if let Some(map) = &self.shadows {
+            map.record(encoder, draw);
+        }
+    }
+
+    /// Draws the ground (first: it is opaque).
+    pub fn draw_ground(&self, pass: &mut wgpu::RenderPass<'_>, renderer: &FurRenderer, view: &FurView) {
+        if let Some(ground) = &self.ground {
+            renderer.draw_plain(pass, view, ground);
+        }
+    }
+}
+
+/// A sphere about the fur (its every layer) and the plain meshes, and their lowest y.
+fn bounds(fur: &FurStructure, plain: &[Mesh]) -> (Vec3, f32, f32) {
+    let points = fur.positions.iter().chain(plain.iter().flat_map(|mesh| mesh.positions.iter()));
+    let (low, high) =
+        points.fold((Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)), |(low, high), p| (low.min(*p), high.max(*p)));
+    if !(low.is_finite() && high.is_finite()) || low.cmpgt(high).any() {
+        return (Vec3::ZERO, 1.0, 0.0);
+    }
+    let centre = 0.5 * (low + high);
+    (centre, (0.5 * (high - low).length()).max(1e-3), low.y)
+}
