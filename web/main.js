@@ -128,6 +128,20 @@ function syncControls() {
   $('length').value = app.length();
   $('length-value').textContent = app.length().toFixed(3);
   $('colour').value = app.colour();
+  attempt((a) => {
+    a.set_shadows($('shadows').checked);
+    a.set_ground($('ground').checked);
+  });
+  syncLight();
+}
+
+/** The light's angles beside its controls ("follows the camera" until it is moved). */
+function syncLight() {
+  if (!app) return;
+  const angles = app.light_angles();
+  $('light-value').textContent = angles.length === 2
+    ? `azimuth ${angles[0].toFixed(0)}°, elevation ${angles[1].toFixed(0)}°` : 'follows the camera';
+  page.light = angles.length === 2 ? [angles[0], angles[1]] : null;
 }
 
 function applyWind() {
@@ -139,10 +153,11 @@ function applyWind() {
 }
 
 // Pointers: one that lands on the fur takes the tool; others turn the view, two of them pinch-zoom.
-// The finger also follows a hovering mouse.
+// With Shift held a drag moves the key light. The finger also follows a hovering mouse.
 let tool = 'touch';
 const pressing = new Set();
 const turning = new Map();
+const lighting = new Map();
 function local(event) {
   const rect = canvas.getBoundingClientRect();
   return [event.clientX - rect.left, event.clientY - rect.top];
@@ -151,7 +166,9 @@ canvas.addEventListener('pointerdown', (event) => {
   if (!app) return;
   canvas.setPointerCapture(event.pointerId);
   const [x, y] = local(event);
-  if (event.button === 0 && !event.altKey && app.pointer_down(event.pointerId, x, y)) {
+  if (event.shiftKey) {
+    lighting.set(event.pointerId, [x, y]);
+  } else if (event.button === 0 && !event.altKey && app.pointer_down(event.pointerId, x, y)) {
     pressing.add(event.pointerId);
   } else {
     turning.set(event.pointerId, [x, y]);
@@ -161,7 +178,12 @@ canvas.addEventListener('pointerdown', (event) => {
 canvas.addEventListener('pointermove', (event) => {
   if (!app) return;
   const [x, y] = local(event);
-  if (pressing.has(event.pointerId)) {
+  if (lighting.has(event.pointerId)) {
+    const [px, py] = lighting.get(event.pointerId);
+    app.drag_light(x - px, y - py);
+    lighting.set(event.pointerId, [x, y]);
+    syncLight();
+  } else if (pressing.has(event.pointerId)) {
     app.pointer_move(event.pointerId, x, y);
   } else if (turning.has(event.pointerId)) {
     const [px, py] = turning.get(event.pointerId);
@@ -181,6 +203,7 @@ canvas.addEventListener('pointermove', (event) => {
 function release(event) {
   if (app && (pressing.delete(event.pointerId) || tool === 'finger')) app.pointer_up(event.pointerId);
   turning.delete(event.pointerId);
+  lighting.delete(event.pointerId);
 }
 canvas.addEventListener('pointerup', release);
 canvas.addEventListener('pointercancel', release);
@@ -230,6 +253,12 @@ $('length').addEventListener('input', (event) => {
 $('length').addEventListener('change', (event) => attempt((a) => a.set_length(Number(event.target.value))));
 $('colour').addEventListener('change', (event) => {
   slow('making textures…', (a) => a.set_colour(event.target.value));
+});
+$('shadows').addEventListener('change', (event) => attempt((a) => a.set_shadows(event.target.checked)));
+$('ground').addEventListener('change', (event) => attempt((a) => a.set_ground(event.target.checked)));
+$('follow-light').addEventListener('click', () => {
+  attempt((a) => a.follow_camera_light());
+  syncLight();
 });
 $('wind').addEventListener('input', applyWind);
 $('wind-dir').addEventListener('input', applyWind);

@@ -549,6 +549,51 @@ test('the groomed Fox draws: bald and shorter where its groom says, longer on th
   assert.deepEqual(page.problems, []);
 });
 
+test('the key light casts the bunny\'s shadow on the ground, and Shift + drag moves it', async () => {
+  const page = await openPage();
+  await waitRunning(page);
+  await hideOverlay(page);
+  await page.click('#ground');
+  await frames(page, 4);
+  const bare = await shot(page, 'light-ground');
+  await page.click('#shadows');
+  await frames(page, 4);
+  const shadowed = await shot(page, 'light-shadow');
+
+  // The ground: grey pixels (the fur is brown, the body absent) unlike the top-left corner (the
+  // background, which the ground does not reach).
+  const bg = pixel(bare, 2, 2);
+  const ground = select(bare, (p) => Math.max(...p) - Math.min(...p) < 24 && differs(p, bg, 12));
+  const darker = (before, after) => ground.xs.filter((x, i) => {
+    const [a, b] = [pixel(before, x, ground.ys[i]), pixel(after, x, ground.ys[i])];
+    return b.every((v, c) => v < a[c] - 10);
+  }).length;
+  const area = bare.width * bare.height;
+  const shaded = darker(bare, shadowed);
+  console.log(`light: ${ground.count} ground pixels, ${shaded} darker with shadows`);
+  assert.ok(ground.count > area / 10, `the ground is hardly drawn (${ground.count} pixels)`);
+  assert.ok(shaded > area / 100, `the bunny's shadow does not darken the ground (${shaded} pixels)`);
+
+  // Shift + drag beside the bunny turns the light half round: the shadow moves.
+  const box = await (await page.$('#fur')).boundingBox();
+  await page.keyboard.down('Shift');
+  await page.mouse.move(box.x + 20, box.y + 20);
+  await page.mouse.down();
+  for (let step = 1; step <= 9; step++) await page.mouse.move(box.x + 20 + 50 * step, box.y + 20);
+  await page.mouse.up();
+  await page.keyboard.up('Shift');
+  const light = await page.evaluate(() => window.pelt.light);
+  assert.ok(Array.isArray(light), 'the dragged light is not fixed in the world');
+  await frames(page, 4);
+  const moved = await shot(page, 'light-moved');
+  const [left, came] = [darker(moved, shadowed), darker(shadowed, moved)];
+  console.log(`light: dragged to ${light.map((a) => a.toFixed(0))}; ${left} ground pixels darkened where the ` +
+    `shadow was, ${came} where it went`);
+  assert.ok(left > area / 200 && came > area / 200, `the shadow did not move with the light (${left}, ${came})`);
+  assert.deepEqual(page.problems, []);
+  await page.close();
+});
+
 test('without WebGPU the page says so instead of showing a blank canvas', async () => {
   const page = await openPage({
     beforeLoad: (p) => p.evaluateOnNewDocument(() => {

@@ -1,6 +1,7 @@
 //! Pelt in the browser: the bunny, the paper's try-on scene and the groomed Fox drawn with
 //! WebGPU, patted, parted with a finger, grasped and sponged wet with pointer events (several at
-//! once), with wind, the shipped presets, fur length and colour.
+//! once), with wind, the shipped presets, fur length and colour, and a key light dragged about,
+//! casting shadows on the fur and on a ground.
 //!
 //! [`model`] and [`presets`] hold the page's state and [`page_gpu`] its frame on a GPU device;
 //! none touches a browser API, so they are tested natively (the frame on lavapipe, against
@@ -9,6 +10,7 @@
 
 #![warn(missing_docs)]
 
+pub mod light;
 pub mod model;
 pub mod orbit;
 pub mod page_gpu;

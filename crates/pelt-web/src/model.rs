@@ -8,6 +8,7 @@ use pelt_core::texture::Rgb;
 use pelt_core::{FurStructure, Mesh, Preset};
 use pelt_render::Camera;
 
+use crate::light::PageLight;
 pub use crate::orbit::Orbit;
 pub use crate::scene::{FOX_NAME, SceneChoice, WalkingBody};
 use crate::scene::{grow, load_scene, stepper};
@@ -79,6 +80,8 @@ pub struct Model {
     pub stepper: FurStepper,
     /// The camera.
     pub orbit: Orbit,
+    /// The key light, its shadows and the ground.
+    pub light: PageLight,
     /// The distance that frames the scene (zoom is bounded around it).
     framed_distance: f32,
     /// Pointers on the fur, held or fading after release. Several at once: each is a `Touch`
@@ -111,6 +114,7 @@ impl Model {
             walking,
             stepper,
             orbit,
+            light: PageLight::default(),
             framed_distance: 1.0,
             touches: Vec::new(),
             tool: Tool::default(),
@@ -162,7 +166,7 @@ impl Model {
         aspect: f32,
     ) -> Result<(), ModelError> {
         preset.simulation.wind = self.preset.simulation.wind.clone();
-        *self = Self { orbit: self.orbit, tool: self.tool, ..Self::new(scene, preset, aspect)? };
+        *self = Self { orbit: self.orbit, light: self.light, tool: self.tool, ..Self::new(scene, preset, aspect)? };
         self.frame(aspect);
         Ok(())
     }

@@ -1,13 +1,15 @@
 //! The page's frame on a GPU device, apart from the canvas: the fur's [`FurDriver`] (the CPU
 //! kernel: a page has one thread), the try-on body and one view, drawn with Pelt's [`Studio`]
-//! into any colour view. The canvas (`gpu`, on `wasm32`) gives it the canvas's sRGB view each
+//! and the model's key light (with its shadows and ground, [`Surroundings`]) into any colour
+//! view. The canvas (`gpu`, on `wasm32`) gives it the canvas's sRGB view each
 //! frame; a native test gives it a texture of the canvas's format and reads it back.
 
 use glam::{Mat4, Vec3};
 use pelt_core::FurTextures;
+use pelt_core::sim::SceneGround;
 use pelt_render::{
     FurDrawSettings, FurDriver, FurLook, FurRenderer, FurTarget, FurView, KernelChoice, PlainMesh, RenderTargets,
-    Studio,
+    Studio, Surroundings,
 };
 
 use crate::model::Model;
@@ -45,6 +47,9 @@ pub struct PageGpu {
     /// The frame in the sRGB format, resolved here and copied into the canvas.
     frame: Option<wgpu::Texture>,
     studio: Studio,
+    /// The shadow map and ground, made for the (shadows, ground) switches they hold; dropped
+    /// when the structure or the body changes.
+    surroundings: Option<((bool, bool), Surroundings)>,
 }
 
 impl PageGpu {
@@ -76,8 +81,16 @@ impl PageGpu {
         driver.set_look(look(tile_scale));
         driver.prepare(queue);
         let view = FurView::new(device, &renderer);
-        let mut gpu =
-            Self { renderer, driver, body: None, view, targets: None, frame: None, studio: Studio::default() };
+        let mut gpu = Self {
+            renderer,
+            driver,
+            body: None,
+            view,
+            targets: None,
+            frame: None,
+            studio: Studio::default(),
+            surroundings: None,
+        };
         gpu.set_body(device, queue, model.body.as_ref())?;
         Ok(gpu)
     }
@@ -112,6 +125,7 @@ impl PageGpu {
         queue: &wgpu::Queue,
         body: Option<&pelt_core::Mesh>,
     ) -> Result<(), String> {
+        self.surroundings = None;
         self.body = match body {
             Some(mesh) => {
                 let plain = PlainMesh::new(device, &self.renderer, mesh, BODY_COLOUR).map_err(|e| e.to_string())?;
@@ -189,17 +203,45 @@ impl PageGpu {
             return Err(format!("the canvas is {w}x{h}, the frame {}x{}", frame.width(), frame.height()));
         }
         let output = frame.create_view(&wgpu::TextureViewDescriptor::default());
+        let switches = (model.light.shadows, model.light.ground);
+        if self.surroundings.as_ref().is_none_or(|(made_for, _)| *made_for != switches) {
+            let ground = switches.1.then(SceneGround::default);
+            let plain: Vec<_> = model.body.iter().cloned().collect();
+            let made = Surroundings::new(
+                device,
+                queue,
+                &self.renderer,
+                switches.0,
+                ground.as_ref(),
+                (&model.structure, &plain),
+            )
+            .map_err(|e| e.to_string())?;
+            self.surroundings = Some((switches, made));
+        }
+        let Some((_, surroundings)) = &self.surroundings else { unreachable!("made just above") };
         let camera = model.orbit.camera();
-        self.view.prepare(queue, &self.studio.view_data(&camera, targets.aspect_ratio()));
+        self.studio.light.direction = model.light.direction();
+        let view_data = self.studio.view_data(&camera, targets.aspect_ratio());
+        self.view.prepare(queue, &view_data);
+        surroundings.prepare(queue, &view_data, &mut self.view);
         let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
         self.driver.record(&mut encoder).map_err(|e| e.to_string())?;
         self.driver.record_view(&mut encoder, &self.renderer, &self.view);
+        let (renderer, driver, body) = (&self.renderer, &self.driver, &self.body);
+        surroundings.record(&mut encoder, |pass, light| {
+            surroundings.draw_ground(pass, renderer, light);
+            if let Some(body) = body {
+                renderer.draw_plain(pass, light, body);
+            }
+            driver.draw(pass, renderer, light, &FurDrawSettings::ALL);
+        });
         {
             let mut pass = targets.begin_pass(&mut encoder, &output, self.studio.background);
-            if let Some(body) = &self.body {
-                self.renderer.draw_plain(&mut pass, &self.view, body);
+            surroundings.draw_ground(&mut pass, renderer, &self.view);
+            if let Some(body) = body {
+                renderer.draw_plain(&mut pass, &self.view, body);
             }
-            self.driver.draw(&mut pass, &self.renderer, &self.view, &PAGE_DRAW);
+            driver.draw(&mut pass, renderer, &self.view, &PAGE_DRAW);
         }
         // The encoded bytes as they are: the canvas shows its bytes as sRGB.
         encoder.copy_texture_to_texture(frame.as_image_copy(), canvas.as_image_copy(), frame.size());

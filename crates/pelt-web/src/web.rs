@@ -271,6 +271,43 @@ impl PeltApp {
         Ok(())
     }
 
+    /// Fixes the key light in the world at `azimuth_deg` (about +Y from +Z toward +X) and
+    /// `elevation_deg` (above the horizon), as `pelt render --light` does.
+    ///
+    /// # Errors
+    /// A message for a non-finite angle or an elevation outside -90 to 90; the light stays.
+    pub fn set_light(&mut self, azimuth_deg: f32, elevation_deg: f32) -> Result<(), JsValue> {
+        self.model.light.set(azimuth_deg, elevation_deg).map_err(message)
+    }
+
+    /// Turns the key light by a drag of CSS pixels: right turns it, up raises it. A light that
+    /// followed the camera stays fixed in the world from then on.
+    pub fn drag_light(&mut self, dx: f32, dy: f32) {
+        let camera = self.model.orbit.camera();
+        self.model.light.drag(Vec2::new(dx, dy), &camera);
+    }
+
+    /// Lets the key light follow the camera again (Pelt's default look).
+    pub fn follow_camera_light(&mut self) {
+        self.model.light.follow_camera();
+    }
+
+    /// The key light's azimuth and elevation in degrees, or nothing while it follows the camera.
+    #[must_use]
+    pub fn light_angles(&self) -> Vec<f32> {
+        self.model.light.angles().map_or_else(Vec::new, |(azimuth, elevation)| vec![azimuth, elevation])
+    }
+
+    /// Switches the key light's shadows (the fur's own included) on or off.
+    pub fn set_shadows(&mut self, on: bool) {
+        self.model.light.shadows = on;
+    }
+
+    /// Switches the ground under the meshes on or off.
+    pub fn set_ground(&mut self, on: bool) {
+        self.model.light.ground = on;
+    }
+
     /// Dries the whole coat at once.
     pub fn dry(&mut self) {
         self.model.dry();

@@ -2,7 +2,8 @@
 //! canvas's format as into the browser's canvas) against `pelt render`'s (a `Headless` target of
 //! `HEADLESS_FORMAT`, the preset's own textures, `Studio::default`), same preset, camera, size and
 //! simulated time, on lavapipe. The bunny's mean colour must agree, and `pelt render`'s must be
-//! the one in `web/test/look.json`, which the browser test holds the real page to.
+//! the one in `web/test/look.json`, which the browser test holds the real page to. The page's
+//! key light, fixed in the world, casts the bunny's shadow on its ground.
 //!
 //! The measurements here read raw bytes and share no code with the renderer: a pixel is the
 //! bunny's when it differs from its image's corner (the background) by more than `DRAWN`.
@@ -14,6 +15,7 @@ use pelt_render::{
     Backend, FurDrawSettings, FurDriver, FurTarget, FurView, Gpu, HEADLESS_FORMAT, Headless, KernelChoice, Studio,
     default_sample_count,
 };
+use pelt_web::light::PageLight;
 use pelt_web::model::{Model, SceneChoice};
 use pelt_web::page_gpu::{CANVAS_USAGE, PageGpu};
 use pelt_web::presets;
@@ -52,9 +54,10 @@ fn gpu() -> Gpu {
 
 /// The page's default bunny after `FRAMES` frames, drawn as the page draws into its canvas:
 /// a texture of the headless Chromium's canvas format (`rgba8unorm`), as the page configures it.
-fn page_frame(gpu: &Gpu, preset: &Preset) -> (image::RgbaImage, Model) {
+fn page_frame(gpu: &Gpu, preset: &Preset, light: PageLight) -> (image::RgbaImage, Model) {
     let (device, queue) = (&gpu.device, &gpu.queue);
     let mut model = Model::new(SceneChoice::Bunny, preset.clone(), WIDTH_PX as f32 / HEIGHT_PX as f32).expect("model");
+    model.light = light;
     let made = presets::web_textures(&model.preset).expect("web textures");
     let canvas = device.create_texture(&wgpu::TextureDescriptor {
         label: Some("canvas"),
@@ -148,7 +151,7 @@ fn bunny_mean(image: &image::RgbaImage) -> ([u8; 3], Vec3, usize) {
 fn the_page_shows_the_default_bunny_as_pelt_render_does() {
     let gpu = gpu();
     let preset = Preset::default();
-    let (page, model) = page_frame(&gpu, &preset);
+    let (page, model) = page_frame(&gpu, &preset, PageLight::default());
     let render = render_frame(gpu, &preset, &model);
     let output = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("look");
     std::fs::create_dir_all(&output).expect("output folder");
@@ -181,4 +184,70 @@ fn the_page_shows_the_default_bunny_as_pelt_render_does() {
         look.background,
         look.bunny_mean
     );
+}
+
+/// Pixels of the ground in `image`: grey (channels within 24 of each other, the fur is brown) and
+/// not the background (the top-left corner's colour, which the ground does not reach).
+fn ground_pixels(image: &image::RgbaImage) -> Vec<(u32, u32)> {
+    let background = image.get_pixel(0, 0).0;
+    image
+        .enumerate_pixels()
+        .filter(|(_, _, p)| {
+            let [r, g, b, _] = p.0;
+            let grey = r.max(g).max(b) - r.min(g).min(b) < 24;
+            grey && (0..3).any(|c| p.0[c].abs_diff(background[c]) > DRAWN)
+        })
+        .map(|(x, y, _)| (x, y))
+        .collect()
+}
+
+/// How many of `pixels` are darker in `after` than in `before` by more than 10 on every channel.
+fn darker(pixels: &[(u32, u32)], before: &image::RgbaImage, after: &image::RgbaImage) -> usize {
+    pixels
+        .iter()
+        .filter(|&&(x, y)| {
+            let (a, b) = (before.get_pixel(x, y).0, after.get_pixel(x, y).0);
+            (0..3).all(|c| i16::from(b[c]) < i16::from(a[c]) - 10)
+        })
+        .count()
+}
+
+/// The page's key light, fixed in the world, casts the bunny's shadow on the page's ground (and
+/// on the fur), and moving the light moves the shadow. Without shadows passed to the frame
+/// (tried once), no ground pixel darkens.
+#[test]
+fn the_pages_key_light_casts_the_bunnys_shadow_on_the_ground() {
+    let gpu = gpu();
+    let preset = Preset::default();
+    let lit = |shadows: bool, azimuth: f32| {
+        let mut light = PageLight::default();
+        (light.shadows, light.ground) = (shadows, true);
+        light.set(azimuth, 50.0).expect("angles");
+        light
+    };
+    let (bare, _) = page_frame(&gpu, &preset, lit(false, 40.0));
+    let (shadowed, _) = page_frame(&gpu, &preset, lit(true, 40.0));
+    let (moved, _) = page_frame(&gpu, &preset, lit(true, 220.0));
+    let output = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("look");
+    std::fs::create_dir_all(&output).expect("output folder");
+    for (name, image) in [("ground.png", &bare), ("shadow.png", &shadowed), ("shadow-moved.png", &moved)] {
+        image.save(output.join(name)).expect(name);
+    }
+
+    let ground = ground_pixels(&bare);
+    let area = (WIDTH_PX * HEIGHT_PX) as usize;
+    let (shaded, lightened) = (darker(&ground, &bare, &shadowed), darker(&ground, &shadowed, &bare));
+    let report = format!(
+        "{} ground pixels; {shaded} darker with shadows, {lightened} lighter (images in {})",
+        ground.len(),
+        output.display()
+    );
+    println!("{report}");
+    assert!(ground.len() > area / 10, "the ground is hardly drawn: {report}");
+    assert!(shaded > area / 100, "the bunny's shadow does not darken the ground: {report}");
+    assert!(lightened < shaded / 20, "shadows lightened the ground: {report}");
+    // The light turned half round: its shadow falls on the other side.
+    let (left, came) = (darker(&ground, &moved, &shadowed), darker(&ground, &shadowed, &moved));
+    println!("the light turned: {left} ground pixels darkened where the shadow was, {came} where it went");
+    assert!(left > area / 200 && came > area / 200, "the shadow did not move with the light: {left}, {came}");
 }
