@@ -8,6 +8,7 @@ mod capture;
 mod contact;
 mod fur;
 mod gpu;
+mod lights;
 mod model;
 mod paint;
 mod panel;
@@ -55,6 +56,8 @@ pub struct Args {
     pub no_lod: bool,
     #[command(flatten)]
     pub shadows: crate::shadows::ShadowArgs,
+    #[command(flatten)]
+    pub lights: crate::light_args::LightArgs,
     /// Window size in logical pixels, `WIDTHxHEIGHT`.
     #[arg(long, value_name = "WxH", default_value = "1280x800", value_parser = crate::values::parse_size)]
     pub size: (u32, u32),

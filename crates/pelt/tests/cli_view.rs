@@ -185,3 +185,23 @@ fn the_window_draws_the_ground_and_the_furs_shadow() {
     assert!(darker > 2_000, "{darker} pixels darker with shadows");
     assert!(brighter < darker / 10, "{brighter} pixels brighter, {darker} darker");
 }
+
+/// `--light` (the Lights section's first sun): the key light fixed in the world casts the
+/// shadow; turned half round, the shadow falls on the other side of the bunny.
+#[test]
+fn the_windows_key_light_places_the_shadow() {
+    let common = ["--builtin", "bunny", "--sim", "cpu", "--no-overlay", "--ground"];
+    let with = |light: &'static str| common.iter().copied().chain(["--light", light]).collect::<Vec<_>>();
+    let one_side = screenshot("light_40", 4, &with("40,45"));
+    let other_side = screenshot("light_220", 4, &with("220,45"));
+    let view = 0..WIDTH_PX - PANEL_PX;
+    let count = |a: &image::RgbaImage, b: &image::RgbaImage| {
+        view.clone()
+            .flat_map(|x| (0..HEIGHT_PX).map(move |y| (x, y)))
+            .filter(|&(x, y)| luminance(a.get_pixel(x, y)) + 20.0 < luminance(b.get_pixel(x, y)))
+            .count()
+    };
+    // Darker in one picture than in the other, each way: where each shadow falls.
+    let (here, there) = (count(&one_side, &other_side), count(&other_side, &one_side));
+    assert!(here > 2_000 && there > 2_000, "the shadow did not move with the light: {here} and {there} pixels");
+}

@@ -231,7 +231,8 @@ impl App {
         let lod = crate::lod::settings(&model.settings.preset.render.lod, model.no_lod);
         let (eye, fov_y_rad) = (model.camera.eye(), model.camera.fov_y_rad);
         model.level = crate::lod::level(&lod, &model.structure, eye, fov_y_rad, model.viewport_px[1]);
-        running.fur.draw(gpu, &mut encoder, &running.viewport, &model.camera, separated, model.level);
+        let studio = model.settings.lights.studio();
+        running.fur.draw(gpu, &mut encoder, &running.viewport, (&model.camera, &studio), separated, model.level);
 
         let screen = egui_wgpu::ScreenDescriptor {
             size_in_pixels: [frame.texture.width(), frame.texture.height()],

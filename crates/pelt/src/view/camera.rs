@@ -59,6 +59,12 @@ impl OrbitCamera {
         (self.distance * 0.01, self.distance * 4.0 + 10.0)
     }
 
+    /// The renderer's camera of this orbit.
+    pub fn camera(&self) -> pelt_render::Camera {
+        let (near, far) = self.near_far();
+        pelt_render::Camera { eye: self.eye(), target: self.target, up: Vec3::Y, fov_y_rad: self.fov_y_rad, near, far }
+    }
+
     /// wgpu clip space (depth 0..1).
     pub fn clip_from_view(&self, aspect: f32) -> Mat4 {
         let (near, far) = self.near_far();

@@ -6,8 +6,8 @@ use pelt_core::sim::{FurStepper, SimParams};
 use pelt_core::texture::FurTextures;
 use pelt_core::{FurStructure, Mesh};
 use pelt_render::{
-    Camera, ColliderMeshes, FurDrawSettings, FurDriver, FurFrame, FurLevel, FurRenderer, FurView, KernelChoice,
-    PlainMesh, SeparatedFur, SeparatedRenderer, SimKernel, Studio, Surroundings,
+    ColliderMeshes, FurDrawSettings, FurDriver, FurFrame, FurLevel, FurRenderer, FurView, KernelChoice, PlainMesh,
+    SeparatedFur, SeparatedRenderer, SimKernel, Studio, Surroundings,
 };
 
 use super::camera::OrbitCamera;
@@ -233,20 +233,18 @@ impl FurScene {
     }
 
     /// Draws the body and the unified structure, or the separated one when `separated` and it is
-    /// built, into the viewport, at the level of detail `level`.
+    /// built, into the viewport, lit by `studio`, at the level of detail `level`.
+    #[allow(clippy::too_many_arguments)]
     pub fn draw(
         &mut self,
         gpu: &pelt_render::Gpu,
         encoder: &mut wgpu::CommandEncoder,
         viewport: &Viewport,
-        camera: &OrbitCamera,
+        (camera, studio): (&OrbitCamera, &Studio),
         separated: bool,
         level: FurLevel,
     ) {
-        let (near, far) = camera.near_far();
-        let camera =
-            Camera { eye: camera.eye(), target: camera.target, up: Vec3::Y, fov_y_rad: camera.fov_y_rad, near, far };
-        let studio = Studio::default();
+        let camera = camera.camera();
         let view_data = studio.view_data(&camera, viewport.targets.aspect_ratio());
         self.view.prepare(&gpu.queue, &view_data);
         let separated = self.separated.as_ref().filter(|_| separated);

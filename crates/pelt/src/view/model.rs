@@ -170,6 +170,7 @@ impl Model {
         settings.overlay = !args.no_overlay;
         settings.draw.ground = args.shadows.ground;
         settings.draw.shadows = !args.shadows.no_shadows && (args.shadows.shadows || args.shadows.ground);
+        settings.lights = super::lights::LightSettings::from_args(&args.lights)?;
         settings.animation = animation_settings(rig.as_ref());
         let structure = grow(mesh, &settings.preset, &settings.mesh)?;
         let mut stepper = FurStepper::new(&structure, &settings.preset.simulation)?;

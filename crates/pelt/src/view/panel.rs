@@ -103,6 +103,8 @@ pub struct Settings {
     pub wet: WetControls,
     /// The ball and the grab.
     pub contact: super::contact::ContactControls,
+    /// The lights and the environment.
+    pub lights: super::lights::LightSettings,
 }
 
 /// The animation controls: which clip, playing or not, speed and the timeline.
@@ -133,6 +135,7 @@ impl Settings {
             paint: super::paint::PaintSettings::default(),
             wet: WetControls::default(),
             contact: super::contact::ContactControls::default(),
+            lights: super::lights::LightSettings::default(),
         }
     }
 }
@@ -221,7 +224,7 @@ fn animation_ui(ui: &mut egui::Ui, animation: &mut AnimationSettings) -> bool {
 pub fn show(
     ui: &mut egui::Ui,
     settings: &mut Settings,
-    mesh_choices: &[MeshChoice],
+    (mesh_choices, placement): (&[MeshChoice], &super::lights::Placement),
     status: &str,
 ) -> (Changes, Requests) {
     let mut changes = Changes::default();
@@ -383,6 +386,9 @@ pub fn show(
                 ui.checkbox(&mut draw.ground, "ground");
             });
             ui.checkbox(&mut settings.overlay, "overlay (O)");
+        });
+        section(ui, "Lights", false, |ui| {
+            super::lights::lights_ui(ui, &mut settings.lights, placement);
         });
         section(ui, "Shortcuts", false, |ui| {
             egui::Grid::new("shortcuts").num_columns(2).striped(true).show(ui, |ui| {

@@ -22,7 +22,9 @@ impl Model {
         if !self.panel_hidden {
             egui::Panel::right("settings").resizable(true).default_size(320.0).min_size(260.0).show(ui, |ui| {
                 self.show_wetness();
-                let (changes, requests) = panel::show(ui, &mut self.settings, &self.mesh_choices, &self.status);
+                let placement = super::lights::Placement::of(&self.camera);
+                let (changes, requests) =
+                    panel::show(ui, &mut self.settings, (&self.mesh_choices, &placement), &self.status);
                 outcome.0.merge(changes);
                 outcome.1.merge(requests);
             });
