@@ -10,6 +10,7 @@
 //! taps times the fur's transmittance `exp(-extinction * opacity)` at its depth (`shadows.wgsl`).
 
 use glam::{Vec3, Vec4};
+use pelt_core::light::LightKind;
 
 use crate::RenderError;
 use crate::renderer::FurRenderer;
@@ -18,7 +19,7 @@ use crate::shaders::{
 };
 use crate::view::{FurView, ShadowPass, ViewData};
 
-/// The light that casts the shadows.
+/// The light that casts the shadows ([`ShadowCaster::for_key_light`] picks a view's).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum ShadowCaster {
     /// A sun toward `toward_light` (world space): an orthographic view fitted to the scene.
@@ -36,6 +37,36 @@ pub enum ShadowCaster {
         /// Half the cone's opening, radians (`0 < cone_rad < pi / 2`).
         cone_rad: f32,
     },
+}
+
+impl ShadowCaster {
+    /// The caster of `view`'s key light (light 0, else its sun) for a scene within `radius` of
+    /// `centre`. A sun casts along its direction. A spot or point light outside that sphere casts
+    /// a perspective view aimed at its centre, just wide enough to hold it (a point light's
+    /// shadows fall away from it, as a spot's do); inside it, a spot keeps its own cone and a
+    /// point light casts as a sun from where it stands (its shadows in every direction would take
+    /// six views).
+    #[must_use]
+    pub fn for_key_light(view: &ViewData, (centre, radius): (Vec3, f32)) -> Self {
+        let Some(key) = view.lights.as_slice().first().filter(|l| l.kind != LightKind::Directional) else {
+            return Self::Directional { toward_light: view.light_direction_world };
+        };
+        let to_centre = centre - key.position;
+        let distance = to_centre.length();
+        if distance > radius * 1.01 {
+            // A hair wider than the sphere, so its rim stays inside the map.
+            let cone_rad = ((radius / distance).asin() * 1.05).min(1.5);
+            return Self::Spot { position: key.position, direction: to_centre / distance, cone_rad };
+        }
+        match key.kind {
+            LightKind::Spot => Self::Spot {
+                position: key.position,
+                direction: key.direction,
+                cone_rad: key.cos_outer.clamp(-1.0, 1.0).acos().clamp(0.01, 1.5),
+            },
+            _ => Self::Directional { toward_light: (key.position - centre).normalize_or(Vec3::Y) },
+        }
+    }
 }
 
 /// A shadow map's resolution and how the fur takes light.
@@ -242,5 +273,39 @@ impl FurView {
     /// with [`ShadowMap::record`] before this view's pass), or without shadows (`None`).
     pub fn set_shadows(&mut self, shadows: Option<&ShadowMap>) {
         self.set_shadow_group(shadows.map(ShadowMap::receiver_group));
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use pelt_core::light::LightSource;
+
+    fn view_with(light: LightSource) -> ViewData {
+        let camera = crate::Camera::orbit(Vec3::ZERO, 0.0, 20.0, 4.0);
+        camera.view_data(1.0, &crate::Light::default()).with_lights(&[light], None)
+    }
+
+    #[test]
+    fn a_point_or_spot_key_light_outside_the_scene_casts_a_view_aimed_at_it() {
+        let point = LightSource {
+            kind: LightKind::Point,
+            position: Vec3::new(0.0, 3.0, 0.0),
+            ..LightSource::directional(Vec3::Y, Vec3::ONE, 1.0)
+        };
+        let ShadowCaster::Spot { position, direction, cone_rad } =
+            ShadowCaster::for_key_light(&view_with(point), (Vec3::ZERO, 1.5))
+        else {
+            panic!("a point light above the scene casts a perspective view");
+        };
+        assert_eq!(position, point.position);
+        assert!(direction.distance(Vec3::NEG_Y) < 1e-6, "{direction}");
+        // Just wider than the sphere's silhouette from the light: asin(1.5 / 3) = 30 degrees.
+        assert!(cone_rad > 30f32.to_radians() && cone_rad < 33f32.to_radians(), "{cone_rad}");
+        let sun = LightSource::directional(Vec3::new(1.0, 1.0, 0.0), Vec3::ONE, 1.0);
+        assert_eq!(
+            ShadowCaster::for_key_light(&view_with(sun), (Vec3::ZERO, 1.5)),
+            ShadowCaster::Directional { toward_light: sun.direction }
+        );
     }
 }

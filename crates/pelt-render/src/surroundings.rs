@@ -70,11 +70,11 @@ impl Surroundings {
         self.ground.is_some()
     }
 
-    /// Aims the shadow map at the key light of `view` (the picture's view data), and lights
-    /// `picture` with it.
+    /// Aims the shadow map at the key light of `view` (the picture's view data; a sun, or a spot
+    /// or point light: [`ShadowCaster::for_key_light`]), and lights `picture` with it.
     pub fn prepare(&self, queue: &wgpu::Queue, view: &ViewData, picture: &mut FurView) {
         if let Some(map) = &self.shadows {
-            map.prepare(queue, &ShadowCaster::Directional { toward_light: view.light_direction_world }, self.bounds);
+            map.prepare(queue, &ShadowCaster::for_key_light(view, self.bounds), self.bounds);
         }
         picture.set_shadows(self.shadows.as_ref());
     }

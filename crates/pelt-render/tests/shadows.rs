@@ -8,6 +8,7 @@ use crate::common;
 use common::{BROWN_ROOT, BROWN_TIP, Rig, strand_textures};
 use glam::{Mat4, Vec3, Vec4Swizzles as _};
 use pelt_core::groom::Groom;
+use pelt_core::light::{LightKind, LightSource};
 use pelt_core::{Builtin, FurParams, FurStructure, GrowthDirection, fur::FurLength};
 use pelt_render::{
     Camera, DEFAULT_BACKGROUND, FurDrawSettings, FurView, GpuFur, Light, LightDirection, PlainMesh, ShadowCaster,
@@ -48,23 +49,37 @@ impl Stage {
     }
 
     /// One frame from `camera` lit from `toward_light`, with the ground if `ground`, the fur if
-    /// any, and a shadow map of `fur_depth` if `shadows`; in linear RGB per pixel.
+    /// any, and a shadow map of `fur_depth` cast along the light if `shadows`; in linear RGB per
+    /// pixel.
     fn render(
         &mut self,
         camera: &Camera,
         toward_light: Vec3,
-        (fur, ground): (Option<&GpuFur>, bool),
+        what: (Option<&GpuFur>, bool),
         shadows: Option<f32>,
+        name: &str,
+    ) -> Vec<Vec3> {
+        let shadows = shadows.map(|fur_depth| (fur_depth, ShadowCaster::Directional { toward_light }));
+        self.render_cast(camera, toward_light, what, shadows, name)
+    }
+
+    /// [`Stage::render`] with the shadow map cast by `caster`.
+    fn render_cast(
+        &mut self,
+        camera: &Camera,
+        toward_light: Vec3,
+        (fur, ground): (Option<&GpuFur>, bool),
+        shadows: Option<(f32, ShadowCaster)>,
         name: &str,
     ) -> Vec<Vec3> {
         let rig = &self.rig;
         let light =
             Light { direction: LightDirection::World(toward_light.normalize()), colour: Vec3::ONE, ambient: 0.2 };
         self.view.prepare(rig.queue(), &camera.view_data(1.0, &light));
-        let map = shadows.map(|fur_depth| {
+        let map = shadows.map(|(fur_depth, caster)| {
             let settings = ShadowSettings { size: 512, fur_depth, extinction: 0.6 };
             let map = ShadowMap::new(rig.device(), &rig.renderer, settings).expect("shadow map");
-            map.prepare(rig.queue(), &ShadowCaster::Directional { toward_light }, (Vec3::ZERO, 1.6));
+            map.prepare(rig.queue(), &caster, (Vec3::ZERO, 1.6));
             map
         });
         self.view.set_shadows(map.as_ref());
@@ -273,4 +288,48 @@ fn the_root_darkening_falls_when_the_fur_is_sparse() {
     let (dense_dark, sparse_dark) = (darkening(&dense, "dense"), darkening(&sparse, "sparse"));
     assert!(dense_dark > 0.05, "dense fur darkens its own roots by {dense_dark:.3}");
     assert!(sparse_dark < 0.7 * dense_dark, "darkening: sparse {sparse_dark:.3}, dense {dense_dark:.3}");
+}
+
+/// A point light above the sphere casts through a perspective view aimed at the scene
+/// (`ShadowCaster::for_key_light`): on the ground its shadow is the sphere's silhouette seen
+/// from the light, wider than a sun's from straight above. The oracle is the cone from the
+/// light tangent to the sphere; a sun's shadow would leave the ring between the two lit.
+#[test]
+fn a_point_light_above_casts_the_spheres_shadow_wider_than_a_sun() {
+    let mut stage = Stage::new();
+    let (radius, light_height) = (1.02, 2.5);
+    let fur = stage.fur(&sphere_fur(4, radius - 1.0, None));
+    let point = LightSource {
+        kind: LightKind::Point,
+        position: Vec3::Y * light_height,
+        ..LightSource::directional(Vec3::Y, Vec3::ONE, 1.0)
+    };
+    let camera = Camera::orbit(Vec3::ZERO, 0.0, 55.0, 6.0);
+    let view = camera.view_data(1.0, &Light::default()).with_lights(&[point], None);
+    let caster = ShadowCaster::for_key_light(&view, (Vec3::ZERO, 1.6));
+    assert!(matches!(caster, ShadowCaster::Spot { .. }), "{caster:?}");
+    let bare = stage.render(&camera, Vec3::Y, (None, true), None, "point-ground");
+    let lit = stage.render(&camera, Vec3::Y, (Some(&fur), true), None, "point-off");
+    let shadowed = stage.render_cast(&camera, Vec3::Y, (Some(&fur), true), Some((0.02, caster)), "point-on");
+    // Where the tangent cone meets the ground.
+    let shadow_radius = (light_height - GROUND_Y) * (radius / light_height).asin().tan();
+    let (mut ring, mut ring_dark, mut outside, mut outside_lit) = (0, 0, 0, 0);
+    for (k, hit) in ground_hits(&camera).into_iter().enumerate() {
+        // The ground in view: the sphere does not hide it.
+        let Some(hit) = hit.filter(|_| (luminance(lit[k]) - luminance(bare[k])).abs() < 0.01) else { continue };
+        let (d, ratio) = (hit.x.hypot(hit.z), luminance(shadowed[k]) / luminance(lit[k]).max(1e-6));
+        if (1.15..0.85 * shadow_radius).contains(&d) {
+            ring += 1;
+            ring_dark += usize::from(ratio < 0.6);
+        } else if d > 1.2 * shadow_radius {
+            outside += 1;
+            outside_lit += usize::from(ratio > 0.9);
+        }
+    }
+    let report = format!(
+        "shadow radius {shadow_radius:.2}: {ring_dark} of {ring} ring pixels dark, {outside_lit} of {outside} outside lit"
+    );
+    assert!(ring > 500 && outside > 2_000, "too few ground pixels: {report}");
+    assert!(ring_dark * 10 > ring * 8, "the ring the point light shades is lit: {report}");
+    assert!(outside_lit * 10 > outside * 9, "the ground past the shadow is dark: {report}");
 }
