@@ -66,6 +66,25 @@ impl LightSettings {
     }
 }
 
+/// Degrees the key light turns per point dragged (Ctrl+drag in the view).
+const DRAG_DEG_PER_POINT: f32 = 0.4;
+
+impl LightSettings {
+    /// Turns the key light by a drag in the view (points; x right, y down): right turns it about
+    /// the vertical, up raises it. Without lights a sun is added where the light that follows
+    /// the camera is (`following`), so the drag starts from the picture's light. A point or spot
+    /// key light stays where it is.
+    pub fn drag_key(&mut self, drag: glam::Vec2, following: Vec3) {
+        if self.lights.is_empty() {
+            self.add_sun(following);
+        }
+        let Some(key) = self.lights.first_mut().filter(|l| l.kind == LightKind::Directional) else { return };
+        let (azimuth, elevation) = angles_of(key.direction);
+        let elevation = (elevation - drag.y * DRAG_DEG_PER_POINT).clamp(2.0, 89.0);
+        key.direction = direction_from_angles(azimuth + drag.x * DRAG_DEG_PER_POINT, elevation);
+    }
+}
+
 /// Where the panel's new lights go, from the viewer's camera.
 #[derive(Clone, Copy, Debug)]
 pub struct Placement {
@@ -220,5 +239,17 @@ mod tests {
         // A sun's illuminance at the target: I / d^2 = pi lux.
         let distance = point.position.length();
         assert!((point.intensity.x / (distance * distance) - SUN_LUX).abs() < 1e-3, "{point:?}");
+    }
+
+    #[test]
+    fn a_drag_turns_the_key_light_from_the_following_one() {
+        let mut settings = LightSettings::default();
+        let following = direction_from_angles(30.0, 40.0);
+        settings.drag_key(glam::Vec2::new(25.0, -25.0), following);
+        let (azimuth, elevation) = angles_of(settings.lights[0].direction);
+        assert!((azimuth - 40.0).abs() < 1e-3 && (elevation - 50.0).abs() < 1e-3, "{azimuth}, {elevation}");
+        settings.drag_key(glam::Vec2::new(0.0, 1000.0), following);
+        assert!((angles_of(settings.lights[0].direction).1 - 2.0).abs() < 1e-3, "held above the horizon");
+        assert_eq!(settings.lights.len(), 1, "one key light, dragged");
     }
 }

@@ -27,6 +27,7 @@ pub const MOUSE: &[(&str, &str)] = &[
     ("left-drag on fur", "pat the fur (release restores it), or paint the groom"),
     ("left-drag off fur, right-drag", "orbit"),
     ("middle-drag, Shift+drag", "pan"),
+    ("Ctrl+drag", "move the key light (with the sponge on: dry the fur)"),
     ("wheel", "zoom"),
     ("Alt+left-drag", "orbit, even over fur"),
 ];

@@ -130,8 +130,10 @@ impl Model {
         let pointer = response.hover_pos().or_else(|| response.interact_pointer_pos());
         let ray = pointer.map(|p| self.camera.ray(Vec2::new(p.x - rect.left(), p.y - rect.top()), size));
         let brush_radius = self.settings.brush_per_radius * self.structure.mesh.bounding_sphere().1;
+        // Ctrl+drag moves the key light, except that with the sponge on it dries the fur.
+        let lighting = primary && modifiers.ctrl && !self.settings.wet.sponge;
         let hover_hit = ray
-            .filter(|_| self.touch.is_none() && !modifiers.alt && !modifiers.shift)
+            .filter(|_| self.touch.is_none() && !modifiers.alt && !modifiers.shift && !lighting)
             .and_then(|ray| self.stepper.simulation().pick(&self.structure.mesh.triangles, ray.origin, ray.direction));
 
         let paint = self.settings.paint.on;
@@ -172,6 +174,9 @@ impl Model {
                 self.stepper.simulation_mut().touch_end();
                 self.touch = None;
             }
+        } else if lighting {
+            let following = super::lights::Placement::of(&self.camera).following;
+            self.settings.lights.drag_key(drag, following);
         } else if response.dragged_by(egui::PointerButton::Middle) || (primary && modifiers.shift) {
             self.camera.pan(drag, size.y);
         } else if response.dragged_by(egui::PointerButton::Secondary) || (primary && !sponging) {
