@@ -16,6 +16,8 @@ mod export_morph;
 mod grasp_hand;
 #[path = "groom.rs"]
 mod groom;
+#[path = "herd.rs"]
+mod herd;
 #[path = "import.rs"]
 mod import;
 #[path = "lights.rs"]

@@ -11,6 +11,7 @@
 //! - `inputs`: one step's inputs for any kernel, computed once: [`StepInputs`] (shared by every
 //!   strand) and [`StrandInputs`] (per strand).
 //! - [`scene`]: scripted wind and touch strokes ([`Scene`]), reproducible frame by frame.
+//! - [`herd`]: many copies of one fur, each placed, heading and phased on its own ([`HerdInstance`]).
 //! - [`motion`]: scripted rigid motion of the meshes (`[[motion]]` keys of a [`Scene`]).
 //! - [`inertia`]: the force from the roots' acceleration on a moving body ([`Inertia`]).
 //! - [`contact`]: the skin, colliders and the grasp, applied after the bend.
@@ -29,6 +30,7 @@ pub mod bend;
 pub mod contact;
 mod dispatch;
 pub mod field;
+pub mod herd;
 pub mod inertia;
 mod inputs;
 mod kernel;
@@ -54,6 +56,7 @@ pub use contact::{
 };
 pub use dispatch::CpuKernel;
 pub use field::{ForceField, Touch};
+pub use herd::HerdInstance;
 pub use inertia::{Inertia, InertiaStep, SpringStep};
 pub use inputs::{InputVersions, StepInputs, StrandInputs};
 pub use kernel::{KernelRest, kernel_rest};

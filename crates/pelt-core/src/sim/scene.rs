@@ -70,6 +70,13 @@
 //! elevation_deg = 35.0
 //! distance = 8.0                   # optional: default the meshes framed
 //!
+//! [[instance]]                     # a herd: one copy of the fur per table (see `sim::herd`)
+//! position = [0.0, 0.0, 0.0]
+//! heading_deg = 90.0
+//! speed = 30.0
+//! clip = "Walk"
+//! time_offset_secs = 0.4
+//!
 //! [ground]                         # optional: a plane under the meshes that takes their shadow
 //! height = -1.0                    # optional: default just under the meshes
 //! size = 6.0                       # optional: side length; default 4 times the meshes' radius
@@ -93,6 +100,7 @@ use glam::{EulerRot, Mat4, Quat, Vec3};
 
 use super::MAX_FORCE;
 use super::contact::{Collider, ColliderKey, ColliderMesh, GraspParams, Shape};
+use super::herd::{self, HerdInstance};
 use super::motion::{self, MotionKey};
 use super::simulation::{SimError, Simulation};
 use crate::light::{self, Environment, EnvironmentError, EnvironmentSpec, LightSource, LightSpec};
@@ -467,6 +475,10 @@ pub struct Scene {
     /// The environment's table; default: the host's own.
     #[serde(default)]
     pub environment: Option<EnvironmentSpec>,
+    /// A herd: one copy of the fur per table, each placed and phased on its own; none draws the
+    /// one fur as usual.
+    #[serde(default)]
+    pub instance: Vec<HerdInstance>,
     /// The environment the table describes, loaded with the script.
     #[serde(skip)]
     pub environment_light: Option<Environment>,
@@ -554,6 +566,7 @@ impl Scene {
         motion::validate(&self.motion)?;
         light::validate_keys(&self.light)?;
         wet::validate(&self.rain, &self.water)?;
+        herd::validate(&self.instance)?;
         for (i, stroke) in self.strokes.iter().enumerate() {
             finite_time(format!("stroke[{i}].start_secs"), stroke.start_secs)?;
             finite_time(format!("stroke[{i}].end_secs"), stroke.end_secs)?;

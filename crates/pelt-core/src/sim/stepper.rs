@@ -6,6 +6,7 @@ use glam::{Mat4, Quat, Vec3};
 
 use super::SimParams;
 use super::contact::{Collider, Shape, StepCollider};
+use super::herd::HerdInstance;
 use super::scene::Scene;
 use super::simulation::{SimError, Simulation};
 use crate::anim::{Pose, Rig};
@@ -55,6 +56,8 @@ pub struct FurStepper {
     wet: WetParams,
     /// The normals the wetness was last advanced with (the posed base's, world space).
     wet_normals: Vec<Vec3>,
+    /// Where a herd's host placed this copy of the fur (after the script's motion).
+    placement: Option<HerdInstance>,
 }
 
 /// Ids of the colliders a [`FurStepper`]'s body gives the simulation (capsule `k` is this plus
@@ -90,7 +93,36 @@ impl FurStepper {
             wetness: Wetness::new(structure.mesh.vertex_count(), 0.0),
             wet: WetParams::default(),
             wet_normals: Vec::new(),
+            placement: None,
         })
+    }
+
+    /// Places this fur as one member of a herd: each step its base is moved by
+    /// [`HerdInstance::world_from_model`] at the step's time (after the script's `[[motion]]`)
+    /// and simulated there, in the world; `None` leaves it where the script puts it. Restarts
+    /// the simulation from the next pose. The clip's phase is the caller's
+    /// ([`FurStepper::advance_herd`] plays each at [`HerdInstance::clip_time`]).
+    pub fn set_placement(&mut self, placement: Option<HerdInstance>) {
+        self.placement = placement;
+        self.restart_pending = true;
+    }
+
+    /// Steps every member of a herd to `time_secs` in one parallel pass: `steppers[k]` (placed
+    /// as `instances[k]`, [`FurStepper::set_placement`]) with its clip at
+    /// `instances[k].clip_time(time_secs)`. Each ends as it would stepped alone, to the bit.
+    ///
+    /// # Errors
+    /// The first stepper's error, as [`FurStepper::advance_to`].
+    ///
+    /// # Panics
+    /// When the two slices differ in length (a host's bug).
+    pub fn advance_herd(steppers: &mut [Self], instances: &[HerdInstance], time_secs: f64) -> Result<(), SimError> {
+        use rayon::prelude::*;
+        assert_eq!(steppers.len(), instances.len(), "one stepper per instance");
+        steppers
+            .par_iter_mut()
+            .zip(instances)
+            .try_for_each(|(stepper, instance)| stepper.advance_with_clip_at(time_secs, instance.clip_time(time_secs)))
     }
 
     /// Makes `mesh` (skinned by `rig`, whose clips are the fur rig's) collide with the fur: every
@@ -146,6 +178,7 @@ impl FurStepper {
     #[must_use]
     pub fn moves(&self) -> bool {
         match &self.posing {
+            _ if self.placement.is_some() => true,
             Posing::Rest => self.scene.as_ref().is_some_and(|s| !s.motion.is_empty()),
             Posing::Rig { clip, .. } => clip.is_some() || self.scene.as_ref().is_some_and(|s| !s.motion.is_empty()),
             Posing::Host => true,
@@ -171,7 +204,11 @@ impl FurStepper {
         if let Some(scene) = &self.scene {
             scene.apply(time_secs, &mut self.simulation)?;
         }
-        let world_from_model = self.scene.as_ref().and_then(|s| s.motion_at(time_secs)).unwrap_or(Mat4::IDENTITY);
+        let motion = self.scene.as_ref().and_then(|s| s.motion_at(time_secs)).unwrap_or(Mat4::IDENTITY);
+        let world_from_model = match &self.placement {
+            Some(placement) => placement.world_from_model(time_secs) * motion,
+            None => motion,
+        };
         self.world_from_model = world_from_model;
         self.moved = std::mem::take(&mut self.host_posed);
         // A rig poses once after a change of clip even when nothing plays (back to its rest).

@@ -1,0 +1,126 @@
+//! Herds: every member stepped in one parallel pass ends as the same fur stepped alone with its
+//! inputs, to the bit; each stands where its heading and speed put it and plays its own phase;
+//! bad `[[instance]]` tables are errors naming the file and key.
+
+use std::path::Path;
+
+use glam::{Mat4, Quat, Vec3};
+use pelt_core::sim::herd;
+use pelt_core::sim::{FurStepper, Scene, SimParams};
+use pelt_core::{FurStructure, ImportOptions, Preset, Stage, StageSource};
+
+fn fox() -> (FurStructure, pelt_core::anim::Rig) {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets/meshes/Fox.glb");
+    let stage = Stage::load(&StageSource::File(path), &[], &ImportOptions::default()).expect("Fox.glb");
+    let preset = Preset::default();
+    let structure = FurStructure::new(stage.fur_mesh.clone(), &preset.fur_params(&stage.fur_mesh)).expect("fur");
+    (structure, stage.rig.expect("the Fox is rigged"))
+}
+
+const WINDY: &str = "
+[[wind]]
+time_secs = 0.0
+direction = [1.0, 0.0, 0.3]
+strength = 0.6
+
+[[instance]]
+position = [0.0, 0.0, 0.0]
+clip = \"Walk\"
+
+[[instance]]
+position = [300.0, 0.0, -40.0]
+heading_deg = 90.0
+speed = 60.0
+clip = \"Walk\"
+time_offset_secs = 0.3
+
+[[instance]]
+position = [-250.0, 0.0, 120.0]
+heading_deg = -35.0
+speed = 150.0
+clip = \"Run\"
+time_offset_secs = 0.7
+";
+
+fn stepper(structure: &FurStructure, rig: &pelt_core::anim::Rig, scene: &Scene, k: usize) -> FurStepper {
+    let instance = &scene.instance[k];
+    let clips = herd::resolve_clips(&scene.instance, Some(rig), Some(0)).expect("clips");
+    let mut stepper = FurStepper::new(structure, &SimParams::default()).expect("stepper");
+    stepper.set_clip(rig.clone(), clips[k]);
+    stepper.set_scene(Some(scene.clone()));
+    stepper.set_placement(Some(instance.clone()));
+    stepper
+}
+
+#[test]
+fn each_member_of_a_herd_steps_as_it_would_alone_to_the_bit() {
+    let (structure, rig) = fox();
+    let scene = Scene::from_toml_str(WINDY, Path::new("herd.toml")).expect("scene");
+    let count = scene.instance.len();
+    let mut herd: Vec<FurStepper> = (0..count).map(|k| stepper(&structure, &rig, &scene, k)).collect();
+    let mut alone: Vec<FurStepper> = (0..count).map(|k| stepper(&structure, &rig, &scene, k)).collect();
+    for frame in 0..24 {
+        let time_secs = f64::from(frame) / 30.0;
+        FurStepper::advance_herd(&mut herd, &scene.instance, time_secs).expect("herd step");
+        for (k, stepper) in alone.iter_mut().enumerate() {
+            stepper.advance_with_clip_at(time_secs, time_secs + scene.instance[k].time_offset_secs).expect("step");
+        }
+        for k in 0..count {
+            assert_eq!(
+                herd[k].simulation().positions(),
+                alone[k].simulation().positions(),
+                "instance {k}, frame {frame}"
+            );
+        }
+    }
+    // The members differ: their own place, clip and phase.
+    assert_ne!(herd[0].simulation().positions(), herd[1].simulation().positions());
+}
+
+#[test]
+fn a_member_stands_where_its_heading_and_speed_take_it_in_its_own_phase() {
+    let (structure, rig) = fox();
+    let scene = Scene::from_toml_str(WINDY, Path::new("herd.toml")).expect("scene");
+    let k = 2;
+    let instance = &scene.instance[k];
+    let mut placed = stepper(&structure, &rig, &scene, k);
+    let time_secs = 0.5;
+    FurStepper::advance_herd(std::slice::from_mut(&mut placed), std::slice::from_ref(instance), time_secs)
+        .expect("step");
+    // By hand: the Run clip 0.7 s ahead, turned -35 degrees about +Y, carried 150 * 0.5 along the
+    // turned +Z.
+    let clip = rig.find_animation("Run").unwrap();
+    let mut pose = pelt_core::anim::Pose::default();
+    rig.pose(&structure.mesh, Some(clip), time_secs + 0.7, &mut pose);
+    let angle = (-35.0f32).to_radians();
+    let ahead = Vec3::new(angle.sin(), 0.0, angle.cos());
+    let world = Mat4::from_translation(Vec3::new(-250.0, 0.0, 120.0) + ahead * 75.0)
+        * Mat4::from_quat(Quat::from_rotation_y(angle));
+    // Within 1e-5 of the farthest point's distance from the origin (f32 rounding of the sums).
+    let reach = pose.positions.iter().map(|p| world.transform_point3(*p).length()).fold(0.0f32, f32::max);
+    for (root, p) in placed.simulation().roots().iter().zip(&pose.positions) {
+        assert!((*root - world.transform_point3(*p)).length() < 1e-5 * reach, "{root} against {p}");
+    }
+    // Another phase is another pose.
+    let mut other = pelt_core::anim::Pose::default();
+    rig.pose(&structure.mesh, Some(clip), time_secs, &mut other);
+    assert_ne!(pose.positions, other.positions);
+}
+
+#[test]
+fn bad_instances_name_the_file_and_key() {
+    let nan = "[[instance]]\nposition = [0.0, nan, 0.0]\n";
+    let error = Scene::from_toml_str(nan, Path::new("herd.toml")).unwrap_err().to_string();
+    assert!(error.contains("herd.toml") && error.contains("instance[0].position"), "{error}");
+    let unknown =
+        "[[instance]]\nposition = [0.0, 0.0, 0.0]\n\n[[instance]]\nposition = [1.0, 0.0, 0.0]\nclip = \"Gallop\"\n";
+    let scene = Scene::from_toml_str(unknown, Path::new("herd.toml")).expect("parsed: clips resolve against a rig");
+    let (_, rig) = fox();
+    let (key, problem) = herd::resolve_clips(&scene.instance, Some(&rig), None).unwrap_err();
+    assert_eq!(key, "instance[1].clip");
+    // The file's clips, listed.
+    assert!(problem.contains("Gallop") && problem.contains("Survey") && problem.contains("Walk"), "{problem}");
+    let misspelt = "[[instance]]\nposition = [0.0, 0.0, 0.0]\nheading = 3.0\n";
+    let error = Scene::from_toml_str(misspelt, Path::new("herd.toml")).unwrap_err().to_string();
+    assert!(error.contains("heading"), "{error}");
+}
