@@ -12,6 +12,7 @@ use pelt_core::sim::{FurStepper, SimError, SimParams, Simulation};
 use pelt_core::{FurStructure, texture::FurTextures};
 
 use crate::RenderError;
+use crate::asset::FurAsset;
 use crate::fur::{FurStates, GpuFur};
 use crate::lod::FurLevel;
 use crate::object::{FurFrame, FurLook};
@@ -94,6 +95,35 @@ impl FurDriver {
         params: &SimParams,
         choice: KernelChoice,
     ) -> Result<Self, RenderError> {
+        let asset = FurAsset::new(device, queue, renderer, structure, textures)?;
+        Self::with_asset(device, queue, renderer, &asset, structure, params, choice)
+    }
+
+    /// One more copy of a fur whose shared data is `asset` (grown as `structure`; a herd's member):
+    /// its own state, simulated with `params` on the kernel `choice` picks. A herd picks once
+    /// (`Auto` times the kernels on every call) and gives the others that kernel.
+    ///
+    /// # Errors
+    /// [`RenderError::Count`] when `structure` is not the asset's (other `V` or `L`); as
+    /// [`FurDriver::new`].
+    pub fn with_asset(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        renderer: &FurRenderer,
+        asset: &FurAsset,
+        structure: &FurStructure,
+        params: &SimParams,
+        choice: KernelChoice,
+    ) -> Result<Self, RenderError> {
+        let expected = (asset.layers() as usize + 1) * asset.vertex_count() as usize;
+        if structure.positions.len() != expected {
+            return Err(RenderError::Count {
+                what: "shared vertex positions of the asset's structure",
+                expected,
+                got: structure.positions.len(),
+                rule: "(L + 1) * V",
+            });
+        }
         let (kernel, kernel_reason) = match choice {
             KernelChoice::Cpu => (SimKernel::Cpu, "asked for".to_owned()),
             KernelChoice::Gpu => (SimKernel::Gpu, "asked for".to_owned()),
@@ -105,7 +135,7 @@ impl FurDriver {
             }
         };
         let mut driver = Self {
-            fur: GpuFur::new(device, queue, renderer, structure, textures, states(kernel))?,
+            fur: GpuFur::from_asset(device, renderer, asset, states(kernel))?,
             gpu_simulation: None,
             kernel,
             kernel_reason,

@@ -8,7 +8,8 @@ use pelt_core::FurStructure;
 use pelt_core::texture::FurTextures;
 
 use crate::RenderError;
-use crate::geometry::{Furred, UnifiedGeometry};
+use crate::asset::FurAsset;
+use crate::geometry::{Furred, SharedGeometry, UnifiedGeometry};
 use crate::listing::{FinList, ShellList};
 use crate::lod::PreparedLevel;
 use crate::object::{FurFrame, GpuBytes};
@@ -84,6 +85,9 @@ impl Coat {
 #[derive(Debug)]
 pub struct GpuFur {
     geometry: UnifiedGeometry,
+    /// What it shares with the other copies of its fur (its geometry's shared part and the
+    /// textures).
+    asset: FurAsset,
     textures: GpuTextures,
     /// The silhouette pass's output (none without fins).
     fins: Option<FinList>,
@@ -107,17 +111,31 @@ impl GpuFur {
         textures: &FurTextures,
         states: FurStates,
     ) -> Result<Self, RenderError> {
+        let asset = FurAsset::upload(device, queue, layouts, structure, textures)?;
+        Self::instance(device, layouts, &asset, states)
+    }
+
+    /// [`GpuFur::from_asset`] with the renderer's layouts.
+    pub(crate) fn instance(
+        device: &wgpu::Device,
+        layouts: &Layouts,
+        asset: &FurAsset,
+        states: FurStates,
+    ) -> Result<Self, RenderError> {
         let scope = ErrorScope::push(device);
-        let furred = Furred::of(structure);
-        let geometry = geometry(device, layouts, (structure, furred.as_ref()), states);
-        let textures = GpuTextures::new(device, queue, layouts, textures, structure.groom.is_some());
-        let fins = fin_list(device, layouts, (structure, furred.as_ref()));
-        let per_shell = geometry.as_ref().map_or(0, |g| g.shape.vertices_per_shell());
-        let shells = shell_list(device, layouts, (structure, furred.as_ref()), per_shell);
+        let (positions, normals) = &*asset.rest;
+        let geometry =
+            UnifiedGeometry::instance(device, layouts, &asset.geometry, (positions, normals), state_count(states));
+        let layers = asset.geometry.shape.layers;
+        let (triangles, edges) = asset.drawn;
+        let fins = FinList::new(device, layouts, edges, layers);
+        let per_shell = asset.geometry.shape.vertices_per_shell();
+        let shells = ShellList::new(device, layouts, (triangles, per_shell), layers);
         scope.pop("uploading the fur")?;
         Ok(Self {
             geometry: geometry?,
-            textures: textures?,
+            asset: asset.clone(),
+            textures: asset.textures.clone(),
             fins: fins?,
             level: PreparedLevel::new(),
             shells: shells?,
@@ -126,7 +144,14 @@ impl GpuFur {
         })
     }
 
-    /// [`GpuFur::set_structure`] with the renderer's layouts.
+    /// What this fur shares with every copy made from it ([`GpuFur::from_asset`]).
+    #[must_use]
+    pub fn asset(&self) -> &FurAsset {
+        &self.asset
+    }
+
+    /// [`GpuFur::set_structure`] with the renderer's layouts: a new asset of its own (other
+    /// copies of the old one keep it).
     pub(crate) fn upload_structure(
         &mut self,
         device: &wgpu::Device,
@@ -136,12 +161,12 @@ impl GpuFur {
         let states = if self.geometry.state_count() == 1 { FurStates::One } else { FurStates::Two };
         let scope = ErrorScope::push(device);
         let furred = Furred::of(structure);
-        let geometry = geometry(device, layouts, (structure, furred.as_ref()), states);
-        let fins = fin_list(device, layouts, (structure, furred.as_ref()));
-        let per_shell = geometry.as_ref().map_or(0, |g| g.shape.vertices_per_shell());
-        let shells = shell_list(device, layouts, (structure, furred.as_ref()), per_shell);
+        let shared =
+            SharedGeometry::new(device, (&structure.mesh, furred.as_ref(), structure.groom.as_ref()), structure.layers);
         scope.pop("uploading the fur")?;
-        (self.geometry, self.fins, self.shells) = (geometry?, fins?, shells?);
+        let asset = FurAsset::from_parts(shared?, self.textures.clone(), structure, furred.as_ref());
+        let fresh = Self::instance(device, layouts, &asset, states)?;
+        (self.geometry, self.asset, self.fins, self.shells) = (fresh.geometry, fresh.asset, fresh.fins, fresh.shells);
         Ok(())
     }
 
@@ -157,6 +182,7 @@ impl GpuFur {
         let textures = GpuTextures::new(device, queue, layouts, textures, self.geometry.shape.groomed);
         scope.pop("uploading the fur textures")?;
         self.textures = textures?;
+        self.asset = self.asset.with_textures(self.textures.clone());
         Ok(())
     }
 
@@ -281,6 +307,14 @@ impl GpuFur {
         GpuBytes { textures: self.textures.bytes, ..self.geometry.bytes() }
     }
 
+    /// Bytes this copy holds apart from its [`FurAsset`] ([`FurAsset::gpu_bytes`]): the shared
+    /// array's states and the base normals. A herd of `n` holds `n` times this, the asset once,
+    /// and each copy's [`GpuFur::silhouette_list_bytes`].
+    #[must_use]
+    pub fn own_bytes(&self) -> GpuBytes {
+        self.geometry.own_bytes()
+    }
+
     /// Bytes of the silhouette pass's fin list (the edges it keeps and their indirect draw) and
     /// of the view-angle pass's shell list (12 bytes a triangle, 20 a layer).
     #[must_use]
@@ -385,41 +419,9 @@ impl GpuFur {
     }
 }
 
-fn fin_list(
-    device: &wgpu::Device,
-    layouts: &Layouts,
-    (structure, furred): (&FurStructure, Option<&Furred>),
-) -> Result<Option<FinList>, RenderError> {
-    let edges = furred.map_or(structure.mesh.edges.len(), |furred| furred.edges.len());
-    FinList::new(device, layouts, edges as u32, structure.layers)
-}
-
-fn shell_list(
-    device: &wgpu::Device,
-    layouts: &Layouts,
-    (structure, furred): (&FurStructure, Option<&Furred>),
-    per_shell: u32,
-) -> Result<Option<ShellList>, RenderError> {
-    let triangles = furred.map_or(structure.mesh.triangles.len(), |furred| furred.triangles.len());
-    ShellList::new(device, layouts, (triangles as u32, per_shell), structure.layers)
-}
-
-fn geometry(
-    device: &wgpu::Device,
-    layouts: &Layouts,
-    (structure, furred): (&FurStructure, Option<&Furred>),
-    states: FurStates,
-) -> Result<UnifiedGeometry, RenderError> {
-    let state_count = match states {
+fn state_count(states: FurStates) -> usize {
+    match states {
         FurStates::One => 1,
         FurStates::Two => 2,
-    };
-    UnifiedGeometry::new(
-        device,
-        layouts,
-        (&structure.mesh, furred, structure.groom.as_ref()),
-        structure.layers,
-        &structure.positions,
-        state_count,
-    )
+    }
 }

@@ -100,82 +100,48 @@ pub(crate) fn shades(groom: &Groom) -> bool {
     groom.density.is_some() || groom.clump.is_some() || groom.tint.is_some()
 }
 
-#[derive(Debug)]
-pub(crate) struct UnifiedGeometry {
+/// What every copy of one mesh shares on the GPU: the topology, the wedges' uvs, the fin strip
+/// and the groom's attributes. Cloning it clones handles, not buffers.
+#[derive(Clone, Debug)]
+pub(crate) struct SharedGeometry {
     pub shape: ObjectShape,
-    uniform: wgpu::Buffer,
-    /// One buffer, or two used in turn: `states[current]` is the newer state.
-    states: Vec<wgpu::Buffer>,
-    current: usize,
-    normals: wgpu::Buffer,
-    /// A wetness per base vertex (`V` `f32`, zero until set): per-frame state like the
-    /// silhouette list, so not counted in [`GpuBytes`].
-    wetness: wgpu::Buffer,
     /// Triangles (3F), edges (2E), edge faces (2E), and for meshes with uvs the wedges' base
     /// vertices (W) and the corners' wedges (3F); also the index buffer of the base triangles (by
     /// vertex, or by wedge with uvs).
     topology: wgpu::Buffer,
+    uvs: wgpu::Buffer,
     /// The fin strip of one edge (`6L` indices into `2(L + 1)` strip vertices), shared by all
     /// edges: indexed, each strip vertex is shaded once however many triangles use it.
     fin_indices: Option<wgpu::Buffer>,
     /// Each vertex's groom attributes (`V` entries for a groomed fur, else one unused entry).
     groom: wgpu::Buffer,
-    /// `bind_groups[c]` reads `states[c]` as current and the other state as previous.
-    bind_groups: Vec<wgpu::BindGroup>,
+    /// The uvs (attributes) and the topology and strip (indices).
     bytes: GpuBytes,
 }
 
-impl UnifiedGeometry {
-    /// Uploads `mesh` with `positions` (`(L + 1) * V`, layer-major) into every state; shells
-    /// and fins draw only what `furred` lists (`None`: everything) and shade with `groom`.
+impl SharedGeometry {
+    /// Uploads what `L = layers` layers over `mesh` share; shells and fins draw only what
+    /// `furred` lists (`None`: everything) and shade with `groom`.
     pub fn new(
         device: &wgpu::Device,
-        layouts: &Layouts,
         (mesh, furred, groom): (&Mesh, Option<&Furred>, Option<&Groom>),
         layers: u32,
-        positions: &[Vec3],
-        state_count: usize,
     ) -> Result<Self, RenderError> {
         let mut shape = ObjectShape::new(mesh, layers);
         if let Some(furred) = furred {
             shape.furred_triangle_count = furred.triangles.len() as u32;
             shape.fin_edge_count = furred.edges.len() as u32;
         }
-        let expected = (layers as usize + 1) * mesh.vertex_count();
-        if positions.len() != expected {
-            return Err(RenderError::Count {
-                what: "shared vertex positions",
-                expected,
-                got: positions.len(),
-                rule: "(L + 1) * V",
-            });
-        }
-        let position_bytes = positions.len() as u64 * POSITION_BYTES;
-        check_size(device, "shared vertex array", position_bytes)?;
         let (topology, wedge_uvs, wedge_count) = topology(mesh, furred);
         shape.wedge_count = wedge_count;
         let wedge_uvs = wedge_uvs.unwrap_or_else(|| vec![Vec2::ZERO]);
         check_size(device, "mesh topology", topology.len() as u64 * 4)?;
         check_size(device, "mesh uvs", wedge_uvs.len() as u64 * 8)?;
-
         let buffer = |label, contents: &[u8], usage| {
             device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents, usage })
         };
-        let states: Vec<wgpu::Buffer> = (0..state_count.clamp(1, 2))
-            .map(|_| buffer("pelt shared vertices", bytemuck::cast_slice(positions), POSITIONS_USAGE))
-            .collect();
-        let normals = buffer(
-            "pelt base normals",
-            bytemuck::cast_slice(&mesh.normals),
-            wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
-        );
-        let wetness = buffer(
-            "pelt wetness",
-            bytemuck::cast_slice(&vec![0.0_f32; mesh.vertex_count().max(1)]),
-            wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
-        );
         let uvs = buffer("pelt wedge uvs", bytemuck::cast_slice(&wedge_uvs), wgpu::BufferUsages::STORAGE);
-        let topology_buffer = buffer(
+        let topology = buffer(
             "pelt topology",
             bytemuck::cast_slice(&topology),
             wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::INDEX,
@@ -194,9 +160,99 @@ impl UnifiedGeometry {
         };
         shape.groomed = groom.is_some();
         shape.groom_shading = groom.is_some_and(shades);
-        let groom_buffer = buffer(
+        let groom = buffer(
             "pelt groom attributes",
             bytemuck::cast_slice(&attributes),
+            wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+        );
+        let bytes = GpuBytes {
+            attributes: uvs.size(),
+            indices: topology.size() + fin_indices.as_ref().map_or(0, wgpu::Buffer::size),
+            ..GpuBytes::default()
+        };
+        Ok(Self { shape, topology, uvs, fin_indices, groom, bytes })
+    }
+
+    /// The buffers' bytes (the groom's attributes not counted: [`UnifiedGeometry::groom_bytes`]).
+    pub fn bytes(&self) -> GpuBytes {
+        self.bytes
+    }
+}
+
+/// One copy of a mesh on the GPU: its own shared-array states, base normals, wetness and object
+/// uniform over a [`SharedGeometry`].
+#[derive(Debug)]
+pub(crate) struct UnifiedGeometry {
+    pub shape: ObjectShape,
+    shared: SharedGeometry,
+    uniform: wgpu::Buffer,
+    /// One buffer, or two used in turn: `states[current]` is the newer state.
+    states: Vec<wgpu::Buffer>,
+    current: usize,
+    normals: wgpu::Buffer,
+    /// A wetness per base vertex (`V` `f32`, zero until set): per-frame state like the
+    /// silhouette list, so not counted in [`GpuBytes`].
+    wetness: wgpu::Buffer,
+    /// `bind_groups[c]` reads `states[c]` as current and the other state as previous.
+    bind_groups: Vec<wgpu::BindGroup>,
+    /// This copy's own bytes: the states and the normals.
+    own_bytes: GpuBytes,
+}
+
+impl UnifiedGeometry {
+    /// Uploads `mesh` with `positions` (`(L + 1) * V`, layer-major) into every state; shells
+    /// and fins draw only what `furred` lists (`None`: everything) and shade with `groom`.
+    pub fn new(
+        device: &wgpu::Device,
+        layouts: &Layouts,
+        (mesh, furred, groom): (&Mesh, Option<&Furred>, Option<&Groom>),
+        layers: u32,
+        positions: &[Vec3],
+        state_count: usize,
+    ) -> Result<Self, RenderError> {
+        let shared = SharedGeometry::new(device, (mesh, furred, groom), layers)?;
+        Self::instance(device, layouts, &shared, (positions, &mesh.normals), state_count)
+    }
+
+    /// A copy of `shared` of its own: `positions` (`(L + 1) * V`, layer-major) in every state,
+    /// `normals` (`V`) as its base normals.
+    pub fn instance(
+        device: &wgpu::Device,
+        layouts: &Layouts,
+        shared: &SharedGeometry,
+        (positions, normals): (&[Vec3], &[Vec3]),
+        state_count: usize,
+    ) -> Result<Self, RenderError> {
+        let shape = shared.shape;
+        let expected = (shape.layers as usize + 1) * shape.vertex_count as usize;
+        if positions.len() != expected {
+            return Err(RenderError::Count {
+                what: "shared vertex positions",
+                expected,
+                got: positions.len(),
+                rule: "(L + 1) * V",
+            });
+        }
+        if normals.len() != shape.vertex_count as usize {
+            let expected = shape.vertex_count as usize;
+            return Err(RenderError::Count { what: "base normals", expected, got: normals.len(), rule: "V" });
+        }
+        let position_bytes = positions.len() as u64 * POSITION_BYTES;
+        check_size(device, "shared vertex array", position_bytes)?;
+        let buffer = |label, contents: &[u8], usage| {
+            device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents, usage })
+        };
+        let states: Vec<wgpu::Buffer> = (0..state_count.clamp(1, 2))
+            .map(|_| buffer("pelt shared vertices", bytemuck::cast_slice(positions), POSITIONS_USAGE))
+            .collect();
+        let normals = buffer(
+            "pelt base normals",
+            bytemuck::cast_slice(normals),
+            wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+        );
+        let wetness = buffer(
+            "pelt wetness",
+            bytemuck::cast_slice(&vec![0.0_f32; (shape.vertex_count as usize).max(1)]),
             wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
         );
         let uniform = uniform_buffer(device);
@@ -211,39 +267,36 @@ impl UnifiedGeometry {
                         wgpu::BindGroupEntry { binding: 1, resource: states[previous].as_entire_binding() },
                         wgpu::BindGroupEntry { binding: 2, resource: states[current].as_entire_binding() },
                         wgpu::BindGroupEntry { binding: 3, resource: normals.as_entire_binding() },
-                        wgpu::BindGroupEntry { binding: 4, resource: uvs.as_entire_binding() },
-                        wgpu::BindGroupEntry { binding: 5, resource: topology_buffer.as_entire_binding() },
-                        wgpu::BindGroupEntry { binding: 6, resource: groom_buffer.as_entire_binding() },
+                        wgpu::BindGroupEntry { binding: 4, resource: shared.uvs.as_entire_binding() },
+                        wgpu::BindGroupEntry { binding: 5, resource: shared.topology.as_entire_binding() },
+                        wgpu::BindGroupEntry { binding: 6, resource: shared.groom.as_entire_binding() },
                         wgpu::BindGroupEntry { binding: 7, resource: wetness.as_entire_binding() },
                     ],
                 })
             })
             .collect();
-        let bytes = GpuBytes {
+        let own_bytes = GpuBytes {
             positions: position_bytes * states.len() as u64,
-            attributes: normals.size() + uvs.size(),
-            indices: topology_buffer.size() + fin_indices.as_ref().map_or(0, wgpu::Buffer::size),
-            textures: 0,
+            attributes: normals.size(),
+            ..GpuBytes::default()
         };
         debug_assert_eq!(uniform.size(), OBJECT_UNIFORM_BYTES);
         Ok(Self {
             shape,
+            shared: shared.clone(),
             uniform,
             states,
             current: 0,
             normals,
             wetness,
-            topology: topology_buffer,
-            fin_indices,
-            groom: groom_buffer,
             bind_groups,
-            bytes,
+            own_bytes,
         })
     }
 
     /// Bytes of the groom attributes (0 without a groom).
     pub fn groom_bytes(&self) -> u64 {
-        if self.shape.groomed { self.groom.size() } else { 0 }
+        if self.shape.groomed { self.shared.groom.size() } else { 0 }
     }
 
     /// Rewrites the groom attributes from `groom` (density, clump, tint; lengths and directions
@@ -256,13 +309,25 @@ impl UnifiedGeometry {
             ));
         }
         groom.validate(vertices, "the groom").map_err(|e| RenderError::Groom(e.to_string()))?;
-        queue.write_buffer(&self.groom, 0, bytemuck::cast_slice(&groom_attributes(groom, vertices)));
+        queue.write_buffer(&self.shared.groom, 0, bytemuck::cast_slice(&groom_attributes(groom, vertices)));
         self.shape.groom_shading = shades(groom);
         Ok(())
     }
 
+    /// Every byte it draws with: its own and the shared ones.
     pub fn bytes(&self) -> GpuBytes {
-        self.bytes
+        let (own, shared) = (self.own_bytes, self.shared.bytes);
+        GpuBytes {
+            positions: own.positions + shared.positions,
+            attributes: own.attributes + shared.attributes,
+            indices: own.indices + shared.indices,
+            textures: own.textures + shared.textures,
+        }
+    }
+
+    /// This copy's own bytes: the states of the shared array and the base normals.
+    pub fn own_bytes(&self) -> GpuBytes {
+        self.own_bytes
     }
 
     pub fn state_count(&self) -> usize {
@@ -374,7 +439,7 @@ impl UnifiedGeometry {
         if drawn == 0 {
             return;
         }
-        let indices = self.topology.slice(4 * first..4 * (first + 3 * u64::from(drawn)));
+        let indices = self.shared.topology.slice(4 * first..4 * (first + 3 * u64::from(drawn)));
         pass.set_index_buffer(indices, wgpu::IndexFormat::Uint32);
         pass.draw_indexed(0..3 * drawn, 0, instances);
     }
@@ -382,7 +447,7 @@ impl UnifiedGeometry {
     /// Draws the fins listed in `instances` (the silhouette pass's edges) through the indirect
     /// draw `draw`.
     pub fn draw_fin_list(&self, pass: &mut wgpu::RenderPass<'_>, instances: &wgpu::Buffer, draw: &wgpu::Buffer) {
-        if let Some(strip) = &self.fin_indices {
+        if let Some(strip) = &self.shared.fin_indices {
             pass.set_index_buffer(strip.slice(..), wgpu::IndexFormat::Uint32);
             pass.set_vertex_buffer(0, instances.slice(..));
             pass.draw_indexed_indirect(draw, 0);
@@ -391,7 +456,7 @@ impl UnifiedGeometry {
 
     /// Draws every fin (instance = edge) with `segments` segments (the level of detail's).
     pub fn draw_fins(&self, pass: &mut wgpu::RenderPass<'_>, segments: u32) {
-        if let Some(strip) = &self.fin_indices {
+        if let Some(strip) = &self.shared.fin_indices {
             pass.set_index_buffer(strip.slice(..), wgpu::IndexFormat::Uint32);
             pass.draw_indexed(0..6 * segments.min(self.shape.layers), 0, 0..self.shape.fin_edge_count);
         }

@@ -103,6 +103,7 @@
 
 #![warn(missing_docs)]
 
+mod asset;
 mod camera;
 mod colliders;
 mod contact;
@@ -132,6 +133,7 @@ mod targets;
 mod textures;
 mod view;
 
+pub use asset::FurAsset;
 pub use camera::Camera;
 pub use colliders::{COLLIDER_COLOUR, ColliderMeshes, HAND_COLOUR, ground_mesh};
 pub use driver::{FurDriver, KernelChoice, SimKernel, cpu_secs_per_step, gpu_secs_per_step, gpu_secs_per_step_of};

@@ -8,7 +8,8 @@ use crate::RenderError;
 use crate::shaders::Layouts;
 
 /// One fur's textures on the GPU with their bind group (group 2 of the fur pipelines).
-#[derive(Debug)]
+/// Cloning it clones handles: the copies of one fur share its textures.
+#[derive(Clone, Debug)]
 pub(crate) struct GpuTextures {
     pub bind_group: wgpu::BindGroup,
     pub shell_slices: u32,

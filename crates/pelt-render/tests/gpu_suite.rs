@@ -20,6 +20,8 @@ mod gpu;
 mod groom;
 #[path = "groom_shading.rs"]
 mod groom_shading;
+#[path = "herd.rs"]
+mod herd;
 #[path = "host.rs"]
 mod host;
 #[path = "lean.rs"]

@@ -7,6 +7,7 @@ use pelt_core::{FurStructure, Mesh};
 
 use super::FurRenderer;
 use crate::RenderError;
+use crate::asset::FurAsset;
 use crate::fur::{FurStates, GpuFur};
 use crate::plain::PlainMesh;
 use crate::view::FurView;
@@ -30,8 +31,23 @@ impl GpuFur {
         Self::upload(device, queue, renderer.layouts(), structure, textures, states)
     }
 
+    /// One more copy of `asset`'s fur, at its rest pose: its own states, normals, wetness and
+    /// uniform; the topology, uvs, fin strip, groom attributes and textures are the asset's
+    /// (a groom painted with [`GpuFur::set_groom`] on any copy shows on all).
+    ///
+    /// # Errors
+    /// As [`GpuFur::new`].
+    pub fn from_asset(
+        device: &wgpu::Device,
+        renderer: &FurRenderer,
+        asset: &FurAsset,
+        states: FurStates,
+    ) -> Result<Self, RenderError> {
+        Self::instance(device, renderer.layouts(), asset, states)
+    }
+
     /// Replaces the structure (new mesh, layer count or rest pose), keeping the textures and the
-    /// number of states.
+    /// number of states; the fur leaves its asset for one of its own.
     ///
     /// # Errors
     /// As [`GpuFur::new`].
@@ -56,6 +72,22 @@ impl GpuFur {
         textures: &FurTextures,
     ) -> Result<(), RenderError> {
         self.upload_textures(device, queue, renderer.layouts(), textures)
+    }
+}
+
+impl FurAsset {
+    /// Uploads what every copy of `structure` with `textures` shares, once.
+    ///
+    /// # Errors
+    /// As [`GpuFur::new`].
+    pub fn new(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        renderer: &FurRenderer,
+        structure: &FurStructure,
+        textures: &FurTextures,
+    ) -> Result<Self, RenderError> {
+        Self::upload(device, queue, renderer.layouts(), structure, textures)
     }
 }
 

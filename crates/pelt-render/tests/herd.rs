@@ -1,0 +1,96 @@
+//! A herd's copies of one fur: a hundred of them allocate its topology, uvs, fin strip and
+//! textures once (counted in the device's own allocator report, by label), and each draws its
+//! own pose exactly as a fur uploaded alone with that pose. Fails, never skips, without an
+//! adapter.
+
+use std::collections::HashMap;
+
+use crate::common;
+
+use common::{BROWN_ROOT, BROWN_TIP, Rig, builtin_fur, framed, settings, strand_textures};
+use glam::Vec3;
+use pelt_core::Builtin;
+use pelt_render::{FurAsset, FurFrame, FurStates, GpuFur};
+
+/// Pelt's allocations by label, and their bytes, from the device's allocator (wgpu's own, such
+/// as the staging of uploads, left out).
+fn allocations(device: &wgpu::Device) -> (HashMap<String, usize>, u64) {
+    // Uploads' staging buffers are freed once their submission is done.
+    device.poll(wgpu::PollType::Wait { submission_index: None, timeout: None }).expect("the device answers");
+    let report = device.generate_allocator_report().expect("the Vulkan device reports its allocations");
+    let mut counts = HashMap::new();
+    let mut bytes = 0;
+    for allocation in report.allocations.iter().filter(|a| !a.name.starts_with("(wgpu internal)")) {
+        *counts.entry(allocation.name.clone()).or_insert(0) += 1;
+        bytes += allocation.size;
+    }
+    (counts, bytes)
+}
+
+#[test]
+fn a_hundred_copies_allocate_the_topology_and_textures_once() {
+    let rig = Rig::new(64, 64);
+    let structure = builtin_fur(Builtin::Bunny, 16);
+    let textures = strand_textures(64, 16, BROWN_ROOT, BROWN_TIP);
+    let (before, bytes_before) = allocations(rig.device());
+    let asset = FurAsset::new(rig.device(), rig.queue(), &rig.renderer, &structure, &textures).expect("asset");
+    let copies: Vec<GpuFur> = (0..100)
+        .map(|_| GpuFur::from_asset(rig.device(), &rig.renderer, &asset, FurStates::Two).expect("copy"))
+        .collect();
+    rig.queue().submit([]);
+    let (after, bytes_after) = allocations(rig.device());
+    let made = |label: &str| after.get(label).copied().unwrap_or(0) - before.get(label).copied().unwrap_or(0);
+    for shared in
+        ["pelt topology", "pelt wedge uvs", "pelt fin strip", "pelt groom attributes", "pelt fin", "pelt shell slices"]
+    {
+        assert_eq!(made(shared), 1, "{shared}: allocated once for 100 copies");
+    }
+    assert_eq!(made("pelt shared vertices"), 200, "two states a copy");
+    assert_eq!(made("pelt base normals"), 100);
+    // The bytes: the asset once, each copy's own bytes and lists, and small per-copy buffers
+    // (uniform, wetness, draw arguments) with the allocator's alignment.
+    let own = copies[0].own_bytes();
+    let own = own.positions + own.attributes + copies[0].silhouette_list_bytes();
+    let shared = asset.gpu_bytes();
+    let expected = shared.positions + shared.attributes + shared.indices + shared.textures + 100 * own;
+    let allocated = bytes_after - bytes_before;
+    assert!(allocated >= expected, "{allocated} bytes allocated, {expected} counted");
+    assert!((allocated as f64) < 1.3 * expected as f64, "{allocated} bytes allocated, {expected} counted");
+    assert!(copies.iter().all(|copy| copy.asset().shares_with(&asset)));
+}
+
+#[test]
+fn each_copy_draws_its_own_pose_as_a_fur_uploaded_alone() {
+    let rig = Rig::new(96, 96);
+    let structure = builtin_fur(Builtin::Bunny, 8);
+    let textures = strand_textures(32, 8, BROWN_ROOT, BROWN_TIP);
+    let asset = FurAsset::new(rig.device(), rig.queue(), &rig.renderer, &structure, &textures).expect("asset");
+    let copies: Vec<GpuFur> = (0..2)
+        .map(|_| GpuFur::from_asset(rig.device(), &rig.renderer, &asset, FurStates::One).expect("copy"))
+        .collect();
+    // The second copy's strands bent sideways by a tenth of the fur's radius at the tips.
+    let radius = structure.mesh.bounding_sphere().1;
+    let v = structure.mesh.vertex_count();
+    let bent: Vec<Vec3> = structure
+        .positions
+        .iter()
+        .enumerate()
+        .map(|(k, p)| *p + Vec3::X * (0.1 * radius * (k / v) as f32 / structure.layers as f32))
+        .collect();
+    copies[1].set_positions(rig.queue(), &bent).expect("positions");
+    for copy in &copies {
+        copy.prepare(rig.queue(), &FurFrame::default());
+    }
+    let camera = framed(&structure, 1.0);
+    let first = rig.render(&copies[0], &camera, &settings());
+    let second = rig.render(&copies[1], &camera, &settings());
+    let alone = rig.fur(&structure, &textures);
+    alone.set_positions(rig.queue(), &bent).expect("positions");
+    alone.prepare(rig.queue(), &FurFrame::default());
+    let bent_alone = rig.render(&alone, &camera, &settings());
+    let rest_alone = rig.render(&rig.fur(&structure, &textures), &camera, &settings());
+    assert_eq!(first, rest_alone, "the first copy draws the rest pose, as a fur alone does");
+    assert_eq!(second, bent_alone, "the second copy draws its own pose, as a fur alone does");
+    let differing = first.pixels().zip(second.pixels()).filter(|(a, b)| a != b).count();
+    assert!(differing > 200, "{differing} pixels differ between the copies");
+}
