@@ -39,7 +39,34 @@ impl Surroundings {
         ground: Option<&SceneGround>,
         (fur, plain): (&FurStructure, &[Mesh]),
     ) -> Result<Self, RenderError> {
-        let (centre, radius, bottom) = bounds(fur, plain);
+        let fur_length = fur.lengths.iter().copied().fold(0.0f32, f32::max);
+        Self::around(device, queue, renderer, (shadows, ground), fur_length, bounds(fur, plain))
+    }
+
+    /// [`Surroundings::new`] about the box `(low, high)` (say, a herd's field over a scene)
+    /// for a fur whose longest strand is `fur_length`.
+    ///
+    /// # Errors
+    /// As [`Surroundings::new`].
+    pub fn around_box(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        renderer: &FurRenderer,
+        (shadows, ground): (bool, Option<&SceneGround>),
+        fur_length: f32,
+        (low, high): (Vec3, Vec3),
+    ) -> Result<Self, RenderError> {
+        Self::around(device, queue, renderer, (shadows, ground), fur_length, box_bounds(low, high))
+    }
+
+    fn around(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        renderer: &FurRenderer,
+        (shadows, ground): (bool, Option<&SceneGround>),
+        fur_length: f32,
+        (centre, radius, bottom): (Vec3, f32, f32),
+    ) -> Result<Self, RenderError> {
         let ground = ground
             .map(|ground| {
                 let size = ground.size.unwrap_or(4.0 * radius);
@@ -51,7 +78,7 @@ impl Surroundings {
                 Ok::<_, RenderError>(mesh)
             })
             .transpose()?;
-        let fur_length = fur.lengths.iter().copied().fold(0.0f32, f32::max).max(1e-3 * radius);
+        let fur_length = fur_length.max(1e-3 * radius);
         let shadows =
             shadows.then(|| ShadowMap::new(device, renderer, ShadowSettings::for_fur(fur_length))).transpose()?;
         // Room for the meshes to move a little (a script's motion, the wind).
@@ -99,6 +126,11 @@ fn bounds(fur: &FurStructure, plain: &[Mesh]) -> (Vec3, f32, f32) {
     let points = fur.positions.iter().chain(plain.iter().flat_map(|mesh| mesh.positions.iter()));
     let (low, high) =
         points.fold((Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)), |(low, high), p| (low.min(*p), high.max(*p)));
+    box_bounds(low, high)
+}
+
+/// A sphere about the box `(low, high)` and its lowest y.
+fn box_bounds(low: Vec3, high: Vec3) -> (Vec3, f32, f32) {
     if !(low.is_finite() && high.is_finite()) || low.cmpgt(high).any() {
         return (Vec3::ZERO, 1.0, 0.0);
     }

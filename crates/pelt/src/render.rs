@@ -8,11 +8,12 @@ use std::time::{Duration, Instant};
 use anyhow::{Context as _, bail};
 use glam::{Mat4, Vec3};
 use pelt_core::anim::{Pose, Rig};
+use pelt_core::sim::herd::{self, HerdInstance};
 use pelt_core::sim::{FurStepper, Scene, SceneCamera, WindParams};
 use pelt_core::{Builtin, FurStructure, Mesh, Preset, Stage};
 use pelt_render::{
-    Backend, Camera, ColliderMeshes, FurDrawSettings, FurDriver, FurTarget, FurView, Gpu, HEADLESS_FORMAT, Headless,
-    PlainMesh, SAMPLE_COUNT, default_sample_count,
+    Backend, Camera, ColliderMeshes, FurAsset, FurDrawSettings, FurDriver, FurTarget, FurView, Gpu, HEADLESS_FORMAT,
+    Headless, KernelChoice, PlainMesh, SAMPLE_COUNT, default_sample_count,
 };
 
 use crate::light_args::{LightArgs, preset_look};
@@ -35,7 +36,9 @@ With no arguments: the built-in bunny, the default fur and a light breeze, to pe
 `pelt render GARMENT.obj --plain-mesh BODY.obj`. An animated glTF plays its first animation
 (`--animation` picks another, `none` keeps the rest pose): `pelt render assets/meshes/Fox.glb
 --animation Walk --frames 90 -o fox.gif`. A script's [[motion]] keys move the meshes:
-`pelt render --builtin tryon --script assets/scenes/catwalk.toml -o catwalk.gif`.")]
+`pelt render --builtin tryon --script assets/scenes/catwalk.toml -o catwalk.gif`. A herd:
+`--herd N` scatters N copies on a ground, a script's [[instance]] tables place them
+(`pelt render --script assets/scenes/herd.toml -o herd.gif`).")]
 pub struct Args {
     #[command(flatten)]
     mesh: MeshArgs,
@@ -98,6 +101,11 @@ pub struct Args {
     wetness: Option<f32>,
     #[command(flatten)]
     shadows: crate::shadows::ShadowArgs,
+    /// A herd: N copies of the fur scattered on a ground, each at its own phase of the clip,
+    /// simulated on the CPU in one parallel pass (a script's [[instance]] tables place them
+    /// instead).
+    #[arg(long, value_name = "N")]
+    herd: Option<usize>,
     /// Output: a .png (one frame), a .gif (animated) or a folder (numbered PNGs).
     #[arg(short, long, default_value = "pelt.png")]
     output: PathBuf,
@@ -162,6 +170,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         let secs = scene.as_ref().map(Scene::duration_secs).or(clip_secs).unwrap_or(2.0);
         ((secs * args.fps).round() as u32).max(1)
     };
+    let instances = herd_instances(args, scene.as_ref(), &mesh, (rig.as_ref(), clip))?;
     let fur = preset.grow(mesh, &args.mesh.source(Builtin::Bunny)?.name())?;
     let textures = preset.generate_textures()?;
     let mut simulation_params = preset.simulation.clone();
@@ -189,20 +198,47 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         Headless::with_target(gpu, FurTarget::new(HEADLESS_FORMAT).with_sample_count(samples), width, height)?;
     let (device, queue) = (&headless.gpu.device, &headless.gpu.queue);
     let renderer = headless.renderer()?;
-    let mut driver = FurDriver::new(device, queue, &renderer, &fur, &textures, &simulation_params, args.sim.into())?;
-    // The wind is set after the state at time 0 is made, as a host changing it live would.
-    let mut stepper = FurStepper::new(&fur, &preset.simulation)?;
-    stepper.simulation_mut().set_wind(&simulation_params.wind)?;
-    stepper.set_wet(&wet_params(&preset, args.wetness))?;
-    // A rig poses the base only while it plays a clip or the script moves it.
-    if let Some(rig) = rig.filter(|_| clip.is_some() || scene.as_ref().is_some_and(|s| !s.motion.is_empty())) {
-        stepper.set_clip(rig, clip);
+    let asset = FurAsset::new(device, queue, &renderer, &fur, &textures)?;
+    // A herd steps on the CPU in one parallel pass; one fur on the kernel asked for.
+    let kernel = match (instances.is_empty(), args.sim) {
+        (true, choice) => choice.into(),
+        (false, SimChoice::Gpu) => bail!("--sim gpu simulates one fur; a herd is simulated on the CPU (--sim cpu)"),
+        (false, _) => KernelChoice::Cpu,
+    };
+    let members = instances.len().max(1);
+    let mut drivers = (0..members)
+        .map(|_| FurDriver::with_asset(device, queue, &renderer, &asset, &fur, &simulation_params, kernel))
+        .collect::<Result<Vec<_>, _>>()?;
+    let clips = match rig.as_ref() {
+        Some(rig) => herd::resolve_clips(&instances, Some(rig), clip),
+        None => herd::resolve_clips(&instances, None, clip),
     }
-    stepper.set_scene(scene);
+    .map_err(|(key, problem)| {
+        let file = args.script.as_deref().map_or_else(|| "--herd".to_owned(), |p| p.display().to_string());
+        anyhow::anyhow!("{file}: {key}: {problem}")
+    })?;
+    let mut steppers = Vec::with_capacity(members);
+    for member in 0..members {
+        // The wind is set after the state at time 0 is made, as a host changing it live would.
+        let mut stepper = FurStepper::new(&fur, &preset.simulation)?;
+        stepper.simulation_mut().set_wind(&simulation_params.wind)?;
+        stepper.set_wet(&wet_params(&preset, args.wetness))?;
+        let clip = clips.get(member).copied().unwrap_or(clip);
+        // A rig poses the base only while it plays a clip or the script moves it.
+        if let Some(rig) =
+            rig.clone().filter(|_| clip.is_some() || scene.as_ref().is_some_and(|s| !s.motion.is_empty()))
+        {
+            stepper.set_clip(rig, clip);
+        }
+        stepper.set_scene(scene.clone());
+        stepper.set_placement(instances.get(member).cloned());
+        steppers.push(stepper);
+    }
     // The walking try-on's body pushes the skirt's fur out of its legs.
-    if let (Some(body), Some(mesh)) = (&body, plain.first()) {
+    if let (Some(body), Some(mesh), [stepper]) = (&body, plain.first(), &mut steppers[..]) {
         stepper.set_body(Some((mesh.clone(), body.rig.clone(), body.capsules.clone())));
     }
+    let stepper = &steppers[0];
     let moves = stepper.moves();
     let plain_meshes = plain
         .iter()
@@ -213,19 +249,37 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     }
     let motion_keys = stepper.scene().map_or(&[][..], |s| &s.motion[..]);
     let scene_camera = stepper.scene().and_then(|s| s.camera.as_ref());
-    let camera = camera(args, &preset, &fur, &plain, (motion_keys, scene_camera), frames, headless.aspect_ratio());
+    let camera =
+        camera(args, (&preset, &fur, &plain), (motion_keys, scene_camera, &instances), frames, headless.aspect_ratio());
     let environment = args.lights.environment(stepper.scene())?;
     let studio = args.lights.studio(stepper.scene(), environment, 0.0);
     let mut view = FurView::new(device, &renderer);
     let view_data = studio.view_data(&camera, headless.aspect_ratio());
     view.prepare(queue, &view_data);
-    driver.set_look(preset_look(&preset));
+    for driver in &mut drivers {
+        driver.set_look(preset_look(&preset));
+    }
+    // A herd stands on a ground (under all of it, wherever it walks) unless the script has one.
     let scene_ground = stepper.scene().and_then(|s| s.ground.as_ref());
-    let surroundings = args.shadows.surroundings((device, queue, &renderer), scene_ground, (&fur, &plain))?;
+    let herd_ground = (!instances.is_empty() && scene_ground.is_none()).then(pelt_core::sim::SceneGround::default);
+    let shadow_args =
+        crate::shadows::ShadowArgs { ground: args.shadows.ground || herd_ground.is_some(), ..args.shadows };
+    let extent = herd_extent(&fur, &instances, f64::from(frames) / args.fps);
+    let surroundings =
+        shadow_args.surroundings_around((device, queue, &renderer), scene_ground, (&fur, &plain), extent.as_ref())?;
     surroundings.prepare(queue, &view_data, &mut view);
-    // The camera stays put, so one level serves every frame.
-    let level = lod::level(&lod::settings(&preset.render.lod, args.no_lod), &fur, camera.eye, camera.fov_y_rad, height);
-    driver.set_level(level);
+    let lod_settings = lod::settings(&preset.render.lod, args.no_lod);
+    // The camera stays put: one level serves every frame of one fur; a herd's members move.
+    let level_at = |member: usize, time_secs: f64| {
+        let eye = instances
+            .get(member)
+            .map_or(camera.eye, |i| i.world_from_model(time_secs).inverse().transform_point3(camera.eye));
+        lod::level(&lod_settings, &fur, eye, camera.fov_y_rad, height)
+    };
+    for (member, driver) in drivers.iter_mut().enumerate() {
+        driver.set_level(level_at(member, 0.0));
+    }
+    let level = level_at(0, 0.0);
     let settings = FurDrawSettings {
         alpha_to_coverage: args.alpha_to_coverage,
         fins: !args.no_fins,
@@ -258,8 +312,21 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     for frame in 0..frames {
         let time_secs = f64::from(frame) / args.fps;
         let sim_started = Instant::now();
-        driver.advance_to(device, queue, &mut stepper, time_secs)?;
+        if instances.is_empty() {
+            drivers[0].advance_to(device, queue, &mut steppers[0], time_secs)?;
+        } else {
+            FurStepper::advance_herd(&mut steppers, &instances, time_secs)?;
+            for (member, (driver, stepper)) in drivers.iter_mut().zip(&steppers).enumerate() {
+                show_stepped(queue, driver, stepper)?;
+                driver.set_level(level_at(member, time_secs));
+            }
+        }
         simulation_time += sim_started.elapsed();
+        let stepper = &steppers[0];
+        // Blended fur draws farthest first.
+        let mut order: Vec<usize> = (0..members).collect();
+        let distance = |k: usize| instances.get(k).map_or(0.0, |i| i.position_at(time_secs).distance(camera.eye));
+        order.sort_by(|&a, &b| distance(b).total_cmp(&distance(a)));
         let render_started = Instant::now();
         // A script's lights may move.
         if frame > 0 && args.lights.light.is_none() && stepper.scene().is_some_and(|s| !s.light.is_empty()) {
@@ -274,7 +341,9 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         // The simulation's GPU steps in a submission of their own: the frame's closures below
         // only read the driver.
         let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("simulation") });
-        driver.record(&mut encoder)?;
+        for driver in &mut drivers {
+            driver.record(&mut encoder)?;
+        }
         queue.submit([encoder.finish()]);
         if moves {
             for mesh in &plain_meshes {
@@ -289,14 +358,18 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         let image = headless.render_with(
             studio.background,
             |encoder| {
-                driver.record_view(encoder, &renderer, &view);
+                for driver in &drivers {
+                    driver.record_view(encoder, &renderer, &view);
+                }
                 surroundings.record(encoder, |pass, light| {
                     surroundings.draw_ground(pass, &renderer, light);
                     for mesh in &plain_meshes {
                         renderer.draw_plain(pass, light, mesh);
                     }
                     colliders.draw(pass, &renderer, light);
-                    driver.draw(pass, &renderer, light, &FurDrawSettings::ALL);
+                    for driver in &drivers {
+                        driver.draw(pass, &renderer, light, &FurDrawSettings::ALL);
+                    }
                 });
             },
             |pass| {
@@ -305,7 +378,9 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                     renderer.draw_plain(pass, &view, mesh);
                 }
                 colliders.draw(pass, &renderer, &view);
-                driver.draw(pass, &renderer, &view, &settings);
+                for &member in &order {
+                    drivers[member].draw(pass, &renderer, &view, &settings);
+                }
             },
         )?;
         render_time += render_started.elapsed();
@@ -330,8 +405,9 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         println!("try-on: {}", body.transfer);
     }
     let per_frame = |total: Duration| total.as_secs_f64() * 1000.0 / f64::from(frames);
+    let herd = if instances.is_empty() { String::new() } else { format!("a herd of {members}, ") };
     println!(
-        "{}: {frames} frame{} of {width}x{height}, {} shell layers on {} triangles (level of detail: {}); mean frame {:.1} ms \
+        "{}: {frames} frame{} of {width}x{height}, {herd}{} shell layers on {} triangles (level of detail: {}); mean frame {:.1} ms \
          (render and read back), simulation {:.1} ms a frame on the {} ({}); {:.1} s in all on {}, {}x MSAA",
         args.output.display(),
         if frames == 1 { "" } else { "s" },
@@ -340,9 +416,10 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         level.describe(fur.layers),
         per_frame(render_time),
         per_frame(simulation_time),
-        driver.kernel(),
+        drivers[0].kernel(),
         match args.sim {
-            SimChoice::Auto => driver.kernel_reason().to_owned(),
+            _ if !instances.is_empty() => "a herd, in one parallel pass".to_owned(),
+            SimChoice::Auto => drivers[0].kernel_reason().to_owned(),
             SimChoice::Cpu => "--sim cpu".to_owned(),
             SimChoice::Gpu => "--sim gpu".to_owned(),
         },
@@ -350,6 +427,60 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         headless.gpu.summary(),
         headless.target().sample_count,
     );
+    Ok(())
+}
+
+/// The herd to draw: `--herd N` scattered, or the script's `[[instance]]`s; none for one fur.
+fn herd_instances(
+    args: &Args,
+    scene: Option<&Scene>,
+    mesh: &Mesh,
+    (rig, clip): (Option<&Rig>, Option<usize>),
+) -> anyhow::Result<Vec<HerdInstance>> {
+    let scripted = scene.map_or(&[][..], |s| &s.instance[..]);
+    match args.herd {
+        Some(_) if !scripted.is_empty() => {
+            bail!("--herd and the script's [[instance]] tables both place a herd: use one of them")
+        }
+        Some(count) => {
+            // A body length and a half apart, each somewhere in its clip's first loop.
+            let (low, high) = mesh.bounds();
+            let spacing = 1.5 * (high - low).max_element();
+            let phase = clip.and_then(|k| rig.map(|r| f64::from(r.animations()[k].duration_secs()))).unwrap_or(1.0);
+            herd::scatter(count, spacing, phase, 0).map_err(|e| anyhow::anyhow!("--herd {count}: {e}"))
+        }
+        None => Ok(scripted.to_vec()),
+    }
+}
+
+/// The box a herd covers over `secs` (every member's mesh at the start and the end, with the
+/// fur's length about it); `None` for one fur.
+fn herd_extent(fur: &FurStructure, instances: &[HerdInstance], secs: f64) -> Option<(Vec3, Vec3)> {
+    if instances.is_empty() {
+        return None;
+    }
+    let (low, high) = fur.mesh.bounds();
+    let length = Vec3::splat(fur.lengths.iter().copied().fold(0.0, f32::max));
+    let corners = [low, high, Vec3::new(low.x, low.y, high.z), Vec3::new(high.x, high.y, low.z)];
+    Some(instances.iter().flat_map(|i| [0.0, secs].map(|t| i.world_from_model(t))).fold(
+        (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)),
+        |(lo, hi), world| {
+            // The fur's length about the sides and above; the ground under the feet.
+            corners
+                .iter()
+                .map(|c| world.transform_point3(*c))
+                .fold((lo, hi), |(lo, hi), p| (lo.min(p - length * Vec3::new(1.0, 0.0, 1.0)), hi.max(p + length)))
+        },
+    ))
+}
+
+/// Shows a herd member its stepper stepped ([`FurStepper::advance_herd`]): the positions, the
+/// posed normals and the wetness, as the CPU kernel's upload.
+fn show_stepped(queue: &wgpu::Queue, driver: &mut FurDriver, stepper: &FurStepper) -> anyhow::Result<()> {
+    let wetness = stepper.wetness();
+    driver.show_wet(queue, (!wetness.is_dry()).then(|| wetness.values()), stepper.wet())?;
+    let normals = stepper.moved_pose().map(|pose| &pose.normals[..]);
+    driver.show_state(queue, stepper.simulation().positions(), normals)?;
     Ok(())
 }
 
@@ -371,22 +502,28 @@ fn choose_animation(args: &Args, rig: Option<&Rig>) -> anyhow::Result<Option<usi
 /// angles, else from the front left.
 fn camera(
     args: &Args,
-    preset: &Preset,
-    fur: &FurStructure,
-    plain: &[Mesh],
-    (motion, scene_camera): (&[pelt_core::sim::MotionKey], Option<&SceneCamera>),
+    (preset, fur, plain): (&Preset, &FurStructure, &[Mesh]),
+    (motion, scene_camera, instances): (&[pelt_core::sim::MotionKey], Option<&SceneCamera>, &[HerdInstance]),
     frames: u32,
     aspect_ratio: f32,
 ) -> Camera {
     let meshes = || std::iter::once(&fur.mesh).chain(plain);
-    // The transforms the meshes take: every tenth of a second of the motion (or none).
-    let transforms: Vec<Mat4> = if motion.is_empty() {
-        vec![Mat4::IDENTITY]
+    // The transforms the meshes take: every tenth of a second of the motion (or none), for each
+    // member of a herd.
+    let secs = f64::from(frames) / args.fps;
+    let times = || (0..=(secs * 10.0).ceil() as u32).map(|k| f64::from(k) / 10.0);
+    let motions: Vec<(f64, Mat4)> = if motion.is_empty() {
+        vec![(0.0, Mat4::IDENTITY)]
     } else {
-        let secs = f64::from(frames) / args.fps;
-        (0..=(secs * 10.0).ceil() as u32)
-            .filter_map(|k| pelt_core::sim::motion::motion_at(motion, f64::from(k) / 10.0))
-            .collect()
+        times().filter_map(|t| pelt_core::sim::motion::motion_at(motion, t).map(|m| (t, m))).collect()
+    };
+    let transforms: Vec<Mat4> = if instances.is_empty() {
+        motions.iter().map(|(_, m)| *m).collect()
+    } else {
+        // A herd walks whether or not the script moves it.
+        let motions: Vec<(f64, Mat4)> =
+            if motion.is_empty() { times().map(|t| (t, Mat4::IDENTITY)).collect() } else { motions };
+        instances.iter().flat_map(|i| motions.iter().map(move |(t, m)| i.world_from_model(*t) * *m)).collect()
     };
     let all_points = || {
         transforms.iter().flat_map(move |m| {

@@ -30,9 +30,26 @@ impl ShadowArgs {
         scene_ground: Option<&SceneGround>,
         (fur, plain): (&FurStructure, &[Mesh]),
     ) -> anyhow::Result<Surroundings> {
+        self.surroundings_around((device, queue, renderer), scene_ground, (fur, plain), None)
+    }
+
+    /// [`ShadowArgs::surroundings`] about the box `extent` (a herd's field) where given.
+    pub fn surroundings_around(
+        &self,
+        (device, queue, renderer): (&wgpu::Device, &wgpu::Queue, &FurRenderer),
+        scene_ground: Option<&SceneGround>,
+        (fur, plain): (&FurStructure, &[Mesh]),
+        extent: Option<&(glam::Vec3, glam::Vec3)>,
+    ) -> anyhow::Result<Surroundings> {
         let ground = (self.ground || scene_ground.is_some()).then(|| scene_ground.cloned().unwrap_or_default());
         let shadows = !self.no_shadows && (self.shadows || ground.is_some());
-        Surroundings::new(device, queue, renderer, shadows, ground.as_ref(), (fur, plain))
-            .context("making the shadow maps and the ground")
+        match extent {
+            Some(&extent) => {
+                let fur_length = fur.lengths.iter().copied().fold(0.0f32, f32::max);
+                Surroundings::around_box(device, queue, renderer, (shadows, ground.as_ref()), fur_length, extent)
+            }
+            None => Surroundings::new(device, queue, renderer, shadows, ground.as_ref(), (fur, plain)),
+        }
+        .context("making the shadow maps and the ground")
     }
 }
