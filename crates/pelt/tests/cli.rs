@@ -10,6 +10,8 @@ mod cli_bench;
 mod cli_export;
 #[path = "cli_fidelity.rs"]
 mod cli_fidelity;
+#[path = "cli_herd.rs"]
+mod cli_herd;
 #[path = "cli_render.rs"]
 mod cli_render;
 #[path = "cli_usd.rs"]

@@ -1,0 +1,109 @@
+//! `pelt render` with a herd: each member walks at its own phase (changing one member's phase
+//! changes only its side of the picture), `--herd N` scatters N Foxes on a ground, and bad
+//! herds are clear errors naming the flag, or the file and key.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn pelt(args: &[&str], dir: &Path) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_pelt")).args(args).current_dir(dir).output().expect("run pelt")
+}
+
+fn temp_dir(name: &str) -> PathBuf {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("cli_herd").join(name);
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    dir
+}
+
+fn text(output: &Output) -> String {
+    format!("{}{}", String::from_utf8_lossy(&output.stdout), String::from_utf8_lossy(&output.stderr))
+}
+
+fn fox() -> String {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets/meshes/Fox.glb").to_str().unwrap().to_owned()
+}
+
+/// Two Foxes side by side facing the camera's right, the second `offset` seconds into its walk;
+/// a fixed camera, the sun straight above (their shadows stay under them), no wind.
+fn two_foxes(dir: &Path, name: &str, offset: f32) -> image::RgbaImage {
+    let script = dir.join(format!("{name}.toml"));
+    std::fs::write(
+        &script,
+        format!(
+            "[camera]\ntarget = [0.0, 40.0, 0.0]\nazimuth_deg = 0.0\nelevation_deg = 10.0\ndistance = 700.0\n\n\
+             [[light]]\nkind = \"directional\"\nazimuth_deg = 0.0\nelevation_deg = 89.0\nlux = 1.0\n\n\
+             [[instance]]\nposition = [-150.0, 0.0, 0.0]\nheading_deg = 90.0\nclip = \"Walk\"\n\n\
+             [[instance]]\nposition = [150.0, 0.0, 0.0]\nheading_deg = 90.0\nclip = \"Walk\"\ntime_offset_secs = {offset}\n"
+        ),
+    )
+    .expect("script");
+    let png = format!("{name}.png");
+    let args = ["render", &fox(), "--script", script.to_str().unwrap(), "--size", "200x100", "--sim", "cpu"];
+    let output = pelt(&[&args[..], &["--wind", "0,0,0", "-o", &png]].concat(), dir);
+    assert!(output.status.success(), "{}", text(&output));
+    assert!(text(&output).contains("a herd of 2"), "{}", text(&output));
+    image::open(dir.join(png)).expect("the PNG").to_rgba8()
+}
+
+/// Pixels of columns `columns` that differ by more than a little.
+fn differing(a: &image::RgbaImage, b: &image::RgbaImage, columns: std::ops::Range<u32>) -> usize {
+    let differs = |x: u32, y: u32| a.get_pixel(x, y).0.iter().zip(b.get_pixel(x, y).0).any(|(p, q)| p.abs_diff(q) > 8);
+    columns.flat_map(|x| (0..a.height()).map(move |y| (x, y))).filter(|&(x, y)| differs(x, y)).count()
+}
+
+#[test]
+fn each_member_walks_at_its_own_phase() {
+    let dir = temp_dir("phase");
+    let together = two_foxes(&dir, "together", 0.0);
+    let apart = two_foxes(&dir, "apart", 0.35);
+    // The left Fox is the same in both; the right one is half a stride further on.
+    let left = differing(&together, &apart, 0..90);
+    let right = differing(&together, &apart, 110..200);
+    assert!(right > 100, "{right} pixels of the right Fox moved");
+    assert!(left * 20 < right, "{left} pixels of the left Fox changed, {right} of the right");
+}
+
+#[test]
+fn herd_n_scatters_foxes_on_a_ground() {
+    let dir = temp_dir("scatter");
+    let args = ["render", &fox(), "--animation", "Walk", "--size", "160x90", "--sim", "cpu"];
+    for n in ["1", "6"] {
+        let output = pelt(&[&args[..], &["--herd", n, "-o", &format!("herd{n}.png")]].concat(), &dir);
+        assert!(output.status.success(), "{}", text(&output));
+        assert!(text(&output).contains(&format!("a herd of {n}")), "{}", text(&output));
+    }
+    // Framed whole either way, the six stand smaller on more ground: the ground's colour takes a
+    // larger share of the picture.
+    let ground = |name: &str| {
+        let image = image::open(dir.join(name)).expect("the PNG").to_rgba8();
+        let grey = |p: &image::Rgba<u8>| p[0].abs_diff(p[1]) < 8 && p[1].abs_diff(p[2]) < 8 && p[0] > 50;
+        image.pixels().filter(|p| grey(p)).count() as f64 / f64::from(image.width() * image.height())
+    };
+    let (one, six) = (ground("herd1.png"), ground("herd6.png"));
+    assert!(one > 0.05 && six > one, "ground share: one Fox {one:.3}, six {six:.3}");
+}
+
+#[test]
+fn bad_herds_are_clear_errors() {
+    let dir = temp_dir("bad");
+    let output = pelt(&["render", &fox(), "--herd", "0", "-o", "x.png"], &dir);
+    assert!(!output.status.success());
+    assert!(text(&output).contains("--herd 0") && text(&output).contains("at least one"), "{}", text(&output));
+    std::fs::write(dir.join("nan.toml"), "[[instance]]\nposition = [0.0, nan, 0.0]\n").unwrap();
+    let output = pelt(&["render", &fox(), "--script", "nan.toml", "-o", "x.png"], &dir);
+    assert!(!output.status.success());
+    assert!(text(&output).contains("nan.toml") && text(&output).contains("instance[0].position"), "{}", text(&output));
+    std::fs::write(dir.join("gallop.toml"), "[[instance]]\nposition = [0.0, 0.0, 0.0]\nclip = \"Gallop\"\n").unwrap();
+    let output = pelt(&["render", &fox(), "--script", "gallop.toml", "-o", "x.png"], &dir);
+    assert!(!output.status.success());
+    let said = text(&output);
+    assert!(said.contains("gallop.toml") && said.contains("instance[0].clip"), "{said}");
+    assert!(
+        said.contains("Survey") && said.contains("Walk") && said.contains("Run"),
+        "the file's clips listed: {said}"
+    );
+    assert!(!dir.join("x.png").exists(), "nothing drawn");
+    let output = pelt(&["render", &fox(), "--script", "gallop.toml", "--herd", "3", "-o", "x.png"], &dir);
+    assert!(!output.status.success() && text(&output).contains("use one of them"), "{}", text(&output));
+}
