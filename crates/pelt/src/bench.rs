@@ -7,6 +7,7 @@
 mod anim;
 mod contact;
 mod guard;
+mod herd;
 mod load;
 mod models;
 mod render;
@@ -84,6 +85,11 @@ pub struct Args {
     /// map, as `pelt render --shadows` draws them), in turn with the frame-time table's cases.
     #[arg(long)]
     pub shadows: bool,
+    /// Instead of the report: 1, 10, 100 and 1,000 walking Foxes (1 and 10 with --quick) at
+    /// 1280x720, one fur asset shared: frame, simulation and recording time, GPU bytes, and what
+    /// one more Fox adds (with --json, the rows as JSON).
+    #[arg(long, conflicts_with_all = ["soak", "contact", "guard"])]
+    pub herd: bool,
     /// Instead of the report: the time to a first frame phase by phase (parse, repair,
     /// structure, textures, skin setup, GPU upload) for every mesh in the meshes folder and
     /// each `--load-mesh`.
@@ -176,6 +182,9 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     }
     if let Some(recorded) = &args.guard {
         return guard::run(recorded);
+    }
+    if args.herd {
+        return herd::run(args.quick, &models::meshes_dir(args.meshes.as_deref()), args.json.as_deref());
     }
     if args.load {
         return load::run(&models::meshes_dir(args.meshes.as_deref()), &args.load_meshes);

@@ -234,3 +234,38 @@ fn soak_reports_the_cpu_and_the_gpu_kernel() {
         assert!(line.ends_with("steps with a non-finite node: 0"), "{line}");
     }
 }
+
+/// `pelt bench --herd --quick`: one and ten Foxes, each row's figures positive, the GPU bytes the
+/// shared asset once plus a Fox's own bytes per Fox, and the device's allocator agreeing within
+/// its alignment.
+#[test]
+fn herd_bench_reports_each_size_with_the_asset_counted_once() {
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("cli_bench_herd");
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    let json = dir.join("herd.json");
+    let meshes = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets/meshes");
+    let output = Command::new(env!("CARGO_BIN_EXE_pelt"))
+        .args(["bench", "--herd", "--quick", "--meshes", meshes.to_str().unwrap(), "--json", json.to_str().unwrap()])
+        .output()
+        .expect("run pelt");
+    let stdout = String::from_utf8_lossy(&output.stdout);
+    assert!(output.status.success(), "{stdout}\n{}", String::from_utf8_lossy(&output.stderr));
+    assert!(stdout.contains("### A herd of walking Foxes"), "{stdout}");
+    let rows: Value = serde_json::from_str(&std::fs::read_to_string(&json).expect("the JSON")).expect("JSON");
+    let rows = rows.as_array().expect("rows");
+    assert_eq!(rows.iter().map(|r| r["foxes"].as_u64().unwrap()).collect::<Vec<_>>(), [1, 10]);
+    for row in rows {
+        for key in ["frame_ms", "simulation_ms", "record_ms", "gpu_and_readback_ms"] {
+            let value = row[key].as_f64().unwrap_or(-1.0);
+            assert!(value.is_finite() && value > 0.0, "{key} = {value} in {row}");
+        }
+        let (shared, own, total) =
+            (count(row, "shared_gpu_bytes"), count(row, "per_fox_gpu_bytes"), count(row, "total_gpu_bytes"));
+        assert_eq!(total, shared + count(row, "foxes") * own, "{row}");
+        let allocated = count(row, "allocated_gpu_bytes");
+        assert!(
+            allocated >= total && (allocated as f64) < 1.3 * total as f64,
+            "allocated {allocated}, counted {total}"
+        );
+    }
+}

@@ -1,0 +1,250 @@
+//! `pelt bench --herd`: how a herd's cost grows. 1, 10, 100 and 1,000 Foxes (default preset,
+//! 16 layers) walk across a field at their own phases (`herd::scatter`, each walking ahead),
+//! framed whole at 1280x720 with the Fox's shadows on a ground, as `pelt render --herd N` draws
+//! them: one `FurAsset`, a driver and a stepper per Fox, the steppers in one parallel pass on
+//! the CPU. Per size: the simulation's time a frame, the CPU's time to record a frame, the
+//! rest of the frame (the GPU's work and the readback), the GPU bytes of the shared asset and
+//! of each Fox, and what one more Fox adds to each.
+
+use std::path::Path;
+use std::time::{Duration, Instant};
+
+use anyhow::Context as _;
+use glam::{Mat4, Vec3};
+use pelt_core::sim::FurStepper;
+use pelt_core::sim::herd;
+use pelt_core::{ImportOptions, Preset, Stage, StageSource};
+use pelt_render::{
+    Backend, Camera, FurAsset, FurDrawSettings, FurDriver, FurTarget, FurView, Gpu, HEADLESS_FORMAT, Headless,
+    KernelChoice, Studio,
+};
+
+/// Figures for one herd size.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct HerdRow {
+    pub foxes: usize,
+    pub frames: u32,
+    /// Stepping every Fox (one parallel pass) and uploading their states, mean per frame.
+    pub simulation_ms: f64,
+    /// Recording the frame on the CPU (the shadow and main passes' draws).
+    pub record_ms: f64,
+    /// From the end of recording to the picture read back: the GPU's work.
+    pub gpu_and_readback_ms: f64,
+    /// The whole frame: simulation, recording, GPU and readback.
+    pub frame_ms: f64,
+    /// Bytes every Fox shares (topology, uvs, fin strip, textures), once.
+    pub shared_gpu_bytes: u64,
+    /// Bytes of each Fox's own state (shared-array state, normals, silhouette and shell lists).
+    pub per_fox_gpu_bytes: u64,
+    pub total_gpu_bytes: u64,
+    /// What the device's allocator holds for the herd's drivers, by its own count (Vulkan; none
+    /// elsewhere): their buffers with the allocator's alignment and the per-Fox uniforms.
+    pub allocated_gpu_bytes: Option<u64>,
+}
+
+/// Bytes the device's allocator holds for Pelt (wgpu's own, such as upload staging, left out).
+fn allocated(device: &wgpu::Device) -> Option<u64> {
+    device.poll(wgpu::PollType::Wait { submission_index: None, timeout: None }).ok()?;
+    let report = device.generate_allocator_report()?;
+    Some(report.allocations.iter().filter(|a| !a.name.starts_with("(wgpu internal)")).map(|a| a.size).sum())
+}
+
+const COUNTS: [usize; 4] = [1, 10, 100, 1000];
+const SIZE: (u32, u32) = (1280, 720);
+/// World units a second: about the Fox's walking pace.
+const PACE: f32 = 70.0;
+
+/// Runs the sizes and prints the table (Markdown); `json` also gets the rows.
+pub fn run(quick: bool, meshes: &Path, json: Option<&Path>) -> anyhow::Result<()> {
+    let path = meshes.join("Fox.glb");
+    let stage = Stage::load(&StageSource::File(path.clone()), &[], &ImportOptions::default())
+        .with_context(|| format!("loading {}", path.display()))?;
+    let rig = stage.rig.context("the Fox is rigged")?;
+    let walk = rig.find_animation("Walk").map_err(|e| anyhow::anyhow!("{}: {e}", path.display()))?;
+    let preset = Preset::default();
+    let fur = preset.grow(stage.fur_mesh.clone(), "fox")?;
+    let textures = preset.generate_textures()?;
+    let headless = Headless::with_target(Gpu::new(Backend::Auto)?, FurTarget::new(HEADLESS_FORMAT), SIZE.0, SIZE.1)?;
+    let (device, queue) = (&headless.gpu.device, &headless.gpu.queue);
+    let renderer = headless.renderer()?;
+    let asset = FurAsset::new(device, queue, &renderer, &fur, &textures)?;
+    let (low, high) = fur.mesh.bounds();
+    let spacing = 1.5 * (high - low).max_element();
+    let counts: &[usize] = if quick { &COUNTS[..2] } else { &COUNTS };
+    let frames: u32 = if quick { 2 } else { 4 };
+    let fps = 30.0;
+    let mut rows = Vec::new();
+    for &foxes in counts {
+        eprintln!("pelt bench: a herd of {foxes}");
+        let duration = f64::from(rig.animations()[walk].duration_secs());
+        let mut instances = herd::scatter(foxes, spacing, duration, 0).map_err(|e| anyhow::anyhow!(e))?;
+        for instance in &mut instances {
+            instance.speed = PACE;
+        }
+        let before = allocated(device);
+        let mut drivers = (0..foxes)
+            .map(|_| {
+                FurDriver::with_asset(device, queue, &renderer, &asset, &fur, &preset.simulation, KernelChoice::Cpu)
+            })
+            .collect::<Result<Vec<_>, _>>()?;
+        let herd_bytes = allocated(device).zip(before).map(|(after, before)| after - before);
+        let mut steppers = instances
+            .iter()
+            .map(|instance| {
+                let mut stepper = FurStepper::new(&fur, &preset.simulation)?;
+                stepper.set_clip(rig.clone(), Some(walk));
+                stepper.set_placement(Some(instance.clone()));
+                Ok(stepper)
+            })
+            .collect::<anyhow::Result<Vec<_>>>()?;
+        let secs = f64::from(frames + 1) / fps;
+        let points = instances.iter().flat_map(|i| {
+            [0.0, secs].into_iter().flat_map(move |t| {
+                let world: Mat4 = i.world_from_model(t);
+                [low, high].map(|p| world.transform_point3(p))
+            })
+        });
+        let (points, centre) = {
+            let points: Vec<Vec3> = points.collect();
+            let centre = points.iter().fold(Vec3::ZERO, |s, p| s + *p) / points.len() as f32;
+            (points, centre)
+        };
+        let length = fur.lengths.iter().copied().fold(0.0, f32::max);
+        let camera =
+            Camera::framing_points(centre, points.iter().copied(), length, 20.0, 28.0, headless.aspect_ratio());
+        let studio = Studio::default();
+        let view_data = studio.view_data(&camera, headless.aspect_ratio());
+        let mut view = FurView::new(device, &renderer);
+        view.prepare(queue, &view_data);
+        let extent =
+            points.iter().fold((Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
+        let ground = pelt_core::sim::SceneGround::default();
+        let surroundings =
+            pelt_render::Surroundings::around_box(device, queue, &renderer, (true, Some(&ground)), length, extent)?;
+        surroundings.prepare(queue, &view_data, &mut view);
+        let lod = crate::lod::settings(&preset.render.lod, false);
+        let (mut simulation, mut record, mut gpu) = (Duration::ZERO, Duration::ZERO, Duration::ZERO);
+        // One frame to warm up (pipelines, first poses), then the timed ones.
+        for frame in 0..=frames {
+            let time_secs = f64::from(frame) / fps;
+            let started = Instant::now();
+            FurStepper::advance_herd(&mut steppers, &instances, time_secs)?;
+            for ((driver, stepper), instance) in drivers.iter_mut().zip(&steppers).zip(&instances) {
+                let normals = stepper.moved_pose().map(|pose| &pose.normals[..]);
+                driver.show_state(queue, stepper.simulation().positions(), normals)?;
+                let eye = instance.world_from_model(time_secs).inverse().transform_point3(camera.eye);
+                driver.set_level(crate::lod::level(&lod, &fur, eye, camera.fov_y_rad, SIZE.1));
+            }
+            let stepped = Instant::now();
+            let mut recorded = None;
+            headless.render_with(
+                studio.background,
+                |encoder| {
+                    for driver in &drivers {
+                        driver.record_view(encoder, &renderer, &view);
+                    }
+                    surroundings.record(encoder, |pass, light| {
+                        surroundings.draw_ground(pass, &renderer, light);
+                        for driver in &drivers {
+                            driver.draw(pass, &renderer, light, &FurDrawSettings::ALL);
+                        }
+                    });
+                },
+                |pass| {
+                    surroundings.draw_ground(pass, &renderer, &view);
+                    for driver in &drivers {
+                        driver.draw(pass, &renderer, &view, &FurDrawSettings::SILHOUETTE);
+                    }
+                    recorded = Some(Instant::now());
+                },
+            )?;
+            let done = Instant::now();
+            let recorded = recorded.unwrap_or(done);
+            if frame > 0 {
+                simulation += stepped - started;
+                record += recorded - stepped;
+                gpu += done - recorded;
+            }
+        }
+        let per_frame = |d: Duration| d.as_secs_f64() * 1000.0 / f64::from(frames);
+        let shared = asset.gpu_bytes();
+        let shared_gpu_bytes = shared.positions + shared.attributes + shared.indices + shared.textures;
+        let own = drivers[0].fur().own_bytes();
+        let per_fox_gpu_bytes = own.positions + own.attributes + drivers[0].fur().silhouette_list_bytes();
+        rows.push(HerdRow {
+            foxes,
+            frames,
+            simulation_ms: per_frame(simulation),
+            record_ms: per_frame(record),
+            gpu_and_readback_ms: per_frame(gpu),
+            frame_ms: per_frame(simulation + record + gpu),
+            shared_gpu_bytes,
+            per_fox_gpu_bytes,
+            total_gpu_bytes: shared_gpu_bytes + foxes as u64 * per_fox_gpu_bytes,
+            // The asset was allocated before every herd: count it once with each.
+            allocated_gpu_bytes: herd_bytes.map(|bytes| bytes + shared_gpu_bytes),
+        });
+    }
+    println!("{}", markdown(&rows, &headless.gpu.summary()));
+    if let Some(path) = json {
+        let text = serde_json::to_string_pretty(&rows)? + "\n";
+        std::fs::write(path, text).with_context(|| format!("cannot write {}", path.display()))?;
+    }
+    Ok(())
+}
+
+fn markdown(rows: &[HerdRow], adapter: &str) -> String {
+    let mut out = format!(
+        "### A herd of walking Foxes (1280x720, 16 layers, shadows on a ground; {adapter})\n\n\
+         | Foxes | frame ms | simulation ms | record ms | GPU + readback ms | one more Fox adds (frame / record, ms) | GPU bytes (shared + per Fox) | allocated |\n\
+         |---:|---:|---:|---:|---:|---:|---:|---:|\n"
+    );
+    for (k, row) in rows.iter().enumerate() {
+        let more = match k.checked_sub(1).map(|p| &rows[p]) {
+            Some(before) => {
+                let n = (row.foxes - before.foxes) as f64;
+                format!("{:.3} / {:.4}", (row.frame_ms - before.frame_ms) / n, (row.record_ms - before.record_ms) / n)
+            }
+            None => "-".to_owned(),
+        };
+        out += &format!(
+            "| {} | {:.1} | {:.1} | {:.2} | {:.1} | {more} | {} ({} + {} x {}) | {} |\n",
+            row.foxes,
+            row.frame_ms,
+            row.simulation_ms,
+            row.record_ms,
+            row.gpu_and_readback_ms,
+            row.total_gpu_bytes,
+            row.shared_gpu_bytes,
+            row.foxes,
+            row.per_fox_gpu_bytes,
+            row.allocated_gpu_bytes.map_or_else(|| "-".to_owned(), |b| b.to_string()),
+        );
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_table_adds_one_more_fox_between_rows() {
+        let row = |foxes, frame_ms, record_ms| HerdRow {
+            foxes,
+            frames: 1,
+            simulation_ms: 0.0,
+            record_ms,
+            gpu_and_readback_ms: 0.0,
+            frame_ms,
+            shared_gpu_bytes: 10,
+            per_fox_gpu_bytes: 2,
+            total_gpu_bytes: 10 + 2 * foxes as u64,
+            allocated_gpu_bytes: Some(11 + 2 * foxes as u64),
+        };
+        let table = markdown(&[row(1, 10.0, 1.0), row(11, 30.0, 2.0)], "lavapipe");
+        assert!(table.contains("| 11 | 30.0 |"), "{table}");
+        assert!(table.contains("2.000 / 0.1000"), "{table}");
+        assert!(table.contains("32 (10 + 11 x 2) | 33 |"), "{table}");
+    }
+}
