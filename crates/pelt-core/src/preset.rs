@@ -130,11 +130,22 @@ pub struct LodParams {
     pub facing_start: f32,
     /// `|cos|` where those layers are gone, `0..=1`. Default 0.7.
     pub facing_full: f32,
+    /// Where strands are too short on screen to show as strands (from 0.6 down to 0.3 pixels),
+    /// the shells and fins fade out and the skin takes the coat's mean colour: a far member of a
+    /// herd costs its skin alone. On by default (with `enabled`).
+    pub coat_fade: bool,
 }
 
 impl Default for LodParams {
     fn default() -> Self {
-        Self { enabled: true, pixels_per_shell: 1.0, view_angle: true, facing_start: 0.4, facing_full: 0.7 }
+        Self {
+            enabled: true,
+            pixels_per_shell: 1.0,
+            view_angle: true,
+            facing_start: 0.4,
+            facing_full: 0.7,
+            coat_fade: true,
+        }
     }
 }
 

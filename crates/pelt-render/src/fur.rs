@@ -219,7 +219,14 @@ impl GpuFur {
         let textures = (self.textures.shell_slices, self.textures.has_surface);
         // One state has nothing to interpolate; 1 lets the shader fetch it once.
         let frame = if self.geometry.state_count() == 1 { FurFrame { interpolation: 1.0, ..*frame } } else { *frame };
-        self.geometry.write_uniform(queue, &self.geometry.shape.uniform(&frame, self.textures.root_colour, textures));
+        // A fading coat's skin turns from the roots' colour to the coat's.
+        let coat = frame.level.clamped(self.geometry.shape.layers).coat;
+        let skin = if coat >= 1.0 {
+            self.textures.root_colour
+        } else {
+            self.textures.coat_colour(frame.look.root_occlusion).lerp(self.textures.root_colour, coat)
+        };
+        self.geometry.write_uniform(queue, &self.geometry.shape.uniform(&frame, skin, textures));
         self.level.set(frame.level, self.geometry.shape.layers);
         self.wet.store(frame.wet, Ordering::Relaxed);
         self.fur_model.store(frame.look.shading.fur_model, Ordering::Relaxed);

@@ -28,11 +28,15 @@ pub struct FurLevel {
     /// strand's root rises from `start` to `full`, the layers twice the stride drops fade out
     /// there (and are not drawn where they are gone). `None`: off.
     pub facing: Option<[f32; 2]>,
+    /// `0..=1`: how much of the coat shows. 1 draws the shells and fins; below 1 they fade and
+    /// the skin takes the coat's mean colour; 0 draws the skin alone in that colour (a fur too
+    /// small on screen for its strands, say a far member of a herd).
+    pub coat: f32,
 }
 
 impl FurLevel {
     /// Every layer and every fin segment.
-    pub const FULL: Self = Self { stride: 1, blend: 0.0, facing: None };
+    pub const FULL: Self = Self { stride: 1, blend: 0.0, facing: None, coat: 1.0 };
 
     /// The level with `stride` made a power of two no coarser than `layers` allow and `blend`
     /// clamped to `0..1` (0 at the coarsest stride).
@@ -43,7 +47,8 @@ impl FurLevel {
         let blend = if stride >= max_stride || !self.blend.is_finite() { 0.0 } else { self.blend.clamp(0.0, 1.0) };
         // Nothing to fade toward at the coarsest stride.
         let facing = self.facing.filter(|&[start, full]| stride < max_stride && valid_facing(start, full));
-        Self { stride, blend, facing }
+        let coat = if self.coat.is_finite() { self.coat.clamp(0.0, 1.0) } else { 1.0 };
+        Self { stride, blend, facing, coat }
     }
 
     /// Shells drawn at this level for a fur of `layers` layers (also its fin segments).
@@ -62,6 +67,11 @@ impl FurLevel {
         }
         if level.facing.is_some() {
             text += &format!(", to {} facing the eye", layers / (2 * level.stride).max(1));
+        }
+        if level.coat <= 0.0 {
+            text = "the skin alone in the coat's colour".to_owned();
+        } else if level.coat < 1.0 {
+            text += &format!(", the coat at {:.0}%", 100.0 * level.coat);
         }
         text
     }
@@ -97,17 +107,29 @@ pub struct LodSettings {
     pub pixels_per_shell: f32,
     /// Shells by view angle ([`FurLevel::facing`]); `None`: by size on screen only.
     pub facing: Option<[f32; 2]>,
+    /// Strand pixels `[gone, full]` over which the coat fades to the skin alone
+    /// ([`FurLevel::coat`]), `0 <= gone < full`; `None`: the coat always drawn.
+    pub coat_fade: Option<[f32; 2]>,
 }
 
 impl Default for LodSettings {
     fn default() -> Self {
-        Self { enabled: true, pixels_per_shell: 1.0, facing: Some(Self::DEFAULT_FACING) }
+        Self {
+            enabled: true,
+            pixels_per_shell: 1.0,
+            facing: Some(Self::DEFAULT_FACING),
+            coat_fade: Some(Self::DEFAULT_COAT_FADE),
+        }
     }
 }
 
 impl LodSettings {
     /// No level of detail.
-    pub const OFF: Self = Self { enabled: false, pixels_per_shell: 1.0, facing: None };
+    pub const OFF: Self = Self { enabled: false, pixels_per_shell: 1.0, facing: None, coat_fade: None };
+
+    /// The default coat fade ([`LodSettings::coat_fade`]): the shells and fins fade out as a
+    /// strand shrinks from 0.6 to 0.3 pixels long, where a strand no longer shows as one.
+    pub const DEFAULT_COAT_FADE: [f32; 2] = [0.3, 0.6];
 
     /// The default view-angle range ([`FurLevel::facing`]): layers start fading where the
     /// surface is within about 66 degrees of facing the eye and are gone within about 46
@@ -120,7 +142,14 @@ impl LodSettings {
         if !self.enabled || layers < 2 || !strand_pixels.is_finite() {
             return FurLevel::FULL;
         }
-        let by_view = FurLevel { facing: self.facing, ..FurLevel::FULL };
+        let coat = match self.coat_fade {
+            Some([gone, full]) if gone.is_finite() && full.is_finite() && 0.0 <= gone && gone < full => {
+                let t = ((strand_pixels - gone) / (full - gone)).clamp(0.0, 1.0);
+                t * t * (3.0 - 2.0 * t)
+            }
+            _ => 1.0,
+        };
+        let by_view = FurLevel { facing: self.facing, coat, ..FurLevel::FULL };
         let wanted = (strand_pixels / self.pixels_per_shell.max(1e-3)).max(1e-3);
         let stride = f64::from(layers) / f64::from(wanted);
         if stride <= 1.0 {
@@ -162,17 +191,29 @@ pub(crate) struct PreparedLevel {
     stride: std::sync::atomic::AtomicU32,
     /// Whether the level thins shells by view angle.
     by_view: std::sync::atomic::AtomicBool,
+    /// Whether any of the coat shows ([`FurLevel::coat`] above 0).
+    coat_shown: std::sync::atomic::AtomicBool,
 }
 
 impl PreparedLevel {
     pub fn new() -> Self {
-        Self { stride: std::sync::atomic::AtomicU32::new(1), by_view: std::sync::atomic::AtomicBool::new(false) }
+        Self {
+            stride: std::sync::atomic::AtomicU32::new(1),
+            by_view: std::sync::atomic::AtomicBool::new(false),
+            coat_shown: std::sync::atomic::AtomicBool::new(true),
+        }
     }
 
     pub fn set(&self, level: FurLevel, layers: u32) {
         let level = level.clamped(layers);
         self.stride.store(level.stride, std::sync::atomic::Ordering::Relaxed);
         self.by_view.store(level.facing.is_some(), std::sync::atomic::Ordering::Relaxed);
+        self.coat_shown.store(level.coat > 0.0, std::sync::atomic::Ordering::Relaxed);
+    }
+
+    /// Whether any of the coat shows: without, the shells, fins and their passes are skipped.
+    pub fn coat_shown(&self) -> bool {
+        self.coat_shown.load(std::sync::atomic::Ordering::Relaxed)
     }
 
     /// The stride (blend and facing left out: the draws need only the layers).
@@ -206,7 +247,7 @@ mod tests {
 
     #[test]
     fn full_until_strands_are_small_then_powers_of_two() {
-        let lod = LodSettings { facing: None, ..LodSettings::default() };
+        let lod = LodSettings { facing: None, coat_fade: None, ..LodSettings::default() };
         assert_eq!(lod.level(16, 40.0), FurLevel::FULL);
         assert_eq!(lod.level(16, 16.0), FurLevel::FULL);
         let half = lod.level(16, 8.0);
@@ -262,34 +303,55 @@ mod tests {
     #[test]
     fn odd_layer_counts_and_bad_input() {
         assert_eq!(
-            FurLevel { stride: 3, blend: 2.0, facing: None }.clamped(16),
-            FurLevel { stride: 4, blend: 1.0, facing: None }
+            FurLevel { stride: 3, blend: 2.0, facing: None, coat: 1.0 }.clamped(16),
+            FurLevel { stride: 4, blend: 1.0, facing: None, coat: 1.0 }
         );
         // 12 layers keep at least two shells: stride 4 is the coarsest, with nothing to blend to.
         assert_eq!(
-            FurLevel { stride: 3, blend: 0.5, facing: None }.clamped(12),
-            FurLevel { stride: 4, blend: 0.0, facing: None }
+            FurLevel { stride: 3, blend: 0.5, facing: None, coat: 1.0 }.clamped(12),
+            FurLevel { stride: 4, blend: 0.0, facing: None, coat: 1.0 }
         );
         assert_eq!(
-            FurLevel { stride: 64, blend: 0.5, facing: None }.clamped(12),
-            FurLevel { stride: 4, blend: 0.0, facing: None }
+            FurLevel { stride: 64, blend: 0.5, facing: None, coat: 1.0 }.clamped(12),
+            FurLevel { stride: 4, blend: 0.0, facing: None, coat: 1.0 }
         );
         assert_eq!(
-            FurLevel { stride: 0, blend: f32::NAN, facing: None }.clamped(12),
-            FurLevel { stride: 1, blend: 0.0, facing: None }
+            FurLevel { stride: 0, blend: f32::NAN, facing: None, coat: 1.0 }.clamped(12),
+            FurLevel { stride: 1, blend: 0.0, facing: None, coat: 1.0 }
         );
-        assert_eq!(FurLevel { stride: 4, blend: 0.0, facing: None }.shells(12), 3);
+        assert_eq!(FurLevel { stride: 4, blend: 0.0, facing: None, coat: 1.0 }.shells(12), 3);
         assert_eq!(LodSettings::default().level(16, f32::NAN), FurLevel::FULL);
         assert!(strand_pixels(0.1, 0.0, 0.8, 720).is_finite());
+    }
+
+    #[test]
+    fn the_coat_fades_to_the_skin_continuously_as_strands_shrink() {
+        let lod = LodSettings::default();
+        let [gone, full] = LodSettings::DEFAULT_COAT_FADE;
+        assert_eq!(lod.level(16, full).coat, 1.0);
+        assert_eq!(lod.level(16, 40.0).coat, 1.0);
+        assert_eq!(lod.level(16, gone).coat, 0.0);
+        assert_eq!(lod.level(16, 0.01).describe(16), "the skin alone in the coat's colour");
+        let mut last = 1.0_f32;
+        for step in 0..200 {
+            let pixels = full * 1.2 * 0.99_f32.powi(step);
+            let coat = lod.level(16, pixels).coat;
+            assert!(coat <= last && last - coat < 0.05, "a jump at {pixels} px: {last} -> {coat}");
+            last = coat;
+        }
+        assert_eq!(last, 0.0);
+        assert_eq!(LodSettings { coat_fade: None, ..lod }.level(16, 0.01).coat, 1.0);
+        assert_eq!(LodSettings { coat_fade: Some([0.5, 0.5]), ..lod }.level(16, 0.01).coat, 1.0);
+        assert_eq!(FurLevel { coat: f32::NAN, ..FurLevel::FULL }.clamped(16).coat, 1.0);
     }
 
     #[test]
     fn drawn_layers_end_at_the_tips() {
         let prepared = PreparedLevel::new();
         assert_eq!(prepared.shell_layers(4).collect::<Vec<_>>(), [1, 2, 3, 4]);
-        prepared.set(FurLevel { stride: 4, blend: 0.3, facing: None }, 12);
+        prepared.set(FurLevel { stride: 4, blend: 0.3, facing: None, coat: 1.0 }, 12);
         assert_eq!(prepared.shell_layers(12).collect::<Vec<_>>(), [4, 8, 12]);
-        prepared.set(FurLevel { stride: 4, blend: 0.0, facing: None }, 10);
+        prepared.set(FurLevel { stride: 4, blend: 0.0, facing: None, coat: 1.0 }, 10);
         assert_eq!(prepared.shell_layers(10).collect::<Vec<_>>(), [6, 10]);
     }
 }

@@ -246,7 +246,8 @@ impl ObjectShape {
             interpolation: frame.interpolation.clamp(0.0, 1.0),
             fin_fade_cos: look.fin_fade_cos.max(1e-3),
             shell_fade_cos: look.shell_fade_cos.max(1e-3),
-            root_occlusion: look.root_occlusion,
+            // The skin stands in for a fading coat: no roots to darken where it is gone.
+            root_occlusion: look.root_occlusion + (1.0 - look.root_occlusion) * (1.0 - level.coat),
             specular: look.specular,
             shininess: look.shininess,
             lod_blend: level.blend,
@@ -268,7 +269,8 @@ impl ObjectShape {
             fur_roughness: look.shading.roughness.clamp(0.05, 1.0),
             fur_cuticle_tilt: look.shading.cuticle_tilt,
             fur_medulla: look.shading.medulla.clamp(0.0, 1.0),
-            _padding_2: [0; 2],
+            coat_fade: level.coat,
+            _padding_2: [0; 1],
         }
     }
 }

@@ -16,6 +16,9 @@ pub(crate) struct GpuTextures {
     pub has_surface: bool,
     /// Alpha-weighted mean strand colour of the root slice, linear RGB.
     pub root_colour: glam::Vec3,
+    /// Each slice's mean colour and coverage ([`GpuTextures::coat_colour`]): what a fur too small
+    /// on screen for its shells is drawn in.
+    pub slice_means: std::sync::Arc<[[f32; 4]]>,
     /// Bytes of all textures with their mipmaps.
     pub bytes: u64,
     /// Whether the strands' keep values are on the GPU (a groomed fur's density reads them).
@@ -103,6 +106,7 @@ impl GpuTextures {
             shell_slices: textures.layers,
             has_surface: textures.surface.is_some(),
             root_colour: root_colour(textures, slice_bytes),
+            slice_means: slice_means(textures, slice_bytes).into(),
             bytes,
             has_keep: with_keep,
             keep_bytes: u64::from(keep_size * keep_size * keep_layers),
@@ -228,6 +232,42 @@ fn upload_keep(
 
 pub(crate) fn srgb_to_linear(value: f32) -> f32 {
     if value <= 0.04045 { value / 12.92 } else { ((value + 0.055) / 1.055).powf(2.4) }
+}
+
+/// Each slice's mean colour (linear, premultiplied by coverage) and mean coverage, roots first.
+fn slice_means(textures: &FurTextures, slice_bytes: usize) -> Vec<[f32; 4]> {
+    textures
+        .shell
+        .chunks_exact(slice_bytes)
+        .map(|slice| {
+            let mut sum = [0.0f32; 4];
+            for texel in slice.chunks_exact(4) {
+                let alpha = f32::from(texel[3]) / 255.0;
+                for c in 0..3 {
+                    sum[c] += srgb_to_linear(f32::from(texel[c]) / 255.0) * alpha;
+                }
+                sum[3] += alpha;
+            }
+            let texels = (slice_bytes / 4).max(1) as f32;
+            sum.map(|v| v / texels)
+        })
+        .collect()
+}
+
+impl GpuTextures {
+    /// The coat's mean colour seen from above as the shells shade it: the slices' means
+    /// composited roots first over the skin, each darkened toward the roots as `occlusion` in
+    /// `shading.wgsl` does with `root_occlusion`, and Kajiya-Kay's 0.85 of diffuse light.
+    pub fn coat_colour(&self, root_occlusion: f32) -> glam::Vec3 {
+        let n = self.slice_means.len().max(1) as f32;
+        let mut colour = self.root_colour * root_occlusion;
+        for (i, [r, g, b, alpha]) in self.slice_means.iter().enumerate() {
+            let height = (i as f32 + 1.0) / n;
+            let occlusion = root_occlusion + (1.0 - root_occlusion) * height.powf(0.7);
+            colour = colour * (1.0 - alpha) + glam::Vec3::new(*r, *g, *b) * occlusion;
+        }
+        colour * 0.85
+    }
 }
 
 /// The colour of the fur at the roots: the first slice's strands, weighted by coverage.

@@ -94,3 +94,49 @@ fn each_copy_draws_its_own_pose_as_a_fur_uploaded_alone() {
     let differing = first.pixels().zip(second.pixels()).filter(|(a, b)| a != b).count();
     assert!(differing > 200, "{differing} pixels differ between the copies");
 }
+
+/// A fur made small on screen loses its coat gradually: as `FurLevel::coat` falls from 1 to 0 in
+/// twenty frames, no frame's change is more than a fifth of the whole, the full coat draws the
+/// bytes it always drew, and the bare skin stands in the coat's mean colour (the picture's mean
+/// colour over the fur moves by less than 25 of 255 levels: the skin is lit as a surface, the
+/// shells as strands).
+#[test]
+fn a_far_fur_fades_to_its_skin_in_the_coats_colour_without_a_jump() {
+    let rig = Rig::new(96, 96);
+    let structure = builtin_fur(Builtin::Bunny, 8);
+    let textures = strand_textures(32, 8, BROWN_ROOT, BROWN_TIP);
+    let fur = rig.fur(&structure, &textures);
+    let camera = framed(&structure, 1.0);
+    let always = rig.render(&fur, &camera, &settings());
+    let at = |coat: f32| {
+        let level = pelt_render::FurLevel { coat, ..pelt_render::FurLevel::FULL };
+        fur.prepare(rig.queue(), &FurFrame { level, ..FurFrame::default() });
+        rig.render(&fur, &camera, &settings())
+    };
+    let frames: Vec<image::RgbaImage> = (0..=20).map(|k| at(1.0 - k as f32 / 20.0)).collect();
+    assert_eq!(frames[0], always, "the full coat draws what it always drew");
+    let background = rig.background();
+    let mean_difference = |a: &image::RgbaImage, b: &image::RgbaImage| {
+        let sum: u64 = a.pixels().zip(b.pixels()).map(|(p, q)| u64::from(common::pixel_difference(p, q))).sum();
+        sum as f64 / f64::from(a.width() * a.height())
+    };
+    let whole = mean_difference(&frames[0], &frames[20]);
+    let steps: Vec<f64> = frames.windows(2).map(|w| mean_difference(&w[0], &w[1])).collect();
+    let largest = steps.iter().copied().fold(0.0, f64::max);
+    eprintln!("coat fade: whole change {whole:.3}, largest step {largest:.3}");
+    assert!(whole > 0.5, "the coat's going changes the picture: {whole}");
+    assert!(largest < 0.2 * whole, "a jump of {largest} in a change of {whole}: {steps:?}");
+    // The mean colour where the fur is, with the coat and with the skin alone.
+    let mean_colour = |image: &image::RgbaImage| {
+        let covered: Vec<&image::Rgba<u8>> = image.pixels().filter(|p| common::covered(p, background)).collect();
+        let sum = covered
+            .iter()
+            .fold([0.0; 3], |s, p| [s[0] + f64::from(p[0]), s[1] + f64::from(p[1]), s[2] + f64::from(p[2])]);
+        sum.map(|c| c / covered.len() as f64)
+    };
+    let (coat, skin) = (mean_colour(&frames[0]), mean_colour(&frames[20]));
+    eprintln!("mean colour with the coat {coat:?}, the skin alone {skin:?}");
+    for channel in 0..3 {
+        assert!((coat[channel] - skin[channel]).abs() < 25.0, "coat {coat:?} against skin {skin:?}");
+    }
+}

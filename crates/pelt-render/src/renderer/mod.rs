@@ -249,7 +249,7 @@ impl FurRenderer {
             geometry.draw_skin(pass);
         }
         let layers = geometry.shape.layers;
-        if layers == 0 || !(settings.shells || settings.fins) {
+        if layers == 0 || !(settings.shells || settings.fins) || !fur.prepared_level().coat_shown() {
             return;
         }
         let coat = self.coat(fur.coat().shadowed(shadowed));
@@ -291,6 +291,9 @@ impl FurRenderer {
     /// the pass that lists the triangles the thinned shells still need, and the next draws of
     /// `fur` (until its next [`GpuFur::prepare`]) draw those shells over that list only.
     pub fn prepare_fins(&self, encoder: &mut wgpu::CommandEncoder, view: &FurView, fur: &GpuFur) {
+        if !fur.prepared_level().coat_shown() {
+            return;
+        }
         if let Some(list) = fur.fin_list() {
             list.record(encoder, &self.listing.silhouette, view.bind_group(), fur.geometry().bind_group());
         }

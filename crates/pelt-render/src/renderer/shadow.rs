@@ -127,7 +127,10 @@ impl FurRenderer {
         pass.set_bind_group(2, fur.textures_bind_group(), &[]);
         pass.set_bind_group(3, view.shadow_group(), &[]);
         let shells = fur.drawn_shells();
-        let furred = geometry.shape.layers > 0 && shells > 0 && (settings.shells || settings.fins);
+        let furred = geometry.shape.layers > 0
+            && shells > 0
+            && (settings.shells || settings.fins)
+            && fur.prepared_level().coat_shown();
         match shadow_pass {
             ShadowPass::Opaque if settings.skin => {
                 pass.set_pipeline(&self.shadow_depth().skin[walk]);

@@ -60,8 +60,9 @@ pub(crate) struct ObjectUniform {
     pub fur_roughness: f32,
     pub fur_cuticle_tilt: f32,
     pub fur_medulla: f32,
+    pub coat_fade: f32,
     /// WGSL rounds the struct up to its 16-byte alignment.
-    pub _padding_2: [u32; 2],
+    pub _padding_2: [u32; 1],
 }
 
 /// One light; the layout of `Light` in `fur_bsdf.wgsl`.
@@ -315,6 +316,7 @@ mod tests {
             fur_roughness,
             fur_cuticle_tilt,
             fur_medulla,
+            coat_fade,
             _padding_2
         });
         assert_mirrors(&unified_shader_source(), "Object", &rust);

@@ -88,6 +88,8 @@ struct Object {
     fur_roughness: f32,
     fur_cuticle_tilt: f32,
     fur_medulla: f32,
+    // How much of the coat shows (`FurLevel::coat`): the shells' and fins' opacity.
+    coat_fade: f32,
 }
 
 // Set per pipeline: shells and fins with alpha-to-coverage output straight colour, blended ones
@@ -634,7 +636,7 @@ fn fs_skin(in: Varyings) -> @location(0) vec4<f32> {
 // A shell fragment from its texel: fading, level of detail, the groom's tint and hair lighting.
 fn shell_colour(texel: vec4<f32>, surface_uv: vec2<f32>, lighting: vec4<f32>, fade_blend_layer: vec3<f32>, tint: vec3<f32>) -> vec4<f32> {
     let layer = varying_layer(fade_blend_layer.z);
-    let alpha = lod_alpha(texel.a * fade_blend_layer.x, layer, fade_blend_layer.y);
+    let alpha = lod_alpha(texel.a * fade_blend_layer.x, layer, fade_blend_layer.y) * object.coat_fade;
     let albedo = texel.rgb * surface_tint(surface_uv) * tint;
     return fur_output(hair_colour(albedo, lighting, layer_height(layer)), alpha);
 }
@@ -688,7 +690,7 @@ fn fin_lighting_height(height: f32) -> f32 {
 // solid band, most of all at the roots where the shells already cover.
 fn fin_colour(texel: vec4<f32>, lighting_fade: vec4<f32>, uvs: vec4<f32>, tint: vec3<f32>, groom_alpha: f32) -> vec4<f32> {
     let height = uvs.y;
-    let alpha = texel.a * lighting_fade.w * mix(0.15, 0.6, height) * groom_alpha;
+    let alpha = texel.a * lighting_fade.w * mix(0.15, 0.6, height) * groom_alpha * object.coat_fade;
     let albedo = texel.rgb * surface_tint(uvs.zw) * tint;
     let lit_height = fin_lighting_height(height);
     let lighting = vec4<f32>(lighting_fade.xyz, occlusion(lit_height));

@@ -105,7 +105,7 @@ fn opacity_stride() -> u32 {
 // (`vs_opacity_shell_*`): their alpha, added to every layer that ends at or past the fragment's depth beyond z0 (the
 // last layer takes every fragment), so each layer holds the opacity in front of its end.
 fn opacity_layers(position: vec4<f32>, shell_alpha: f32) -> vec4<f32> {
-    let alpha = clamp(shell_alpha, 0.0, 1.0) * f32(opacity_stride());
+    let alpha = clamp(shell_alpha, 0.0, 1.0) * f32(opacity_stride()) * object.coat_fade;
     let z0 = textureLoad(fur_depth, vec2<i32>(position.xy), 0).x;
     let beyond = shadow_linear_depth(position.z) - shadow_linear_depth(z0);
     let e = shadow.layer_ends;
