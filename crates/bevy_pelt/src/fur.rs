@@ -7,7 +7,7 @@
 //! [`crate::base`]), so the roots' acceleration is the body's and pelt-core's `Inertia` makes the
 //! fur lag, swing and settle; gravity, wind and the touch ray keep their world directions.
 
-use std::collections::HashSet;
+use std::collections::{HashMap, HashSet};
 use std::sync::Arc;
 
 use bevy::asset::{AssetEvent, AssetId, Assets, Handle};
@@ -159,6 +159,13 @@ impl FurState {
         self.world_from_simulation
     }
 
+    /// Whether this fur and `other` share one grown structure (and so one GPU asset): furs of
+    /// one mesh, preset and skeleton do, however many there are.
+    #[must_use]
+    pub fn shares_structure_with(&self, other: &FurState) -> bool {
+        Arc::ptr_eq(&self.structure, &other.structure)
+    }
+
     /// The unified shell-and-fin structure at rest (its `groom`, when the preset has one).
     #[must_use]
     pub fn structure(&self) -> &FurStructure {
@@ -183,10 +190,15 @@ pub(crate) fn build_furs(
     furs: Query<(Entity, &Fur, &Mesh3d, Option<&SkinnedMesh>, Option<&FurState>, Option<&Name>)>,
     mut failed: Local<HashSet<(Entity, AssetId<FurPreset>, AssetId<Mesh>)>>,
     mut next_revision: Local<u64>,
+    mut built: Local<SharedStructures>,
 ) {
     let changed_presets: HashSet<AssetId<FurPreset>> = preset_events.read().filter_map(changed_id).collect();
     let changed_meshes: HashSet<AssetId<Mesh>> = mesh_events.read().filter_map(changed_id).collect();
     failed.retain(|(_, preset, mesh)| !changed_presets.contains(preset) && !changed_meshes.contains(mesh));
+    // A changed mesh or preset grows anew; what no fur holds any more is let go.
+    built.0.retain(|(preset, mesh, _), (structure, _)| {
+        !changed_presets.contains(preset) && !changed_meshes.contains(mesh) && structure.strong_count() > 0
+    });
     for (entity, fur, mesh3d, skinned, state, name) in &furs {
         let (preset_id, mesh_id) = (fur.preset.id(), mesh3d.id());
         let stale = match state {
@@ -206,8 +218,11 @@ pub(crate) fn build_furs(
         let label = name.map_or_else(|| format!("entity {entity}"), |n| format!("{n} ({entity})"));
         *next_revision += 1;
         let joint_count = skinned.map(|s| s.joints.len());
-        match build(&label, preset, mesh, joint_count, preset_id, mesh_id, *next_revision) {
+        let key = (preset_id, mesh_id, joint_count);
+        let shared = built.0.get(&key).and_then(|(structure, skin)| Some((structure.upgrade()?, skin.clone())));
+        match build(&label, preset, (mesh, shared), joint_count, (preset_id, mesh_id), *next_revision) {
             Ok(state) => {
+                built.0.insert(key, (Arc::downgrade(&state.structure), state.skin.clone()));
                 commands.entity(entity).insert(state);
             }
             Err(problem) => {
@@ -225,32 +240,32 @@ fn changed_id<A: bevy::asset::Asset>(event: &AssetEvent<A>) -> Option<AssetId<A>
     }
 }
 
+/// Structures already grown, by preset, mesh and joint count, with their skins: the entities of
+/// one mesh and preset (a herd) share one structure, and the render world one GPU asset.
+#[derive(Default)]
+pub(crate) struct SharedStructures(HashMap<SharedKey, (std::sync::Weak<FurStructure>, Option<Skin>)>);
+
+type SharedKey = (AssetId<FurPreset>, AssetId<Mesh>, Option<usize>);
+
 fn build(
     label: &str,
     preset: &FurPreset,
-    bevy_mesh: &Mesh,
+    (bevy_mesh, shared): (&Mesh, Option<(Arc<FurStructure>, Option<Skin>)>),
     joint_count: Option<usize>,
-    preset_id: AssetId<FurPreset>,
-    mesh_id: AssetId<Mesh>,
+    (preset_id, mesh_id): (AssetId<FurPreset>, AssetId<Mesh>),
     revision: u64,
 ) -> Result<FurState, String> {
-    let (mesh, source) = pelt_mesh(bevy_mesh, label).map_err(|e| e.to_string())?;
-    let skin = joint_count.map(|joints| pelt_skin(bevy_mesh, &source, joints)).transpose()?;
-    if let Some(skin) = &skin {
-        for line in skin.report() {
-            bevy::log::warn!("{label}: {line}");
-        }
-    }
-    let params = preset.preset.fur_params(&mesh);
-    let radius = mesh.bounding_sphere().1;
-    let groom = preset.groom(&mesh, label).map_err(|e| e.to_string())?;
+    let (structure, skin) = match shared {
+        Some(shared) => shared,
+        None => grow(label, preset, bevy_mesh, joint_count)?,
+    };
+    let radius = structure.mesh.bounding_sphere().1;
     let file = preset.preset.file().display();
-    let structure = FurStructure::new_groomed(mesh, &params, groom).map_err(|e| format!("{file}: {e}"))?;
     let mut stepper = FurStepper::new(&structure, &preset.preset.simulation).map_err(|e| format!("{file}: {e}"))?;
     stepper.set_wet(&preset.preset.wet).map_err(|e| format!("{file}: {e}"))?;
     let positions = Arc::new(stepper.simulation().positions().to_vec());
     Ok(FurState {
-        structure: Arc::new(structure),
+        structure,
         textures: Arc::clone(&preset.textures),
         stepper,
         revision,
@@ -268,6 +283,27 @@ fn build(
         wet: preset.preset.wet.clone(),
         shading: preset.preset.shading.clone(),
     })
+}
+
+/// Grows the fur of `preset` on `bevy_mesh` (skinned by `joint_count` joints).
+fn grow(
+    label: &str,
+    preset: &FurPreset,
+    bevy_mesh: &Mesh,
+    joint_count: Option<usize>,
+) -> Result<(Arc<FurStructure>, Option<Skin>), String> {
+    let (mesh, source) = pelt_mesh(bevy_mesh, label).map_err(|e| e.to_string())?;
+    let skin = joint_count.map(|joints| pelt_skin(bevy_mesh, &source, joints)).transpose()?;
+    if let Some(skin) = &skin {
+        for line in skin.report() {
+            bevy::log::warn!("{label}: {line}");
+        }
+    }
+    let params = preset.preset.fur_params(&mesh);
+    let groom = preset.groom(&mesh, label).map_err(|e| e.to_string())?;
+    let file = preset.preset.file().display();
+    let structure = FurStructure::new_groomed(mesh, &params, groom).map_err(|e| format!("{file}: {e}"))?;
+    Ok((Arc::new(structure), skin))
 }
 
 /// Steps every fur to the current time: the base posed from the entity's transform or Bevy's

@@ -76,7 +76,7 @@ pub use pelt_core;
 /// Pelt's renderer, for [`FurLight`]'s `Light`.
 pub use pelt_render;
 pub use preset::{FurPreset, FurPresetLoader};
-pub use render::FurLight;
+pub use render::{FurGpuStats, FurLight};
 pub use wet::FurSponge;
 
 /// Adds fur: the [`FurPreset`] asset and loader, the build and simulation systems, and the
@@ -96,6 +96,7 @@ impl Plugin for PeltPlugin {
         render_app
             .init_resource::<render::ExtractedFurs>()
             .init_resource::<render::FurGpu>()
+            .init_resource::<render::FurGpuStats>()
             .init_resource::<passes::FurPasses>()
             .add_systems(ExtractSchedule, render::extract_furs)
             .add_systems(

@@ -20,7 +20,7 @@ use pelt_core::sim::SimParams;
 use pelt_core::texture::FurTextures;
 use pelt_core::wet::WetParams;
 use pelt_render::{
-    FurDrawSettings, FurDriver, FurLook, FurRenderer, FurShading, FurTarget, FurView, KernelChoice, Light,
+    FurAsset, FurDrawSettings, FurDriver, FurLook, FurRenderer, FurShading, FurTarget, FurView, KernelChoice, Light,
     LightDirection, ViewData,
 };
 
@@ -230,6 +230,29 @@ pub(crate) struct FurGpu {
     /// One per 3D view (render-world view entity).
     views: HashMap<Entity, ViewEntry>,
     failed_furs: HashSet<(Entity, u64)>,
+    /// What the furs of one structure and textures share on the GPU, once per target: a
+    /// hundred entities of one mesh and preset upload their topology and textures once.
+    assets: HashMap<AssetKey, SharedAsset>,
+}
+
+/// A structure and its textures (by address: the main world shares one `Arc` among the furs
+/// of one mesh and preset) and a target.
+type AssetKey = (usize, usize, FurTarget);
+
+struct SharedAsset {
+    asset: FurAsset,
+    /// Held so the addresses in the key stay theirs while the asset lives.
+    _sources: (Arc<FurStructure>, Arc<FurTextures>),
+}
+
+/// How many furs the render world draws and how many GPU assets they share (the furs of one
+/// mesh and preset share one), as of the last frame prepared. A render-world resource.
+#[derive(Resource, Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct FurGpuStats {
+    /// Furs uploaded (one per fur and camera target description).
+    pub furs: usize,
+    /// Shared assets: topology, uvs, fin strip and textures, each uploaded once.
+    pub assets: usize,
 }
 
 struct GpuFurEntry {
@@ -293,6 +316,7 @@ pub(crate) fn prepare_furs(
     queue: Res<RenderQueue>,
     extracted: Res<ExtractedFurs>,
     mut gpu: ResMut<FurGpu>,
+    mut stats: ResMut<FurGpuStats>,
     views: Query<
         (
             Entity,
@@ -365,6 +389,7 @@ pub(crate) fn prepare_furs(
     gpu.views.retain(|entity, _| seen_views.contains(entity));
 
     let mut seen_furs = HashSet::new();
+    let mut seen_assets = HashSet::new();
     for fur in &extracted.furs {
         if gpu.failed_furs.contains(&(fur.entity, fur.revision)) {
             continue;
@@ -372,11 +397,23 @@ pub(crate) fn prepare_furs(
         for &target in &targets {
             let key = (fur.entity, target);
             let renderer = &gpu.renderers[&target];
+            let asset_key = (Arc::as_ptr(&fur.structure) as usize, Arc::as_ptr(&fur.textures) as usize, target);
+            seen_assets.insert(asset_key);
             let stale = gpu.furs.get(&key).is_none_or(|entry| entry.revision != fur.revision);
             if stale {
                 let params = SimParams::default();
-                match FurDriver::new(device, queue, renderer, &fur.structure, &fur.textures, &params, KernelChoice::Cpu)
-                {
+                let asset = match gpu.assets.get(&asset_key) {
+                    Some(shared) => Ok(shared.asset.clone()),
+                    None => FurAsset::new(device, queue, renderer, &fur.structure, &fur.textures).inspect(|asset| {
+                        let sources = (Arc::clone(&fur.structure), Arc::clone(&fur.textures));
+                        gpu.assets.insert(asset_key, SharedAsset { asset: asset.clone(), _sources: sources });
+                    }),
+                };
+                let renderer = &gpu.renderers[&target];
+                let driver = asset.and_then(|asset| {
+                    FurDriver::with_asset(device, queue, renderer, &asset, &fur.structure, &params, KernelChoice::Cpu)
+                });
+                match driver {
                     Ok(gpu_fur) => {
                         gpu.furs.insert(
                             key,
@@ -409,6 +446,8 @@ pub(crate) fn prepare_furs(
         }
     }
     gpu.furs.retain(|key, _| seen_furs.contains(key));
+    gpu.assets.retain(|key, _| seen_assets.contains(key));
+    *stats = FurGpuStats { furs: gpu.furs.len(), assets: gpu.assets.len() };
 }
 
 /// Draws every fur into one 3D view's main pass: the view's colour target (through an sRGB view

@@ -4,6 +4,8 @@
 #[path = "common/mod.rs"]
 mod common;
 
+#[path = "herd.rs"]
+mod herd;
 #[path = "interaction.rs"]
 mod interaction;
 #[path = "lights.rs"]
