@@ -40,7 +40,9 @@ fn main() {
                     focus: Vec3::new(0.0, 0.3, 0.0),
                 },
                 sun_lux: 6000.0,
-                screenshot_frame: 120,
+                // A hundred Foxes take seconds a frame on a CPU rasteriser: the herd is built and
+                // walking by then.
+                screenshot_frame: 40,
             },
         ))
         .insert_resource(Args::from_env("presets/fox.toml"))
@@ -82,7 +84,9 @@ fn setup(
     let scene = assets.load(GltfAssetLabel::Scene(0).from_asset(FOX));
     for k in 0..SIDE * SIDE {
         // A jittered grid, all heading roughly along +X, each at its own phase and pace.
-        let hash = |salt: u32| ((k as u32 * 2_654_435_761).wrapping_add(salt * 40_503) % 1000) as f32 / 1000.0;
+        let hash = |salt: u32| {
+            ((k as u32).wrapping_mul(2_654_435_761).wrapping_add(salt.wrapping_mul(40_503)) % 1000) as f32 / 1000.0
+        };
         let x = ((k % SIDE) as f32 - 0.5 * (SIDE - 1) as f32 + 0.35 * (hash(1) - 0.5)) * SPACING;
         let z = ((k / SIDE) as f32 - 0.5 * (SIDE - 1) as f32 + 0.35 * (hash(2) - 0.5)) * SPACING;
         let heading = std::f32::consts::FRAC_PI_2 + 0.5 * (hash(3) - 0.5);

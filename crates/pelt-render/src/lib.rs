@@ -12,6 +12,9 @@
 //! - [`GpuFur`]: one fur's GPU data (shared array in one or two simulation states, topology,
 //!   uvs, base normals, textures, uniform); [`PlainMesh`] a furless mesh. Each has a model
 //!   transform.
+//! - [`FurAsset`]: what the copies of one fur share (topology, uvs, fin strip, groom attributes,
+//!   textures), uploaded once; [`GpuFur::from_asset`] and [`FurDriver::with_asset`] make one more
+//!   copy of it (a herd's member) holding only its own state.
 //! - [`FurView`]: one view's uniform buffer, written from [`ViewData`] (`clip_from_world`, camera
 //!   position, [`Light`]); several views in one submission each have their own.
 //! - [`Studio`]: the light, exposure and background of Pelt's own pictures, one default that

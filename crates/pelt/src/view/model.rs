@@ -180,6 +180,15 @@ impl Model {
             Some(path) => Some(Scene::load(path)?),
             None => None,
         };
+        if let (Some(path), Some(scene)) = (&args.script, &scene)
+            && !scene.instance.is_empty()
+        {
+            eprintln!(
+                "{}: the viewer draws one copy of the fur; its {} [[instance]] tables are drawn by `pelt render`",
+                path.display(),
+                scene.instance.len()
+            );
+        }
         stepper.set_wet(&settings.preset.wet)?;
         stepper.set_scene(scene.clone());
         if let Some(rig) = &rig {
