@@ -6,6 +6,7 @@
 
 mod anim;
 mod contact;
+mod device_report;
 mod guard;
 mod herd;
 mod load;
@@ -90,6 +91,12 @@ pub struct Args {
     /// one more Fox adds (with --json, the rows as JSON).
     #[arg(long, conflicts_with_all = ["soak", "contact", "guard"])]
     pub herd: bool,
+    /// Instead of the report: every figure that needs a real GPU, written to FILE as JSON in a
+    /// few minutes on one (frames at 1920x1080 with the adapter's MSAA, shadows on and off, herds
+    /// of 100 and 1,000 Foxes, the GPU kernel on the 35,000-vertex torus, contact's share);
+    /// `--quick` shrinks every part, to check the command on a CPU rasteriser.
+    #[arg(long, value_name = "FILE", conflicts_with_all = ["soak", "contact", "guard", "herd"])]
+    pub device_report: Option<PathBuf>,
     /// Instead of the report: the time to a first frame phase by phase (parse, repair,
     /// structure, textures, skin setup, GPU upload) for every mesh in the meshes folder and
     /// each `--load-mesh`.
@@ -182,6 +189,9 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     }
     if let Some(recorded) = &args.guard {
         return guard::run(recorded);
+    }
+    if let Some(out) = &args.device_report {
+        return device_report::run(&models::meshes_dir(args.meshes.as_deref()), out, args.quick);
     }
     if args.herd {
         return herd::run(args.quick, &models::meshes_dir(args.meshes.as_deref()), args.json.as_deref());

@@ -269,3 +269,46 @@ fn herd_bench_reports_each_size_with_the_asset_counted_once() {
         );
     }
 }
+
+/// `pelt bench --device-report FILE --quick` on lavapipe: the command a GPU session runs first
+/// writes every part (frames with and without shadows, herds, the torus, contact), each figure
+/// positive.
+#[test]
+fn device_report_writes_every_part() {
+    let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("cli_bench_device");
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    let json = dir.join("device.json");
+    let meshes = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets/meshes");
+    let output = Command::new(env!("CARGO_BIN_EXE_pelt"))
+        .args(["bench", "--device-report", json.to_str().unwrap(), "--quick", "--meshes", meshes.to_str().unwrap()])
+        .output()
+        .expect("run pelt");
+    assert!(output.status.success(), "{}", String::from_utf8_lossy(&output.stderr));
+    let report: Value = serde_json::from_str(&std::fs::read_to_string(&json).expect("the JSON")).expect("JSON");
+    let positive = |value: &Value, what: &str| {
+        let v = value.as_f64().unwrap_or(-1.0);
+        assert!(v.is_finite() && v > 0.0, "{what} = {value}");
+    };
+    assert_eq!(report["size"], "320x180");
+    let frames = report["frames"].as_array().expect("frames");
+    assert_eq!(frames.iter().map(|f| f["model"].as_str().unwrap()).collect::<Vec<_>>(), ["bunny", "women"]);
+    for model in frames {
+        let figures = &model["figures"];
+        for key in
+            ["frame_ms_unified_1280x720", "frame_ms_unified_shadows_1280x720", "frame_ms_unified_shadows_256x256"]
+        {
+            positive(&figures[key], key);
+        }
+        positive(&figures["extra_sizes"][0]["frame_ms_unified"], "frame_ms_unified at 320x180");
+    }
+    let herd = report["herd"].as_array().expect("herd");
+    assert_eq!(herd.iter().map(|r| r["foxes"].as_u64().unwrap()).collect::<Vec<_>>(), [1, 10]);
+    herd.iter().for_each(|row| positive(&row["frame_ms"], "herd frame_ms"));
+    positive(&report["gpu_sim_node_updates_per_sec_torus"], "torus");
+    for (case, row) in ["off", "skin", "skin + 8 colliders"].iter().zip(report["contact"]["bunny"].as_array().unwrap())
+    {
+        assert_eq!(row["case"], *case);
+        positive(&row["gpu_node_updates_per_sec"], case);
+    }
+    assert_eq!(report["contact"]["try_on"].as_array().unwrap().len(), 3);
+}

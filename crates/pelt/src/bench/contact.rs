@@ -63,8 +63,34 @@ fn params(skin: bool) -> SimParams {
     params
 }
 
+/// One case's node updates per second: CPU (all threads) and GPU (none without an adapter).
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct ContactRow {
+    pub case: &'static str,
+    pub cpu_node_updates_per_sec: f64,
+    pub gpu_node_updates_per_sec: Option<f64>,
+    /// The share of the kernel's time contact takes against the first case (contact off):
+    /// `1 - rate / rate off`.
+    pub cpu_contact_share: f64,
+    pub gpu_contact_share: Option<f64>,
+}
+
+/// The bunny's and the walking try-on's cases.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct ContactFigures {
+    pub bunny: Vec<ContactRow>,
+    pub try_on: Vec<ContactRow>,
+}
+
 /// Runs the cases and prints the table (Markdown).
 pub fn run(quick: bool) -> anyhow::Result<()> {
+    let (_, md) = measure(quick)?;
+    println!("{md}");
+    Ok(())
+}
+
+/// The cases' figures, and their tables (Markdown).
+pub fn measure(quick: bool) -> anyhow::Result<(ContactFigures, String)> {
     let mut preset = Preset::default();
     preset.layers = LAYERS;
     let fur = preset.grow(Builtin::Bunny.mesh().0, "bunny")?;
@@ -106,13 +132,30 @@ pub fn run(quick: bool) -> anyhow::Result<()> {
         rows.push((case.name, cpu, gpu_rate));
     }
     let mut md = table(&format!("bunny, L = {LAYERS}, {} strands", fur.vertex_count()), &rows);
-    md.push_str(&try_on(quick, gpu.as_ref().ok())?);
-    println!("{md}");
-    Ok(())
+    let (try_on_rows, try_on_md) = try_on(quick, gpu.as_ref().ok())?;
+    md.push_str(&try_on_md);
+    Ok((ContactFigures { bunny: figures(&rows), try_on: figures(&try_on_rows) }, md))
 }
 
-/// The walking try-on's rows: the skirt's fur off, with its skin, and with the body too.
-fn try_on(quick: bool, gpu: Option<&Gpu>) -> anyhow::Result<String> {
+/// `rows` (`name`, CPU rate, GPU rate; the first contact off) with contact's shares.
+fn figures(rows: &[(&'static str, f64, Option<f64>)]) -> Vec<ContactRow> {
+    let (_, cpu_off, gpu_off) = rows[0];
+    rows.iter()
+        .map(|&(case, cpu, gpu)| ContactRow {
+            case,
+            cpu_node_updates_per_sec: cpu,
+            gpu_node_updates_per_sec: gpu,
+            cpu_contact_share: 1.0 - cpu / cpu_off,
+            gpu_contact_share: gpu.zip(gpu_off).map(|(on, off)| 1.0 - on / off),
+        })
+        .collect()
+}
+
+/// The walking try-on's rows (the skirt's fur off, with its skin, and with the body too) and
+/// their table.
+type Rows = Vec<(&'static str, f64, Option<f64>)>;
+
+fn try_on(quick: bool, gpu: Option<&Gpu>) -> anyhow::Result<(Rows, String)> {
     let stage = Stage::load(&StageSource::builtin("tryon")?, &[], &ImportOptions::default())?;
     let (Some(rig), Some(body), Some(body_mesh)) = (stage.rig.clone(), stage.body.as_ref(), stage.plain.first()) else {
         anyhow::bail!("the try-on stage has no walking body");
@@ -154,7 +197,8 @@ fn try_on(quick: bool, gpu: Option<&Gpu>) -> anyhow::Result<String> {
         };
         rows.push((name, cpu, gpu_rate));
     }
-    Ok(table(&format!("walking try-on's skirt, L = {LAYERS}, {} strands", fur.vertex_count()), &rows))
+    let md = table(&format!("walking try-on's skirt, L = {LAYERS}, {} strands", fur.vertex_count()), &rows);
+    Ok((rows, md))
 }
 
 /// The GPU kernel's node updates per second stepping `stepper` (the driver `--sim gpu` runs).

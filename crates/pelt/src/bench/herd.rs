@@ -23,6 +23,9 @@ use pelt_render::{
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct HerdRow {
     pub foxes: usize,
+    /// `WIDTHxHEIGHT`, and the MSAA samples.
+    pub size: String,
+    pub msaa_samples: u32,
     pub frames: u32,
     /// Stepping every Fox (one parallel pass) and uploading their states, mean per frame.
     pub simulation_ms: f64,
@@ -56,6 +59,29 @@ const PACE: f32 = 70.0;
 
 /// Runs the sizes and prints the table (Markdown); `json` also gets the rows.
 pub fn run(quick: bool, meshes: &Path, json: Option<&Path>) -> anyhow::Result<()> {
+    let counts: &[usize] = if quick { &COUNTS[..2] } else { &COUNTS };
+    let frames: u32 = if quick { 2 } else { 4 };
+    let gpu = Gpu::new(Backend::Auto)?;
+    // Lavapipe's single sample, as `pelt render` draws there (MSAA where a GPU is).
+    let samples = pelt_render::default_sample_count(&gpu.adapter.get_info());
+    let (rows, adapter) = measure(gpu, meshes, counts, (SIZE, samples), frames)?;
+    println!("{}", markdown(&rows, &adapter));
+    if let Some(path) = json {
+        let text = serde_json::to_string_pretty(&rows)? + "\n";
+        std::fs::write(path, text).with_context(|| format!("cannot write {}", path.display()))?;
+    }
+    Ok(())
+}
+
+/// The rows for herds of `counts` Foxes at `size` with `samples` MSAA samples, `frames` timed
+/// frames each, on `gpu`; and the adapter's summary.
+pub fn measure(
+    gpu: Gpu,
+    meshes: &Path,
+    counts: &[usize],
+    (size, samples): ((u32, u32), u32),
+    frames: u32,
+) -> anyhow::Result<(Vec<HerdRow>, String)> {
     let path = meshes.join("Fox.glb");
     let stage = Stage::load(&StageSource::File(path.clone()), &[], &ImportOptions::default())
         .with_context(|| format!("loading {}", path.display()))?;
@@ -64,14 +90,13 @@ pub fn run(quick: bool, meshes: &Path, json: Option<&Path>) -> anyhow::Result<()
     let preset = Preset::default();
     let fur = preset.grow(stage.fur_mesh.clone(), "fox")?;
     let textures = preset.generate_textures()?;
-    let headless = Headless::with_target(Gpu::new(Backend::Auto)?, FurTarget::new(HEADLESS_FORMAT), SIZE.0, SIZE.1)?;
+    let target = FurTarget::new(HEADLESS_FORMAT).with_sample_count(samples);
+    let headless = Headless::with_target(gpu, target, size.0, size.1)?;
     let (device, queue) = (&headless.gpu.device, &headless.gpu.queue);
     let renderer = headless.renderer()?;
     let asset = FurAsset::new(device, queue, &renderer, &fur, &textures)?;
     let (low, high) = fur.mesh.bounds();
     let spacing = 1.5 * (high - low).max_element();
-    let counts: &[usize] = if quick { &COUNTS[..2] } else { &COUNTS };
-    let frames: u32 = if quick { 2 } else { 4 };
     let fps = 30.0;
     let mut rows = Vec::new();
     for &foxes in counts {
@@ -133,7 +158,7 @@ pub fn run(quick: bool, meshes: &Path, json: Option<&Path>) -> anyhow::Result<()
                 let normals = stepper.moved_pose().map(|pose| &pose.normals[..]);
                 driver.show_state(queue, stepper.simulation().positions(), normals)?;
                 let eye = instance.world_from_model(time_secs).inverse().transform_point3(camera.eye);
-                driver.set_level(crate::lod::level(&lod, &fur, eye, camera.fov_y_rad, SIZE.1));
+                driver.set_level(crate::lod::level(&lod, &fur, eye, camera.fov_y_rad, size.1));
             }
             let stepped = Instant::now();
             let mut recorded = None;
@@ -173,6 +198,8 @@ pub fn run(quick: bool, meshes: &Path, json: Option<&Path>) -> anyhow::Result<()
         let per_fox_gpu_bytes = own.positions + own.attributes + drivers[0].fur().silhouette_list_bytes();
         rows.push(HerdRow {
             foxes,
+            size: format!("{}x{}", size.0, size.1),
+            msaa_samples: samples,
             frames,
             simulation_ms: per_frame(simulation),
             record_ms: per_frame(record),
@@ -185,19 +212,16 @@ pub fn run(quick: bool, meshes: &Path, json: Option<&Path>) -> anyhow::Result<()
             allocated_gpu_bytes: herd_bytes.map(|bytes| bytes + shared_gpu_bytes),
         });
     }
-    println!("{}", markdown(&rows, &headless.gpu.summary()));
-    if let Some(path) = json {
-        let text = serde_json::to_string_pretty(&rows)? + "\n";
-        std::fs::write(path, text).with_context(|| format!("cannot write {}", path.display()))?;
-    }
-    Ok(())
+    Ok((rows, headless.gpu.summary()))
 }
 
 fn markdown(rows: &[HerdRow], adapter: &str) -> String {
     let mut out = format!(
-        "### A herd of walking Foxes (1280x720, 16 layers, shadows on a ground; {adapter})\n\n\
+        "### A herd of walking Foxes ({}, {}x MSAA, 16 layers, shadows on a ground; {adapter})\n\n\
          | Foxes | frame ms | simulation ms | record ms | GPU + readback ms | one more Fox adds (frame / record, ms) | GPU bytes (shared + per Fox) | allocated |\n\
-         |---:|---:|---:|---:|---:|---:|---:|---:|\n"
+         |---:|---:|---:|---:|---:|---:|---:|---:|\n",
+        rows.first().map_or("", |r| r.size.as_str()),
+        rows.first().map_or(1, |r| r.msaa_samples),
     );
     for (k, row) in rows.iter().enumerate() {
         let more = match k.checked_sub(1).map(|p| &rows[p]) {
@@ -232,6 +256,8 @@ mod tests {
     fn the_table_adds_one_more_fox_between_rows() {
         let row = |foxes, frame_ms, record_ms| HerdRow {
             foxes,
+            size: "1280x720".to_owned(),
+            msaa_samples: 1,
             frames: 1,
             simulation_ms: 0.0,
             record_ms,

@@ -1,0 +1,103 @@
+//! `pelt bench --device-report FILE`: every figure that needs a real GPU, in one run of a few
+//! minutes on one, written as one JSON object: the bunny's and the try-on's frames at 1920x1080
+//! (the adapter's MSAA: 4x on a GPU) with and without the key light's shadows, herds of 100 and
+//! 1,000 walking Foxes at that size, the GPU kernel's node updates per second on the
+//! 35,000-vertex torus, and contact's share of each kernel (`pelt bench --contact`). A session
+//! lent a GPU runs it first and records the figures (BENCHMARKS.md).
+
+use std::path::Path;
+use std::time::Instant;
+
+use anyhow::Context as _;
+use pelt_core::Preset;
+use pelt_render::{Backend, Gpu};
+
+use super::models::{self, MODELS, Model};
+use super::report::{Adapter, RenderFigures};
+use super::{contact, herd, render};
+
+/// Frames of one model at the report's size.
+#[derive(Debug, serde::Serialize)]
+struct ModelFrames {
+    model: &'static str,
+    layers: u32,
+    figures: RenderFigures,
+}
+
+#[derive(Debug, serde::Serialize)]
+struct DeviceReport {
+    pelt_version: &'static str,
+    date_utc: String,
+    quick: bool,
+    adapter: Adapter,
+    /// `WIDTHxHEIGHT` of the frames and herds.
+    size: String,
+    frames: Vec<ModelFrames>,
+    herd: Vec<herd::HerdRow>,
+    torus_vertices: u64,
+    torus_layers: u32,
+    gpu_sim_node_updates_per_sec_torus: f64,
+    contact: contact::ContactFigures,
+    wall_time_s: f64,
+}
+
+/// Runs every part and writes `out`; `quick` shrinks each (a CPU rasteriser's check that the
+/// command works: 320x180, herds of 1 and 10, few frames and steps).
+pub fn run(meshes: &Path, out: &Path, quick: bool) -> anyhow::Result<()> {
+    let started = Instant::now();
+    let bench = render::Bench::open(pelt_render::Studio::default())?;
+    let adapter = bench.adapter();
+    eprintln!("pelt bench: device report on {}", adapter.name);
+    let size = if quick { (320, 180) } else { (1920, 1080) };
+    let budget = if quick {
+        render::RenderBudget { warmup_frames: 1, min_frames: 2, max_frames: 2, max_secs_per_case: 0.0 }
+    } else {
+        render::RenderBudget { warmup_frames: 2, min_frames: 5, max_frames: 61, max_secs_per_case: 1.0 }
+    };
+    let mut frames = Vec::new();
+    for key in ["bunny", "women"] {
+        let spec = MODELS.into_iter().find(|m| m.key == key).context("the model table")?;
+        let model = Model::load(spec, meshes)?;
+        let mut preset = Preset::default();
+        preset.layers = 16;
+        let fur = preset.grow(model.fur.clone(), key)?;
+        let textures = preset.generate_textures()?;
+        eprintln!("pelt bench: {key} frames");
+        let lod = crate::lod::settings(&preset.render.lod, false);
+        let figures = bench.measure(&fur, model.body.as_ref(), &textures, budget, lod, &[size], true)?;
+        frames.push(ModelFrames { model: key, layers: preset.layers, figures });
+    }
+    let counts: &[usize] = if quick { &[1, 10] } else { &[100, 1000] };
+    let (herd, _) = herd::measure(
+        Gpu::new(Backend::Auto)?,
+        meshes,
+        counts,
+        (size, adapter.msaa_samples),
+        if quick { 1 } else { 4 },
+    )?;
+    eprintln!("pelt bench: the GPU kernel on the torus");
+    let mut preset = Preset::default();
+    preset.layers = 32;
+    let torus = preset.grow(models::large_mesh()?, models::LARGE_MESH)?;
+    let (steps, runs) = if quick { (2, 1) } else { (30, 7) };
+    let node_updates = bench.node_updates_per_sec(&torus, &preset.simulation, steps, runs)?;
+    let (contact, _) = contact::measure(quick)?;
+    let report = DeviceReport {
+        pelt_version: env!("CARGO_PKG_VERSION"),
+        date_utc: super::system::utc_now(),
+        quick,
+        adapter,
+        size: format!("{}x{}", size.0, size.1),
+        frames,
+        herd,
+        torus_vertices: torus.vertex_count() as u64,
+        torus_layers: preset.layers,
+        gpu_sim_node_updates_per_sec_torus: node_updates,
+        contact,
+        wall_time_s: started.elapsed().as_secs_f64(),
+    };
+    let json = serde_json::to_string_pretty(&report)? + "\n";
+    std::fs::write(out, json).with_context(|| format!("cannot write {}", out.display()))?;
+    eprintln!("pelt bench: wrote {} in {:.0} s", out.display(), report.wall_time_s);
+    Ok(())
+}
