@@ -240,11 +240,13 @@ fn slice_means(textures: &FurTextures, slice_bytes: usize) -> Vec<[f32; 4]> {
         .shell
         .chunks_exact(slice_bytes)
         .map(|slice| {
+            // A table of the 256 sRGB values: millions of texels, no `powf` each.
+            let linear: [f32; 256] = std::array::from_fn(|v| srgb_to_linear(v as f32 / 255.0));
             let mut sum = [0.0f32; 4];
             for texel in slice.chunks_exact(4) {
                 let alpha = f32::from(texel[3]) / 255.0;
                 for c in 0..3 {
-                    sum[c] += srgb_to_linear(f32::from(texel[c]) / 255.0) * alpha;
+                    sum[c] += linear[usize::from(texel[c])] * alpha;
                 }
                 sum[3] += alpha;
             }
