@@ -130,6 +130,9 @@ pub struct FurState {
     pub(crate) world_from_simulation: glam::Mat4,
     /// The base's bounding-box centre in world space, to draw far furs first.
     pub(crate) centre_world: glam::Vec3,
+    /// A world radius about `centre_world` holding the fur at its longest, so views that cannot
+    /// see it skip it.
+    pub(crate) radius_world: f32,
     /// The skin when the entity has a `SkinnedMesh`: the base follows Bevy's joints.
     skin: Option<Skin>,
     base: Base,
@@ -275,6 +278,7 @@ fn build(
         normals: Arc::new(Vec::new()),
         world_from_simulation: glam::Mat4::IDENTITY,
         centre_world: glam::Vec3::ZERO,
+        radius_world: f32::INFINITY,
         skin,
         base: Base::default(),
         radius,
@@ -358,6 +362,10 @@ pub(crate) fn simulate_furs(
         apply_sponges(&mut state.stepper, &sponges, scale);
         state.world_from_simulation = base.world_from_simulation();
         state.centre_world = state.world_from_simulation.transform_point3(box_centre(&base.positions));
+        let reach = box_radius(&base.positions) + state.structure.lengths.iter().copied().fold(0.0, f32::max);
+        let w = state.world_from_simulation;
+        let scale = w.x_axis.truncate().length().max(w.y_axis.truncate().length()).max(w.z_axis.truncate().length());
+        state.radius_world = reach * scale;
         let mut params = state.stepper.simulation().params().clone();
         // The preset's gravity direction is the world's (Bevy's +Y is up), and so is the
         // simulation's frame.
@@ -407,6 +415,14 @@ fn pose_base(
     }
     state.base.skinned(skin, &state.structure.mesh, joint_matrices).map_err(|e| e.to_string())?;
     Ok(true)
+}
+
+/// Half the diagonal of the points' bounding box.
+fn box_radius(points: &[glam::Vec3]) -> f32 {
+    let (min, max) = points
+        .iter()
+        .fold((glam::Vec3::splat(f32::MAX), glam::Vec3::splat(f32::MIN)), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
+    if points.is_empty() { 0.0 } else { 0.5 * (max - min).length() }
 }
 
 fn box_centre(points: &[glam::Vec3]) -> glam::Vec3 {

@@ -102,6 +102,8 @@ pub(crate) struct ExtractedFur {
     normals: Arc<Vec<glam::Vec3>>,
     pub(crate) world_from_simulation: glam::Mat4,
     centre_world: glam::Vec3,
+    /// About `centre_world`, the fur at its longest (views that cannot see it skip it).
+    radius_world: f32,
     pub(crate) skin: bool,
     /// Drawn into Bevy's shadow maps (no `NotShadowCaster`).
     pub(crate) casts_shadows: bool,
@@ -177,6 +179,7 @@ pub(crate) fn extract_furs(
             normals: Arc::clone(&state.normals),
             world_from_simulation: state.world_from_simulation,
             centre_world: state.centre_world,
+            radius_world: state.radius_world,
             skin: fur.skin,
             casts_shadows: !not_caster,
             wetness: state.wetness.clone(),
@@ -210,6 +213,11 @@ fn jittered_clip_from_world(view: &ExtractedView, jitter: Option<&TemporalJitter
 }
 
 impl ViewEntry {
+    /// Whether any of `fur` can be in this view (a fur whose bounds are unknown is).
+    pub(crate) fn sees(&self, fur: &ExtractedFur) -> bool {
+        self.data.as_ref().is_none_or(|data| data.sees_sphere(fur.centre_world, fur.radius_world))
+    }
+
     pub(crate) fn target(&self) -> FurTarget {
         self.target
     }
@@ -245,14 +253,17 @@ struct SharedAsset {
     _sources: (Arc<FurStructure>, Arc<FurTextures>),
 }
 
-/// How many furs the render world draws and how many GPU assets they share (the furs of one
-/// mesh and preset share one), as of the last frame prepared. A render-world resource.
-#[derive(Resource, Clone, Copy, Debug, Default, PartialEq, Eq)]
+/// How many furs the render world holds and draws, and how many GPU assets they share (the
+/// furs of one mesh and preset share one), as of the last frame. A render-world resource.
+#[derive(Resource, Debug, Default)]
 pub struct FurGpuStats {
     /// Furs uploaded (one per fur and camera target description).
     pub furs: usize,
     /// Shared assets: topology, uvs, fin strip and textures, each uploaded once.
     pub assets: usize,
+    /// Furs drawn into the cameras' main passes, summed over the cameras: a fur no camera can
+    /// see (its bounds outside every view) is not drawn.
+    pub drawn: std::sync::atomic::AtomicUsize,
 }
 
 struct GpuFurEntry {
@@ -271,6 +282,8 @@ pub(crate) struct ViewEntry {
     /// (Bevy's default compositing space); Pelt's shaders output linear colour.
     srgb_view: bool,
     camera_position: glam::Vec3,
+    /// What the view sees (without the TAA jitter), to skip the furs it cannot.
+    data: Option<ViewData>,
 }
 
 /// The colour format Pelt's pipelines write for a view, and whether that is an sRGB view of a
@@ -359,7 +372,8 @@ pub(crate) fn prepare_furs(
             Some(entry) if entry.target == target => entry,
             _ => {
                 let view = FurView::new(device, renderer);
-                gpu.views.insert(entity, ViewEntry { target, view, srgb_view, camera_position: glam::Vec3::ZERO });
+                let camera_position = glam::Vec3::ZERO;
+                gpu.views.insert(entity, ViewEntry { target, view, srgb_view, camera_position, data: None });
                 gpu.views.get_mut(&entity).expect("just inserted")
             }
         };
@@ -383,6 +397,7 @@ pub(crate) fn prepare_furs(
             data = data.with_lights(&lights, Some(ambient));
         }
         entry.view.prepare(queue, &data);
+        entry.data = Some(ViewData::new(self::clip_from_world(view), world_from_view, &light));
         seen_views.insert(entity);
         targets.insert(target);
     }
@@ -447,7 +462,7 @@ pub(crate) fn prepare_furs(
     }
     gpu.furs.retain(|key, _| seen_furs.contains(key));
     gpu.assets.retain(|key, _| seen_assets.contains(key));
-    *stats = FurGpuStats { furs: gpu.furs.len(), assets: gpu.assets.len() };
+    *stats = FurGpuStats { furs: gpu.furs.len(), assets: gpu.assets.len(), drawn: 0.into() };
 }
 
 /// Draws every fur into one 3D view's main pass: the view's colour target (through an sRGB view
@@ -456,6 +471,7 @@ pub(crate) fn draw_furs(
     view: ViewQuery<(&ExtractedCamera, &ViewTarget, &ViewDepthStencilTexture)>,
     gpu: Res<FurGpu>,
     extracted: Res<ExtractedFurs>,
+    stats: Res<FurGpuStats>,
     mut ctx: RenderContext,
 ) {
     let view_entity = view.entity();
@@ -466,8 +482,10 @@ pub(crate) fn draw_furs(
     let mut furs: Vec<(&ExtractedFur, &FurDriver)> = extracted
         .furs
         .iter()
+        .filter(|fur| entry.sees(fur))
         .filter_map(|fur| gpu.furs.get(&(fur.entity, entry.target)).map(|e| (fur, &e.fur)))
         .collect();
+    stats.drawn.fetch_add(furs.len(), std::sync::atomic::Ordering::Relaxed);
     if furs.is_empty() {
         return;
     }

@@ -1,6 +1,7 @@
 //! A herd in Bevy: a hundred entities of one mesh and preset grow one structure and upload one
-//! GPU asset, each drawn where it stands; despawning one leaves the others drawn and the asset
-//! shared (`FurGpuStats`, copied out of the render world each frame).
+//! GPU asset, each drawn where it stands; one far outside the camera's view is not drawn;
+//! despawning one leaves the others drawn and the asset shared (`FurGpuStats`, copied out of the
+//! render world each frame).
 
 use std::sync::{Arc, Mutex};
 
@@ -15,12 +16,12 @@ use bevy_pelt::{Fur, FurGpuStats, FurState};
 use crate::common::{self, test_assets as assets, update};
 use crate::render::{SIZE, capture_now, cuboid, preset};
 
-/// The render world's stats, readable from the main world.
+/// The render world's stats (furs, assets, drawn), readable from the main world.
 #[derive(Resource, Clone, Default)]
-struct StatsCopy(Arc<Mutex<FurGpuStats>>);
+struct StatsCopy(Arc<Mutex<(usize, usize, usize)>>);
 
 fn copy_stats(stats: Res<FurGpuStats>, copy: Res<StatsCopy>) {
-    *copy.0.lock().unwrap() = *stats;
+    *copy.0.lock().unwrap() = (stats.furs, stats.assets, stats.drawn.load(std::sync::atomic::Ordering::Relaxed));
 }
 
 const HERD: usize = 100;
@@ -31,7 +32,7 @@ fn a_hundred_entities_of_one_mesh_and_preset_share_one_asset() {
     let mut app = common::headless_app_with(&assets(), false, None, |app| {
         app.sub_app_mut(RenderApp)
             .insert_resource(copy.clone())
-            .add_systems(Render, copy_stats.after(RenderSystems::PrepareResources).before(RenderSystems::Render));
+            .add_systems(Render, copy_stats.after(RenderSystems::Render).before(RenderSystems::Cleanup));
     });
     let world = app.world_mut();
     let mut image = Image::new_target_texture(SIZE, SIZE, TextureFormat::Rgba8UnormSrgb, None);
@@ -46,6 +47,8 @@ fn a_hundred_entities_of_one_mesh_and_preset_share_one_asset() {
             world.spawn((Mesh3d(cube.clone()), Fur::new(coat.clone()), Transform::from_xyz(x, 0.0, z))).id()
         })
         .collect();
+    // One more of the same, far outside the camera's view.
+    world.spawn((Mesh3d(cube.clone()), Fur::new(coat.clone()), Transform::from_xyz(500.0, 0.0, 0.0)));
     world.spawn((
         Camera3d::default(),
         RenderTarget::Image(target.clone().into()),
@@ -56,7 +59,7 @@ fn a_hundred_entities_of_one_mesh_and_preset_share_one_asset() {
     loop {
         update(&mut app);
         let world = app.world_mut();
-        if world.query::<&FurState>().iter(world).count() == HERD {
+        if world.query::<&FurState>().iter(world).count() == HERD + 1 {
             break;
         }
         assert!(std::time::Instant::now() < deadline, "the herd was not built in two minutes");
@@ -69,14 +72,15 @@ fn a_hundred_entities_of_one_mesh_and_preset_share_one_asset() {
     for &entity in &entities[1..] {
         assert!(app.world().get::<FurState>(entity).unwrap().shares_structure_with(first), "{entity}");
     }
-    assert_eq!(*copy.0.lock().unwrap(), FurGpuStats { furs: HERD, assets: 1 });
+    // Uploaded: every fur on one asset; drawn: all but the one out of view.
+    assert_eq!(*copy.0.lock().unwrap(), (HERD + 1, 1, HERD));
     let before = capture_now(&mut app, &target);
     // The middle one goes; the others stay drawn, on the same asset.
     app.world_mut().despawn(entities[44]);
     for _ in 0..3 {
         update(&mut app);
     }
-    assert_eq!(*copy.0.lock().unwrap(), FurGpuStats { furs: HERD - 1, assets: 1 });
+    assert_eq!(*copy.0.lock().unwrap(), (HERD, 1, HERD - 1));
     let after = capture_now(&mut app, &target);
     crate::render::save(&before, "herd_before");
     crate::render::save(&after, "herd_after");

@@ -105,6 +105,25 @@ pub struct ViewData {
 }
 
 impl ViewData {
+    /// Whether any of the sphere (`centre`, `radius`, world space) can be in this view: it is
+    /// not wholly outside one of the frustum's planes (either depth convention). Hosts skip the
+    /// furs it rules out (a herd's members off screen); a sphere near a corner may pass without
+    /// showing.
+    #[must_use]
+    pub fn sees_sphere(&self, centre: Vec3, radius: f32) -> bool {
+        let m = self.clip_from_world;
+        let rows = [m.row(0), m.row(1), m.row(2), m.row(3)];
+        let p = centre.extend(1.0);
+        // -w <= x, y <= w and 0 <= z <= w, as planes (a, b, c, d) . p >= 0.
+        let planes =
+            [rows[3] + rows[0], rows[3] - rows[0], rows[3] + rows[1], rows[3] - rows[1], rows[2], rows[3] - rows[2]];
+        planes.iter().all(|plane| {
+            let length = plane.truncate().length();
+            // A degenerate plane (an infinite far plane's) rules nothing out.
+            length <= f32::EPSILON || plane.dot(p) / length >= -radius
+        })
+    }
+
     /// A view from the host's camera: `clip_from_world` and the camera's transform
     /// `world_from_view` (its position is the translation), with `light` resolved to world space.
     #[must_use]
@@ -324,6 +343,23 @@ impl FurView {
 
 #[cfg(test)]
 mod tests {
+
+    #[test]
+    fn a_sphere_is_seen_unless_wholly_outside_a_plane() {
+        use crate::Camera;
+        let camera = Camera::orbit(Vec3::ZERO, 0.0, 0.0, 10.0);
+        let view = camera.view_data(1.0, &Light::default());
+        assert!(view.sees_sphere(Vec3::ZERO, 0.1));
+        // Behind the camera, and far to the side of the view.
+        assert!(!view.sees_sphere(Vec3::new(0.0, 0.0, 20.0), 1.0));
+        assert!(!view.sees_sphere(Vec3::new(50.0, 0.0, 0.0), 1.0));
+        // Just outside the left edge, and the same sphere grown to reach in.
+        let half_width = 10.0 * (0.5 * camera.fov_y_rad).tan();
+        let outside = Vec3::new(-(half_width + 0.6), 0.0, 0.0);
+        assert!(!view.sees_sphere(outside, 0.4));
+        assert!(view.sees_sphere(outside, 0.8));
+    }
+
     use super::*;
 
     #[test]

@@ -279,6 +279,13 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     for (member, driver) in drivers.iter_mut().enumerate() {
         driver.set_level(level_at(member, 0.0));
     }
+    let (mesh_centre, mesh_radius) = fur.mesh.bounding_sphere();
+    let reach = mesh_radius + fur.lengths.iter().copied().fold(0.0, f32::max);
+    let member_seen = |member: usize, time_secs: f64| {
+        instances
+            .get(member)
+            .is_none_or(|i| view_data.sees_sphere(i.world_from_model(time_secs).transform_point3(mesh_centre), reach))
+    };
     let level = level_at(0, 0.0);
     let settings = FurDrawSettings {
         alpha_to_coverage: args.alpha_to_coverage,
@@ -308,6 +315,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     };
     let mut colliders = ColliderMeshes::new();
     let (mut render_time, mut simulation_time) = (Duration::ZERO, Duration::ZERO);
+    let mut out_of_view = 0;
     let mut body_pose = Pose::default();
     for frame in 0..frames {
         let time_secs = f64::from(frame) / args.fps;
@@ -323,8 +331,10 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         }
         simulation_time += sim_started.elapsed();
         let stepper = &steppers[0];
-        // Blended fur draws farthest first.
-        let mut order: Vec<usize> = (0..members).collect();
+        // Blended fur draws farthest first; a member the camera cannot see is not drawn (it still
+        // casts its shadow).
+        let mut order: Vec<usize> = (0..members).filter(|&k| member_seen(k, time_secs)).collect();
+        out_of_view = members - order.len();
         let distance = |k: usize| instances.get(k).map_or(0.0, |i| i.position_at(time_secs).distance(camera.eye));
         order.sort_by(|&a, &b| distance(b).total_cmp(&distance(a)));
         let render_started = Instant::now();
@@ -358,8 +368,8 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         let image = headless.render_with(
             studio.background,
             |encoder| {
-                for driver in &drivers {
-                    driver.record_view(encoder, &renderer, &view);
+                for &member in &order {
+                    drivers[member].record_view(encoder, &renderer, &view);
                 }
                 surroundings.record(encoder, |pass, light| {
                     surroundings.draw_ground(pass, &renderer, light);
@@ -405,7 +415,11 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         println!("try-on: {}", body.transfer);
     }
     let per_frame = |total: Duration| total.as_secs_f64() * 1000.0 / f64::from(frames);
-    let herd = if instances.is_empty() { String::new() } else { format!("a herd of {members}, ") };
+    let herd = if instances.is_empty() {
+        String::new()
+    } else {
+        format!("a herd of {members} ({out_of_view} out of view in the last frame), ")
+    };
     println!(
         "{}: {frames} frame{} of {width}x{height}, {herd}{} shell layers on {} triangles (level of detail: {}); mean frame {:.1} ms \
          (render and read back), simulation {:.1} ms a frame on the {} ({}); {:.1} s in all on {}, {}x MSAA",

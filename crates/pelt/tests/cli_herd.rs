@@ -42,7 +42,7 @@ fn two_foxes(dir: &Path, name: &str, offset: f32) -> image::RgbaImage {
     let args = ["render", &fox(), "--script", script.to_str().unwrap(), "--size", "200x100", "--sim", "cpu"];
     let output = pelt(&[&args[..], &["--wind", "0,0,0", "-o", &png]].concat(), dir);
     assert!(output.status.success(), "{}", text(&output));
-    assert!(text(&output).contains("a herd of 2"), "{}", text(&output));
+    assert!(text(&output).contains("a herd of 2 (0 out of view"), "{}", text(&output));
     image::open(dir.join(png)).expect("the PNG").to_rgba8()
 }
 
@@ -62,6 +62,32 @@ fn each_member_walks_at_its_own_phase() {
     let right = differing(&together, &apart, 110..200);
     assert!(right > 100, "{right} pixels of the right Fox moved");
     assert!(left * 20 < right, "{left} pixels of the left Fox changed, {right} of the right");
+}
+
+/// Members the camera cannot see are not drawn (the summary counts them), and the one it can is
+/// drawn as it is alone: three Foxes 5,000 units apart, against the middle one by itself (no
+/// shadows: their map would be fitted to the whole herd).
+#[test]
+fn members_out_of_view_are_not_drawn() {
+    let dir = temp_dir("out-of-view");
+    let camera = "[camera]\ntarget = [0.0, 40.0, 0.0]\nazimuth_deg = 0.0\nelevation_deg = 10.0\ndistance = 400.0\n\n\
+                  [ground]\nsize = 600.0\nheight = -0.5\n\n";
+    let fox_at = |x: f32| format!("[[instance]]\nposition = [{x}, 0.0, 0.0]\nclip = \"Walk\"\n\n");
+    let render = |name: &str, script: String| {
+        std::fs::write(dir.join(format!("{name}.toml")), script).unwrap();
+        let script = format!("{name}.toml");
+        let png = format!("{name}.png");
+        let args = ["render", &fox(), "--script", &script, "--size", "160x90", "--sim", "cpu", "--no-shadows"];
+        let output = pelt(&[&args[..], &["-o", &png]].concat(), &dir);
+        assert!(output.status.success(), "{}", text(&output));
+        (text(&output), image::open(dir.join(png)).expect("the PNG").to_rgba8())
+    };
+    let (said, three) = render("three", format!("{camera}{}{}{}", fox_at(-5000.0), fox_at(0.0), fox_at(5000.0)));
+    assert!(said.contains("a herd of 3 (2 out of view"), "{said}");
+    let (said, one) = render("one", format!("{camera}{}", fox_at(0.0)));
+    assert!(said.contains("a herd of 1 (0 out of view"), "{said}");
+    let differing = differing(&three, &one, 0..160);
+    assert!(differing < 10, "{differing} pixels differ from the middle Fox drawn alone");
 }
 
 #[test]
