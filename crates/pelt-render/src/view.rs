@@ -343,24 +343,28 @@ impl FurView {
 
 #[cfg(test)]
 mod tests {
+    use super::*;
 
     #[test]
     fn a_sphere_is_seen_unless_wholly_outside_a_plane() {
-        use crate::Camera;
-        let camera = Camera::orbit(Vec3::ZERO, 0.0, 0.0, 10.0);
-        let view = camera.view_data(1.0, &Light::default());
+        // From +Z 10 units out, looking at the origin, 35 degrees high, square.
+        let fov = 35.0_f32.to_radians();
+        let eye = Vec3::new(0.0, 0.0, 10.0);
+        let world_from_view = glam::camera::rh::view::look_at_mat4(eye, Vec3::ZERO, Vec3::Y).inverse();
+        let clip_from_view = glam::camera::rh::proj::directx::perspective(fov, 1.0, 0.1, 100.0);
+        let clip_from_world = clip_from_view * world_from_view.inverse();
+        let view = ViewData::new(clip_from_world, world_from_view, &Light::default());
         assert!(view.sees_sphere(Vec3::ZERO, 0.1));
-        // Behind the camera, and far to the side of the view.
+        // Behind the camera, far to the side of the view, and past the far plane.
         assert!(!view.sees_sphere(Vec3::new(0.0, 0.0, 20.0), 1.0));
         assert!(!view.sees_sphere(Vec3::new(50.0, 0.0, 0.0), 1.0));
+        assert!(!view.sees_sphere(Vec3::new(0.0, 0.0, -150.0), 1.0));
         // Just outside the left edge, and the same sphere grown to reach in.
-        let half_width = 10.0 * (0.5 * camera.fov_y_rad).tan();
+        let half_width = 10.0 * (0.5 * fov).tan();
         let outside = Vec3::new(-(half_width + 0.6), 0.0, 0.0);
         assert!(!view.sees_sphere(outside, 0.4));
         assert!(view.sees_sphere(outside, 0.8));
     }
-
-    use super::*;
 
     #[test]
     fn view_space_light_turns_with_the_camera() {
