@@ -88,7 +88,6 @@ pub struct GpuFur {
     /// What it shares with the other copies of its fur (its geometry's shared part and the
     /// textures).
     asset: FurAsset,
-    textures: GpuTextures,
     /// The silhouette pass's output (none without fins).
     fins: Option<FinList>,
     /// The level of detail of the last `prepare`.
@@ -135,7 +134,6 @@ impl GpuFur {
         Ok(Self {
             geometry: geometry?,
             asset: asset.clone(),
-            textures: asset.textures.clone(),
             fins: fins?,
             level: PreparedLevel::new(),
             shells: shells?,
@@ -164,7 +162,7 @@ impl GpuFur {
         let shared =
             SharedGeometry::new(device, (&structure.mesh, furred.as_ref(), structure.groom.as_ref()), structure.layers);
         scope.pop("uploading the fur")?;
-        let asset = FurAsset::from_parts(shared?, self.textures.clone(), structure, furred.as_ref());
+        let asset = FurAsset::from_parts(shared?, self.asset.textures.clone(), structure, furred.as_ref());
         let fresh = Self::instance(device, layouts, &asset, states)?;
         (self.geometry, self.asset, self.fins, self.shells) = (fresh.geometry, fresh.asset, fresh.fins, fresh.shells);
         Ok(())
@@ -181,8 +179,7 @@ impl GpuFur {
         let scope = ErrorScope::push(device);
         let textures = GpuTextures::new(device, queue, layouts, textures, self.geometry.shape.groomed);
         scope.pop("uploading the fur textures")?;
-        self.textures = textures?;
-        self.asset = self.asset.with_textures(self.textures.clone());
+        self.asset = self.asset.with_textures(textures?);
         Ok(())
     }
 
@@ -197,7 +194,7 @@ impl GpuFur {
     /// [`RenderError::Groom`] for a fur without a groom, a density map on textures without keep
     /// values, or a groom that does not fit the mesh.
     pub fn set_groom(&mut self, queue: &wgpu::Queue, groom: &pelt_core::groom::Groom) -> Result<(), RenderError> {
-        if self.geometry.shape.groomed && groom.density.is_some() && !self.textures.has_keep {
+        if self.geometry.shape.groomed && groom.density.is_some() && !self.asset.textures.has_keep {
             return Err(RenderError::Groom(
                 "a density map needs the textures uploaded with a groom (set_textures after set_structure)".to_owned(),
             ));
@@ -209,22 +206,22 @@ impl GpuFur {
     /// keep values (one byte a shell texel). 0 without a groom.
     #[must_use]
     pub fn groom_bytes(&self) -> u64 {
-        let keep = if self.textures.has_keep { self.textures.keep_bytes } else { 0 };
+        let keep = if self.asset.textures.has_keep { self.asset.textures.keep_bytes } else { 0 };
         self.geometry.groom_bytes() + keep
     }
 
     /// Writes this frame's model transform, interpolation and look (takes effect at the next
     /// submission; one transform per fur and submission).
     pub fn prepare(&self, queue: &wgpu::Queue, frame: &FurFrame) {
-        let textures = (self.textures.shell_slices, self.textures.has_surface);
+        let textures = (self.asset.textures.shell_slices, self.asset.textures.has_surface);
         // One state has nothing to interpolate; 1 lets the shader fetch it once.
         let frame = if self.geometry.state_count() == 1 { FurFrame { interpolation: 1.0, ..*frame } } else { *frame };
         // A fading coat's skin turns from the roots' colour to the coat's.
         let coat = frame.level.clamped(self.geometry.shape.layers).coat;
         let skin = if coat >= 1.0 {
-            self.textures.root_colour
+            self.asset.textures.root_colour
         } else {
-            self.textures.coat_colour(frame.look.root_occlusion).lerp(self.textures.root_colour, coat)
+            self.asset.textures.coat_colour(frame.look.root_occlusion).lerp(self.asset.textures.root_colour, coat)
         };
         self.geometry.write_uniform(queue, &self.geometry.shape.uniform(&frame, skin, textures));
         self.level.set(frame.level, self.geometry.shape.layers);
@@ -311,7 +308,7 @@ impl GpuFur {
     /// working memory, not structure, and is not counted here.
     #[must_use]
     pub fn gpu_bytes(&self) -> GpuBytes {
-        GpuBytes { textures: self.textures.bytes, ..self.geometry.bytes() }
+        GpuBytes { textures: self.asset.textures.bytes, ..self.geometry.bytes() }
     }
 
     /// Bytes this copy holds apart from its [`FurAsset`] ([`FurAsset::gpu_bytes`]): the shared
@@ -404,7 +401,7 @@ impl GpuFur {
     }
 
     pub(crate) fn textures_bind_group(&self) -> &wgpu::BindGroup {
-        &self.textures.bind_group
+        &self.asset.textures.bind_group
     }
 
     pub(crate) fn fin_list(&self) -> Option<&FinList> {
