@@ -44,7 +44,8 @@ const OPACITY_SHELLS: u32 = 4;
 #[derive(Debug, Default)]
 pub(super) struct ShadowSet {
     depth: OnceLock<ShadowPipelines>,
-    /// By the coat's index without shadows (groomed, wet).
+    /// By the coat's index without shadows or the fur model (groomed, wet): opacity needs
+    /// neither.
     opacity: [OnceLock<OpacityPipelines>; 4],
 }
 
@@ -108,7 +109,8 @@ impl FurRenderer {
     }
 
     fn opacity(&self, coat: Coat) -> &OpacityPipelines {
-        let coat = coat.shadowed(false);
+        // The lighting the vertex stage computes is not read, so the cheaper model's.
+        let coat = Coat { shadowed: false, fur_model: false, ..coat };
         self.shadows.opacity[coat.index()].get_or_init(|| self.coat_builder.opacity(coat))
     }
 
