@@ -72,7 +72,7 @@ impl ShadowCaster {
 /// A shadow map's resolution and how the fur takes light.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct ShadowSettings {
-    /// Texels along each side of the maps.
+    /// Texels along each side of the opaque map (the fur's maps have half as many).
     pub size: u32,
     /// How deep (world units) below the fur's first surface the opacity layers reach: about
     /// the fur's length.
@@ -91,7 +91,7 @@ impl ShadowSettings {
 }
 
 /// The key light's shadow maps: an opaque depth map, the fur's first surface and its opacity
-/// layers, each `size` squared. Make one per light and renderer; each frame
+/// layers (the first `size` squared, the fur's half that). Make one per light and renderer; each frame
 /// [`ShadowMap::prepare`] it, [`ShadowMap::record`] it before the picture's pass, and draw the
 /// picture through a view lit with it ([`FurView::set_shadows`]).
 #[derive(Debug)]
@@ -135,8 +135,11 @@ impl ShadowMap {
         });
         let size = settings.size;
         let depth = shadow_texture(device, DEPTH_FORMAT, size, true);
-        let fur_depth = shadow_texture(device, DEPTH_FORMAT, size, true);
-        let opacity = shadow_texture(device, OPACITY_FORMAT, size, true);
+        // The fur's maps at half the size: light through fur varies smoothly, and the opacity
+        // pass's fragments were most of a small picture's shadow cost.
+        let fur_size = size.div_ceil(2);
+        let fur_depth = shadow_texture(device, DEPTH_FORMAT, fur_size, true);
+        let opacity = shadow_texture(device, OPACITY_FORMAT, fur_size, true);
         // The opacity pass reads z0; what it draws into stands in as 1x1 textures.
         let stand_in_depth = shadow_texture(device, DEPTH_FORMAT, 1, false);
         let stand_in_opacity = shadow_texture(device, OPACITY_FORMAT, 1, false);
@@ -249,12 +252,9 @@ impl ShadowMap {
                     store: wgpu::StoreOp::Store,
                 },
             })],
-            // Fur behind the opaque casters is in their shadow already.
-            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: &self.depth,
-                depth_ops: None,
-                stencil_ops: None,
-            }),
+            // No depth test against the opaque map (another size): fur behind the opaque
+            // casters adds opacity only past their own shadow.
+            depth_stencil_attachment: None,
             timestamp_writes: None,
             occlusion_query_set: None,
             multiview_mask: None,

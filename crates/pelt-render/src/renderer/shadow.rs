@@ -213,7 +213,7 @@ fn create_shadow_pipeline(
             cull_mode,
             ..wgpu::PrimitiveState::default()
         },
-        depth_stencil: Some(wgpu::DepthStencilState {
+        depth_stencil: (kind != ShadowKind::Opacity).then_some(wgpu::DepthStencilState {
             format: DEPTH_FORMAT,
             depth_write_enabled: Some(depth_write),
             depth_compare: Some(wgpu::CompareFunction::LessEqual),

@@ -139,7 +139,7 @@ fn fur_terms(tangent: vec3<f32>, normal: vec3<f32>, world_position: vec3<f32>, h
             let fade = clamp((cone - outer) / max(light.intensity_cos_inner.w - outer, 1e-4), 0.0, 1.0);
             irradiance *= fade * fade / d2;
         }
-        let visibility = light_visibility(i, world_position, normal);
+        let visibility = strand_visibility(i, world_position, normal);
         sum += fur_bsdf(tangent, to_camera, to_light, normal, wet) * (irradiance * visibility);
     }
     // The environment: irradiance / pi as the scattered fill (a white strand under a uniform

@@ -444,7 +444,7 @@ fn kajiya_kay_terms(tangent: vec3<f32>, normal: vec3<f32>, world_position: vec3<
     let diffuse = sqrt(max(1.0 - t_dot_l * t_dot_l, 0.0));
     // The key light's shadow at the vertex: the fur's transmittance is smooth, and a shell
     // fragment then pays for no lookup.
-    let lit_side = smoothstep(-0.25, 0.6, dot(normal, to_light)) * light_visibility(0u, world_position, normal);
+    let lit_side = smoothstep(-0.25, 0.6, dot(normal, to_light)) * strand_visibility(0u, world_position, normal);
     return vec4<f32>(diffuse, max(1.0 - t_dot_h * t_dot_h, 0.0), lit_side, occlusion(height));
 }
 
