@@ -93,7 +93,8 @@ fn light_visibility(light_index: u32, world_position: vec3<f32>, world_normal: v
 
 // The same for a strand's vertex (shells and fins): one filtered tap of the opaque map, as a
 // strand vertex's light is interpolated over its triangle anyway (four taps cost a software
-// rasteriser about 4 ms of the bunny's 256x256 frame).
+// rasteriser about 4 ms of the bunny's 256x256 frame). Its own copy of the projection, not a
+// helper shared with `light_visibility`: lavapipe (Mesa 22.3) crashed drawing with that helper.
 fn strand_visibility(light_index: u32, world_position: vec3<f32>, world_normal: vec3<f32>) -> f32 {
     if !SHADOWS || light_index != 0u {
         return 1.0;
