@@ -124,3 +124,72 @@ fn bad_instances_name_the_file_and_key() {
     let error = Scene::from_toml_str(misspelt, Path::new("herd.toml")).unwrap_err().to_string();
     assert!(error.contains("heading"), "{error}");
 }
+
+/// A walking Fox in wind stepped at every `stride`-th step, with `params`, shown at frames of
+/// 90 per second: its positions at each frame.
+fn strided_walk(params: &SimParams, stride: u32, frames: u32) -> (Vec<Vec<Vec3>>, u64) {
+    let (structure, rig) = fox();
+    let scene = Scene::from_toml_str(WINDY, Path::new("herd.toml")).expect("scene");
+    let mut stepper = FurStepper::new(&structure, params).expect("stepper");
+    stepper.set_clip(rig, Some(0));
+    stepper.set_scene(Some(scene));
+    stepper.set_step_stride(stride);
+    let shown = (0..frames)
+        .map(|f| {
+            stepper.advance_to(f64::from(f) / 90.0).expect("step");
+            stepper.simulation().positions().to_vec()
+        })
+        .collect();
+    (shown, stepper.simulation().steps_taken())
+}
+
+/// Without inertia a step's state depends only on its time, so a fur stepped every second step
+/// shows the full rate's states, one full-rate step later (each shown state is the previous one
+/// at its step's time), and halfway between them halfway between two of them.
+#[test]
+fn a_far_member_stepped_every_second_step_shows_the_full_rates_states() {
+    let params = SimParams { inertia: 0.0, ..SimParams::default() };
+    // 90 frames a second at 30 steps a second: a full step every 3 frames, a strided one every 6.
+    let (full, full_steps) = strided_walk(&params, 1, 60);
+    let (strided, strided_steps) = strided_walk(&params, 2, 60);
+    assert!(strided_steps * 10 < full_steps * 6, "steps taken: {strided_steps} strided, {full_steps} full");
+    // Frame 6m shows state 2m - 2 (strided) and frame 6m - 3 shows it too (full rate).
+    for m in 2..10 {
+        assert_eq!(strided[6 * m], full[6 * m - 3], "frame {}: the strided state", 6 * m);
+        // Frame 6m + 3 is halfway from state 2m - 2 to 2m.
+        for (k, p) in strided[6 * m + 3].iter().enumerate() {
+            let halfway = 0.5 * (full[6 * m - 3][k] + full[6 * m + 3][k]);
+            assert!(p.distance(halfway) < 1e-3, "frame {} node {k}: {p} against {halfway}", 6 * m + 3);
+        }
+    }
+}
+
+/// Strides changed while the Fox walks with inertia: every position finite, and every root
+/// segment its rest length in the states shown whole (frames on a step of every stride; between
+/// them the interpolation shortens strands a little, as at the full rate).
+#[test]
+fn changing_a_members_stride_keeps_its_strands_whole() {
+    let (structure, rig) = fox();
+    let scene = Scene::from_toml_str(WINDY, Path::new("herd.toml")).expect("scene");
+    let mut stepper = FurStepper::new(&structure, &SimParams::default()).expect("stepper");
+    stepper.set_clip(rig, Some(0));
+    stepper.set_scene(Some(scene));
+    let v = structure.mesh.vertex_count();
+    for f in 0..120u32 {
+        stepper.set_step_stride([1, 4, 2, 1][(f / 30) as usize]);
+        stepper.advance_to(f64::from(f) / 30.0).expect("step");
+        let positions = stepper.simulation().positions();
+        assert!(positions.iter().all(|p| p.is_finite()), "frame {f}: a position is not finite");
+        if f % 4 != 0 {
+            continue;
+        }
+        for j in (0..v).step_by(7) {
+            let rest = structure.positions[v + j].distance(structure.positions[j]);
+            let shown = positions[v + j].distance(positions[j]);
+            assert!(
+                (shown - rest).abs() < 1e-3 * rest.max(1e-3) + 1e-4,
+                "frame {f} vertex {j}: {shown} against {rest}"
+            );
+        }
+    }
+}

@@ -51,6 +51,21 @@ impl FurLevel {
         Self { stride, blend, facing, coat }
     }
 
+    /// How often a fur drawn at this level needs its simulation stepped
+    /// (`FurStepper::set_step_stride`): every step while it draws every shell or every second
+    /// one, every second step from every fourth shell on, every fourth once its coat fades
+    /// (strands shorter than a pixel, whose motion spans less). Hosts of herds use it.
+    #[must_use]
+    pub fn step_stride(self) -> u32 {
+        if self.coat < 1.0 {
+            4
+        } else if self.stride >= 4 {
+            2
+        } else {
+            1
+        }
+    }
+
     /// Shells drawn at this level for a fur of `layers` layers (also its fin segments).
     #[must_use]
     pub fn shells(self, layers: u32) -> u32 {
@@ -353,5 +368,18 @@ mod tests {
         assert_eq!(prepared.shell_layers(12).collect::<Vec<_>>(), [4, 8, 12]);
         prepared.set(FurLevel { stride: 4, blend: 0.0, facing: None, coat: 1.0 }, 10);
         assert_eq!(prepared.shell_layers(10).collect::<Vec<_>>(), [6, 10]);
+    }
+
+    #[test]
+    fn far_furs_are_stepped_less_often() {
+        let lod = LodSettings::default();
+        // Near: every step; strands a few pixels long: every second; a fading coat: every fourth.
+        assert_eq!(lod.level(16, 40.0).step_stride(), 1);
+        assert_eq!(lod.level(16, 8.0).step_stride(), 1);
+        assert_eq!(lod.level(16, 2.0).step_stride(), 2);
+        assert_eq!(lod.level(16, 0.4).step_stride(), 4);
+        // The stride never falls as the fur shrinks.
+        let strides: Vec<u32> = (0..200).map(|k| lod.level(16, 40.0 * 0.97f32.powi(k)).step_stride()).collect();
+        assert!(strides.windows(2).all(|w| w[0] <= w[1]), "{strides:?}");
     }
 }

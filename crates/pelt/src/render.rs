@@ -323,10 +323,15 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         if instances.is_empty() {
             drivers[0].advance_to(device, queue, &mut steppers[0], time_secs)?;
         } else {
+            // Far members are stepped less often (their level's stride), interpolated between.
+            let levels: Vec<_> = (0..members).map(|member| level_at(member, time_secs)).collect();
+            for (stepper, level) in steppers.iter_mut().zip(&levels) {
+                stepper.set_step_stride(level.step_stride());
+            }
             FurStepper::advance_herd(&mut steppers, &instances, time_secs)?;
-            for (member, (driver, stepper)) in drivers.iter_mut().zip(&steppers).enumerate() {
+            for ((driver, stepper), level) in drivers.iter_mut().zip(&steppers).zip(levels) {
                 show_stepped(queue, driver, stepper)?;
-                driver.set_level(level_at(member, time_secs));
+                driver.set_level(level);
             }
         }
         simulation_time += sim_started.elapsed();
@@ -418,7 +423,13 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let herd = if instances.is_empty() {
         String::new()
     } else {
-        format!("a herd of {members} ({out_of_view} out of view in the last frame), ")
+        let stride = |k: u32| steppers.iter().filter(|s| s.simulation().step_stride() == k).count();
+        format!(
+            "a herd of {members} ({out_of_view} out of view, {} stepped every second step and {} every fourth in the \
+             last frame), ",
+            stride(2),
+            stride(4)
+        )
     };
     println!(
         "{}: {frames} frame{} of {width}x{height}, {herd}{} shell layers on {} triangles (level of detail: {}); mean frame {:.1} ms \

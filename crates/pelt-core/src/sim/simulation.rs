@@ -137,6 +137,8 @@ pub struct Simulation {
     /// Layer-major `lerp(previous, current, alpha)` for the last render time.
     output: Vec<Vec3>,
     step_index: i64,
+    /// Fixed steps between the ones taken (1 = every step; `set_step_stride`).
+    step_stride: u32,
     time_secs: f64,
     alpha: f32,
     last_step_secs: f64,
@@ -244,6 +246,7 @@ impl Simulation {
             current: vec![[[0.0; LANES]; 3]; batch_nodes],
             output: vec![Vec3::ZERO; nodes],
             step_index: 0,
+            step_stride: 1,
             time_secs: 0.0,
             alpha: 0.0,
             last_step_secs: 0.0,
@@ -764,10 +767,11 @@ impl Simulation {
         }
         self.time_secs = time_secs;
         if self.params.interpolate {
+            let stride = i64::from(self.step_stride);
             let steps = time_secs * f64::from(self.params.rate_hz);
-            let index = steps.floor() as i64;
+            let index = self.step_index_at(time_secs);
             if index != self.step_index {
-                if index.checked_sub(1) == Some(self.step_index) {
+                if index.checked_sub(stride) == Some(self.step_index) {
                     std::mem::swap(&mut self.previous, &mut self.current);
                     self.step_into_current(index as f64 / f64::from(self.params.rate_hz));
                     self.step_index = index;
@@ -775,7 +779,7 @@ impl Simulation {
                     self.jump_to_step(index);
                 }
             }
-            self.alpha = (steps - index as f64).clamp(0.0, 1.0) as f32;
+            self.alpha = ((steps - index as f64) / stride as f64).clamp(0.0, 1.0) as f32;
         } else {
             std::mem::swap(&mut self.previous, &mut self.current);
             self.step_into_current(time_secs);
@@ -886,6 +890,40 @@ impl Simulation {
     #[must_use]
     pub fn last_step_secs(&self) -> f64 {
         self.last_step_secs
+    }
+
+    /// Takes every `stride`-th fixed step only (1, 2 or 4; others are rounded down to one of
+    /// them), the frames between interpolated as ever: a host steps a fur far from the camera
+    /// less often, where its strands' motion spans less than a pixel. With inertia the swing
+    /// follows the longer steps; without it a step's state depends only on its time, so the
+    /// states taken equal the full rate's. Takes effect at the next step.
+    pub fn set_step_stride(&mut self, stride: u32) {
+        self.step_stride = match stride {
+            0..=1 => 1,
+            2..=3 => 2,
+            _ => 4,
+        };
+    }
+
+    /// Whether [`Simulation::advance_to`] at `time_secs` takes a step (else it only
+    /// interpolates): a host can skip posing a base that no step reads.
+    #[must_use]
+    pub fn steps_at(&self, time_secs: f64) -> bool {
+        !self.params.interpolate || !time_secs.is_finite() || self.step_index_at(time_secs) != self.step_index
+    }
+
+    /// The last step at or before `time_secs`, numbered at the full rate; a stride of k takes
+    /// every k-th of them.
+    fn step_index_at(&self, time_secs: f64) -> i64 {
+        let stride = i64::from(self.step_stride);
+        let steps = time_secs * f64::from(self.params.rate_hz);
+        (steps / stride as f64).floor() as i64 * stride
+    }
+
+    /// The stride [`Simulation::set_step_stride`] set.
+    #[must_use]
+    pub fn step_stride(&self) -> u32 {
+        self.step_stride
     }
 
     /// Steps run since construction.
@@ -1018,7 +1056,7 @@ impl Simulation {
         // The inertia sees the two steps' times: a short skip forward keeps the swing going (the
         // acceleration is taken over the uneven steps), a jump back or far ahead starts it over.
         let rate = f64::from(self.params.rate_hz);
-        self.step_into_current((index as f64 - 1.0) / rate);
+        self.step_into_current((index as f64 - f64::from(self.step_stride)) / rate);
         std::mem::swap(&mut self.previous, &mut self.current);
         self.step_into_current(index as f64 / rate);
         self.step_index = index;

@@ -125,6 +125,12 @@ impl FurStepper {
             .try_for_each(|(stepper, instance)| stepper.advance_with_clip_at(time_secs, instance.clip_time(time_secs)))
     }
 
+    /// Steps this fur every `stride`-th fixed step (1, 2 or 4), interpolated between:
+    /// [`Simulation::set_step_stride`]. A herd's host steps its far members less often.
+    pub fn set_step_stride(&mut self, stride: u32) {
+        self.simulation.set_step_stride(stride);
+    }
+
     /// Makes `mesh` (skinned by `rig`, whose clips are the fur rig's) collide with the fur: every
     /// step its [`BodyCapsules`] are posed with the fur's clip and the script's motion and handed
     /// to the simulation as capsule colliders, beside any the script places. `None` removes it.
@@ -213,7 +219,13 @@ impl FurStepper {
         self.moved = std::mem::take(&mut self.host_posed);
         // A rig poses once after a change of clip even when nothing plays (back to its rest).
         let rig_jumps = matches!(self.posing, Posing::Rig { .. }) && self.restart_pending;
-        if self.moves() || rig_jumps {
+        // A fur stepped less often is posed only for its steps: between them nothing reads
+        // the pose (the skin shows the interpolated roots; its normals stay the last step's).
+        let between_steps = self.simulation.step_stride() > 1
+            && !self.restart_pending
+            && !self.moved
+            && !self.simulation.steps_at(time_secs);
+        if (self.moves() || rig_jumps) && !between_steps {
             match &self.posing {
                 Posing::Rig { rig, clip } => {
                     rig.pose(&self.mesh, *clip, clip_time_secs, &mut self.pose);
