@@ -121,7 +121,8 @@ fn play_walk(
     }
 }
 
-/// Fur on every skinned mesh the scenes spawn: one mesh and one preset, so one shared asset.
+/// Fur on every skinned mesh the scenes spawn: one mesh and one preset, so one shared asset;
+/// every third Fox a shade darker, every fifth greyer (`Fur::with_tint`).
 fn grow_fur(
     mut commands: Commands,
     skinned: Query<Entity, Added<SkinnedMesh>>,
@@ -129,8 +130,13 @@ fn grow_fur(
     assets: Res<AssetServer>,
 ) {
     let preset = assets.load(args.preset.clone());
-    for entity in &skinned {
-        commands.entity(entity).insert(Fur::new(preset.clone()).without_skin());
+    for (k, entity) in skinned.iter().enumerate() {
+        let tint = match (k % 3, k % 5) {
+            (_, 0) => Vec3::new(0.8, 0.8, 0.9),
+            (0, _) => Vec3::splat(0.65),
+            _ => Vec3::ONE,
+        };
+        commands.entity(entity).insert(Fur::new(preset.clone()).without_skin().with_tint(tint));
     }
 }
 

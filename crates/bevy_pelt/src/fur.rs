@@ -43,13 +43,22 @@ pub struct Fur {
     /// Draw Pelt's opaque skin (layer 0, coloured like the roots) under the fur. Turn it off when
     /// the entity's own material draws the surface.
     pub skin: bool,
+    /// Multiplies this entity's coat colour (linear RGB; white keeps the preset's): one animal of
+    /// a herd in its own colour, its structure and textures still shared.
+    pub tint: Vec3,
 }
 
 impl Fur {
     /// Fur from `preset`, with Pelt's skin under it.
     #[must_use]
     pub fn new(preset: Handle<FurPreset>) -> Self {
-        Self { preset, skin: true }
+        Self { preset, skin: true, tint: Vec3::ONE }
+    }
+
+    /// The same fur with its colour multiplied by `tint`.
+    #[must_use]
+    pub fn with_tint(self, tint: Vec3) -> Self {
+        Self { tint, ..self }
     }
 
     /// The same fur over the entity's own material (no Pelt skin).

@@ -110,6 +110,7 @@ pub(crate) struct ExtractedFur {
     wetness: Option<Arc<Vec<f32>>>,
     wet: WetParams,
     shading: FurShading,
+    tint: glam::Vec3,
 }
 
 pub(crate) fn extract_furs(
@@ -185,6 +186,7 @@ pub(crate) fn extract_furs(
             wetness: state.wetness.clone(),
             wet: state.wet.clone(),
             shading: FurShading::from_params(&state.shading),
+            tint: glam::Vec3::from_array(fur.tint.to_array()),
         });
     }
 }
@@ -445,7 +447,7 @@ pub(crate) fn prepare_furs(
             }
             let Some(entry) = gpu.furs.get_mut(&key) else { continue };
             entry.fur.set_world_from_model(fur.world_from_simulation);
-            entry.fur.set_look(FurLook { shading: fur.shading, ..FurLook::default() });
+            entry.fur.set_look(FurLook { shading: fur.shading, tint: fur.tint, ..FurLook::default() });
             if let Err(problem) = entry.fur.show_wet(queue, fur.wetness.as_deref().map(Vec::as_slice), &fur.wet) {
                 error!("Pelt cannot show the wetness of {}: {problem}", fur.entity);
             }

@@ -1,7 +1,7 @@
 //! A herd in Bevy: a hundred entities of one mesh and preset grow one structure and upload one
 //! GPU asset, each drawn where it stands; one far outside the camera's view is not drawn;
-//! despawning one leaves the others drawn and the asset shared (`FurGpuStats`, copied out of the
-//! render world each frame).
+//! despawning one leaves the others drawn and the asset shared, and tinting one colours it alone
+//! (`FurGpuStats`, copied out of the render world each frame).
 
 use std::sync::{Arc, Mutex};
 
@@ -90,4 +90,17 @@ fn a_hundred_entities_of_one_mesh_and_preset_share_one_asset() {
     // One cube of a hundred (with its fur and what the light leaves round it) changes, no more.
     assert!(changed > total / 400, "{changed} pixels changed: the despawned fur was still drawn");
     assert!(changed < total / 25, "{changed} pixels changed: more than the despawned fur went");
+    // One animal in its own colour: the same asset, and only its pixels turn toward blue.
+    app.world_mut().get_mut::<Fur>(entities[0]).unwrap().tint = Vec3::new(0.2, 0.4, 1.0);
+    for _ in 0..3 {
+        update(&mut app);
+    }
+    assert_eq!(*copy.0.lock().unwrap(), (HERD, 1, HERD - 1));
+    let tinted = capture_now(&mut app, &target);
+    crate::render::save(&tinted, "herd_tinted");
+    let blueness = |p: &[u8]| i32::from(p[2]) - i32::from(p[0]);
+    let bluer = after.pixels().zip(tinted.pixels()).filter(|(a, b)| blueness(&b.0) > blueness(&a.0) + 16).count();
+    let moved = after.pixels().zip(tinted.pixels()).filter(|(a, b)| a.0 != b.0).count();
+    assert!(bluer > total / 400, "{bluer} pixels turned bluer: the tint did not reach the fur");
+    assert!(moved < total / 25, "{moved} pixels changed: the tint reached more than one fur");
 }

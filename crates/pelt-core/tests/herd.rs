@@ -123,6 +123,41 @@ fn bad_instances_name_the_file_and_key() {
     let misspelt = "[[instance]]\nposition = [0.0, 0.0, 0.0]\nheading = 3.0\n";
     let error = Scene::from_toml_str(misspelt, Path::new("herd.toml")).unwrap_err().to_string();
     assert!(error.contains("heading"), "{error}");
+    for (line, key) in [
+        ("tint = [1.0, nan, 1.0]", "instance[0].tint"),
+        ("tint = [1.0, -0.5, 1.0]", "instance[0].tint"),
+        ("length_scale = 0.0", "instance[0].length_scale"),
+        ("length_scale = 50.0", "instance[0].length_scale"),
+    ] {
+        let bad = format!("[[instance]]\nposition = [0.0, 0.0, 0.0]\n{line}\n");
+        let error = Scene::from_toml_str(&bad, Path::new("herd.toml")).unwrap_err().to_string();
+        assert!(error.contains("herd.toml") && error.contains(key), "{line}: {error}");
+    }
+}
+
+/// A member's `length_scale` grows its strands that much longer from the same roots, along the
+/// same strands: every segment scaled, the topology and roots kept.
+#[test]
+fn a_members_length_scale_lengthens_every_segment_from_its_root() {
+    let (structure, _) = fox();
+    let scaled = structure.with_length_scale(1.5);
+    let v = structure.mesh.vertex_count();
+    assert_eq!(scaled.positions.len(), structure.positions.len());
+    assert_eq!(&scaled.positions[..v], &structure.positions[..v], "the roots stay");
+    for (k, (a, b)) in structure.positions.iter().zip(&scaled.positions).enumerate().skip(v) {
+        let (below, below_scaled) = (structure.positions[k - v], scaled.positions[k - v]);
+        let (segment, segment_scaled) = (*a - below, *b - below_scaled);
+        assert!((segment_scaled - 1.5 * segment).length() <= 1e-4 * segment.length().max(1.0), "node {k}");
+    }
+    assert!(structure.lengths.iter().zip(&scaled.lengths).all(|(a, b)| (b - 1.5 * a).abs() <= 1e-5 * a.max(1.0)));
+    // A member stepped with it keeps its longer strands.
+    let mut stepper = FurStepper::new(&scaled, &SimParams::default()).expect("stepper");
+    stepper.advance_to(0.5).expect("step");
+    let shown = stepper.simulation().positions();
+    for j in (0..v).step_by(11) {
+        let rest = scaled.positions[v + j].distance(scaled.positions[j]);
+        assert!((shown[v + j].distance(shown[j]) - rest).abs() < 1e-3 * rest, "vertex {j}");
+    }
 }
 
 /// A walking Fox in wind stepped at every `stride`-th step, with `params`, shown at frames of

@@ -223,6 +223,8 @@ impl GpuFur {
         } else {
             self.asset.textures.coat_colour(frame.look.root_occlusion).lerp(self.asset.textures.root_colour, coat)
         };
+        let tint = frame.look.tint;
+        let skin = if tint.is_finite() { skin * tint.max(Vec3::ZERO) } else { skin };
         self.geometry.write_uniform(queue, &self.geometry.shape.uniform(&frame, skin, textures));
         self.level.set(frame.level, self.geometry.shape.layers);
         self.wet.store(frame.wet, Ordering::Relaxed);

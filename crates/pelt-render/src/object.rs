@@ -37,6 +37,9 @@ pub struct FurLook {
     pub clump_strength: f32,
     /// The reflectance model and its parameters (`[shading]`).
     pub shading: FurShading,
+    /// Multiplies the coat's colour, strands and skin (linear RGB; white keeps the textures'):
+    /// one member of a herd in its own colour on the shared textures.
+    pub tint: Vec3,
 }
 
 /// The reflectance model a fur is lit with and the fur model's parameters (`[shading]`).
@@ -104,6 +107,7 @@ impl Default for FurLook {
             clump_size: 12.0,
             clump_strength: 0.8,
             shading: FurShading::default(),
+            tint: Vec3::ONE,
         }
     }
 }
@@ -271,6 +275,8 @@ impl ObjectShape {
             fur_medulla: look.shading.medulla.clamp(0.0, 1.0),
             coat_fade: level.coat,
             _padding_2: [0; 1],
+            tint: if look.tint.is_finite() { look.tint.max(Vec3::ZERO) } else { Vec3::ONE },
+            _padding_3: 0.0,
         }
     }
 }

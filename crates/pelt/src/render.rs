@@ -12,8 +12,8 @@ use pelt_core::sim::herd::{self, HerdInstance};
 use pelt_core::sim::{FurStepper, Scene, SceneCamera, WindParams};
 use pelt_core::{Builtin, FurStructure, Mesh, Preset, Stage};
 use pelt_render::{
-    Backend, Camera, ColliderMeshes, FurAsset, FurDrawSettings, FurDriver, FurTarget, FurView, Gpu, HEADLESS_FORMAT,
-    Headless, KernelChoice, PlainMesh, SAMPLE_COUNT, default_sample_count,
+    Backend, Camera, ColliderMeshes, FurAsset, FurDrawSettings, FurDriver, FurLook, FurTarget, FurView, Gpu,
+    HEADLESS_FORMAT, Headless, KernelChoice, PlainMesh, SAMPLE_COUNT, default_sample_count,
 };
 
 use crate::light_args::{LightArgs, preset_look};
@@ -217,10 +217,17 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         let file = args.script.as_deref().map_or_else(|| "--herd".to_owned(), |p| p.display().to_string());
         anyhow::anyhow!("{file}: {key}: {problem}")
     })?;
+    // A member with its own length scale grows its own strands on the shared topology.
+    let member_furs: Vec<std::borrow::Cow<'_, FurStructure>> = (0..members)
+        .map(|member| match instances.get(member).map(|i| i.length_scale) {
+            Some(scale) if scale != 1.0 => std::borrow::Cow::Owned(fur.with_length_scale(scale)),
+            _ => std::borrow::Cow::Borrowed(&fur),
+        })
+        .collect();
     let mut steppers = Vec::with_capacity(members);
     for member in 0..members {
         // The wind is set after the state at time 0 is made, as a host changing it live would.
-        let mut stepper = FurStepper::new(&fur, &preset.simulation)?;
+        let mut stepper = FurStepper::new(&member_furs[member], &preset.simulation)?;
         stepper.simulation_mut().set_wind(&simulation_params.wind)?;
         stepper.set_wet(&wet_params(&preset, args.wetness))?;
         let clip = clips.get(member).copied().unwrap_or(clip);
@@ -256,8 +263,9 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let mut view = FurView::new(device, &renderer);
     let view_data = studio.view_data(&camera, headless.aspect_ratio());
     view.prepare(queue, &view_data);
-    for driver in &mut drivers {
-        driver.set_look(preset_look(&preset));
+    for (member, driver) in drivers.iter_mut().enumerate() {
+        let tint = instances.get(member).map_or(Vec3::ONE, |i| i.tint);
+        driver.set_look(FurLook { tint, ..preset_look(&preset) });
     }
     // A herd stands on a ground (under all of it, wherever it walks) unless the script has one.
     let scene_ground = stepper.scene().and_then(|s| s.ground.as_ref());
@@ -274,7 +282,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         let eye = instances
             .get(member)
             .map_or(camera.eye, |i| i.world_from_model(time_secs).inverse().transform_point3(camera.eye));
-        lod::level(&lod_settings, &fur, eye, camera.fov_y_rad, height)
+        lod::level(&lod_settings, &member_furs[member], eye, camera.fov_y_rad, height)
     };
     for (member, driver) in drivers.iter_mut().enumerate() {
         driver.set_level(level_at(member, 0.0));

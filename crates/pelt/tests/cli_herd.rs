@@ -27,6 +27,11 @@ fn fox() -> String {
 /// Two Foxes side by side facing the camera's right, the second `offset` seconds into its walk;
 /// a fixed camera, the sun straight above (their shadows stay under them), no wind.
 fn two_foxes(dir: &Path, name: &str, offset: f32) -> image::RgbaImage {
+    two_foxes_with(dir, name, offset, "")
+}
+
+/// [`two_foxes`] with `extra` lines in the second Fox's `[[instance]]`.
+fn two_foxes_with(dir: &Path, name: &str, offset: f32, extra: &str) -> image::RgbaImage {
     let script = dir.join(format!("{name}.toml"));
     std::fs::write(
         &script,
@@ -34,7 +39,7 @@ fn two_foxes(dir: &Path, name: &str, offset: f32) -> image::RgbaImage {
             "[camera]\ntarget = [0.0, 40.0, 0.0]\nazimuth_deg = 0.0\nelevation_deg = 10.0\ndistance = 700.0\n\n\
              [[light]]\nkind = \"directional\"\nazimuth_deg = 0.0\nelevation_deg = 89.0\nlux = 1.0\n\n\
              [[instance]]\nposition = [-150.0, 0.0, 0.0]\nheading_deg = 90.0\nclip = \"Walk\"\n\n\
-             [[instance]]\nposition = [150.0, 0.0, 0.0]\nheading_deg = 90.0\nclip = \"Walk\"\ntime_offset_secs = {offset}\n"
+             [[instance]]\nposition = [150.0, 0.0, 0.0]\nheading_deg = 90.0\nclip = \"Walk\"\ntime_offset_secs = {offset}\n{extra}"
         ),
     )
     .expect("script");
@@ -132,4 +137,32 @@ fn bad_herds_are_clear_errors() {
     assert!(!dir.join("x.png").exists(), "nothing drawn");
     let output = pelt(&["render", &fox(), "--script", "gallop.toml", "--herd", "3", "-o", "x.png"], &dir);
     assert!(!output.status.success() && text(&output).contains("use one of them"), "{}", text(&output));
+}
+
+/// Sums `value` of each pixel in `columns`.
+fn sum_over(image: &image::RgbaImage, columns: std::ops::Range<u32>, value: impl Fn([u8; 4]) -> i64) -> i64 {
+    columns.flat_map(|x| (0..image.height()).map(move |y| (x, y))).map(|(x, y)| value(image.get_pixel(x, y).0)).sum()
+}
+
+/// A member's `tint` colours its coat alone, and its `length_scale` makes its coat larger on
+/// screen; the other Fox stays as it was.
+#[test]
+fn a_members_tint_and_length_scale_reach_its_coat_only() {
+    let dir = temp_dir("tint");
+    let plain = two_foxes(&dir, "plain", 0.0);
+    let blue = two_foxes_with(&dir, "blue", 0.0, "tint = [0.3, 0.5, 1.0]\n");
+    let long = two_foxes_with(&dir, "long", 0.0, "length_scale = 2.0\n");
+    for (name, image) in [("blue", &blue), ("long", &long)] {
+        let moved = differing(&plain, image, 0..100);
+        assert!(moved < 10, "{name}: {moved} pixels of the left Fox moved");
+    }
+    // Blue over red on the right Fox's pixels: the orange coat turns toward blue.
+    let blueness = |image: &image::RgbaImage| sum_over(image, 100..200, |p| i64::from(p[2]) - i64::from(p[0]));
+    let (before, after) = (blueness(&plain), blueness(&blue));
+    assert!(after > before + 2_000, "blue minus red on the right: {before} plain, {after} tinted");
+    // The coat's pixels (red well above blue: neither the grey ground nor the sky).
+    let coat =
+        |image: &image::RgbaImage, columns| sum_over(image, columns, |p| i64::from(p[0] > p[2].saturating_add(25)));
+    let (short, longer) = (coat(&plain, 100..200), coat(&long, 100..200));
+    assert!(longer as f64 > 1.07 * short as f64, "coat pixels on the right: {short} plain, {longer} twice as long");
 }

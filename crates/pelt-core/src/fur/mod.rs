@@ -216,6 +216,23 @@ impl FurStructure {
         Ok(Self { mesh, layers, directions, lengths, positions, groom })
     }
 
+    /// The same fur with every strand `scale` times as long: each layer's node moved along its
+    /// strand from the root, the roots, directions and topology kept (a herd member's
+    /// `length_scale`; the shells, fins and textures stay shared).
+    #[must_use]
+    pub fn with_length_scale(&self, scale: f32) -> Self {
+        let v = self.vertex_count();
+        let mut scaled = self.clone();
+        for (k, p) in scaled.positions.iter_mut().enumerate().skip(v) {
+            let root = self.positions[k % v];
+            *p = root + (*p - root) * scale;
+        }
+        for length in &mut scaled.lengths {
+            *length *= scale;
+        }
+        scaled
+    }
+
     /// Whether base triangle `t` gets shell faces: not when all three of its vertices are bald
     /// (so the fur tapers to nothing across the triangles around a bald patch). Always without
     /// a groom.

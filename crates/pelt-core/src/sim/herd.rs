@@ -8,6 +8,8 @@
 //! speed = 30.0                     # optional (default 0): world units a second, straight ahead
 //! clip = "Walk"                    # optional: the animation it plays (default: the host's)
 //! time_offset_secs = 0.4           # optional (default 0): how far into its clip it starts
+//! tint = [1.0, 0.8, 0.6]           # optional (default white): multiplies its coat's colour
+//! length_scale = 1.2               # optional (default 1): its strands this much longer
 //! ```
 //!
 //! Each instance is simulated in the world with its own [`FurStepper`](super::FurStepper)
@@ -37,13 +39,38 @@ pub struct HerdInstance {
     /// Seconds into its clip at time 0.
     #[serde(default)]
     pub time_offset_secs: f64,
+    /// Multiplies its coat's colour (linear RGB; white keeps the textures').
+    #[serde(default = "white")]
+    pub tint: Vec3,
+    /// Its strands' lengths over the fur's ([`FurStructure::with_length_scale`](crate::FurStructure::with_length_scale)).
+    #[serde(default = "one")]
+    pub length_scale: f32,
 }
+
+fn white() -> Vec3 {
+    Vec3::ONE
+}
+
+fn one() -> f32 {
+    1.0
+}
+
+/// The largest [`HerdInstance::length_scale`]: a coat grown ten times longer is another preset.
+pub const MAX_LENGTH_SCALE: f32 = 10.0;
 
 impl HerdInstance {
     /// Standing at `position`, heading along +Z, the host's clip from its start.
     #[must_use]
     pub fn at(position: Vec3) -> Self {
-        Self { position, heading_deg: 0.0, speed: 0.0, clip: None, time_offset_secs: 0.0 }
+        Self {
+            position,
+            heading_deg: 0.0,
+            speed: 0.0,
+            clip: None,
+            time_offset_secs: 0.0,
+            tint: Vec3::ONE,
+            length_scale: 1.0,
+        }
     }
 
     /// Its model-to-world transform at `time_secs`: turned by its heading, carried ahead at its
@@ -88,6 +115,18 @@ pub fn validate(instances: &[HerdInstance]) -> Result<(), (String, String)> {
             return Err((
                 key("time_offset_secs"),
                 format!("must be finite and at least 0, got {}", instance.time_offset_secs),
+            ));
+        }
+        if !(instance.tint.is_finite() && instance.tint.min_element() >= 0.0) {
+            return Err((key("tint"), format!("must be three finite numbers of at least 0, got {}", instance.tint)));
+        }
+        if !(instance.length_scale.is_finite()
+            && instance.length_scale > 0.0
+            && instance.length_scale <= MAX_LENGTH_SCALE)
+        {
+            return Err((
+                key("length_scale"),
+                format!("must be above 0 and at most {MAX_LENGTH_SCALE}, got {}", instance.length_scale),
             ));
         }
         if instance.clip.as_deref() == Some("") {
@@ -154,11 +193,9 @@ pub fn scatter(count: usize, spacing: f32, phase_secs: f64, seed: u64) -> Result
                 (row as f32 - 0.5 * (rows - 1) as f32) * spacing,
             );
             HerdInstance {
-                position: grid + jitter,
                 heading_deg: 90.0 + 50.0 * (unit(k, 2) - 0.5),
-                speed: 0.0,
-                clip: None,
                 time_offset_secs: f64::from(unit(k, 3)) * phase_secs.max(0.0),
+                ..HerdInstance::at(grid + jitter)
             }
         })
         .collect())

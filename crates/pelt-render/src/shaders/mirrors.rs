@@ -61,8 +61,11 @@ pub(crate) struct ObjectUniform {
     pub fur_cuticle_tilt: f32,
     pub fur_medulla: f32,
     pub coat_fade: f32,
-    /// WGSL rounds the struct up to its 16-byte alignment.
+    /// WGSL aligns the vec3 below to 16 bytes.
     pub _padding_2: [u32; 1],
+    pub tint: Vec3,
+    /// WGSL rounds the struct up to its 16-byte alignment.
+    pub _padding_3: f32,
 }
 
 /// One light; the layout of `Light` in `fur_bsdf.wgsl`.
@@ -317,7 +320,9 @@ mod tests {
             fur_cuticle_tilt,
             fur_medulla,
             coat_fade,
-            _padding_2
+            _padding_2,
+            tint,
+            _padding_3
         });
         assert_mirrors(&unified_shader_source(), "Object", &rust);
     }

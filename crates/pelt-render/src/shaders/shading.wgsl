@@ -90,6 +90,8 @@ struct Object {
     fur_medulla: f32,
     // How much of the coat shows (`FurLevel::coat`): the shells' and fins' opacity.
     coat_fade: f32,
+    // Multiplies the strands' albedo (`FurLook::tint`; the skin's colour is tinted on the CPU).
+    tint: vec3<f32>,
 }
 
 // Set per pipeline: shells and fins with alpha-to-coverage output straight colour, blended ones
@@ -448,7 +450,8 @@ fn kajiya_kay_terms(tangent: vec3<f32>, normal: vec3<f32>, world_position: vec3<
     return vec4<f32>(diffuse, max(1.0 - t_dot_h * t_dot_h, 0.0), lit_side, occlusion(height));
 }
 
-fn hair_colour(albedo: vec3<f32>, terms: vec4<f32>, height: f32) -> vec3<f32> {
+fn hair_colour(texel_albedo: vec3<f32>, terms: vec4<f32>, height: f32) -> vec3<f32> {
+    let albedo = texel_albedo * object.tint;
     if fur_model() {
         return fur_colour(albedo, terms);
     }
