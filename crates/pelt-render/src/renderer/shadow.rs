@@ -124,15 +124,24 @@ impl FurRenderer {
     ) {
         let geometry = fur.geometry();
         let walk = usize::from(!geometry.shape.has_uvs);
-        pass.set_bind_group(0, view.bind_group(), &[]);
-        pass.set_bind_group(1, geometry.bind_group(), &[]);
-        pass.set_bind_group(2, fur.textures_bind_group(), &[]);
-        pass.set_bind_group(3, view.shadow_group(), &[]);
         let shells = fur.drawn_shells();
         let furred = geometry.shape.layers > 0
             && shells > 0
             && (settings.shells || settings.fins)
             && fur.prepared_level().coat_shown();
+        // Nothing to draw, nothing bound (a far herd's faded coats draw nothing into the fur's
+        // maps).
+        let draws = match shadow_pass {
+            ShadowPass::Opaque => settings.skin,
+            ShadowPass::FurDepth | ShadowPass::Opacity => furred,
+        };
+        if !draws {
+            return;
+        }
+        pass.set_bind_group(0, view.bind_group(), &[]);
+        pass.set_bind_group(1, geometry.bind_group(), &[]);
+        pass.set_bind_group(2, fur.textures_bind_group(), &[]);
+        pass.set_bind_group(3, view.shadow_group(), &[]);
         match shadow_pass {
             ShadowPass::Opaque if settings.skin => {
                 pass.set_pipeline(&self.shadow_depth().skin[walk]);
