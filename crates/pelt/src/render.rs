@@ -225,9 +225,9 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         })
         .collect();
     let mut steppers = Vec::with_capacity(members);
-    for member in 0..members {
+    for (member, member_fur) in member_furs.iter().enumerate() {
         // The wind is set after the state at time 0 is made, as a host changing it live would.
-        let mut stepper = FurStepper::new(&member_furs[member], &preset.simulation)?;
+        let mut stepper = FurStepper::new(member_fur, &preset.simulation)?;
         stepper.simulation_mut().set_wind(&simulation_params.wind)?;
         stepper.set_wet(&wet_params(&preset, args.wetness))?;
         let clip = clips.get(member).copied().unwrap_or(clip);
