@@ -35,12 +35,12 @@ struct Shadow {
 // every branch, taken or not).
 override SHADOWS: bool = false;
 
-// Light-space depth in world units from a depth-buffer value.
+// Light-space depth in world units from a depth-buffer value. A `select`, not an `if`: lavapipe
+// (Mesa 22.3) inlines uniforms that alone decide a branch and compiles the shader anew each time
+// their buffer is bound, which made every fur of a herd cost a shader compile a draw.
 fn shadow_linear_depth(z: f32) -> f32 {
-    if shadow.perspective > 0.5 {
-        return shadow.near * shadow.far / (shadow.far - z * (shadow.far - shadow.near));
-    }
-    return shadow.near + z * (shadow.far - shadow.near);
+    let perspective = shadow.near * shadow.far / (shadow.far - z * (shadow.far - shadow.near));
+    return select(shadow.near + z * (shadow.far - shadow.near), perspective, shadow.perspective > 0.5);
 }
 
 // The fur's opacity at `beyond` world units past its first surface: the four cumulative layers
