@@ -161,7 +161,7 @@ pub use shaders::{
 };
 #[cfg(feature = "lab")]
 pub use shaders::{separated_shader_source, strands_shader_source};
-pub use shadows::{ShadowCaster, ShadowMap, ShadowSettings};
+pub use shadows::{MAX_FITTED_SIZE, ShadowCaster, ShadowMap, ShadowSettings, fitted_shadow_size};
 pub use simulation::GpuSimulation;
 pub use studio::Studio;
 pub use surroundings::{GROUND_COLOUR, Surroundings};

@@ -86,8 +86,27 @@ impl ShadowSettings {
     /// Pelt's default map (512 texels a side) for fur `fur_length` long.
     #[must_use]
     pub fn for_fur(fur_length: f32) -> Self {
-        Self { size: 512, fur_depth: fur_length, extinction: 0.6 }
+        Self { size: MAX_FITTED_SIZE, fur_depth: fur_length, extinction: 0.6 }
     }
+
+    /// [`ShadowSettings::for_fur`] with the map fitted to a `width` x `height` picture
+    /// ([`fitted_shadow_size`]).
+    #[must_use]
+    pub fn for_frame(fur_length: f32, (width, height): (u32, u32)) -> Self {
+        Self { size: fitted_shadow_size(width, height), ..Self::for_fur(fur_length) }
+    }
+}
+
+/// The largest map [`fitted_shadow_size`] gives, and [`ShadowSettings::for_fur`]'s.
+pub const MAX_FITTED_SIZE: u32 = 512;
+
+/// The opaque map's side for a `width` x `height` picture: the picture's longer side rounded up
+/// to a power of two, 256 to [`MAX_FITTED_SIZE`]. Both frame the scene's bounds, so a shadow
+/// texel stays about a pixel, and a small picture does not pay for a large map's depth and
+/// opacity passes (most of a 256x256 frame's shadow cost on a software rasteriser).
+#[must_use]
+pub fn fitted_shadow_size(width: u32, height: u32) -> u32 {
+    width.max(height).max(1).next_power_of_two().clamp(256, MAX_FITTED_SIZE)
 }
 
 /// The key light's shadow maps: an opaque depth map, the fur's first surface and its opacity

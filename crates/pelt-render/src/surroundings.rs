@@ -20,6 +20,8 @@ pub const GROUND_COLOUR: Vec3 = Vec3::new(0.34, 0.32, 0.3);
 pub struct Surroundings {
     shadows: Option<ShadowMap>,
     ground: Option<PlainMesh>,
+    /// The fur's depth the shadow maps were made for (refitting keeps it).
+    fur_length: f32,
     /// Every caster lies within this sphere.
     bounds: (Vec3, f32),
 }
@@ -82,7 +84,28 @@ impl Surroundings {
         let shadows =
             shadows.then(|| ShadowMap::new(device, renderer, ShadowSettings::for_fur(fur_length))).transpose()?;
         // Room for the meshes to move a little (a script's motion, the wind).
-        Ok(Self { shadows, ground, bounds: (centre, 1.25 * radius) })
+        Ok(Self { shadows, ground, fur_length, bounds: (centre, 1.25 * radius) })
+    }
+
+    /// Fits the shadow maps (if any) to a `width` x `height` picture
+    /// ([`crate::fitted_shadow_size`]), making them anew only where their size changes. Call
+    /// it before [`Surroundings::prepare`] when the picture's size is known or changes.
+    ///
+    /// # Errors
+    /// The new maps' [`RenderError`].
+    pub fn fit_to_frame(
+        &mut self,
+        device: &wgpu::Device,
+        renderer: &FurRenderer,
+        (width, height): (u32, u32),
+    ) -> Result<(), RenderError> {
+        let settings = ShadowSettings::for_frame(self.fur_length, (width, height));
+        if let Some(map) = &mut self.shadows
+            && map.settings() != settings
+        {
+            *map = ShadowMap::new(device, renderer, settings)?;
+        }
+        Ok(())
     }
 
     /// Whether the key light casts shadows.

@@ -273,8 +273,9 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let shadow_args =
         crate::shadows::ShadowArgs { ground: args.shadows.ground || herd_ground.is_some(), ..args.shadows };
     let extent = herd_extent(&fur, &instances, f64::from(frames) / args.fps);
-    let surroundings =
+    let mut surroundings =
         shadow_args.surroundings_around((device, queue, &renderer), scene_ground, (&fur, &plain), extent.as_ref())?;
+    surroundings.fit_to_frame(device, &renderer, (width, height)).context("fitting the shadow maps to the picture")?;
     surroundings.prepare(queue, &view_data, &mut view);
     let lod_settings = lod::settings(&preset.render.lod, args.no_lod);
     // The camera stays put: one level serves every frame of one fur; a herd's members move.

@@ -164,7 +164,7 @@ impl Bench {
         let radius = radius + fur.lengths.iter().copied().fold(0.0, f32::max);
         // The shadowed case: the key light's maps as `pelt render --shadows` draws them.
         let plain: Vec<Mesh> = body_mesh.into_iter().cloned().collect();
-        let surroundings = shadows
+        let mut surroundings = shadows
             .then(|| Surroundings::new(device, queue, &renderer, true, None, (fur, &plain)))
             .transpose()
             .context("making the shadow maps")?;
@@ -182,7 +182,8 @@ impl Bench {
             let output_view = output.create_view(&Default::default());
             let camera = Camera::framing(centre, radius, 35.0, 20.0, targets.aspect_ratio());
             let view_data = self.studio.view_data(&camera, targets.aspect_ratio());
-            if let Some(surroundings) = &surroundings {
+            if let Some(surroundings) = &mut surroundings {
+                surroundings.fit_to_frame(device, &renderer, (width, height))?;
                 surroundings.prepare(queue, &view_data, &mut shadowed_view);
             }
             // Every structure draws the same scene the same way: the view written, the body
