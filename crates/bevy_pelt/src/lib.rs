@@ -38,7 +38,9 @@
 //!   MSAA, so fur and Bevy's geometry occlude each other. Fur is lit by the scene's first
 //!   `DirectionalLight` (its direction and colour, its illuminance times the camera's exposure
 //!   over pi, as Bevy lights a white diffuse surface facing it), or by [`FurLight`]'s light when
-//!   there is none; [`FurLight`]'s ambient applies either way.
+//!   there is none; Bevy's ambient light (the camera's `AmbientLight`, else the
+//!   `GlobalAmbientLight`) is the fur's ambient, [`FurLight`]'s only where the render world has
+//!   neither.
 //! - Fur casts into Bevy's shadow maps (directional cascades, point and spot lights) unless its
 //!   entity has `NotShadowCaster`, and on a camera with `DepthPrepass` (and
 //!   `MotionVectorPrepass`, as TAA and motion blur need) writes its depth (and motion vectors)

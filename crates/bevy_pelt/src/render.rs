@@ -7,7 +7,7 @@ use std::sync::Arc;
 
 use bevy::camera::{Camera3d, CompositingSpace, Exposure};
 use bevy::ecs::prelude::*;
-use bevy::light::{DirectionalLight, NotShadowCaster, PointLight, SpotLight};
+use bevy::light::{AmbientLight, DirectionalLight, GlobalAmbientLight, NotShadowCaster, PointLight, SpotLight};
 use bevy::log::error;
 use bevy::prelude::{Color, GlobalTransform, InheritedVisibility};
 use bevy::render::Extract;
@@ -28,16 +28,18 @@ use crate::convert::{to_pelt, to_pelt_mat4};
 use crate::fur::{Fur, FurState};
 
 /// The light Pelt shades fur with (Kajiya-Kay strands) when the scene has no
-/// `DirectionalLight`, and the ambient term always. Pelt's default follows the camera from the
-/// upper left.
+/// `DirectionalLight`, and the ambient where the render world has no Bevy ambient light. Pelt's
+/// default follows the camera from the upper left.
 ///
 /// With a directional light in the scene (the first one by entity, among the visible), the fur
 /// takes its direction and its colour times `illuminance * exposure / pi`, the camera's exposure
 /// (Bevy's `Exposure`) included: the brightness Bevy gives a white diffuse surface facing the
 /// light, so fur and Bevy's materials agree. Every other visible light (point and spot lights,
 /// more directional lights; up to 8 in all) reaches a coat shaded with the fur model
-/// (`[shading] model = "fur"`), in the same units; Kajiya-Kay takes the first. Environment maps
-/// do not reach the fur: `FurLight`'s ambient stands for them.
+/// (`[shading] model = "fur"`), in the same units; Kajiya-Kay takes the first. Bevy's ambient light
+/// (the camera's `AmbientLight`, else the `GlobalAmbientLight`) is the fur's too: colour times
+/// brightness times exposure, the radiance a white diffuse surface shows under it in Bevy.
+/// Environment maps do not reach the fur.
 #[derive(Resource, Clone, Copy, Debug, Default, PartialEq)]
 pub struct FurLight(pub Light);
 
@@ -340,16 +342,18 @@ pub(crate) fn prepare_furs(
             Option<&ResolvedCompositingSpace>,
             Option<&ExtractedCamera>,
             Option<&TemporalJitter>,
+            Option<&AmbientLight>,
         ),
         (With<ViewTarget>, With<Camera3d>),
     >,
+    global_ambient: Option<Res<GlobalAmbientLight>>,
 ) {
     let device = device.wgpu_device();
     let queue: &wgpu::Queue = &queue;
     let gpu = &mut *gpu;
     let mut seen_views = HashSet::new();
     let mut targets = HashSet::new();
-    for (entity, view, msaa, space, camera, jitter) in &views {
+    for (entity, view, msaa, space, camera, jitter, camera_ambient) in &views {
         let (colour, srgb_view) = colour_format(view.target_format, ResolvedCompositingSpace::space(space));
         let target = FurTarget::new(colour)
             .with_depth(DEPTH_FORMAT, wgpu::CompareFunction::GreaterEqual)
@@ -384,7 +388,18 @@ pub(crate) fn prepare_furs(
         let clip_from_world = jittered_clip_from_world(view, jitter);
         entry.camera_position = world_from_view.w_axis.truncate();
         let exposure = camera.map_or_else(|| Exposure::default().exposure(), |camera| camera.exposure);
-        let light = extracted.sun.map_or(extracted.light, |sun| sun.light(exposure, extracted.light.ambient));
+        // Bevy's ambient as a radiance (before exposure, like the lights), else `FurLight`'s.
+        let bevy_ambient = camera_ambient
+            .map(|a| (a.color, a.brightness))
+            .or_else(|| global_ambient.as_deref().map(|a| (a.color, a.brightness)))
+            .map(|(colour, brightness)| linear(colour) * brightness)
+            .filter(|radiance| radiance.is_finite());
+        let ambient = bevy_ambient.map_or(glam::Vec3::splat(extracted.light.ambient), |radiance| radiance * exposure);
+        // Kajiya-Kay's ambient is one level: the radiance's luminance.
+        let ambient_level = ambient.dot(glam::Vec3::new(0.2126, 0.7152, 0.0722));
+        let light = extracted.sun.map_or(Light { ambient: ambient_level, ..extracted.light }, |sun| {
+            sun.light(exposure, ambient_level)
+        });
         let mut data = ViewData::new(clip_from_world, world_from_view, &light);
         // The fur model sums the lights it is given; Kajiya-Kay alone needs only the key light.
         if !extracted.others.is_empty() || extracted.furs.iter().any(|f| f.shading.fur_model) {
@@ -395,8 +410,7 @@ pub(crate) fn prepare_furs(
                 .chain(extracted.others.iter().copied())
                 .map(|l| LightSource { intensity: l.intensity * exposure, ..l })
                 .collect();
-            let ambient = Environment::uniform(glam::Vec3::splat(extracted.light.ambient));
-            data = data.with_lights(&lights, Some(ambient));
+            data = data.with_lights(&lights, Some(Environment::uniform(ambient)));
         }
         entry.view.prepare(queue, &data);
         entry.data = Some(ViewData::new(self::clip_from_world(view), world_from_view, &light));

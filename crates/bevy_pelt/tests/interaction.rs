@@ -243,6 +243,7 @@ fn render_ball(sponge: bool) -> image::RgbaImage {
     let mut app = headless_app(&test_assets(), false);
     let ball = spawn_furred_ball(&mut app, "presets/contact.toml");
     let world = app.world_mut();
+    crate::render::pelt_ambient(world);
     let mut target = Image::new_target_texture(SIZE, SIZE, TextureFormat::Rgba8UnormSrgb, None);
     target.asset_usage = RenderAssetUsages::RENDER_WORLD;
     let target = world.resource_mut::<Assets<Image>>().add(target);

@@ -3,6 +3,7 @@
 
 use bevy::camera::RenderTarget;
 use bevy::core_pipeline::tonemapping::Tonemapping;
+use bevy::light::{AmbientLight, GlobalAmbientLight};
 use bevy::prelude::*;
 use bevy_pelt::Fur;
 
@@ -42,4 +43,55 @@ fn a_point_light_reaches_fur_shaded_with_the_fur_model() {
     let darker = lit.pixels().zip(unlit.pixels()).filter(|(a, b)| luma(a) + 20.0 < luma(b)).count();
     assert!(brighter > 1000, "{brighter} pixels brighter with the point light");
     assert!(darker < brighter / 20, "{darker} pixels darker, {brighter} brighter");
+}
+
+/// The skinless furred cube (fur model) with no light but Bevy's global ambient of `brightness`
+/// (cd/m^2), and optionally a camera `AmbientLight` of `camera_brightness` over it.
+fn ambient_lit(brightness: f32, camera_brightness: Option<f32>) -> image::RgbaImage {
+    let images = capture(1, |world, targets| {
+        world.insert_resource(GlobalAmbientLight { brightness, ..default() });
+        let cube = cuboid(world, Vec3::ONE);
+        let fur = Fur::new(preset(world, "presets/long_fur_model.toml")).without_skin();
+        world.spawn((Mesh3d(cube), fur, Transform::from_rotation(Quat::from_rotation_y(0.5))));
+        let mut camera = world.spawn((
+            Camera3d::default(),
+            RenderTarget::Image(targets[0].clone().into()),
+            Tonemapping::None,
+            Transform::from_xyz(0.0, 0.5, 4.0).looking_at(Vec3::ZERO, Vec3::Y),
+        ));
+        if let Some(brightness) = camera_brightness {
+            camera.insert(AmbientLight { brightness, ..default() });
+        }
+    });
+    images.into_iter().next().unwrap()
+}
+
+/// Mean luma of the pixels that differ from the background in `image`.
+fn mean_fur_luma(image: &image::RgbaImage, background: &image::RgbaImage) -> (f32, usize) {
+    let fur: Vec<f32> = image
+        .pixels()
+        .zip(background.pixels())
+        .filter(|(a, b)| (luma(a) - luma(b)).abs() > 4.0)
+        .map(|(a, _)| luma(a))
+        .collect();
+    (fur.iter().sum::<f32>() / fur.len().max(1) as f32, fur.len())
+}
+
+#[test]
+fn bevys_ambient_light_reaches_the_fur() {
+    // Under the default exposure (EV100 9.7) an ambient of 400 cd/m^2 shows a white diffuse
+    // surface at about 0.4; none leaves the coat black.
+    let dark = ambient_lit(0.0, None);
+    let lit = ambient_lit(400.0, None);
+    let camera_lit = ambient_lit(0.0, Some(400.0));
+    save(&dark, "ambient_none");
+    save(&lit, "ambient_global");
+    save(&camera_lit, "ambient_camera");
+    let brighter = lit.pixels().zip(dark.pixels()).filter(|(a, b)| luma(a) > luma(b) + 20.0).count();
+    assert!(brighter > 1000, "{brighter} pixels brighter under the global ambient");
+    let (global, global_pixels) = mean_fur_luma(&lit, &dark);
+    let (camera, camera_pixels) = mean_fur_luma(&camera_lit, &dark);
+    assert!(global_pixels > 1000 && camera_pixels > 1000, "{global_pixels} and {camera_pixels} fur pixels");
+    // The camera's own ambient replaces the global one, at the same brightness the same look.
+    assert!((global - camera).abs() < 0.1 * global, "mean fur luma {global} (global) against {camera} (camera)");
 }

@@ -101,8 +101,16 @@ pub(crate) fn preset(world: &mut World, path: &'static str) -> Handle<FurPreset>
 
 /// The scene: a backdrop far behind, the cube (furred or not) in the middle, and a wall in front
 /// of the cube's left third. Unlit materials, no tonemapping, so colours are exact.
+/// Bevy's global ambient at the radiance Pelt's own ambient has (0.25) under the default exposure:
+/// the scenes drawn before the fur took Bevy's ambient keep their look.
+pub(crate) fn pelt_ambient(world: &mut World) {
+    let brightness = 0.25 / bevy::camera::Exposure::default().exposure();
+    world.insert_resource(bevy::light::GlobalAmbientLight { brightness, ..default() });
+}
+
 fn render(furred: bool) -> image::RgbaImage {
     let images = capture(1, |world, targets| {
+        pelt_ambient(world);
         let (backdrop, cube, wall) = (unlit(world, BACKDROP), unlit(world, CUBE), unlit(world, WALL));
         let (backdrop_mesh, cube_mesh, wall_mesh) = (
             cuboid(world, Vec3::new(20.0, 20.0, 0.1)),
