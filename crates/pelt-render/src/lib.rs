@@ -130,6 +130,7 @@ mod requirements;
 mod shaders;
 mod shadows;
 mod simulation;
+mod skinning;
 mod studio;
 mod surroundings;
 mod targets;
@@ -156,13 +157,14 @@ pub use plain::PlainMesh;
 pub use renderer::{FurDrawSettings, FurMotion, FurPrepass, FurRenderer, MotionData, PrepassTarget};
 pub use requirements::{check_adapter, required_downlevel_flags, required_features, required_limits};
 pub use shaders::{
-    prepass_shader_source, silhouette_shader_source, simulation_shader_source, unified_shader_source,
-    view_lod_shader_source,
+    prepass_shader_source, silhouette_shader_source, simulation_shader_source, skinning_shader_source,
+    unified_shader_source, view_lod_shader_source,
 };
 #[cfg(feature = "lab")]
 pub use shaders::{separated_shader_source, strands_shader_source};
 pub use shadows::{MAX_FITTED_SIZE, ShadowCaster, ShadowMap, ShadowSettings, fitted_shadow_size};
 pub use simulation::GpuSimulation;
+pub use skinning::GpuSkin;
 pub use studio::Studio;
 pub use surroundings::{GROUND_COLOUR, Surroundings};
 pub use targets::{DEFAULT_BACKGROUND, DEPTH_FORMAT, FurTarget, RenderTargets, SAMPLE_COUNT, default_sample_count};

@@ -34,5 +34,7 @@ mod shadows;
 mod simulation;
 #[path = "simulation_inputs.rs"]
 mod simulation_inputs;
+#[path = "skinning.rs"]
+mod skinning;
 #[path = "wet.rs"]
 mod wet;

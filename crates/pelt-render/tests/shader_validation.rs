@@ -56,6 +56,7 @@ fn every_wgsl_file_is_part_of_a_validated_module() {
         pelt_render::view_lod_shader_source(),
         pelt_render::prepass_shader_source(),
         pelt_render::strands_shader_source(),
+        pelt_render::skinning_shader_source(),
     ];
     // Every .wgsl under src/, wherever it lies.
     let mut dirs = vec![std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("src")];
@@ -73,8 +74,13 @@ fn every_wgsl_file_is_part_of_a_validated_module() {
         }
     }
     assert_eq!(
-        checked, 15,
+        checked, 16,
         "shading, wet, fur_bsdf, shadows, unified, prepass, separated, scan, silhouette, view_lod, simulation_wind, \
-         simulation, simulation_inputs, simulation_contact and strands"
+         simulation, simulation_inputs, simulation_contact, strands and skinning"
     );
+}
+
+#[test]
+fn skinning_module_validates() {
+    validate("skinning.wgsl", &pelt_render::skinning_shader_source());
 }

@@ -412,6 +412,13 @@ impl Rig {
         self.palette.len()
     }
 
+    /// Each base vertex's four palette joints and their weights (unused slots weigh 0), as
+    /// [`Rig::pose`] blends them: what a GPU skins the base with ([`Rig::joint_matrices`] per pose).
+    #[must_use]
+    pub fn vertex_influences(&self) -> Vec<([u32; 4], [f32; 4])> {
+        self.influences.iter().map(|inf| (inf.joints, inf.weights)).collect()
+    }
+
     /// The node a palette joint follows (`None` for a joint fixed at the identity).
     #[must_use]
     pub fn joint_node(&self, joint: usize) -> Option<usize> {
