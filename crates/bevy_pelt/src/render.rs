@@ -397,9 +397,9 @@ pub(crate) fn prepare_furs(
         let ambient = bevy_ambient.map_or(glam::Vec3::splat(extracted.light.ambient), |radiance| radiance * exposure);
         // Kajiya-Kay's ambient is one level: the radiance's luminance.
         let ambient_level = ambient.dot(glam::Vec3::new(0.2126, 0.7152, 0.0722));
-        let light = extracted.sun.map_or(Light { ambient: ambient_level, ..extracted.light }, |sun| {
-            sun.light(exposure, ambient_level)
-        });
+        let light = extracted
+            .sun
+            .map_or(Light { ambient: ambient_level, ..extracted.light }, |sun| sun.light(exposure, ambient_level));
         let mut data = ViewData::new(clip_from_world, world_from_view, &light);
         // The fur model sums the lights it is given; Kajiya-Kay alone needs only the key light.
         if !extracted.others.is_empty() || extracted.furs.iter().any(|f| f.shading.fur_model) {

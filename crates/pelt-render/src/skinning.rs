@@ -75,7 +75,9 @@ impl GpuSkin {
         let joint_total = u32::try_from(joint_count).map_err(|_| too_many("joints"))?;
         let instance_count = u32::try_from(instances).map_err(|_| too_many("instances"))?;
         if let Some(v) = (0..positions.len()).find(|&v| !(positions[v].is_finite() && normals[v].is_finite())) {
-            return Err(RenderError::Target(format!("GPU skinning: vertex {v}'s rest position or normal is not finite")));
+            return Err(RenderError::Target(format!(
+                "GPU skinning: vertex {v}'s rest position or normal is not finite"
+            )));
         }
         let mut influence_words = Vec::with_capacity(2 * influences.len());
         for (v, (joints, weights)) in influences.iter().enumerate() {
@@ -104,11 +106,10 @@ impl GpuSkin {
 
         let scope = ErrorScope::push(device);
         let init = |label, contents: &[u8], usage| {
-            wgpu::util::DeviceExt::create_buffer_init(device, &wgpu::util::BufferInitDescriptor {
-                label: Some(label),
-                contents,
-                usage,
-            })
+            wgpu::util::DeviceExt::create_buffer_init(
+                device,
+                &wgpu::util::BufferInitDescriptor { label: Some(label), contents, usage },
+            )
         };
         let params = SkinParams { vertex_count, joint_count: joint_total, instance_count, padding: 0 };
         let params = init("pelt skin params", bytemuck::bytes_of(&params), wgpu::BufferUsages::UNIFORM);
@@ -207,11 +208,8 @@ impl GpuSkin {
             .iter()
             .flat_map(|m| {
                 let upper = Mat3::from_mat4(*m);
-                let normal = if upper.determinant().abs() > f32::MIN_POSITIVE {
-                    upper.inverse().transpose()
-                } else {
-                    upper
-                };
+                let normal =
+                    if upper.determinant().abs() > f32::MIN_POSITIVE { upper.inverse().transpose() } else { upper };
                 [m.to_cols_array(), Mat4::from_mat3(normal).to_cols_array()]
             })
             .collect();
@@ -222,10 +220,8 @@ impl GpuSkin {
 
     /// Records the skinning of every instance: one compute pass, one dispatch.
     pub fn record(&self, encoder: &mut wgpu::CommandEncoder) {
-        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-            label: Some("pelt skinning"),
-            timestamp_writes: None,
-        });
+        let mut pass = encoder
+            .begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("pelt skinning"), timestamp_writes: None });
         pass.set_pipeline(&self.pipeline);
         pass.set_bind_group(0, &self.bind_group, &[]);
         pass.dispatch_workgroups(self.vertex_count.div_ceil(WORKGROUP), self.instance_count, 1);

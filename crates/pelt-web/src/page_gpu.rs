@@ -219,7 +219,9 @@ impl PageGpu {
             self.surroundings = Some((switches, made));
         }
         let Some((_, surroundings)) = &mut self.surroundings else { unreachable!("made just above") };
-        surroundings.fit_to_frame(device, &self.renderer, (frame.width(), frame.height())).map_err(|e| e.to_string())?;
+        surroundings
+            .fit_to_frame(device, &self.renderer, (frame.width(), frame.height()))
+            .map_err(|e| e.to_string())?;
         let camera = model.orbit.camera();
         self.studio.light.direction = model.light.direction();
         let view_data = self.studio.view_data(&camera, targets.aspect_ratio());
