@@ -48,9 +48,12 @@ fn gpu_skinning_agrees_with_pelt_core_for_every_instance_in_one_dispatch() {
     .expect("GPU skin");
     let mut poses = Vec::new();
     for (instance, &time) in times.iter().enumerate() {
+        // The GPU's joints from the clip alone (`pose_joints`), the oracle's vertices from `pose`.
+        let mut joints = Pose::default();
+        rig.pose_joints(Some(walk), time, &mut joints);
+        skin.set_joints(&gpu.queue, instance, &rig.joint_matrices(&joints)).expect("joints");
         let mut pose = Pose::default();
         rig.pose(&mesh, Some(walk), time, &mut pose);
-        skin.set_joints(&gpu.queue, instance, &rig.joint_matrices(&pose)).expect("joints");
         poses.push(pose);
     }
     let posed = read_posed(&gpu, &skin);

@@ -285,6 +285,40 @@ impl Rig {
     /// If `mesh` has another vertex count than the rig, or `animation` is out of range.
     pub fn pose(&self, mesh: &Mesh, animation: Option<usize>, time_secs: f64, pose: &mut Pose) {
         assert_eq!(mesh.vertex_count(), self.influences.len(), "the rig belongs to another mesh");
+        self.pose_joints(animation, time_secs, pose);
+        let joints: Vec<skin::JointTransform> = self
+            .palette
+            .iter()
+            .map(|joint| {
+                skin::JointTransform::new(joint.node.map_or(Mat4::IDENTITY, |n| pose.world[n]) * joint.inverse_bind)
+            })
+            .collect();
+
+        pose.morphed.clear();
+        pose.morphed.extend(mesh.positions.iter().copied().zip(mesh.normals.iter().copied()));
+        for set in &self.morphs {
+            for (target, &weight) in set.targets.iter().zip(&pose.weights[set.node]) {
+                if weight != 0.0 {
+                    for &(v, dp, dn) in target {
+                        let (p, n) = &mut pose.morphed[v as usize];
+                        *p += dp * weight;
+                        *n += dn * weight;
+                    }
+                }
+            }
+        }
+        let morphed = std::mem::take(&mut pose.morphed);
+        skin::blend(&joints, &self.influences, &morphed, &mesh.normals, pose);
+        pose.morphed = morphed;
+    }
+
+    /// The part of [`Rig::pose`] before the vertices: `animation` sampled at `time_secs` and
+    /// every node's world transform, so [`Rig::joint_matrices`] reads `pose`; its vertices are
+    /// left as they were (for a GPU to skin, `pelt_render::GpuSkin`).
+    ///
+    /// # Panics
+    /// If `animation` is out of range.
+    pub fn pose_joints(&self, animation: Option<usize>, time_secs: f64, pose: &mut Pose) {
         pose.local.clear();
         pose.local.extend(self.nodes.iter().map(|n| n.rest));
         pose.weights.resize(self.nodes.len(), Vec::new());
@@ -322,30 +356,6 @@ impl Rig {
             };
             pose.world[n] = node.parent.map_or(local, |p| pose.world[p] * local);
         }
-        let joints: Vec<skin::JointTransform> = self
-            .palette
-            .iter()
-            .map(|joint| {
-                skin::JointTransform::new(joint.node.map_or(Mat4::IDENTITY, |n| pose.world[n]) * joint.inverse_bind)
-            })
-            .collect();
-
-        pose.morphed.clear();
-        pose.morphed.extend(mesh.positions.iter().copied().zip(mesh.normals.iter().copied()));
-        for set in &self.morphs {
-            for (target, &weight) in set.targets.iter().zip(&pose.weights[set.node]) {
-                if weight != 0.0 {
-                    for &(v, dp, dn) in target {
-                        let (p, n) = &mut pose.morphed[v as usize];
-                        *p += dp * weight;
-                        *n += dn * weight;
-                    }
-                }
-            }
-        }
-        let morphed = std::mem::take(&mut pose.morphed);
-        skin::blend(&joints, &self.influences, &morphed, &mesh.normals, pose);
-        pose.morphed = morphed;
     }
 }
 

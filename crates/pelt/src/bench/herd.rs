@@ -4,7 +4,8 @@
 //! them: one `FurAsset`, a driver and a stepper per Fox, the steppers in one parallel pass on
 //! the CPU. Per size: the simulation's time a frame, the CPU's time to record a frame, the
 //! rest of the frame (the GPU's work and the readback), the GPU bytes of the shared asset and
-//! of each Fox, and what one more Fox adds to each.
+//! of each Fox, what one more Fox adds to each, and posing every Fox's base once on the CPU
+//! (`Rig::pose`) against on the GPU (`Rig::pose_joints` per Fox, then one `GpuSkin` dispatch).
 
 use std::path::Path;
 use std::time::{Duration, Instant};
@@ -16,7 +17,7 @@ use pelt_core::sim::herd;
 use pelt_core::{ImportOptions, Preset, Stage, StageSource};
 use pelt_render::{
     Backend, Camera, FurAsset, FurDrawSettings, FurDriver, FurTarget, FurView, Gpu, HEADLESS_FORMAT, Headless,
-    KernelChoice, Studio,
+    GpuSkin, KernelChoice, Studio,
 };
 
 /// Figures for one herd size.
@@ -35,6 +36,11 @@ pub struct HerdRow {
     pub gpu_and_readback_ms: f64,
     /// The whole frame: simulation, recording, GPU and readback.
     pub frame_ms: f64,
+    /// Posing every Fox's base on the CPU (`Rig::pose`: the clip, the joints and the vertices).
+    pub cpu_pose_ms: f64,
+    /// Posing them on the GPU: the clip and joints on the CPU, the vertices in one `GpuSkin`
+    /// dispatch, waited for.
+    pub gpu_pose_ms: f64,
     /// Bytes every Fox shares (topology, uvs, fin strip, textures), once.
     pub shared_gpu_bytes: u64,
     /// Bytes of each Fox's own state (shared-array state, normals, silhouette and shell lists).
@@ -201,6 +207,7 @@ pub fn measure(
                 gpu += done - recorded;
             }
         }
+        let (cpu_pose_ms, gpu_pose_ms) = time_posing((device, queue), (&rig, walk), &fur.mesh, &instances, frames)?;
         let per_frame = |d: Duration| d.as_secs_f64() * 1000.0 / f64::from(frames);
         let shared = asset.gpu_bytes();
         let shared_gpu_bytes = shared.positions + shared.attributes + shared.indices + shared.textures;
@@ -215,6 +222,8 @@ pub fn measure(
             record_ms: per_frame(record),
             gpu_and_readback_ms: per_frame(gpu),
             frame_ms: per_frame(simulation + record + gpu),
+            cpu_pose_ms,
+            gpu_pose_ms,
             shared_gpu_bytes,
             per_fox_gpu_bytes,
             total_gpu_bytes: shared_gpu_bytes + foxes as u64 * per_fox_gpu_bytes,
@@ -225,11 +234,53 @@ pub fn measure(
     Ok((rows, headless.gpu.summary()))
 }
 
+/// Milliseconds to pose every member's base at one time, on the CPU and on the GPU (after one
+/// untimed round of each), the mean of `rounds` rounds.
+fn time_posing(
+    (device, queue): (&wgpu::Device, &wgpu::Queue),
+    (rig, walk): (&pelt_core::anim::Rig, usize),
+    mesh: &pelt_core::Mesh,
+    instances: &[herd::HerdInstance],
+    rounds: u32,
+) -> anyhow::Result<(f64, f64)> {
+    let skin = GpuSkin::new(
+        device,
+        (&mesh.positions, &mesh.normals),
+        &rig.vertex_influences(),
+        rig.joint_count(),
+        instances.len(),
+    )?;
+    let mut pose = pelt_core::anim::Pose::default();
+    let (mut cpu, mut gpu) = (Duration::ZERO, Duration::ZERO);
+    for round in 0..=rounds {
+        let time_secs = f64::from(round) / 30.0;
+        let started = Instant::now();
+        for instance in instances {
+            rig.pose(mesh, Some(walk), instance.clip_time(time_secs), &mut pose);
+        }
+        let posed_on_cpu = Instant::now();
+        for (k, instance) in instances.iter().enumerate() {
+            rig.pose_joints(Some(walk), instance.clip_time(time_secs), &mut pose);
+            skin.set_joints(queue, k, &rig.joint_matrices(&pose))?;
+        }
+        let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("herd skin") });
+        skin.record(&mut encoder);
+        queue.submit([encoder.finish()]);
+        device.poll(wgpu::PollType::wait_indefinitely())?;
+        if round > 0 {
+            cpu += posed_on_cpu - started;
+            gpu += posed_on_cpu.elapsed();
+        }
+    }
+    let per_round = |d: Duration| d.as_secs_f64() * 1000.0 / f64::from(rounds.max(1));
+    Ok((per_round(cpu), per_round(gpu)))
+}
+
 fn markdown(rows: &[HerdRow], adapter: &str) -> String {
     let mut out = format!(
         "### A herd of walking Foxes ({}, {}x MSAA, 16 layers, shadows on a ground; {adapter})\n\n\
-         | Foxes | frame ms | simulation ms | record ms | GPU + readback ms | one more Fox adds (frame / record, ms) | GPU bytes (shared + per Fox) | allocated |\n\
-         |---:|---:|---:|---:|---:|---:|---:|---:|\n",
+         | Foxes | frame ms | simulation ms | record ms | GPU + readback ms | one more Fox adds (frame / record, ms) | GPU bytes (shared + per Fox) | allocated | posing every base, CPU / GPU ms |\n\
+         |---:|---:|---:|---:|---:|---:|---:|---:|---:|\n",
         rows.first().map_or("", |r| r.size.as_str()),
         rows.first().map_or(1, |r| r.msaa_samples),
     );
@@ -242,7 +293,7 @@ fn markdown(rows: &[HerdRow], adapter: &str) -> String {
             None => "-".to_owned(),
         };
         out += &format!(
-            "| {} | {:.1} | {:.1} | {:.2} | {:.1} | {more} | {} ({} + {} x {}) | {} |\n",
+            "| {} | {:.1} | {:.1} | {:.2} | {:.1} | {more} | {} ({} + {} x {}) | {} | {:.2} / {:.2} |\n",
             row.foxes,
             row.frame_ms,
             row.simulation_ms,
@@ -253,6 +304,8 @@ fn markdown(rows: &[HerdRow], adapter: &str) -> String {
             row.foxes,
             row.per_fox_gpu_bytes,
             row.allocated_gpu_bytes.map_or_else(|| "-".to_owned(), |b| b.to_string()),
+            row.cpu_pose_ms,
+            row.gpu_pose_ms,
         );
     }
     out
@@ -273,6 +326,8 @@ mod tests {
             record_ms,
             gpu_and_readback_ms: 0.0,
             frame_ms,
+            cpu_pose_ms: 3.0,
+            gpu_pose_ms: 0.5,
             shared_gpu_bytes: 10,
             per_fox_gpu_bytes: 2,
             total_gpu_bytes: 10 + 2 * foxes as u64,
@@ -281,6 +336,6 @@ mod tests {
         let table = markdown(&[row(1, 10.0, 1.0), row(11, 30.0, 2.0)], "lavapipe");
         assert!(table.contains("| 11 | 30.0 |"), "{table}");
         assert!(table.contains("2.000 / 0.1000"), "{table}");
-        assert!(table.contains("32 (10 + 11 x 2) | 33 |"), "{table}");
+        assert!(table.contains("32 (10 + 11 x 2) | 33 | 3.00 / 0.50 |"), "{table}");
     }
 }
