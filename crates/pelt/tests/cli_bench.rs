@@ -255,14 +255,7 @@ fn herd_bench_reports_each_size_with_the_asset_counted_once() {
     let rows = rows.as_array().expect("rows");
     assert_eq!(rows.iter().map(|r| r["foxes"].as_u64().unwrap()).collect::<Vec<_>>(), [1, 10]);
     for row in rows {
-        for key in [
-            "frame_ms",
-            "simulation_ms",
-            "record_ms",
-            "gpu_and_readback_ms",
-            "cpu_pose_ms",
-            "gpu_pose_ms",
-        ] {
+        for key in ["frame_ms", "simulation_ms", "record_ms", "gpu_and_readback_ms", "cpu_pose_ms", "gpu_pose_ms"] {
             let value = row[key].as_f64().unwrap_or(-1.0);
             assert!(value.is_finite() && value > 0.0, "{key} = {value} in {row}");
         }

@@ -16,8 +16,8 @@ use pelt_core::sim::FurStepper;
 use pelt_core::sim::herd;
 use pelt_core::{ImportOptions, Preset, Stage, StageSource};
 use pelt_render::{
-    Backend, Camera, FurAsset, FurDrawSettings, FurDriver, FurTarget, FurView, Gpu, HEADLESS_FORMAT, Headless,
-    GpuSkin, KernelChoice, Studio,
+    Backend, Camera, FurAsset, FurDrawSettings, FurDriver, FurTarget, FurView, Gpu, GpuSkin, HEADLESS_FORMAT, Headless,
+    KernelChoice, Studio,
 };
 
 /// Figures for one herd size.
