@@ -327,4 +327,14 @@ mod tests {
             ShadowCaster::Directional { toward_light: sun.direction }
         );
     }
+
+    #[test]
+    fn the_fitted_map_follows_the_pictures_longer_side_within_256_to_512() {
+        let cases = [((64, 64), 256), ((256, 256), 256), ((257, 100), 512), ((300, 480), 512), ((1280, 720), 512)];
+        for ((width, height), size) in cases {
+            assert_eq!(fitted_shadow_size(width, height), size, "{width}x{height}");
+        }
+        assert_eq!(fitted_shadow_size(0, 0), 256);
+        assert_eq!(ShadowSettings::for_frame(0.1, (1920, 1080)), ShadowSettings::for_fur(0.1));
+    }
 }

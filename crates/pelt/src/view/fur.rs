@@ -247,6 +247,12 @@ impl FurScene {
         let camera = camera.camera();
         let view_data = studio.view_data(&camera, viewport.targets.aspect_ratio());
         self.view.prepare(&gpu.queue, &view_data);
+        if let Some((_, surroundings)) = &mut self.surroundings {
+            // The window's size: a small window draws small shadow maps. A failure keeps the maps.
+            if let Err(problem) = surroundings.fit_to_frame(&gpu.device, &self.renderer, viewport.targets.size()) {
+                eprintln!("pelt view: keeping the shadow maps: {problem}");
+            }
+        }
         let separated = self.separated.as_ref().filter(|_| separated);
         // The separated structure draws with pipelines of its own, which read no shadow maps.
         let surroundings = self.surroundings.as_ref().map(|(_, s)| s).filter(|_| separated.is_none());
