@@ -6,26 +6,14 @@ use pelt_core::anim::Pose;
 use pelt_core::{ImportOptions, Mesh};
 use pelt_render::{GpuSkin, RenderError};
 
-use crate::common::{asset, gpu};
+use crate::common::{asset, gpu, read_bytes};
 
-/// The posed `[position, normal]` pairs of every instance, read back (waits for the GPU).
+/// The posed `[position, normal]` pairs of every instance after one dispatch, read back.
 fn read_posed(gpu: &pelt_render::Gpu, skin: &GpuSkin) -> Vec<[f32; 4]> {
-    let (device, queue) = (&gpu.device, &gpu.queue);
-    let size = skin.posed().size();
-    let staging = device.create_buffer(&wgpu::BufferDescriptor {
-        label: Some("test skin readback"),
-        size,
-        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
-        mapped_at_creation: false,
-    });
-    let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor::default());
+    let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor::default());
     skin.record(&mut encoder);
-    encoder.copy_buffer_to_buffer(skin.posed(), 0, &staging, 0, size);
-    queue.submit([encoder.finish()]);
-    staging.slice(..).map_async(wgpu::MapMode::Read, |result| result.expect("map"));
-    device.poll(wgpu::PollType::wait_indefinitely()).expect("poll");
-    let bytes = staging.slice(..).get_mapped_range().expect("mapped").to_vec();
-    bytes
+    gpu.queue.submit([encoder.finish()]);
+    read_bytes(&gpu.device, &gpu.queue, skin.posed())
         .chunks_exact(16)
         .map(|c| std::array::from_fn(|k| f32::from_le_bytes([c[4 * k], c[4 * k + 1], c[4 * k + 2], c[4 * k + 3]])))
         .collect()

@@ -206,19 +206,7 @@ impl Rig {
 
     /// The `u32`s of a small `COPY_SRC` buffer, read back (waits for the GPU).
     pub fn read_u32s(&self, buffer: &wgpu::Buffer) -> Vec<u32> {
-        let device = self.device();
-        let staging = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("test readback"),
-            size: buffer.size(),
-            usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
-            mapped_at_creation: false,
-        });
-        let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor::default());
-        encoder.copy_buffer_to_buffer(buffer, 0, &staging, 0, buffer.size());
-        self.queue().submit([encoder.finish()]);
-        staging.slice(..).map_async(wgpu::MapMode::Read, |result| result.expect("map"));
-        device.poll(wgpu::PollType::wait_indefinitely()).expect("poll");
-        let bytes = staging.slice(..).get_mapped_range().expect("mapped").to_vec();
+        let bytes = read_bytes(self.device(), self.queue(), buffer);
         bytes.chunks_exact(4).map(|w| u32::from_le_bytes([w[0], w[1], w[2], w[3]])).collect()
     }
 
@@ -229,6 +217,23 @@ impl Rig {
         let p = empty.get_pixel(0, 0).0;
         [p[0], p[1], p[2]]
     }
+}
+
+/// The bytes of a `COPY_SRC` buffer, read back after everything submitted before (waits for the
+/// GPU).
+pub fn read_bytes(device: &wgpu::Device, queue: &wgpu::Queue, buffer: &wgpu::Buffer) -> Vec<u8> {
+    let staging = device.create_buffer(&wgpu::BufferDescriptor {
+        label: Some("test readback"),
+        size: buffer.size(),
+        usage: wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::MAP_READ,
+        mapped_at_creation: false,
+    });
+    let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor::default());
+    encoder.copy_buffer_to_buffer(buffer, 0, &staging, 0, buffer.size());
+    queue.submit([encoder.finish()]);
+    staging.slice(..).map_async(wgpu::MapMode::Read, |result| result.expect("map"));
+    device.poll(wgpu::PollType::wait_indefinitely()).expect("poll");
+    staging.slice(..).get_mapped_range().expect("mapped").to_vec()
 }
 
 pub fn framed(fur: &FurStructure, aspect_ratio: f32) -> Camera {
