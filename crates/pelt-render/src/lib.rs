@@ -17,7 +17,8 @@
 //!   copy of it (a herd's member) holding only its own state.
 //! - [`FurView`]: one view's uniform buffer, written from [`ViewData`] (`clip_from_world`, camera
 //!   position, [`Light`]); several views in one submission each have their own.
-//! - [`Studio`]: the light, exposure and background of Pelt's own pictures, one default that
+//! - [`Studio`]: the lights, environment, exposure and background of Pelt's own pictures (its
+//!   key light fixed in the world and a sky-ground fill by default), one default that
 //!   `pelt render`, the viewer, the web page and the examples share.
 //!
 //! # The order a host calls things in
@@ -165,7 +166,7 @@ pub use shaders::{separated_shader_source, strands_shader_source};
 pub use shadows::{MAX_FITTED_SIZE, ShadowCaster, ShadowMap, ShadowSettings, fitted_shadow_size};
 pub use simulation::GpuSimulation;
 pub use skinning::GpuSkin;
-pub use studio::Studio;
+pub use studio::{GROUND_RADIANCE, KEY_LIGHT_ANGLES, SKY_RADIANCE, Studio};
 pub use surroundings::{GROUND_COLOUR, Surroundings};
 pub use targets::{DEFAULT_BACKGROUND, DEPTH_FORMAT, FurTarget, RenderTargets, SAMPLE_COUNT, default_sample_count};
 pub use view::{FurView, Light, LightDirection, LightSet, ViewData};

@@ -48,6 +48,7 @@ fn render(collide: bool) -> (image::RgbaImage, Camera, Vec3, f32) {
     params.wind.strength = 0.0;
     let mut driver =
         FurDriver::new(device, queue, &renderer, &structure, &textures, &params, KernelChoice::Cpu).expect("driver");
+    driver.set_look(common::paper_look());
     let mut stepper = FurStepper::new(&structure, &params).expect("stepper");
     if collide {
         stepper.set_scene(Some(scene));

@@ -42,6 +42,7 @@ fn render(collide: bool) -> (image::RgbaImage, Camera) {
     params.wind.strength = 0.0;
     let mut driver =
         FurDriver::new(device, queue, &renderer, &structure, &textures, &params, KernelChoice::Cpu).expect("driver");
+    driver.set_look(common::paper_look());
     let mut stepper = FurStepper::new(&structure, &params).expect("stepper");
     if collide {
         stepper.set_scene(Some(Scene::from_toml_str(SCRIPT, Path::new("colliders-test.toml")).expect("script")));

@@ -14,7 +14,7 @@ const SIZE_PX: u32 = 160;
 const WHITE: [u8; 3] = [255, 255, 255];
 
 fn look(fur_model: bool) -> FurLook {
-    FurLook { shading: FurShading { fur_model, ..FurShading::default() }, ..FurLook::default() }
+    FurLook { shading: FurShading { fur_model, ..FurShading::default() }, ..common::paper_look() }
 }
 
 /// The sphere's fur in `look`, lit by `lights` and `environment`, over black.
@@ -26,7 +26,7 @@ fn render(
     environment: Environment,
     name: &str,
 ) -> image::RgbaImage {
-    fur.prepare(rig.queue(), &FurFrame { look, ..FurFrame::default() });
+    fur.prepare(rig.queue(), &FurFrame { look, ..common::paper_frame() });
     let structure = builtin_fur(Builtin::Sphere, 16);
     let camera = framed(&structure, 1.0);
     let view = camera.view_data(1.0, &Light::default()).with_lights(lights, Some(environment));

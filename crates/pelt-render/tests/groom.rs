@@ -8,7 +8,7 @@ use common::{Rig, load_asset, out_dir, pixel_difference, strand_textures};
 use glam::{Vec3, Vec4Swizzles as _};
 use pelt_core::sim::pick;
 use pelt_core::{FurStructure, Preset};
-use pelt_render::{Camera, DEFAULT_BACKGROUND, FurDrawSettings, FurFrame, Light, SeparatedFur, SeparatedRenderer};
+use pelt_render::{Camera, DEFAULT_BACKGROUND, FurDrawSettings, Light, SeparatedFur, SeparatedRenderer};
 
 const SIZE_PX: u32 = 192;
 /// Red roots, green tips: fur drawn over the root-coloured skin shows.
@@ -101,7 +101,7 @@ fn separated_baseline_is_groomed_too() {
     let separated_renderer = SeparatedRenderer::new(rig.device(), &rig.renderer).expect("separated renderer");
     let textures = strand_textures(64, fur.layers, ROOT, TIP);
     let separated = SeparatedFur::new(rig.device(), rig.queue(), &rig.renderer, &fur, &textures, 8).expect("separated");
-    separated.prepare(rig.queue(), &FurFrame::default());
+    separated.prepare(rig.queue(), &common::paper_frame());
     rig.view.prepare(rig.queue(), &camera.view_data(1.0, &Light::default()));
     let draw = |settings: &FurDrawSettings| {
         rig.headless

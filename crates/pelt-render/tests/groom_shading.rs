@@ -39,8 +39,8 @@ fn camera() -> Camera {
 /// (two pixels a texel), no highlight, so each channel is the albedo times the coverage.
 fn render(rig: &Rig, fur: &FurStructure, name: &str) -> Vec<Vec3> {
     let gpu_fur: GpuFur = rig.fur(fur, &strand_textures(128, fur.layers, WHITE, WHITE));
-    let look = FurLook { specular: 0.0, tiles_per_radius: 1.4, ..FurLook::default() };
-    gpu_fur.prepare(rig.queue(), &FurFrame { look, ..FurFrame::default() });
+    let look = FurLook { specular: 0.0, tiles_per_radius: 1.4, ..common::paper_look() };
+    gpu_fur.prepare(rig.queue(), &FurFrame { look, ..common::paper_frame() });
     let camera = camera();
     rig.view.prepare(rig.queue(), &camera.view_data(1.0, &Light::default()));
     let image =
@@ -172,8 +172,8 @@ fn set_groom_rewrites_the_shading_in_place() {
         ..Groom::default()
     };
     let draw = |fur: &GpuFur| {
-        let look = FurLook { tiles_per_radius: 1.4, ..FurLook::default() };
-        fur.prepare(rig.queue(), &FurFrame { look, ..FurFrame::default() });
+        let look = FurLook { tiles_per_radius: 1.4, ..common::paper_look() };
+        fur.prepare(rig.queue(), &FurFrame { look, ..common::paper_frame() });
         rig.view.prepare(rig.queue(), &camera().view_data(1.0, &Light::default()));
         rig.headless.render(Vec3::ZERO, |pass| rig.renderer.draw(pass, &rig.view, fur, &SHELLS)).expect("frame")
     };

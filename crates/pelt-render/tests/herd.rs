@@ -79,14 +79,14 @@ fn each_copy_draws_its_own_pose_as_a_fur_uploaded_alone() {
         .collect();
     copies[1].set_positions(rig.queue(), &bent).expect("positions");
     for copy in &copies {
-        copy.prepare(rig.queue(), &FurFrame::default());
+        copy.prepare(rig.queue(), &common::paper_frame());
     }
     let camera = framed(&structure, 1.0);
     let first = rig.render(&copies[0], &camera, &settings());
     let second = rig.render(&copies[1], &camera, &settings());
     let alone = rig.fur(&structure, &textures);
     alone.set_positions(rig.queue(), &bent).expect("positions");
-    alone.prepare(rig.queue(), &FurFrame::default());
+    alone.prepare(rig.queue(), &common::paper_frame());
     let bent_alone = rig.render(&alone, &camera, &settings());
     let rest_alone = rig.render(&rig.fur(&structure, &textures), &camera, &settings());
     assert_eq!(first, rest_alone, "the first copy draws the rest pose, as a fur alone does");
@@ -110,7 +110,7 @@ fn a_far_fur_fades_to_its_skin_in_the_coats_colour_without_a_jump() {
     let always = rig.render(&fur, &camera, &settings());
     let at = |coat: f32| {
         let level = pelt_render::FurLevel { coat, ..pelt_render::FurLevel::FULL };
-        fur.prepare(rig.queue(), &FurFrame { level, ..FurFrame::default() });
+        fur.prepare(rig.queue(), &FurFrame { level, ..common::paper_frame() });
         rig.render(&fur, &camera, &settings())
     };
     let frames: Vec<image::RgbaImage> = (0..=20).map(|k| at(1.0 - k as f32 / 20.0)).collect();

@@ -49,7 +49,7 @@ fn two_states_interpolate_like_the_cpu() {
     fur.push_state(rig.queue(), &current).expect("current state");
     let camera = Camera::orbit(Vec3::ZERO, 0.0, 0.0, 6.0);
     let draw = |t: f32| {
-        fur.prepare(rig.queue(), &FurFrame { interpolation: t, ..FurFrame::default() });
+        fur.prepare(rig.queue(), &FurFrame { interpolation: t, ..common::paper_frame() });
         rig.render(&fur, &camera, &settings())
     };
     let reference = |positions: &[Vec3]| {
@@ -87,7 +87,7 @@ fn model_transform_matches_transforming_on_the_cpu() {
         Vec3::new(0.4, -0.2, 0.3),
     );
     let moved = rig.fur(&structure, &textures);
-    moved.prepare(rig.queue(), &FurFrame { world_from_model, ..FurFrame::default() });
+    moved.prepare(rig.queue(), &FurFrame { world_from_model, ..common::paper_frame() });
     let baked = rig.fur(&structure, &textures);
     let positions: Vec<Vec3> = structure.positions.iter().map(|p| world_from_model.transform_point3(*p)).collect();
     let normal_matrix = Mat3::from_mat4(world_from_model).inverse().transpose();
@@ -156,7 +156,7 @@ fn reverse_z_draws_what_conventional_depth_draws() {
     let (device, queue) = (&headless.gpu.device, &headless.gpu.queue);
     let renderer = FurRenderer::new(device, target).expect("renderer");
     let fur = GpuFur::new(device, queue, &renderer, &structure, &textures, FurStates::One).expect("fur");
-    fur.prepare(queue, &FurFrame::default());
+    fur.prepare(queue, &common::paper_frame());
     let camera = framed(&structure, 1.0);
     let view_from_world = camera.view_from_world();
     let clip_from_world =

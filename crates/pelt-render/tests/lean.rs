@@ -115,7 +115,7 @@ fn cpu_and_compute_silhouettes_keep_the_same_fins() {
             let frame = FurFrame {
                 world_from_model,
                 level: FurLevel { stride: 2, blend: 0.0, ..FurLevel::FULL },
-                ..FurFrame::default()
+                ..common::paper_frame()
             };
             gpu_fur.prepare(rig.queue(), &frame);
             let camera = framed(&fur, 1.0);
@@ -165,7 +165,7 @@ fn cpu_and_compute_silhouettes_keep_the_same_fins() {
         rig.queue(),
         &mut other,
         &bunny.positions,
-        &FurFrame::default(),
+        &common::paper_frame(),
         Vec3::new(0.0, 0.0, 5.0),
     );
     assert!(refused.is_err(), "a silhouette of the box drew the bunny's fins");

@@ -111,7 +111,7 @@ fn triangle_key(triple: [u32; 3], by_wedges: Option<&HashMap<[u32; 3], usize>>) 
 }
 
 fn render_at(rig: &Rig, gpu_fur: &GpuFur, camera: &Camera, level: FurLevel) -> image::RgbaImage {
-    gpu_fur.prepare(rig.queue(), &FurFrame { level, ..FurFrame::default() });
+    gpu_fur.prepare(rig.queue(), &FurFrame { level, ..common::paper_frame() });
     rig.render_silhouette(gpu_fur, camera, &FurDrawSettings::SILHOUETTE)
 }
 

@@ -257,8 +257,8 @@ fn underside_darker_with_shadows(fur_model: bool) {
         sphere_fur(16, 0.2, None)
     };
     let fur = stage.fur(&structure);
-    let look = FurLook { shading: FurShading { fur_model, ..FurShading::default() }, ..FurLook::default() };
-    fur.prepare(stage.rig.queue(), &FurFrame { look, ..FurFrame::default() });
+    let look = FurLook { shading: FurShading { fur_model, ..FurShading::default() }, ..common::paper_look() };
+    fur.prepare(stage.rig.queue(), &FurFrame { look, ..common::paper_frame() });
     let camera = Camera::orbit(Vec3::ZERO, 0.0, 0.0, 6.0);
     let name = if fur_model { "underside-fur-model" } else { "underside" };
     let off = stage.render(&camera, Vec3::Y, (Some(&fur), false), None, &format!("{name}-off"));

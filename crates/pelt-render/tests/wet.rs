@@ -48,7 +48,11 @@ impl Scenery {
 
     fn driver(&self, params: &SimParams, choice: KernelChoice) -> FurDriver {
         let (device, queue) = (&self.headless.gpu.device, &self.headless.gpu.queue);
-        FurDriver::new(device, queue, &self.renderer, &self.structure, &self.textures, params, choice).expect("driver")
+        let mut driver = FurDriver::new(device, queue, &self.renderer, &self.structure, &self.textures, params, choice)
+            .expect("driver");
+        // The paper's look, which the view's light (following the camera) goes with.
+        driver.set_look(common::paper_look());
+        driver
     }
 
     fn stepper(&self, params: &SimParams, wet: &WetParams, script: Option<&str>) -> FurStepper {

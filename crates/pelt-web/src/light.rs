@@ -1,10 +1,11 @@
-//! The page's key light and shadows. The light follows the camera (Pelt's default look) until it
-//! is dragged or set; then it stays fixed in the world at its azimuth and elevation, as
-//! `pelt render --light` places it. Shadows and a ground under the meshes are switches.
+//! The page's key light and shadows: Pelt's studio (its key light fixed in the world, the
+//! `sky-ground` environment, shadows on), as `pelt render` draws it. A drag turns the light; it
+//! can follow the camera instead, as the paper's does. Shadows and a ground under the meshes are
+//! switches.
 
 use glam::{Vec2, Vec3};
-use pelt_core::light::direction_from_angles;
-use pelt_render::{Camera, Light, LightDirection};
+use pelt_core::light::{Environment, LightSource, direction_from_angles};
+use pelt_render::{Camera, GROUND_RADIANCE, KEY_LIGHT_ANGLES, Light, LightDirection, SKY_RADIANCE, Studio};
 
 /// Degrees the light turns per CSS pixel dragged (the orbit's rate).
 const LIGHT_DEG_PER_PX: f32 = 0.4;
@@ -14,7 +15,7 @@ const LIGHT_DEG_PER_PX: f32 = 0.4;
 const ELEVATION_RANGE_DEG: (f32, f32) = (2.0, 89.0);
 
 /// The key light and what it casts.
-#[derive(Clone, Copy, Debug, Default, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PageLight {
     /// Azimuth and elevation in degrees, fixed in the world; `None` follows the camera.
     angles: Option<(f32, f32)>,
@@ -22,6 +23,13 @@ pub struct PageLight {
     pub shadows: bool,
     /// A ground plane under the meshes, taking their shadow.
     pub ground: bool,
+}
+
+impl Default for PageLight {
+    /// Pelt's studio: the key light at [`KEY_LIGHT_ANGLES`], casting shadows; no ground.
+    fn default() -> Self {
+        Self { angles: Some(KEY_LIGHT_ANGLES), shadows: true, ground: false }
+    }
 }
 
 impl PageLight {
@@ -61,12 +69,25 @@ impl PageLight {
         self.angles = Some(((azimuth + drag_css_px.x * LIGHT_DEG_PER_PX).rem_euclid(360.0), elevation));
     }
 
-    /// The key light's direction for the studio.
+    /// The key light's direction.
     #[must_use]
     pub fn direction(&self) -> LightDirection {
         match self.angles {
             Some((azimuth, elevation)) => LightDirection::World(direction_from_angles(azimuth, elevation)),
             None => Light::default().direction,
+        }
+    }
+
+    /// The studio this light makes: [`Studio::default`] with the key light where it is, or the
+    /// paper's studio ([`Studio::following_camera`]) while it follows the camera.
+    #[must_use]
+    pub fn studio(&self) -> Studio {
+        match self.angles {
+            Some((azimuth, elevation)) => {
+                let key = LightSource { direction: direction_from_angles(azimuth, elevation), ..Studio::key_light() };
+                Studio::default().with_lights(&[key], Some(Environment::sky_ground(SKY_RADIANCE, GROUND_RADIANCE)))
+            }
+            None => Studio::following_camera(),
         }
     }
 }
@@ -82,10 +103,21 @@ mod tests {
     use super::*;
 
     #[test]
+    fn the_page_starts_in_pelts_studio() {
+        let light = PageLight::default();
+        assert_eq!(light.studio(), Studio::default());
+        assert!(light.shadows && !light.ground);
+        let mut following = light;
+        following.follow_camera();
+        assert_eq!(following.studio(), Studio::following_camera());
+    }
+
+    #[test]
     fn a_drag_starts_from_where_the_following_light_was() {
         let camera = Camera::orbit(Vec3::ZERO, 35.0, 15.0, 2.0);
         let following = camera.view_data(1.0, &Light::default()).light_direction_world;
         let mut light = PageLight::default();
+        light.follow_camera();
         light.drag(Vec2::ZERO, &camera);
         let LightDirection::World(fixed) = light.direction() else { panic!("a dragged light is fixed in the world") };
         assert!(fixed.distance(following) < 1e-4, "{fixed} against {following}");

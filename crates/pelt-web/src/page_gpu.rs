@@ -223,7 +223,7 @@ impl PageGpu {
             .fit_to_frame(device, &self.renderer, (frame.width(), frame.height()))
             .map_err(|e| e.to_string())?;
         let camera = model.orbit.camera();
-        self.studio.light.direction = model.light.direction();
+        self.studio = model.light.studio();
         let view_data = self.studio.view_data(&camera, targets.aspect_ratio());
         self.view.prepare(queue, &view_data);
         surroundings.prepare(queue, &view_data, &mut self.view);

@@ -1,6 +1,6 @@
 //! One look for every host: the page's frame (its `PageGpu`, copied into a texture of the
 //! canvas's format as into the browser's canvas) against `pelt render`'s (a `Headless` target of
-//! `HEADLESS_FORMAT`, the preset's own textures, `Studio::default`), same preset, camera, size and
+//! `HEADLESS_FORMAT`, the preset's own textures, `Studio::default` and its shadows), same preset, camera, size and
 //! simulated time, on lavapipe. The bunny's mean colour must agree, and `pelt render`'s must be
 //! the one in `web/test/look.json`, which the browser test holds the real page to. The page's
 //! key light, fixed in the world, casts the bunny's shadow on its ground.
@@ -13,7 +13,7 @@ use pelt_core::sim::FurStepper;
 use pelt_core::{FurStructure, Preset};
 use pelt_render::{
     Backend, FurDrawSettings, FurDriver, FurTarget, FurView, Gpu, HEADLESS_FORMAT, Headless, KernelChoice, Studio,
-    default_sample_count,
+    Surroundings, default_sample_count,
 };
 use pelt_web::light::PageLight;
 use pelt_web::model::{Model, SceneChoice};
@@ -95,13 +95,22 @@ fn render_frame(gpu: Gpu, preset: &Preset, model: &Model) -> image::RgbaImage {
     for frame in 1..=FRAMES {
         driver.advance_to(device, queue, &mut stepper, f64::from(frame) * FRAME_SECS).expect("advance");
     }
+    // Pelt's studio and its key light's shadows, as `pelt render` draws by default.
     let studio = Studio::default();
-    let view = FurView::new(device, &renderer);
-    view.prepare(queue, &studio.view_data(&model.orbit.camera(), headless.aspect_ratio()));
+    let view_data = studio.view_data(&model.orbit.camera(), headless.aspect_ratio());
+    let mut surroundings =
+        Surroundings::new(device, queue, &renderer, true, None, (&structure, &[])).expect("shadow maps");
+    surroundings.fit_to_frame(device, &renderer, (WIDTH_PX, HEIGHT_PX)).expect("fitted maps");
+    let mut view = FurView::new(device, &renderer);
+    view.prepare(queue, &view_data);
+    surroundings.prepare(queue, &view_data, &mut view);
     headless
         .render_with(
             studio.background,
-            |encoder| driver.record_view(encoder, &renderer, &view),
+            |encoder| {
+                driver.record_view(encoder, &renderer, &view);
+                surroundings.record(encoder, |pass, light| driver.draw(pass, &renderer, light, &FurDrawSettings::ALL));
+            },
             |pass| driver.draw(pass, &renderer, &view, &FurDrawSettings::SILHOUETTE),
         )
         .expect("frame")

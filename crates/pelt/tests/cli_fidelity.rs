@@ -55,6 +55,11 @@ fn fidelity_front(dir: &Path, name: &str, extra: &[&str]) -> (serde_json::Value,
     let out = dir.join(name);
     let output = Command::new(env!("CARGO_BIN_EXE_pelt"))
         .args(["fidelity", "--builtin", "bunny", "--size", "96x96", "--supersample", "2", "--views", "front"])
+        // The paper's studio (Kajiya-Kay, whose albedo the wetness darkens, in a light following
+        // the camera): the fur model's brown coat is mostly its white highlight, which water
+        // sharpens rather than darkens.
+        .args(["--preset", concat!(env!("CARGO_MANIFEST_DIR"), "/../../assets/presets/kajiya_kay.toml")])
+        .args(["--light", "camera"])
         .args(extra)
         .arg("--json")
         .arg(out.join("out.json"))

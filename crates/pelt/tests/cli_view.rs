@@ -111,11 +111,28 @@ fn scripted_touch(kernel: &str) {
     .unwrap();
     // Long upright fur, so a pat shows plainly.
     let preset = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("cli_view_touch_preset_{kernel}.toml"));
-    std::fs::write(&preset, "length = 0.2\n[direction]\nrandom_angle_deg = 0.0\ncomb_blend = 0.0\n").unwrap();
+    // In the paper's studio (Kajiya-Kay, the light following the camera, no shadows), where a flattened coat's
+    // highlight turns plainest toward the camera.
+    std::fs::write(
+        &preset,
+        "length = 0.2\n[direction]\nrandom_angle_deg = 0.0\ncomb_blend = 0.0\n[shading]\nmodel = \"kajiya-kay\"\n",
+    )
+    .unwrap();
     let preset = preset.to_str().unwrap();
     let frames = 60;
     // Without the overlay, so only the fur can differ (not the timings or the brush).
-    let base = ["--builtin", "plane", "--no-overlay", "--preset", preset, "--sim", kernel];
+    let base = [
+        "--builtin",
+        "plane",
+        "--no-overlay",
+        "--preset",
+        preset,
+        "--sim",
+        kernel,
+        "--light",
+        "camera",
+        "--no-shadows",
+    ];
     let untouched = screenshot(&format!("untouched-{kernel}"), frames, &base);
     let script = script.to_str().unwrap();
     let touched = screenshot(&format!("touched-{kernel}"), frames, &[&base[..], &["--script", script]].concat());
@@ -163,7 +180,7 @@ fn an_animated_file_moves_in_the_window() {
 }
 
 /// `--ground` and the Drawing section's switches: the ground under the bunny, and with shadows
-/// (on with the ground unless `--no-shadows`) the fur's shadow on it and on itself.
+/// (on unless `--no-shadows`) the fur's shadow on it and on itself.
 #[test]
 fn the_window_draws_the_ground_and_the_furs_shadow() {
     let common = ["--builtin", "bunny", "--sim", "cpu", "--no-overlay"];
@@ -180,8 +197,11 @@ fn the_window_draws_the_ground_and_the_furs_shadow() {
     };
     let ground = count(&bare, &unshadowed, 10.0) + count(&unshadowed, &bare, 10.0);
     assert!(ground > 20_000, "the ground changed {ground} pixels");
-    let darker = count(&shadowed, &unshadowed, 20.0);
-    let brighter = count(&unshadowed, &shadowed, 20.0);
+    // The sky-ground fill lights the shadow from above: it darkens the ground by less than the
+    // key light alone would.
+    let darker = count(&shadowed, &unshadowed, 10.0);
+    let brighter = count(&unshadowed, &shadowed, 10.0);
+    println!("{darker} pixels darker with shadows, {brighter} brighter");
     assert!(darker > 2_000, "{darker} pixels darker with shadows");
     assert!(brighter < darker / 10, "{brighter} pixels brighter, {darker} darker");
 }

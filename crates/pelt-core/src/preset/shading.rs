@@ -2,10 +2,10 @@
 //!
 //! ```toml
 //! [shading]
-//! model = "fur"           # "kajiya-kay" (default) | "fur"
+//! model = "fur"           # "fur" (default) | "kajiya-kay"
 //! roughness = 0.35        # fur: longitudinal width of the lobes, 0.05..=1
 //! cuticle_tilt_deg = 3.0  # fur: the scales' tilt, shifting the lobes along the strand, 0..=10
-//! medulla = 0.3           # fur: share of light the medulla scatters, 0..=1
+//! medulla = 0.4           # fur: share of light the medulla scatters, 0..=1
 //! melanin = 1.0           # fur: eumelanin, 0..=8; with pheomelanin tints the coat's colour
 //! pheomelanin = 0.0       # fur: 0..=8
 //! ```
@@ -25,12 +25,13 @@ fn check_range(key: &str, value: f32, low: f32, high: f32) -> Result<(), ParamEr
 /// Which reflectance model lights the strands.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum ShadingModel {
-    /// Kajiya-Kay's diffuse and highlight about the strand, one key light and an ambient term.
-    #[default]
+    /// Kajiya-Kay's diffuse and highlight about the strand, one key light and an ambient term:
+    /// the paper's look.
     #[serde(rename = "kajiya-kay")]
     KajiyaKay,
     /// R, TT and TRT lobes (Karis 2016's cheap form of Marschner et al.) with the medulla's
     /// scattered lobes (after Yan et al. 2017), every light and the environment.
+    #[default]
     #[serde(rename = "fur")]
     Fur,
 }
@@ -39,13 +40,13 @@ pub enum ShadingModel {
 #[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct ShadingParams {
-    /// The model. Default `"kajiya-kay"`.
+    /// The model. Default `"fur"`.
     pub model: ShadingModel,
     /// Longitudinal roughness, `0.05..=1`. Default 0.35.
     pub roughness: f32,
     /// Cuticle tilt, degrees, `0..=10`. Default 3.
     pub cuticle_tilt_deg: f32,
-    /// Share of the light entering a strand that its medulla scatters, `0..=1`. Default 0.3.
+    /// Share of the light entering a strand that its medulla scatters, `0..=1`. Default 0.4.
     pub medulla: f32,
     /// Eumelanin concentration, `0..=8`; leave out (with `pheomelanin`) to take the colour from
     /// the texture alone.
@@ -59,10 +60,10 @@ pub struct ShadingParams {
 impl Default for ShadingParams {
     fn default() -> Self {
         Self {
-            model: ShadingModel::KajiyaKay,
+            model: ShadingModel::Fur,
             roughness: 0.35,
             cuticle_tilt_deg: 3.0,
-            medulla: 0.3,
+            medulla: 0.4,
             melanin: None,
             pheomelanin: None,
         }

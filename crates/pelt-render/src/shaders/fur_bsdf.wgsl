@@ -64,9 +64,15 @@ fn hair_r_albedo(cos_v: f32) -> f32 {
         + 0.32607258 * (hair_fresnel(c * 0.94398) + hair_fresnel(c * 0.74237));
 }
 
+// The longitudinal roughness at wetness `wet`: water smooths the cuticle.
+fn wet_roughness(wet: f32) -> f32 {
+    return object.fur_roughness * (1.0 - 0.5 * clamp(object.wet_shine, 0.0, 1.0) * wet);
+}
+
 // The BSDF times the cosine for one light: (white R lobe, albedo-tinted lobes), per unit
 // irradiance from `l`. `t` strand tangent, `v` toward the eye, `n` surface normal, all unit.
-// `wet` (0..1) makes it smoother (narrower lobes), shinier and darker.
+// `wet` (0..1) makes it smoother (lobes narrower by the preset's wet shine, their energy kept:
+// the highlight sharpens, it does not brighten the coat) and darker (the tinted lobes).
 fn fur_bsdf(t: vec3<f32>, v: vec3<f32>, l: vec3<f32>, n: vec3<f32>, wet: f32) -> vec2<f32> {
     let sin_l = clamp(dot(t, l), -1.0, 1.0);
     let sin_v = clamp(dot(t, v), -1.0, 1.0);
@@ -78,7 +84,7 @@ fn fur_bsdf(t: vec3<f32>, v: vec3<f32>, l: vec3<f32>, n: vec3<f32>, wet: f32) ->
     let cos_v = sqrt(max(1.0 - sin_v * sin_v, 0.0));
     // cos((theta_v - theta_l) / 2) by the half-angle identity.
     let cos_theta_d = sqrt(clamp(0.5 + 0.5 * (cos_v * cos_l + sin_v * sin_l), 1e-4, 1.0));
-    let roughness = object.fur_roughness * (1.0 - 0.5 * wet);
+    let roughness = wet_roughness(wet);
     let b = roughness * roughness;
     let shift = object.fur_cuticle_tilt;
     let s = sin_l + sin_v;
@@ -90,7 +96,7 @@ fn fur_bsdf(t: vec3<f32>, v: vec3<f32>, l: vec3<f32>, n: vec3<f32>, wet: f32) ->
     let through = smoothstep(-0.4, 0.05, n_dot_l);
     // R: reflected at the surface, white.
     let r = hair_gaussian(b, s + 2.0 * shift) * 0.25 * cos_half_phi
-        * hair_fresnel(sqrt(clamp(0.5 + 0.5 * dot(v, l), 0.0, 1.0))) * (1.0 + object.wet_shine * wet) * lit_side;
+        * hair_fresnel(sqrt(clamp(0.5 + 0.5 * dot(v, l), 0.0, 1.0))) * lit_side;
     // TT: through the strand, forward (back light at the rim).
     let a = 1.0 / (1.19 / cos_theta_d + 0.36 * cos_theta_d);
     let h = cos_half_phi * (1.0 + a * (0.6 - 0.8 * cos_phi));
@@ -145,10 +151,10 @@ fn fur_terms(tangent: vec3<f32>, normal: vec3<f32>, world_position: vec3<f32>, h
     // The environment: irradiance / pi as the scattered fill (a white strand under a uniform
     // environment returns at most its radiance) and a blurred radiance about the mirror
     // direction as the rough highlight, sharing one budget with it.
-    let specular = 0.05 * (1.0 + object.wet_shine * wet);
+    let specular = 0.05;
     let diffuse = environment_sh(normal, 1.0, 0.6666667, 0.25) * (1.0 - object.wet_darkening * wet);
     let mirror = reflect(-to_camera, normal);
-    let width = object.fur_roughness * (1.0 - 0.5 * wet);
+    let width = wet_roughness(wet);
     let w2 = width * width;
     let highlight = environment_sh(mirror, 1.0, exp(-w2), exp(-3.0 * w2));
     return vec4<f32>(sum.x + specular * max(highlight, 0.0), sum.y, (1.0 - specular) * max(diffuse, 0.0), occlusion(height));

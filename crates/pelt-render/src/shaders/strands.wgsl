@@ -50,12 +50,12 @@ fn fs_strand(in: Varyings) -> @location(0) vec4<f32> {
     // The albedo travels in `tile_position`, which strands do not otherwise use.
     var albedo = in.tile_position;
     var terms = hair_terms(normalize(in.tangent), normalize(in.normal), in.world_position, in.height);
-    // A uniform branch: a wet strand darkens and shines as `wet_groom` and `wet_terms` make the
-    // shells do; a dry coat keeps `hair_lighting`'s very arithmetic.
+    // A uniform branch: a wet strand darkens and shines as `wet_groom` and `coat_terms` make the
+    // shells do (either model); a dry coat keeps `hair_lighting`'s very arithmetic.
     if wet_on() {
         let w = clamp(in.surface_uv.x, 0.0, 1.0);
         albedo *= 1.0 - object.wet_darkening * w;
-        terms = wet_terms(terms, w);
+        terms = coat_terms(normalize(in.tangent), normalize(in.normal), in.world_position, in.height, w);
     }
     return vec4<f32>(hair_colour(albedo, terms, in.height), 1.0);
 }

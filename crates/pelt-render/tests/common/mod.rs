@@ -7,12 +7,13 @@ use std::path::{Path, PathBuf};
 
 use glam::Vec3;
 use pelt_core::fur::FurLength;
+use pelt_core::preset::{ShadingModel, ShadingParams};
 use pelt_core::sim::{SimParams, Simulation, WindParams};
 use pelt_core::texture::FurTextures;
 use pelt_core::{Builtin, FurParams, FurStructure, GrowthDirection, Mesh};
 use pelt_render::{
-    Backend, Camera, DEFAULT_BACKGROUND, FurDrawSettings, FurFrame, FurRenderer, FurStates, FurView, Gpu, GpuFur,
-    Headless, Light, PlainMesh,
+    Backend, Camera, DEFAULT_BACKGROUND, FurDrawSettings, FurFrame, FurLook, FurRenderer, FurShading, FurStates,
+    FurView, Gpu, GpuFur, Headless, Light, PlainMesh, Studio,
 };
 
 fn hash(x: u32, y: u32, salt: u32) -> u32 {
@@ -125,6 +126,19 @@ pub fn headless(width: u32, height: u32) -> Headless {
     Headless::with_gpu(gpu(), width, height).expect("headless target")
 }
 
+/// The paper's look: Kajiya-Kay, which goes with the rig's light that follows the camera. Tests of
+/// what is not shading (fins, levels, grooms, colliders) draw in it; Pelt's look is
+/// [`Rig::render_in_studio`]'s.
+pub fn paper_look() -> FurLook {
+    let params = ShadingParams { model: ShadingModel::KajiyaKay, ..ShadingParams::default() };
+    FurLook { shading: FurShading::from_params(&params), ..FurLook::default() }
+}
+
+/// [`FurFrame::default`] in [`paper_look`].
+pub fn paper_frame() -> FurFrame {
+    FurFrame { look: paper_look(), ..FurFrame::default() }
+}
+
 /// A headless target with a renderer for it and one view: what most GPU tests draw with.
 pub struct Rig {
     pub headless: Headless,
@@ -148,15 +162,27 @@ impl Rig {
         &self.headless.gpu.queue
     }
 
-    /// The rest pose of `structure`, one state, with its look at the defaults.
+    /// The rest pose of `structure`, one state, in the paper's look ([`paper_frame`]).
     pub fn fur(&self, structure: &FurStructure, textures: &FurTextures) -> GpuFur {
         self.fur_with_states(structure, textures, FurStates::One)
     }
 
     pub fn fur_with_states(&self, structure: &FurStructure, textures: &FurTextures, states: FurStates) -> GpuFur {
         let fur = GpuFur::new(self.device(), self.queue(), &self.renderer, structure, textures, states).expect("fur");
-        fur.prepare(self.queue(), &FurFrame::default());
+        fur.prepare(self.queue(), &paper_frame());
         fur
+    }
+
+    /// One frame of `fur` in Pelt's look: [`FurFrame::default`] (the fur model) lit by
+    /// [`Studio::default`] (its key light fixed in the world, the sky-ground fill; no shadows,
+    /// which a host adds).
+    pub fn render_in_studio(&self, fur: &GpuFur, camera: &Camera, settings: &FurDrawSettings) -> image::RgbaImage {
+        fur.prepare(self.queue(), &FurFrame::default());
+        let studio = Studio::default();
+        self.view.prepare(self.queue(), &studio.view_data(camera, self.headless.aspect_ratio()));
+        self.headless
+            .render(studio.background, |pass| self.renderer.draw(pass, &self.view, fur, settings))
+            .expect("frame")
     }
 
     pub fn plain(&self, mesh: &Mesh, colour: Vec3) -> PlainMesh {
@@ -165,7 +191,8 @@ impl Rig {
         plain
     }
 
-    /// One frame: the plain meshes, then the fur, from `camera` with the default light.
+    /// One frame: the plain meshes, then the fur, from `camera` with the paper's light (following
+    /// the camera, [`Light::default`]).
     pub fn render_scene(
         &self,
         plain: &[&PlainMesh],

@@ -1,6 +1,6 @@
 //! `pelt bench --guard FILE`: the speed guard CI runs. Each figure is a ratio of two timings
 //! taken in the same run, in turns, so a slower or busier machine moves both alike: the default
-//! bunny frame against its skin alone (what the fur costs to draw), and the skin contact's setup
+//! bunny frame, shadows included, against its skin alone (what the fur costs to draw), and the skin contact's setup
 //! against growing the same fur (what finding the skin planes costs). A figure more than
 //! [`TOLERANCE`] above the one recorded in FILE (BENCHMARKS.md's "CI speed guard" table) fails
 //! the run.
@@ -14,7 +14,7 @@ use pelt_core::sim::contact::{skin_planes, skin_surface};
 use pelt_core::{Builtin, ImportOptions, Mesh, Preset};
 use pelt_render::{
     Backend, Camera, FurDrawSettings, FurDriver, FurTarget, FurView, Gpu, HEADLESS_FORMAT, Headless, KernelChoice,
-    Studio, default_sample_count,
+    Studio, Surroundings, default_sample_count,
 };
 
 /// How much worse than recorded a ratio may be.
@@ -114,8 +114,8 @@ fn ratio_in_turns(
     Ok(ratios[rounds / 2])
 }
 
-/// The default `pelt render` frame of the bunny (drawn and read back) over the same frame with
-/// the skin alone.
+/// The default `pelt render` frame of the bunny (Pelt's studio, the key light's shadow maps
+/// recorded, drawn and read back) over the same frame with the skin alone, unshadowed.
 fn frame_ratio((width, height): (u32, u32), key: &'static str, limit: f64) -> anyhow::Result<Figure> {
     let preset = Preset::default();
     let fur = preset.grow(Builtin::Bunny.mesh().0, "bunny")?;
@@ -138,22 +138,41 @@ fn frame_ratio((width, height): (u32, u32), key: &'static str, limit: f64) -> an
         15.0,
         headless.aspect_ratio(),
     );
+    // The default look: Pelt's studio and the key light's shadows, maps fitted to the frame.
     let studio = Studio::default();
-    let view = FurView::new(device, &renderer);
-    view.prepare(queue, &studio.view_data(&camera, headless.aspect_ratio()));
+    let view_data = studio.view_data(&camera, headless.aspect_ratio());
+    let mut surroundings = Surroundings::new(device, queue, &renderer, true, None, (&fur, &[]))?;
+    surroundings.fit_to_frame(device, &renderer, (width, height))?;
+    let mut view = FurView::new(device, &renderer);
+    view.prepare(queue, &view_data);
+    surroundings.prepare(queue, &view_data, &mut view);
+    // The reference: the skin alone, unshadowed (it moves with the machine, not with the fur).
+    let skin_view = FurView::new(device, &renderer);
+    skin_view.prepare(queue, &view_data);
     let lod = crate::lod::settings(&preset.render.lod, false);
     driver.set_level(crate::lod::level(&lod, &fur, camera.eye, camera.fov_y_rad, height));
-    let frame = |settings: FurDrawSettings| -> anyhow::Result<Duration> {
+    let fur_frame = || -> anyhow::Result<Duration> {
         let started = Instant::now();
         headless.render_with(
             studio.background,
-            |encoder| driver.record_view(encoder, &renderer, &view),
-            |pass| driver.draw(pass, &renderer, &view, &settings),
+            |encoder| {
+                driver.record_view(encoder, &renderer, &view);
+                surroundings.record(encoder, |pass, light| driver.draw(pass, &renderer, light, &FurDrawSettings::ALL));
+            },
+            |pass| driver.draw(pass, &renderer, &view, &FurDrawSettings::SILHOUETTE),
         )?;
         Ok(started.elapsed())
     };
-    let ratio =
-        ratio_in_turns(FRAME_ROUNDS, limit, || frame(FurDrawSettings::SILHOUETTE), || frame(FurDrawSettings::SKIN))?;
+    let skin_frame = || -> anyhow::Result<Duration> {
+        let started = Instant::now();
+        headless.render_with(
+            studio.background,
+            |encoder| driver.record_view(encoder, &renderer, &skin_view),
+            |pass| driver.draw(pass, &renderer, &skin_view, &FurDrawSettings::SKIN),
+        )?;
+        Ok(started.elapsed())
+    };
+    let ratio = ratio_in_turns(FRAME_ROUNDS, limit, fur_frame, skin_frame)?;
     Ok(Figure { key, what: "bunny frame / its skin alone", ratio })
 }
 

@@ -165,8 +165,10 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         width * factor,
         height * factor,
     )?;
-    let shell_side = Side::new(&shells, &fur, &textures, &mut stepper, &plain)?;
-    let strand_side = Side::new(&strands, &fur, &textures, &mut stepper, &plain)?;
+    // The preset's `[shading]`, for the shells and the strands alike.
+    let look = crate::light_args::preset_look(&preset);
+    let shell_side = Side::new(&shells, &fur, &textures, &mut stepper, &plain, look)?;
+    let strand_side = Side::new(&strands, &fur, &textures, &mut stepper, &plain, look)?;
     let positions = stepper.simulation().positions();
     let reference = strand_reference(&fur, field, &stepper)?;
     let strand_renderer = StrandRenderer::new(&strands.gpu.device, &strand_side.renderer)?;
@@ -319,12 +321,14 @@ impl Side {
         textures: &pelt_core::FurTextures,
         stepper: &mut FurStepper,
         plain: &[Mesh],
+        look: FurLook,
     ) -> anyhow::Result<Self> {
         let (device, queue) = (&headless.gpu.device, &headless.gpu.queue);
         let renderer = headless.renderer()?;
         // The fur settled under gravity (and `--wind`): a still frame.
         let params = stepper.simulation().params().clone();
         let mut gpu_fur = FurDriver::new(device, queue, &renderer, fur, textures, &params, KernelChoice::Cpu)?;
+        gpu_fur.set_look(look);
         gpu_fur.advance_to(device, queue, stepper, SETTLE_SECS)?;
         let plain = plain
             .iter()

@@ -183,6 +183,7 @@ impl App {
         if let Some(textures) = model.poll_textures() {
             running.fur.set_textures(&running.gpu, &textures)?;
         }
+        running.fur.set_shading(&model.settings.preset);
         running.fur.body_colliders = model.settings.draw.body_colliders;
         let draw = model.settings.draw;
         running.fur.set_surroundings(&running.gpu, &model.structure, model.body.as_ref(), draw.shadows, draw.ground)?;

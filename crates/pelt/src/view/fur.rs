@@ -111,6 +111,15 @@ impl FurScene {
         Ok(())
     }
 
+    /// Draws with the preset's `[shading]` from the next frame on (its other looks stay).
+    pub fn set_shading(&mut self, preset: &pelt_core::Preset) {
+        let look = crate::light_args::preset_look(preset);
+        let frame = self.driver.frame();
+        if frame.look.shading != look.shading {
+            self.driver.set_look(pelt_render::FurLook { shading: look.shading, ..frame.look });
+        }
+    }
+
     /// Steps the fur to `time_secs` (its clip at `clip_time_secs`) and writes this frame's state:
     /// the GPU simulation's new steps (a compute pass, submitted now) or the CPU's interpolated
     /// output.

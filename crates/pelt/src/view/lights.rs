@@ -1,12 +1,15 @@
 //! The viewer's lights: the panel's Lights section (add, drag and remove suns and point lights;
-//! the environment) and the studio they make. Without lights, Pelt's key light follows the
-//! camera; the first light is the key light, the one that casts the shadows.
+//! the environment) and the studio they make. They start as Pelt's studio (its key light and
+//! `sky-ground`); without lights the key light follows the camera. The first light is the key
+//! light, the one that casts the shadows.
 
 use glam::Vec3;
 use pelt_core::light::{Environment, LightKind, LightSource, direction_from_angles};
 use pelt_render::Studio;
 
-use crate::light_args::{GROUND, LightArgs, SKY};
+use pelt_render::{GROUND_RADIANCE, SKY_RADIANCE};
+
+use crate::light_args::LightArgs;
 
 /// A new sun's illuminance: pi lux, so a white Lambertian surface facing it shows white.
 const SUN_LUX: f32 = std::f32::consts::PI;
@@ -29,7 +32,8 @@ impl LightSettings {
     /// # Errors
     /// An environment image that cannot be read, named.
     pub fn from_args(args: &LightArgs) -> anyhow::Result<Self> {
-        let environment = args.environment(None)?.map(|e| (args.environment.clone().unwrap_or_default(), e));
+        let name = args.environment.clone().unwrap_or_else(|| "sky-ground".to_owned());
+        let environment = args.environment(None)?.map(|e| (name, e));
         Ok(Self { lights: args.lights_at(None, 0.0), environment: environment.clone(), given_environment: environment })
     }
 
@@ -154,7 +158,7 @@ pub fn lights_ui(ui: &mut egui::Ui, settings: &mut LightSettings, placement: &Pl
     let mut sky = settings.environment.as_ref().is_some_and(|(name, _)| name == "sky-ground");
     if ui.checkbox(&mut sky, "sky-ground environment").on_hover_text("a pale sky over a dark ground").changed() {
         settings.environment = if sky {
-            Some(("sky-ground".to_owned(), Environment::sky_ground(SKY, GROUND)))
+            Some(("sky-ground".to_owned(), Environment::sky_ground(SKY_RADIANCE, GROUND_RADIANCE)))
         } else {
             settings.given_environment.clone().filter(|(name, _)| name != "sky-ground")
         };

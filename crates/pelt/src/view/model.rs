@@ -169,7 +169,7 @@ impl Model {
         let mut settings = Settings::new(choice, preset, preset_path);
         settings.overlay = !args.no_overlay;
         settings.draw.ground = args.shadows.ground;
-        settings.draw.shadows = !args.shadows.no_shadows && (args.shadows.shadows || args.shadows.ground);
+        settings.draw.shadows = !args.shadows.no_shadows;
         settings.lights = super::lights::LightSettings::from_args(&args.lights)?;
         settings.animation = animation_settings(rig.as_ref());
         let structure = grow(mesh, &settings.preset, &settings.mesh)?;
