@@ -221,7 +221,11 @@ impl GpuFur {
         let skin = if coat >= 1.0 {
             self.asset.textures.root_colour
         } else {
-            self.asset.textures.coat_colour(frame.look.root_occlusion).lerp(self.asset.textures.root_colour, coat)
+            let look = &frame.look;
+            self.asset
+                .textures
+                .coat_colour(look.root_occlusion, look.shading.fur_model)
+                .lerp(self.asset.textures.root_colour, coat)
         };
         let tint = frame.look.tint;
         let skin = if tint.is_finite() { skin * tint.max(Vec3::ZERO) } else { skin };

@@ -256,11 +256,19 @@ fn slice_means(textures: &FurTextures, slice_bytes: usize) -> Vec<[f32; 4]> {
         .collect()
 }
 
+/// The share of a surface's light a coat returns as the skin is lit (wrapped Lambert): Kajiya-Kay's
+/// diffuse term, and the fur model's lobes, whose strands absorb and scatter more of it away
+/// (measured on the bunny in Pelt's studio: its brown coat's mean colour against its skin's,
+/// about 0.3-0.45 by channel in linear light; the white highlight makes it less saturated).
+const KAJIYA_KAY_REFLECTANCE: f32 = 0.85;
+const FUR_MODEL_REFLECTANCE: f32 = 0.3;
+
 impl GpuTextures {
     /// The coat's mean colour seen from above as the shells shade it: the slices' means
     /// composited roots first over the skin, each darkened toward the roots as `occlusion` in
-    /// `shading.wgsl` does with `root_occlusion`, and Kajiya-Kay's 0.85 of diffuse light.
-    pub fn coat_colour(&self, root_occlusion: f32) -> glam::Vec3 {
+    /// `shading.wgsl` does with `root_occlusion`, times the share of light the shading model's
+    /// strands return (`fur_model`: the fur model's, else Kajiya-Kay's).
+    pub fn coat_colour(&self, root_occlusion: f32, fur_model: bool) -> glam::Vec3 {
         let n = self.slice_means.len().max(1) as f32;
         let mut colour = self.root_colour * root_occlusion;
         for (i, [r, g, b, alpha]) in self.slice_means.iter().enumerate() {
@@ -268,7 +276,7 @@ impl GpuTextures {
             let occlusion = root_occlusion + (1.0 - root_occlusion) * height.powf(0.7);
             colour = colour * (1.0 - alpha) + glam::Vec3::new(*r, *g, *b) * occlusion;
         }
-        colour * 0.85
+        colour * if fur_model { FUR_MODEL_REFLECTANCE } else { KAJIYA_KAY_REFLECTANCE }
     }
 }
 

@@ -8,8 +8,8 @@ use glam::{Mat4, Vec3};
 use pelt_core::FurTextures;
 use pelt_core::sim::SceneGround;
 use pelt_render::{
-    FurDrawSettings, FurDriver, FurLook, FurRenderer, FurTarget, FurView, KernelChoice, PlainMesh, RenderTargets,
-    Studio, Surroundings,
+    FurDrawSettings, FurDriver, FurLook, FurRenderer, FurShading, FurTarget, FurView, KernelChoice, PlainMesh,
+    RenderTargets, Studio, Surroundings,
 };
 
 use crate::model::Model;
@@ -175,6 +175,12 @@ impl PageGpu {
         frame_secs: f64,
     ) -> Result<(), String> {
         let time_secs = model.tick(frame_secs).map_err(|e| e.to_string())?;
+        // The preset's `[shading]`, as `pelt render` draws it.
+        let shading = FurShading::from_params(&model.preset.shading);
+        let look = self.driver.frame().look;
+        if look.shading != shading {
+            self.driver.set_look(FurLook { shading, ..look });
+        }
         self.driver.advance_to(device, queue, &mut model.stepper, time_secs).map_err(|e| e.to_string())?;
         // The walking try-on body takes the skirt's clip at the same time.
         if let (Some(body), Some((positions, normals))) = (&self.body, model.pose_body()) {

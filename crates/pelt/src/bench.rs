@@ -356,7 +356,7 @@ fn measure(
                 plan.render_budget(),
                 lod,
                 plan.extra_sizes,
-                plan.shadows,
+                (plan.shadows, crate::light_args::preset_look(&preset)),
             )?
         }
         Err(reason) => RenderFigures { render_unavailable_reason: Some(reason.clone()), ..RenderFigures::default() },

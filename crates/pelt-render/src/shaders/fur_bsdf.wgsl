@@ -64,6 +64,12 @@ fn hair_r_albedo(cos_v: f32) -> f32 {
         + 0.32607258 * (hair_fresnel(c * 0.94398) + hair_fresnel(c * 0.74237));
 }
 
+// What a wet cuticle reflects of a dry one's: the air-water and water-keratin interfaces at
+// normal incidence (Fresnel 0.020 + 0.006, indices 1.33 and 1.55) against air-keratin (0.047).
+fn water_film(wet: f32) -> f32 {
+    return 1.0 - 0.45 * wet;
+}
+
 // The longitudinal roughness at wetness `wet`: water smooths the cuticle.
 fn wet_roughness(wet: f32) -> f32 {
     return object.fur_roughness * (1.0 - 0.5 * clamp(object.wet_shine, 0.0, 1.0) * wet);
@@ -71,8 +77,8 @@ fn wet_roughness(wet: f32) -> f32 {
 
 // The BSDF times the cosine for one light: (white R lobe, albedo-tinted lobes), per unit
 // irradiance from `l`. `t` strand tangent, `v` toward the eye, `n` surface normal, all unit.
-// `wet` (0..1) makes it smoother (lobes narrower by the preset's wet shine, their energy kept:
-// the highlight sharpens, it does not brighten the coat) and darker (the tinted lobes).
+// `wet` (0..1) makes it smoother (lobes narrower by the preset's wet shine, the highlight's
+// peak kept) and darker (the tinted lobes).
 fn fur_bsdf(t: vec3<f32>, v: vec3<f32>, l: vec3<f32>, n: vec3<f32>, wet: f32) -> vec2<f32> {
     let sin_l = clamp(dot(t, l), -1.0, 1.0);
     let sin_v = clamp(dot(t, v), -1.0, 1.0);
@@ -94,8 +100,10 @@ fn fur_bsdf(t: vec3<f32>, v: vec3<f32>, l: vec3<f32>, n: vec3<f32>, wet: f32) ->
     let n_dot_l = dot(n, l);
     let lit_side = smoothstep(-0.25, 0.6, n_dot_l);
     let through = smoothstep(-0.4, 0.05, n_dot_l);
-    // R: reflected at the surface, white.
-    let r = hair_gaussian(b, s + 2.0 * shift) * 0.25 * cos_half_phi
+    // R: reflected at the surface, white. Wet, the narrower lobe keeps its dry peak (the
+    // highlight sharpens, it does not spread brighter) and the water film reflects less.
+    let sharpened = b / max(object.fur_roughness * object.fur_roughness, 1e-6);
+    let r = hair_gaussian(b, s + 2.0 * shift) * sharpened * water_film(wet) * 0.25 * cos_half_phi
         * hair_fresnel(sqrt(clamp(0.5 + 0.5 * dot(v, l), 0.0, 1.0))) * lit_side;
     // TT: through the strand, forward (back light at the rim).
     let a = 1.0 / (1.19 / cos_theta_d + 0.36 * cos_theta_d);
@@ -151,7 +159,7 @@ fn fur_terms(tangent: vec3<f32>, normal: vec3<f32>, world_position: vec3<f32>, h
     // The environment: irradiance / pi as the scattered fill (a white strand under a uniform
     // environment returns at most its radiance) and a blurred radiance about the mirror
     // direction as the rough highlight, sharing one budget with it.
-    let specular = 0.05;
+    let specular = 0.05 * water_film(wet);
     let diffuse = environment_sh(normal, 1.0, 0.6666667, 0.25) * (1.0 - object.wet_darkening * wet);
     let mirror = reflect(-to_camera, normal);
     let width = wet_roughness(wet);

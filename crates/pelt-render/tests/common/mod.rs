@@ -177,7 +177,18 @@ impl Rig {
     /// [`Studio::default`] (its key light fixed in the world, the sky-ground fill; no shadows,
     /// which a host adds).
     pub fn render_in_studio(&self, fur: &GpuFur, camera: &Camera, settings: &FurDrawSettings) -> image::RgbaImage {
-        fur.prepare(self.queue(), &FurFrame::default());
+        self.render_frame_in_studio(fur, &FurFrame::default(), camera, settings)
+    }
+
+    /// [`Rig::render_in_studio`] with `frame` (its look, level, transform) instead of the default.
+    pub fn render_frame_in_studio(
+        &self,
+        fur: &GpuFur,
+        frame: &FurFrame,
+        camera: &Camera,
+        settings: &FurDrawSettings,
+    ) -> image::RgbaImage {
+        fur.prepare(self.queue(), frame);
         let studio = Studio::default();
         self.view.prepare(self.queue(), &studio.view_data(camera, self.headless.aspect_ratio()));
         self.headless

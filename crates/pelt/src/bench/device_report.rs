@@ -64,7 +64,15 @@ pub fn run(meshes: &Path, out: &Path, quick: bool) -> anyhow::Result<()> {
         let textures = preset.generate_textures()?;
         eprintln!("pelt bench: {key} frames");
         let lod = crate::lod::settings(&preset.render.lod, false);
-        let figures = bench.measure(&fur, model.body.as_ref(), &textures, budget, lod, &[size], true)?;
+        let figures = bench.measure(
+            &fur,
+            model.body.as_ref(),
+            &textures,
+            budget,
+            lod,
+            &[size],
+            (true, crate::light_args::preset_look(&preset)),
+        )?;
         frames.push(ModelFrames { model: key, layers: preset.layers, figures });
     }
     let counts: &[usize] = if quick { &[1, 10] } else { &[100, 1000] };

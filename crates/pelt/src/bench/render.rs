@@ -122,7 +122,8 @@ impl Bench {
     /// Median frame times of the three structures at both sizes, each drawing the same scene:
     /// the fur and, for the try-on model, the plain `body` under it; at `extra_sizes` also
     /// frames per second (`SizeFigures`). With `shadows`, the unified fur is also timed with the
-    /// key light's shadow maps (interleaved with the rest, at the two standard sizes).
+    /// key light's shadow maps (interleaved with the rest, at the two standard sizes). Every fur
+    /// draws in `look` (the preset's).
     #[allow(clippy::too_many_arguments)]
     pub fn measure(
         &self,
@@ -132,7 +133,7 @@ impl Bench {
         budget: RenderBudget,
         lod: pelt_render::LodSettings,
         extra_sizes: &[(u32, u32)],
-        shadows: bool,
+        (shadows, look): (bool, pelt_render::FurLook),
     ) -> anyhow::Result<RenderFigures> {
         let (device, queue) = (&self.gpu.device, &self.gpu.queue);
         // The samples `pelt render` and the viewer use on this adapter.
@@ -148,9 +149,11 @@ impl Bench {
             .context("building the separated structure (2-face fins)")?;
         let separated30 = SeparatedFur::new(device, queue, &renderer, fur, textures, MANY_FIN_FACES)
             .context("building the separated structure (30-face fins)")?;
-        unified.prepare(queue, &FurFrame::default());
-        separated2.prepare(queue, &FurFrame::default());
-        separated30.prepare(queue, &FurFrame::default());
+        // Every structure in the preset's look.
+        let base = FurFrame { look, ..FurFrame::default() };
+        unified.prepare(queue, &base);
+        separated2.prepare(queue, &base);
+        separated30.prepare(queue, &base);
         let body = body_mesh.map(|body| PlainMesh::new(device, &renderer, body, PLAIN_COLOUR)).transpose()?;
         if let Some(body) = &body {
             body.prepare(queue, glam::Mat4::IDENTITY);
@@ -245,9 +248,9 @@ impl Bench {
                     <[f64; 3]>::try_from(self.frames_per_second(cases, frames)?).expect("one rate per case");
                 let (level, fps_unified_lod) = if lod.enabled {
                     let level = crate::lod::level(&lod, fur, camera.eye, camera.fov_y_rad, height);
-                    unified.prepare(queue, &FurFrame { level, ..FurFrame::default() });
+                    unified.prepare(queue, &FurFrame { level, ..base });
                     let fps = self.frames_per_second(&cases[..1], frames);
-                    unified.prepare(queue, &FurFrame::default());
+                    unified.prepare(queue, &base);
                     (Some(level.describe(fur.layers)), Some(fps?[0]))
                 } else {
                     (None, None)
@@ -279,7 +282,7 @@ impl Bench {
                 let level = |camera: &Camera| crate::lod::level(&lod, fur, camera.eye, camera.fov_y_rad, height);
                 let (near_level, far_level) = (level(&camera), level(&far_camera));
                 let timed = |view_data: &pelt_render::ViewData, level: pelt_render::FurLevel| {
-                    unified.prepare(queue, &FurFrame { level, ..FurFrame::default() });
+                    unified.prepare(queue, &FurFrame { level, ..base });
                     let record = |encoder: &mut wgpu::CommandEncoder| {
                         view.prepare(queue, view_data);
                         renderer.prepare_fins(encoder, &view, &unified);
@@ -297,7 +300,7 @@ impl Bench {
                 let (near_ms, near_triangles) = timed(&view_data, near_level)?;
                 let (far_lod_ms, far_lod_triangles) = timed(&far_view, far_level)?;
                 let (far_full_ms, far_full_triangles) = timed(&far_view, pelt_render::FurLevel::FULL)?;
-                unified.prepare(queue, &FurFrame::default());
+                unified.prepare(queue, &base);
                 lod_figures.push(LodFigures {
                     size: format!("{width}x{height}"),
                     level_near: near_level.describe(fur.layers),
