@@ -311,8 +311,8 @@ function bunnyCentre(image) {
 }
 
 /** Changed pixels between two shots: how many, and how many lie within `reach` of `press`. */
-function changes(a, b, press, reach) {
-  const changed = select(a, (p, x, y) => differs(p, pixel(b, x, y), 24));
+function changes(a, b, press, reach, by = 24) {
+  const changed = select(a, (p, x, y) => differs(p, pixel(b, x, y), by));
   const near = changed.xs.filter((x, i) => Math.hypot(x - press[0], changed.ys[i] - press[1]) < reach).length;
   return { count: changed.count, near };
 }
@@ -365,12 +365,13 @@ test('finger: the pointer over the fur parts it, and leaving lets it stand again
   await frames(page, 8);
   const lifted = await shot(page, 'finger-out');
 
-  // Here the finger changed 726 pixels (a hole in the fur down to the skin), all near it.
-  const changed = changes(pressed, still, press, 0.5 * radiusPx);
+  // Here the finger changed 899 pixels by more than 12 levels (a hole in the fur down to the
+  // skin, which in Pelt's look is close to the coat's colour), all near it.
+  const changed = changes(pressed, still, press, 0.5 * radiusPx, 12);
   console.log(`finger: ${changed.count} pixels changed, ${changed.near} near the pointer`);
   assert.ok(changed.count > 150, `the finger changed only ${changed.count} pixels`);
   assert.ok(changed.near > 0.9 * changed.count, `${changed.count - changed.near} of ${changed.count} changed pixels lie far from the finger`);
-  const left = changes(lifted, still, press, 0.5 * radiusPx);
+  const left = changes(lifted, still, press, 0.5 * radiusPx, 12);
   assert.ok(left.count < Math.max(50, 0.1 * changed.count), `${left.count} pixels stay changed after the finger left`);
   assert.deepEqual(page.problems, []);
 });
