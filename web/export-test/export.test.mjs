@@ -19,7 +19,8 @@ import { validate, summary } from './validate.mjs';
 const here = path.dirname(fileURLToPath(import.meta.url));
 const output = path.join(here, 'output');
 const chromium = process.env.CHROMIUM || '/usr/bin/chromium';
-// `run.sh` renders the bunny with `pelt render --camera 30,15,DISTANCE --size WIDTHxHEIGHT`.
+// `run.sh` renders the bunny with `pelt render --camera 30,15,DISTANCE --size WIDTHxHEIGHT` in the
+// paper's studio (`--preset assets/presets/kajiya_kay.toml --light camera --no-shadows`), page.html's.
 const VIEW = { width: 480, height: 360, azimuth: 30, elevation: 15, distance: 24 };
 // `pelt render`'s background, as its PNG holds it (sRGB bytes of linear 0.045, 0.05, 0.06).
 const BACKGROUND = [60, 63, 69];

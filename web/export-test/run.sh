@@ -28,8 +28,10 @@ mkdir -p "$out"
 "$pelt" export --builtin bunny --layers 8 --motion 1 -o "$out/bunny-motion.glb"
 "$pelt" export assets/meshes/Fox.glb --preset assets/presets/fox.toml --layers 4 --motion 1 -o "$out/fox-motion.glb"
 # The picture three.js must match: no wind (the export settles without), every layer; the camera
-# is export.test.mjs's VIEW.
-"$pelt" render --builtin bunny --wind 0,0,0 --no-lod --camera 30,15,24 --size 480x360 -o "$out/bunny-pelt.png"
+# is export.test.mjs's VIEW; the studio is page.html's (the paper's: Kajiya-Kay in a key light
+# fixed to the camera, a uniform ambient, no shadows), which a standard PBR material can stand in for.
+"$pelt" render --builtin bunny --wind 0,0,0 --no-lod --camera 30,15,24 --size 480x360 \
+  --preset assets/presets/kajiya_kay.toml --light camera --no-shadows -o "$out/bunny-pelt.png"
 
 cd web/export-test
 PUPPETEER_SKIP_DOWNLOAD=1 npm ci --no-fund --no-audit --loglevel=error
