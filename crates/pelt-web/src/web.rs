@@ -287,7 +287,7 @@ impl PeltApp {
         self.model.light.drag(Vec2::new(dx, dy), &camera);
     }
 
-    /// Lets the key light follow the camera again (Pelt's default look).
+    /// Lets the key light follow the camera, as the paper lights its fur.
     pub fn follow_camera_light(&mut self) {
         self.model.light.follow_camera();
     }
