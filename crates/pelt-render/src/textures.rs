@@ -259,9 +259,10 @@ fn slice_means(textures: &FurTextures, slice_bytes: usize) -> Vec<[f32; 4]> {
 /// The share of a surface's light a coat returns as the skin is lit (wrapped Lambert): Kajiya-Kay's
 /// diffuse term, and the fur model's lobes, whose strands absorb and scatter more of it away
 /// (measured on the bunny in Pelt's studio: its brown coat's mean colour against its skin's,
-/// about 0.3-0.45 by channel in linear light; the white highlight makes it less saturated).
+/// 0.65-0.8 of Kajiya-Kay's share by channel in linear light; the white highlight makes it less
+/// saturated).
 const KAJIYA_KAY_REFLECTANCE: f32 = 0.85;
-const FUR_MODEL_REFLECTANCE: f32 = 0.3;
+const FUR_MODEL_REFLECTANCE: f32 = 0.6;
 
 impl GpuTextures {
     /// The coat's mean colour seen from above as the shells shade it: the slices' means

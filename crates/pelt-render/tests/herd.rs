@@ -106,8 +106,8 @@ fn a_far_fur_fades_to_its_skin_in_the_coats_colour_without_a_jump() {
 }
 
 /// The same in Pelt's look (the fur model in Pelt's studio), whose coat reflects less than a
-/// surface of its colour: the skin it fades to is darkened to match. With Kajiya-Kay's share
-/// instead (tried once) the skin was 54 levels lighter than the coat in red.
+/// surface of its colour: the skin it fades to is darkened to match, within 10 levels. With
+/// Kajiya-Kay's share instead (tried once) the skin was 23 levels lighter than the coat in red.
 #[test]
 fn a_far_fur_fades_to_the_coats_colour_in_pelts_look_too() {
     coat_fade(true);
@@ -154,7 +154,8 @@ fn coat_fade(pelts_look: bool) {
     };
     let (coat, skin) = (mean_colour(&frames[0]), mean_colour(&frames[20]));
     eprintln!("mean colour with the coat {coat:?}, the skin alone {skin:?}");
+    let bound = if pelts_look { 10.0 } else { 25.0 };
     for channel in 0..3 {
-        assert!((coat[channel] - skin[channel]).abs() < 25.0, "coat {coat:?} against skin {skin:?}");
+        assert!((coat[channel] - skin[channel]).abs() < bound, "coat {coat:?} against skin {skin:?}");
     }
 }

@@ -128,9 +128,9 @@ fn a_water_level_darkens_the_fur_below_it_and_leaves_it_above_the_band_as_it_was
 }
 
 /// The same with the fur model (Pelt's look): water sharpens its highlight without brightening
-/// the coat (0.89 of the dry luminance here). With the narrower wet lobe's energy kept and no
-/// water film (tried once) the soaked fur was 1.12 as light as the dry; keeping the lobe's peak
-/// without the film, 1.00.
+/// the coat (0.76 of the dry luminance here). Tried once without the coat's scattering term:
+/// with the narrower wet lobe's energy kept and no water film the soaked fur was 1.12 as light
+/// as the dry; keeping the lobe's peak without the film, 1.00.
 #[test]
 fn a_water_level_darkens_fur_shaded_with_the_fur_model() {
     water_level(pelt_render::FurLook::default());

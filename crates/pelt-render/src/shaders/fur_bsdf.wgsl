@@ -70,6 +70,10 @@ fn water_film(wet: f32) -> f32 {
     return 1.0 - 0.45 * wet;
 }
 
+// The share of a light's irradiance the coat's strands scatter among themselves and return
+// diffusely (times the texel's colour).
+const MULTIPLE_SCATTERING: f32 = 0.6;
+
 // The longitudinal roughness at wetness `wet`: water smooths the cuticle.
 fn wet_roughness(wet: f32) -> f32 {
     return object.fur_roughness * (1.0 - 0.5 * clamp(object.wet_shine, 0.0, 1.0) * wet);
@@ -117,7 +121,12 @@ fn fur_bsdf(t: vec3<f32>, v: vec3<f32>, l: vec3<f32>, n: vec3<f32>, wet: f32) ->
     // (normalised over phi), taking the entering light's medulla share.
     let m = object.fur_medulla;
     let scattered = hair_gaussian(b + 0.6, s) * (1.0 - 0.4 * cos_phi) * 0.15915494 * (1.0 - f_tt) * lit_side;
-    let tinted = ((1.0 - m) * (tt + trt) + m * scattered) * (1.0 - hair_r_albedo(cos_v)) * (1.0 - object.wet_darkening * wet);
+    // Light scattered from strand to strand through the coat (what Unreal's hair BSDF adds as its
+    // diffuse scatter): a soft, wrapped cosine about the surface, as the environment's fill is.
+    // Without it a coat under a sun and little sky returns a third of a surface of its colour.
+    let multiple = MULTIPLE_SCATTERING * 0.31830988 * clamp((n_dot_l + 0.3) / 1.3, 0.0, 1.0);
+    let single = ((1.0 - m) * (tt + trt) + m * scattered) * (1.0 - hair_r_albedo(cos_v));
+    let tinted = (single + multiple) * (1.0 - object.wet_darkening * wet);
     return vec2<f32>(r, tinted);
 }
 
