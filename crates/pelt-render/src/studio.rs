@@ -41,8 +41,7 @@ impl Default for Studio {
     /// environment ([`SKY_RADIANCE`] over [`GROUND_RADIANCE`]) as the fill, exposure 1 and [`DEFAULT_BACKGROUND`].
     /// Hosts add the key light's shadows ([`crate::Surroundings`]).
     fn default() -> Self {
-        Self::following_camera()
-            .with_lights(&[Self::key_light()], Some(Environment::sky_ground(SKY_RADIANCE, GROUND_RADIANCE)))
+        Self::following_camera().with_lights(&[Self::key_light()], Some(Self::sky_ground()))
     }
 }
 
@@ -52,7 +51,20 @@ impl Studio {
     #[must_use]
     pub fn key_light() -> LightSource {
         let (azimuth, elevation) = KEY_LIGHT_ANGLES;
-        LightSource::directional(direction_from_angles(azimuth, elevation), Vec3::ONE, std::f32::consts::PI)
+        Self::sun_at(azimuth, elevation)
+    }
+
+    /// A white sun of pi lux at `azimuth_deg`, `elevation_deg` (as [`KEY_LIGHT_ANGLES`]), fixed
+    /// in the world and casting shadows: what `--light` and a dragged key light place.
+    #[must_use]
+    pub fn sun_at(azimuth_deg: f32, elevation_deg: f32) -> LightSource {
+        LightSource::directional(direction_from_angles(azimuth_deg, elevation_deg), Vec3::ONE, std::f32::consts::PI)
+    }
+
+    /// The `sky-ground` environment: [`SKY_RADIANCE`] over [`GROUND_RADIANCE`].
+    #[must_use]
+    pub fn sky_ground() -> Environment {
+        Environment::sky_ground(SKY_RADIANCE, GROUND_RADIANCE)
     }
 
     /// The paper's studio: one key light that follows the camera ([`Light::default`]) and a

@@ -4,8 +4,8 @@
 //! switches.
 
 use glam::{Vec2, Vec3};
-use pelt_core::light::{Environment, LightSource, direction_from_angles};
-use pelt_render::{Camera, GROUND_RADIANCE, KEY_LIGHT_ANGLES, Light, LightDirection, SKY_RADIANCE, Studio};
+use pelt_core::light::direction_from_angles;
+use pelt_render::{Camera, KEY_LIGHT_ANGLES, Light, LightDirection, Studio};
 
 /// Degrees the light turns per CSS pixel dragged (the orbit's rate).
 const LIGHT_DEG_PER_PX: f32 = 0.4;
@@ -84,8 +84,7 @@ impl PageLight {
     pub fn studio(&self) -> Studio {
         match self.angles {
             Some((azimuth, elevation)) => {
-                let key = LightSource { direction: direction_from_angles(azimuth, elevation), ..Studio::key_light() };
-                Studio::default().with_lights(&[key], Some(Environment::sky_ground(SKY_RADIANCE, GROUND_RADIANCE)))
+                Studio::default().with_lights(&[Studio::sun_at(azimuth, elevation)], Some(Studio::sky_ground()))
             }
             None => Studio::following_camera(),
         }

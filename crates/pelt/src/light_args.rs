@@ -5,11 +5,10 @@
 use std::path::Path;
 
 use anyhow::Context as _;
-use glam::Vec3;
-use pelt_core::light::{Environment, LightSource, direction_from_angles};
+use pelt_core::light::{Environment, LightSource};
 use pelt_core::preset::Preset;
 use pelt_core::sim::Scene;
-use pelt_render::{FurLook, FurShading, GROUND_RADIANCE, SKY_RADIANCE, Studio};
+use pelt_render::{FurLook, FurShading, Studio};
 
 /// `--light` and `--environment`.
 #[derive(Debug, Clone, Default, clap::Args)]
@@ -62,7 +61,6 @@ impl LightArgs {
     /// An image that cannot be read or is not one, named; an environment given with the key light
     /// following the camera.
     pub fn environment(&self, scene: Option<&Scene>) -> anyhow::Result<Option<Environment>> {
-        let sky_ground = || Environment::sky_ground(SKY_RADIANCE, GROUND_RADIANCE);
         match (self.environment.as_deref(), self.light) {
             (Some("ambient"), _) => Ok(None),
             (Some(_), Some(KeyLight::Camera)) => {
@@ -70,10 +68,10 @@ impl LightArgs {
                     "--environment: the key light that follows the camera has a uniform ambient; fix the light with --light AZIMUTH,ELEVATION"
                 )
             }
-            (Some("sky-ground"), _) => Ok(Some(sky_ground())),
+            (Some("sky-ground"), _) => Ok(Some(Studio::sky_ground())),
             (Some(file), _) => Environment::load_image(Path::new(file)).map(Some).context("--environment"),
             (None, Some(KeyLight::Camera)) => Ok(None),
-            (None, _) => Ok(Some(scene.and_then(|s| s.environment_light).unwrap_or_else(sky_ground))),
+            (None, _) => Ok(Some(scene.and_then(|s| s.environment_light).unwrap_or_else(Studio::sky_ground))),
         }
     }
 
@@ -81,13 +79,7 @@ impl LightArgs {
     #[must_use]
     pub fn lights_at(&self, scene: Option<&Scene>, time_secs: f64) -> Vec<LightSource> {
         match self.light {
-            Some(KeyLight::Fixed(azimuth, elevation)) => {
-                vec![LightSource::directional(
-                    direction_from_angles(azimuth, elevation),
-                    Vec3::ONE,
-                    std::f32::consts::PI,
-                )]
-            }
+            Some(KeyLight::Fixed(azimuth, elevation)) => vec![Studio::sun_at(azimuth, elevation)],
             Some(KeyLight::Camera) => Vec::new(),
             None => {
                 let script = scene.map(|s| s.lights_at(time_secs)).unwrap_or_default();

@@ -7,8 +7,6 @@ use glam::Vec3;
 use pelt_core::light::{Environment, LightKind, LightSource, direction_from_angles};
 use pelt_render::Studio;
 
-use pelt_render::{GROUND_RADIANCE, SKY_RADIANCE};
-
 use crate::light_args::LightArgs;
 
 /// A new sun's illuminance: pi lux, so a white Lambertian surface facing it shows white.
@@ -158,7 +156,7 @@ pub fn lights_ui(ui: &mut egui::Ui, settings: &mut LightSettings, placement: &Pl
     let mut sky = settings.environment.as_ref().is_some_and(|(name, _)| name == "sky-ground");
     if ui.checkbox(&mut sky, "sky-ground environment").on_hover_text("a pale sky over a dark ground").changed() {
         settings.environment = if sky {
-            Some(("sky-ground".to_owned(), Environment::sky_ground(SKY_RADIANCE, GROUND_RADIANCE)))
+            Some(("sky-ground".to_owned(), Studio::sky_ground()))
         } else {
             settings.given_environment.clone().filter(|(name, _)| name != "sky-ground")
         };
