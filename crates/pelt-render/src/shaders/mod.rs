@@ -10,10 +10,13 @@ mod layouts;
 mod mirrors;
 
 pub(crate) use layouts::Layouts;
-pub(crate) use layouts::{SHADOW_DEPTH_FORMAT, SHADOW_OPACITY_FORMAT, shadow_texture};
+pub(crate) use layouts::{SHADOW_DEPTH_FORMAT, SHADOW_OPACITY_FORMAT, array_view, shadow_texture};
 #[cfg(all(test, feature = "lab"))]
 pub(crate) use mirrors::assert_vertex_mirrors;
-pub(crate) use mirrors::{GpuLight, LightsUniform, OBJECT_UNIFORM_BYTES, ObjectUniform, ShadowUniform, ViewUniform};
+pub(crate) use mirrors::{
+    GpuLight, LightsUniform, OBJECT_UNIFORM_BYTES, ObjectUniform, SHADOW_VIEWS, ShadowUniform, ShadowViewUniform,
+    ViewUniform,
+};
 #[cfg(test)]
 pub(crate) use mirrors::{RustLayout, assert_mirrors, rust_layout};
 
@@ -23,7 +26,7 @@ pub(crate) const SHADING_WGSL: &str = include_str!("shading.wgsl");
 const WET_WGSL: &str = include_str!("wet.wgsl");
 /// The fur model's lights, environment and BSDF, likewise appended.
 const FUR_BSDF_WGSL: &str = include_str!("fur_bsdf.wgsl");
-/// The key light's visibility (shadow map and deep opacity map) and the shadow views' opacity
+/// The lights' visibility (shadow maps and deep opacity maps) and the shadow views' opacity
 /// fragments, appended to the shading wherever it goes.
 const SHADOWS_WGSL: &str = include_str!("shadows.wgsl");
 /// The unified structure's vertex and fragment shaders, over the shared vertex array.
