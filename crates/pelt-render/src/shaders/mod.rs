@@ -47,6 +47,8 @@ const SIMULATION_WGSL: &str = include_str!("simulation.wgsl");
 const SIMULATION_INPUTS_WGSL: &str = include_str!("simulation_inputs.wgsl");
 /// Contact after the bend (skin, colliders, grasp), called by the simulation's step.
 const SIMULATION_CONTACT_WGSL: &str = include_str!("simulation_contact.wgsl");
+/// A host's shadow map copied into one of Pelt's layers (`HostShadows`).
+const SHADOW_COPY_WGSL: &str = include_str!("shadow_copy.wgsl");
 /// Linear blend skinning of many instances (`GpuSkin`).
 const SKINNING_WGSL: &str = include_str!("skinning.wgsl");
 /// The separated structure of Lengyel et al. 2001 (the `lab` feature's baseline).
@@ -83,6 +85,12 @@ pub fn silhouette_shader_source() -> String {
 #[must_use]
 pub fn view_lod_shader_source() -> String {
     format!("{SHADING_WGSL}\n{WET_WGSL}\n{FUR_BSDF_WGSL}\n{SHADOWS_WGSL}\n{UNIFIED_WGSL}\n{SCAN_WGSL}\n{VIEW_LOD_WGSL}")
+}
+
+/// The WGSL module that copies a host's shadow map into Pelt's (`shadow_copy.wgsl`).
+#[must_use]
+pub fn shadow_copy_shader_source() -> String {
+    SHADOW_COPY_WGSL.to_owned()
 }
 
 /// The WGSL module of the GPU skinning (`skinning.wgsl`).
