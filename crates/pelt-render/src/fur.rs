@@ -16,6 +16,7 @@ use crate::object::{FurFrame, GpuBytes};
 use crate::requirements::ErrorScope;
 use crate::shaders::Layouts;
 use crate::textures::GpuTextures;
+use crate::view::ShadowLookups;
 
 /// How many simulation states a [`GpuFur`] keeps on the GPU.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
@@ -39,24 +40,28 @@ pub(crate) struct Coat {
     pub groomed: bool,
     /// Some strand is wet.
     pub wet: bool,
-    /// The view it is drawn through reads the key light's shadow maps (`SHADOWS` in
-    /// `shadows.wgsl`): a coat seen without shadows runs none of their lookups.
+    /// The view it is drawn through reads shadow maps (`SHADOWS` in `shadows.wgsl`): a coat
+    /// seen without shadows runs none of their lookups.
     pub shadowed: bool,
     /// The fur model lights it (else Kajiya-Kay).
     pub fur_model: bool,
+    /// The maps hold one view, light 0's (`SHADOW_KEY_ONLY`): the lookups read it at fixed
+    /// offsets.
+    pub key_shadows: bool,
 }
 
 impl Coat {
     /// Dry and ungroomed, Kajiya-Kay, without shadows: the lean entry points.
-    pub const PLAIN: Self = Self { groomed: false, wet: false, shadowed: false, fur_model: false };
+    pub const PLAIN: Self = Self { groomed: false, wet: false, shadowed: false, fur_model: false, key_shadows: false };
     /// Every coat, by [`Coat::index`].
-    pub const COUNT: usize = 16;
+    pub const COUNT: usize = 32;
 
     pub fn index(self) -> usize {
         usize::from(self.groomed)
             | usize::from(self.wet) << 1
             | usize::from(self.shadowed) << 2
             | usize::from(self.fur_model) << 3
+            | usize::from(self.key_shadows) << 4
     }
 
     /// The entry point of `name`'s kind for this coat: the lean one, or its `_groomed` twin.
@@ -64,9 +69,9 @@ impl Coat {
         if self.groomed || self.wet { format!("{name}_groomed") } else { name.to_owned() }
     }
 
-    /// The same coat, seen with shadows or without.
-    pub fn shadowed(self, shadowed: bool) -> Self {
-        Self { shadowed, ..self }
+    /// The same coat, seen with `lookups`.
+    pub fn shadowed(self, lookups: ShadowLookups) -> Self {
+        Self { shadowed: lookups != ShadowLookups::Off, key_shadows: lookups == ShadowLookups::Key, ..self }
     }
 }
 
@@ -402,6 +407,7 @@ impl GpuFur {
             groomed: self.geometry.shape.groom_shading,
             wet: self.wet.load(Ordering::Relaxed),
             shadowed: false,
+            key_shadows: false,
             fur_model: self.fur_model.load(Ordering::Relaxed),
         }
     }

@@ -13,7 +13,7 @@ use crate::shaders::{
     SHADOW_DEPTH_FORMAT, SHADOW_OPACITY_FORMAT, SHADOW_VIEWS, ShadowUniform, ShadowViewUniform, array_view,
     shadow_copy_shader_source, shadow_texture,
 };
-use crate::view::FurView;
+use crate::view::{FurView, ShadowLookups};
 
 /// One of a host's shadow views: what drew it, and how its depth reads.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -206,8 +206,8 @@ impl HostShadows {
         }
     }
 
-    pub(crate) fn receiver_group(&self) -> &wgpu::BindGroup {
-        &self.receiver
+    pub(crate) fn receiver(&self) -> (&wgpu::BindGroup, ShadowLookups) {
+        (&self.receiver, ShadowLookups::Every)
     }
 }
 
@@ -255,6 +255,6 @@ impl FurView {
     /// Lights the draws through this view with a host's shadow maps ([`HostShadows`], copied
     /// with [`HostShadows::record_copy`] before this view's pass), or without shadows (`None`).
     pub fn set_host_shadows(&mut self, shadows: Option<&HostShadows>) {
-        self.set_shadow_group(shadows.map(HostShadows::receiver_group));
+        self.set_shadow_group(shadows.map(HostShadows::receiver));
     }
 }

@@ -20,7 +20,7 @@ use crate::shaders::{
     SHADOW_DEPTH_FORMAT as DEPTH_FORMAT, SHADOW_OPACITY_FORMAT as OPACITY_FORMAT, SHADOW_VIEWS, ShadowUniform,
     ShadowViewUniform, array_view, shadow_texture,
 };
-use crate::view::{FurView, ShadowPass, ViewData};
+use crate::view::{FurView, ShadowLookups, ShadowPass, ViewData};
 
 /// The most light views one [`ShadowMap`] holds: a point light takes six, a directional or spot
 /// light one. Shadowing lights past them cast no shadow.
@@ -235,6 +235,8 @@ pub struct ShadowMap {
     receiver: wgpu::BindGroup,
     /// The light views this frame's lights use, and which of them see the scene.
     used: Vec<bool>,
+    /// This frame's only light view is light 0's (the lookups read it at fixed offsets).
+    key_only: bool,
 }
 
 /// One light view's layers and the three passes' views into them.
@@ -340,7 +342,7 @@ impl ShadowMap {
             .collect();
         let receiver =
             layouts.shadow_group(device, &uniform, (&array_view(&depth), &fur_depth_array, &array_view(&opacity)));
-        Ok(Self { settings, uniform, slots, receiver, used: Vec::new() })
+        Ok(Self { settings, uniform, slots, receiver, used: Vec::new(), key_only: false })
     }
 
     /// The settings the maps were made with.
@@ -381,6 +383,7 @@ impl ShadowMap {
         };
         self.used.clear();
         let mut cast = 0;
+        let mut lights = Vec::new();
         for &(light, caster) in casters {
             let first = self.used.len();
             let count = caster.view_count() as usize;
@@ -396,8 +399,10 @@ impl ShadowMap {
                 }
                 self.used.push(seen);
             }
+            lights.push(light);
             cast += 1;
         }
+        self.key_only = lights == [0] && self.used.len() == 1;
         queue.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&uniform));
         for (index, slot) in self.slots.iter().enumerate().take(self.used.len()) {
             uniform.pass_view = index as u32;
@@ -461,9 +466,9 @@ impl ShadowMap {
         }
     }
 
-    /// Group 3 of the views lit with these maps.
-    pub(crate) fn receiver_group(&self) -> &wgpu::BindGroup {
-        &self.receiver
+    /// Group 3 of the views lit with these maps, and how their draws read them.
+    pub(crate) fn receiver(&self) -> (&wgpu::BindGroup, ShadowLookups) {
+        (&self.receiver, if self.key_only { ShadowLookups::Key } else { ShadowLookups::Every })
     }
 }
 
@@ -471,7 +476,7 @@ impl FurView {
     /// Lights the draws through this view with `shadows` (the lights' shadow maps, recorded
     /// with [`ShadowMap::record`] before this view's pass), or without shadows (`None`).
     pub fn set_shadows(&mut self, shadows: Option<&ShadowMap>) {
-        self.set_shadow_group(shadows.map(ShadowMap::receiver_group));
+        self.set_shadow_group(shadows.map(ShadowMap::receiver));
     }
 }
 

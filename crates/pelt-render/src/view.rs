@@ -240,9 +240,20 @@ pub struct FurView {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(crate) enum ViewRole {
     /// The host's picture, lit with the shadow maps or without.
-    Camera { shadowed: bool },
+    Camera { shadows: ShadowLookups },
     /// One pass of a shadow map, seen from the light.
     Shadow(ShadowPass),
+}
+
+/// How a picture's draws read shadow maps: pipelines are built for each.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum ShadowLookups {
+    /// None (no maps).
+    Off,
+    /// One light view, light 0's (Pelt's studio): read at fixed offsets.
+    Key,
+    /// Any light's views, cube faces included.
+    Every,
 }
 
 /// The passes of a [`ShadowMap`](crate::ShadowMap), in order.
@@ -286,7 +297,7 @@ impl FurView {
             bind_group,
             shadow_group: no_shadows.clone(),
             no_shadows,
-            role: ViewRole::Camera { shadowed: false },
+            role: ViewRole::Camera { shadows: ShadowLookups::Off },
         }
     }
 
@@ -300,11 +311,11 @@ impl FurView {
         Self { shadow_group, role: ViewRole::Shadow(pass), ..Self::create(device, layouts) }
     }
 
-    /// Binds a shadow map's receiver group (`None`: the stand-ins, no shadows); hosts call
-    /// `FurView::set_shadows` (`shadows.rs`).
-    pub(crate) fn set_shadow_group(&mut self, group: Option<&wgpu::BindGroup>) {
-        self.shadow_group = group.map_or_else(|| self.no_shadows.clone(), Clone::clone);
-        self.role = ViewRole::Camera { shadowed: group.is_some() };
+    /// Binds a shadow map's receiver group and how it is read (`None`: the stand-ins, no
+    /// shadows); hosts call `FurView::set_shadows` (`shadows.rs`).
+    pub(crate) fn set_shadow_group(&mut self, group: Option<(&wgpu::BindGroup, ShadowLookups)>) {
+        self.shadow_group = group.map_or_else(|| self.no_shadows.clone(), |(group, _)| group.clone());
+        self.role = ViewRole::Camera { shadows: group.map_or(ShadowLookups::Off, |(_, lookups)| lookups) };
     }
 
     /// This view drawing without shadows: the same uniforms (prepared with it), for objects
@@ -318,7 +329,7 @@ impl FurView {
             shadow_group: self.no_shadows.clone(),
             no_shadows: self.no_shadows.clone(),
             role: match self.role {
-                ViewRole::Camera { .. } => ViewRole::Camera { shadowed: false },
+                ViewRole::Camera { .. } => ViewRole::Camera { shadows: ShadowLookups::Off },
                 role @ ViewRole::Shadow(_) => role,
             },
         }
@@ -327,7 +338,7 @@ impl FurView {
     /// Whether draws through this view read a shadow map.
     #[must_use]
     pub fn has_shadows(&self) -> bool {
-        self.role == ViewRole::Camera { shadowed: true }
+        matches!(self.role, ViewRole::Camera { shadows: ShadowLookups::Key | ShadowLookups::Every })
     }
 
     pub(crate) fn role(&self) -> ViewRole {

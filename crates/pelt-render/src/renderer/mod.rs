@@ -27,7 +27,7 @@ use crate::plain::PlainMesh;
 use crate::requirements::{ErrorScope, check_features_and_limits};
 use crate::shaders::{Layouts, unified_shader_source};
 use crate::targets::FurTarget;
-use crate::view::{FurView, ViewRole};
+use crate::view::{FurView, ShadowLookups, ViewRole};
 
 /// Which parts of a fur a draw records; everything here can change every draw.
 ///
@@ -107,7 +107,7 @@ struct CoatBuilder {
 
 impl CoatBuilder {
     /// The plain and skin pipelines of one walk, seen with shadows or without.
-    fn surface(&self, target: &FurTarget, mesh_uvs: bool, shadowed: bool) -> SurfacePipelines {
+    fn surface(&self, target: &FurTarget, mesh_uvs: bool, shadowed: ShadowLookups) -> SurfacePipelines {
         let skin = format!("vs_skin_{}", if mesh_uvs { "wedges" } else { "indexed" });
         let build = |label, layout, fragment_entry| {
             let source = PipelineSource {
@@ -177,7 +177,7 @@ pub struct FurRenderer {
     /// The skin and plain meshes, without shadows and with them: meshes with uvs (indexed by
     /// the corners' wedges), then meshes without (by the base triangles). Those without shadows
     /// are built with the rest.
-    surfaces: [[OnceLock<SurfacePipelines>; 2]; 2],
+    surfaces: [[OnceLock<SurfacePipelines>; 2]; 3],
     /// Shells and fins per [`Coat`] (by [`Coat::index`]); the plain coat's built with the rest.
     coats: [OnceLock<CoatPipelines>; Coat::COUNT],
     coat_builder: CoatBuilder,
@@ -208,9 +208,9 @@ impl FurRenderer {
         let fur_layout = layouts.pipeline_layout(device, "pelt unified", &layouts.unified_object, true);
         let plain_layout = layouts.pipeline_layout(device, "pelt plain", &layouts.unified_object, false);
         let coat_builder = CoatBuilder { device: device.clone(), module, layout: fur_layout, plain_layout };
-        let surfaces = [(); 2].map(|()| [(); 2].map(|()| OnceLock::new()));
+        let surfaces = [(); 3].map(|()| [(); 2].map(|()| OnceLock::new()));
         for (walk, mesh_uvs) in [true, false].into_iter().enumerate() {
-            let _ = surfaces[0][walk].set(coat_builder.surface(&target, mesh_uvs, false));
+            let _ = surfaces[0][walk].set(coat_builder.surface(&target, mesh_uvs, ShadowLookups::Off));
         }
         let coats = [(); Coat::COUNT].map(|()| OnceLock::new());
         let _ = coats[Coat::PLAIN.index()].set(coat_builder.build(&target, Coat::PLAIN));
@@ -234,7 +234,7 @@ impl FurRenderer {
     /// that shadow pass instead: its skin as an opaque caster, its shells and fins as opacity.
     pub fn draw(&self, pass: &mut wgpu::RenderPass<'_>, view: &FurView, fur: &GpuFur, settings: &FurDrawSettings) {
         let shadowed = match view.role() {
-            ViewRole::Camera { shadowed } => shadowed,
+            ViewRole::Camera { shadows } => shadows,
             ViewRole::Shadow(shadow_pass) => return self.draw_shadow(pass, (view, shadow_pass), fur, settings),
         };
         let geometry = fur.geometry();
@@ -308,7 +308,7 @@ impl FurRenderer {
     /// [`PlainMesh::prepare`] before submitting.
     pub fn draw_plain(&self, pass: &mut wgpu::RenderPass<'_>, view: &FurView, mesh: &PlainMesh) {
         let shadowed = match view.role() {
-            ViewRole::Camera { shadowed } => shadowed,
+            ViewRole::Camera { shadows } => shadows,
             ViewRole::Shadow(shadow_pass) => return self.draw_plain_shadow(pass, (view, shadow_pass), mesh),
         };
         let geometry = mesh.geometry();
@@ -320,9 +320,9 @@ impl FurRenderer {
         geometry.draw_skin(pass);
     }
 
-    fn surface(&self, has_uvs: bool, shadowed: bool) -> &SurfacePipelines {
+    fn surface(&self, has_uvs: bool, shadowed: ShadowLookups) -> &SurfacePipelines {
         let walk = usize::from(!has_uvs);
-        self.surfaces[usize::from(shadowed)][walk]
+        self.surfaces[shadowed as usize][walk]
             .get_or_init(|| self.coat_builder.surface(&self.target, has_uvs, shadowed))
     }
 

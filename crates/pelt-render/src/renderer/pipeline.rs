@@ -50,7 +50,7 @@ pub(crate) struct PipelineSource<'a> {
 impl PipelineSource<'_> {
     /// The shaders' override constants for this source (`shading.wgsl`, `unified.wgsl`,
     /// `shadows.wgsl`); `coverage` sets `ALPHA_TO_COVERAGE`.
-    pub(crate) fn constants(&self, coverage: bool) -> [(&'static str, f64); 6] {
+    pub(crate) fn constants(&self, coverage: bool) -> [(&'static str, f64); 7] {
         let mesh_uvs = match self.mesh_uvs {
             None => 0.0,
             Some(true) => 1.0,
@@ -68,6 +68,7 @@ impl PipelineSource<'_> {
             ("GROOM", switch(self.coat.map(|c| c.groomed))),
             ("WET", switch(self.coat.map(|c| c.wet))),
             ("SHADOWS", if self.coat.is_some_and(|c| c.shadowed) { 1.0 } else { 0.0 }),
+            ("SHADOW_KEY_ONLY", if self.coat.is_some_and(|c| c.shadowed && c.key_shadows) { 1.0 } else { 0.0 }),
             ("SHADING", switch(self.coat.map(|c| c.fur_model))),
         ]
     }

@@ -8,7 +8,7 @@ use crate::fur::{Coat, GpuFur};
 use crate::plain::PlainMesh;
 use crate::renderer::FurDrawSettings;
 use crate::shaders::{SHADOW_DEPTH_FORMAT as DEPTH_FORMAT, SHADOW_OPACITY_FORMAT as OPACITY_FORMAT};
-use crate::view::{FurView, ShadowPass};
+use crate::view::{FurView, ShadowLookups, ShadowPass};
 
 /// What a shadow pipeline writes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -110,7 +110,7 @@ impl FurRenderer {
 
     fn opacity(&self, coat: Coat) -> &OpacityPipelines {
         // The lighting the vertex stage computes is not read, so the cheaper model's.
-        let coat = Coat { shadowed: false, fur_model: false, ..coat };
+        let coat = Coat { shadowed: false, key_shadows: false, fur_model: false, ..coat };
         self.shadows.opacity[coat.index()].get_or_init(|| self.coat_builder.opacity(coat))
     }
 
@@ -188,7 +188,7 @@ fn create_shadow_pipeline(
     kind: ShadowKind,
 ) -> wgpu::RenderPipeline {
     // The shadow views draw a coat's own shapes without reading shadows themselves.
-    let coat = source.coat.unwrap_or(Coat::PLAIN).shadowed(false);
+    let coat = source.coat.unwrap_or(Coat::PLAIN).shadowed(ShadowLookups::Off);
     let constants = PipelineSource { coat: Some(coat), ..*source }.constants(false);
     let compilation_options = wgpu::PipelineCompilationOptions { constants: &constants, ..Default::default() };
     let (depth_write, bias, cull_mode) = match kind {

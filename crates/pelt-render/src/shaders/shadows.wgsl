@@ -54,6 +54,10 @@ struct Shadow {
 // Set per pipeline: only views with a shadow map compile the lookups (a software rasteriser runs
 // every branch, taken or not).
 override SHADOWS: bool = false;
+// Set per pipeline with SHADOWS: the maps hold one light view, light 0's (Pelt's studio), so the
+// lookups read view 0 at fixed offsets. A software rasteriser gathers a uniform read at a
+// computed index lane by lane, which cost the default frame a tenth of its time.
+override SHADOW_KEY_ONLY: bool = false;
 
 // Light-space depth in world units from a depth-buffer value of view `v`. A `select`, not an
 // `if`: lavapipe (Mesa 22.3) inlines uniforms that alone decide a branch and compiles the shader
@@ -82,6 +86,9 @@ fn deep_opacity(layers: vec4<f32>, beyond: f32) -> f32 {
 // light has none: its one view, or the cube face of a point light that the point lies toward
 // (+x, -x, +y, -y, +z, -z). Selects, no branches.
 fn shadow_view_index(light_index: u32, world_position: vec3<f32>) -> u32 {
+    if SHADOW_KEY_ONLY {
+        return select(SHADOW_VIEWS, 0u, light_index == 0u);
+    }
     let views = shadow.light_views[min(light_index, 7u)];
     let d = world_position - shadow.views[min(views.x, SHADOW_VIEWS - 1u)].light.xyz;
     let a = abs(d);
@@ -97,7 +104,7 @@ fn shadow_view_index(light_index: u32, world_position: vec3<f32>) -> u32 {
 // rasteriser fetches for the lanes a branch has left too, and an out-of-range layer crashed
 // lavapipe (Mesa 22.3).
 fn shadow_layer(index: u32) -> i32 {
-    return i32(min(index, max(shadow.layers, 1u) - 1u));
+    return select(i32(min(index, max(shadow.layers, 1u) - 1u)), 0, SHADOW_KEY_ONLY);
 }
 
 // How much of light `light_index` reaches `world_position` (surface normal `world_normal`):
@@ -109,7 +116,7 @@ fn light_visibility(light_index: u32, world_position: vec3<f32>, world_normal: v
         return 1.0;
     }
     let index = shadow_view_index(light_index, world_position);
-    let v = min(index, SHADOW_VIEWS - 1u);
+    let v = select(min(index, SHADOW_VIEWS - 1u), 0u, SHADOW_KEY_ONLY);
     let light = shadow.views[v].light;
     let to_light = select(light.xyz, normalize(light.xyz - world_position), light.w > 0.5);
     // Slope-scaled: surfaces turning from the light move further off themselves.
@@ -146,7 +153,7 @@ fn strand_visibility(light_index: u32, world_position: vec3<f32>, world_normal: 
         return 1.0;
     }
     let index = shadow_view_index(light_index, world_position);
-    let v = min(index, SHADOW_VIEWS - 1u);
+    let v = select(min(index, SHADOW_VIEWS - 1u), 0u, SHADOW_KEY_ONLY);
     let light = shadow.views[v].light;
     let to_light = select(light.xyz, normalize(light.xyz - world_position), light.w > 0.5);
     // Slope-scaled: surfaces turning from the light move further off themselves.
