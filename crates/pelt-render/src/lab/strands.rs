@@ -36,6 +36,9 @@ struct RibbonVertex {
 const VERTEX_ATTRIBUTES: [wgpu::VertexAttribute; 6] = wgpu::vertex_attr_array![
     0 => Float32x3, 1 => Float32x3, 2 => Float32x3, 3 => Float32x4, 4 => Float32, 5 => Float32
 ];
+/// The key light's transmittance at each ribbon vertex, in a buffer of its own (rewritten per
+/// light without rebuilding the ribbons).
+const TRANSMITTANCE_ATTRIBUTES: [wgpu::VertexAttribute; 1] = wgpu::vertex_attr_array![6 => Float32];
 
 /// The strand pipeline for the target of a [`FurRenderer`] (its layouts, so it draws with the
 /// same [`FurView`]s and [`GpuFur`] uniforms).
@@ -69,11 +72,18 @@ impl StrandRenderer {
                 module: &module,
                 entry_point: Some("vs_strand"),
                 compilation_options: compilation_options.clone(),
-                buffers: &[Some(wgpu::VertexBufferLayout {
-                    array_stride: size_of::<RibbonVertex>() as u64,
-                    step_mode: wgpu::VertexStepMode::Vertex,
-                    attributes: &VERTEX_ATTRIBUTES,
-                })],
+                buffers: &[
+                    Some(wgpu::VertexBufferLayout {
+                        array_stride: size_of::<RibbonVertex>() as u64,
+                        step_mode: wgpu::VertexStepMode::Vertex,
+                        attributes: &VERTEX_ATTRIBUTES,
+                    }),
+                    Some(wgpu::VertexBufferLayout {
+                        array_stride: size_of::<f32>() as u64,
+                        step_mode: wgpu::VertexStepMode::Vertex,
+                        attributes: &TRANSMITTANCE_ATTRIBUTES,
+                    }),
+                ],
             },
             primitive: wgpu::PrimitiveState {
                 topology: wgpu::PrimitiveTopology::TriangleList,
@@ -123,6 +133,7 @@ impl StrandRenderer {
         pass.set_bind_group(2, &self.empty, &[]);
         pass.set_bind_group(3, view.shadow_group(), &[]);
         pass.set_vertex_buffer(0, ribbons.vertices.slice(..));
+        pass.set_vertex_buffer(1, ribbons.transmittance.slice(..));
         pass.set_index_buffer(ribbons.indices.slice(..), wgpu::IndexFormat::Uint32);
         pass.draw_indexed(0..ribbons.index_count, 0, 0..1);
     }
@@ -132,9 +143,12 @@ impl StrandRenderer {
 #[derive(Debug)]
 pub struct StrandRibbons {
     vertices: wgpu::Buffer,
+    /// The key light's transmittance per ribbon vertex (1 until [`StrandRibbons::set_transmittance`]).
+    transmittance: wgpu::Buffer,
     indices: wgpu::Buffer,
     index_count: u32,
     strands: usize,
+    nodes: usize,
 }
 
 impl StrandRibbons {
@@ -152,7 +166,7 @@ impl StrandRibbons {
         triangles: &[[u32; 3]],
     ) -> Result<Self, RenderError> {
         let nodes = reference.node_positions(positions).map_err(|e| RenderError::Textures(e.to_string()))?;
-        let taper = reference.field.params.taper;
+        let radii = reference.node_radii();
         let surface = reference.field.surface();
         let mut vertices = Vec::with_capacity(nodes.len() * 2);
         let mut indices = Vec::with_capacity(nodes.len() * 6);
@@ -184,7 +198,7 @@ impl StrandRibbons {
                     .colour(strand, node.height)
                     .map(|c| srgb_to_linear((c.clamp(0.0, 1.0) * 255.0).round() / 255.0))
                     * tint;
-                let half_width = strand.radius_at(node.height, taper) * placed.world_per_texel;
+                let half_width = radii[first + k];
                 let colour_height = Vec4::from((albedo, node.height)).to_array();
                 let base = vertices.len() as u32;
                 for side in [-1.0, 1.0] {
@@ -216,10 +230,40 @@ impl StrandRibbons {
         let pad = |bytes: &[u8]| if bytes.is_empty() { vec![0u8; 4] } else { bytes.to_vec() };
         Ok(Self {
             vertices: buffer("pelt strand ribbons", &pad(vertex_bytes), wgpu::BufferUsages::VERTEX),
+            transmittance: buffer(
+                "pelt strand transmittance",
+                &pad(bytemuck::cast_slice(&vec![1.0f32; vertices.len()])),
+                wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST,
+            ),
             indices: buffer("pelt strand ribbon indices", &pad(index_bytes), wgpu::BufferUsages::INDEX),
             index_count: indices.len() as u32,
             strands: reference.strands.len(),
+            nodes: nodes.len(),
         })
+    }
+
+    /// Sets how much of the key light (light 0) reaches each node, in the order of the
+    /// reference's nodes (`pelt_core::reference::shadow::key_light_transmittance`); `None`: 1
+    /// everywhere (unshadowed). It multiplies the key light's share of a strand's light only.
+    ///
+    /// # Errors
+    /// [`RenderError::Textures`] for a list of another length than the nodes.
+    pub fn set_transmittance(&self, queue: &wgpu::Queue, per_node: Option<&[f32]>) -> Result<(), RenderError> {
+        let values: Vec<f32> = match per_node {
+            Some(values) if values.len() == self.nodes => values.iter().flat_map(|&t| [t, t]).collect(),
+            Some(values) => {
+                return Err(RenderError::Textures(format!(
+                    "{} transmittance values for {} strand nodes",
+                    values.len(),
+                    self.nodes
+                )));
+            }
+            None => vec![1.0; 2 * self.nodes],
+        };
+        if !values.is_empty() {
+            queue.write_buffer(&self.transmittance, 0, bytemuck::cast_slice(&values));
+        }
+        Ok(())
     }
 
     /// Strands drawn.
