@@ -56,8 +56,51 @@ pub fn key_light_transmittance(casters: &ShadowCasters<'_>, toward_light: Vec3) 
         return vec![1.0; casters.nodes.len()];
     };
     let mut out = vec![1.0f32; casters.nodes.len()];
-    let mut chunks: Vec<(usize, &mut [f32])> = Vec::with_capacity(casters.strands.len());
-    let mut rest = out.as_mut_slice();
+    let chunks = strand_chunks(casters, &mut out);
+    chunks.into_par_iter().for_each(|(strand, out)| {
+        let range = casters.strands[strand].clone();
+        for (value, node) in out.iter_mut().zip(range) {
+            *value = grid.transmittance(casters.nodes[node], casters.radii[node], Some(strand as u32));
+        }
+    });
+    out
+}
+
+/// [`key_light_transmittance`] for each half of each node's ribbon: the half on the `-side`
+/// and the half on the `+side` of the node (`sides`: one unit vector per node across the strand,
+/// as the ribbon is drawn), each a receiver half the node's radius wide about its middle. A
+/// renderer that interpolates the two across the ribbon shows the lit half of a half-covered
+/// strand lit (seen from the light, the covered half is the one hidden).
+///
+/// # Panics
+/// As [`key_light_transmittance`], and when `sides` and `nodes` differ in length.
+#[must_use]
+pub fn ribbon_transmittance(casters: &ShadowCasters<'_>, toward_light: Vec3, sides: &[Vec3]) -> Vec<[f32; 2]> {
+    assert_eq!(casters.nodes.len(), casters.radii.len(), "one radius per node");
+    assert_eq!(casters.nodes.len(), sides.len(), "one side per node");
+    let Some(grid) = LightGrid::new(casters, toward_light) else {
+        return vec![[1.0; 2]; casters.nodes.len()];
+    };
+    let mut out = vec![[1.0f32; 2]; casters.nodes.len()];
+    let chunks = strand_chunks(casters, &mut out);
+    chunks.into_par_iter().for_each(|(strand, out)| {
+        let range = casters.strands[strand].clone();
+        for (value, node) in out.iter_mut().zip(range) {
+            let (p, r) = (casters.nodes[node], 0.5 * casters.radii[node]);
+            let across = sides[node] * r;
+            *value = [
+                grid.transmittance(p - across, r, Some(strand as u32)),
+                grid.transmittance(p + across, r, Some(strand as u32)),
+            ];
+        }
+    });
+    out
+}
+
+/// `out` (one value per node) cut into each strand's nodes, with the strand's index.
+fn strand_chunks<'a, T>(casters: &ShadowCasters<'_>, out: &'a mut [T]) -> Vec<(usize, &'a mut [T])> {
+    let mut chunks = Vec::with_capacity(casters.strands.len());
+    let mut rest = out;
     let mut at = 0;
     for (index, strand) in casters.strands.iter().enumerate() {
         assert!(strand.start >= at && strand.end <= casters.nodes.len(), "strands are ordered and inside nodes");
@@ -67,13 +110,7 @@ pub fn key_light_transmittance(casters: &ShadowCasters<'_>, toward_light: Vec3) 
         at = strand.end;
         chunks.push((index, head));
     }
-    chunks.into_par_iter().for_each(|(strand, out)| {
-        let range = casters.strands[strand].clone();
-        for (value, node) in out.iter_mut().zip(range) {
-            *value = grid.transmittance(casters.nodes[node], casters.radii[node], Some(strand as u32));
-        }
-    });
-    out
+    chunks
 }
 
 /// The transmittance toward `toward_light` at `points` (each of radius `radius`; 0: points),
@@ -381,6 +418,19 @@ mod tests {
             }
             // The blocker, nearer the light, is lit whatever the offset.
             assert!(light[ranges[1].clone()].iter().all(|&t| t == 1.0));
+        }
+    }
+
+    #[test]
+    fn a_half_covered_ribbon_is_lit_on_its_open_half() {
+        // The blocker covers the receiver's +z half from the light (+x); the ribbon runs across z.
+        let r = 0.01;
+        let (points, radii, ranges) = upright(&[Vec2::new(0.0, 0.0), Vec2::new(0.5, r)], 4, r);
+        let sides = vec![Vec3::Z; points.len()];
+        let casters = ShadowCasters { nodes: &points, radii: &radii, strands: &ranges, surfaces: &[] };
+        let light = ribbon_transmittance(&casters, Vec3::X, &sides);
+        for [minus, plus] in &light[ranges[0].clone()] {
+            assert!(*minus > 0.99 && *plus < 0.01, "open half {minus}, covered half {plus}");
         }
     }
 

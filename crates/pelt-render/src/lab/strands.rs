@@ -242,15 +242,17 @@ impl StrandRibbons {
         })
     }
 
-    /// Sets how much of the key light (light 0) reaches each node, in the order of the
-    /// reference's nodes (`pelt_core::reference::shadow::key_light_transmittance`); `None`: 1
+    /// Sets how much of the key light (light 0) reaches each node's ribbon, in the order of the
+    /// reference's nodes: for the ribbon's vertex on the `-side` and on the `+side` of the node,
+    /// the side being the direction across the strand that faces the camera, `cross(tangent,
+    /// to camera)` normalised (`pelt_core::reference::shadow::ribbon_transmittance`); `None`: 1
     /// everywhere (unshadowed). It multiplies the key light's share of a strand's light only.
     ///
     /// # Errors
     /// [`RenderError::Textures`] for a list of another length than the nodes.
-    pub fn set_transmittance(&self, queue: &wgpu::Queue, per_node: Option<&[f32]>) -> Result<(), RenderError> {
+    pub fn set_transmittance(&self, queue: &wgpu::Queue, per_node: Option<&[[f32; 2]]>) -> Result<(), RenderError> {
         let values: Vec<f32> = match per_node {
-            Some(values) if values.len() == self.nodes => values.iter().flat_map(|&t| [t, t]).collect(),
+            Some(values) if values.len() == self.nodes => values.iter().flatten().copied().collect(),
             Some(values) => {
                 return Err(RenderError::Textures(format!(
                     "{} transmittance values for {} strand nodes",

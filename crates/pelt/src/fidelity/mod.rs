@@ -11,7 +11,7 @@ use anyhow::{Context as _, bail};
 use glam::{Mat4, Vec3};
 use pelt_core::anim::Pose;
 use pelt_core::light::direction_from_angles;
-use pelt_core::reference::shadow::{ShadowCasters, key_light_transmittance};
+use pelt_core::reference::shadow::{ShadowCasters, ribbon_transmittance};
 use pelt_core::reference::{StrandReference, WetClumps};
 use pelt_core::sim::{FurStepper, SimParams, WindParams};
 use pelt_core::{Builtin, FurStructure, Mesh, Preset, Stage, texture};
@@ -211,8 +211,15 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         .collect();
     let casters =
         ShadowCasters { nodes: &node_positions, radii: &node_radii, strands: &node_ranges, surfaces: &surfaces };
-    // The direction the strands' shadow was last traced for.
-    let mut traced: Option<Vec3> = None;
+    // Each node's direction along its strand, as the ribbons take it.
+    let node_tangents: Vec<Vec3> = node_ranges
+        .iter()
+        .flat_map(|range| {
+            let points = &node_positions[range.clone()];
+            (0..points.len())
+                .map(move |k| if k + 1 < points.len() { points[k + 1] - points[k] } else { points[k] - points[k - 1] })
+        })
+        .collect();
 
     std::fs::create_dir_all(&args.out).with_context(|| format!("cannot create {}", args.out.display()))?;
     let front = preset.render.camera_azimuth_deg.unwrap_or(30.0);
@@ -252,20 +259,28 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         let view_data = studio.view_data(&camera, aspect);
         shell_side.prepare(&shells, &view_data);
         strand_side.prepare(&strands, &view_data);
-        // The strands' own shadow, traced on the CPU for this view's key light.
-        if shadows && traced != Some(view_data.light_direction_world) {
+        // The strands' own shadow, traced on the CPU for this view's key light, for each half of
+        // each ribbon as this camera sees it (the fur's transform is the identity here).
+        if shadows {
             let started = std::time::Instant::now();
-            let light = view_data.light_direction_world;
-            let transmittance = key_light_transmittance(&casters, light);
+            let sides: Vec<Vec3> = node_positions
+                .iter()
+                .zip(&node_tangents)
+                .map(|(p, t)| {
+                    let t = t.normalize_or(Vec3::Y);
+                    t.cross((camera.eye - *p).normalize_or(Vec3::Z)).normalize_or(t.any_orthonormal_vector())
+                })
+                .collect();
+            let transmittance = ribbon_transmittance(&casters, view_data.light_direction_world, &sides);
             ribbons.set_transmittance(&strands.gpu.queue, Some(&transmittance))?;
-            let mean = transmittance.iter().map(|&t| f64::from(t)).sum::<f64>() / transmittance.len().max(1) as f64;
+            let sum: f64 = transmittance.iter().flatten().map(|&t| f64::from(t)).sum();
             println!(
-                "{:>8} the strands' shadow traced in {:.1} s: mean transmittance {mean:.3} over {} nodes",
+                "{:>8} {name:<5} the strands' shadow traced in {:.1} s: mean transmittance {:.3} over {} nodes",
                 "",
                 started.elapsed().as_secs_f64(),
+                sum / (2 * transmittance.len()).max(1) as f64,
                 transmittance.len()
             );
-            traced = Some(light);
         }
         let mut tag = tag.clone();
         if let Some(angle) = angle {
