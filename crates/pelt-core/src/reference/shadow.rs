@@ -34,6 +34,8 @@ pub struct ShadowCasters<'a> {
     pub strands: &'a [Range<usize>],
     /// Opaque triangles (the skin and plain meshes), corner positions.
     pub surfaces: &'a [[Vec3; 3]],
+    /// The share of the light a strand stops where it covers a receiver (1: opaque strands).
+    pub opacity: f32,
 }
 
 /// Cells the grid aims for per strand segment.
@@ -66,35 +68,40 @@ pub fn key_light_transmittance(casters: &ShadowCasters<'_>, toward_light: Vec3) 
     out
 }
 
-/// [`key_light_transmittance`] for each half of each node's ribbon: the half on the `-side`
-/// and the half on the `+side` of the node (`sides`: one unit vector per node across the strand,
-/// as the ribbon is drawn), each a receiver half the node's radius wide about its middle. A
-/// renderer that interpolates the two across the ribbon shows the lit half of a half-covered
-/// strand lit (seen from the light, the covered half is the one hidden).
-///
-/// # Panics
-/// As [`key_light_transmittance`], and when `sides` and `nodes` differ in length.
+/// A point of a strand's ribbon that takes the key light: a node, or a point between two.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Receiver {
+    /// Where it is (on the strand's centre line).
+    pub position: Vec3,
+    /// Unit vector across the strand, as its ribbon is drawn (facing the camera).
+    pub across: Vec3,
+    /// The strand's radius there.
+    pub radius: f32,
+    /// The strand it lies on (an index into [`ShadowCasters::strands`]), which does not shadow it.
+    pub strand: u32,
+}
+
+/// [`key_light_transmittance`] for each half of each receiver's ribbon: the half on the
+/// `-across` and the half on the `+across` side, each a receiver half the radius wide about its
+/// middle. A renderer that interpolates the two across the ribbon shows the open half of a
+/// half-covered strand lit (seen from the light, the covered half is the one hidden). Receivers
+/// are independent: the same bytes on any number of threads.
 #[must_use]
-pub fn ribbon_transmittance(casters: &ShadowCasters<'_>, toward_light: Vec3, sides: &[Vec3]) -> Vec<[f32; 2]> {
-    assert_eq!(casters.nodes.len(), casters.radii.len(), "one radius per node");
-    assert_eq!(casters.nodes.len(), sides.len(), "one side per node");
+pub fn ribbon_transmittance(casters: &ShadowCasters<'_>, toward_light: Vec3, receivers: &[Receiver]) -> Vec<[f32; 2]> {
     let Some(grid) = LightGrid::new(casters, toward_light) else {
-        return vec![[1.0; 2]; casters.nodes.len()];
+        return vec![[1.0; 2]; receivers.len()];
     };
-    let mut out = vec![[1.0f32; 2]; casters.nodes.len()];
-    let chunks = strand_chunks(casters, &mut out);
-    chunks.into_par_iter().for_each(|(strand, out)| {
-        let range = casters.strands[strand].clone();
-        for (value, node) in out.iter_mut().zip(range) {
-            let (p, r) = (casters.nodes[node], 0.5 * casters.radii[node]);
-            let across = sides[node] * r;
-            *value = [
-                grid.transmittance(p - across, r, Some(strand as u32)),
-                grid.transmittance(p + across, r, Some(strand as u32)),
-            ];
-        }
-    });
-    out
+    receivers
+        .par_iter()
+        .map(|receiver| {
+            let r = 0.5 * receiver.radius.max(0.0);
+            let across = receiver.across * r;
+            [
+                grid.transmittance(receiver.position - across, r, Some(receiver.strand)),
+                grid.transmittance(receiver.position + across, r, Some(receiver.strand)),
+            ]
+        })
+        .collect()
 }
 
 /// `out` (one value per node) cut into each strand's nodes, with the strand's index.
@@ -157,6 +164,7 @@ struct LightGrid {
     surface_starts: Vec<u32>,
     surface_items: Vec<u32>,
     surface_epsilon: f32,
+    opacity: f32,
 }
 
 impl LightGrid {
@@ -224,6 +232,7 @@ impl LightGrid {
             surface_starts: Vec::new(),
             surface_items: Vec::new(),
             surface_epsilon: SURFACE_EPSILON * scene,
+            opacity: casters.opacity.clamp(0.0, 1.0),
         };
         // A segment reaches every node within its radius plus the node's own.
         let boxes: Vec<(Vec2, Vec2)> = segments
@@ -313,12 +322,12 @@ impl LightGrid {
                 continue;
             }
             if segment.strand != strand {
-                light *= 1.0 - covered;
+                light *= 1.0 - self.opacity * covered;
                 (strand, covered) = (segment.strand, 0.0);
             }
             covered = covered.max(segment.covered(q, depth, radius));
         }
-        (light * (1.0 - covered)).max(0.0)
+        (light * (1.0 - self.opacity * covered)).max(0.0)
     }
 }
 
@@ -380,7 +389,7 @@ mod tests {
     }
 
     fn trace(points: &[Vec3], radii: &[f32], ranges: &[Range<usize>], surfaces: &[[Vec3; 3]], light: Vec3) -> Vec<f32> {
-        key_light_transmittance(&ShadowCasters { nodes: points, radii, strands: ranges, surfaces }, light)
+        key_light_transmittance(&ShadowCasters { nodes: points, radii, strands: ranges, surfaces, opacity: 1.0 }, light)
     }
 
     #[test]
@@ -426,10 +435,13 @@ mod tests {
         // The blocker covers the receiver's +z half from the light (+x); the ribbon runs across z.
         let r = 0.01;
         let (points, radii, ranges) = upright(&[Vec2::new(0.0, 0.0), Vec2::new(0.5, r)], 4, r);
-        let sides = vec![Vec3::Z; points.len()];
-        let casters = ShadowCasters { nodes: &points, radii: &radii, strands: &ranges, surfaces: &[] };
-        let light = ribbon_transmittance(&casters, Vec3::X, &sides);
-        for [minus, plus] in &light[ranges[0].clone()] {
+        let casters = ShadowCasters { nodes: &points, radii: &radii, strands: &ranges, surfaces: &[], opacity: 1.0 };
+        let receivers: Vec<Receiver> = ranges[0]
+            .clone()
+            .map(|k| Receiver { position: points[k], across: Vec3::Z, radius: r, strand: 0 })
+            .collect();
+        let light = ribbon_transmittance(&casters, Vec3::X, &receivers);
+        for [minus, plus] in &light {
             assert!(*minus > 0.99 && *plus < 0.01, "open half {minus}, covered half {plus}");
         }
     }
@@ -449,7 +461,7 @@ mod tests {
         let light = trace(&points, &radii, &ranges, &[floor], Vec3::Y);
         assert!(light.iter().all(|&t| t == 1.0), "{light:?}");
         let under = points_transmittance(
-            &ShadowCasters { nodes: &points, radii: &radii, strands: &ranges, surfaces: &[roof] },
+            &ShadowCasters { nodes: &points, radii: &radii, strands: &ranges, surfaces: &[roof], opacity: 1.0 },
             Vec3::Y,
             &[Vec3::new(1.0, 0.0, 0.0)],
             0.0,

@@ -12,6 +12,7 @@
 use bytemuck::{Pod, Zeroable};
 use glam::{Vec3, Vec4};
 use pelt_core::reference::StrandReference;
+use pelt_core::reference::shadow::Receiver;
 
 use crate::RenderError;
 use crate::fur::GpuFur;
@@ -148,7 +149,17 @@ pub struct StrandRibbons {
     indices: wgpu::Buffer,
     index_count: u32,
     strands: usize,
-    nodes: usize,
+    /// Each pair of ribbon vertices' point on its strand (CPU side, for the traced shadow).
+    points: Vec<RibbonPoint>,
+}
+
+/// One pair of ribbon vertices: the point on the strand's centre line between them.
+#[derive(Clone, Copy, Debug)]
+struct RibbonPoint {
+    position: Vec3,
+    tangent: Vec3,
+    radius: f32,
+    strand: u32,
 }
 
 impl StrandRibbons {
@@ -170,7 +181,8 @@ impl StrandRibbons {
         let surface = reference.field.surface();
         let mut vertices = Vec::with_capacity(nodes.len() * 2);
         let mut indices = Vec::with_capacity(nodes.len() * 6);
-        for placed in &reference.strands {
+        let mut receivers = Vec::with_capacity(nodes.len());
+        for (strand_index, placed) in (0u32..).zip(&reference.strands) {
             let strand = reference.field_strand(placed);
             let triangle = triangles
                 .get(placed.triangle as usize)
@@ -211,6 +223,7 @@ impl StrandRibbons {
                         wetness: placed.wetness,
                     });
                 }
+                receivers.push(RibbonPoint { position: points[k], tangent, radius: half_width, strand: strand_index });
                 if k + 1 < points.len() {
                     indices.extend_from_slice(&[base, base + 1, base + 3, base, base + 3, base + 2]);
                 }
@@ -238,29 +251,46 @@ impl StrandRibbons {
             indices: buffer("pelt strand ribbon indices", &pad(index_bytes), wgpu::BufferUsages::INDEX),
             index_count: indices.len() as u32,
             strands: reference.strands.len(),
-            nodes: nodes.len(),
+            points: receivers,
         })
     }
 
-    /// Sets how much of the key light (light 0) reaches each node's ribbon, in the order of the
-    /// reference's nodes: for the ribbon's vertex on the `-side` and on the `+side` of the node,
-    /// the side being the direction across the strand that faces the camera, `cross(tangent,
-    /// to camera)` normalised (`pelt_core::reference::shadow::ribbon_transmittance`); `None`: 1
-    /// everywhere (unshadowed). It multiplies the key light's share of a strand's light only.
+    /// The points that take the key light, one per pair of ribbon vertices in their order, as
+    /// a camera at `eye` sees them (model space: the fur's transform is left out): each on its
+    /// strand's centre line, `across` it as `vs_strand` widens the ribbon, `cross(tangent, to
+    /// the camera)`. Trace them with `pelt_core::reference::shadow::ribbon_transmittance`.
+    #[must_use]
+    pub fn shadow_receivers(&self, eye: Vec3) -> Vec<Receiver> {
+        self.points
+            .iter()
+            .map(|p| {
+                let tangent = p.tangent.normalize_or(Vec3::Y);
+                let across = tangent
+                    .cross((eye - p.position).normalize_or(Vec3::Z))
+                    .normalize_or(tangent.any_orthonormal_vector());
+                Receiver { position: p.position, across, radius: p.radius, strand: p.strand }
+            })
+            .collect()
+    }
+
+    /// Sets how much of the key light (light 0) reaches each ribbon vertex: per pair in the
+    /// order of [`StrandRibbons::shadow_receivers`], the vertex on the `-across` and on the
+    /// `+across` side; `None`: 1 everywhere (unshadowed). It multiplies the key light's share of
+    /// a strand's light only.
     ///
     /// # Errors
-    /// [`RenderError::Textures`] for a list of another length than the nodes.
-    pub fn set_transmittance(&self, queue: &wgpu::Queue, per_node: Option<&[[f32; 2]]>) -> Result<(), RenderError> {
-        let values: Vec<f32> = match per_node {
-            Some(values) if values.len() == self.nodes => values.iter().flatten().copied().collect(),
+    /// [`RenderError::Textures`] for a list of another length than the receivers.
+    pub fn set_transmittance(&self, queue: &wgpu::Queue, per_pair: Option<&[[f32; 2]]>) -> Result<(), RenderError> {
+        let values: Vec<f32> = match per_pair {
+            Some(values) if values.len() == self.points.len() => values.iter().flatten().copied().collect(),
             Some(values) => {
                 return Err(RenderError::Textures(format!(
-                    "{} transmittance values for {} strand nodes",
+                    "{} transmittance values for {} ribbon points",
                     values.len(),
-                    self.nodes
+                    self.points.len()
                 )));
             }
-            None => vec![1.0; 2 * self.nodes],
+            None => vec![1.0; 2 * self.points.len()],
         };
         if !values.is_empty() {
             queue.write_buffer(&self.transmittance, 0, bytemuck::cast_slice(&values));

@@ -72,6 +72,11 @@ pub struct Args {
     /// maps as `pelt render` draws them, and the strands their own shadow traced on the CPU).
     #[arg(long)]
     no_shadows: bool,
+    /// The share of the key light a strand stops where it covers another from the light, in
+    /// the strands' traced shadow: 1 (the default) makes them opaque, as they are drawn; less
+    /// lets that share of what crosses them through (a what-if: hair passes some light on).
+    #[arg(long, default_value_t = 1.0, value_name = "A", value_parser = parse_opacity)]
+    strand_opacity: f32,
     /// Folder for the side-by-side images.
     #[arg(long, default_value = "fidelity", value_name = "DIR")]
     out: PathBuf,
@@ -88,6 +93,13 @@ pub struct Args {
     /// Graphics backend: vulkan, gl (or metal, dx12); default `WGPU_BACKEND`, else the best there is.
     #[arg(long, default_value = "auto")]
     backend: Backend,
+}
+
+fn parse_opacity(text: &str) -> Result<f32, String> {
+    match text.trim().parse::<f32>() {
+        Ok(value) if (0.0..=1.0).contains(&value) => Ok(value),
+        _ => Err(format!("expected a share from 0 to 1, got {text:?}")),
+    }
 }
 
 /// One model and view's figures (the `--json` keys).
@@ -209,17 +221,13 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         .map(|t| t.map(|j| skin[j as usize]))
         .chain(plain.iter().flat_map(|m| m.triangles.iter().map(|t| t.map(|j| m.positions[j as usize]))))
         .collect();
-    let casters =
-        ShadowCasters { nodes: &node_positions, radii: &node_radii, strands: &node_ranges, surfaces: &surfaces };
-    // Each node's direction along its strand, as the ribbons take it.
-    let node_tangents: Vec<Vec3> = node_ranges
-        .iter()
-        .flat_map(|range| {
-            let points = &node_positions[range.clone()];
-            (0..points.len())
-                .map(move |k| if k + 1 < points.len() { points[k + 1] - points[k] } else { points[k] - points[k - 1] })
-        })
-        .collect();
+    let casters = ShadowCasters {
+        nodes: &node_positions,
+        radii: &node_radii,
+        strands: &node_ranges,
+        surfaces: &surfaces,
+        opacity: args.strand_opacity,
+    };
 
     std::fs::create_dir_all(&args.out).with_context(|| format!("cannot create {}", args.out.display()))?;
     let front = preset.render.camera_azimuth_deg.unwrap_or(30.0);
@@ -263,19 +271,12 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         // each ribbon as this camera sees it (the fur's transform is the identity here).
         if shadows {
             let started = std::time::Instant::now();
-            let sides: Vec<Vec3> = node_positions
-                .iter()
-                .zip(&node_tangents)
-                .map(|(p, t)| {
-                    let t = t.normalize_or(Vec3::Y);
-                    t.cross((camera.eye - *p).normalize_or(Vec3::Z)).normalize_or(t.any_orthonormal_vector())
-                })
-                .collect();
-            let transmittance = ribbon_transmittance(&casters, view_data.light_direction_world, &sides);
+            let receivers = ribbons.shadow_receivers(camera.eye);
+            let transmittance = ribbon_transmittance(&casters, view_data.light_direction_world, &receivers);
             ribbons.set_transmittance(&strands.gpu.queue, Some(&transmittance))?;
             let sum: f64 = transmittance.iter().flatten().map(|&t| f64::from(t)).sum();
             println!(
-                "{:>8} {name:<5} the strands' shadow traced in {:.1} s: mean transmittance {:.3} over {} nodes",
+                "{:>8} {name:<5} the strands' shadow traced in {:.1} s: mean transmittance {:.3} over {} points",
                 "",
                 started.elapsed().as_secs_f64(),
                 sum / (2 * transmittance.len()).max(1) as f64,
