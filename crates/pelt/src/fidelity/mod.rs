@@ -36,7 +36,9 @@ const CHANGED: u8 = 3;
 #[command(after_help = "\
 Renders shells + fins, shells alone and the explicit strands (the same seeded strands, as
 supersampled ribbons) from each view; writes MODEL-VIEW.png (shells + fins | shells | strands |
-difference heat map) into --out and prints SSIM over the fur and over the silhouette band.
+difference heat map) into --out and prints SSIM over the fur and over the silhouette band. The
+key light's shadow falls on both pictures unless --no-shadows; --light-angles 0,45,90,180
+measures each view at those view-light angles.
 Example: `pelt fidelity assets/meshes/spot.obj --preset assets/presets/spot.toml --json spot.json`.")]
 pub struct Args {
     #[command(flatten)]
