@@ -394,9 +394,12 @@ mod tests {
 
     #[test]
     fn a_lone_strand_is_fully_lit() {
+        // A strand never shadows itself, even lit along its length.
         let (points, radii, ranges) = upright(&[Vec2::ZERO], 8, 0.01);
-        let light = trace(&points, &radii, &ranges, &[], Vec3::new(1.0, 1.0, 0.0).normalize());
-        assert!(light.iter().all(|&t| t == 1.0), "{light:?}");
+        for toward in [Vec3::new(1.0, 1.0, 0.0).normalize(), Vec3::Y] {
+            let light = trace(&points, &radii, &ranges, &[], toward);
+            assert!(light.iter().all(|&t| t == 1.0), "toward {toward}: {light:?}");
+        }
     }
 
     #[test]
