@@ -42,7 +42,9 @@
 //!   `GlobalAmbientLight`) is the fur's ambient, [`FurLight`]'s only where the render world has
 //!   neither.
 //! - Fur casts into Bevy's shadow maps (directional cascades, point and spot lights) unless its
-//!   entity has `NotShadowCaster`, and on a camera with `DepthPrepass` (and
+//!   entity has `NotShadowCaster`, and receives the directional cascades' and spot lights'
+//!   (copied into pelt-render's `HostShadows`) unless it has `NotShadowReceiver`; on a camera
+//!   with `DepthPrepass` (and
 //!   `MotionVectorPrepass`, as TAA and motion blur need) writes its depth (and motion vectors)
 //!   into Bevy's prepass textures; under TAA it is drawn with the camera's jitter.
 
@@ -58,6 +60,7 @@ mod fur;
 mod mesh;
 mod passes;
 mod preset;
+mod receive;
 mod render;
 mod wet;
 
@@ -100,10 +103,13 @@ impl Plugin for PeltPlugin {
             .init_resource::<render::FurGpu>()
             .init_resource::<render::FurGpuStats>()
             .init_resource::<passes::FurPasses>()
+            .init_resource::<receive::FurReceivers>()
             .add_systems(ExtractSchedule, render::extract_furs)
             .add_systems(
                 Render,
-                (render::prepare_furs, passes::prepare_fur_passes).chain().in_set(RenderSystems::PrepareResources),
+                (render::prepare_furs, passes::prepare_fur_passes, receive::prepare_fur_receivers)
+                    .chain()
+                    .in_set(RenderSystems::PrepareResources),
             )
             .add_systems(
                 Core3d,
@@ -122,6 +128,8 @@ impl Plugin for PeltPlugin {
                     passes::draw_fur_shared_shadows
                         .after(shared_shadow_pass::<LATE_SHADOW_PASS>)
                         .before(Core3dSystems::MainPass),
+                    // After the fur's own depth is in Bevy's cascades, before the fur reads them.
+                    receive::copy_fur_receivers.after(passes::draw_fur_cascades).before(Core3dSystems::MainPass),
                 ),
             );
     }

@@ -7,7 +7,9 @@ use std::sync::Arc;
 
 use bevy::camera::{Camera3d, CompositingSpace, Exposure};
 use bevy::ecs::prelude::*;
-use bevy::light::{AmbientLight, DirectionalLight, GlobalAmbientLight, NotShadowCaster, PointLight, SpotLight};
+use bevy::light::{
+    AmbientLight, DirectionalLight, GlobalAmbientLight, NotShadowCaster, NotShadowReceiver, PointLight, SpotLight,
+};
 use bevy::log::error;
 use bevy::prelude::{Color, GlobalTransform, InheritedVisibility};
 use bevy::render::Extract;
@@ -54,6 +56,9 @@ pub(crate) struct ExtractedFurs {
     sun: Option<Sun>,
     /// The scene's other lights (point, spot, more directional), world space, before exposure.
     others: Vec<pelt_core::light::LightSource>,
+    /// The main world's entity of each of the fur's lights, in the order the fur takes them:
+    /// the sun (if any), then the others.
+    light_entities: Vec<Entity>,
 }
 
 /// The scene's first directional light.
@@ -109,6 +114,8 @@ pub(crate) struct ExtractedFur {
     pub(crate) skin: bool,
     /// Drawn into Bevy's shadow maps (no `NotShadowCaster`).
     pub(crate) casts_shadows: bool,
+    /// Shaded with Bevy's shadow maps (no `NotShadowReceiver`).
+    receives_shadows: bool,
     wetness: Option<Arc<Vec<f32>>>,
     wet: WetParams,
     shading: FurShading,
@@ -118,7 +125,9 @@ pub(crate) struct ExtractedFur {
 pub(crate) fn extract_furs(
     mut extracted: ResMut<ExtractedFurs>,
     light: Extract<Res<FurLight>>,
-    furs: Extract<Query<(Entity, &Fur, &FurState, Option<&InheritedVisibility>, Has<NotShadowCaster>)>>,
+    furs: Extract<
+        Query<(Entity, &Fur, &FurState, Option<&InheritedVisibility>, Has<NotShadowCaster>, Has<NotShadowReceiver>)>,
+    >,
     suns: Extract<Query<(Entity, &DirectionalLight, &GlobalTransform, Option<&InheritedVisibility>)>>,
     bulbs: Extract<Query<(Entity, &PointLight, &GlobalTransform, Option<&InheritedVisibility>)>>,
     spots: Extract<Query<(Entity, &SpotLight, &GlobalTransform, Option<&InheritedVisibility>)>>,
@@ -134,42 +143,51 @@ pub(crate) fn extract_furs(
         colour_lux.is_finite().then_some(Sun { toward_light, colour_lux })
     };
     extracted.sun = suns.first().and_then(sun);
-    let mut others: Vec<LightSource> = suns.iter().skip(1).filter_map(sun).map(|s| s.source()).collect();
+    let mut others: Vec<(Entity, LightSource)> =
+        suns.iter().skip(1).filter_map(|s| Some((s.0, sun(s)?.source()))).collect();
     // Bevy gives point and spot lights in lumens over the whole sphere (a spot is a point light
     // masked by its cone): candela = lumens / 4 pi.
     let candela = |lumens: f32| lumens / (4.0 * std::f32::consts::PI);
     let mut bulbs: Vec<_> = bulbs.iter().filter(|(.., v)| visible(*v)).collect();
     bulbs.sort_by_key(|(entity, ..)| *entity);
-    for (_, bulb, transform, _) in bulbs {
-        others.push(LightSource {
-            kind: LightKind::Point,
-            position: to_pelt(transform.translation()),
-            direction: glam::Vec3::ZERO,
-            intensity: linear(bulb.color) * candela(bulb.intensity),
-            cos_inner: -1.0,
-            cos_outer: -1.0,
-            casts_shadows: false,
-        });
+    for (entity, bulb, transform, _) in bulbs {
+        others.push((
+            entity,
+            LightSource {
+                kind: LightKind::Point,
+                position: to_pelt(transform.translation()),
+                direction: glam::Vec3::ZERO,
+                intensity: linear(bulb.color) * candela(bulb.intensity),
+                cos_inner: -1.0,
+                cos_outer: -1.0,
+                casts_shadows: false,
+            },
+        ));
     }
     let mut spots: Vec<_> = spots.iter().filter(|(.., v)| visible(*v)).collect();
     spots.sort_by_key(|(entity, ..)| *entity);
-    for (_, spot, transform, _) in spots {
-        others.push(LightSource {
-            kind: LightKind::Spot,
-            position: to_pelt(transform.translation()),
-            direction: to_pelt(transform.forward().as_vec3()).normalize_or(glam::Vec3::NEG_Y),
-            intensity: linear(spot.color) * candela(spot.intensity),
-            // Bevy's angles are half angles.
-            cos_inner: spot.inner_angle.cos(),
-            cos_outer: spot.outer_angle.cos(),
-            casts_shadows: false,
-        });
+    for (entity, spot, transform, _) in spots {
+        others.push((
+            entity,
+            LightSource {
+                kind: LightKind::Spot,
+                position: to_pelt(transform.translation()),
+                direction: to_pelt(transform.forward().as_vec3()).normalize_or(glam::Vec3::NEG_Y),
+                intensity: linear(spot.color) * candela(spot.intensity),
+                // Bevy's angles are half angles.
+                cos_inner: spot.inner_angle.cos(),
+                cos_outer: spot.outer_angle.cos(),
+                casts_shadows: false,
+            },
+        ));
     }
-    others.retain(|l| l.intensity.is_finite() && l.position.is_finite() && l.direction.is_finite());
+    others.retain(|(_, l)| l.intensity.is_finite() && l.position.is_finite() && l.direction.is_finite());
     others.truncate(MAX_LIGHTS - 1);
-    extracted.others = others;
+    let sun_entity = extracted.sun.and(suns.first().map(|(entity, ..)| *entity));
+    extracted.light_entities = sun_entity.into_iter().chain(others.iter().map(|(entity, _)| *entity)).collect();
+    extracted.others = others.into_iter().map(|(_, light)| light).collect();
     extracted.furs.clear();
-    for (entity, fur, state, visibility, not_caster) in &furs {
+    for (entity, fur, state, visibility, not_caster, not_receiver) in &furs {
         if visibility.is_some_and(|v| !v.get()) {
             continue;
         }
@@ -185,6 +203,7 @@ pub(crate) fn extract_furs(
             radius_world: state.radius_world,
             skin: fur.skin,
             casts_shadows: !not_caster,
+            receives_shadows: !not_receiver,
             wetness: state.wetness.clone(),
             wet: state.wet.clone(),
             shading: FurShading::from_params(&state.shading),
@@ -193,9 +212,26 @@ pub(crate) fn extract_furs(
     }
 }
 
+impl ExtractedFur {
+    /// A sphere about the fur at its longest, world space.
+    pub(crate) fn bounds(&self) -> (glam::Vec3, f32) {
+        (self.centre_world, self.radius_world)
+    }
+
+    /// Its longest strand (model units).
+    pub(crate) fn longest_strand(&self) -> f32 {
+        self.structure.lengths.iter().copied().fold(0.0, f32::max)
+    }
+}
+
 impl ExtractedFurs {
     pub(crate) fn furs(&self) -> &[ExtractedFur] {
         &self.furs
+    }
+
+    /// The index among the fur's lights of the light `entity` (main world), if it is one.
+    pub(crate) fn light_index(&self, entity: Entity) -> Option<usize> {
+        self.light_entities.iter().position(|&e| e == entity)
     }
 }
 
@@ -228,6 +264,10 @@ impl ViewEntry {
 
     pub(crate) fn fur_view(&self) -> &FurView {
         &self.view
+    }
+
+    pub(crate) fn fur_view_mut(&mut self) -> &mut FurView {
+        &mut self.view
     }
 }
 
@@ -304,6 +344,10 @@ fn colour_format(target_format: wgpu::TextureFormat, space: Option<CompositingSp
 impl FurGpu {
     pub(crate) fn view(&self, entity: Entity) -> Option<&ViewEntry> {
         self.views.get(&entity)
+    }
+
+    pub(crate) fn view_mut(&mut self, entity: Entity) -> Option<&mut ViewEntry> {
+        self.views.get_mut(&entity)
     }
 
     /// The renderer of a target some view has.
@@ -535,8 +579,10 @@ pub(crate) fn draw_furs(
         multiview_mask: None,
     });
     set_camera_viewport(&mut pass, camera);
+    let unshadowed = entry.view.unshadowed();
     for (fur, driver) in furs {
         let settings = FurDrawSettings { skin: fur.skin, ..FurDrawSettings::ALL };
-        driver.draw(&mut pass, renderer, &entry.view, &settings);
+        let view = if fur.receives_shadows { &entry.view } else { &unshadowed };
+        driver.draw(&mut pass, renderer, view, &settings);
     }
 }

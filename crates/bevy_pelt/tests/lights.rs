@@ -1,9 +1,10 @@
 //! Bevy's lights on the fur: a point light, with no directional light in the scene, lights a coat
-//! shaded with the fur model.
+//! shaded with the fur model; a plate between the sun and the fur shades it through Bevy's shadow
+//! maps, a sun's cascades and a spot light's map alike.
 
 use bevy::camera::RenderTarget;
 use bevy::core_pipeline::tonemapping::Tonemapping;
-use bevy::light::{AmbientLight, GlobalAmbientLight};
+use bevy::light::{AmbientLight, GlobalAmbientLight, NotShadowCaster, NotShadowReceiver};
 use bevy::prelude::*;
 use bevy_pelt::Fur;
 
@@ -94,4 +95,79 @@ fn bevys_ambient_light_reaches_the_fur() {
     assert!(global_pixels > 1000 && camera_pixels > 1000, "{global_pixels} and {camera_pixels} fur pixels");
     // The camera's own ambient replaces the global one, at the same brightness the same look.
     assert!((global - camera).abs() < 0.1 * global, "mean fur luma {global} (global) against {camera} (camera)");
+}
+
+/// The skinless furred cube (`preset`) seen from the side, lit from above by a sun (or a spot
+/// light) with shadows, under a plate out of the camera's view that casts into Bevy's shadow
+/// maps, or does not (`NotShadowCaster`); the fur receives shadows unless `NotShadowReceiver`.
+fn under_a_plate(preset_path: &'static str, spot: bool, (plate_casts, fur_receives): (bool, bool)) -> image::RgbaImage {
+    let images = capture(1, |world, targets| {
+        let cube = cuboid(world, Vec3::ONE);
+        let fur = Fur::new(preset(world, preset_path)).without_skin();
+        let mut furred = world.spawn((Mesh3d(cube), fur, Transform::from_rotation(Quat::from_rotation_y(0.5))));
+        if !fur_receives {
+            furred.insert(NotShadowReceiver);
+        }
+        let plate = cuboid(world, Vec3::new(3.0, 0.1, 3.0));
+        let material = world.resource_mut::<Assets<StandardMaterial>>().add(StandardMaterial::from(Color::WHITE));
+        let mut plate = world.spawn((Mesh3d(plate), MeshMaterial3d(material), Transform::from_xyz(0.0, 2.5, 0.0)));
+        if !plate_casts {
+            plate.insert(NotShadowCaster);
+        }
+        let above = Transform::from_xyz(0.3, 6.0, 0.2).looking_at(Vec3::ZERO, Vec3::Y);
+        if spot {
+            world.spawn((
+                SpotLight {
+                    intensity: 40_000_000.0,
+                    range: 30.0,
+                    outer_angle: 0.5,
+                    shadow_maps_enabled: true,
+                    ..default()
+                },
+                above,
+            ));
+        } else {
+            world.spawn((DirectionalLight { illuminance: 4000.0, shadow_maps_enabled: true, ..default() }, above));
+        }
+        world.spawn((
+            Camera3d::default(),
+            RenderTarget::Image(targets[0].clone().into()),
+            Tonemapping::None,
+            Transform::from_xyz(0.0, 0.2, 4.0).looking_at(Vec3::ZERO, Vec3::Y),
+        ));
+    });
+    images.into_iter().next().unwrap()
+}
+
+/// The pixels darker and brighter (by over 10 levels) with the plate casting than without, on a
+/// fur that receives shadows or not.
+fn shaded_by_the_plate(preset_path: &'static str, spot: bool, fur_receives: bool, name: &str) -> (usize, usize) {
+    let shaded = under_a_plate(preset_path, spot, (true, fur_receives));
+    let open = under_a_plate(preset_path, spot, (false, fur_receives));
+    save(&shaded, &format!("{name}_shaded"));
+    save(&open, &format!("{name}_open"));
+    let darker = shaded.pixels().zip(open.pixels()).filter(|(a, b)| luma(a) + 10.0 < luma(b)).count();
+    let brighter = shaded.pixels().zip(open.pixels()).filter(|(a, b)| luma(a) > luma(b) + 10.0).count();
+    (darker, brighter)
+}
+
+#[test]
+fn a_plate_between_the_sun_and_the_fur_darkens_it() {
+    for (preset_path, name) in
+        [("presets/long.toml", "plate_kajiya_kay"), ("presets/long_fur_model.toml", "plate_fur_model")]
+    {
+        let (darker, brighter) = shaded_by_the_plate(preset_path, false, true, name);
+        assert!(darker > 1000, "{name}: {darker} fur pixels darker under the casting plate");
+        assert!(brighter < darker / 20, "{name}: {brighter} pixels brighter, {darker} darker");
+    }
+    // `NotShadowReceiver` on the fur: the plate's shadow does not reach it.
+    let (darker, brighter) = shaded_by_the_plate("presets/long_fur_model.toml", false, false, "plate_not_receiver");
+    assert!(darker + brighter < 20, "{darker} pixels darker, {brighter} brighter on a fur that receives no shadows");
+}
+
+#[test]
+fn a_plate_between_a_spot_light_and_the_fur_darkens_it() {
+    let (darker, brighter) = shaded_by_the_plate("presets/long_fur_model.toml", true, true, "plate_spot");
+    assert!(darker > 1000, "{darker} fur pixels darker under the casting plate");
+    assert!(brighter < darker / 20, "{brighter} pixels brighter, {darker} darker");
 }

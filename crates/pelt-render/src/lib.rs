@@ -120,6 +120,7 @@ mod geometry;
 mod gpu;
 #[cfg(feature = "headless")]
 mod headless;
+mod host_shadows;
 #[cfg(feature = "lab")]
 mod lab;
 mod listing;
@@ -149,6 +150,7 @@ pub use geometry::POSITIONS_USAGE;
 pub use gpu::{Backend, Gpu};
 #[cfg(feature = "headless")]
 pub use headless::{HEADLESS_FORMAT, Headless};
+pub use host_shadows::{HostLight, HostShadowView, HostShadows};
 #[cfg(feature = "lab")]
 pub use lab::{CpuSilhouette, SeparatedFur, SeparatedRenderer, StrandRenderer, StrandRibbons};
 pub use lod::{FurLevel, LodSettings, strand_pixels, strand_pixels_in_view};
@@ -158,8 +160,8 @@ pub use plain::PlainMesh;
 pub use renderer::{FurDrawSettings, FurMotion, FurPrepass, FurRenderer, MotionData, PrepassTarget};
 pub use requirements::{check_adapter, required_downlevel_flags, required_features, required_limits};
 pub use shaders::{
-    prepass_shader_source, silhouette_shader_source, simulation_shader_source, skinning_shader_source,
-    unified_shader_source, view_lod_shader_source,
+    prepass_shader_source, shadow_copy_shader_source, silhouette_shader_source, simulation_shader_source,
+    skinning_shader_source, unified_shader_source, view_lod_shader_source,
 };
 #[cfg(feature = "lab")]
 pub use shaders::{separated_shader_source, strands_shader_source};

@@ -1,5 +1,5 @@
-//! What surrounds a fur in Pelt's own hosts (`pelt render`, the viewer, the web page): the key
-//! light's [`ShadowMap`] and a ground plane under the meshes, each where asked for.
+//! What surrounds a fur in Pelt's own hosts (`pelt render`, the viewer, the web page): the
+//! lights' [`ShadowMap`] and a ground plane under the meshes, each where asked for.
 
 use glam::{Mat4, Vec3};
 use pelt_core::sim::SceneGround;
@@ -9,13 +9,13 @@ use crate::RenderError;
 use crate::colliders::ground_mesh;
 use crate::plain::PlainMesh;
 use crate::renderer::FurRenderer;
-use crate::shadows::{ShadowCaster, ShadowMap, ShadowSettings};
+use crate::shadows::{MAX_SHADOW_VIEWS, ShadowCaster, ShadowMap, ShadowSettings};
 use crate::view::{FurView, ViewData};
 
 /// The ground's colour without a script's (linear RGB): a warm mid grey.
 pub const GROUND_COLOUR: Vec3 = Vec3::new(0.34, 0.32, 0.3);
 
-/// The key light's shadow map and the ground, around one fur and its plain meshes.
+/// The lights' shadow maps and the ground, around one fur and its plain meshes.
 #[derive(Debug)]
 pub struct Surroundings {
     shadows: Option<ShadowMap>,
@@ -103,12 +103,12 @@ impl Surroundings {
         if let Some(map) = &mut self.shadows
             && map.settings() != settings
         {
-            *map = ShadowMap::new(device, renderer, settings)?;
+            *map = ShadowMap::with_views(device, renderer, settings, map.view_capacity())?;
         }
         Ok(())
     }
 
-    /// Whether the key light casts shadows.
+    /// Whether the lights cast shadows.
     #[must_use]
     pub fn has_shadows(&self) -> bool {
         self.shadows.is_some()
@@ -120,16 +120,33 @@ impl Surroundings {
         self.ground.is_some()
     }
 
-    /// Aims the shadow map at the key light of `view` (the picture's view data; a sun, or a spot
-    /// or point light: [`ShadowCaster::for_key_light`]), and lights `picture` with it.
-    pub fn prepare(&self, queue: &wgpu::Queue, view: &ViewData, picture: &mut FurView) {
-        if let Some(map) = &self.shadows {
-            map.prepare(queue, &ShadowCaster::for_key_light(view, self.bounds), self.bounds);
+    /// Aims the shadow maps at every shadowing light of `view` (the picture's view data; suns,
+    /// spots and point lights: [`ShadowCaster::for_view`]), making them anew with more light views
+    /// where its lights need them, and lights `picture` with them. Call it again when the lights
+    /// move.
+    ///
+    /// # Errors
+    /// The new maps' [`RenderError`].
+    pub fn prepare(
+        &mut self,
+        (device, queue): (&wgpu::Device, &wgpu::Queue),
+        renderer: &FurRenderer,
+        view: &ViewData,
+        picture: &mut FurView,
+    ) -> Result<(), RenderError> {
+        if let Some(map) = &mut self.shadows {
+            let casters = ShadowCaster::for_view(view, self.bounds);
+            let needed = casters.iter().map(|(_, caster)| caster.view_count()).sum::<u32>().min(MAX_SHADOW_VIEWS);
+            if needed > map.view_capacity() {
+                *map = ShadowMap::with_views(device, renderer, map.settings(), needed)?;
+            }
+            map.prepare(queue, &casters, self.bounds);
         }
         picture.set_shadows(self.shadows.as_ref());
+        Ok(())
     }
 
-    /// Records the shadow map (if any): `draw` draws the scene through the view it is given.
+    /// Records the shadow maps (if any): `draw` draws the scene through the view it is given.
     pub fn record(&self, encoder: &mut wgpu::CommandEncoder, draw: impl FnMut(&mut wgpu::RenderPass<'_>, &FurView)) {
         if let Some(map) = &self.shadows {
             map.record(encoder, draw);

@@ -307,6 +307,23 @@ impl FurView {
         self.role = ViewRole::Camera { shadowed: group.is_some() };
     }
 
+    /// This view drawing without shadows: the same uniforms (prepared with it), for objects
+    /// that receive no shadows (Bevy's `NotShadowReceiver`).
+    #[must_use]
+    pub fn unshadowed(&self) -> Self {
+        Self {
+            buffer: self.buffer.clone(),
+            lights: self.lights.clone(),
+            bind_group: self.bind_group.clone(),
+            shadow_group: self.no_shadows.clone(),
+            no_shadows: self.no_shadows.clone(),
+            role: match self.role {
+                ViewRole::Camera { .. } => ViewRole::Camera { shadowed: false },
+                role @ ViewRole::Shadow(_) => role,
+            },
+        }
+    }
+
     /// Whether draws through this view read a shadow map.
     #[must_use]
     pub fn has_shadows(&self) -> bool {

@@ -57,6 +57,7 @@ fn every_wgsl_file_is_part_of_a_validated_module() {
         pelt_render::prepass_shader_source(),
         pelt_render::strands_shader_source(),
         pelt_render::skinning_shader_source(),
+        pelt_render::shadow_copy_shader_source(),
     ];
     // Every .wgsl under src/, wherever it lies.
     let mut dirs = vec![std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("src")];
@@ -74,10 +75,15 @@ fn every_wgsl_file_is_part_of_a_validated_module() {
         }
     }
     assert_eq!(
-        checked, 16,
+        checked, 17,
         "shading, wet, fur_bsdf, shadows, unified, prepass, separated, scan, silhouette, view_lod, simulation_wind, \
-         simulation, simulation_inputs, simulation_contact, strands and skinning"
+         simulation, simulation_inputs, simulation_contact, strands, skinning and shadow_copy"
     );
+}
+
+#[test]
+fn shadow_copy_module_validates() {
+    validate("shadow_copy.wgsl", &pelt_render::shadow_copy_shader_source());
 }
 
 #[test]

@@ -1,4 +1,4 @@
-//! The key light's shadows: a furred mesh over a ground, drawn with its `ShadowMap` and without.
+//! The lights' shadows: a furred mesh over a ground, drawn with its `ShadowMap` and without.
 //! The oracles are geometric (rays against the ground plane, the mesh's vertices projected along
 //! the light) and photometric (linear light of the same pixels with shadows on and off); they
 //! share nothing with the shadow maps they check.
@@ -83,8 +83,8 @@ impl Stage {
         self.view.prepare(rig.queue(), &camera.view_data(1.0, &light));
         let map = shadows.map(|(fur_depth, caster)| {
             let settings = ShadowSettings { size: 512, fur_depth, extinction: 0.6 };
-            let map = ShadowMap::new(rig.device(), &rig.renderer, settings).expect("shadow map");
-            map.prepare(rig.queue(), &caster, (Vec3::ZERO, 1.6));
+            let mut map = ShadowMap::new(rig.device(), &rig.renderer, settings).expect("shadow map");
+            map.prepare(rig.queue(), &[(0, caster)], (Vec3::ZERO, 1.6));
             map
         });
         self.view.set_shadows(map.as_ref());
@@ -96,6 +96,57 @@ impl Stage {
             if let Some(fur) = fur {
                 rig.renderer.draw(pass, view, fur, &FurDrawSettings::ALL);
             }
+        };
+        let image = rig
+            .headless
+            .render_with(
+                DEFAULT_BACKGROUND,
+                |encoder| {
+                    if let Some(map) = &map {
+                        map.record(encoder, draw);
+                    }
+                },
+                |pass| draw(pass, view),
+            )
+            .expect("frame");
+        image.save(common::out_dir().join(format!("shadows-{name}.png"))).expect("save");
+        let linear = |c: u8| {
+            let c = f32::from(c) / 255.0;
+            if c <= 0.04045 { c / 12.92 } else { ((c + 0.055) / 1.055).powf(2.4) }
+        };
+        image.pixels().map(|p| Vec3::new(linear(p[0]), linear(p[1]), linear(p[2]))).collect()
+    }
+}
+
+impl Stage {
+    /// One frame from `camera` lit by `lights` (no environment), with the ground and `fur`,
+    /// every shadowing light's maps made as hosts make them (`ShadowCaster::for_view`) if
+    /// `shadows`; in linear RGB per pixel.
+    fn render_lit(
+        &mut self,
+        camera: &Camera,
+        lights: &[LightSource],
+        fur: &GpuFur,
+        shadows: bool,
+        name: &str,
+    ) -> Vec<Vec3> {
+        let rig = &self.rig;
+        let view_data = camera.view_data(1.0, &Light::default()).with_lights(lights, None);
+        self.view.prepare(rig.queue(), &view_data);
+        let bounds = (Vec3::ZERO, 1.6);
+        let map = shadows.then(|| {
+            let casters = ShadowCaster::for_view(&view_data, bounds);
+            let views = casters.iter().map(|(_, caster)| caster.view_count()).sum();
+            let settings = ShadowSettings { size: 512, fur_depth: 0.1, extinction: 0.6 };
+            let mut map = ShadowMap::with_views(rig.device(), &rig.renderer, settings, views).expect("shadow map");
+            assert_eq!(map.prepare(rig.queue(), &casters, bounds), casters.len(), "every caster has its views");
+            map
+        });
+        self.view.set_shadows(map.as_ref());
+        let (view, plane) = (&self.view, &self.ground);
+        let draw = |pass: &mut wgpu::RenderPass<'_>, view: &FurView| {
+            rig.renderer.draw_plain(pass, view, plane);
+            rig.renderer.draw(pass, view, fur, &FurDrawSettings::ALL);
         };
         let image = rig
             .headless
@@ -365,4 +416,91 @@ fn a_point_light_above_casts_the_spheres_shadow_wider_than_a_sun() {
     assert!(ring > 500 && outside > 2_000, "too few ground pixels: {report}");
     assert!(ring_dark * 10 > ring * 8, "the ring the point light shades is lit: {report}");
     assert!(outside_lit * 10 > outside * 9, "the ground past the shadow is dark: {report}");
+}
+
+/// Whether the segment from `point` to `light` passes within `radius` of the origin.
+fn segment_meets_sphere(point: Vec3, light: Vec3, radius: f32) -> bool {
+    let d = light - point;
+    let t = ((-point).dot(d) / d.length_squared()).clamp(0.0, 1.0);
+    (point + d * t).length() < radius
+}
+
+/// Two suns, each casting: the ground in the second's shadow alone is darker than with the
+/// second casting none, and the ground in neither shadow keeps its light. Only the key light
+/// (light 0) cast shadows once: then the second sun's shadow is missing.
+#[test]
+fn a_second_light_casts_its_own_shadow() {
+    let mut stage = Stage::new();
+    let fur = stage.fur(&sphere_fur(8, 0.1, None));
+    // Low suns on either side, seen from high above: both shadows reach out from under the sphere.
+    let (first, second) = (Vec3::new(1.2, 1.0, 0.3), Vec3::new(-1.2, 1.0, -0.4));
+    let suns = [LightSource::directional(first, Vec3::ONE, 1.5), LightSource::directional(second, Vec3::ONE, 1.5)];
+    let camera = Camera::orbit(Vec3::new(0.0, GROUND_Y, 0.0), 20.0, 70.0, 7.0);
+    let both = stage.render_lit(&camera, &suns, &fur, true, "two-suns-on");
+    let first_only = [suns[0], LightSource { casts_shadows: false, ..suns[1] }];
+    let one = stage.render_lit(&camera, &first_only, &fur, true, "two-suns-first");
+    let (mut second_shadow, mut second_dark, mut open, mut open_same) = (0, 0, 0, 0);
+    for (k, hit) in ground_hits(&camera).into_iter().enumerate() {
+        // Ground the furred sphere does not hide from the camera.
+        let Some(hit) = hit.filter(|hit| !segment_meets_sphere(*hit, camera.eye, 1.15)) else { continue };
+        let (a, b) = (outside_sphere_shadow(hit, first), outside_sphere_shadow(hit, second));
+        let ratio = luminance(both[k]) / luminance(one[k]).max(1e-6);
+        if a > 0.5 && b < -0.3 {
+            second_shadow += 1;
+            second_dark += usize::from(ratio < 0.7);
+        } else if a > 0.5 && b > 0.5 {
+            open += 1;
+            open_same += usize::from((ratio - 1.0).abs() < 0.03);
+        }
+    }
+    let report = format!(
+        "{second_dark} of {second_shadow} pixels in the second shadow darker, {open_same} of {open} open ground the same"
+    );
+    assert!(second_shadow > 200 && open > 2_000, "too few ground pixels: {report}");
+    assert!(second_dark * 10 > second_shadow * 8, "the second sun casts no shadow: {report}");
+    assert!(open_same * 10 > open * 9, "the ground in neither shadow changed: {report}");
+}
+
+/// A point light among the casters (inside the scene's bounds) casts through a cube of six
+/// views: the ground is dark where the segment to the light meets the sphere and lit where it
+/// passes clear, on every face the ground is seen through (the side faces behind the sphere,
+/// the one below the light). Cast as one sun's view from where it stands, as it once was, the
+/// shadow behind the sphere falls in the wrong place.
+#[test]
+fn a_point_light_among_the_casters_shadows_every_side_through_its_cube() {
+    let mut stage = Stage::new();
+    let fur = stage.fur(&sphere_fur(8, 0.05, None));
+    let position = Vec3::new(1.45, -0.3, 0.0);
+    let bulb = LightSource { kind: LightKind::Point, position, ..LightSource::directional(Vec3::Y, Vec3::ONE, 3.0) };
+    let camera = Camera::orbit(Vec3::new(0.0, GROUND_Y, 0.0), 150.0, 60.0, 7.0);
+    let view = camera.view_data(1.0, &Light::default()).with_lights(&[bulb], None);
+    assert_eq!(ShadowCaster::for_view(&view, (Vec3::ZERO, 1.6)), vec![(0, ShadowCaster::Point { position })]);
+    let on = stage.render_lit(&camera, &[bulb], &fur, true, "cube-on");
+    let off = stage.render_lit(&camera, &[bulb], &fur, false, "cube-off");
+    let (mut dark, mut dark_ok, mut clear, mut clear_ok) = (0, 0, 0, 0);
+    let mut faces = [0usize; 2];
+    for (k, hit) in ground_hits(&camera).into_iter().enumerate() {
+        // Ground the furred sphere does not hide from the camera, lit enough to measure.
+        let Some(hit) = hit.filter(|hit| !segment_meets_sphere(*hit, camera.eye, 1.15)) else { continue };
+        if luminance(off[k]) < 0.02 || (hit - position).length() > 3.5 {
+            continue;
+        }
+        let ratio = luminance(on[k]) / luminance(off[k]);
+        let d = (hit - position).abs();
+        if segment_meets_sphere(hit, position, 0.9) {
+            dark += 1;
+            dark_ok += usize::from(ratio < 0.3);
+            faces[usize::from(d.y > d.x.max(d.z))] += 1;
+        } else if !segment_meets_sphere(hit, position, 1.25) {
+            clear += 1;
+            clear_ok += usize::from(ratio > 0.9);
+        }
+    }
+    let report = format!(
+        "{dark_ok} of {dark} shadowed pixels dark ({} by the side faces, {} below), {clear_ok} of {clear} clear pixels lit",
+        faces[0], faces[1]
+    );
+    assert!(dark > 300 && clear > 1_000, "too few ground pixels: {report}");
+    assert!(dark_ok * 10 > dark * 8, "the sphere's shadow from the point light is missing: {report}");
+    assert!(clear_ok * 10 > clear * 9, "ground the light reaches is dark: {report}");
 }

@@ -232,7 +232,7 @@ impl PageGpu {
         self.studio = model.light.studio();
         let view_data = self.studio.view_data(&camera, targets.aspect_ratio());
         self.view.prepare(queue, &view_data);
-        surroundings.prepare(queue, &view_data, &mut self.view);
+        surroundings.prepare((device, queue), &self.renderer, &view_data, &mut self.view).map_err(|e| e.to_string())?;
         let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
         self.driver.record(&mut encoder).map_err(|e| e.to_string())?;
         self.driver.record_view(&mut encoder, &self.renderer, &self.view);

@@ -103,7 +103,7 @@ fn render_frame(gpu: Gpu, preset: &Preset, model: &Model) -> image::RgbaImage {
     surroundings.fit_to_frame(device, &renderer, (WIDTH_PX, HEIGHT_PX)).expect("fitted maps");
     let mut view = FurView::new(device, &renderer);
     view.prepare(queue, &view_data);
-    surroundings.prepare(queue, &view_data, &mut view);
+    surroundings.prepare((device, queue), &renderer, &view_data, &mut view).expect("aimed maps");
     headless
         .render_with(
             studio.background,

@@ -276,7 +276,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let mut surroundings =
         shadow_args.surroundings_around((device, queue, &renderer), scene_ground, (&fur, &plain), extent.as_ref())?;
     surroundings.fit_to_frame(device, &renderer, (width, height)).context("fitting the shadow maps to the picture")?;
-    surroundings.prepare(queue, &view_data, &mut view);
+    surroundings.prepare((device, queue), &renderer, &view_data, &mut view).context("aiming the shadow maps")?;
     let lod_settings = lod::settings(&preset.render.lod, args.no_lod);
     // The camera stays put: one level serves every frame of one fur; a herd's members move.
     let level_at = |member: usize, time_secs: f64| {
@@ -355,7 +355,12 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         // A script's lights may move.
         if frame > 0 && args.lights.light.is_none() && stepper.scene().is_some_and(|s| !s.light.is_empty()) {
             let studio = args.lights.studio(stepper.scene(), environment, time_secs);
-            view.prepare(queue, &studio.view_data(&camera, headless.aspect_ratio()));
+            let view_data = studio.view_data(&camera, headless.aspect_ratio());
+            view.prepare(queue, &view_data);
+            // Their shadows move with them.
+            surroundings
+                .prepare((device, queue), &renderer, &view_data, &mut view)
+                .context("aiming the shadow maps")?;
         }
         // The walking try-on body takes the fur's clip at the same time.
         if let (Some(body), Some(body_mesh), Some(plain_mesh)) = (&body, plain.first(), plain_meshes.first()) {

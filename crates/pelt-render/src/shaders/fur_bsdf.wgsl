@@ -130,6 +130,29 @@ fn fur_bsdf(t: vec3<f32>, v: vec3<f32>, l: vec3<f32>, n: vec3<f32>, wet: f32) ->
     return vec2<f32>(r, tinted);
 }
 
+// Light `i` arriving at `world_position`: the unit vector toward it and its irradiance (linear
+// RGB, lux) on a surface facing it, a point or spot light's falling off with the squared distance
+// and a spot's between its cones.
+struct Incident {
+    to_light: vec3<f32>,
+    irradiance: vec3<f32>,
+}
+
+fn light_incident(i: u32, world_position: vec3<f32>) -> Incident {
+    let light = lights.light[i];
+    var incident = Incident(light.position_or_direction.xyz, light.intensity_cos_inner.xyz);
+    if light.position_or_direction.w != 0.0 {
+        let offset = light.position_or_direction.xyz - world_position;
+        let d2 = max(dot(offset, offset), 1e-8);
+        incident.to_light = offset * inverseSqrt(d2);
+        let cone = dot(-incident.to_light, light.spot_axis_cos_outer.xyz);
+        let outer = light.spot_axis_cos_outer.w;
+        let fade = clamp((cone - outer) / max(light.intensity_cos_inner.w - outer, 1e-4), 0.0, 1.0);
+        incident.irradiance *= fade * fade / d2;
+    }
+    return incident;
+}
+
 // The environment's SH coefficient `k` (rgb).
 fn environment_coefficient(k: u32) -> vec3<f32> {
     return lights.environment_sh[k].xyz;
@@ -150,20 +173,9 @@ fn fur_terms(tangent: vec3<f32>, normal: vec3<f32>, world_position: vec3<f32>, h
     let wet = clamp(wetness, 0.0, 1.0);
     var sum = vec2<f32>(0.0);
     for (var i = 0u; i < lights.count; i++) {
-        let light = lights.light[i];
-        var to_light = light.position_or_direction.xyz;
-        var irradiance = luminance(light.intensity_cos_inner.xyz);
-        if light.position_or_direction.w != 0.0 {
-            let offset = light.position_or_direction.xyz - world_position;
-            let d2 = max(dot(offset, offset), 1e-8);
-            to_light = offset * inverseSqrt(d2);
-            let cone = dot(-to_light, light.spot_axis_cos_outer.xyz);
-            let outer = light.spot_axis_cos_outer.w;
-            let fade = clamp((cone - outer) / max(light.intensity_cos_inner.w - outer, 1e-4), 0.0, 1.0);
-            irradiance *= fade * fade / d2;
-        }
+        let incident = light_incident(i, world_position);
         let visibility = strand_visibility(i, world_position, normal);
-        sum += fur_bsdf(tangent, to_camera, to_light, normal, wet) * (irradiance * visibility);
+        sum += fur_bsdf(tangent, to_camera, incident.to_light, normal, wet) * (luminance(incident.irradiance) * visibility);
     }
     // The environment: irradiance / pi as the scattered fill (a white strand under a uniform
     // environment returns at most its radiance) and a blurred radiance about the mirror

@@ -20,7 +20,7 @@ pub(crate) struct Layouts {
     pub shell_list: wgpu::BindGroupLayout,
     pub shell_sampler: wgpu::Sampler,
     pub fin_sampler: wgpu::Sampler,
-    /// Group 3 of every drawing pipeline: the key light's shadow maps (`shadows.wgsl`).
+    /// Group 3 of every drawing pipeline: the lights' shadow maps (`shadows.wgsl`).
     pub shadow: wgpu::BindGroupLayout,
     /// Group 2 of plain meshes: nothing.
     pub empty: wgpu::BindGroupLayout,
@@ -93,12 +93,12 @@ impl Layouts {
         let render = wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT;
         let depth_texture = wgpu::BindingType::Texture {
             sample_type: wgpu::TextureSampleType::Depth,
-            view_dimension: wgpu::TextureViewDimension::D2,
+            view_dimension: wgpu::TextureViewDimension::D2Array,
             multisampled: false,
         };
         let unfilterable = wgpu::BindingType::Texture {
             sample_type: wgpu::TextureSampleType::Float { filterable: false },
-            view_dimension: wgpu::TextureViewDimension::D2,
+            view_dimension: wgpu::TextureViewDimension::D2Array,
             multisampled: false,
         };
         let textures = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -122,7 +122,7 @@ impl Layouts {
                 // The fur's first-surface depth, fetched by texel as a float texture (GLSL
                 // cannot fetch from a depth texture).
                 entry(3, render, unfilterable),
-                entry(4, render, texture(wgpu::TextureViewDimension::D2)),
+                entry(4, render, texture(wgpu::TextureViewDimension::D2Array)),
                 entry(5, render, filtering),
             ],
         });
@@ -252,30 +252,37 @@ fn shadow_group(
     })
 }
 
-/// A 1x1 texture of `format` for the shadow stand-ins.
+/// A `size` x `size` texture of `format` with `layers` layers (one per light view), whole as an
+/// array view; `attachment`: drawn into as well.
 pub(crate) fn shadow_texture(
     device: &wgpu::Device,
     format: wgpu::TextureFormat,
-    size: u32,
+    (size, layers): (u32, u32),
     attachment: bool,
-) -> wgpu::TextureView {
+) -> wgpu::Texture {
     let usage = if attachment {
         wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::RENDER_ATTACHMENT
     } else {
         wgpu::TextureUsages::TEXTURE_BINDING
     };
-    device
-        .create_texture(&wgpu::TextureDescriptor {
-            label: Some("pelt shadow map"),
-            size: wgpu::Extent3d { width: size, height: size, depth_or_array_layers: 1 },
-            mip_level_count: 1,
-            sample_count: 1,
-            dimension: wgpu::TextureDimension::D2,
-            format,
-            usage,
-            view_formats: &[],
-        })
-        .create_view(&wgpu::TextureViewDescriptor::default())
+    device.create_texture(&wgpu::TextureDescriptor {
+        label: Some("pelt shadow map"),
+        size: wgpu::Extent3d { width: size, height: size, depth_or_array_layers: layers },
+        mip_level_count: 1,
+        sample_count: 1,
+        dimension: wgpu::TextureDimension::D2,
+        format,
+        usage,
+        view_formats: &[],
+    })
+}
+
+/// The whole of a shadow texture as an array view (one layer too: the shaders read arrays).
+pub(crate) fn array_view(texture: &wgpu::Texture) -> wgpu::TextureView {
+    texture.create_view(&wgpu::TextureViewDescriptor {
+        dimension: Some(wgpu::TextureViewDimension::D2Array),
+        ..wgpu::TextureViewDescriptor::default()
+    })
 }
 
 /// The shadows' group for views without a shadow map: nothing in it is read.
@@ -290,8 +297,8 @@ fn stand_in_shadows(
         usage: wgpu::BufferUsages::UNIFORM,
         mapped_at_creation: false,
     });
-    let depth = shadow_texture(device, wgpu::TextureFormat::Depth32Float, 1, false);
-    let opacity = shadow_texture(device, wgpu::TextureFormat::Rgba16Float, 1, false);
+    let depth = array_view(&shadow_texture(device, SHADOW_DEPTH_FORMAT, (1, 1), false));
+    let opacity = array_view(&shadow_texture(device, SHADOW_OPACITY_FORMAT, (1, 1), false));
     shadow_group(device, layout, &uniform, (&depth, &depth, &opacity), samplers)
 }
 

@@ -92,20 +92,36 @@ pub(crate) struct LightsUniform {
     pub light: [GpuLight; 8],
 }
 
-/// The key light's shadow maps; the layout of `Shadow` in `shadows.wgsl`.
+/// One view from a shadowing light; the layout of `ShadowView` in `shadows.wgsl`.
 #[repr(C)]
-#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
-pub(crate) struct ShadowUniform {
+#[derive(Clone, Copy, Debug, Default, bytemuck::Pod, bytemuck::Zeroable)]
+pub(crate) struct ShadowViewUniform {
     pub light_clip_from_world: Mat4,
+    pub light: Vec4,
     pub texel_world: f32,
     pub bias_world: f32,
-    pub extinction: f32,
     pub perspective: f32,
     pub near: f32,
     pub far: f32,
     pub texel: f32,
-    pub _padding: f32,
+    pub _padding_0: f32,
+    pub _padding_1: f32,
+}
+
+/// The most light views one shadow map holds (`SHADOW_VIEWS` in `shadows.wgsl`).
+pub(crate) const SHADOW_VIEWS: usize = 12;
+
+/// Every shadowing light's maps; the layout of `Shadow` in `shadows.wgsl`.
+#[repr(C)]
+#[derive(Clone, Copy, Debug, bytemuck::Pod, bytemuck::Zeroable)]
+pub(crate) struct ShadowUniform {
+    pub extinction: f32,
+    pub pass_view: u32,
+    pub layers: u32,
+    pub _padding_1: u32,
     pub layer_ends: Vec4,
+    pub light_views: [[u32; 4]; 8],
+    pub views: [ShadowViewUniform; SHADOW_VIEWS],
 }
 
 pub(crate) const OBJECT_UNIFORM_BYTES: u64 = size_of::<ObjectUniform>() as u64;
@@ -248,19 +264,23 @@ mod tests {
 
     #[test]
     fn shadow_uniform_mirrors_shadow() {
-        let rust = rust_layout!(ShadowUniform {
+        let rust =
+            rust_layout!(ShadowUniform { extinction, pass_view, layers, _padding_1, layer_ends, light_views, views });
+        assert_mirrors(&unified_shader_source(), "Shadow", &rust);
+        let rust = rust_layout!(ShadowViewUniform {
             light_clip_from_world,
+            light,
             texel_world,
             bias_world,
-            extinction,
             perspective,
             near,
             far,
             texel,
-            _padding,
-            layer_ends
+            _padding_0,
+            _padding_1
         });
-        assert_mirrors(&unified_shader_source(), "Shadow", &rust);
+        assert_mirrors(&unified_shader_source(), "ShadowView", &rust);
+        assert!(unified_shader_source().contains(&format!("const SHADOW_VIEWS = {SHADOW_VIEWS}u;")));
     }
 
     #[test]

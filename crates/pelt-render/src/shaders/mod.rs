@@ -10,10 +10,13 @@ mod layouts;
 mod mirrors;
 
 pub(crate) use layouts::Layouts;
-pub(crate) use layouts::{SHADOW_DEPTH_FORMAT, SHADOW_OPACITY_FORMAT, shadow_texture};
+pub(crate) use layouts::{SHADOW_DEPTH_FORMAT, SHADOW_OPACITY_FORMAT, array_view, shadow_texture};
 #[cfg(all(test, feature = "lab"))]
 pub(crate) use mirrors::assert_vertex_mirrors;
-pub(crate) use mirrors::{GpuLight, LightsUniform, OBJECT_UNIFORM_BYTES, ObjectUniform, ShadowUniform, ViewUniform};
+pub(crate) use mirrors::{
+    GpuLight, LightsUniform, OBJECT_UNIFORM_BYTES, ObjectUniform, SHADOW_VIEWS, ShadowUniform, ShadowViewUniform,
+    ViewUniform,
+};
 #[cfg(test)]
 pub(crate) use mirrors::{RustLayout, assert_mirrors, rust_layout};
 
@@ -23,7 +26,7 @@ pub(crate) const SHADING_WGSL: &str = include_str!("shading.wgsl");
 const WET_WGSL: &str = include_str!("wet.wgsl");
 /// The fur model's lights, environment and BSDF, likewise appended.
 const FUR_BSDF_WGSL: &str = include_str!("fur_bsdf.wgsl");
-/// The key light's visibility (shadow map and deep opacity map) and the shadow views' opacity
+/// The lights' visibility (shadow maps and deep opacity maps) and the shadow views' opacity
 /// fragments, appended to the shading wherever it goes.
 const SHADOWS_WGSL: &str = include_str!("shadows.wgsl");
 /// The unified structure's vertex and fragment shaders, over the shared vertex array.
@@ -44,6 +47,8 @@ const SIMULATION_WGSL: &str = include_str!("simulation.wgsl");
 const SIMULATION_INPUTS_WGSL: &str = include_str!("simulation_inputs.wgsl");
 /// Contact after the bend (skin, colliders, grasp), called by the simulation's step.
 const SIMULATION_CONTACT_WGSL: &str = include_str!("simulation_contact.wgsl");
+/// A host's shadow map copied into one of Pelt's layers (`HostShadows`).
+const SHADOW_COPY_WGSL: &str = include_str!("shadow_copy.wgsl");
 /// Linear blend skinning of many instances (`GpuSkin`).
 const SKINNING_WGSL: &str = include_str!("skinning.wgsl");
 /// The separated structure of Lengyel et al. 2001 (the `lab` feature's baseline).
@@ -80,6 +85,12 @@ pub fn silhouette_shader_source() -> String {
 #[must_use]
 pub fn view_lod_shader_source() -> String {
     format!("{SHADING_WGSL}\n{WET_WGSL}\n{FUR_BSDF_WGSL}\n{SHADOWS_WGSL}\n{UNIFIED_WGSL}\n{SCAN_WGSL}\n{VIEW_LOD_WGSL}")
+}
+
+/// The WGSL module that copies a host's shadow map into Pelt's (`shadow_copy.wgsl`).
+#[must_use]
+pub fn shadow_copy_shader_source() -> String {
+    SHADOW_COPY_WGSL.to_owned()
 }
 
 /// The WGSL module of the GPU skinning (`skinning.wgsl`).

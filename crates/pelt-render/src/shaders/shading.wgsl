@@ -2,7 +2,7 @@
 // lighting. `unified.wgsl` and `separated.wgsl` are appended to this file to make one module each.
 //
 // Bind groups: 0 = one view (`FurView`), 1 = one object (a fur or a plain mesh), 2 = the fur's
-// textures (fur pipelines; empty for plain meshes), 3 = the key light's shadows (`shadows.wgsl`).
+// textures (fur pipelines; empty for plain meshes), 3 = the lights' shadows (`shadows.wgsl`).
 
 // One view, written by the host every frame (`ViewData`).
 struct View {
@@ -466,11 +466,22 @@ fn hair_colour(texel_albedo: vec3<f32>, terms: vec4<f32>, height: f32) -> vec3<f
     return colour + light * highlight * (specular * object.specular * ao * height);
 }
 
-// Lambert with a soft terminator for surfaces without fur (the skin, plain meshes).
+// Lambert with a soft terminator for surfaces without fur (the skin, plain meshes): the view's
+// lights, each shadowed, or its one key light where it has none (the paper's studio).
 fn surface_lighting(albedo: vec3<f32>, normal: vec3<f32>, world_position: vec3<f32>) -> vec3<f32> {
-    let wrapped = max(dot(normal, view.light_direction) * 0.7 + 0.3, 0.0);
-    let visibility = light_visibility(0u, world_position, normal);
-    return albedo * (view.ambient + view.light_colour * wrapped * visibility);
+    if lights.count == 0u {
+        let wrapped = max(dot(normal, view.light_direction) * 0.7 + 0.3, 0.0);
+        let visibility = light_visibility(0u, world_position, normal);
+        return albedo * (view.ambient + view.light_colour * wrapped * visibility);
+    }
+    var light = vec3<f32>(0.0);
+    for (var i = 0u; i < lights.count; i++) {
+        let incident = light_incident(i, world_position);
+        let wrapped = max(dot(normal, incident.to_light) * 0.7 + 0.3, 0.0);
+        light += incident.irradiance * (wrapped * light_visibility(i, world_position, normal));
+    }
+    // Irradiance / pi: a white surface facing a sun of pi lux shows 1.
+    return albedo * (view.ambient + light * 0.31830988);
 }
 
 // Shell slices are sampled half a mip level sharper than the hardware's choice: trilinear

@@ -145,7 +145,7 @@ fn frame_ratio((width, height): (u32, u32), key: &'static str, limit: f64) -> an
     surroundings.fit_to_frame(device, &renderer, (width, height))?;
     let mut view = FurView::new(device, &renderer);
     view.prepare(queue, &view_data);
-    surroundings.prepare(queue, &view_data, &mut view);
+    surroundings.prepare((device, queue), &renderer, &view_data, &mut view)?;
     // The reference: the skin alone, unshadowed (it moves with the machine, not with the fur).
     let skin_view = FurView::new(device, &renderer);
     skin_view.prepare(queue, &view_data);

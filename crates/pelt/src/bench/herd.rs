@@ -150,9 +150,9 @@ pub fn measure(
         let extent =
             points.iter().fold((Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)), |(lo, hi), p| (lo.min(*p), hi.max(*p)));
         let ground = pelt_core::sim::SceneGround::default();
-        let surroundings =
+        let mut surroundings =
             pelt_render::Surroundings::around_box(device, queue, &renderer, (true, Some(&ground)), length, extent)?;
-        surroundings.prepare(queue, &view_data, &mut view);
+        surroundings.prepare((device, queue), &renderer, &view_data, &mut view)?;
         let lod = crate::lod::settings(&preset.render.lod, false);
         let (mut simulation, mut record, mut gpu) = (Duration::ZERO, Duration::ZERO, Duration::ZERO);
         // One frame to warm up (pipelines, first poses), then the timed ones.

@@ -187,7 +187,7 @@ impl Bench {
             let view_data = self.studio.view_data(&camera, targets.aspect_ratio());
             if let Some(surroundings) = &mut surroundings {
                 surroundings.fit_to_frame(device, &renderer, (width, height))?;
-                surroundings.prepare(queue, &view_data, &mut shadowed_view);
+                surroundings.prepare((device, queue), &renderer, &view_data, &mut shadowed_view)?;
             }
             // Every structure draws the same scene the same way: the view written, the body
             // (if any), then the fur, in one pass.

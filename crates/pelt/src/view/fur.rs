@@ -264,11 +264,17 @@ impl FurScene {
         }
         let separated = self.separated.as_ref().filter(|_| separated);
         // The separated structure draws with pipelines of its own, which read no shadow maps.
-        let surroundings = self.surroundings.as_ref().map(|(_, s)| s).filter(|_| separated.is_none());
-        match surroundings {
-            Some(s) => s.prepare(&gpu.queue, &view_data, &mut self.view),
+        match self.surroundings.as_mut().map(|(_, s)| s).filter(|_| separated.is_none()) {
+            Some(s) => {
+                // A failure (more light views than the device holds) draws without shadows.
+                if let Err(problem) = s.prepare((&gpu.device, &gpu.queue), &self.renderer, &view_data, &mut self.view) {
+                    eprintln!("pelt view: drawing without shadows: {problem}");
+                    self.view.set_shadows(None);
+                }
+            }
             None => self.view.set_shadows(None),
         }
+        let surroundings = self.surroundings.as_ref().map(|(_, s)| s).filter(|_| separated.is_none());
         match separated {
             Some((_, fur)) => fur.prepare(&gpu.queue, &FurFrame { level, ..*self.driver.frame() }),
             None => {
