@@ -83,18 +83,7 @@ fn key_light_lobes(tangent: vec3<f32>, normal: vec3<f32>, world_position: vec3<f
     if lights.count == 0u {
         return vec2<f32>(0.0);
     }
-    let light = lights.light[0];
     let to_camera = safe_normalize(view.camera_position - world_position, normal);
-    var to_light = light.position_or_direction.xyz;
-    var irradiance = luminance(light.intensity_cos_inner.xyz);
-    if light.position_or_direction.w != 0.0 {
-        let offset = light.position_or_direction.xyz - world_position;
-        let d2 = max(dot(offset, offset), 1e-8);
-        to_light = offset * inverseSqrt(d2);
-        let cone = dot(-to_light, light.spot_axis_cos_outer.xyz);
-        let outer = light.spot_axis_cos_outer.w;
-        let fade = clamp((cone - outer) / max(light.intensity_cos_inner.w - outer, 1e-4), 0.0, 1.0);
-        irradiance *= fade * fade / d2;
-    }
-    return fur_bsdf(tangent, to_camera, to_light, normal, wet) * irradiance;
+    let incident = light_incident(0u, world_position);
+    return fur_bsdf(tangent, to_camera, incident.to_light, normal, wet) * luminance(incident.irradiance);
 }

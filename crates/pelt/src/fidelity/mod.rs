@@ -267,8 +267,8 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             None => (studio, key_light_angles(&studio)),
         };
         let view_data = studio.view_data(&camera, aspect);
-        shell_side.prepare(&shells, &view_data);
-        strand_side.prepare(&strands, &view_data);
+        shell_side.prepare(&shells, &view_data)?;
+        strand_side.prepare(&strands, &view_data)?;
         // The strands' own shadow, traced on the CPU for this view's key light, for each half of
         // each ribbon as this camera sees it (the fur's transform is the identity here).
         if shadows {
@@ -474,12 +474,14 @@ impl Side {
 
     /// Prepares the view for `view_data` and draws the key light's shadow maps (skin, plain
     /// meshes, shells and fins) for it.
-    fn prepare(&mut self, headless: &Headless, view_data: &ViewData) {
+    fn prepare(&mut self, headless: &Headless, view_data: &ViewData) -> anyhow::Result<()> {
         let (device, queue) = (&headless.gpu.device, &headless.gpu.queue);
         self.view.prepare(queue, view_data);
-        self.surroundings.prepare(queue, view_data, &mut self.view);
+        self.surroundings
+            .prepare((device, queue), &self.renderer, view_data, &mut self.view)
+            .context("aiming the shadow maps")?;
         if !self.surroundings.has_shadows() {
-            return;
+            return Ok(());
         }
         let mut encoder =
             device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("pelt fidelity shadows") });
@@ -490,6 +492,7 @@ impl Side {
             self.fur.draw(pass, &self.renderer, light, &FurDrawSettings::ALL);
         });
         queue.submit([encoder.finish()]);
+        Ok(())
     }
 
     /// The shells' side: `settings` for the fur, with or without the plain meshes.
