@@ -49,17 +49,21 @@ fn fidelity_runs_small_and_writes_images_and_json() {
     assert!(String::from_utf8_lossy(&bad.stderr).contains("unknown view \"top\""));
 }
 
-/// Runs `pelt fidelity` on the bunny's front at 96x96 with `extra` arguments into `dir/name`;
-/// the JSON's one result and the side-by-side image.
+/// Runs `pelt fidelity` on the bunny's front at 96x96 with `extra` arguments into `dir/name`,
+/// in the paper's studio (Kajiya-Kay, whose albedo the wetness darkens, in a light following
+/// the camera: the fur model's brown coat is mostly its white highlight, which water sharpens
+/// rather than darkens); the JSON's one result and the side-by-side image.
 fn fidelity_front(dir: &Path, name: &str, extra: &[&str]) -> (serde_json::Value, image::RgbaImage, Vec<u8>) {
+    let preset = concat!(env!("CARGO_MANIFEST_DIR"), "/../../assets/presets/kajiya_kay.toml");
+    let paper = ["--preset", preset, "--light", "camera"];
+    fidelity_bunny_front(dir, name, &[&paper, extra].concat())
+}
+
+/// [`fidelity_front`] in Pelt's own studio.
+fn fidelity_bunny_front(dir: &Path, name: &str, extra: &[&str]) -> (serde_json::Value, image::RgbaImage, Vec<u8>) {
     let out = dir.join(name);
     let output = Command::new(env!("CARGO_BIN_EXE_pelt"))
         .args(["fidelity", "--builtin", "bunny", "--size", "96x96", "--supersample", "2", "--views", "front"])
-        // The paper's studio (Kajiya-Kay, whose albedo the wetness darkens, in a light following
-        // the camera): the fur model's brown coat is mostly its white highlight, which water
-        // sharpens rather than darkens.
-        .args(["--preset", concat!(env!("CARGO_MANIFEST_DIR"), "/../../assets/presets/kajiya_kay.toml")])
-        .args(["--light", "camera"])
         .args(extra)
         .arg("--json")
         .arg(out.join("out.json"))
@@ -124,4 +128,27 @@ fn wet_strands_are_darker_and_wetness_zero_is_dry() {
         let stderr = String::from_utf8_lossy(&output.stderr);
         assert!(stderr.contains("--wetness") && stderr.contains("from 0 (dry) to 1 (soaked)"), "{stderr}");
     }
+}
+
+#[test]
+fn the_strands_shadow_themselves_unless_no_shadows() {
+    let dir = Path::new(env!("CARGO_TARGET_TMPDIR")).join("cli_fidelity_shadows");
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    // The key light 90 degrees round from the camera: half the coat faces away, and the lit
+    // half's strands stand in each other's light.
+    let (lit, lit_sheet, _) = fidelity_bunny_front(&dir, "shadows", &["--light-angles", "90"]);
+    let (plain, plain_sheet, _) = fidelity_bunny_front(&dir, "none", &["--light-angles", "90", "--no-shadows"]);
+    assert_eq!((lit["shadows"].as_bool(), plain["shadows"].as_bool()), (Some(true), Some(false)));
+    assert_eq!(lit["light_angle_deg"].as_f64(), Some(90.0));
+    let (lit_luma, plain_luma) = (strands_panel_luma(&lit_sheet), strands_panel_luma(&plain_sheet));
+    eprintln!("strands' luma: shadowed {lit_luma:.1}, unshadowed {plain_luma:.1}");
+    assert!(lit_luma < plain_luma - 2.0, "shadowed strands' luma {lit_luma} against {plain_luma}");
+    // The light's angle from the camera replaces --light.
+    let clash = Command::new(env!("CARGO_BIN_EXE_pelt"))
+        .args(["fidelity", "--builtin", "sphere", "--light", "40,35", "--light-angles", "90"])
+        .current_dir(&dir)
+        .output()
+        .expect("run pelt");
+    assert!(!clash.status.success());
 }

@@ -22,6 +22,7 @@
 //! ([`WetClumps`], the `clumps` module) before it is placed, so wet strands are clumped geometry.
 
 mod clumps;
+pub mod shadow;
 
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
@@ -308,6 +309,31 @@ impl StrandReference {
     pub fn strand_nodes(&self, strand: &PlacedStrand) -> &[StrandNode] {
         let first = strand.first_node as usize;
         &self.nodes[first..first + strand.node_count as usize]
+    }
+
+    /// Every node's cross-section radius (model units), in the order of [`Self::nodes`]: the
+    /// strand's radius tapered at the node's height ([`Strand::radius_at`]) times its
+    /// triangle's [`PlacedStrand::world_per_texel`]. The ribbons are this wide either side and
+    /// the strands' shadow ([`shadow`]) blocks light this far from each.
+    #[must_use]
+    pub fn node_radii(&self) -> Vec<f32> {
+        let taper = self.field.params.taper;
+        let mut radii = Vec::with_capacity(self.nodes.len());
+        for placed in &self.strands {
+            let strand = self.field_strand(placed);
+            radii.extend(
+                self.strand_nodes(placed)
+                    .iter()
+                    .map(|node| strand.radius_at(node.height, taper) * placed.world_per_texel),
+            );
+        }
+        radii
+    }
+
+    /// Each strand's nodes in [`Self::nodes`] (and in [`Self::node_positions`]' output).
+    #[must_use]
+    pub fn node_ranges(&self) -> Vec<std::ops::Range<usize>> {
+        self.strands.iter().map(|s| s.first_node as usize..(s.first_node + s.node_count) as usize).collect()
     }
 
     /// Every node's model-space position for one state of the shared array (`(L + 1) * V`

@@ -12,6 +12,7 @@
 use bytemuck::{Pod, Zeroable};
 use glam::{Vec3, Vec4};
 use pelt_core::reference::StrandReference;
+use pelt_core::reference::shadow::Receiver;
 
 use crate::RenderError;
 use crate::fur::GpuFur;
@@ -36,6 +37,9 @@ struct RibbonVertex {
 const VERTEX_ATTRIBUTES: [wgpu::VertexAttribute; 6] = wgpu::vertex_attr_array![
     0 => Float32x3, 1 => Float32x3, 2 => Float32x3, 3 => Float32x4, 4 => Float32, 5 => Float32
 ];
+/// The key light's transmittance at each ribbon vertex, in a buffer of its own (rewritten per
+/// light without rebuilding the ribbons).
+const TRANSMITTANCE_ATTRIBUTES: [wgpu::VertexAttribute; 1] = wgpu::vertex_attr_array![6 => Float32];
 
 /// The strand pipeline for the target of a [`FurRenderer`] (its layouts, so it draws with the
 /// same [`FurView`]s and [`GpuFur`] uniforms).
@@ -69,11 +73,18 @@ impl StrandRenderer {
                 module: &module,
                 entry_point: Some("vs_strand"),
                 compilation_options: compilation_options.clone(),
-                buffers: &[Some(wgpu::VertexBufferLayout {
-                    array_stride: size_of::<RibbonVertex>() as u64,
-                    step_mode: wgpu::VertexStepMode::Vertex,
-                    attributes: &VERTEX_ATTRIBUTES,
-                })],
+                buffers: &[
+                    Some(wgpu::VertexBufferLayout {
+                        array_stride: size_of::<RibbonVertex>() as u64,
+                        step_mode: wgpu::VertexStepMode::Vertex,
+                        attributes: &VERTEX_ATTRIBUTES,
+                    }),
+                    Some(wgpu::VertexBufferLayout {
+                        array_stride: size_of::<f32>() as u64,
+                        step_mode: wgpu::VertexStepMode::Vertex,
+                        attributes: &TRANSMITTANCE_ATTRIBUTES,
+                    }),
+                ],
             },
             primitive: wgpu::PrimitiveState {
                 topology: wgpu::PrimitiveTopology::TriangleList,
@@ -123,6 +134,7 @@ impl StrandRenderer {
         pass.set_bind_group(2, &self.empty, &[]);
         pass.set_bind_group(3, view.shadow_group(), &[]);
         pass.set_vertex_buffer(0, ribbons.vertices.slice(..));
+        pass.set_vertex_buffer(1, ribbons.transmittance.slice(..));
         pass.set_index_buffer(ribbons.indices.slice(..), wgpu::IndexFormat::Uint32);
         pass.draw_indexed(0..ribbons.index_count, 0, 0..1);
     }
@@ -132,9 +144,22 @@ impl StrandRenderer {
 #[derive(Debug)]
 pub struct StrandRibbons {
     vertices: wgpu::Buffer,
+    /// The key light's transmittance per ribbon vertex (1 until [`StrandRibbons::set_transmittance`]).
+    transmittance: wgpu::Buffer,
     indices: wgpu::Buffer,
     index_count: u32,
     strands: usize,
+    /// Each pair of ribbon vertices' point on its strand (CPU side, for the traced shadow).
+    points: Vec<RibbonPoint>,
+}
+
+/// One pair of ribbon vertices: the point on the strand's centre line between them.
+#[derive(Clone, Copy, Debug)]
+struct RibbonPoint {
+    position: Vec3,
+    tangent: Vec3,
+    radius: f32,
+    strand: u32,
 }
 
 impl StrandRibbons {
@@ -152,11 +177,12 @@ impl StrandRibbons {
         triangles: &[[u32; 3]],
     ) -> Result<Self, RenderError> {
         let nodes = reference.node_positions(positions).map_err(|e| RenderError::Textures(e.to_string()))?;
-        let taper = reference.field.params.taper;
+        let radii = reference.node_radii();
         let surface = reference.field.surface();
         let mut vertices = Vec::with_capacity(nodes.len() * 2);
         let mut indices = Vec::with_capacity(nodes.len() * 6);
-        for placed in &reference.strands {
+        let mut receivers = Vec::with_capacity(nodes.len());
+        for (strand_index, placed) in (0u32..).zip(&reference.strands) {
             let strand = reference.field_strand(placed);
             let triangle = triangles
                 .get(placed.triangle as usize)
@@ -184,7 +210,7 @@ impl StrandRibbons {
                     .colour(strand, node.height)
                     .map(|c| srgb_to_linear((c.clamp(0.0, 1.0) * 255.0).round() / 255.0))
                     * tint;
-                let half_width = strand.radius_at(node.height, taper) * placed.world_per_texel;
+                let half_width = radii[first + k];
                 let colour_height = Vec4::from((albedo, node.height)).to_array();
                 let base = vertices.len() as u32;
                 for side in [-1.0, 1.0] {
@@ -197,6 +223,7 @@ impl StrandRibbons {
                         wetness: placed.wetness,
                     });
                 }
+                receivers.push(RibbonPoint { position: points[k], tangent, radius: half_width, strand: strand_index });
                 if k + 1 < points.len() {
                     indices.extend_from_slice(&[base, base + 1, base + 3, base, base + 3, base + 2]);
                 }
@@ -216,10 +243,59 @@ impl StrandRibbons {
         let pad = |bytes: &[u8]| if bytes.is_empty() { vec![0u8; 4] } else { bytes.to_vec() };
         Ok(Self {
             vertices: buffer("pelt strand ribbons", &pad(vertex_bytes), wgpu::BufferUsages::VERTEX),
+            transmittance: buffer(
+                "pelt strand transmittance",
+                &pad(bytemuck::cast_slice(&vec![1.0f32; vertices.len()])),
+                wgpu::BufferUsages::VERTEX | wgpu::BufferUsages::COPY_DST,
+            ),
             indices: buffer("pelt strand ribbon indices", &pad(index_bytes), wgpu::BufferUsages::INDEX),
             index_count: indices.len() as u32,
             strands: reference.strands.len(),
+            points: receivers,
         })
+    }
+
+    /// The points that take the key light, one per pair of ribbon vertices in their order, as
+    /// a camera at `eye` sees them (model space: the fur's transform is left out): each on its
+    /// strand's centre line, `across` it as `vs_strand` widens the ribbon, `cross(tangent, to
+    /// the camera)`. Trace them with `pelt_core::reference::shadow::ribbon_transmittance`.
+    #[must_use]
+    pub fn shadow_receivers(&self, eye: Vec3) -> Vec<Receiver> {
+        self.points
+            .iter()
+            .map(|p| {
+                let tangent = p.tangent.normalize_or(Vec3::Y);
+                let across = tangent
+                    .cross((eye - p.position).normalize_or(Vec3::Z))
+                    .normalize_or(tangent.any_orthonormal_vector());
+                Receiver { position: p.position, across, radius: p.radius, strand: p.strand }
+            })
+            .collect()
+    }
+
+    /// Sets how much of the key light (light 0) reaches each ribbon vertex: per pair in the
+    /// order of [`StrandRibbons::shadow_receivers`], the vertex on the `-across` and on the
+    /// `+across` side; `None`: 1 everywhere (unshadowed). It multiplies the key light's share of
+    /// a strand's light only.
+    ///
+    /// # Errors
+    /// [`RenderError::Textures`] for a list of another length than the receivers.
+    pub fn set_transmittance(&self, queue: &wgpu::Queue, per_pair: Option<&[[f32; 2]]>) -> Result<(), RenderError> {
+        let values: Vec<f32> = match per_pair {
+            Some(values) if values.len() == self.points.len() => values.iter().flatten().copied().collect(),
+            Some(values) => {
+                return Err(RenderError::Textures(format!(
+                    "{} transmittance values for {} ribbon points",
+                    values.len(),
+                    self.points.len()
+                )));
+            }
+            None => vec![1.0; 2 * self.points.len()],
+        };
+        if !values.is_empty() {
+            queue.write_buffer(&self.transmittance, 0, bytemuck::cast_slice(&values));
+        }
+        Ok(())
     }
 
     /// Strands drawn.

@@ -18,8 +18,10 @@ struct StrandVertex {
     @location(5) wetness: f32,
 }
 
+// `transmittance` (its own vertex buffer): how much of the key light reaches the node through
+// the other strands and the skin, traced offline (`pelt_core::reference::shadow`); 1 unshadowed.
 @vertex
-fn vs_strand(in: StrandVertex) -> Varyings {
+fn vs_strand(in: StrandVertex, @location(6) transmittance: f32) -> Varyings {
     let centre = world_from_model_point(in.position);
     let normal = world_from_model_normal(in.normal);
     let tangent = safe_normalize(world_from_model_direction(in.tangent), normal);
@@ -39,8 +41,9 @@ fn vs_strand(in: StrandVertex) -> Varyings {
     out.slice = 0;
     out.height = in.colour_height.a;
     out.fade = 1.0;
-    // The wetness travels in `surface_uv.x`, which strands do not otherwise use.
-    out.surface_uv = vec2<f32>(in.wetness, 0.0);
+    // The wetness and the key light's transmittance travel in `surface_uv`, which strands do
+    // not otherwise use.
+    out.surface_uv = vec2<f32>(in.wetness, transmittance);
     return out;
 }
 
@@ -49,13 +52,38 @@ fn vs_strand(in: StrandVertex) -> Varyings {
 fn fs_strand(in: Varyings) -> @location(0) vec4<f32> {
     // The albedo travels in `tile_position`, which strands do not otherwise use.
     var albedo = in.tile_position;
-    var terms = hair_terms(normalize(in.tangent), normalize(in.normal), in.world_position, in.height);
+    let tangent = normalize(in.tangent);
+    let normal = normalize(in.normal);
+    var terms = hair_terms(tangent, normal, in.world_position, in.height);
     // A uniform branch: a wet strand darkens and shines as `wet_groom` and `coat_terms` make the
     // shells do (either model); a dry coat keeps `hair_lighting`'s very arithmetic.
+    var wet = 0.0;
     if wet_on() {
-        let w = clamp(in.surface_uv.x, 0.0, 1.0);
-        albedo *= 1.0 - object.wet_darkening * w;
-        terms = coat_terms(normalize(in.tangent), normalize(in.normal), in.world_position, in.height, w);
+        wet = clamp(in.surface_uv.x, 0.0, 1.0);
+        albedo *= 1.0 - object.wet_darkening * wet;
+        terms = coat_terms(tangent, normal, in.world_position, in.height, wet);
+    }
+    // The strands' own shadow takes its share of the key light (light 0) only; the
+    // environment's fill stays unshadowed, as on the shells. Unshadowed strands keep their bytes.
+    let transmittance = clamp(in.surface_uv.y, 0.0, 1.0);
+    if transmittance < 1.0 {
+        if fur_model() {
+            let key = key_light_lobes(tangent, normal, in.world_position, wet);
+            terms = vec4<f32>(max(terms.xy - (1.0 - transmittance) * key, vec2<f32>(0.0)), terms.zw);
+        } else {
+            terms.z *= transmittance;
+        }
     }
     return vec4<f32>(hair_colour(albedo, terms, in.height), 1.0);
+}
+
+// The fur model's lobes from the key light (light 0) alone, as `fur_terms` sums them (the strand
+// pipeline has no shadow maps: its visibility is 1).
+fn key_light_lobes(tangent: vec3<f32>, normal: vec3<f32>, world_position: vec3<f32>, wet: f32) -> vec2<f32> {
+    if lights.count == 0u {
+        return vec2<f32>(0.0);
+    }
+    let to_camera = safe_normalize(view.camera_position - world_position, normal);
+    let incident = light_incident(0u, world_position);
+    return fur_bsdf(tangent, to_camera, incident.to_light, normal, wet) * luminance(incident.irradiance);
 }

@@ -10,13 +10,15 @@ use std::path::PathBuf;
 use anyhow::{Context as _, bail};
 use glam::{Mat4, Vec3};
 use pelt_core::anim::Pose;
+use pelt_core::light::direction_from_angles;
+use pelt_core::reference::shadow::{ShadowCasters, ribbon_transmittance};
 use pelt_core::reference::{StrandReference, WetClumps};
 use pelt_core::sim::{FurStepper, SimParams, WindParams};
 use pelt_core::{Builtin, FurStructure, Mesh, Preset, Stage, texture};
 use pelt_render::{
     Backend, Camera, DEFAULT_BACKGROUND, FurDrawSettings, FurDriver, FurLook, FurRenderer, FurTarget, FurView, Gpu,
-    HEADLESS_FORMAT, Headless, KernelChoice, PlainMesh, StrandRenderer, StrandRibbons, default_sample_count,
-    tile_mapping,
+    HEADLESS_FORMAT, Headless, KernelChoice, PlainMesh, StrandRenderer, StrandRibbons, Studio, Surroundings, ViewData,
+    default_sample_count, tile_mapping,
 };
 
 use self::metrics::Mask;
@@ -34,7 +36,9 @@ const CHANGED: u8 = 3;
 #[command(after_help = "\
 Renders shells + fins, shells alone and the explicit strands (the same seeded strands, as
 supersampled ribbons) from each view; writes MODEL-VIEW.png (shells + fins | shells | strands |
-difference heat map) into --out and prints SSIM over the fur and over the silhouette band.
+difference heat map) into --out and prints SSIM over the fur and over the silhouette band. The
+key light's shadow falls on both pictures unless --no-shadows; --light-angles 0,45,90,180
+measures each view at those view-light angles.
 Example: `pelt fidelity assets/meshes/spot.obj --preset assets/presets/spot.toml --json spot.json`.")]
 pub struct Args {
     #[command(flatten)]
@@ -59,6 +63,22 @@ pub struct Args {
     json: Option<PathBuf>,
     #[command(flatten)]
     lights: crate::light_args::LightArgs,
+    /// View-light angles, degrees, comma separated (e.g. 0,45,90,180): each view is measured
+    /// once per angle, the key light (a sun) placed that far round from the direction to the
+    /// camera, turned about the camera's vertical (toward increasing azimuth), so 0 lights the
+    /// fur from the eye and 180 from straight behind it. Replaces --light's direction.
+    #[arg(long, value_name = "DEGREES,...", value_delimiter = ',', conflicts_with = "light")]
+    light_angles: Vec<f32>,
+    /// No shadows: the shells without the key light's shadow maps and the strands without
+    /// their traced shadow (by default the shells take the key light's shadow and deep opacity
+    /// maps as `pelt render` draws them, and the strands their own shadow traced on the CPU).
+    #[arg(long)]
+    no_shadows: bool,
+    /// The share of the key light a strand stops where it covers another from the light, in
+    /// the strands' traced shadow: 1 (the default) makes them opaque, as they are drawn; less
+    /// lets that share of what crosses them through (a what-if: hair passes some light on).
+    #[arg(long, default_value_t = 1.0, value_name = "A", value_parser = parse_opacity)]
+    strand_opacity: f32,
     /// Folder for the side-by-side images.
     #[arg(long, default_value = "fidelity", value_name = "DIR")]
     out: PathBuf,
@@ -77,6 +97,13 @@ pub struct Args {
     backend: Backend,
 }
 
+fn parse_opacity(text: &str) -> Result<f32, String> {
+    match text.trim().parse::<f32>() {
+        Ok(value) if (0.0..=1.0).contains(&value) => Ok(value),
+        _ => Err(format!("expected a share from 0 to 1, got {text:?}")),
+    }
+}
+
 /// One model and view's figures (the `--json` keys).
 #[derive(Debug, serde::Serialize)]
 struct Figures {
@@ -84,6 +111,12 @@ struct Figures {
     view: String,
     wind: [f32; 3],
     wetness: f32,
+    /// Whether the key light cast shadows (shells: shadow maps; strands: traced).
+    shadows: bool,
+    /// The key light's azimuth and elevation, degrees (none: it follows the camera).
+    light_deg: Option<[f32; 2]>,
+    /// The angle between the directions to the camera and to the key light, degrees.
+    light_angle_deg: Option<f32>,
     ssim_fur_shells_fins: f64,
     ssim_fur_shells: f64,
     ssim_silhouette_shells_fins: f64,
@@ -167,13 +200,36 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     )?;
     // The preset's `[shading]`, for the shells and the strands alike.
     let look = crate::light_args::preset_look(&preset);
-    let shell_side = Side::new(&shells, &fur, &textures, &mut stepper, &plain, look)?;
-    let strand_side = Side::new(&strands, &fur, &textures, &mut stepper, &plain, look)?;
+    let shadows = !args.no_shadows;
+    let mut shell_side = Side::new(&shells, &fur, &textures, &mut stepper, &plain, look, (shadows, (width, height)))?;
+    // The strands' side has the same shadow maps (fitted to the output's size, not the
+    // supersampled one): the skin and plain meshes under the strands take the same shadow as
+    // under the shells; the strands themselves take their traced shadow instead.
+    let mut strand_side = Side::new(&strands, &fur, &textures, &mut stepper, &plain, look, (shadows, (width, height)))?;
     let positions = stepper.simulation().positions();
     let reference = strand_reference(&fur, field, &stepper)?;
     let strand_renderer = StrandRenderer::new(&strands.gpu.device, &strand_side.renderer)?;
     let normals = stepper.moved_pose().map_or(&fur.mesh.normals, |pose| &pose.normals);
     let ribbons = StrandRibbons::new(&strands.gpu.device, &reference, positions, normals, &fur.mesh.triangles)?;
+    // What casts the strands' traced shadow: the strands and the posed skin and plain meshes.
+    let node_positions = reference.node_positions(positions)?;
+    let node_radii = reference.node_radii();
+    let node_ranges = reference.node_ranges();
+    let skin = &positions[..fur.mesh.vertex_count()];
+    let surfaces: Vec<[Vec3; 3]> = fur
+        .mesh
+        .triangles
+        .iter()
+        .map(|t| t.map(|j| skin[j as usize]))
+        .chain(plain.iter().flat_map(|m| m.triangles.iter().map(|t| t.map(|j| m.positions[j as usize]))))
+        .collect();
+    let casters = ShadowCasters {
+        nodes: &node_positions,
+        radii: &node_radii,
+        strands: &node_ranges,
+        surfaces: &surfaces,
+        opacity: args.strand_opacity,
+    };
 
     std::fs::create_dir_all(&args.out).with_context(|| format!("cannot create {}", args.out.display()))?;
     let front = preset.render.camera_azimuth_deg.unwrap_or(30.0);
@@ -194,13 +250,45 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     }
     let environment = args.lights.environment(None)?;
     let studio = args.lights.studio(None, environment, 0.0);
+    // Each view once per view-light angle, or once in --light's (or the default) light.
+    let angles: Vec<Option<f32>> =
+        if args.light_angles.is_empty() { vec![None] } else { args.light_angles.iter().copied().map(Some).collect() };
     let mut results = Vec::new();
-    for (name, azimuth) in &views {
+    for ((name, azimuth), angle) in views.iter().flat_map(|v| angles.iter().map(move |a| (v, *a))) {
+        let camera_azimuth = front + azimuth;
         let camera =
-            Camera::framing_points(centre, points.iter().copied(), fur_length, front + azimuth, elevation, aspect);
+            Camera::framing_points(centre, points.iter().copied(), fur_length, camera_azimuth, elevation, aspect);
+        let (studio, light_deg) = match angle {
+            Some(angle) => {
+                let (light_azimuth, light_elevation) = light_at_angle(camera_azimuth, elevation, angle);
+                let sun = Studio::sun_at(light_azimuth, light_elevation);
+                (studio.with_lights(&[sun], studio.environment), Some([light_azimuth, light_elevation]))
+            }
+            None => (studio, key_light_angles(&studio)),
+        };
         let view_data = studio.view_data(&camera, aspect);
-        shell_side.view.prepare(&shells.gpu.queue, &view_data);
-        strand_side.view.prepare(&strands.gpu.queue, &view_data);
+        shell_side.prepare(&shells, &view_data)?;
+        strand_side.prepare(&strands, &view_data)?;
+        // The strands' own shadow, traced on the CPU for this view's key light, for each half of
+        // each ribbon as this camera sees it (the fur's transform is the identity here).
+        if shadows {
+            let started = std::time::Instant::now();
+            let receivers = ribbons.shadow_receivers(camera.eye);
+            let transmittance = ribbon_transmittance(&casters, view_data.light_direction_world, &receivers);
+            ribbons.set_transmittance(&strands.gpu.queue, Some(&transmittance))?;
+            let sum: f64 = transmittance.iter().flatten().map(|&t| f64::from(t)).sum();
+            println!(
+                "{:>8} {name:<5} the strands' shadow traced in {:.1} s: mean transmittance {:.3} over {} points",
+                "",
+                started.elapsed().as_secs_f64(),
+                sum / (2 * transmittance.len()).max(1) as f64,
+                transmittance.len()
+            );
+        }
+        let mut tag = tag.clone();
+        if let Some(angle) = angle {
+            tag += &format!("-light{angle}");
+        }
         let empty = shells.render(DEFAULT_BACKGROUND, |_| {})?;
         let skin = shell_side.render(&shells, FurDrawSettings::SKIN, true)?;
         let fur_skin = shell_side.render(&shells, FurDrawSettings::SKIN, false)?;
@@ -239,6 +327,9 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             view: name.clone(),
             wind: wind.to_array(),
             wetness,
+            shadows,
+            light_deg,
+            light_angle_deg: angle,
             ssim_fur_shells_fins: ssim(&shells_fins, &fur_mask)?,
             ssim_fur_shells: ssim(&shells_only, &fur_mask)?,
             ssim_silhouette_shells_fins: ssim(&shells_fins, &band)?,
@@ -268,6 +359,14 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             let (mean, contrast) = metrics::luma_statistics(image, &fur_mask);
             format!("{mean:.0}/{contrast:.1}")
         };
+        if let Some([light_azimuth, light_elevation]) = light_deg {
+            println!(
+                "{:>8} {name:<5} key light at {light_azimuth:.1},{light_elevation:.1}{}, shadows {}",
+                "",
+                angle.map_or(String::new(), |a| format!(" ({a} degrees from the camera)")),
+                if shadows { "on" } else { "off" }
+            );
+        }
         println!(
             "{:>8} {name:<5} the strands against themselves {shift}/{factor} pixel off: SSIM fur {:.3}",
             "", result.ssim_fur_reference_shifted
@@ -306,12 +405,38 @@ fn load_meshes(args: &MeshArgs) -> anyhow::Result<(String, Stage)> {
     Ok((name, args.stage(Builtin::Bunny, &[])?))
 }
 
-/// One headless target's renderer, fur, view and plain meshes.
+/// The key light's azimuth and elevation (degrees) for a light that points `toward` it:
+/// [`direction_from_angles`] undone.
+fn angles_of(toward: Vec3) -> [f32; 2] {
+    let d = toward.normalize_or(Vec3::Y);
+    [d.x.atan2(d.z).to_degrees(), d.y.clamp(-1.0, 1.0).asin().to_degrees()]
+}
+
+/// The studio's key light's angles, when it is a sun fixed in the world.
+fn key_light_angles(studio: &Studio) -> Option<[f32; 2]> {
+    let key = studio.lights.as_slice().first()?;
+    (key.kind == pelt_core::light::LightKind::Directional).then(|| angles_of(key.direction))
+}
+
+/// The key light `angle_deg` degrees round from the direction to a camera at `azimuth_deg`,
+/// `elevation_deg` (about the camera's vertical, toward increasing azimuth), as azimuth and
+/// elevation in degrees: the direction to the camera turned in the plane it shares with the
+/// horizontal direction across the view, so the angle between the two is exactly `angle_deg`.
+fn light_at_angle(azimuth_deg: f32, elevation_deg: f32, angle_deg: f32) -> (f32, f32) {
+    let to_camera = direction_from_angles(azimuth_deg, elevation_deg);
+    let across = direction_from_angles(azimuth_deg + 90.0, 0.0);
+    let (sin, cos) = angle_deg.to_radians().sin_cos();
+    let [azimuth, elevation] = angles_of(to_camera * cos + across * sin);
+    (azimuth, elevation)
+}
+
+/// One headless target's renderer, fur, view, plain meshes and the key light's shadow maps.
 struct Side {
     renderer: FurRenderer,
     fur: FurDriver,
     view: FurView,
     plain: Vec<PlainMesh>,
+    surroundings: Surroundings,
 }
 
 impl Side {
@@ -320,8 +445,9 @@ impl Side {
         fur: &FurStructure,
         textures: &pelt_core::FurTextures,
         stepper: &mut FurStepper,
-        plain: &[Mesh],
+        plain_meshes: &[Mesh],
         look: FurLook,
+        (shadows, picture_size): (bool, (u32, u32)),
     ) -> anyhow::Result<Self> {
         let (device, queue) = (&headless.gpu.device, &headless.gpu.queue);
         let renderer = headless.renderer()?;
@@ -330,7 +456,7 @@ impl Side {
         let mut gpu_fur = FurDriver::new(device, queue, &renderer, fur, textures, &params, KernelChoice::Cpu)?;
         gpu_fur.set_look(look);
         gpu_fur.advance_to(device, queue, stepper, SETTLE_SECS)?;
-        let plain = plain
+        let plain = plain_meshes
             .iter()
             .map(|mesh| PlainMesh::new(device, &renderer, mesh, PLAIN_COLOUR))
             .collect::<Result<Vec<_>, _>>()?;
@@ -338,7 +464,35 @@ impl Side {
             mesh.prepare(queue, Mat4::IDENTITY);
         }
         let view = FurView::new(device, &renderer);
-        Ok(Self { renderer, fur: gpu_fur, view, plain })
+        // As `pelt render` draws them: the key light's shadow and deep opacity maps fitted to
+        // the picture.
+        let mut surroundings = Surroundings::new(device, queue, &renderer, shadows, None, (fur, plain_meshes))
+            .context("making the shadow maps")?;
+        surroundings.fit_to_frame(device, &renderer, picture_size).context("fitting the shadow maps")?;
+        Ok(Self { renderer, fur: gpu_fur, view, plain, surroundings })
+    }
+
+    /// Prepares the view for `view_data` and draws the key light's shadow maps (skin, plain
+    /// meshes, shells and fins) for it.
+    fn prepare(&mut self, headless: &Headless, view_data: &ViewData) -> anyhow::Result<()> {
+        let (device, queue) = (&headless.gpu.device, &headless.gpu.queue);
+        self.view.prepare(queue, view_data);
+        self.surroundings
+            .prepare((device, queue), &self.renderer, view_data, &mut self.view)
+            .context("aiming the shadow maps")?;
+        if !self.surroundings.has_shadows() {
+            return Ok(());
+        }
+        let mut encoder =
+            device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("pelt fidelity shadows") });
+        self.surroundings.record(&mut encoder, |pass, light| {
+            for mesh in &self.plain {
+                self.renderer.draw_plain(pass, light, mesh);
+            }
+            self.fur.draw(pass, &self.renderer, light, &FurDrawSettings::ALL);
+        });
+        queue.submit([encoder.finish()]);
+        Ok(())
     }
 
     /// The shells' side: `settings` for the fur, with or without the plain meshes.
