@@ -361,12 +361,12 @@ impl ShadowMap {
     /// casts, as [`ShadowCaster::for_view`] lists them): everything that casts lies within
     /// `radius` of `centre` (world space). Receivers further from a light than that compare as at
     /// the far edge, so a ground below the casters takes their shadow without being inside.
-    /// Returns how many of `casters` have maps: those past the room the maps have (or past
-    /// light 7) cast no shadow.
+    /// `light_count` is how many lights the picture's view has. Returns how many of `casters`
+    /// have maps: those past the room the maps have (or past light 7) cast no shadow.
     pub fn prepare(
         &mut self,
         queue: &wgpu::Queue,
-        casters: &[(usize, ShadowCaster)],
+        (casters, light_count): (&[(usize, ShadowCaster)], usize),
         (centre, radius): (Vec3, f32),
     ) -> usize {
         let radius = if radius.is_finite() && radius > 0.0 { radius } else { 1.0 };
@@ -402,7 +402,8 @@ impl ShadowMap {
             lights.push(light);
             cast += 1;
         }
-        self.key_only = lights == [0] && self.used.len() == 1;
+        // One light, casting one view: the studio's key light, read at fixed offsets.
+        self.key_only = light_count <= 1 && lights == [0] && self.used.len() == 1;
         queue.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&uniform));
         for (index, slot) in self.slots.iter().enumerate().take(self.used.len()) {
             uniform.pass_view = index as u32;

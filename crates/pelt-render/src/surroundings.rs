@@ -140,7 +140,7 @@ impl Surroundings {
             if needed > map.view_capacity() {
                 *map = ShadowMap::with_views(device, renderer, map.settings(), needed)?;
             }
-            map.prepare(queue, &casters, self.bounds);
+            map.prepare(queue, (&casters, view.lights.as_slice().len()), self.bounds);
         }
         picture.set_shadows(self.shadows.as_ref());
         Ok(())

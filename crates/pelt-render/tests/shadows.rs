@@ -84,7 +84,7 @@ impl Stage {
         let map = shadows.map(|(fur_depth, caster)| {
             let settings = ShadowSettings { size: 512, fur_depth, extinction: 0.6 };
             let mut map = ShadowMap::new(rig.device(), &rig.renderer, settings).expect("shadow map");
-            map.prepare(rig.queue(), &[(0, caster)], (Vec3::ZERO, 1.6));
+            map.prepare(rig.queue(), (&[(0, caster)], 1), (Vec3::ZERO, 1.6));
             map
         });
         self.view.set_shadows(map.as_ref());
@@ -139,7 +139,11 @@ impl Stage {
             let views = casters.iter().map(|(_, caster)| caster.view_count()).sum();
             let settings = ShadowSettings { size: 512, fur_depth: 0.1, extinction: 0.6 };
             let mut map = ShadowMap::with_views(rig.device(), &rig.renderer, settings, views).expect("shadow map");
-            assert_eq!(map.prepare(rig.queue(), &casters, bounds), casters.len(), "every caster has its views");
+            assert_eq!(
+                map.prepare(rig.queue(), (&casters, lights.len()), bounds),
+                casters.len(),
+                "every caster has its views"
+            );
             map
         });
         self.view.set_shadows(map.as_ref());

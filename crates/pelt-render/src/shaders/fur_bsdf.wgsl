@@ -139,18 +139,21 @@ struct Incident {
 }
 
 fn light_incident(i: u32, world_position: vec3<f32>) -> Incident {
+    // Selects, not an `if` on the light's kind: lavapipe (Mesa 22.3) inlines a uniform that alone
+    // decides a fragment's branch and compiles anew whenever another view's lights are bound.
     let light = lights.light[i];
-    var incident = Incident(light.position_or_direction.xyz, light.intensity_cos_inner.xyz);
-    if light.position_or_direction.w != 0.0 {
-        let offset = light.position_or_direction.xyz - world_position;
-        let d2 = max(dot(offset, offset), 1e-8);
-        incident.to_light = offset * inverseSqrt(d2);
-        let cone = dot(-incident.to_light, light.spot_axis_cos_outer.xyz);
-        let outer = light.spot_axis_cos_outer.w;
-        let fade = clamp((cone - outer) / max(light.intensity_cos_inner.w - outer, 1e-4), 0.0, 1.0);
-        incident.irradiance *= fade * fade / d2;
-    }
-    return incident;
+    let positional = light.position_or_direction.w != 0.0;
+    let offset = light.position_or_direction.xyz - world_position;
+    let d2 = max(dot(offset, offset), 1e-8);
+    let toward = offset * inverseSqrt(d2);
+    let cone = dot(-toward, light.spot_axis_cos_outer.xyz);
+    let outer = light.spot_axis_cos_outer.w;
+    let fade = clamp((cone - outer) / max(light.intensity_cos_inner.w - outer, 1e-4), 0.0, 1.0);
+    let irradiance = light.intensity_cos_inner.xyz;
+    return Incident(
+        select(light.position_or_direction.xyz, toward, positional),
+        select(irradiance, irradiance * (fade * fade / d2), positional),
+    );
 }
 
 // The environment's SH coefficient `k` (rgb).

@@ -166,6 +166,11 @@ struct Varyings {
     // Shells without mesh uvs: the base normal in model space, which picks the axis-aligned
     // projection of the tiles (fixed to the model, so it moves with it).
     @location(10) tile_normal: vec3<f32>,
+    // The skin and plain meshes: how many of the view's lights light them (`Lights::count`),
+    // handed on by the vertex so no fragment branches on a uniform alone: lavapipe (Mesa 22.3)
+    // inlines such uniforms into fragment shaders and compiles anew whenever another view's
+    // buffer is bound (alternating views cost a frame five times over).
+    @location(11) @interpolate(flat) light_count: u32,
 }
 
 // What a shell fragment reads and nothing more, packed four to a location: software
@@ -467,15 +472,16 @@ fn hair_colour(texel_albedo: vec3<f32>, terms: vec4<f32>, height: f32) -> vec3<f
 }
 
 // Lambert with a soft terminator for surfaces without fur (the skin, plain meshes): the view's
-// lights, each shadowed, or its one key light where it has none (the paper's studio).
-fn surface_lighting(albedo: vec3<f32>, normal: vec3<f32>, world_position: vec3<f32>) -> vec3<f32> {
-    if lights.count == 0u {
+// lights, each shadowed; its one key light where it has no others or its maps hold the key
+// light's view alone (`SHADOW_KEY_ONLY`: Pelt's studio, whose frame the loop slowed on lavapipe).
+fn surface_lighting(albedo: vec3<f32>, normal: vec3<f32>, world_position: vec3<f32>, light_count: u32) -> vec3<f32> {
+    if SHADOW_KEY_ONLY || light_count == 0u {
         let wrapped = max(dot(normal, view.light_direction) * 0.7 + 0.3, 0.0);
         let visibility = light_visibility(0u, world_position, normal);
         return albedo * (view.ambient + view.light_colour * wrapped * visibility);
     }
     var light = vec3<f32>(0.0);
-    for (var i = 0u; i < lights.count; i++) {
+    for (var i = 0u; i < min(light_count, 8u); i++) {
         let incident = light_incident(i, world_position);
         let wrapped = max(dot(normal, incident.to_light) * 0.7 + 0.3, 0.0);
         light += incident.irradiance * (wrapped * light_visibility(i, world_position, normal));
@@ -635,7 +641,7 @@ fn fur_output(colour: vec3<f32>, alpha: f32) -> vec4<f32> {
 // Plain meshes (no fur, e.g. the body under a furry garment): lit in the object's colour.
 @fragment
 fn fs_plain(in: Varyings) -> @location(0) vec4<f32> {
-    return vec4<f32>(surface_lighting(object.colour.rgb, normalize(in.normal), in.world_position), 1.0);
+    return vec4<f32>(surface_lighting(object.colour.rgb, normalize(in.normal), in.world_position, in.light_count), 1.0);
 }
 
 // The opaque skin under the fur, in the colour of the roots.
@@ -643,7 +649,7 @@ fn fs_plain(in: Varyings) -> @location(0) vec4<f32> {
 fn fs_skin(in: Varyings) -> @location(0) vec4<f32> {
     let normal = normalize(in.normal);
     let albedo = object.colour.rgb * surface_tint(root_surface_uv(in));
-    let colour = surface_lighting(albedo, normal, in.world_position) * object.root_occlusion;
+    let colour = surface_lighting(albedo, normal, in.world_position, in.light_count) * object.root_occlusion;
     return vec4<f32>(colour, 1.0);
 }
 

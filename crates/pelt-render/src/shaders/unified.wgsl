@@ -111,6 +111,7 @@ fn surface_varyings(vertex: u32, wedge: u32, layer: u32) -> Varyings {
         out.tangent = strand_tangent(layer, vertex, here, out.normal);
     }
     out.tile_normal = rest_normal;
+    out.light_count = lights.count;
     if uses_mesh_uvs() {
         out.tile_position = vec3<f32>(0.0);
         out.surface_uv = wedge_uvs[wedge];
