@@ -165,7 +165,7 @@ pub use shaders::{
 };
 #[cfg(feature = "lab")]
 pub use shaders::{separated_shader_source, strands_shader_source};
-pub use shadows::{MAX_FITTED_SIZE, ShadowCaster, ShadowMap, ShadowSettings, fitted_shadow_size};
+pub use shadows::{MAX_FITTED_SIZE, MAX_SHADOW_VIEWS, ShadowCaster, ShadowMap, ShadowSettings, fitted_shadow_size};
 pub use simulation::GpuSimulation;
 pub use skinning::GpuSkin;
 pub use studio::{GROUND_RADIANCE, KEY_LIGHT_ANGLES, SKY_RADIANCE, Studio};
