@@ -6,6 +6,7 @@ mod export_usd;
 mod fidelity;
 mod format;
 mod groom;
+mod herd;
 mod light_args;
 mod lod;
 mod mesh_args;

@@ -170,7 +170,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         let secs = scene.as_ref().map(Scene::duration_secs).or(clip_secs).unwrap_or(2.0);
         ((secs * args.fps).round() as u32).max(1)
     };
-    let instances = herd_instances(args, scene.as_ref(), &mesh, (rig.as_ref(), clip))?;
+    let instances = crate::herd::instances(args.herd, scene.as_ref(), &mesh, (rig.as_ref(), clip))?;
     let fur = preset.grow(mesh, &args.mesh.source(Builtin::Bunny)?.name())?;
     let textures = preset.generate_textures()?;
     let mut simulation_params = preset.simulation.clone();
@@ -272,9 +272,9 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let herd_ground = (!instances.is_empty() && scene_ground.is_none()).then(pelt_core::sim::SceneGround::default);
     let shadow_args =
         crate::shadows::ShadowArgs { ground: args.shadows.ground || herd_ground.is_some(), ..args.shadows };
-    let extent = herd_extent(&fur, &instances, f64::from(frames) / args.fps);
+    let extent = crate::herd::extent(&fur, &instances, &[0.0, f64::from(frames) / args.fps]);
     let mut surroundings =
-        shadow_args.surroundings_around((device, queue, &renderer), scene_ground, (&fur, &plain), extent.as_ref())?;
+        shadow_args.surroundings((device, queue, &renderer), scene_ground, (&fur, &plain), extent.as_ref())?;
     surroundings.fit_to_frame(device, &renderer, (width, height)).context("fitting the shadow maps to the picture")?;
     surroundings.prepare((device, queue), &renderer, &view_data, &mut view).context("aiming the shadow maps")?;
     let lod_settings = lod::settings(&preset.render.lod, args.no_lod);
@@ -339,7 +339,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             }
             FurStepper::advance_herd(&mut steppers, &instances, time_secs)?;
             for ((driver, stepper), level) in drivers.iter_mut().zip(&steppers).zip(levels) {
-                show_stepped(queue, driver, stepper)?;
+                crate::herd::show_stepped(queue, driver, stepper)?;
                 driver.set_level(level);
             }
         }
@@ -466,60 +466,6 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         headless.gpu.summary(),
         headless.target().sample_count,
     );
-    Ok(())
-}
-
-/// The herd to draw: `--herd N` scattered, or the script's `[[instance]]`s; none for one fur.
-fn herd_instances(
-    args: &Args,
-    scene: Option<&Scene>,
-    mesh: &Mesh,
-    (rig, clip): (Option<&Rig>, Option<usize>),
-) -> anyhow::Result<Vec<HerdInstance>> {
-    let scripted = scene.map_or(&[][..], |s| &s.instance[..]);
-    match args.herd {
-        Some(_) if !scripted.is_empty() => {
-            bail!("--herd and the script's [[instance]] tables both place a herd: use one of them")
-        }
-        Some(count) => {
-            // A body length and a half apart, each somewhere in its clip's first loop.
-            let (low, high) = mesh.bounds();
-            let spacing = 1.5 * (high - low).max_element();
-            let phase = clip.and_then(|k| rig.map(|r| f64::from(r.animations()[k].duration_secs()))).unwrap_or(1.0);
-            herd::scatter(count, spacing, phase, 0).map_err(|e| anyhow::anyhow!("--herd {count}: {e}"))
-        }
-        None => Ok(scripted.to_vec()),
-    }
-}
-
-/// The box a herd covers over `secs` (every member's mesh at the start and the end, with the
-/// fur's length about it); `None` for one fur.
-fn herd_extent(fur: &FurStructure, instances: &[HerdInstance], secs: f64) -> Option<(Vec3, Vec3)> {
-    if instances.is_empty() {
-        return None;
-    }
-    let (low, high) = fur.mesh.bounds();
-    let length = Vec3::splat(fur.lengths.iter().copied().fold(0.0, f32::max));
-    let corners = [low, high, Vec3::new(low.x, low.y, high.z), Vec3::new(high.x, high.y, low.z)];
-    Some(instances.iter().flat_map(|i| [0.0, secs].map(|t| i.world_from_model(t))).fold(
-        (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)),
-        |(lo, hi), world| {
-            // The fur's length about the sides and above; the ground under the feet.
-            corners
-                .iter()
-                .map(|c| world.transform_point3(*c))
-                .fold((lo, hi), |(lo, hi), p| (lo.min(p - length * Vec3::new(1.0, 0.0, 1.0)), hi.max(p + length)))
-        },
-    ))
-}
-
-/// Shows a herd member its stepper stepped ([`FurStepper::advance_herd`]): the positions, the
-/// posed normals and the wetness, as the CPU kernel's upload.
-fn show_stepped(queue: &wgpu::Queue, driver: &mut FurDriver, stepper: &FurStepper) -> anyhow::Result<()> {
-    let wetness = stepper.wetness();
-    driver.show_wet(queue, (!wetness.is_dry()).then(|| wetness.values()), stepper.wet())?;
-    let normals = stepper.moved_pose().map(|pose| &pose.normals[..]);
-    driver.show_state(queue, stepper.simulation().positions(), normals)?;
     Ok(())
 }
 

@@ -24,18 +24,9 @@ pub struct ShadowArgs {
 
 impl ShadowArgs {
     /// The shadows and ground these flags and the script's `[ground]` ask for, around `fur` and
-    /// `plain`: shadows unless `--no-shadows`.
+    /// `plain`, or about the box `extent` (a herd's field) where given: shadows unless
+    /// `--no-shadows`.
     pub fn surroundings(
-        &self,
-        (device, queue, renderer): (&wgpu::Device, &wgpu::Queue, &FurRenderer),
-        scene_ground: Option<&SceneGround>,
-        (fur, plain): (&FurStructure, &[Mesh]),
-    ) -> anyhow::Result<Surroundings> {
-        self.surroundings_around((device, queue, renderer), scene_ground, (fur, plain), None)
-    }
-
-    /// [`ShadowArgs::surroundings`] about the box `extent` (a herd's field) where given.
-    pub fn surroundings_around(
         &self,
         (device, queue, renderer): (&wgpu::Device, &wgpu::Queue, &FurRenderer),
         scene_ground: Option<&SceneGround>,

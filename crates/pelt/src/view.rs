@@ -8,6 +8,7 @@ mod capture;
 mod contact;
 mod fur;
 mod gpu;
+mod herd;
 mod lights;
 mod model;
 mod paint;
@@ -58,6 +59,11 @@ pub struct Args {
     pub shadows: crate::shadows::ShadowArgs,
     #[command(flatten)]
     pub lights: crate::light_args::LightArgs,
+    /// A herd: N copies of the fur scattered on a ground, each at its own phase of the clip (a
+    /// script's [[instance]] tables place them instead). The panel edits them all; the first is
+    /// the one touched and painted.
+    #[arg(long, value_name = "N")]
+    pub herd: Option<usize>,
     /// Window size in logical pixels, `WIDTHxHEIGHT`.
     #[arg(long, value_name = "WxH", default_value = "1280x800", value_parser = crate::values::parse_size)]
     pub size: (u32, u32),

@@ -225,3 +225,58 @@ fn the_windows_key_light_places_the_shadow() {
     let (here, there) = (count(&one_side, &other_side), count(&other_side, &one_side));
     assert!(here > 2_000 && there > 2_000, "the shadow did not move with the light: {here} and {there} pixels");
 }
+
+/// A herd in the window (a script's `[[instance]]`s): two Foxes side by side, the right one
+/// `offset` seconds further into its walk. Each member is drawn and walks on its own: moving the
+/// right one's phase changes the right half of the 3D view and leaves the left one's alone.
+#[test]
+fn the_window_draws_a_herd_each_member_at_its_own_phase() {
+    let fox = concat!(env!("CARGO_MANIFEST_DIR"), "/../../assets/meshes/Fox.glb");
+    let herd = |name: &str, offset: f32| {
+        let script = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("cli_view_{name}.toml"));
+        std::fs::write(
+            &script,
+            format!(
+                "[[instance]]\nposition = [-150.0, 0.0, 0.0]\nheading_deg = 90.0\nclip = \"Walk\"\n\n\
+                 [[instance]]\nposition = [150.0, 0.0, 0.0]\nheading_deg = 90.0\nclip = \"Walk\"\n\
+                 time_offset_secs = {offset}\n"
+            ),
+        )
+        .expect("the script");
+        let script = script.to_str().unwrap().to_owned();
+        screenshot(name, 12, &[fox, "--script", &script, "--sim", "cpu", "--no-overlay", "--no-shadows"])
+    };
+    let together = herd("herd_together", 0.0);
+    let apart = herd("herd_apart", 0.35);
+    let half = (WIDTH_PX - PANEL_PX) / 2;
+    let differing = |x0: u32, x1: u32| {
+        (x0..x1)
+            .flat_map(|x| (0..HEIGHT_PX).map(move |y| (x, y)))
+            .filter(|&(x, y)| (luminance(together.get_pixel(x, y)) - luminance(apart.get_pixel(x, y))).abs() > 8.0)
+            .count()
+    };
+    let (left, right) = (differing(0, half), differing(half, 2 * half));
+    println!("{left} pixels of the left half differ, {right} of the right");
+    assert!(right > 300, "{right} pixels of the right Fox moved");
+    assert!(left * 20 < right, "{left} pixels of the left Fox changed, {right} of the right");
+}
+
+/// A herd's bad input stops the viewer before any window opens.
+#[test]
+fn a_bad_herd_is_refused_before_any_window_opens() {
+    for (args, says) in [
+        (&["--herd", "0"][..], "--herd 0: a herd needs at least one instance"),
+        (&["--herd", "3", "--sim", "gpu"][..], "a herd is simulated on the CPU"),
+    ] {
+        let output = Command::new(env!("CARGO_BIN_EXE_pelt"))
+            .args(["view", "--builtin", "box"])
+            .args(args)
+            .env_remove("DISPLAY")
+            .env_remove("WAYLAND_DISPLAY")
+            .output()
+            .unwrap();
+        assert!(!output.status.success());
+        let stderr = String::from_utf8_lossy(&output.stderr);
+        assert!(stderr.contains(says), "{args:?}: {stderr}");
+    }
+}

@@ -106,7 +106,10 @@ impl App {
         fur.set_body(&gpu, model.body.as_ref())?;
         let (kernel, reason) = fur.kernel();
         model.settings.gpu_sim = kernel == SimKernel::Gpu;
-        model.kernel_reason = reason.to_owned();
+        model.kernel_reason = match &model.herd {
+            Some(_) => "a herd, in one parallel pass".to_owned(),
+            None => reason.to_owned(),
+        };
         Ok(Running {
             window,
             gpu,
@@ -186,18 +189,40 @@ impl App {
         running.fur.set_shading(&model.settings.preset);
         running.fur.body_colliders = model.settings.draw.body_colliders;
         let draw = model.settings.draw;
-        running.fur.set_surroundings(&running.gpu, &model.structure, model.body.as_ref(), draw.shadows, draw.ground)?;
-        if let Some((time_secs, clip_secs)) = model.simulate(frame_secs) {
+        let now = model.stepper.simulation().time_secs();
+        let extent = model.herd.as_ref().and_then(|herd| {
+            super::herd::shadow_extent(&model.structure, herd, now, running.fur.surroundings_extent())
+        });
+        running.fur.set_surroundings(
+            &running.gpu,
+            (&model.structure, model.body.as_ref()),
+            (draw.shadows, draw.ground, model.stepper.scene().and_then(|s| s.ground.as_ref())),
+            extent,
+        )?;
+        let others = model.herd.as_ref().map_or(0, |herd| herd.len() - 1);
+        running.fur.sync_herd(&running.gpu, &model.structure, model.stepper.simulation().params(), others)?;
+        let members = if let Some((time_secs, clip_secs)) = model.simulate(frame_secs) {
+            let members = model.member_frames(time_secs);
             let started = std::time::Instant::now();
-            running.fur.advance(&running.gpu, &mut model.stepper, time_secs, clip_secs)?;
+            let offset = model.herd.as_ref().map_or(0.0, |herd| herd.instances[0].time_offset_secs);
+            running.fur.advance(&running.gpu, &mut model.stepper, time_secs, clip_secs + offset)?;
+            if let Some(herd) = &mut model.herd {
+                // Far members are stepped less often, as in `pelt render`.
+                let strides: Vec<u32> = members[1..].iter().map(|m| m.level.step_stride()).collect();
+                herd.advance(time_secs, clip_secs, &strides)?;
+                running.fur.show_herd(&running.gpu, herd, &members)?;
+            }
             if let Some((positions, normals, world_from_model)) = model.pose_body(clip_secs) {
                 running.fur.pose_body(&running.gpu, positions, normals, world_from_model)?;
             }
             model.took(started.elapsed().as_secs_f64());
+            members
         } else {
             // Paused: the colliders still follow what the pointer does to them.
-            running.fur.show_colliders(&running.gpu, &model.stepper, model.stepper.simulation().time_secs())?;
-        }
+            running.fur.show_colliders(&running.gpu, &model.stepper, now)?;
+            model.member_frames(now)
+        };
+        model.herd_in_view = members.iter().filter(|m| m.seen).count();
         if requests.screenshot {
             model.screenshot_pending = true;
         }
@@ -231,9 +256,13 @@ impl App {
         model.separated_bytes = running.fur.separated_bytes();
         let lod = crate::lod::settings(&model.settings.preset.render.lod, model.no_lod);
         let (eye, fov_y_rad) = (model.camera.eye(), model.camera.fov_y_rad);
-        model.level = crate::lod::level(&lod, &model.structure, eye, fov_y_rad, model.viewport_px[1]);
+        model.level = match members.first() {
+            Some(first) => first.level,
+            None => crate::lod::level(&lod, &model.structure, eye, fov_y_rad, model.viewport_px[1]),
+        };
         let studio = model.settings.lights.studio();
-        running.fur.draw(gpu, &mut encoder, &running.viewport, (&model.camera, &studio), separated, model.level);
+        let shown = (separated, model.level);
+        running.fur.draw(gpu, &mut encoder, &running.viewport, (&model.camera, &studio), shown, &members);
 
         let screen = egui_wgpu::ScreenDescriptor {
             size_in_pixels: [frame.texture.width(), frame.texture.height()],

@@ -2,7 +2,7 @@
 //! (a new mesh or layer count rebuilds the structure, a texture setting the textures).
 
 use glam::{Mat4, Vec3};
-use pelt_core::sim::{FurStepper, SimParams};
+use pelt_core::sim::{FurStepper, SceneGround, SimParams};
 use pelt_core::texture::FurTextures;
 use pelt_core::{FurStructure, Mesh};
 use pelt_render::{
@@ -11,6 +11,7 @@ use pelt_render::{
 };
 
 use super::camera::OrbitCamera;
+use super::herd::{Herd, HerdDrivers, MemberFrame};
 use super::shell_share::ShellShare;
 use super::viewport::{Viewport, target};
 use crate::shadows::ShadowArgs;
@@ -40,10 +41,17 @@ pub struct FurScene {
     pub body_colliders: bool,
     /// The view-angle pass's count, read back for the overlay.
     shell_share: ShellShare,
-    /// The shadow maps and the ground, with the (shadows, ground) switches they were made for;
-    /// `None` until asked for, and again after a new structure or body.
-    surroundings: Option<((bool, bool), Surroundings)>,
+    /// The shadow maps and the ground, with the (shadows, ground) switches and the herd's box
+    /// they were made for; `None` until asked for, and again after a new structure or body.
+    surroundings: Option<(SurroundingsFor, Surroundings)>,
+    /// A herd's other members (the main fur is the first), and whether the edited fur changed
+    /// since they were made.
+    herd: Option<HerdDrivers>,
+    herd_stale: bool,
 }
+
+/// What the surroundings were made for: the shadows and ground switches and a herd's box.
+type SurroundingsFor = (bool, bool, Option<(Vec3, Vec3)>);
 
 impl FurScene {
     /// The fur on `gpu`, simulated on the kernel `choice` picks (`auto` times both here).
@@ -69,6 +77,8 @@ impl FurScene {
             body_colliders: false,
             shell_share: ShellShare::new(&gpu.device),
             surroundings: None,
+            herd: None,
+            herd_stale: false,
         })
     }
 
@@ -80,6 +90,7 @@ impl FurScene {
     pub fn set_structure(&mut self, gpu: &pelt_render::Gpu, structure: &FurStructure) -> anyhow::Result<()> {
         self.separated = None;
         self.surroundings = None;
+        self.herd_stale = true;
         self.driver.set_structure(&gpu.device, &gpu.queue, &self.renderer, structure)?;
         Ok(())
     }
@@ -88,6 +99,7 @@ impl FurScene {
     /// groom (or textures without keep values) is uploaded groomed once, textures as they are.
     pub fn set_groom(&mut self, gpu: &pelt_render::Gpu, structure: &FurStructure) -> anyhow::Result<()> {
         let Some(groom) = &structure.groom else { return self.set_structure(gpu, structure) };
+        self.herd_stale = true;
         if self.driver.set_groom(&gpu.queue, groom).is_err() {
             self.set_structure(gpu, structure)?;
             self.driver.set_textures(&gpu.device, &gpu.queue, &self.renderer, &self.textures)?;
@@ -159,32 +171,74 @@ impl FurScene {
 
     pub fn set_textures(&mut self, gpu: &pelt_render::Gpu, textures: &FurTextures) -> anyhow::Result<()> {
         self.separated = None;
+        self.herd_stale = true;
         self.textures = textures.clone();
         self.driver.set_textures(&gpu.device, &gpu.queue, &self.renderer, textures)?;
         Ok(())
     }
 
-    /// Replaces the furless body drawn with the fur (the try-on scene's), if any.
-    /// The shadow maps and ground the switches ask for, around `structure` and `body` (made again
-    /// when a switch changes or after a new structure or body).
+    /// The shadow maps and ground the switches ask for (the script's ground where it has one),
+    /// around `structure` and `body`, or about
+    /// a herd's box `extent` (made again when a switch or the box changes, or after a new
+    /// structure or body).
     pub fn set_surroundings(
         &mut self,
         gpu: &pelt_render::Gpu,
-        structure: &FurStructure,
-        body: Option<&Mesh>,
-        shadows: bool,
-        ground: bool,
+        (structure, body): (&FurStructure, Option<&Mesh>),
+        (shadows, ground, scene_ground): (bool, bool, Option<&SceneGround>),
+        extent: Option<(Vec3, Vec3)>,
     ) -> anyhow::Result<()> {
-        if self.surroundings.as_ref().is_some_and(|(made_for, _)| *made_for == (shadows, ground)) {
+        let wanted = (shadows, ground, extent);
+        if self.surroundings.as_ref().is_some_and(|(made_for, _)| *made_for == wanted) {
             return Ok(());
         }
         let args = ShadowArgs { shadows, no_shadows: !shadows, ground };
         let plain: Vec<Mesh> = body.into_iter().cloned().collect();
-        let surroundings = args.surroundings((&gpu.device, &gpu.queue, &self.renderer), None, (structure, &plain))?;
-        self.surroundings = Some(((shadows, ground), surroundings));
+        let surroundings = args.surroundings(
+            (&gpu.device, &gpu.queue, &self.renderer),
+            scene_ground.filter(|_| ground),
+            (structure, &plain),
+            extent.as_ref(),
+        )?;
+        self.surroundings = Some((wanted, surroundings));
         Ok(())
     }
 
+    /// The herd's box the shadow maps were made about, if any.
+    pub fn surroundings_extent(&self) -> Option<(Vec3, Vec3)> {
+        self.surroundings.as_ref().and_then(|((_, _, extent), _)| *extent)
+    }
+
+    /// Makes the herd's other copies (`others` of them; none for one fur) anew when their count
+    /// or the edited fur changed.
+    pub fn sync_herd(
+        &mut self,
+        gpu: &pelt_render::Gpu,
+        structure: &FurStructure,
+        params: &SimParams,
+        others: usize,
+    ) -> anyhow::Result<()> {
+        if others == 0 {
+            self.herd = None;
+        } else if self.herd_stale || self.herd.as_ref().is_none_or(|h| h.len() != others) {
+            self.herd = Some(HerdDrivers::new(gpu, &self.renderer, (structure, &self.textures), params, others)?);
+        }
+        self.herd_stale = false;
+        Ok(())
+    }
+
+    /// Shows the herd's members as they stepped this frame: the main fur takes the first
+    /// member's tint, the others their steppers' state, level and tint.
+    pub fn show_herd(&mut self, gpu: &pelt_render::Gpu, herd: &Herd, frames: &[MemberFrame]) -> anyhow::Result<()> {
+        let look = pelt_render::FurLook { tint: herd.instances[0].tint, ..self.driver.frame().look };
+        self.driver.set_look(look);
+        if let Some(drivers) = &mut self.herd {
+            drivers.show(gpu, herd, frames, look)?;
+        }
+        Ok(())
+    }
+
+    /// Replaces the furless body drawn with the fur (the try-on scene's), if any.
     pub fn set_body(&mut self, gpu: &pelt_render::Gpu, body: Option<&Mesh>) -> anyhow::Result<()> {
         self.surroundings = None;
         self.body = match body {
@@ -242,16 +296,16 @@ impl FurScene {
     }
 
     /// Draws the body and the unified structure, or the separated one when `separated` and it is
-    /// built, into the viewport, lit by `studio`, at the level of detail `level`.
-    #[allow(clippy::too_many_arguments)]
+    /// built, into the viewport, lit by `studio`, at the level of detail `level`; a herd's
+    /// members (`members`, the main fur first; empty for one fur) where seen, farthest first.
     pub fn draw(
         &mut self,
         gpu: &pelt_render::Gpu,
         encoder: &mut wgpu::CommandEncoder,
         viewport: &Viewport,
         (camera, studio): (&OrbitCamera, &Studio),
-        separated: bool,
-        level: FurLevel,
+        (separated, level): (bool, FurLevel),
+        members: &[MemberFrame],
     ) {
         let camera = camera.camera();
         let view_data = studio.view_data(&camera, viewport.targets.aspect_ratio());
@@ -275,12 +329,22 @@ impl FurScene {
             None => self.view.set_shadows(None),
         }
         let surroundings = self.surroundings.as_ref().map(|(_, s)| s).filter(|_| separated.is_none());
+        // A herd's members in view, farthest first (blended fur); the main fur is member 0.
+        let mut order: Vec<usize> = (0..members.len()).filter(|&k| members[k].seen).collect();
+        order.sort_by(|&a, &b| members[b].distance.total_cmp(&members[a].distance));
+        let others: Vec<usize> = order.iter().copied().filter(|&k| k > 0).collect();
+        let main_drawn = members.is_empty() || order.contains(&0);
+        let every_other: Vec<usize> = (1..=self.herd.as_ref().map_or(0, HerdDrivers::len)).collect();
+        let herd = self.herd.as_ref().filter(|_| separated.is_none());
         match separated {
             Some((_, fur)) => fur.prepare(&gpu.queue, &FurFrame { level, ..*self.driver.frame() }),
             None => {
-                self.driver.set_level(level);
+                self.driver.set_level(members.first().map_or(level, |m| m.level));
                 self.driver.prepare(&gpu.queue);
                 self.driver.record_view(encoder, &self.renderer, &self.view);
+                if let Some(herd) = herd {
+                    herd.record_view(encoder, &self.renderer, &self.view, &others);
+                }
             }
         }
         if let Some(s) = surroundings {
@@ -291,6 +355,10 @@ impl FurScene {
                 }
                 self.colliders.draw(pass, &self.renderer, light);
                 self.driver.draw(pass, &self.renderer, light, &FurDrawSettings::ALL);
+                // Members out of view still cast their shadows.
+                if let Some(herd) = herd {
+                    herd.draw(pass, &self.renderer, light, (&every_other, &FurDrawSettings::ALL));
+                }
             });
         }
         {
@@ -302,9 +370,20 @@ impl FurScene {
                 self.renderer.draw_plain(&mut pass, &self.view, body);
             }
             self.colliders.draw(&mut pass, &self.renderer, &self.view);
-            match separated {
-                Some((renderer, fur)) => renderer.draw(&mut pass, &self.view, fur, &self.settings),
-                None => self.driver.draw(&mut pass, &self.renderer, &self.view, &self.settings),
+            match (separated, herd) {
+                (Some((renderer, fur)), _) => renderer.draw(&mut pass, &self.view, fur, &self.settings),
+                (None, Some(herd)) => {
+                    for &member in &order {
+                        match member {
+                            0 => self.driver.draw(&mut pass, &self.renderer, &self.view, &self.settings),
+                            k => herd.draw(&mut pass, &self.renderer, &self.view, (&[k], &self.settings)),
+                        }
+                    }
+                }
+                (None, None) if main_drawn => {
+                    self.driver.draw(&mut pass, &self.renderer, &self.view, &self.settings);
+                }
+                (None, None) => {}
             }
         }
         if separated.is_none() {

@@ -12,6 +12,7 @@ use pelt_core::{Builtin, FurStructure, FurTextures, Mesh, Preset, PresetError, S
 
 use super::Args;
 use super::camera::OrbitCamera;
+use super::herd::Herd;
 use super::panel::{AnimationSettings, Changes, MeshChoice, Settings};
 use pelt_render::SimKernel;
 
@@ -100,6 +101,10 @@ pub(super) struct Model {
     pub(super) rig: Option<Rig>,
     /// While the try-on is shown: the skirt's rig and the walking body's, with the body's pose.
     pub(super) walking: Option<(Rig, StageBody, Pose)>,
+    /// A herd (`--herd N`, the script's `[[instance]]`s): this fur is its first member.
+    pub(super) herd: Option<Herd>,
+    /// How many of the herd's members the last frame drew.
+    pub(super) herd_in_view: usize,
 }
 
 /// The panel's clips for `rig`: the first one playing.
@@ -180,19 +185,44 @@ impl Model {
             Some(path) => Some(Scene::load(path)?),
             None => None,
         };
-        if let (Some(path), Some(scene)) = (&args.script, &scene)
-            && !scene.instance.is_empty()
-        {
-            eprintln!(
-                "{}: the viewer draws one copy of the fur; its {} [[instance]] tables are drawn by `pelt render`",
-                path.display(),
-                scene.instance.len()
-            );
+        // A script's ground is drawn, as in `pelt render` (the panel's switch turns it off).
+        settings.draw.ground |= scene.as_ref().is_some_and(|s| s.ground.is_some());
+        let instances = crate::herd::instances(
+            args.herd,
+            scene.as_ref(),
+            &structure.mesh,
+            (rig.as_ref(), settings.animation.clip),
+        )?;
+        let mut herd = None;
+        if !instances.is_empty() {
+            // The herd steps on the CPU in one parallel pass, as in `pelt render`.
+            if args.sim == SimChoice::Gpu {
+                anyhow::bail!("--sim gpu simulates one fur; a herd is simulated on the CPU (--sim cpu)");
+            }
+            let clips =
+                pelt_core::sim::herd::resolve_clips(&instances, rig.as_ref(), None).map_err(|(key, problem)| {
+                    let file = args.script.as_deref().map_or_else(|| "--herd".to_owned(), |p| p.display().to_string());
+                    anyhow::anyhow!("{file}: {key}: {problem}")
+                })?;
+            let made = Herd::new(instances, clips);
+            // This fur is the first member; the herd stands on a ground, as in `pelt render`.
+            stepper.set_placement(Some(made.first()));
+            settings.animation.clip = made.clip(0, settings.animation.clip);
+            settings.draw.ground = true;
+            herd = Some(made);
         }
         stepper.set_wet(&settings.preset.wet)?;
         stepper.set_scene(scene.clone());
         if let Some(rig) = &rig {
             stepper.set_clip(rig.clone(), settings.animation.clip);
+        }
+        if let Some(herd) = &mut herd {
+            herd.rebuild(
+                (&structure, &settings.preset),
+                stepper.scene(),
+                (rig.as_ref(), settings.animation.clip),
+                None,
+            )?;
         }
         let groom_editor = super::paint::editor(&structure, &settings.preset)?;
         // The try-on's rig is the skirt's, kept with the body (not as the file's).
@@ -231,7 +261,7 @@ impl Model {
             sim_time_secs: 0.0,
             shown_times_secs: [0.0; 2],
             shown_at: None,
-            sim_choice: args.sim,
+            sim_choice: if herd.is_some() { SimChoice::Cpu } else { args.sim },
             kernel_reason: String::new(),
             touch: None,
             contact_drag: None,
@@ -248,12 +278,21 @@ impl Model {
             status: String::new(),
             rig,
             walking,
+            herd,
+            herd_in_view: 0,
         };
         Ok(model)
     }
 
-    /// Looks at the whole fur (mesh plus its longest strand).
+    /// Looks at the whole fur (mesh plus its longest strand), or the whole herd where it stands.
     pub(super) fn frame(&mut self, aspect: f32) {
+        let now = self.stepper.simulation().time_secs();
+        if let Some((low, high)) =
+            self.herd.as_ref().and_then(|h| crate::herd::extent(&self.structure, &h.instances, &[now]))
+        {
+            self.camera.frame(0.5 * (low + high), 0.5 * (high - low).length(), aspect);
+            return;
+        }
         let (center, radius) = self.structure.mesh.bounding_sphere();
         let longest = self.structure.lengths.iter().copied().fold(0.0, f32::max);
         // A garment is seen on the whole body wearing it.
@@ -423,7 +462,17 @@ impl Model {
         if changes.textures {
             self.textures_stale = true;
         }
+        self.apply_to_herd(&changes, rebuilt)?;
         Ok(rebuilt)
+    }
+
+    /// The rig playing on the mesh shown: the file's, the try-on skirt's, or none.
+    pub(super) fn shown_rig(&self) -> Option<&Rig> {
+        match self.settings.mesh {
+            MeshChoice::TryOn => self.walking.as_ref().map(|w| &w.0),
+            MeshChoice::File(_) => self.rig.as_ref(),
+            MeshChoice::Builtin(_) => None,
+        }
     }
 }
 

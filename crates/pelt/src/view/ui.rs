@@ -304,6 +304,10 @@ impl Model {
             self.structure.layers,
             if self.no_lod { "off (--no-lod)".to_owned() } else { self.lod_line() },
         );
+        let text = match &self.herd {
+            Some(herd) => format!("{text}\nherd     {} members, {} in view", herd.len(), self.herd_in_view),
+            None => text,
+        };
         let galley = painter.layout_no_wrap(text, egui::FontId::monospace(12.0), egui::Color32::from_gray(225));
         let origin = rect.left_top() + egui::vec2(12.0, 12.0);
         painter.rect_filled(

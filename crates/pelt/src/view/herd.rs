@@ -1,0 +1,322 @@
+//! A herd in the viewer (`--herd N`, a script's `[[instance]]`s). The fur the panel edits is the
+//! first member, placed as the first instance; the others are copies of it, each simulated on its
+//! own (stepped on the CPU in one parallel pass) and drawn from one shared asset, rebuilt from
+//! the edited fur whenever its structure, textures, groom or simulation change.
+
+use super::model::Model;
+use super::panel::{Changes, MeshChoice};
+use glam::{Mat4, Vec3};
+use pelt_core::anim::Rig;
+use pelt_core::sim::herd::HerdInstance;
+use pelt_core::sim::{FurStepper, Scene};
+use pelt_core::{FurStructure, FurTextures, Preset};
+use pelt_render::{
+    FurAsset, FurDrawSettings, FurDriver, FurLevel, FurLook, FurRenderer, FurView, KernelChoice, ViewData,
+};
+
+/// The CPU half: where the members stand and the others' simulations.
+pub(super) struct Herd {
+    pub(super) instances: Vec<HerdInstance>,
+    /// Each member's clip in the rig (`None`: the panel's).
+    clips: Vec<Option<usize>>,
+    /// Members 1.. (member 0 is the model's own stepper).
+    followers: Vec<FurStepper>,
+}
+
+impl Herd {
+    /// A herd of `instances` (at least one) with their clips resolved; the followers are built by
+    /// [`Herd::rebuild`].
+    pub(super) fn new(instances: Vec<HerdInstance>, clips: Vec<Option<usize>>) -> Self {
+        Self { instances, clips, followers: Vec::new() }
+    }
+
+    pub(super) fn len(&self) -> usize {
+        self.instances.len()
+    }
+
+    /// The first member's place: the model's own stepper stands there.
+    pub(super) fn first(&self) -> HerdInstance {
+        self.instances[0].clone()
+    }
+
+    /// Member `k`'s clip: its own, else `panel_clip`.
+    pub(super) fn clip(&self, k: usize, panel_clip: Option<usize>) -> Option<usize> {
+        self.clips.get(k).copied().flatten().or(panel_clip)
+    }
+
+    /// Every member plays the panel's clip from now on (a mesh without the instances' clips).
+    pub(super) fn forget_clips(&mut self) {
+        self.clips.iter_mut().for_each(|clip| *clip = None);
+    }
+
+    pub(super) fn followers(&self) -> &[FurStepper] {
+        &self.followers
+    }
+
+    /// Makes the others anew as copies of the edited fur: `structure` (each grown to its own
+    /// length scale), the preset's simulation and `[wet]`, the model's script, `rig` playing
+    /// each member's clip (`None` for a mesh without one). A coat set to one wetness is set on
+    /// every copy (`uniform_wetness`).
+    ///
+    /// # Errors
+    /// The simulation's errors for a preset it refuses.
+    pub(super) fn rebuild(
+        &mut self,
+        (structure, preset): (&FurStructure, &Preset),
+        scene: Option<&Scene>,
+        (rig, panel_clip): (Option<&Rig>, Option<usize>),
+        uniform_wetness: Option<f32>,
+    ) -> anyhow::Result<()> {
+        self.followers = (1..self.instances.len())
+            .map(|k| {
+                let instance = &self.instances[k];
+                let grown;
+                let structure = if instance.length_scale == 1.0 {
+                    structure
+                } else {
+                    grown = structure.with_length_scale(instance.length_scale);
+                    &grown
+                };
+                let mut stepper = FurStepper::new(structure, &preset.simulation)?;
+                stepper.set_wet(&preset.wet)?;
+                if let Some(wetness) = uniform_wetness {
+                    stepper.wetness_mut().set_uniform(wetness);
+                }
+                if let Some(rig) = rig {
+                    stepper.set_clip(rig.clone(), self.clip(k, panel_clip));
+                }
+                stepper.set_scene(scene.cloned());
+                stepper.set_placement(Some(instance.clone()));
+                Ok(stepper)
+            })
+            .collect::<anyhow::Result<_>>()?;
+        Ok(())
+    }
+
+    /// The preset's new simulation settings on every copy (their states kept).
+    ///
+    /// # Errors
+    /// The simulation's errors for settings it refuses.
+    pub(super) fn set_params(&mut self, params: &pelt_core::sim::SimParams) -> anyhow::Result<()> {
+        for stepper in &mut self.followers {
+            stepper.simulation_mut().set_params(params)?;
+        }
+        Ok(())
+    }
+
+    /// The edited fur's `[wet]`, a coat set to one wetness (`uniform_wetness`) and the script
+    /// with the panel's rain and water, on every copy.
+    ///
+    /// # Errors
+    /// The simulation's errors for `[wet]` settings it refuses.
+    pub(super) fn set_wet(
+        &mut self,
+        wet: &pelt_core::wet::WetParams,
+        uniform_wetness: Option<f32>,
+        scene: Option<&Scene>,
+    ) -> anyhow::Result<()> {
+        for stepper in &mut self.followers {
+            stepper.set_wet(wet)?;
+            if let Some(wetness) = uniform_wetness {
+                stepper.wetness_mut().set_uniform(wetness);
+            }
+            stepper.set_scene(scene.cloned());
+        }
+        Ok(())
+    }
+
+    /// Steps the others to `time_secs` in one parallel pass, each with its clip at `clip_secs`
+    /// plus its own offset and every `strides[k - 1]`-th step (far members less often).
+    ///
+    /// # Errors
+    /// The first member's simulation error.
+    pub(super) fn advance(&mut self, time_secs: f64, clip_secs: f64, strides: &[u32]) -> anyhow::Result<()> {
+        use rayon::prelude::*;
+        for (stepper, &stride) in self.followers.iter_mut().zip(strides) {
+            stepper.set_step_stride(stride);
+        }
+        self.followers.par_iter_mut().zip(&self.instances[1..]).try_for_each(|(stepper, instance)| {
+            stepper.advance_with_clip_at(time_secs, clip_secs + instance.time_offset_secs)
+        })?;
+        Ok(())
+    }
+
+    /// Where member `k`'s model stands in the world at `time_secs`.
+    pub(super) fn world_from_model(&self, k: usize, time_secs: f64) -> Mat4 {
+        self.instances[k].world_from_model(time_secs)
+    }
+}
+
+impl Model {
+    /// Each herd member's level of detail, whether it is in view and how far, at `time_secs`;
+    /// empty for one fur.
+    pub(super) fn member_frames(&self, time_secs: f64) -> Vec<super::herd::MemberFrame> {
+        let Some(herd) = &self.herd else { return Vec::new() };
+        let lod = crate::lod::settings(&self.settings.preset.render.lod, self.no_lod);
+        let camera = self.camera.camera();
+        let [width, height] = self.viewport_px;
+        let view = self.settings.lights.studio().view_data(&camera, width as f32 / height.max(1) as f32);
+        let fov_y_rad = self.camera.fov_y_rad;
+        super::herd::member_frames(herd, (&self.structure, time_secs), (camera.eye, &view), |structure, eye| {
+            crate::lod::level(&lod, structure, eye, fov_y_rad, height)
+        })
+    }
+
+    /// The panel's changes on the herd's other members: made anew for a new fur or clip, given
+    /// the new settings otherwise (their states kept).
+    pub(super) fn apply_to_herd(&mut self, changes: &Changes, rebuilt: bool) -> anyhow::Result<()> {
+        let Some(mut herd) = self.herd.take() else { return Ok(()) };
+        let wet = &self.settings.preset.wet;
+        let uniform = changes.wet.uniform.then_some(wet.wetness);
+        let result = if rebuilt || changes.animation {
+            // The instances' own clips name the file's clips; on another mesh they play the panel's.
+            let rig = self.shown_rig();
+            let own_clips = matches!(self.settings.mesh, MeshChoice::File(_));
+            let panel_clip = self.settings.animation.clip;
+            if !own_clips {
+                herd.forget_clips();
+            }
+            herd.rebuild((&self.structure, &self.settings.preset), self.stepper.scene(), (rig, panel_clip), uniform)
+        } else {
+            let params = if changes.simulation { herd.set_params(&self.settings.preset.simulation) } else { Ok(()) };
+            params.and_then(|()| match changes.wet.any() {
+                true => herd.set_wet(wet, uniform, self.stepper.scene()),
+                false => Ok(()),
+            })
+        };
+        self.herd = Some(herd);
+        result
+    }
+}
+
+/// One member as drawn this frame.
+#[derive(Clone, Copy, Debug)]
+pub(super) struct MemberFrame {
+    pub(super) level: FurLevel,
+    /// Its model's centre is within the view (with the fur's reach about it).
+    pub(super) seen: bool,
+    /// From the eye, for drawing blended fur farthest first.
+    pub(super) distance: f32,
+}
+
+/// Each member's level of detail, whether it is seen and how far it stands, at `time_secs`:
+/// `level_of(structure_k, eye in member k's model space)` gives the level.
+pub(super) fn member_frames(
+    herd: &Herd,
+    (structure, time_secs): (&FurStructure, f64),
+    (eye, view): (Vec3, &ViewData),
+    level_of: impl Fn(&FurStructure, Vec3) -> FurLevel,
+) -> Vec<MemberFrame> {
+    let (centre, radius) = structure.mesh.bounding_sphere();
+    let reach = radius + structure.lengths.iter().copied().fold(0.0, f32::max);
+    (0..herd.len())
+        .map(|k| {
+            let world_from_model = herd.world_from_model(k, time_secs);
+            let world_centre = world_from_model.transform_point3(centre);
+            MemberFrame {
+                level: level_of(structure, world_from_model.inverse().transform_point3(eye)),
+                seen: view.sees_sphere(world_centre, reach),
+                distance: world_centre.distance(eye),
+            }
+        })
+        .collect()
+}
+
+/// The GPU half: the others' drivers over one asset.
+#[derive(Debug)]
+pub(super) struct HerdDrivers {
+    /// Kept so the copies share one upload of the topology and textures.
+    _asset: FurAsset,
+    drivers: Vec<FurDriver>,
+}
+
+impl HerdDrivers {
+    /// `count` copies of `structure` with `textures`, simulated on the CPU.
+    ///
+    /// # Errors
+    /// The upload's errors.
+    pub(super) fn new(
+        gpu: &pelt_render::Gpu,
+        renderer: &FurRenderer,
+        (structure, textures): (&FurStructure, &FurTextures),
+        params: &pelt_core::sim::SimParams,
+        count: usize,
+    ) -> anyhow::Result<Self> {
+        let (device, queue) = (&gpu.device, &gpu.queue);
+        let asset = FurAsset::new(device, queue, renderer, structure, textures)?;
+        let drivers = (0..count)
+            .map(|_| FurDriver::with_asset(device, queue, renderer, &asset, structure, params, KernelChoice::Cpu))
+            .collect::<Result<Vec<_>, _>>()?;
+        Ok(Self { _asset: asset, drivers })
+    }
+
+    pub(super) fn len(&self) -> usize {
+        self.drivers.len()
+    }
+
+    /// Shows each copy what its stepper stepped, at its level and with `look` tinted by its
+    /// instance's tint.
+    pub(super) fn show(
+        &mut self,
+        gpu: &pelt_render::Gpu,
+        herd: &Herd,
+        frames: &[MemberFrame],
+        look: FurLook,
+    ) -> anyhow::Result<()> {
+        for (k, (driver, stepper)) in self.drivers.iter_mut().zip(herd.followers()).enumerate() {
+            crate::herd::show_stepped(&gpu.queue, driver, stepper)?;
+            let member = k + 1;
+            if let Some(frame) = frames.get(member) {
+                driver.set_level(frame.level);
+            }
+            driver.set_look(FurLook { tint: herd.instances[member].tint, ..look });
+            driver.prepare(&gpu.queue);
+        }
+        Ok(())
+    }
+
+    /// The silhouette listings of the copies `drawn` lists (member indices, 1..).
+    pub(super) fn record_view(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        renderer: &FurRenderer,
+        view: &FurView,
+        drawn: &[usize],
+    ) {
+        for &member in drawn {
+            self.drivers[member - 1].record_view(encoder, renderer, view);
+        }
+    }
+
+    /// Draws the copies `drawn` lists (member indices, 1..; every copy into a shadow map).
+    pub(super) fn draw(
+        &self,
+        pass: &mut wgpu::RenderPass<'_>,
+        renderer: &FurRenderer,
+        view: &FurView,
+        (drawn, settings): (&[usize], &FurDrawSettings),
+    ) {
+        for &member in drawn {
+            self.drivers[member - 1].draw(pass, renderer, view, settings);
+        }
+    }
+}
+
+/// How far ahead a herd's shadow maps reach: made about where the members walk over this long,
+/// made again when one walks out.
+const SHADOW_SPAN_SECS: f64 = 8.0;
+
+/// The box the herd's shadow maps and ground cover at `time_secs`: `made` (the box they were made
+/// about) while every member stands inside it, else where the members walk next.
+pub(super) fn shadow_extent(
+    structure: &FurStructure,
+    herd: &Herd,
+    time_secs: f64,
+    made: Option<(Vec3, Vec3)>,
+) -> Option<(Vec3, Vec3)> {
+    let (low, high) = crate::herd::extent(structure, &herd.instances, &[time_secs])?;
+    match made {
+        Some((made_low, made_high)) if made_low.cmple(low).all() && high.cmple(made_high).all() => made,
+        _ => crate::herd::extent(structure, &herd.instances, &[time_secs, time_secs + SHADOW_SPAN_SECS]),
+    }
+}
