@@ -118,6 +118,8 @@ function restart(why) {
   start();
 }
 
+// The scene the controls were last synced with.
+let sceneShown = null;
 function syncControls() {
   if (!app) return;
   // A scene or preset change can bring the other along (a Fox preset shows the Fox).
@@ -128,6 +130,9 @@ function syncControls() {
   $('length').value = app.length();
   $('length-value').textContent = app.length().toFixed(3);
   $('colour').value = app.colour();
+  // The herd stands on a ground (the switch turns it off again).
+  if (scene === 'herd' && sceneShown !== 'herd') $('ground').checked = true;
+  sceneShown = scene;
   attempt((a) => {
     a.set_shadows($('shadows').checked);
     a.set_ground($('ground').checked);

@@ -550,6 +550,61 @@ test('the groomed Fox draws: bald and shorter where its groom says, longer on th
   assert.deepEqual(page.problems, []);
 });
 
+/** The 4-connected regions of the pixels `inside(p)` keeps, each as its pixels' indices. */
+function regions(image, inside) {
+  const { width, height } = image;
+  const seen = new Uint8Array(width * height);
+  const found = [];
+  for (let start = 0; start < width * height; start++) {
+    if (seen[start] || !inside(pixel(image, start % width, Math.floor(start / width)))) continue;
+    const region = [start];
+    seen[start] = 1;
+    for (let k = 0; k < region.length; k++) {
+      const i = region[k];
+      const [x, y] = [i % width, Math.floor(i / width)];
+      for (const [nx, ny] of [[x - 1, y], [x + 1, y], [x, y - 1], [x, y + 1]]) {
+        const n = ny * width + nx;
+        if (nx >= 0 && ny >= 0 && nx < width && ny < height && !seen[n] && inside(pixel(image, nx, ny))) {
+          seen[n] = 1;
+          region.push(n);
+        }
+      }
+    }
+    found.push(region);
+  }
+  return found;
+}
+
+test('the herd: sixteen Foxes walk on the ground, each at its own phase', async () => {
+  const page = await openPage();
+  await waitRunning(page);
+  await hideOverlay(page);
+  await page.click('input[name=scene][value=herd]');
+  await page.waitForFunction(() => window.pelt.stats.scene === 'herd', { timeout: 120_000 });
+  // Green fur, which neither the ground nor the background has (the herd is made again with it).
+  await setControl(page, '#colour', FUR_HEX);
+  await settled(page);
+  const first = await shot(page, 'herd');
+  await frames(page, 3);
+  const later = await shot(page, 'herd-later');
+  const foxes = regions(first, isFur).filter((region) => region.length >= 20);
+  const at = (image, i) => pixel(image, i % image.width, Math.floor(i / image.width));
+  const walking = foxes.filter((region) =>
+    region.filter((i) => differs(at(first, i), at(later, i), 24)).length > 0.1 * region.length);
+  const report = `${foxes.length} fur-coloured regions of 20 pixels or more, ${walking.length} of them moved ` +
+    `(${foxes.map((r) => r.length).join(', ')})`;
+  console.log(`herd: ${report}`);
+  const bg = background(first);
+  const ground = select(first, (p) => differs(p, bg, 10) && !isFur(p) && !furTinted(p)).count;
+  console.log(`herd: ${ground} ground pixels of ${first.width * first.height}`);
+  // Overlapping Foxes merge into one region (here 16 Foxes made 10); one Fox alone makes one or two.
+  assert.ok(foxes.length >= 8, `fewer Foxes than the herd holds: ${report}`);
+  assert.ok(walking.length >= 6, `the Foxes do not walk: ${report}`);
+  assert.ok(ground > 0.1 * first.width * first.height, `the herd stands on no ground (${ground} pixels)`);
+  assert.deepEqual(page.problems, []);
+  await page.close();
+});
+
 test('the key light casts the bunny\'s shadow on the ground, and Shift + drag moves it', async () => {
   const page = await openPage();
   await waitRunning(page);

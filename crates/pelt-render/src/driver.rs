@@ -390,6 +390,19 @@ impl FurDriver {
         self.finish_upload(queue, moved_normals)
     }
 
+    /// Shows what `stepper` stepped on its own (a herd's member, stepped with the others by
+    /// [`FurStepper::advance_herd`]): its positions, its posed normals when the base moved and its
+    /// wetness, as [`FurDriver::show_state`] and [`FurDriver::show_wet`].
+    ///
+    /// # Errors
+    /// As [`FurDriver::show_state`], for a stepper of another fur.
+    pub fn show_stepped(&mut self, queue: &wgpu::Queue, stepper: &FurStepper) -> Result<(), RenderError> {
+        let wetness = stepper.wetness();
+        self.show_wet(queue, (!wetness.is_dry()).then(|| wetness.values()), stepper.wet())?;
+        let normals = stepper.moved_pose().map(|pose| &pose.normals[..]);
+        self.show_state(queue, stepper.simulation().positions(), normals)
+    }
+
     /// With the GPU kernel, steps prepared and never recorded mean the host does not record:
     /// the CPU bends from now on.
     fn fall_back_when_unrecorded(&mut self) {

@@ -137,8 +137,8 @@ impl CanvasGpu {
     ///
     /// # Errors
     /// The renderer's message.
-    pub fn set_textures(&mut self, textures: &FurTextures, tile_scale: f32) -> Result<(), String> {
-        self.page.set_textures(&self.device, &self.queue, textures, tile_scale)
+    pub fn set_textures(&mut self, model: &Model, textures: &FurTextures, tile_scale: f32) -> Result<(), String> {
+        self.page.set_textures((&self.device, &self.queue), model, textures, tile_scale)
     }
 
     /// Advances the model's fur by `frame_secs` of wall time (see [`PageGpu::advance`]).

@@ -10,6 +10,7 @@
 
 #![warn(missing_docs)]
 
+pub mod herd;
 pub mod light;
 pub mod model;
 pub mod orbit;

@@ -3,11 +3,13 @@
 //! orbit camera. Nothing here touches a browser API, so it is tested natively.
 
 use glam::{Vec2, Vec3};
+use pelt_core::anim::Rig;
 use pelt_core::sim::{FurStepper, Touch};
 use pelt_core::texture::Rgb;
 use pelt_core::{FurStructure, Mesh, Preset};
 use pelt_render::Camera;
 
+use crate::herd::Herd;
 use crate::light::PageLight;
 pub use crate::orbit::Orbit;
 pub use crate::scene::{FOX_NAME, SceneChoice, WalkingBody};
@@ -75,6 +77,9 @@ pub struct Model {
     pub body: Option<Mesh>,
     /// The try-on body's walk: its rig, the skirt's and the capsules the fur collides with.
     walking: Option<WalkingBody>,
+    /// The herd scene's other Foxes (`stepper` is the first) and the rig they walk with.
+    pub herd: Option<Herd>,
+    herd_rig: Option<Rig>,
     /// The simulation of `structure`, stepped by the page's frame driver (or by
     /// [`Model::simulate`] without a GPU).
     pub stepper: FurStepper,
@@ -101,9 +106,10 @@ impl Model {
     /// # Errors
     /// [`ModelError`] if the preset does not fit the mesh.
     pub fn new(scene: SceneChoice, preset: Preset, aspect: f32) -> Result<Self, ModelError> {
-        let (mesh, walking) = load_scene(scene)?;
+        let (mesh, walking, herd_rig) = load_scene(scene)?;
         let structure = grow(mesh, scene, &preset)?;
-        let stepper = stepper(&structure, &preset, walking.as_ref())?;
+        let mut stepper = stepper(&structure, &preset, walking.as_ref())?;
+        let herd = herd_rig.as_ref().map(|rig| make_herd(&structure, &preset, rig, &mut stepper)).transpose()?;
         let body = walking.as_ref().map(|w| w.mesh.clone());
         let orbit = Orbit { target: Vec3::ZERO, azimuth_deg: 35.0, elevation_deg: 15.0, distance: 1.0 };
         let mut model = Self {
@@ -112,6 +118,8 @@ impl Model {
             structure,
             body,
             walking,
+            herd,
+            herd_rig,
             stepper,
             orbit,
             light: PageLight::default(),
@@ -121,6 +129,8 @@ impl Model {
             tools: Tools::default(),
             clock_secs: 0.0,
         };
+        // The herd stands on a ground.
+        model.light.ground |= model.herd.is_some();
         model.frame(aspect);
         Ok(model)
     }
@@ -128,9 +138,13 @@ impl Model {
     /// Looks at the whole scene (the body for the try-on, else the fur) from the current angles.
     pub fn frame(&mut self, aspect: f32) {
         let longest = self.structure.lengths.iter().copied().fold(0.0, f32::max);
-        let (centre, radius) = match &self.body {
-            Some(body) => body.bounding_sphere(),
-            None => {
+        let (centre, radius) = match (&self.body, &self.herd) {
+            (Some(body), _) => body.bounding_sphere(),
+            (None, Some(herd)) => {
+                let (low, high) = herd.extent(&self.structure);
+                (0.5 * (low + high), 0.5 * (high - low).length())
+            }
+            (None, None) => {
                 let (centre, radius) = self.structure.mesh.bounding_sphere();
                 (centre, radius + longest)
             }
@@ -167,6 +181,7 @@ impl Model {
     ) -> Result<(), ModelError> {
         preset.simulation.wind = self.preset.simulation.wind.clone();
         *self = Self { orbit: self.orbit, light: self.light, tool: self.tool, ..Self::new(scene, preset, aspect)? };
+        self.light.ground |= self.herd.is_some();
         self.frame(aspect);
         Ok(())
     }
@@ -215,6 +230,9 @@ impl Model {
         wind.direction = Vec3::new(angle.cos(), 0.0, angle.sin());
         wind.strength = strength;
         self.stepper.simulation_mut().set_wind(&wind)?;
+        if let Some(herd) = &mut self.herd {
+            herd.set_wind(&wind)?;
+        }
         self.preset.simulation.wind = wind;
         Ok(())
     }
@@ -222,7 +240,9 @@ impl Model {
     fn rebuild(&mut self, preset: Preset) -> Result<(), ModelError> {
         preset.validate()?;
         let structure = grow(self.structure.mesh.clone(), self.scene, &preset)?;
-        let stepper = stepper(&structure, &preset, self.walking.as_ref())?;
+        let mut stepper = stepper(&structure, &preset, self.walking.as_ref())?;
+        let herd = self.herd_rig.as_ref().map(|rig| make_herd(&structure, &preset, rig, &mut stepper)).transpose()?;
+        self.herd = herd;
         self.preset = preset;
         self.structure = structure;
         self.stepper = stepper;
@@ -396,13 +416,17 @@ impl Model {
         Ok(self.clock_secs)
     }
 
-    /// A frame without a GPU: [`Model::tick`], then the stepper on the CPU.
+    /// A frame without a GPU: [`Model::tick`], then the stepper (and the herd's) on the CPU.
     ///
     /// # Errors
     /// [`ModelError::Sim`] for a step the simulation refuses.
     pub fn simulate(&mut self, frame_secs: f64) -> Result<(), ModelError> {
         let time_secs = self.tick(frame_secs)?;
-        Ok(self.stepper.advance_to(time_secs)?)
+        self.stepper.advance_to(time_secs)?;
+        if let Some(herd) = &mut self.herd {
+            herd.advance_to(time_secs)?;
+        }
+        Ok(())
     }
 
     /// The try-on body posed at the page's clock, where the stepper poses the skirt (the walk's
@@ -424,6 +448,12 @@ impl Model {
     pub fn walk_cycle_secs(&self) -> Option<f64> {
         Some(f64::from(self.walking.as_ref()?.cycle_secs()))
     }
+}
+
+/// The herd scene's Foxes walking `rig`'s Walk, `first` the first of them.
+fn make_herd(structure: &FurStructure, preset: &Preset, rig: &Rig, first: &mut FurStepper) -> Result<Herd, ModelError> {
+    let walk = rig.find_animation("Walk").map_err(|e| ModelError::Control(format!("{FOX_NAME}: {e}")))?;
+    Herd::new((structure, preset), (rig, walk), first)
 }
 
 #[cfg(test)]

@@ -12,6 +12,7 @@ use pelt_render::{
     RenderTargets, Studio, Surroundings,
 };
 
+use crate::herd::HerdGpu;
 use crate::model::Model;
 
 /// Colour of the try-on body, linear RGB (the viewer's).
@@ -50,6 +51,9 @@ pub struct PageGpu {
     /// The shadow map and ground, made for the (shadows, ground) switches they hold; dropped
     /// when the structure or the body changes.
     surroundings: Option<((bool, bool), Surroundings)>,
+    /// The herd scene's other Foxes, made with the textures kept here.
+    herd: Option<HerdGpu>,
+    textures: FurTextures,
 }
 
 impl PageGpu {
@@ -90,8 +94,11 @@ impl PageGpu {
             frame: None,
             studio: Studio::default(),
             surroundings: None,
+            herd: None,
+            textures: textures.clone(),
         };
         gpu.set_body(device, queue, model.body.as_ref())?;
+        gpu.set_herd(device, queue, model)?;
         Ok(gpu)
     }
 
@@ -101,22 +108,41 @@ impl PageGpu {
     /// The renderer's message.
     pub fn set_structure(&mut self, device: &wgpu::Device, queue: &wgpu::Queue, model: &Model) -> Result<(), String> {
         self.driver.set_structure(device, queue, &self.renderer, &model.structure).map_err(|e| e.to_string())?;
-        self.set_body(device, queue, model.body.as_ref())
+        self.set_body(device, queue, model.body.as_ref())?;
+        self.set_herd(device, queue, model)
     }
 
-    /// New textures, made with a tile `tile_scale` times smaller than the preset's.
+    /// The herd's other Foxes anew (the herd scene), or none.
+    fn set_herd(&mut self, device: &wgpu::Device, queue: &wgpu::Queue, model: &Model) -> Result<(), String> {
+        self.herd = match &model.herd {
+            Some(herd) => Some(HerdGpu::new(
+                (device, queue),
+                &self.renderer,
+                (&model.structure, &self.textures),
+                &model.preset,
+                herd.others().len(),
+            )?),
+            None => None,
+        };
+        Ok(())
+    }
+
+    /// New textures, made with a tile `tile_scale` times smaller than the preset's; `model`'s
+    /// herd (if any) is made again with them.
     ///
     /// # Errors
     /// The renderer's message.
     pub fn set_textures(
         &mut self,
-        device: &wgpu::Device,
-        queue: &wgpu::Queue,
+        (device, queue): (&wgpu::Device, &wgpu::Queue),
+        model: &Model,
         textures: &FurTextures,
         tile_scale: f32,
     ) -> Result<(), String> {
         self.driver.set_look(look(tile_scale));
-        self.driver.set_textures(device, queue, &self.renderer, textures).map_err(|e| e.to_string())
+        self.driver.set_textures(device, queue, &self.renderer, textures).map_err(|e| e.to_string())?;
+        self.textures = textures.clone();
+        self.set_herd(device, queue, model)
     }
 
     fn set_body(
@@ -182,6 +208,10 @@ impl PageGpu {
             self.driver.set_look(FurLook { shading, ..look });
         }
         self.driver.advance_to(device, queue, &mut model.stepper, time_secs).map_err(|e| e.to_string())?;
+        if let (Some(herd), Some(gpu_herd)) = (&mut model.herd, &mut self.herd) {
+            herd.advance_to(time_secs).map_err(|e| e.to_string())?;
+            gpu_herd.show(queue, herd.others(), self.driver.frame().look)?;
+        }
         // The walking try-on body takes the skirt's clip at the same time.
         if let (Some(body), Some((positions, normals))) = (&self.body, model.pose_body()) {
             body.set_pose(queue, positions, normals).map_err(|e| e.to_string())?;
@@ -213,14 +243,29 @@ impl PageGpu {
         if self.surroundings.as_ref().is_none_or(|(made_for, _)| *made_for != switches) {
             let ground = switches.1.then(SceneGround::default);
             let plain: Vec<_> = model.body.iter().cloned().collect();
-            let made = Surroundings::new(
-                device,
-                queue,
-                &self.renderer,
-                switches.0,
-                ground.as_ref(),
-                (&model.structure, &plain),
-            )
+            let made = match &model.herd {
+                // The herd's maps and ground take in the whole field.
+                Some(herd) => {
+                    let fur_length = model.structure.lengths.iter().copied().fold(0.0, f32::max);
+                    let extent = herd.extent(&model.structure);
+                    Surroundings::around_box(
+                        device,
+                        queue,
+                        &self.renderer,
+                        (switches.0, ground.as_ref()),
+                        fur_length,
+                        extent,
+                    )
+                }
+                None => Surroundings::new(
+                    device,
+                    queue,
+                    &self.renderer,
+                    switches.0,
+                    ground.as_ref(),
+                    (&model.structure, &plain),
+                ),
+            }
             .map_err(|e| e.to_string())?;
             self.surroundings = Some((switches, made));
         }
@@ -236,13 +281,27 @@ impl PageGpu {
         let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("frame") });
         self.driver.record(&mut encoder).map_err(|e| e.to_string())?;
         self.driver.record_view(&mut encoder, &self.renderer, &self.view);
-        let (renderer, driver, body) = (&self.renderer, &self.driver, &self.body);
+        if let Some(herd) = &self.herd {
+            herd.record_view(&mut encoder, &self.renderer, &self.view);
+        }
+        let (renderer, driver, body, herd) = (&self.renderer, &self.driver, &self.body, &self.herd);
+        // The herd's members farthest first (blended fur); the model's own fur is member 0.
+        let mut order: Vec<usize> = (0..=herd.as_ref().map_or(0, HerdGpu::len)).collect();
+        if let Some(members) = model.herd.as_ref().map(|h| &h.instances) {
+            let distance = |k: usize| members[k].position.distance(camera.eye);
+            order.sort_by(|&a, &b| distance(b).total_cmp(&distance(a)));
+        }
         surroundings.record(&mut encoder, |pass, light| {
             surroundings.draw_ground(pass, renderer, light);
             if let Some(body) = body {
                 renderer.draw_plain(pass, light, body);
             }
             driver.draw(pass, renderer, light, &FurDrawSettings::ALL);
+            if let Some(herd) = herd {
+                for k in 0..herd.len() {
+                    herd.draw(k, pass, (renderer, light), &FurDrawSettings::ALL);
+                }
+            }
         });
         {
             let mut pass = targets.begin_pass(&mut encoder, &output, self.studio.background);
@@ -250,7 +309,13 @@ impl PageGpu {
             if let Some(body) = body {
                 renderer.draw_plain(&mut pass, &self.view, body);
             }
-            driver.draw(&mut pass, renderer, &self.view, &PAGE_DRAW);
+            for &member in &order {
+                match (member, herd) {
+                    (0, _) => driver.draw(&mut pass, renderer, &self.view, &PAGE_DRAW),
+                    (k, Some(herd)) => herd.draw(k - 1, &mut pass, (renderer, &self.view), &PAGE_DRAW),
+                    (_, None) => {}
+                }
+            }
         }
         // The encoded bytes as they are: the canvas shows its bytes as sRGB.
         encoder.copy_texture_to_texture(frame.as_image_copy(), canvas.as_image_copy(), frame.size());

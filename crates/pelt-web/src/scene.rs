@@ -20,16 +20,19 @@ pub enum SceneChoice {
     TryOn,
     /// The glTF Fox in its rest pose (the groomed Fox's mesh).
     Fox,
+    /// Sixteen Foxes walking on the spot on a ground ([`crate::herd`]).
+    Herd,
 }
 
 impl SceneChoice {
-    /// `"bunny"`, `"tryon"` or `"fox"`.
+    /// `"bunny"`, `"tryon"`, `"fox"` or `"herd"`.
     #[must_use]
     pub fn from_name(name: &str) -> Option<Self> {
         match name {
             "bunny" => Some(Self::Bunny),
             "tryon" => Some(Self::TryOn),
             "fox" => Some(Self::Fox),
+            "herd" => Some(Self::Herd),
             _ => None,
         }
     }
@@ -41,6 +44,7 @@ impl SceneChoice {
             Self::Bunny => "bunny",
             Self::TryOn => "tryon",
             Self::Fox => "fox",
+            Self::Herd => "herd",
         }
     }
 }
@@ -81,10 +85,10 @@ impl WalkingBody {
     }
 }
 
-/// The furred mesh and the try-on's walking body.
-pub(crate) fn load_scene(scene: SceneChoice) -> Result<(Mesh, Option<WalkingBody>), ModelError> {
+/// The furred mesh, the try-on's walking body and the herd's rig (the Fox's, with its Walk).
+pub(crate) fn load_scene(scene: SceneChoice) -> Result<(Mesh, Option<WalkingBody>, Option<Rig>), ModelError> {
     Ok(match scene {
-        SceneChoice::Bunny => (Builtin::Bunny.mesh().0, None),
+        SceneChoice::Bunny => (Builtin::Bunny.mesh().0, None, None),
         SceneChoice::TryOn => {
             let stage = Stage::load(&StageSource::TryOn, &[], &ImportOptions::default())?;
             let missing = || pelt_core::MeshError::Parse {
@@ -96,10 +100,20 @@ pub(crate) fn load_scene(scene: SceneChoice) -> Result<(Mesh, Option<WalkingBody
             else {
                 return Err(missing().into());
             };
-            (stage.fur_mesh, Some(WalkingBody { mesh, garment_rig, body, pose: Pose::default() }))
+            (stage.fur_mesh, Some(WalkingBody { mesh, garment_rig, body, pose: Pose::default() }), None)
         }
         SceneChoice::Fox => {
-            (Mesh::from_gltf_slice(FOX_GLB, std::path::Path::new(FOX_NAME), &ImportOptions::default())?.0, None)
+            (Mesh::from_gltf_slice(FOX_GLB, std::path::Path::new(FOX_NAME), &ImportOptions::default())?.0, None, None)
+        }
+        SceneChoice::Herd => {
+            let name = std::path::Path::new(FOX_NAME);
+            let (mesh, _, rig) = Mesh::from_gltf_slice_animated(FOX_GLB, name, &ImportOptions::default())?;
+            let rig = rig.ok_or_else(|| pelt_core::MeshError::Parse {
+                file: FOX_NAME.into(),
+                line: None,
+                message: "the Fox has no skeleton to walk with".to_owned(),
+            })?;
+            (mesh, None, Some(rig))
         }
     })
 }
@@ -109,7 +123,7 @@ pub(crate) fn load_scene(scene: SceneChoice) -> Result<(Mesh, Option<WalkingBody
 pub(crate) fn grow(mesh: Mesh, scene: SceneChoice, preset: &Preset) -> Result<FurStructure, ModelError> {
     let params = preset.fur_params(&mesh);
     let mesh_name = match scene {
-        SceneChoice::Fox => FOX_NAME.to_owned(),
+        SceneChoice::Fox | SceneChoice::Herd => FOX_NAME.to_owned(),
         other => format!("the {} mesh", other.name()),
     };
     let groom = presets::web_groom(preset, &mesh, &mesh_name)?;

@@ -56,7 +56,7 @@ pub struct PeltApp {
 
 #[wasm_bindgen]
 impl PeltApp {
-    /// Opens WebGPU on `canvas` and shows `scene` (`"bunny"` or `"tryon"`) with the shipped
+    /// Opens WebGPU on `canvas` and shows `scene` (`"bunny"`, `"tryon"`, `"fox"` or `"herd"`) with the shipped
     /// preset `preset`.
     ///
     /// # Errors
@@ -127,7 +127,7 @@ impl PeltApp {
         }
     }
 
-    /// Shows `"bunny"`, `"tryon"` or `"fox"`. A shipped preset made for another mesh gives way:
+    /// Shows `"bunny"`, `"tryon"`, `"fox"` or `"herd"`. A shipped preset made for another mesh gives way:
     /// the Fox takes `fox_groomed`, the others `default` after a Fox preset.
     ///
     /// # Errors
@@ -182,7 +182,7 @@ impl PeltApp {
         self.texture_ms = texture_ms;
         name.clone_into(&mut self.preset_name);
         self.gpu.set_structure(&self.model).map_err(message)?;
-        self.gpu.set_textures(&made.textures, made.tile_scale).map_err(message)
+        self.gpu.set_textures(&self.model, &made.textures, made.tile_scale).map_err(message)
     }
 
     /// Uses a preset file the user picked (`text`, named `file_name` in messages).
@@ -204,7 +204,7 @@ impl PeltApp {
         self.model.set_preset(preset).map_err(message)?;
         self.texture_ms = texture_ms;
         self.gpu.set_structure(&self.model).map_err(message)?;
-        self.gpu.set_textures(&made.textures, made.tile_scale).map_err(message)
+        self.gpu.set_textures(&self.model, &made.textures, made.tile_scale).map_err(message)
     }
 
     /// Fur length as a fraction of the mesh's bounding radius.
@@ -227,7 +227,7 @@ impl PeltApp {
         match presets::web_textures(&self.model.preset) {
             Ok(made) => {
                 self.texture_ms = started.elapsed().as_secs_f64() * 1e3;
-                self.gpu.set_textures(&made.textures, made.tile_scale).map_err(message)
+                self.gpu.set_textures(&self.model, &made.textures, made.tile_scale).map_err(message)
             }
             Err(error) => {
                 self.model.preset.colour = before;
@@ -313,7 +313,7 @@ impl PeltApp {
         self.model.dry();
     }
 
-    /// The scene shown (`"bunny"`, `"tryon"` or `"fox"`), for the page's controls.
+    /// The scene shown (`"bunny"`, `"tryon"`, `"fox"` or `"herd"`), for the page's controls.
     #[must_use]
     pub fn scene(&self) -> String {
         self.model.scene.name().to_owned()

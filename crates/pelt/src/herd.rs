@@ -1,13 +1,12 @@
 //! What `pelt render` and `pelt view` share about herds: where the members stand (`--herd N` or a
-//! script's `[[instance]]`s), the ground they cover, and how a member stepped on the CPU is shown.
+//! script's `[[instance]]`s) and the ground they cover.
 
 use anyhow::bail;
 use glam::Vec3;
 use pelt_core::anim::Rig;
+use pelt_core::sim::Scene;
 use pelt_core::sim::herd::{self, HerdInstance};
-use pelt_core::sim::{FurStepper, Scene};
 use pelt_core::{FurStructure, Mesh};
-use pelt_render::FurDriver;
 
 /// The herd to draw: `--herd N` (`count`) scattered, or the script's `[[instance]]`s; none for
 /// one fur.
@@ -52,14 +51,4 @@ pub fn extent(fur: &FurStructure, instances: &[HerdInstance], secs: &[f64]) -> O
                 .fold((lo, hi), |(lo, hi), p| (lo.min(p - length * Vec3::new(1.0, 0.0, 1.0)), hi.max(p + length)))
         },
     ))
-}
-
-/// Shows a herd member its stepper stepped ([`FurStepper::advance_herd`]): the positions, the
-/// posed normals and the wetness, as the CPU kernel's upload.
-pub fn show_stepped(queue: &wgpu::Queue, driver: &mut FurDriver, stepper: &FurStepper) -> anyhow::Result<()> {
-    let wetness = stepper.wetness();
-    driver.show_wet(queue, (!wetness.is_dry()).then(|| wetness.values()), stepper.wet())?;
-    let normals = stepper.moved_pose().map(|pose| &pose.normals[..]);
-    driver.show_state(queue, stepper.simulation().positions(), normals)?;
-    Ok(())
 }

@@ -339,7 +339,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             }
             FurStepper::advance_herd(&mut steppers, &instances, time_secs)?;
             for ((driver, stepper), level) in drivers.iter_mut().zip(&steppers).zip(levels) {
-                crate::herd::show_stepped(queue, driver, stepper)?;
+                driver.show_stepped(queue, stepper)?;
                 driver.set_level(level);
             }
         }

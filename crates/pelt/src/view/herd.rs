@@ -264,7 +264,7 @@ impl HerdDrivers {
         look: FurLook,
     ) -> anyhow::Result<()> {
         for (k, (driver, stepper)) in self.drivers.iter_mut().zip(herd.followers()).enumerate() {
-            crate::herd::show_stepped(&gpu.queue, driver, stepper)?;
+            driver.show_stepped(&gpu.queue, stepper)?;
             let member = k + 1;
             if let Some(frame) = frames.get(member) {
                 driver.set_level(frame.level);
