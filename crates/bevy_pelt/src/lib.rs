@@ -40,7 +40,10 @@
 //!   over pi, as Bevy lights a white diffuse surface facing it), or by [`FurLight`]'s light when
 //!   there is none; Bevy's ambient light (the camera's `AmbientLight`, else the
 //!   `GlobalAmbientLight`) is the fur's ambient, [`FurLight`]'s only where the render world has
-//!   neither.
+//!   neither. A camera's `EnvironmentMapLight` adds its diffuse cube map (read from the main
+//!   world's `Assets<Image>` once per image: `Rgba16Float`, `Rgba32Float` or `Rgb9e5Ufloat` data
+//!   kept on the CPU) as the fur's environment, by direction and colour, turned by its rotation,
+//!   times its intensity and the exposure.
 //! - Fur casts into Bevy's shadow maps (directional cascades, point and spot lights) unless its
 //!   entity has `NotShadowCaster`, and receives the directional cascades' and spot lights'
 //!   (copied into pelt-render's `HostShadows`) unless it has `NotShadowReceiver`; on a camera
@@ -56,6 +59,7 @@
 mod base;
 mod contact;
 mod convert;
+mod environment;
 mod fur;
 mod mesh;
 mod passes;
@@ -96,7 +100,9 @@ impl Plugin for PeltPlugin {
             .init_resource::<FurWind>()
             .init_resource::<FurTouch>()
             .init_resource::<FurLight>()
-            .add_systems(PostUpdate, (fur::build_furs, fur::simulate_furs).chain().after(TransformSystems::Propagate));
+            .init_resource::<environment::ImageVersions>()
+            .add_systems(PostUpdate, (fur::build_furs, fur::simulate_furs).chain().after(TransformSystems::Propagate))
+            .add_systems(PostUpdate, environment::track_image_versions);
         let Some(render_app) = app.get_sub_app_mut(RenderApp) else { return };
         render_app
             .init_resource::<render::ExtractedFurs>()
@@ -104,7 +110,8 @@ impl Plugin for PeltPlugin {
             .init_resource::<render::FurGpuStats>()
             .init_resource::<passes::FurPasses>()
             .init_resource::<receive::FurReceivers>()
-            .add_systems(ExtractSchedule, render::extract_furs)
+            .init_resource::<environment::FurEnvironments>()
+            .add_systems(ExtractSchedule, (render::extract_furs, environment::extract_environments))
             .add_systems(
                 Render,
                 (render::prepare_furs, passes::prepare_fur_passes, receive::prepare_fur_receivers)
