@@ -45,8 +45,9 @@
 //!   kept on the CPU) as the fur's environment, by direction and colour, turned by its rotation,
 //!   times its intensity and the exposure.
 //! - Fur casts into Bevy's shadow maps (directional cascades, point and spot lights) unless its
-//!   entity has `NotShadowCaster`, and receives the directional cascades' and spot lights'
-//!   (copied into pelt-render's `HostShadows`) unless it has `NotShadowReceiver`; on a camera
+//!   entity has `NotShadowCaster`, and receives them all (the directional cascades, spot lights'
+//!   maps and point lights' cube faces, copied into pelt-render's `HostShadows`) unless it has
+//!   `NotShadowReceiver`; on a camera
 //!   with `DepthPrepass` (and
 //!   `MotionVectorPrepass`, as TAA and motion blur need) writes its depth (and motion vectors)
 //!   into Bevy's prepass textures; under TAA it is drawn with the camera's jitter.

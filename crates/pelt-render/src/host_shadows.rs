@@ -1,5 +1,6 @@
 //! Shadows a host draws itself ([`HostShadows`]): an engine's shadow maps (Bevy's directional
-//! cascades and spot lights), each copied into a layer of Pelt's maps with the view that drew it,
+//! cascades, spot lights and point lights' cube faces), each copied into a layer of Pelt's maps
+//! with the view that drew it,
 //! so the fur receives what the engine's meshes cast through the same lookups as its own maps
 //! (`shadows.wgsl`). The fur has no deep opacity map here: what it casts into the engine's maps
 //! shades the engine's meshes, and its own strands lie within the depth bias (the fur's length).
@@ -35,8 +36,17 @@ pub struct HostShadowView {
 pub enum HostLight {
     /// A sun: the unit vector toward it.
     Directional(Vec3),
-    /// A point or spot light at this position.
+    /// A point or spot light at this position, one view.
     Positional(Vec3),
+    /// One face of a point light's cube at `position`: `face` 0 to 5 is the view of the points
+    /// whose offset from the light is largest along +X, -X, +Y, -Y, +Z or -Z (world space). A
+    /// light's six faces take six layers in that order.
+    CubeFace {
+        /// The light's position.
+        position: Vec3,
+        /// Which face.
+        face: usize,
+    },
 }
 
 /// A host's shadow maps copied into Pelt's: make one per camera and renderer, each frame
@@ -53,12 +63,12 @@ pub struct HostShadows {
     receiver: wgpu::BindGroup,
     copy: wgpu::RenderPipeline,
     copy_layout: wgpu::BindGroupLayout,
-    /// This frame's sources, one a layer in use.
-    copies: Vec<wgpu::BindGroup>,
+    /// This frame's sources, one a layer in use (none: a cube face not given, cleared).
+    copies: Vec<Option<wgpu::BindGroup>>,
 }
 
 impl HostShadows {
-    /// Room for `layers` of the host's views, each `size` texels a side (the host's map size),
+    /// Room for `layers` of the host's views, each `size` texels a side (the largest host map's),
     /// for fur at most `fur_depth` long.
     ///
     /// # Errors
@@ -127,8 +137,10 @@ impl HostShadows {
     }
 
     /// Aims the layers at `views`, each with the host's depth map that view drew (`sources`:
-    /// one layer of depth, `size` texels a side, reverse-Z or not as its view says): those past
-    /// the layers, or of a light past the 8th, cast nothing. Returns how many are used.
+    /// one layer of depth, square, reverse-Z or not as its view says; one smaller than the
+    /// layers is read at its nearest texel). Each view takes a layer, a point light's faces six
+    /// in face order (the first face met reserves them; a face not given is unshadowed); views
+    /// past the layers, or of a light past the 8th, cast nothing. Returns how many layers are used.
     pub fn prepare(
         &mut self,
         (device, queue): (&wgpu::Device, &wgpu::Queue),
@@ -147,15 +159,47 @@ impl HostShadows {
         };
         // Clip z to `w - z`: a reverse-Z depth read as Pelt's forward one (`shadow_copy.wgsl`).
         let flip = Mat4::from_cols(Vec4::X, Vec4::Y, Vec4::new(0.0, 0.0, -1.0, 0.0), Vec4::new(0.0, 0.0, 1.0, 1.0));
-        self.copies.clear();
+        let capacity = (self.layers as usize).min(SHADOW_VIEWS);
+        let mut layers: Vec<Option<wgpu::BindGroup>> = Vec::new();
         let usable = views.iter().zip(sources).filter(|(v, _)| v.light_index < MAX_LIGHTS);
-        for (view, source) in usable.take(self.layers as usize) {
-            let index = self.copies.len();
-            let light = match view.light {
-                HostLight::Directional(toward) => toward.normalize_or(Vec3::Y).extend(0.0),
-                HostLight::Positional(position) => position.extend(1.0),
+        for (view, source) in usable {
+            let slot = uniform.light_views[view.light_index];
+            let (layer, light) = match view.light {
+                HostLight::CubeFace { face, .. } if face >= 6 => continue,
+                HostLight::CubeFace { position, face } => {
+                    let first = match slot[1] {
+                        6 => slot[0] as usize,
+                        0 if layers.len() + 6 <= capacity => {
+                            let first = layers.len();
+                            layers.resize(first + 6, None);
+                            uniform.light_views[view.light_index] = [first as u32, 6, 0, 0];
+                            // Every face knows the light: the lookups pick the face from it.
+                            for index in first..first + 6 {
+                                uniform.views[index].light = position.extend(1.0);
+                            }
+                            first
+                        }
+                        _ => continue,
+                    };
+                    (first + face, position.extend(1.0))
+                }
+                HostLight::Directional(_) | HostLight::Positional(_) => {
+                    if layers.len() >= capacity || slot[1] == 6 {
+                        continue;
+                    }
+                    // A light's first view in use: one view a light.
+                    if slot[1] == 0 {
+                        uniform.light_views[view.light_index] = [layers.len() as u32, 1, 0, 0];
+                    }
+                    layers.push(None);
+                    let light = match view.light {
+                        HostLight::Directional(toward) => toward.normalize_or(Vec3::Y).extend(0.0),
+                        HostLight::Positional(position) | HostLight::CubeFace { position, .. } => position.extend(1.0),
+                    };
+                    (layers.len() - 1, light)
+                }
             };
-            uniform.views[index] = ShadowViewUniform {
+            uniform.views[layer] = ShadowViewUniform {
                 light_clip_from_world: if view.reverse_z { flip * view.clip_from_world } else { view.clip_from_world },
                 light,
                 texel_world: view.texel_world,
@@ -169,18 +213,14 @@ impl HostShadows {
                 _padding_0: 0.0,
                 _padding_1: 0.0,
             };
-            // A light's first view in use: one view a light.
-            let slot = &mut uniform.light_views[view.light_index];
-            if slot[1] == 0 {
-                *slot = [index as u32, 1, 0, 0];
-            }
-            self.copies.push(device.create_bind_group(&wgpu::BindGroupDescriptor {
+            layers[layer] = Some(device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("pelt host shadow copy"),
                 layout: &self.copy_layout,
                 entries: &[wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(source) }],
             }));
         }
         queue.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&uniform));
+        self.copies = layers;
         self.copies.len()
     }
 
@@ -200,9 +240,12 @@ impl HostShadows {
                 occlusion_query_set: None,
                 multiview_mask: None,
             });
-            pass.set_pipeline(&self.copy);
-            pass.set_bind_group(0, group, &[]);
-            pass.draw(0..3, 0..1);
+            // A face not given keeps the clear: the far plane, unshadowed.
+            if let Some(group) = group {
+                pass.set_pipeline(&self.copy);
+                pass.set_bind_group(0, group, &[]);
+                pass.draw(0..3, 0..1);
+            }
         }
     }
 
