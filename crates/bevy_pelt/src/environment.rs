@@ -50,6 +50,8 @@ impl FurEnvironments {
 }
 
 /// Reads each 3D camera's `EnvironmentMapLight` (its diffuse map) into the fur's environment.
+/// Runs before Bevy's asset extraction, which takes the data of an image kept for the render
+/// world only: such a map is read in the frame it is added or changed, if a camera uses it then.
 pub(crate) fn extract_environments(
     mut environments: ResMut<FurEnvironments>,
     cameras: Extract<Query<(RenderEntity, &EnvironmentMapLight), With<Camera3d>>>,
@@ -72,12 +74,14 @@ pub(crate) fn extract_environments(
                 }
                 // Not loaded yet: no environment until it is.
                 let Some(image) = images.get(id) else { continue };
-                match cube_environment(image) {
-                    Ok(environment) => {
+                let handed_over = environments.read.get(&id).filter(|_| image.data.is_none()).map(|(_, e)| *e);
+                match (cube_environment(image), handed_over) {
+                    // Or read before Bevy took its data for the render world, unchanged since.
+                    (Ok(environment), _) | (Err(_), Some(environment)) => {
                         environments.read.insert(id, (version, environment));
                         environment
                     }
-                    Err(problem) => {
+                    (Err(problem), None) => {
                         error!(
                             "Pelt's fur cannot take the environment map light of {camera}: its diffuse map \
                              {id}: {problem}; the fur takes the ambient light alone"
@@ -127,8 +131,8 @@ pub(crate) fn cube_environment(image: &Image) -> Result<Environment, String> {
         }
     };
     let Some(data) = image.data.as_deref() else {
-        return Err("its data is not kept on the CPU (RenderAssetUsages::RENDER_WORLD only); \
-                    give it RenderAssetUsages::default() to light the fur"
+        return Err("its data is not kept on the CPU (RenderAssetUsages::RENDER_WORLD only) and was handed \
+                    to the render world before a camera used it; give it RenderAssetUsages::default()"
             .into());
     };
     let side = size.width as usize;

@@ -43,10 +43,13 @@ use crate::fur::{Fur, FurState};
 /// (the camera's `AmbientLight`, else the `GlobalAmbientLight`) is the fur's too: colour times
 /// brightness times exposure, the radiance a white diffuse surface shows under it in Bevy. A
 /// camera's `EnvironmentMapLight` adds to it, as in Bevy: its diffuse map (a cube map in
-/// `Rgba16Float`, `Rgba32Float` or `Rgb9e5Ufloat` whose data the main world keeps) reduced to
-/// spherical harmonics, turned by its `rotation`, times its `intensity` and the exposure; the
-/// fur model takes it by direction and colour, Kajiya-Kay its mean. A diffuse map that cannot be
-/// read (kept for the render world only, another format) is reported once and left out.
+/// `Rgba16Float`, `Rgba32Float` or `Rgb9e5Ufloat`) reduced to spherical harmonics once per image,
+/// turned by its `rotation`, times its `intensity` and the exposure; the fur model takes it by
+/// direction and colour, Kajiya-Kay its mean. The map's data must be on the CPU when it is read:
+/// kept in the main world (`RenderAssetUsages::default()`, as Bevy's KTX2 maps are), or, for an
+/// image kept for the render world only (Bevy's `EnvironmentMapLight::solid_color` and
+/// `hemispherical_gradient`), used by a camera in the frame it is added or changed. A map that
+/// cannot be read (handed over before, another format) is reported once and left out.
 #[derive(Resource, Clone, Copy, Debug, Default, PartialEq)]
 pub struct FurLight(pub Light);
 

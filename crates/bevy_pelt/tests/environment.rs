@@ -1,6 +1,7 @@
 //! Bevy's environment map light on the fur: a camera's `EnvironmentMapLight`, with no other
 //! light in the scene, lights a coat shaded with the fur model, by direction (a sky above
-//! lights it more than the same sky below) and by colour (a blue sky makes it bluish).
+//! lights it more than the same sky below) and by colour (a blue sky makes it bluish); Bevy's
+//! own gradient map, kept for the render world only, lights it too.
 
 use bevy::asset::RenderAssetUsages;
 use bevy::camera::RenderTarget;
@@ -66,6 +67,9 @@ enum Lighting {
     Sky {
         upside_down: bool,
     },
+    /// Bevy's own `EnvironmentMapLight::hemispherical_gradient`: a 1x1 cube kept for the render
+    /// world only, read in the frame Bevy hands it over.
+    BevysGradient,
     /// Bevy's global ambient at this brightness.
     Grey(f32),
 }
@@ -93,6 +97,14 @@ fn environment_lit(lighting: Lighting) -> image::RgbaImage {
                 intensity: 1000.0,
                 ..default()
             });
+        }
+        if let Lighting::BevysGradient = lighting {
+            let colour = |c: [f32; 3]| Color::linear_rgb(c[0], c[1], c[2]);
+            let light = camera.world_scope(|world| {
+                let mut images = world.resource_mut::<Assets<Image>>();
+                EnvironmentMapLight::hemispherical_gradient(&mut images, colour(SKY), colour(SKY), colour(GROUND))
+            });
+            camera.insert(light.with_intensity(1000.0));
         }
     });
     images.into_iter().next().unwrap()
@@ -137,4 +149,13 @@ fn an_environment_map_light_lights_the_fur_by_direction_and_colour() {
     );
     let [.., ground_luma] = mean_colour(&ground, &lit);
     assert!(sky_luma > ground_luma + 5.0, "mean fur luma {sky_luma} with the sky above, {ground_luma} below");
+}
+
+#[test]
+fn bevys_own_gradient_environment_map_lights_the_fur() {
+    let dark = environment_lit(Lighting::Nothing);
+    let gradient = environment_lit(Lighting::BevysGradient);
+    save(&gradient, "environment_bevys_gradient");
+    let lit = gradient.pixels().zip(dark.pixels()).filter(|(a, b)| luma(a) > luma(b) + 20.0).count();
+    assert!(lit > 1000, "{lit} fur pixels brighter under Bevy's gradient than under nothing");
 }
