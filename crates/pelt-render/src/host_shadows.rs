@@ -159,46 +159,21 @@ impl HostShadows {
         };
         // Clip z to `w - z`: a reverse-Z depth read as Pelt's forward one (`shadow_copy.wgsl`).
         let flip = Mat4::from_cols(Vec4::X, Vec4::Y, Vec4::new(0.0, 0.0, -1.0, 0.0), Vec4::new(0.0, 0.0, 1.0, 1.0));
-        let capacity = (self.layers as usize).min(SHADOW_VIEWS);
-        let mut layers: Vec<Option<wgpu::BindGroup>> = Vec::new();
-        let usable = views.iter().zip(sources).filter(|(v, _)| v.light_index < MAX_LIGHTS);
-        for (view, source) in usable {
-            let slot = uniform.light_views[view.light_index];
-            let (layer, light) = match view.light {
-                HostLight::CubeFace { face, .. } if face >= 6 => continue,
-                HostLight::CubeFace { position, face } => {
-                    let first = match slot[1] {
-                        6 => slot[0] as usize,
-                        0 if layers.len() + 6 <= capacity => {
-                            let first = layers.len();
-                            layers.resize(first + 6, None);
-                            uniform.light_views[view.light_index] = [first as u32, 6, 0, 0];
-                            // Every face knows the light: the lookups pick the face from it.
-                            for index in first..first + 6 {
-                                uniform.views[index].light = position.extend(1.0);
-                            }
-                            first
-                        }
-                        _ => continue,
-                    };
-                    (first + face, position.extend(1.0))
-                }
-                HostLight::Directional(_) | HostLight::Positional(_) => {
-                    if layers.len() >= capacity || slot[1] == 6 {
-                        continue;
-                    }
-                    // A light's first view in use: one view a light.
-                    if slot[1] == 0 {
-                        uniform.light_views[view.light_index] = [layers.len() as u32, 1, 0, 0];
-                    }
-                    layers.push(None);
-                    let light = match view.light {
-                        HostLight::Directional(toward) => toward.normalize_or(Vec3::Y).extend(0.0),
-                        HostLight::Positional(position) | HostLight::CubeFace { position, .. } => position.extend(1.0),
-                    };
-                    (layers.len() - 1, light)
-                }
+        let (assigned, light_views, used) = assign_layers(views, (self.layers as usize).min(SHADOW_VIEWS));
+        uniform.light_views = light_views;
+        let mut layers: Vec<Option<wgpu::BindGroup>> = vec![None; used];
+        for ((view, source), layer) in views.iter().zip(sources).zip(assigned) {
+            let Some(layer) = layer else { continue };
+            let light = match view.light {
+                HostLight::Directional(toward) => toward.normalize_or(Vec3::Y).extend(0.0),
+                HostLight::Positional(position) | HostLight::CubeFace { position, .. } => position.extend(1.0),
             };
+            if let HostLight::CubeFace { face, .. } = view.light {
+                // Every face knows the light, given or not: the lookups pick the face from it.
+                for index in layer - face..layer - face + 6 {
+                    uniform.views[index].light = light;
+                }
+            }
             uniform.views[layer] = ShadowViewUniform {
                 light_clip_from_world: if view.reverse_z { flip * view.clip_from_world } else { view.clip_from_world },
                 light,
@@ -294,10 +269,77 @@ fn copy_pipeline(device: &wgpu::Device, layout: &wgpu::BindGroupLayout) -> wgpu:
     })
 }
 
+/// Where each of `views` goes among `capacity` layers: its layer (none: it casts nothing), each
+/// light's first layer and count (`Shadow::light_views`), and the layers used. A light's first
+/// view takes the next layer, or, a cube face, the next six (face `f` at the first plus `f`);
+/// more views of a one-view light take layers the lookups do not read.
+fn assign_layers(views: &[HostShadowView], capacity: usize) -> (Vec<Option<usize>>, [[u32; 4]; MAX_LIGHTS], usize) {
+    let mut light_views = [[0u32; 4]; MAX_LIGHTS];
+    let mut used = 0;
+    let assigned = views
+        .iter()
+        .map(|view| {
+            let slot = light_views.get_mut(view.light_index)?;
+            match view.light {
+                HostLight::CubeFace { face, .. } if face >= 6 => None,
+                HostLight::CubeFace { face, .. } => {
+                    if slot[1] == 0 && used + 6 <= capacity {
+                        *slot = [used as u32, 6, 0, 0];
+                        used += 6;
+                    }
+                    (slot[1] == 6).then_some(slot[0] as usize + face)
+                }
+                HostLight::Directional(_) | HostLight::Positional(_) => {
+                    if used >= capacity || slot[1] == 6 {
+                        return None;
+                    }
+                    if slot[1] == 0 {
+                        *slot = [used as u32, 1, 0, 0];
+                    }
+                    used += 1;
+                    Some(used - 1)
+                }
+            }
+        })
+        .collect();
+    (assigned, light_views, used)
+}
+
 impl FurView {
     /// Lights the draws through this view with a host's shadow maps ([`HostShadows`], copied
     /// with [`HostShadows::record_copy`] before this view's pass), or without shadows (`None`).
     pub fn set_host_shadows(&mut self, shadows: Option<&HostShadows>) {
         self.set_shadow_group(shadows.map(HostShadows::receiver));
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn view(light_index: usize, light: HostLight) -> HostShadowView {
+        HostShadowView { light_index, clip_from_world: Mat4::IDENTITY, reverse_z: true, texel_world: 0.01, light }
+    }
+
+    #[test]
+    fn a_point_lights_faces_take_six_layers_in_face_order() {
+        let sun = HostLight::Directional(Vec3::Y);
+        let face = |face| HostLight::CubeFace { position: Vec3::ONE, face };
+        // Two cascades of the sun, a cube's faces out of order, a spot light.
+        let mut views = vec![view(0, sun), view(0, sun)];
+        views.extend([5, 0, 3, 1, 2, 4].map(|f| view(1, face(f))));
+        views.push(view(2, HostLight::Positional(Vec3::Y)));
+        let (assigned, light_views, used) = assign_layers(&views, 12);
+        assert_eq!(assigned, [0, 1, 7, 2, 5, 3, 4, 6, 8].map(Some));
+        assert_eq!(&light_views[..3], &[[0, 1, 0, 0], [2, 6, 0, 0], [8, 1, 0, 0]]);
+        assert_eq!(used, 9);
+        // Too few layers for the cube: its faces cast nothing, the spot light still does.
+        let (assigned, light_views, used) = assign_layers(&views, 4);
+        assert_eq!(assigned, [Some(0), Some(1), None, None, None, None, None, None, Some(2)]);
+        assert_eq!(light_views[1], [0; 4]);
+        assert_eq!(used, 3);
+        // A face past the sixth, a light past the eighth: nothing.
+        let odd = [view(0, face(6)), view(MAX_LIGHTS, sun)];
+        assert_eq!(assign_layers(&odd, 12), (vec![None, None], [[0; 4]; MAX_LIGHTS], 0));
     }
 }
