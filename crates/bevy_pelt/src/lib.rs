@@ -40,10 +40,14 @@
 //!   over pi, as Bevy lights a white diffuse surface facing it), or by [`FurLight`]'s light when
 //!   there is none; Bevy's ambient light (the camera's `AmbientLight`, else the
 //!   `GlobalAmbientLight`) is the fur's ambient, [`FurLight`]'s only where the render world has
-//!   neither.
+//!   neither. A camera's `EnvironmentMapLight` adds its diffuse cube map (read from the main
+//!   world's `Assets<Image>` once per image: `Rgba16Float`, `Rgba32Float` or `Rgb9e5Ufloat`
+//!   data on the CPU; see [`FurLight`]) as the fur's environment, by direction and colour,
+//!   turned by its rotation, times its intensity and the exposure.
 //! - Fur casts into Bevy's shadow maps (directional cascades, point and spot lights) unless its
-//!   entity has `NotShadowCaster`, and receives the directional cascades' and spot lights'
-//!   (copied into pelt-render's `HostShadows`) unless it has `NotShadowReceiver`; on a camera
+//!   entity has `NotShadowCaster`, and receives them all (the directional cascades, spot lights'
+//!   maps and point lights' cube faces, copied into pelt-render's `HostShadows`) unless it has
+//!   `NotShadowReceiver`; on a camera
 //!   with `DepthPrepass` (and
 //!   `MotionVectorPrepass`, as TAA and motion blur need) writes its depth (and motion vectors)
 //!   into Bevy's prepass textures; under TAA it is drawn with the camera's jitter.
@@ -56,6 +60,7 @@
 mod base;
 mod contact;
 mod convert;
+mod environment;
 mod fur;
 mod mesh;
 mod passes;
@@ -65,12 +70,13 @@ mod render;
 mod wet;
 
 use bevy::app::{App, Plugin, PostUpdate};
-use bevy::asset::AssetApp;
+use bevy::asset::{AssetApp, AssetEventSystems};
 use bevy::core_pipeline::core_3d::{main_opaque_pass_3d, main_transparent_pass_3d};
 use bevy::core_pipeline::prepass::node::late_prepass;
 use bevy::core_pipeline::{Core3dSystems, schedule::Core3d};
 use bevy::ecs::schedule::IntoScheduleConfigs;
 use bevy::pbr::{LATE_SHADOW_PASS, per_view_shadow_pass, shared_shadow_pass};
+use bevy::render::render_asset::AssetExtractionSystems;
 use bevy::render::{ExtractSchedule, Render, RenderApp, RenderSystems};
 use bevy::transform::TransformSystems;
 
@@ -96,7 +102,9 @@ impl Plugin for PeltPlugin {
             .init_resource::<FurWind>()
             .init_resource::<FurTouch>()
             .init_resource::<FurLight>()
-            .add_systems(PostUpdate, (fur::build_furs, fur::simulate_furs).chain().after(TransformSystems::Propagate));
+            .init_resource::<environment::ImageVersions>()
+            .add_systems(PostUpdate, (fur::build_furs, fur::simulate_furs).chain().after(TransformSystems::Propagate))
+            .add_systems(PostUpdate, environment::track_image_versions.after(AssetEventSystems));
         let Some(render_app) = app.get_sub_app_mut(RenderApp) else { return };
         render_app
             .init_resource::<render::ExtractedFurs>()
@@ -104,7 +112,11 @@ impl Plugin for PeltPlugin {
             .init_resource::<render::FurGpuStats>()
             .init_resource::<passes::FurPasses>()
             .init_resource::<receive::FurReceivers>()
-            .add_systems(ExtractSchedule, render::extract_furs)
+            .init_resource::<environment::FurEnvironments>()
+            .add_systems(
+                ExtractSchedule,
+                (render::extract_furs, environment::extract_environments.before(AssetExtractionSystems)),
+            )
             .add_systems(
                 Render,
                 (render::prepare_furs, passes::prepare_fur_passes, receive::prepare_fur_receivers)

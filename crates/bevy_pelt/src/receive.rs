@@ -1,7 +1,7 @@
-//! The fur receives Bevy's shadows: each camera's directional cascades and spot lights' maps,
-//! drawn by Bevy's shadow passes (the fur's own depth among them), copied into pelt-render's
-//! `HostShadows` after those passes and read by the fur's lights in the main pass. Point lights'
-//! cube maps are not read.
+//! The fur receives Bevy's shadows: each camera's directional cascades, spot lights' maps and
+//! point lights' cube faces, drawn by Bevy's shadow passes (the fur's own depth among them),
+//! copied into pelt-render's `HostShadows` after those passes and read by the fur's lights in the
+//! main pass.
 
 use std::collections::{HashMap, HashSet};
 
@@ -13,7 +13,7 @@ use bevy::render::renderer::{RenderContext, ViewQuery};
 use bevy::render::sync_world::MainEntity;
 use bevy::render::texture::DepthStencilViews;
 use bevy::render::view::ExtractedView;
-use pelt_render::{HostLight, HostShadowView, HostShadows};
+use pelt_render::{HostLight, HostShadowView, HostShadows, MAX_SHADOW_VIEWS};
 
 use crate::convert::to_pelt_mat4;
 use crate::render::{ExtractedFurs, FurGpu, clip_from_world};
@@ -57,14 +57,16 @@ pub(crate) fn prepare_fur_receivers(
         let Some(entry) = gpu.view(camera) else { continue };
         let target = entry.target();
         let mut candidates: Vec<Candidate> = Vec::new();
-        // The camera's own cascades, and the spot lights' maps every camera shares.
-        let spots = shadow_views.iter().filter(|(.., light)| matches!(light, LightEntity::Spot { .. }));
+        // The camera's own cascades, and the spot and point lights' maps every camera shares.
+        let shared = shadow_views.iter().filter(|(.., light)| !matches!(light, LightEntity::Directional { .. }));
         let own = lights.lights.iter().filter_map(|&light_view| shadow_views.get(light_view).ok());
-        for (shadow_view, view, light) in own.filter(|(.., l)| !matches!(l, LightEntity::Spot { .. })).chain(spots) {
+        for (shadow_view, view, light) in
+            own.filter(|(.., l)| matches!(l, LightEntity::Directional { .. })).chain(shared)
+        {
             let (light_entity, cascade) = match *light {
                 LightEntity::Directional { light_entity, cascade_index } => (light_entity, cascade_index),
                 LightEntity::Spot { light_entity } => (light_entity, 0),
-                LightEntity::Point { .. } => continue,
+                LightEntity::Point { light_entity, face_index } => (light_entity, face_index),
             };
             let Some(light_index) =
                 main_entities.get(light_entity).ok().and_then(|main| extracted.light_index(main.id()))
@@ -79,16 +81,24 @@ pub(crate) fn prepare_fur_receivers(
             let world_from_view = to_pelt_mat4(&view.world_from_view.to_matrix());
             let directional = matches!(light, LightEntity::Directional { .. });
             let clip_from_view = to_pelt_mat4(&view.clip_from_view);
+            let position = world_from_view.w_axis.truncate();
             let (host_light, texel_world) = if directional {
                 // Orthographic: the view's width over its texels.
                 let width = 2.0 / clip_from_view.x_axis.x.abs().max(1e-12);
                 (HostLight::Directional(world_from_view.z_axis.truncate()), width / size as f32)
             } else {
                 // Perspective: a texel's span at the furs' distance from the light.
-                let position = world_from_view.w_axis.truncate();
                 let distance = furs.first().map_or(1.0, |fur| fur.bounds().0.distance(position));
                 let span = 2.0 * distance / clip_from_view.y_axis.y.abs().max(1e-12);
-                (HostLight::Positional(position), span / size as f32)
+                let host_light = match light {
+                    // The face is the axis the view looks along (Bevy's cube faces are
+                    // left-handed: its "+z" face looks along -Z).
+                    LightEntity::Point { .. } => {
+                        HostLight::CubeFace { position, face: axis_face(-world_from_view.z_axis.truncate()) }
+                    }
+                    _ => HostLight::Positional(position),
+                };
+                (host_light, span / size as f32)
             };
             candidates.push(Candidate {
                 light_index,
@@ -111,8 +121,9 @@ pub(crate) fn prepare_fur_receivers(
         };
         let mut chosen: Vec<Candidate> = Vec::new();
         for candidate in candidates {
+            let cube_face = matches!(candidate.view.light, HostLight::CubeFace { .. });
             match chosen.last_mut() {
-                Some(last) if last.light_index == candidate.light_index => {
+                Some(last) if last.light_index == candidate.light_index && !cube_face => {
                     if !holds_every_fur(last) {
                         *last = candidate;
                     }
@@ -120,14 +131,14 @@ pub(crate) fn prepare_fur_receivers(
                 _ => chosen.push(candidate),
             }
         }
-        let Some(size) = chosen.first().map(|c| c.size) else {
+        // Layers as large as the largest map (a point light's beside a sun's, of other sizes).
+        let Some(size) = chosen.iter().map(|c| c.size).max() else {
             if let Some(entry) = gpu.view_mut(camera) {
                 entry.fur_view_mut().set_host_shadows(None);
             }
             continue;
         };
-        chosen.retain(|c| c.size == size);
-        let layers = chosen.len() as u32;
+        let layers = (chosen.len() as u32).min(MAX_SHADOW_VIEWS);
         let stale = receivers.cameras.get(&camera).is_none_or(|r| {
             let (made_size, made_layers) = r.size_and_layers();
             made_size != size || made_layers < layers
@@ -155,6 +166,19 @@ pub(crate) fn prepare_fur_receivers(
         seen.insert(camera);
     }
     receivers.cameras.retain(|camera, _| seen.contains(camera));
+}
+
+/// The cube face (0 to 5: +X, -X, +Y, -Y, +Z, -Z) whose axis `d` lies closest to.
+fn axis_face(d: glam::Vec3) -> usize {
+    let a = d.abs();
+    let axis = if a.x >= a.y && a.x >= a.z {
+        0
+    } else if a.y >= a.z {
+        1
+    } else {
+        2
+    };
+    2 * axis + usize::from(d[axis] < 0.0)
 }
 
 /// Copies one camera's shadow maps after Bevy's shadow passes (and the fur's draws into them).

@@ -27,6 +27,7 @@ use pelt_render::{
 };
 
 use crate::convert::{to_pelt, to_pelt_mat4};
+use crate::environment::FurEnvironments;
 use crate::fur::{Fur, FurState};
 
 /// The light Pelt shades fur with (Kajiya-Kay strands) when the scene has no
@@ -40,8 +41,15 @@ use crate::fur::{Fur, FurState};
 /// more directional lights; up to 8 in all) reaches a coat shaded with the fur model
 /// (`[shading] model = "fur"`), in the same units; Kajiya-Kay takes the first. Bevy's ambient light
 /// (the camera's `AmbientLight`, else the `GlobalAmbientLight`) is the fur's too: colour times
-/// brightness times exposure, the radiance a white diffuse surface shows under it in Bevy.
-/// Environment maps do not reach the fur.
+/// brightness times exposure, the radiance a white diffuse surface shows under it in Bevy. A
+/// camera's `EnvironmentMapLight` adds to it, as in Bevy: its diffuse map (a cube map in
+/// `Rgba16Float`, `Rgba32Float` or `Rgb9e5Ufloat`) reduced to spherical harmonics once per image,
+/// turned by its `rotation`, times its `intensity` and the exposure; the fur model takes it by
+/// direction and colour, Kajiya-Kay its mean. The map's data must be on the CPU when it is read:
+/// kept in the main world (`RenderAssetUsages::default()`, as Bevy's KTX2 maps are), or, for an
+/// image kept for the render world only (Bevy's `EnvironmentMapLight::solid_color` and
+/// `hemispherical_gradient`), used by a camera in the frame it is added or changed. A map that
+/// cannot be read (handed over before, another format) is reported once and left out.
 #[derive(Resource, Clone, Copy, Debug, Default, PartialEq)]
 pub struct FurLight(pub Light);
 
@@ -391,6 +399,7 @@ pub(crate) fn prepare_furs(
         (With<ViewTarget>, With<Camera3d>),
     >,
     global_ambient: Option<Res<GlobalAmbientLight>>,
+    environments: Res<FurEnvironments>,
 ) {
     let device = device.wgpu_device();
     let queue: &wgpu::Queue = &queue;
@@ -439,13 +448,25 @@ pub(crate) fn prepare_furs(
             .map(|(colour, brightness)| linear(colour) * brightness)
             .filter(|radiance| radiance.is_finite());
         let ambient = bevy_ambient.map_or(glam::Vec3::splat(extracted.light.ambient), |radiance| radiance * exposure);
-        // Kajiya-Kay's ambient is one level: the radiance's luminance.
-        let ambient_level = ambient.dot(glam::Vec3::new(0.2126, 0.7152, 0.0722));
+        // Bevy adds the camera's environment map light to its ambient light.
+        let environment_map = environments.camera(entity).map(|map| map.sh.scaled(exposure));
+        let environment = match environment_map {
+            Some(map) => {
+                let uniform = Environment::uniform(ambient).sh;
+                let mut sh = map;
+                sh.coefficients.iter_mut().zip(uniform.coefficients).for_each(|(c, u)| *c += u);
+                Environment { sh }
+            }
+            None => Environment::uniform(ambient),
+        };
+        // Kajiya-Kay's ambient is one level: the environment's mean radiance's luminance.
+        let ambient_level = environment.sh.mean().dot(glam::Vec3::new(0.2126, 0.7152, 0.0722));
         let light = extracted
             .sun
             .map_or(Light { ambient: ambient_level, ..extracted.light }, |sun| sun.light(exposure, ambient_level));
         let mut data = ViewData::new(clip_from_world, world_from_view, &light);
-        // The fur model sums the lights it is given; Kajiya-Kay alone needs only the key light.
+        // The fur model sums the lights it is given; Kajiya-Kay alone needs only the key light
+        // and the ambient level.
         if !extracted.others.is_empty() || extracted.furs.iter().any(|f| f.shading.fur_model) {
             // The sun (if any) first: Kajiya-Kay keeps it as its key light.
             let sun = extracted.sun.as_ref().map(Sun::source);
@@ -454,7 +475,7 @@ pub(crate) fn prepare_furs(
                 .chain(extracted.others.iter().copied())
                 .map(|l| LightSource { intensity: l.intensity * exposure, ..l })
                 .collect();
-            data = data.with_lights(&lights, Some(Environment::uniform(ambient)));
+            data = data.with_lights(&lights, Some(environment));
         }
         entry.view.prepare(queue, &data);
         entry.data = Some(ViewData::new(self::clip_from_world(view), world_from_view, &light));

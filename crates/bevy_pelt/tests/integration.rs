@@ -4,6 +4,8 @@
 #[path = "common/mod.rs"]
 mod common;
 
+#[path = "environment.rs"]
+mod environment;
 #[path = "herd.rs"]
 mod herd;
 #[path = "interaction.rs"]

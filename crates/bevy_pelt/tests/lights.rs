@@ -1,6 +1,6 @@
 //! Bevy's lights on the fur: a point light, with no directional light in the scene, lights a coat
 //! shaded with the fur model; a plate between the sun and the fur shades it through Bevy's shadow
-//! maps, a sun's cascades and a spot light's map alike.
+//! maps, a sun's cascades, a spot light's map and a point light's cube alike.
 
 use bevy::camera::RenderTarget;
 use bevy::core_pipeline::tonemapping::Tonemapping;
@@ -170,4 +170,66 @@ fn a_plate_between_a_spot_light_and_the_fur_darkens_it() {
     let (darker, brighter) = shaded_by_the_plate("presets/long_fur_model.toml", true, true, "plate_spot");
     assert!(darker > 1000, "{darker} fur pixels darker under the casting plate");
     assert!(brighter < darker / 20, "{brighter} pixels brighter, {darker} darker");
+}
+
+/// Where a point light shines on the fur from, and the plate between them.
+#[derive(Clone, Copy, Debug)]
+enum Beside {
+    /// From +Z of the fur (Bevy's left-handed "+z" cube face, which looks along -Z).
+    Front,
+    /// From above (the "-y" face), with a sun of another shadow map size in the scene too.
+    AboveWithASun,
+}
+
+/// The skinless furred cube (fur model) seen from the front right, lit by a point light with
+/// shadows, a plate between them that casts into Bevy's cube map or does not.
+fn beside_a_point_light(beside: Beside, plate_casts: bool) -> image::RgbaImage {
+    let images = capture(1, |world, targets| {
+        let cube = cuboid(world, Vec3::ONE);
+        let fur = Fur::new(preset(world, "presets/long_fur_model.toml")).without_skin();
+        world.spawn((Mesh3d(cube), fur, Transform::from_rotation(Quat::from_rotation_y(0.5))));
+        let (light, plate_size, plate) = match beside {
+            Beside::Front => (Vec3::new(0.3, 0.5, 5.5), Vec3::new(3.0, 3.0, 0.1), Vec3::new(0.0, 0.0, 2.5)),
+            Beside::AboveWithASun => (Vec3::new(0.3, 6.0, 0.2), Vec3::new(3.0, 0.1, 3.0), Vec3::new(0.0, 2.5, 0.0)),
+        };
+        let plate_mesh = cuboid(world, plate_size);
+        let material = world.resource_mut::<Assets<StandardMaterial>>().add(StandardMaterial::from(Color::WHITE));
+        let mut plate = world.spawn((Mesh3d(plate_mesh), MeshMaterial3d(material), Transform::from_translation(plate)));
+        if !plate_casts {
+            plate.insert(NotShadowCaster);
+        }
+        world.spawn((
+            PointLight { intensity: 40_000_000.0, range: 30.0, shadow_maps_enabled: true, ..default() },
+            Transform::from_translation(light),
+        ));
+        if let Beside::AboveWithASun = beside {
+            // A dim sun from the camera's side, casting too: its cascades' maps are larger than
+            // the point light's cube faces.
+            world.spawn((
+                DirectionalLight { illuminance: 300.0, shadow_maps_enabled: true, ..default() },
+                Transform::from_xyz(3.0, 1.0, 3.0).looking_at(Vec3::ZERO, Vec3::Y),
+            ));
+        }
+        world.spawn((
+            Camera3d::default(),
+            RenderTarget::Image(targets[0].clone().into()),
+            Tonemapping::None,
+            Transform::from_xyz(3.0, 0.5, 3.0).looking_at(Vec3::ZERO, Vec3::Y),
+        ));
+    });
+    images.into_iter().next().unwrap()
+}
+
+#[test]
+fn a_plate_between_a_point_light_and_the_fur_darkens_it() {
+    for beside in [Beside::Front, Beside::AboveWithASun] {
+        let shaded = beside_a_point_light(beside, true);
+        let open = beside_a_point_light(beside, false);
+        save(&shaded, &format!("plate_point_{beside:?}_shaded"));
+        save(&open, &format!("plate_point_{beside:?}_open"));
+        let darker = shaded.pixels().zip(open.pixels()).filter(|(a, b)| luma(a) + 10.0 < luma(b)).count();
+        let brighter = shaded.pixels().zip(open.pixels()).filter(|(a, b)| luma(a) > luma(b) + 10.0).count();
+        assert!(darker > 1000, "{beside:?}: {darker} fur pixels darker behind the casting plate");
+        assert!(brighter < darker / 20, "{beside:?}: {brighter} pixels brighter, {darker} darker");
+    }
 }

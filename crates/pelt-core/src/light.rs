@@ -11,7 +11,7 @@
 mod environment;
 mod sh;
 
-pub use environment::{Environment, EnvironmentError, EnvironmentSpec};
+pub use environment::{CubeContent, Environment, EnvironmentError, EnvironmentSpec};
 pub use sh::{SH_BANDS, Sh9, sh9_basis};
 
 use glam::Vec3;

@@ -1,5 +1,6 @@
 //! Shadows a host draws itself ([`HostShadows`]): an engine's shadow maps (Bevy's directional
-//! cascades and spot lights), each copied into a layer of Pelt's maps with the view that drew it,
+//! cascades, spot lights and point lights' cube faces), each copied into a layer of Pelt's maps
+//! with the view that drew it,
 //! so the fur receives what the engine's meshes cast through the same lookups as its own maps
 //! (`shadows.wgsl`). The fur has no deep opacity map here: what it casts into the engine's maps
 //! shades the engine's meshes, and its own strands lie within the depth bias (the fur's length).
@@ -35,8 +36,17 @@ pub struct HostShadowView {
 pub enum HostLight {
     /// A sun: the unit vector toward it.
     Directional(Vec3),
-    /// A point or spot light at this position.
+    /// A point or spot light at this position, one view.
     Positional(Vec3),
+    /// One face of a point light's cube at `position`: `face` 0 to 5 is the view of the points
+    /// whose offset from the light is largest along +X, -X, +Y, -Y, +Z or -Z (world space). A
+    /// light's six faces take six layers in that order.
+    CubeFace {
+        /// The light's position.
+        position: Vec3,
+        /// Which face.
+        face: usize,
+    },
 }
 
 /// A host's shadow maps copied into Pelt's: make one per camera and renderer, each frame
@@ -53,12 +63,12 @@ pub struct HostShadows {
     receiver: wgpu::BindGroup,
     copy: wgpu::RenderPipeline,
     copy_layout: wgpu::BindGroupLayout,
-    /// This frame's sources, one a layer in use.
-    copies: Vec<wgpu::BindGroup>,
+    /// This frame's sources, one a layer in use (none: a cube face not given, cleared).
+    copies: Vec<Option<wgpu::BindGroup>>,
 }
 
 impl HostShadows {
-    /// Room for `layers` of the host's views, each `size` texels a side (the host's map size),
+    /// Room for `layers` of the host's views, each `size` texels a side (the largest host map's),
     /// for fur at most `fur_depth` long.
     ///
     /// # Errors
@@ -127,8 +137,10 @@ impl HostShadows {
     }
 
     /// Aims the layers at `views`, each with the host's depth map that view drew (`sources`:
-    /// one layer of depth, `size` texels a side, reverse-Z or not as its view says): those past
-    /// the layers, or of a light past the 8th, cast nothing. Returns how many are used.
+    /// one layer of depth, square, reverse-Z or not as its view says; one smaller than the
+    /// layers is read at its nearest texel). Each view takes a layer, a point light's faces six
+    /// in face order (the first face met reserves them; a face not given is unshadowed); views
+    /// past the layers, or of a light past the 8th, cast nothing. Returns how many layers are used.
     pub fn prepare(
         &mut self,
         (device, queue): (&wgpu::Device, &wgpu::Queue),
@@ -147,15 +159,22 @@ impl HostShadows {
         };
         // Clip z to `w - z`: a reverse-Z depth read as Pelt's forward one (`shadow_copy.wgsl`).
         let flip = Mat4::from_cols(Vec4::X, Vec4::Y, Vec4::new(0.0, 0.0, -1.0, 0.0), Vec4::new(0.0, 0.0, 1.0, 1.0));
-        self.copies.clear();
-        let usable = views.iter().zip(sources).filter(|(v, _)| v.light_index < MAX_LIGHTS);
-        for (view, source) in usable.take(self.layers as usize) {
-            let index = self.copies.len();
+        let (assigned, light_views, used) = assign_layers(views, (self.layers as usize).min(SHADOW_VIEWS));
+        uniform.light_views = light_views;
+        let mut layers: Vec<Option<wgpu::BindGroup>> = vec![None; used];
+        for ((view, source), layer) in views.iter().zip(sources).zip(assigned) {
+            let Some(layer) = layer else { continue };
             let light = match view.light {
                 HostLight::Directional(toward) => toward.normalize_or(Vec3::Y).extend(0.0),
-                HostLight::Positional(position) => position.extend(1.0),
+                HostLight::Positional(position) | HostLight::CubeFace { position, .. } => position.extend(1.0),
             };
-            uniform.views[index] = ShadowViewUniform {
+            if let HostLight::CubeFace { face, .. } = view.light {
+                // Every face knows the light, given or not: the lookups pick the face from it.
+                for index in layer - face..layer - face + 6 {
+                    uniform.views[index].light = light;
+                }
+            }
+            uniform.views[layer] = ShadowViewUniform {
                 light_clip_from_world: if view.reverse_z { flip * view.clip_from_world } else { view.clip_from_world },
                 light,
                 texel_world: view.texel_world,
@@ -169,18 +188,14 @@ impl HostShadows {
                 _padding_0: 0.0,
                 _padding_1: 0.0,
             };
-            // A light's first view in use: one view a light.
-            let slot = &mut uniform.light_views[view.light_index];
-            if slot[1] == 0 {
-                *slot = [index as u32, 1, 0, 0];
-            }
-            self.copies.push(device.create_bind_group(&wgpu::BindGroupDescriptor {
+            layers[layer] = Some(device.create_bind_group(&wgpu::BindGroupDescriptor {
                 label: Some("pelt host shadow copy"),
                 layout: &self.copy_layout,
                 entries: &[wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(source) }],
             }));
         }
         queue.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&uniform));
+        self.copies = layers;
         self.copies.len()
     }
 
@@ -200,9 +215,12 @@ impl HostShadows {
                 occlusion_query_set: None,
                 multiview_mask: None,
             });
-            pass.set_pipeline(&self.copy);
-            pass.set_bind_group(0, group, &[]);
-            pass.draw(0..3, 0..1);
+            // A face not given keeps the clear: the far plane, unshadowed.
+            if let Some(group) = group {
+                pass.set_pipeline(&self.copy);
+                pass.set_bind_group(0, group, &[]);
+                pass.draw(0..3, 0..1);
+            }
         }
     }
 
@@ -251,10 +269,77 @@ fn copy_pipeline(device: &wgpu::Device, layout: &wgpu::BindGroupLayout) -> wgpu:
     })
 }
 
+/// Where each of `views` goes among `capacity` layers: its layer (none: it casts nothing), each
+/// light's first layer and count (`Shadow::light_views`), and the layers used. A light's first
+/// view takes the next layer, or, a cube face, the next six (face `f` at the first plus `f`);
+/// more views of a one-view light take layers the lookups do not read.
+fn assign_layers(views: &[HostShadowView], capacity: usize) -> (Vec<Option<usize>>, [[u32; 4]; MAX_LIGHTS], usize) {
+    let mut light_views = [[0u32; 4]; MAX_LIGHTS];
+    let mut used = 0;
+    let assigned = views
+        .iter()
+        .map(|view| {
+            let slot = light_views.get_mut(view.light_index)?;
+            match view.light {
+                HostLight::CubeFace { face, .. } if face >= 6 => None,
+                HostLight::CubeFace { face, .. } => {
+                    if slot[1] == 0 && used + 6 <= capacity {
+                        *slot = [used as u32, 6, 0, 0];
+                        used += 6;
+                    }
+                    (slot[1] == 6).then_some(slot[0] as usize + face)
+                }
+                HostLight::Directional(_) | HostLight::Positional(_) => {
+                    if used >= capacity || slot[1] == 6 {
+                        return None;
+                    }
+                    if slot[1] == 0 {
+                        *slot = [used as u32, 1, 0, 0];
+                    }
+                    used += 1;
+                    Some(used - 1)
+                }
+            }
+        })
+        .collect();
+    (assigned, light_views, used)
+}
+
 impl FurView {
     /// Lights the draws through this view with a host's shadow maps ([`HostShadows`], copied
     /// with [`HostShadows::record_copy`] before this view's pass), or without shadows (`None`).
     pub fn set_host_shadows(&mut self, shadows: Option<&HostShadows>) {
         self.set_shadow_group(shadows.map(HostShadows::receiver));
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn view(light_index: usize, light: HostLight) -> HostShadowView {
+        HostShadowView { light_index, clip_from_world: Mat4::IDENTITY, reverse_z: true, texel_world: 0.01, light }
+    }
+
+    #[test]
+    fn a_point_lights_faces_take_six_layers_in_face_order() {
+        let sun = HostLight::Directional(Vec3::Y);
+        let face = |face| HostLight::CubeFace { position: Vec3::ONE, face };
+        // Two cascades of the sun, a cube's faces out of order, a spot light.
+        let mut views = vec![view(0, sun), view(0, sun)];
+        views.extend([5, 0, 3, 1, 2, 4].map(|f| view(1, face(f))));
+        views.push(view(2, HostLight::Positional(Vec3::Y)));
+        let (assigned, light_views, used) = assign_layers(&views, 12);
+        assert_eq!(assigned, [0, 1, 7, 2, 5, 3, 4, 6, 8].map(Some));
+        assert_eq!(&light_views[..3], &[[0, 1, 0, 0], [2, 6, 0, 0], [8, 1, 0, 0]]);
+        assert_eq!(used, 9);
+        // Too few layers for the cube: its faces cast nothing, the spot light still does.
+        let (assigned, light_views, used) = assign_layers(&views, 4);
+        assert_eq!(assigned, [Some(0), Some(1), None, None, None, None, None, None, Some(2)]);
+        assert_eq!(light_views[1], [0; 4]);
+        assert_eq!(used, 3);
+        // A face past the sixth, a light past the eighth: nothing.
+        let odd = [view(0, face(6)), view(MAX_LIGHTS, sun)];
+        assert_eq!(assign_layers(&odd, 12), (vec![None, None], [[0; 4]; MAX_LIGHTS], 0));
     }
 }

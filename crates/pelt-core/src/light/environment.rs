@@ -1,13 +1,17 @@
-//! The environment: light from every direction, given as a sky/ground colour pair or an
-//! equirectangular image (PNG, Radiance HDR or OpenEXR), reduced to spherical harmonics.
+//! The environment: light from every direction, given as a sky/ground colour pair, an
+//! equirectangular image (PNG, Radiance HDR or OpenEXR) or a cube map's six faces, reduced to
+//! spherical harmonics.
 //!
 //! An image's columns run once around +Y (column 0 toward -Z, turning from -Z toward +X as the
 //! column grows) and its rows from straight up (+Y, row 0) to straight down.
+//!
+//! A cube map's faces follow the cube textures of wgpu, Vulkan and Direct3D: see
+//! [`Environment::cube_direction`].
 
 use std::f32::consts::PI;
 use std::path::{Path, PathBuf};
 
-use glam::{Quat, Vec3};
+use glam::{Mat3, Quat, Vec3};
 
 use super::sh::{Sh9, sh9_basis};
 
@@ -66,6 +70,17 @@ pub enum EnvironmentError {
     },
 }
 
+/// What a cube map's texels hold.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum CubeContent {
+    /// The radiance arriving from each texel's direction.
+    Radiance,
+    /// The cosine-weighted mean of the radiance about each texel's direction (the irradiance of
+    /// a surface facing it, over pi): what prefiltered diffuse ("irradiance") maps hold, so that
+    /// a white Lambertian surface of normal `n` shows the texel toward `n`.
+    Irradiance,
+}
+
 /// The environment as the renderer takes it: its radiance in 9 SH coefficients per channel.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
 pub struct Environment {
@@ -119,6 +134,76 @@ impl Environment {
             });
         }
         Ok(Self { sh: project(texels, width, height) })
+    }
+
+    /// The direction (unit, in the cube's own frame) of the centre of texel `(column, row)` of
+    /// face `face` (0 to 5: +X, -X, +Y, -Y, +Z, -Z) of a cube map `size` texels square, each
+    /// face's rows from the top. With `s` and `t` the texel centre's column and row mapped to
+    /// -1..1, the faces look along `(1, -t, -s)`, `(-1, -t, s)`, `(s, 1, t)`, `(s, -1, -t)`,
+    /// `(s, -t, 1)` and `(-s, -t, -1)`: the layout of wgpu's, Vulkan's and Direct3D's cube
+    /// textures, whose lookup direction this is.
+    #[must_use]
+    pub fn cube_direction(face: usize, column: f32, row: f32, size: u32) -> Vec3 {
+        let s = 2.0 * (column + 0.5) / size as f32 - 1.0;
+        let t = 2.0 * (row + 0.5) / size as f32 - 1.0;
+        let d = match face {
+            0 => Vec3::new(1.0, -t, -s),
+            1 => Vec3::new(-1.0, -t, s),
+            2 => Vec3::new(s, 1.0, t),
+            3 => Vec3::new(s, -1.0, -t),
+            4 => Vec3::new(s, -t, 1.0),
+            _ => Vec3::new(-s, -t, -1.0),
+        };
+        d.normalize()
+    }
+
+    /// Projects a cube map's six faces of linear RGB (`6 * size * size` texels: face after face
+    /// in [`Environment::cube_direction`]'s order, each row after row from the top), each texel
+    /// weighted by its exact solid angle. The environment's directions are the cube's lookup
+    /// directions (see [`Environment::transformed`] to place it in a world). An
+    /// [`CubeContent::Irradiance`] map is turned back into the band-limited radiance whose
+    /// irradiance it holds (bands 1 and 2 scaled by 3/2 and 4, the inverse of the cosine lobe's
+    /// convolution).
+    ///
+    /// # Errors
+    /// [`EnvironmentError::Invalid`] for an empty cube, a size that does not match, or a texel
+    /// that is negative or not finite.
+    pub fn from_cube_faces(texels: &[Vec3], size: u32, content: CubeContent) -> Result<Self, EnvironmentError> {
+        let face_texels = size as usize * size as usize;
+        if size == 0 || texels.len() != 6 * face_texels {
+            return Err(EnvironmentError::Invalid {
+                key: "cube".into(),
+                problem: format!("{} texels for six faces of {size}x{size}", texels.len()),
+            });
+        }
+        if let Some(i) = texels.iter().position(|t| !t.is_finite() || t.min_element() < 0.0) {
+            return Err(EnvironmentError::Invalid {
+                key: "cube".into(),
+                problem: format!(
+                    "texel {} of face {} is negative or not finite ({})",
+                    i % face_texels,
+                    i / face_texels,
+                    texels[i]
+                ),
+            });
+        }
+        let mut coefficients = [Vec3::ZERO; 9];
+        for (i, &texel) in texels.iter().enumerate() {
+            let (face, within) = (i / face_texels, i % face_texels);
+            let (column, row) = ((within % size as usize) as f32, (within / size as usize) as f32);
+            let d = Self::cube_direction(face, column, row, size);
+            let weight = cube_texel_solid_angle(column, row, size);
+            for (c, b) in coefficients.iter_mut().zip(sh9_basis(d)) {
+                *c += texel * (b * weight);
+            }
+        }
+        if content == CubeContent::Irradiance {
+            // The cosine lobe's band weights over pi: 1, 2/3 and 1/4.
+            for (k, c) in coefficients.iter_mut().enumerate() {
+                *c *= [1.0, 1.5, 1.5, 1.5, 4.0, 4.0, 4.0, 4.0, 4.0][k];
+            }
+        }
+        Ok(Self { sh: Sh9 { coefficients } })
     }
 
     /// Loads an equirectangular image (PNG as sRGB, HDR and EXR as linear radiance).
@@ -183,18 +268,41 @@ impl Environment {
         if degrees == 0.0 {
             return *self;
         }
-        let turn = Quat::from_rotation_y(degrees.to_radians());
+        self.transformed(Mat3::from_quat(Quat::from_rotation_y(degrees.to_radians())))
+    }
+
+    /// This environment carried by the rotation or reflection `new_from_old` (an orthogonal
+    /// matrix): the radiance it held toward `d` now arrives from `new_from_old * d`. Its
+    /// band-limited radiance is reprojected; a matrix that is not orthogonal (or not finite)
+    /// leaves the environment as it is.
+    #[must_use]
+    pub fn transformed(&self, new_from_old: Mat3) -> Self {
+        let orthogonal = (new_from_old.transpose() * new_from_old).abs_diff_eq(Mat3::IDENTITY, 1e-3);
+        if !new_from_old.is_finite() || !orthogonal || new_from_old == Mat3::IDENTITY {
+            return *self;
+        }
+        let old_from_new = new_from_old.transpose();
         // Band 0-2 rotations are exact on a fine enough grid of directions.
         let (width, height) = (64u32, 32u32);
         let texels: Vec<Vec3> = (0..height)
             .flat_map(|row| (0..width).map(move |column| (column, row)))
             .map(|(column, row)| {
                 let d = Self::equirect_direction(column as f32, row as f32, width, height);
-                self.sh.radiance(turn.inverse() * d)
+                self.sh.radiance(old_from_new * d)
             })
             .collect();
         Self { sh: project(&texels, width, height) }
     }
+}
+
+/// The solid angle of a cube map's texel `(column, row)` on a face `size` texels square: the
+/// area on the unit sphere of its square on the face at distance 1, by the closed form of the
+/// integral of `(1 + x^2 + y^2)^(-3/2)` from a corner.
+fn cube_texel_solid_angle(column: f32, row: f32, size: u32) -> f32 {
+    let corner = |x: f32, y: f32| (x * y).atan2((x * x + y * y + 1.0).sqrt());
+    let edge = |i: f32| 2.0 * i / size as f32 - 1.0;
+    let (x0, x1, y0, y1) = (edge(column), edge(column + 1.0), edge(row), edge(row + 1.0));
+    corner(x1, y1) - corner(x0, y1) - corner(x1, y0) + corner(x0, y0)
 }
 
 /// The SH projection of an equirectangular image, each texel weighted by its exact solid angle.
