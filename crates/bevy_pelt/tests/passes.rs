@@ -3,6 +3,7 @@
 //! along its motion (read back from Bevy's motion-vector texture) and a still one converges to
 //! the picture drawn without TAA.
 
+use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::{Arc, Mutex};
 
 use bevy::anti_alias::taa::TemporalAntiAliasing;
@@ -13,10 +14,10 @@ use bevy::core_pipeline::tonemapping::Tonemapping;
 use bevy::core_pipeline::{Core3dSystems, schedule::Core3d};
 use bevy::light::NotShadowCaster;
 use bevy::prelude::*;
-use bevy::render::RenderApp;
 use bevy::render::render_resource::TextureFormat;
 use bevy::render::renderer::{RenderContext, RenderDevice, ViewQuery};
-use bevy_pelt::{Fur, FurState};
+use bevy::render::{Render, RenderApp, RenderSystems};
+use bevy_pelt::{Fur, FurGpuStats, FurState};
 
 use crate::common::{self, luma, test_assets as assets, update};
 use crate::render::{SIZE, capture, capture_now, cuboid, preset};
@@ -151,6 +152,15 @@ fn read_motion(app: &App) -> Vec<[f32; 2]> {
         .collect()
 }
 
+/// How many furs the render world's cameras drew last frame (`FurGpuStats::drawn`), readable from
+/// the main world.
+#[derive(Resource, Clone, Default)]
+struct DrawnCopy(Arc<AtomicUsize>);
+
+fn copy_drawn(stats: Res<FurGpuStats>, copy: Res<DrawnCopy>) {
+    copy.0.store(stats.drawn.load(Ordering::Relaxed), Ordering::Relaxed);
+}
+
 /// Moves the furred cube along +X each frame by this much while `Moving` is set.
 #[derive(Resource)]
 struct Moving(f32);
@@ -169,13 +179,16 @@ fn slide(moving: Res<Moving>, mut furred: Query<&mut Transform, With<Furred>>) {
 /// frames with the fur built.
 fn prepass_app(taa: bool, step: f32, frames: u32) -> (App, Handle<Image>) {
     let readback = MotionReadback::default();
+    let drawn = DrawnCopy::default();
     let mut app = common::headless_app_with(&assets(), false, None, |app| {
         app.sub_app_mut(RenderApp)
             .insert_resource(readback.clone())
-            .add_systems(Core3d, copy_motion_vectors.after(Core3dSystems::Prepass).before(Core3dSystems::MainPass));
+            .insert_resource(drawn.clone())
+            .add_systems(Core3d, copy_motion_vectors.after(Core3dSystems::Prepass).before(Core3dSystems::MainPass))
+            .add_systems(Render, copy_drawn.after(RenderSystems::Render).before(RenderSystems::Cleanup));
     });
-    // The same buffer slot, read from the main world.
-    app.insert_resource(readback);
+    // The same buffer slot and count, read from the main world.
+    app.insert_resource(readback).insert_resource(drawn);
     app.insert_resource(Moving(0.0)).add_systems(Update, slide);
     let world = app.world_mut();
     let mut image = Image::new_target_texture(SIZE, SIZE, TextureFormat::Rgba8UnormSrgb, None);
@@ -196,16 +209,18 @@ fn prepass_app(taa: bool, step: f32, frames: u32) -> (App, Handle<Image>) {
     if taa {
         camera.insert(TemporalAntiAliasing::default());
     }
-    // Built within two minutes however loaded the machine, then drawn still for a few frames, so
-    // the slide starts from fur already on the GPU (its previous frame's transform known).
+    // Built and drawn by the camera within two minutes however loaded the machine (the camera's
+    // first frame can come after the fur is built), then drawn still for a few frames, so the
+    // slide starts from fur already on the GPU (its previous frame's transform known).
     let deadline = std::time::Instant::now() + std::time::Duration::from_secs(120);
     loop {
         update(&mut app);
+        let drawn = app.world().resource::<DrawnCopy>().0.load(Ordering::Relaxed);
         let world = app.world_mut();
-        if world.query::<&FurState>().iter(world).count() == 1 {
+        if world.query::<&FurState>().iter(world).count() == 1 && drawn == 1 {
             break;
         }
-        assert!(std::time::Instant::now() < deadline, "the fur was not built in two minutes");
+        assert!(std::time::Instant::now() < deadline, "the fur was not built and drawn in two minutes");
         std::thread::sleep(std::time::Duration::from_millis(10));
     }
     for _ in 0..3 {
