@@ -320,3 +320,52 @@ pub(super) fn shadow_extent(
         _ => crate::herd::extent(structure, &herd.instances, &[time_secs, time_secs + SHADOW_SPAN_SECS]),
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::super::model::test_model;
+    use super::super::panel::{Changes, MeshChoice};
+
+    /// The herd follows the panel: a new shape or mesh makes the others anew from the edited fur,
+    /// a simulation change keeps their states; the first member stands where its instance does
+    /// and every member steps at its own phase.
+    #[test]
+    fn the_viewers_herd_follows_the_panels_edits() {
+        let fox = concat!(env!("CARGO_MANIFEST_DIR"), "/../../assets/meshes/Fox.glb");
+        let mut model = test_model(&[fox, "--herd", "4"]);
+        let herd = model.herd.as_ref().expect("a herd of 4");
+        assert_eq!((herd.len(), herd.followers().len()), (4, 3));
+        assert!(model.settings.draw.ground, "the herd stands on a ground");
+        let (time_secs, clip_secs) = model.simulate(0.1).unwrap();
+        model.stepper.advance_with_clip_at(time_secs, clip_secs).unwrap();
+        let herd = model.herd.as_mut().unwrap();
+        herd.advance(time_secs, clip_secs, &[1, 1, 1]).unwrap();
+        // The first member (the model's stepper) stands at its instance's place.
+        let first = herd.instances[0].position_at(time_secs);
+        let roots = model.stepper.simulation().roots();
+        let centre = roots.iter().fold(glam::Vec3::ZERO, |sum, r| sum + *r) / roots.len() as f32;
+        let size = model.structure.mesh.bounding_sphere().1;
+        assert!((centre - first).length() < 2.0 * size, "the first member stands {centre} from {first}");
+        let state = |model: &super::super::model::Model, k: usize| {
+            model.herd.as_ref().unwrap().followers()[k].simulation().positions().to_vec()
+        };
+        let before = state(&model, 0);
+        assert!(
+            model.herd.as_ref().unwrap().followers().iter().all(|s| s.simulation().positions().len() == before.len())
+        );
+        // A simulation change keeps the others' states; a new shape makes them anew at its size.
+        model.settings.preset.simulation.damping *= 0.5;
+        model.apply(Changes { simulation: true, ..Changes::default() }).unwrap();
+        assert_eq!(state(&model, 0), before, "a simulation change restarted the others");
+        model.settings.preset.layers = 8;
+        assert!(model.apply(Changes { structure: true, ..Changes::default() }).unwrap());
+        let expected = model.structure.positions.len();
+        assert!(model.herd.as_ref().unwrap().followers().iter().all(|s| s.simulation().positions().len() == expected));
+        assert_ne!(expected, before.len(), "the others kept the old shape");
+        // Another mesh: the others take it and the panel's clip (the file's clips are gone).
+        model.settings.mesh = MeshChoice::Builtin(pelt_core::Builtin::Sphere);
+        assert!(model.apply(Changes { mesh: true, ..Changes::default() }).unwrap());
+        let expected = model.structure.positions.len();
+        assert!(model.herd.as_ref().unwrap().followers().iter().all(|s| s.simulation().positions().len() == expected));
+    }
+}
