@@ -6,7 +6,7 @@
 use std::collections::{HashMap, HashSet};
 
 use bevy::ecs::prelude::*;
-use bevy::log::error;
+use bevy::log::{error, warn};
 use bevy::pbr::{LightEntity, ShadowView, ViewLightEntities};
 use bevy::render::camera::ExtractedCamera;
 use bevy::render::renderer::{RenderContext, ViewQuery};
@@ -24,6 +24,8 @@ pub(crate) struct FurReceivers {
     cameras: HashMap<Entity, HostShadows>,
     /// Cameras whose copies could not be made (reported once).
     failed: HashSet<Entity>,
+    /// Cameras whose lights want more views than the copies hold (reported once).
+    overflowing: HashSet<Entity>,
 }
 
 /// A shadow view of Bevy's that a fur's light reads: the light's index, the view, its depth.
@@ -139,6 +141,13 @@ pub(crate) fn prepare_fur_receivers(
             continue;
         };
         let layers = (chosen.len() as u32).min(MAX_SHADOW_VIEWS);
+        if chosen.len() > MAX_SHADOW_VIEWS as usize && receivers.overflowing.insert(camera) {
+            warn!(
+                "Pelt's fur receives at most {MAX_SHADOW_VIEWS} of Bevy's shadow views (a point light takes six); \
+                 {camera}'s lights have {}: the lights past them cast no shadow on the fur",
+                chosen.len()
+            );
+        }
         let stale = receivers.cameras.get(&camera).is_none_or(|r| {
             let (made_size, made_layers) = r.size_and_layers();
             made_size != size || made_layers < layers
