@@ -90,14 +90,7 @@ impl Herd {
     /// The box every member's fur stands in (walking on the spot, where they stand).
     #[must_use]
     pub fn extent(&self, structure: &FurStructure) -> (Vec3, Vec3) {
-        let (low, high) = structure.mesh.bounds();
-        let length = Vec3::splat(structure.lengths.iter().copied().fold(0.0, f32::max));
-        let corners = [low, high, Vec3::new(low.x, low.y, high.z), Vec3::new(high.x, high.y, low.z)];
-        self.instances.iter().flat_map(|i| corners.map(|c| i.world_from_model(0.0).transform_point3(c))).fold(
-            (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)),
-            // The fur's length about the sides and above; the ground under the feet.
-            |(lo, hi), p| (lo.min(p - length * Vec3::new(1.0, 0.0, 1.0)), hi.max(p + length)),
-        )
+        herd::extent(structure, &self.instances, &[0.0]).unwrap_or((Vec3::ZERO, Vec3::ZERO))
     }
 }
 

@@ -272,7 +272,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let herd_ground = (!instances.is_empty() && scene_ground.is_none()).then(pelt_core::sim::SceneGround::default);
     let shadow_args =
         crate::shadows::ShadowArgs { ground: args.shadows.ground || herd_ground.is_some(), ..args.shadows };
-    let extent = crate::herd::extent(&fur, &instances, &[0.0, f64::from(frames) / args.fps]);
+    let extent = pelt_core::sim::herd::extent(&fur, &instances, &[0.0, f64::from(frames) / args.fps]);
     let mut surroundings =
         shadow_args.surroundings((device, queue, &renderer), scene_ground, (&fur, &plain), extent.as_ref())?;
     surroundings.fit_to_frame(device, &renderer, (width, height)).context("fitting the shadow maps to the picture")?;

@@ -153,17 +153,24 @@ fn scripted_touch(kernel: &str) {
     assert!(panel < 0.5, "the panel looks the same: {panel:.2}");
 }
 
+/// Runs `pelt view --builtin box ARGS` without a display: it must fail before opening a window;
+/// returns its stderr.
+fn refused_without_a_window(args: &[&str]) -> String {
+    let output = Command::new(env!("CARGO_BIN_EXE_pelt"))
+        .args(["view", "--builtin", "box"])
+        .args(args)
+        .env_remove("DISPLAY")
+        .env_remove("WAYLAND_DISPLAY")
+        .output()
+        .unwrap();
+    assert!(!output.status.success(), "{args:?} was not refused");
+    String::from_utf8_lossy(&output.stderr).into_owned()
+}
+
 #[test]
 fn a_missing_preset_or_script_is_named_before_any_window_opens() {
     for (flag, file) in [("--preset", "no-such-preset.toml"), ("--script", "no-such-scene.toml")] {
-        let output = Command::new(env!("CARGO_BIN_EXE_pelt"))
-            .args(["view", "--builtin", "box", flag, file])
-            .env_remove("DISPLAY")
-            .env_remove("WAYLAND_DISPLAY")
-            .output()
-            .unwrap();
-        assert!(!output.status.success());
-        let stderr = String::from_utf8_lossy(&output.stderr);
+        let stderr = refused_without_a_window(&[flag, file]);
         assert!(stderr.contains(file), "{flag}: the error names the file: {stderr}");
     }
 }
@@ -268,15 +275,7 @@ fn a_bad_herd_is_refused_before_any_window_opens() {
         (&["--herd", "0"][..], "--herd 0: a herd needs at least one instance"),
         (&["--herd", "3", "--sim", "gpu"][..], "a herd is simulated on the CPU"),
     ] {
-        let output = Command::new(env!("CARGO_BIN_EXE_pelt"))
-            .args(["view", "--builtin", "box"])
-            .args(args)
-            .env_remove("DISPLAY")
-            .env_remove("WAYLAND_DISPLAY")
-            .output()
-            .unwrap();
-        assert!(!output.status.success());
-        let stderr = String::from_utf8_lossy(&output.stderr);
+        let stderr = refused_without_a_window(args);
         assert!(stderr.contains(says), "{args:?}: {stderr}");
     }
 }

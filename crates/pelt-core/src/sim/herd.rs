@@ -161,6 +161,28 @@ pub fn resolve_clips(
         .collect()
 }
 
+/// The box `instances` of `fur` cover at the times `secs` (every member's mesh at each, with the
+/// fur's longest strand about its sides and above; the ground under its feet); `None` for no
+/// instances. Hosts fit a herd's shadow maps, ground and camera to it.
+#[must_use]
+pub fn extent(fur: &crate::FurStructure, instances: &[HerdInstance], secs: &[f64]) -> Option<(Vec3, Vec3)> {
+    if instances.is_empty() {
+        return None;
+    }
+    let (low, high) = fur.mesh.bounds();
+    let length = Vec3::splat(fur.lengths.iter().copied().fold(0.0, f32::max));
+    let corners = [low, high, Vec3::new(low.x, low.y, high.z), Vec3::new(high.x, high.y, low.z)];
+    Some(instances.iter().flat_map(|i| secs.iter().map(|&t| i.world_from_model(t))).fold(
+        (Vec3::splat(f32::MAX), Vec3::splat(f32::MIN)),
+        |(lo, hi), world| {
+            corners
+                .iter()
+                .map(|c| world.transform_point3(*c))
+                .fold((lo, hi), |(lo, hi), p| (lo.min(p - length * Vec3::new(1.0, 0.0, 1.0)), hi.max(p + length)))
+        },
+    ))
+}
+
 /// Most instances [`scatter`] places.
 pub const MAX_SCATTERED: usize = 100_000;
 

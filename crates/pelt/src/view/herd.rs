@@ -314,10 +314,10 @@ pub(super) fn shadow_extent(
     time_secs: f64,
     made: Option<(Vec3, Vec3)>,
 ) -> Option<(Vec3, Vec3)> {
-    let (low, high) = crate::herd::extent(structure, &herd.instances, &[time_secs])?;
+    let (low, high) = pelt_core::sim::herd::extent(structure, &herd.instances, &[time_secs])?;
     match made {
         Some((made_low, made_high)) if made_low.cmple(low).all() && high.cmple(made_high).all() => made,
-        _ => crate::herd::extent(structure, &herd.instances, &[time_secs, time_secs + SHADOW_SPAN_SECS]),
+        _ => pelt_core::sim::herd::extent(structure, &herd.instances, &[time_secs, time_secs + SHADOW_SPAN_SECS]),
     }
 }
 

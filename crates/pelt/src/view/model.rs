@@ -288,7 +288,7 @@ impl Model {
     pub(super) fn frame(&mut self, aspect: f32) {
         let now = self.stepper.simulation().time_secs();
         if let Some((low, high)) =
-            self.herd.as_ref().and_then(|h| crate::herd::extent(&self.structure, &h.instances, &[now]))
+            self.herd.as_ref().and_then(|h| pelt_core::sim::herd::extent(&self.structure, &h.instances, &[now]))
         {
             self.camera.frame(0.5 * (low + high), 0.5 * (high - low).length(), aspect);
             return;
