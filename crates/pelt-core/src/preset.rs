@@ -134,6 +134,9 @@ pub struct LodParams {
     /// the shells and fins fade out and the skin takes the coat's mean colour: a far member of a
     /// herd costs its skin alone. On by default (with `enabled`).
     pub coat_fade: bool,
+    /// Where strands are two pixels long or less on screen, the fins fade out (gone at one
+    /// pixel), and with them their silhouette pass and draw. On by default (with `enabled`).
+    pub fin_fade: bool,
 }
 
 impl Default for LodParams {
@@ -145,6 +148,7 @@ impl Default for LodParams {
             facing_start: 0.4,
             facing_full: 0.7,
             coat_fade: true,
+            fin_fade: true,
         }
     }
 }

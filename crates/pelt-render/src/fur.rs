@@ -433,6 +433,13 @@ impl GpuFur {
     pub fn drawn_shells(&self) -> u32 {
         self.level.get().shells(self.geometry.shape.layers)
     }
+
+    /// Whether the level of the last [`GpuFur::prepare`] draws fins (and records their silhouette
+    /// pass): not once the coat or the fins have faded out ([`crate::FurLevel::fins`]).
+    #[must_use]
+    pub fn fins_drawn(&self) -> bool {
+        self.level.fins_shown()
+    }
 }
 
 fn state_count(states: FurStates) -> usize {

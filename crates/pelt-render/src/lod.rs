@@ -32,11 +32,15 @@ pub struct FurLevel {
     /// the skin takes the coat's mean colour; 0 draws the skin alone in that colour (a fur too
     /// small on screen for its strands, say a far member of a herd).
     pub coat: f32,
+    /// `0..=1`: how much of the fins show, on top of [`FurLevel::coat`]. A fin is as tall as a
+    /// strand is long on screen; at a pixel or two it adds little to the shells' silhouette but
+    /// costs its silhouette pass and draw, so far furs fade their fins first. 0 skips both.
+    pub fins: f32,
 }
 
 impl FurLevel {
     /// Every layer and every fin segment.
-    pub const FULL: Self = Self { stride: 1, blend: 0.0, facing: None, coat: 1.0 };
+    pub const FULL: Self = Self { stride: 1, blend: 0.0, facing: None, coat: 1.0, fins: 1.0 };
 
     /// The level with `stride` made a power of two no coarser than `layers` allow and `blend`
     /// clamped to `0..1` (0 at the coarsest stride).
@@ -48,7 +52,8 @@ impl FurLevel {
         // Nothing to fade toward at the coarsest stride.
         let facing = self.facing.filter(|&[start, full]| stride < max_stride && valid_facing(start, full));
         let coat = if self.coat.is_finite() { self.coat.clamp(0.0, 1.0) } else { 1.0 };
-        Self { stride, blend, facing, coat }
+        let fins = if self.fins.is_finite() { self.fins.clamp(0.0, 1.0) } else { 1.0 };
+        Self { stride, blend, facing, coat, fins }
     }
 
     /// How often a fur drawn at this level needs its simulation stepped
@@ -82,6 +87,11 @@ impl FurLevel {
         }
         if level.facing.is_some() {
             text += &format!(", to {} facing the eye", layers / (2 * level.stride).max(1));
+        }
+        if level.fins <= 0.0 {
+            text += ", no fins";
+        } else if level.fins < 1.0 {
+            text += &format!(", the fins at {:.0}%", 100.0 * level.fins);
         }
         if level.coat <= 0.0 {
             text = "the skin alone in the coat's colour".to_owned();
@@ -125,6 +135,9 @@ pub struct LodSettings {
     /// Strand pixels `[gone, full]` over which the coat fades to the skin alone
     /// ([`FurLevel::coat`]), `0 <= gone < full`; `None`: the coat always drawn.
     pub coat_fade: Option<[f32; 2]>,
+    /// Strand pixels `[gone, full]` over which the fins fade out ([`FurLevel::fins`]),
+    /// `0 <= gone < full`; `None`: the fins drawn wherever the coat is.
+    pub fin_fade: Option<[f32; 2]>,
 }
 
 impl Default for LodSettings {
@@ -134,17 +147,23 @@ impl Default for LodSettings {
             pixels_per_shell: 1.0,
             facing: Some(Self::DEFAULT_FACING),
             coat_fade: Some(Self::DEFAULT_COAT_FADE),
+            fin_fade: Some(Self::DEFAULT_FIN_FADE),
         }
     }
 }
 
 impl LodSettings {
     /// No level of detail.
-    pub const OFF: Self = Self { enabled: false, pixels_per_shell: 1.0, facing: None, coat_fade: None };
+    pub const OFF: Self = Self { enabled: false, pixels_per_shell: 1.0, facing: None, coat_fade: None, fin_fade: None };
 
     /// The default coat fade ([`LodSettings::coat_fade`]): the shells and fins fade out as a
     /// strand shrinks from 0.6 to 0.3 pixels long, where a strand no longer shows as one.
     pub const DEFAULT_COAT_FADE: [f32; 2] = [0.3, 0.6];
+
+    /// The default fin fade ([`LodSettings::fin_fade`]): the fins fade out as a strand shrinks
+    /// from 2 to 1 pixel long, where a fin is a fringe a pixel or two wide that the outer shells
+    /// already cover (BENCHMARKS.md: a herd of 1,000 Foxes draws in well under its time with fins).
+    pub const DEFAULT_FIN_FADE: [f32; 2] = [1.0, 2.0];
 
     /// The default view-angle range ([`FurLevel::facing`]): layers start fading where the
     /// surface is within about 66 degrees of facing the eye and are gone within about 46
@@ -157,14 +176,9 @@ impl LodSettings {
         if !self.enabled || layers < 2 || !strand_pixels.is_finite() {
             return FurLevel::FULL;
         }
-        let coat = match self.coat_fade {
-            Some([gone, full]) if gone.is_finite() && full.is_finite() && 0.0 <= gone && gone < full => {
-                let t = ((strand_pixels - gone) / (full - gone)).clamp(0.0, 1.0);
-                t * t * (3.0 - 2.0 * t)
-            }
-            _ => 1.0,
-        };
-        let by_view = FurLevel { facing: self.facing, coat, ..FurLevel::FULL };
+        let coat = fade(self.coat_fade, strand_pixels);
+        let fins = fade(self.fin_fade, strand_pixels);
+        let by_view = FurLevel { facing: self.facing, coat, fins, ..FurLevel::FULL };
         let wanted = (strand_pixels / self.pixels_per_shell.max(1e-3)).max(1e-3);
         let stride = f64::from(layers) / f64::from(wanted);
         if stride <= 1.0 {
@@ -173,6 +187,17 @@ impl LodSettings {
         let octave = stride.log2();
         let whole = octave.floor();
         FurLevel { stride: 1 << (whole as u32).min(16), blend: (octave - whole) as f32, ..by_view }.clamped(layers)
+    }
+}
+
+/// A smooth step from 0 at `gone` strand pixels to 1 at `full`; 1 without a (valid) range.
+fn fade(range: Option<[f32; 2]>, strand_pixels: f32) -> f32 {
+    match range {
+        Some([gone, full]) if gone.is_finite() && full.is_finite() && 0.0 <= gone && gone < full => {
+            let t = ((strand_pixels - gone) / (full - gone)).clamp(0.0, 1.0);
+            t * t * (3.0 - 2.0 * t)
+        }
+        _ => 1.0,
     }
 }
 
@@ -208,6 +233,8 @@ pub(crate) struct PreparedLevel {
     by_view: std::sync::atomic::AtomicBool,
     /// Whether any of the coat shows ([`FurLevel::coat`] above 0).
     coat_shown: std::sync::atomic::AtomicBool,
+    /// Whether any of the fins show (the coat and [`FurLevel::fins`] above 0).
+    fins_shown: std::sync::atomic::AtomicBool,
 }
 
 impl PreparedLevel {
@@ -216,6 +243,7 @@ impl PreparedLevel {
             stride: std::sync::atomic::AtomicU32::new(1),
             by_view: std::sync::atomic::AtomicBool::new(false),
             coat_shown: std::sync::atomic::AtomicBool::new(true),
+            fins_shown: std::sync::atomic::AtomicBool::new(true),
         }
     }
 
@@ -224,6 +252,12 @@ impl PreparedLevel {
         self.stride.store(level.stride, std::sync::atomic::Ordering::Relaxed);
         self.by_view.store(level.facing.is_some(), std::sync::atomic::Ordering::Relaxed);
         self.coat_shown.store(level.coat > 0.0, std::sync::atomic::Ordering::Relaxed);
+        self.fins_shown.store(level.coat > 0.0 && level.fins > 0.0, std::sync::atomic::Ordering::Relaxed);
+    }
+
+    /// Whether any of the fins show: without, their silhouette pass and draw are skipped.
+    pub fn fins_shown(&self) -> bool {
+        self.fins_shown.load(std::sync::atomic::Ordering::Relaxed)
     }
 
     /// Whether any of the coat shows: without, the shells, fins and their passes are skipped.
@@ -318,23 +352,23 @@ mod tests {
     #[test]
     fn odd_layer_counts_and_bad_input() {
         assert_eq!(
-            FurLevel { stride: 3, blend: 2.0, facing: None, coat: 1.0 }.clamped(16),
-            FurLevel { stride: 4, blend: 1.0, facing: None, coat: 1.0 }
+            FurLevel { stride: 3, blend: 2.0, facing: None, coat: 1.0, fins: 1.0 }.clamped(16),
+            FurLevel { stride: 4, blend: 1.0, facing: None, coat: 1.0, fins: 1.0 }
         );
         // 12 layers keep at least two shells: stride 4 is the coarsest, with nothing to blend to.
         assert_eq!(
-            FurLevel { stride: 3, blend: 0.5, facing: None, coat: 1.0 }.clamped(12),
-            FurLevel { stride: 4, blend: 0.0, facing: None, coat: 1.0 }
+            FurLevel { stride: 3, blend: 0.5, facing: None, coat: 1.0, fins: 1.0 }.clamped(12),
+            FurLevel { stride: 4, blend: 0.0, facing: None, coat: 1.0, fins: 1.0 }
         );
         assert_eq!(
-            FurLevel { stride: 64, blend: 0.5, facing: None, coat: 1.0 }.clamped(12),
-            FurLevel { stride: 4, blend: 0.0, facing: None, coat: 1.0 }
+            FurLevel { stride: 64, blend: 0.5, facing: None, coat: 1.0, fins: 1.0 }.clamped(12),
+            FurLevel { stride: 4, blend: 0.0, facing: None, coat: 1.0, fins: 1.0 }
         );
         assert_eq!(
-            FurLevel { stride: 0, blend: f32::NAN, facing: None, coat: 1.0 }.clamped(12),
-            FurLevel { stride: 1, blend: 0.0, facing: None, coat: 1.0 }
+            FurLevel { stride: 0, blend: f32::NAN, facing: None, coat: 1.0, fins: 1.0 }.clamped(12),
+            FurLevel { stride: 1, blend: 0.0, facing: None, coat: 1.0, fins: 1.0 }
         );
-        assert_eq!(FurLevel { stride: 4, blend: 0.0, facing: None, coat: 1.0 }.shells(12), 3);
+        assert_eq!(FurLevel { stride: 4, blend: 0.0, facing: None, coat: 1.0, fins: 1.0 }.shells(12), 3);
         assert_eq!(LodSettings::default().level(16, f32::NAN), FurLevel::FULL);
         assert!(strand_pixels(0.1, 0.0, 0.8, 720).is_finite());
     }
@@ -361,12 +395,42 @@ mod tests {
     }
 
     #[test]
+    fn the_fins_fade_out_continuously_before_the_coat_and_then_skip_their_passes() {
+        let lod = LodSettings::default();
+        let [gone, full] = LodSettings::DEFAULT_FIN_FADE;
+        assert!(gone > LodSettings::DEFAULT_COAT_FADE[1], "the fins go while the coat still shows");
+        assert_eq!(lod.level(16, full).fins, 1.0);
+        assert_eq!(lod.level(16, gone).fins, 0.0);
+        assert_eq!(lod.level(16, gone).coat, 1.0);
+        assert!(lod.level(16, gone).describe(16).ends_with(", no fins"), "{}", lod.level(16, gone).describe(16));
+        let mut last = 1.0_f32;
+        for step in 0..200 {
+            let pixels = full * 1.2 * 0.99_f32.powi(step);
+            let fins = lod.level(16, pixels).fins;
+            assert!(fins <= last && last - fins < 0.05, "a jump at {pixels} px: {last} -> {fins}");
+            last = fins;
+        }
+        assert_eq!(last, 0.0);
+        assert_eq!(LodSettings { fin_fade: None, ..lod }.level(16, 0.5).fins, 1.0);
+        assert_eq!(FurLevel { fins: f32::INFINITY, ..FurLevel::FULL }.clamped(16).fins, 1.0);
+        // What the renderer reads back: the fins' pass and draw go with the fins or the coat.
+        let prepared = PreparedLevel::new();
+        assert!(prepared.fins_shown());
+        prepared.set(lod.level(16, 0.5 * (gone + full)), 16);
+        assert!(prepared.fins_shown() && prepared.coat_shown());
+        prepared.set(lod.level(16, gone), 16);
+        assert!(!prepared.fins_shown() && prepared.coat_shown());
+        prepared.set(FurLevel { coat: 0.0, ..FurLevel::FULL }, 16);
+        assert!(!prepared.fins_shown());
+    }
+
+    #[test]
     fn drawn_layers_end_at_the_tips() {
         let prepared = PreparedLevel::new();
         assert_eq!(prepared.shell_layers(4).collect::<Vec<_>>(), [1, 2, 3, 4]);
-        prepared.set(FurLevel { stride: 4, blend: 0.3, facing: None, coat: 1.0 }, 12);
+        prepared.set(FurLevel { stride: 4, blend: 0.3, facing: None, coat: 1.0, fins: 1.0 }, 12);
         assert_eq!(prepared.shell_layers(12).collect::<Vec<_>>(), [4, 8, 12]);
-        prepared.set(FurLevel { stride: 4, blend: 0.0, facing: None, coat: 1.0 }, 10);
+        prepared.set(FurLevel { stride: 4, blend: 0.0, facing: None, coat: 1.0, fins: 1.0 }, 10);
         assert_eq!(prepared.shell_layers(10).collect::<Vec<_>>(), [6, 10]);
     }
 

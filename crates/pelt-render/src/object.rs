@@ -274,7 +274,7 @@ impl ObjectShape {
             fur_cuticle_tilt: look.shading.cuticle_tilt,
             fur_medulla: look.shading.medulla.clamp(0.0, 1.0),
             coat_fade: level.coat,
-            _padding_2: [0; 1],
+            fin_fade: level.fins,
             tint: if look.tint.is_finite() { look.tint.max(Vec3::ZERO) } else { Vec3::ONE },
             _padding_3: 0.0,
         }

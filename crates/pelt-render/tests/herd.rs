@@ -159,3 +159,41 @@ fn coat_fade(pelts_look: bool) {
         assert!((coat[channel] - skin[channel]).abs() < bound, "coat {coat:?} against skin {skin:?}");
     }
 }
+
+/// A far fur's fins go before its coat: drawn alone (the silhouette pass's fins, as Pelt's
+/// commands draw them), they fade as `FurLevel::fins` falls from 1 to 0 in twenty frames with no
+/// frame's change above a fifth of the whole, and at 0 nothing of them is drawn. With the whole
+/// fur, full fins draw the bytes the fur always drew.
+#[test]
+fn a_far_furs_fins_fade_out_without_a_jump() {
+    let rig = Rig::new(96, 96);
+    let structure = builtin_fur(Builtin::Bunny, 8);
+    let textures = strand_textures(32, 8, BROWN_ROOT, BROWN_TIP);
+    let fur = rig.fur(&structure, &textures);
+    let camera = framed(&structure, 1.0);
+    let base = common::paper_frame();
+    let fins_only = pelt_render::FurDrawSettings { skin: false, shells: false, ..settings() };
+    let at = |fins: f32, settings: &pelt_render::FurDrawSettings| {
+        fur.prepare(
+            rig.queue(),
+            &FurFrame { level: pelt_render::FurLevel { fins, ..pelt_render::FurLevel::FULL }, ..base },
+        );
+        rig.render_silhouette(&fur, &camera, settings)
+    };
+    fur.prepare(rig.queue(), &base);
+    assert_eq!(at(1.0, &settings()), rig.render_silhouette(&fur, &camera, &settings()), "full fins: the fur as always");
+    let frames: Vec<image::RgbaImage> = (0..=20).map(|k| at(1.0 - k as f32 / 20.0, &fins_only)).collect();
+    let background = rig.background();
+    let covered = |image: &image::RgbaImage| image.pixels().filter(|p| common::covered(p, background)).count();
+    assert!(covered(&frames[0]) > 300, "{} fin pixels at full fins", covered(&frames[0]));
+    assert_eq!(covered(&frames[20]), 0, "no fins drawn at 0");
+    let mean_difference = |a: &image::RgbaImage, b: &image::RgbaImage| {
+        let sum: u64 = a.pixels().zip(b.pixels()).map(|(p, q)| u64::from(common::pixel_difference(p, q))).sum();
+        sum as f64 / f64::from(a.width() * a.height())
+    };
+    let whole = mean_difference(&frames[0], &frames[20]);
+    let steps: Vec<f64> = frames.windows(2).map(|w| mean_difference(&w[0], &w[1])).collect();
+    let largest = steps.iter().copied().fold(0.0, f64::max);
+    eprintln!("fin fade: {} fin pixels, whole change {whole:.3}, largest step {largest:.3}", covered(&frames[0]));
+    assert!(largest < 0.2 * whole, "a jump of {largest} in a change of {whole}: {steps:?}");
+}

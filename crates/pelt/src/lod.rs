@@ -12,6 +12,7 @@ pub fn settings(params: &LodParams, no_lod: bool) -> LodSettings {
         pixels_per_shell: params.pixels_per_shell,
         facing: params.view_angle.then_some([params.facing_start, params.facing_full]),
         coat_fade: params.coat_fade.then_some(LodSettings::DEFAULT_COAT_FADE),
+        fin_fade: params.fin_fade.then_some(LodSettings::DEFAULT_FIN_FADE),
     }
 }
 

@@ -267,7 +267,7 @@ impl FurRenderer {
         }
         // Fins after the shells: at the silhouette, where fins matter, they stand outside the
         // shells and must not be covered by the faded outer layers.
-        if settings.fins {
+        if settings.fins && fur.prepared_level().fins_shown() {
             match fur.fin_list() {
                 Some(list) if settings.silhouette_fins => {
                     pass.set_pipeline(&coat.silhouette_fins[which]);
@@ -294,7 +294,7 @@ impl FurRenderer {
         if !fur.prepared_level().coat_shown() {
             return;
         }
-        if let Some(list) = fur.fin_list() {
+        if let Some(list) = fur.fin_list().filter(|_| fur.prepared_level().fins_shown()) {
             list.record(encoder, &self.listing.silhouette, view.bind_group(), fur.geometry().bind_group());
         }
         if let Some(list) = fur.shell_list()

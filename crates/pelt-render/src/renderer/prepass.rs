@@ -236,8 +236,10 @@ impl FurPrepass {
         }
         pass.set_pipeline(&self.shells[walk]);
         geometry.draw_shells(pass, 0..fur.drawn_shells());
-        pass.set_pipeline(&self.fins);
-        geometry.draw_fins(pass, fur.drawn_shells());
+        if fur.prepared_level().fins_shown() {
+            pass.set_pipeline(&self.fins);
+            geometry.draw_fins(pass, fur.drawn_shells());
+        }
     }
 }
 

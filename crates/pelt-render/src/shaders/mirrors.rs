@@ -61,8 +61,7 @@ pub(crate) struct ObjectUniform {
     pub fur_cuticle_tilt: f32,
     pub fur_medulla: f32,
     pub coat_fade: f32,
-    /// WGSL aligns the vec3 below to 16 bytes.
-    pub _padding_2: [u32; 1],
+    pub fin_fade: f32,
     pub tint: Vec3,
     /// WGSL rounds the struct up to its 16-byte alignment.
     pub _padding_3: f32,
@@ -340,7 +339,7 @@ mod tests {
             fur_cuticle_tilt,
             fur_medulla,
             coat_fade,
-            _padding_2,
+            fin_fade,
             tint,
             _padding_3
         });

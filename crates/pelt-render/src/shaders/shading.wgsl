@@ -90,6 +90,8 @@ struct Object {
     fur_medulla: f32,
     // How much of the coat shows (`FurLevel::coat`): the shells' and fins' opacity.
     coat_fade: f32,
+    // How much of the fins show (`FurLevel::fins`): their opacity, on top of the coat's.
+    fin_fade: f32,
     // Multiplies the strands' albedo (`FurLook::tint`; the skin's colour is tinted on the CPU).
     tint: vec3<f32>,
 }
@@ -710,7 +712,7 @@ fn fin_lighting_height(height: f32) -> f32 {
 // solid band, most of all at the roots where the shells already cover.
 fn fin_colour(texel: vec4<f32>, lighting_fade: vec4<f32>, uvs: vec4<f32>, tint: vec3<f32>, groom_alpha: f32) -> vec4<f32> {
     let height = uvs.y;
-    let alpha = texel.a * lighting_fade.w * mix(0.15, 0.6, height) * groom_alpha * object.coat_fade;
+    let alpha = texel.a * lighting_fade.w * mix(0.15, 0.6, height) * groom_alpha * object.coat_fade * object.fin_fade;
     let albedo = texel.rgb * surface_tint(uvs.zw) * tint;
     let lit_height = fin_lighting_height(height);
     let lighting = vec4<f32>(lighting_fade.xyz, occlusion(lit_height));

@@ -455,8 +455,8 @@ impl Bench {
         let faces = fur.mesh.triangles.len() as u64;
         let shells = u64::from(unified.drawn_shells());
         let fin_edges = match unified.silhouette_draw() {
-            Some(draw) => u64::from(self.read_u32(draw, 1)?),
-            None => 0,
+            Some(draw) if unified.fins_drawn() => u64::from(self.read_u32(draw, 1)?),
+            _ => 0,
         };
         let thinned = u64::from(unified.shells_thinned());
         let listed = match unified.view_lod_count() {
