@@ -122,13 +122,16 @@ fn still() -> SimParams {
     SimParams { inertia: 0.0, ..SimParams::default() }
 }
 
+/// Below the water the coat is darker than dry (0.94 of its luminance in the paper's look) and
+/// than the same water with `[wet] darkening` off (0.86): its clumps cover about as densely as
+/// the dry coat, so the darkening, not bare skin, darkens it.
 #[test]
 fn a_water_level_darkens_the_fur_below_it_and_leaves_it_above_the_band_as_it_was() {
     water_level(common::paper_look());
 }
 
 /// The same with the fur model (Pelt's look): water sharpens its highlight without brightening
-/// the coat (0.76 of the dry luminance here). Tried once without the coat's scattering term:
+/// the coat (0.81 of the dry luminance here, 0.82 of the undarkened wet coat's). Tried once without the coat's scattering term:
 /// with the narrower wet lobe's energy kept and no water film the soaked fur was 1.12 as light
 /// as the dry; keeping the lobe's peak without the film, 1.00.
 #[test]
@@ -151,6 +154,13 @@ fn water_level(look: pelt_render::FurLook) {
     let mut wet_stepper = scenery.stepper(&still(), &wet, Some(&script));
     let soaked = scenery.frame(&mut wet_driver, &mut wet_stepper, 0.5, &settings);
     assert!(!wet_stepper.wetness().is_dry());
+    // The same water with the look's darkening off: what the wet coat's clumps and highlight do
+    // alone.
+    let mut undarkened_driver = scenery.driver(&still(), KernelChoice::Cpu);
+    undarkened_driver.set_look(look);
+    let undarkened_wet = WetParams { darkening: 0.0, ..wet };
+    let mut undarkened_stepper = scenery.stepper(&still(), &undarkened_wet, Some(&script));
+    let undarkened = scenery.frame(&mut undarkened_driver, &mut undarkened_stepper, 0.5, &settings);
 
     // Rows wholly above the band (its top plus the longest strand) and wholly below the water
     // (less a strand), wherever on the bunny a point at that height is.
@@ -159,7 +169,7 @@ fn water_level(look: pelt_render::FurLook) {
     let below_rows = scenery.rows_at_height(centre.y - 2.0 * length).1;
     let background = [0, 1, 2].map(|c| dry.get_pixel(0, 0)[c]);
     let (mut above, mut above_changed) = (0_u32, 0_u32);
-    let (mut below, mut dry_light, mut wet_light) = (0_u32, 0.0, 0.0);
+    let (mut below, mut dry_light, mut wet_light, mut undarkened_light) = (0_u32, 0.0, 0.0, 0.0);
     for (x, y, d) in dry.enumerate_pixels() {
         if !common::covered(d, background) {
             continue;
@@ -173,15 +183,18 @@ fn water_level(look: pelt_render::FurLook) {
             below += 1;
             dry_light += luminance(d);
             wet_light += luminance(w);
+            undarkened_light += luminance(undarkened.get_pixel(x, y));
         }
     }
     assert!(above > 500 && below > 500, "both regions hold fur: {above} above, {below} below");
     assert!(above_changed * 200 <= above, "{above_changed} of {above} fur pixels above the band changed");
-    let ratio = wet_light / dry_light;
+    let (ratio, darkened) = (wet_light / dry_light, wet_light / undarkened_light);
     eprintln!(
-        "water level: {above} px above the band ({above_changed} changed), below {below} px at {ratio:.3} of the dry luminance"
+        "water level: {above} px above the band ({above_changed} changed), below {below} px at {ratio:.3} of the dry \
+         luminance and {darkened:.3} of the undarkened wet fur's"
     );
-    assert!(ratio < 0.9, "the soaked fur is {ratio:.3} as light as the dry fur");
+    assert!(ratio < 0.97, "the soaked fur is {ratio:.3} as light as the dry fur");
+    assert!(darkened < 0.9, "the darkening leaves the soaked fur {darkened:.3} as light as without it");
 }
 
 #[test]
@@ -214,9 +227,11 @@ fn clumps_part_the_coat_more_as_it_wets() {
     for pair in gaps.windows(2) {
         assert!(pair[1] > pair[0], "the gap between clumps must grow with wetness: {gaps:?}");
     }
-    // Coverage = 1 - gap: the soaked coat covers at least 10% less of the body than the dry one.
+    // Coverage = 1 - gap: the soaked coat's partings bare at least 5% more of the body than the
+    // dry coat does. (The gathered strands keep their width, so their clumps cover densely: the
+    // strand reference's wet coat hides about as much skin as its dry one.)
     let (dry, soaked) = (1.0 - gaps[0], 1.0 - gaps[4]);
-    assert!(soaked <= 0.9 * dry, "coverage dry {dry:.3}, soaked {soaked:.3}");
+    assert!(soaked <= dry - 0.05, "coverage dry {dry:.3}, soaked {soaked:.3}");
 }
 
 const SHOWER: &str = "[[rain]]\nstart_secs = 0.0\nend_secs = 1.0\nrate = 2.0\n";

@@ -27,14 +27,20 @@ fn wet_terms(terms: vec4<f32>, wetness: f32) -> vec4<f32> {
     return vec4<f32>(terms.x, raised, terms.z, terms.w);
 }
 
-// A wet, ungroomed shell fragment's texel at `uv` (tiles): clumped as a groom's clump map
-// clumps, parted between clumps. Where nothing clumps (a dry strand of a wet coat) it is the
-// dry fragment's very fetch, so dry parts of a wet coat keep their bytes.
+// A wet, ungroomed shell fragment's texel at `uv` (tiles): the strands gathered toward their
+// clump's centre as the strand reference gathers them (`wet_gather`), parted between clumps.
+// Where nothing clumps (a dry strand of a wet coat) it is the dry fragment's very fetch, so dry
+// parts of a wet coat keep their bytes.
 fn wet_shell_texel(uv: vec2<f32>, slice: i32, clump: f32, height: f32) -> vec4<f32> {
-    let cells = clump_cells_per_tile();
-    let amount = groom_clump_amount(clump, height);
-    var texel = sample_shell(select(uv, clump_uv(uv, cells, amount), amount > 0.0), slice);
-    texel.a *= clump_parting(uv, cells, clump, height);
+    let gather = wet_gather(uv, clump_cells_per_tile(), clump, height);
+    // The texel of the strand the gathering brings here; the implicit gradients of the gathered
+    // position widen its footprint alike, so the read is as smooth as a dry one.
+    var texel = sample_shell(gather.xy, slice);
+    // The same strands keep their width in a (1 - a)^2 share of their cell: their coverage
+    // compounds there as that many layers of it would.
+    let spread = 1.0 / (1.0 - gather.w);
+    let compounded = 1.0 - pow(1.0 - clamp(texel.a, 0.0, 1.0), spread * spread);
+    texel.a = select(texel.a, compounded, gather.w > 0.0) * gather.z;
     return texel;
 }
 
@@ -45,9 +51,15 @@ fn wet_shell_texel(uv: vec2<f32>, slice: i32, clump: f32, height: f32) -> vec4<f
 // amount and the height (the roots part a little, so the skin shows along the partings); the
 // edge is soft and as wide as the gathering, so coverage returns to 1 as the clump goes to 0.
 fn clump_parting(uv: vec2<f32>, cells_per_tile: f32, clump: f32, height: f32) -> f32 {
+    return wet_gather(uv, cells_per_tile, clump, height).z;
+}
+
+// `clump_parting`'s gathering at `uv` (tiles): the root the fragment's strand grows from (in
+// tiles), the coverage left by the parting, and `a`; `(uv, 1, 0)` where nothing gathers.
+fn wet_gather(uv: vec2<f32>, cells_per_tile: f32, clump: f32, height: f32) -> vec4<f32> {
     let a = CLUMP_PARTING * clamp(clump, 0.0, 1.0) * mix(0.35, 1.0, clamp(height, 0.0, 1.0));
     if a <= 0.0 {
-        return 1.0;
+        return vec4<f32>(uv, 1.0, 0.0);
     }
     let p = uv * cells_per_tile;
     let cell = floor(p);
@@ -73,7 +85,7 @@ fn clump_parting(uv: vec2<f32>, cells_per_tile: f32, clump: f32, height: f32) ->
             margin = min(margin, distance(source, centres[k]) - own);
         }
     }
-    return clamp(margin / (0.25 * a), 0.0, 1.0);
+    return vec4<f32>(source / cells_per_tile, clamp(margin / (0.25 * a), 0.0, 1.0), a);
 }
 
 // The most a soaked strand's clump gathers (in cell units, at the tips).
