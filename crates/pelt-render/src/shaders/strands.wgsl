@@ -60,7 +60,8 @@ fn fs_strand(in: Varyings) -> @location(0) vec4<f32> {
     var wet = 0.0;
     if wet_on() {
         wet = clamp(in.surface_uv.x, 0.0, 1.0);
-        albedo *= 1.0 - object.wet_darkening * wet;
+        // As `wet_groom`: the fur model darkens through its BSDF's parameters, not the albedo.
+        albedo *= 1.0 - select(object.wet_darkening * wet, 0.0, fur_model());
         terms = coat_terms(tangent, normal, in.world_position, in.height, wet);
     }
     // The strands' own shadow takes its share of the key light (light 0) only; the

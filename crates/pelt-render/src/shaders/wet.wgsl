@@ -33,9 +33,13 @@ fn wet_terms(terms: vec4<f32>, wetness: f32) -> vec4<f32> {
 // parts of a wet coat keep their bytes.
 fn wet_shell_texel(uv: vec2<f32>, slice: i32, clump: f32, height: f32) -> vec4<f32> {
     let gather = wet_gather(uv, clump_cells_per_tile(), clump, height);
-    // The texel of the strand the gathering brings here; the implicit gradients of the gathered
-    // position widen its footprint alike, so the read is as smooth as a dry one.
-    var texel = sample_shell(gather.xy, slice);
+    // The texel of the strand the gathering brings here, read over the fragment's own footprint
+    // (the gathered position's gradients would blur the strands by the spread). Both reads run
+    // so that neither sits in non-uniform control flow; the wet coats alone pay for the second.
+    let dx = dpdx(uv) * SHELL_GRAD_SCALE;
+    let dy = dpdy(uv) * SHELL_GRAD_SCALE;
+    let gathered = textureSampleGrad(shell_texture, shell_sampler, gather.xy, slice, dx, dy);
+    var texel = select(sample_shell(uv, slice), gathered, gather.w > 0.0);
     // The same strands keep their width in a (1 - a)^2 share of their cell: their coverage
     // compounds there as that many layers of it would.
     let spread = 1.0 / (1.0 - gather.w);
@@ -49,7 +53,8 @@ fn wet_shell_texel(uv: vec2<f32>, slice: i32, clump: f32, height: f32) -> vec4<f
 // the strand rooted at `centre + (p - centre) / (1 - a)`, and where that root lies in another
 // clump's cell no strand reaches it: the parting, down to the skin. `a` grows with the clump
 // amount and the height (the roots part a little, so the skin shows along the partings); the
-// edge is soft and as wide as the gathering, so coverage returns to 1 as the clump goes to 0.
+// edge is soft, centred on the cells' border (strands rooted just inside it reach over it) and
+// as wide as the gathering, so the partings close as the clump goes to 0.
 fn clump_parting(uv: vec2<f32>, cells_per_tile: f32, clump: f32, height: f32) -> f32 {
     return wet_gather(uv, cells_per_tile, clump, height).z;
 }
@@ -85,7 +90,7 @@ fn wet_gather(uv: vec2<f32>, cells_per_tile: f32, clump: f32, height: f32) -> ve
             margin = min(margin, distance(source, centres[k]) - own);
         }
     }
-    return vec4<f32>(source / cells_per_tile, clamp(margin / (0.25 * a), 0.0, 1.0), a);
+    return vec4<f32>(source / cells_per_tile, clamp(0.5 + margin / (0.25 * a), 0.0, 1.0), a);
 }
 
 // The most a soaked strand's clump gathers (in cell units, at the tips).
