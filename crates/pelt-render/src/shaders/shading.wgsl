@@ -739,14 +739,18 @@ fn fs_fin_groomed(in: GroomedFinVaryings) -> @location(0) vec4<f32> {
     let dx = dpdx(fin_uv);
     let dy = dpdy(fin_uv);
     let cells = clump_cells_per_tile();
-    let amount = groom_clump_amount(in.clump, height);
-    let along = clump_uv(vec2<f32>(fin_uv.x, 0.5 / cells), cells, amount).x;
     var texel: vec4<f32>;
     if groom_on() {
+        let along = clump_uv(vec2<f32>(fin_uv.x, 0.5 / cells), cells, groom_clump_amount(in.clump, height)).x;
         texel = textureSampleGrad(fin_texture, fin_sampler, vec2<f32>(along, fin_uv.y), dx, dy);
     } else {
-        // Wet only: where nothing clumps, the dry fin's very fetch.
-        texel = textureSample(fin_texture, fin_sampler, vec2<f32>(select(fin_uv.x, along, amount > 0.0), fin_uv.y));
+        // Wet only: the strand the gathering brings here, as the wet shells read it, its coverage
+        // compounded along the fin; where nothing clumps, the dry fin's very fetch.
+        let gather = wet_gather(vec2<f32>(fin_uv.x, 0.5 / cells), cells, in.clump, height);
+        let gathered = textureSampleGrad(fin_texture, fin_sampler, vec2<f32>(gather.x, fin_uv.y), dx, dy);
+        texel = select(textureSample(fin_texture, fin_sampler, fin_uv), gathered, gather.w > 0.0);
+        let compounded = 1.0 - pow(1.0 - clamp(texel.a, 0.0, 1.0), 1.0 / (1.0 - gather.w));
+        texel.a = select(texel.a, compounded, gather.w > 0.0);
     }
     var groom_alpha = clamp(in.tint_density.a, 0.0, 1.0);
     if wet_on() {
