@@ -87,34 +87,7 @@ impl Stage {
             map.prepare(rig.queue(), (&[(0, caster)], 1), (Vec3::ZERO, 1.6));
             map
         });
-        self.view.set_shadows(map.as_ref());
-        let (view, plane) = (&self.view, &self.ground);
-        let draw = |pass: &mut wgpu::RenderPass<'_>, view: &FurView| {
-            if ground {
-                rig.renderer.draw_plain(pass, view, plane);
-            }
-            if let Some(fur) = fur {
-                rig.renderer.draw(pass, view, fur, &FurDrawSettings::ALL);
-            }
-        };
-        let image = rig
-            .headless
-            .render_with(
-                DEFAULT_BACKGROUND,
-                |encoder| {
-                    if let Some(map) = &map {
-                        map.record(encoder, draw);
-                    }
-                },
-                |pass| draw(pass, view),
-            )
-            .expect("frame");
-        image.save(common::out_dir().join(format!("shadows-{name}.png"))).expect("save");
-        let linear = |c: u8| {
-            let c = f32::from(c) / 255.0;
-            if c <= 0.04045 { c / 12.92 } else { ((c + 0.055) / 1.055).powf(2.4) }
-        };
-        image.pixels().map(|p| Vec3::new(linear(p[0]), linear(p[1]), linear(p[2]))).collect()
+        self.frame(map.as_ref(), (fur, ground), name)
     }
 }
 
@@ -146,18 +119,29 @@ impl Stage {
             );
             map
         });
-        self.view.set_shadows(map.as_ref());
+        self.frame(map.as_ref(), (Some(fur), true), name)
+    }
+
+    /// The frame through `self.view` shadowed by `map` (recorded first), with the ground and
+    /// `fur` where asked; saved as `shadows-{name}.png`, returned in linear RGB per pixel.
+    fn frame(&mut self, map: Option<&ShadowMap>, (fur, ground): (Option<&GpuFur>, bool), name: &str) -> Vec<Vec3> {
+        let rig = &self.rig;
+        self.view.set_shadows(map);
         let (view, plane) = (&self.view, &self.ground);
         let draw = |pass: &mut wgpu::RenderPass<'_>, view: &FurView| {
-            rig.renderer.draw_plain(pass, view, plane);
-            rig.renderer.draw(pass, view, fur, &FurDrawSettings::ALL);
+            if ground {
+                rig.renderer.draw_plain(pass, view, plane);
+            }
+            if let Some(fur) = fur {
+                rig.renderer.draw(pass, view, fur, &FurDrawSettings::ALL);
+            }
         };
         let image = rig
             .headless
             .render_with(
                 DEFAULT_BACKGROUND,
                 |encoder| {
-                    if let Some(map) = &map {
+                    if let Some(map) = map {
                         map.record(encoder, draw);
                     }
                 },
