@@ -373,6 +373,19 @@ mod tests {
         assert!(strand_pixels(0.1, 0.0, 0.8, 720).is_finite());
     }
 
+    /// `share` of strand pixels falls from 1 above `full` to 0 as strands shrink by 1% a step,
+    /// never rising and never by 0.05 or more in one step.
+    fn assert_fades_without_a_jump(full: f32, share: impl Fn(f32) -> f32) {
+        let mut last = 1.0_f32;
+        for step in 0..200 {
+            let pixels = full * 1.2 * 0.99_f32.powi(step);
+            let now = share(pixels);
+            assert!(now <= last && last - now < 0.05, "a jump at {pixels} px: {last} -> {now}");
+            last = now;
+        }
+        assert_eq!(last, 0.0);
+    }
+
     #[test]
     fn the_coat_fades_to_the_skin_continuously_as_strands_shrink() {
         let lod = LodSettings::default();
@@ -381,14 +394,7 @@ mod tests {
         assert_eq!(lod.level(16, 40.0).coat, 1.0);
         assert_eq!(lod.level(16, gone).coat, 0.0);
         assert_eq!(lod.level(16, 0.01).describe(16), "the skin alone in the coat's colour");
-        let mut last = 1.0_f32;
-        for step in 0..200 {
-            let pixels = full * 1.2 * 0.99_f32.powi(step);
-            let coat = lod.level(16, pixels).coat;
-            assert!(coat <= last && last - coat < 0.05, "a jump at {pixels} px: {last} -> {coat}");
-            last = coat;
-        }
-        assert_eq!(last, 0.0);
+        assert_fades_without_a_jump(full, |pixels| lod.level(16, pixels).coat);
         assert_eq!(LodSettings { coat_fade: None, ..lod }.level(16, 0.01).coat, 1.0);
         assert_eq!(LodSettings { coat_fade: Some([0.5, 0.5]), ..lod }.level(16, 0.01).coat, 1.0);
         assert_eq!(FurLevel { coat: f32::NAN, ..FurLevel::FULL }.clamped(16).coat, 1.0);
@@ -403,14 +409,7 @@ mod tests {
         assert_eq!(lod.level(16, gone).fins, 0.0);
         assert_eq!(lod.level(16, gone).coat, 1.0);
         assert!(lod.level(16, gone).describe(16).ends_with(", no fins"), "{}", lod.level(16, gone).describe(16));
-        let mut last = 1.0_f32;
-        for step in 0..200 {
-            let pixels = full * 1.2 * 0.99_f32.powi(step);
-            let fins = lod.level(16, pixels).fins;
-            assert!(fins <= last && last - fins < 0.05, "a jump at {pixels} px: {last} -> {fins}");
-            last = fins;
-        }
-        assert_eq!(last, 0.0);
+        assert_fades_without_a_jump(full, |pixels| lod.level(16, pixels).fins);
         assert_eq!(LodSettings { fin_fade: None, ..lod }.level(16, 0.5).fins, 1.0);
         assert_eq!(FurLevel { fins: f32::INFINITY, ..FurLevel::FULL }.clamped(16).fins, 1.0);
         // What the renderer reads back: the fins' pass and draw go with the fins or the coat.
