@@ -246,3 +246,20 @@ fn shipped_leopard_pattern_is_the_generated_one() {
     let shipped = ImageRgba8::load(&path).unwrap();
     assert!(shipped == expected, "assets/patterns/leopard.png is stale: rerun with PELT_WRITE_PATTERNS=1");
 }
+
+/// The strands' lean the wet partings read: none for straight strands without clumping pull,
+/// every strand leaning `lean * (0.5..1)` texels for the random style (mean 0.75 `lean`), the
+/// mixed style's share of them, and the same numbers on every run.
+#[test]
+fn strand_lean_is_the_share_that_leans_and_its_mean_offset() {
+    let unpulled = |style, lean| TextureParams { style, lean, clump: 0.0, size: 256, ..TextureParams::default() };
+    let straight = make(&unpulled(Style::Straight, 5.0)).lean;
+    assert_eq!((straight.share, straight.texels), (0.0, 0.0));
+    let random = make(&unpulled(Style::Random, 6.0)).lean;
+    assert!(random.share > 0.999, "{random:?}");
+    assert!((random.texels - 4.5).abs() < 0.1, "{random:?}");
+    let mixed = make(&TextureParams { mixed_ratio: 0.6, ..unpulled(Style::Mixed, 6.0) }).lean;
+    assert!((mixed.share - 0.6).abs() < 0.03, "{mixed:?}");
+    assert!((mixed.texels - 4.5).abs() < 0.15, "{mixed:?}");
+    assert_eq!(make(&unpulled(Style::Mixed, 6.0)).lean, mixed);
+}

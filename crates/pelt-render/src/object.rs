@@ -7,6 +7,7 @@ use pelt_core::Mesh;
 
 use crate::lod::FurLevel;
 use crate::shaders::{OBJECT_UNIFORM_BYTES, ObjectUniform};
+use crate::textures::TextureShape;
 
 /// How one fur looks, beyond its textures: lighting response, fading and strand density.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -218,9 +219,9 @@ impl ObjectShape {
         if self.has_uvs { self.wedge_count } else { self.vertex_count }
     }
 
-    /// The uniform for one frame. `colour`: the skin's (furs) or the mesh's (plain) colour;
-    /// `textures`: `(shell slices, has a surface texture)`.
-    pub fn uniform(&self, frame: &FurFrame, colour: Vec3, (shell_slices, has_surface): (u32, bool)) -> ObjectUniform {
+    /// The uniform for one frame. `colour`: the skin's (furs) or the mesh's (plain) colour.
+    pub fn uniform(&self, frame: &FurFrame, colour: Vec3, textures: TextureShape) -> ObjectUniform {
+        let TextureShape { shell_slices, has_surface, lean } = textures;
         let look = &frame.look;
         let level = frame.level.clamped(self.layers);
         let tiles_per_world = look.tiles_per_radius / self.radius;
@@ -276,7 +277,9 @@ impl ObjectShape {
             coat_fade: level.coat,
             fin_fade: level.fins,
             tint: if look.tint.is_finite() { look.tint.max(Vec3::ZERO) } else { Vec3::ONE },
-            _padding_3: 0.0,
+            lean_share: lean.share.clamp(0.0, 1.0),
+            lean_texels: lean.texels.max(0.0),
+            _padding_3: [0.0; 3],
         }
     }
 }
@@ -287,7 +290,11 @@ impl ObjectShape {
 #[must_use]
 pub fn tile_mapping(mesh: &Mesh, look: &FurLook) -> pelt_core::reference::TileMapping {
     let shape = ObjectShape::new(mesh, 1);
-    let uniform = shape.uniform(&FurFrame { look: *look, ..FurFrame::default() }, Vec3::ONE, (1, false));
+    let uniform = shape.uniform(
+        &FurFrame { look: *look, ..FurFrame::default() },
+        Vec3::ONE,
+        TextureShape { shell_slices: 1, ..TextureShape::default() },
+    );
     pelt_core::reference::TileMapping { tiles_per_uv: uniform.tiles_per_uv, tiles_per_world: uniform.tiles_per_world }
 }
 
@@ -317,7 +324,7 @@ mod tests {
         let (mesh, _) = pelt_core::Builtin::Box.mesh();
         let shape = ObjectShape::new(&mesh, 4);
         let frame = FurFrame { world_from_model: Mat4::from_scale(Vec3::new(2.0, 1.0, 1.0)), ..FurFrame::default() };
-        let uniform = shape.uniform(&frame, Vec3::ONE, (4, false));
+        let uniform = shape.uniform(&frame, Vec3::ONE, TextureShape { shell_slices: 4, ..TextureShape::default() });
         let normal_matrix = Mat3::from_cols(
             uniform.world_normal_from_model[0].truncate(),
             uniform.world_normal_from_model[1].truncate(),
@@ -328,7 +335,7 @@ mod tests {
         let in_plane = frame.world_from_model.transform_vector3(Vec3::new(1.0, 1.0, 0.0));
         assert!(normal.dot(in_plane).abs() < 1e-6, "normal {normal} stays perpendicular to {in_plane}");
         let flat = FurFrame { world_from_model: Mat4::from_scale(Vec3::new(1.0, 0.0, 1.0)), ..frame };
-        let uniform = shape.uniform(&flat, Vec3::ONE, (4, false));
+        let uniform = shape.uniform(&flat, Vec3::ONE, TextureShape { shell_slices: 4, ..TextureShape::default() });
         assert!(uniform.world_normal_from_model.iter().all(|c| c.is_finite()));
     }
 }

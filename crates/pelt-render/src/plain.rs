@@ -8,6 +8,7 @@ use crate::geometry::UnifiedGeometry;
 use crate::object::{FurFrame, GpuBytes};
 use crate::requirements::ErrorScope;
 use crate::shaders::Layouts;
+use crate::textures::TextureShape;
 
 /// A furless mesh on the GPU, drawn with [`FurRenderer::draw_plain`](crate::FurRenderer::draw_plain)
 /// before the furs.
@@ -34,7 +35,7 @@ impl PlainMesh {
     /// Writes this frame's model transform (takes effect at the next submission).
     pub fn prepare(&self, queue: &wgpu::Queue, world_from_model: Mat4) {
         let frame = FurFrame { world_from_model, ..FurFrame::default() };
-        self.geometry.write_uniform(queue, &self.geometry.shape.uniform(&frame, self.colour, (0, false)));
+        self.geometry.write_uniform(queue, &self.geometry.shape.uniform(&frame, self.colour, TextureShape::default()));
     }
 
     /// Moves the mesh's vertices (a skinned body's pose this frame, in model space).

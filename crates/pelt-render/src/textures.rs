@@ -2,10 +2,18 @@
 //! with mipmaps (pelt-core's alpha-weighted filter) so distant fur averages out instead of
 //! sparkling.
 
-use pelt_core::texture::{FurTextures, downsample_rgba8};
+use pelt_core::texture::{FurTextures, StrandLean, downsample_rgba8};
 
 use crate::RenderError;
 use crate::shaders::Layouts;
+
+/// What the object uniform reads of a fur's textures (plain meshes: the default, no slices).
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct TextureShape {
+    pub shell_slices: u32,
+    pub has_surface: bool,
+    pub lean: StrandLean,
+}
 
 /// One fur's textures on the GPU with their bind group (group 2 of the fur pipelines).
 /// Cloning it clones handles: the copies of one fur share its textures.
@@ -14,6 +22,8 @@ pub(crate) struct GpuTextures {
     pub bind_group: wgpu::BindGroup,
     pub shell_slices: u32,
     pub has_surface: bool,
+    /// How far the strands stand off their roots (wet partings soften by it).
+    pub lean: StrandLean,
     /// Alpha-weighted mean strand colour of the root slice, linear RGB.
     pub root_colour: glam::Vec3,
     /// Each slice's mean colour and coverage ([`GpuTextures::coat_colour`]): what a fur too small
@@ -28,6 +38,11 @@ pub(crate) struct GpuTextures {
 }
 
 impl GpuTextures {
+    /// What the object uniform reads of these textures.
+    pub fn shape(&self) -> TextureShape {
+        TextureShape { shell_slices: self.shell_slices, has_surface: self.has_surface, lean: self.lean }
+    }
+
     pub fn new(
         device: &wgpu::Device,
         queue: &wgpu::Queue,
@@ -105,6 +120,7 @@ impl GpuTextures {
             bind_group,
             shell_slices: textures.layers,
             has_surface: textures.surface.is_some(),
+            lean: textures.lean,
             root_colour: root_colour(textures, slice_bytes),
             slice_means: slice_means(textures, slice_bytes).into(),
             bytes,
@@ -313,6 +329,7 @@ mod tests {
             fin: vec![0; 16],
             strand_keep: vec![0; 16],
             surface: None,
+            lean: StrandLean::default(),
         };
         assert!(matches!(validate(&textures), Err(RenderError::Textures(_))));
         let textures = FurTextures { shell: vec![0; 4 * 4 * 4 * 2], strand_keep: vec![0; 32], ..textures };

@@ -61,6 +61,39 @@ pub struct FurTextures {
     /// grey per-strand brightness; the renderer multiplies it by this image sampled with the
     /// mesh's corner UVs. `None` in the other modes (the RGB is the final strand colour).
     pub surface: Option<ImageRgba8>,
+    /// How far the strands stand off their roots at the tips (wet clumps read it).
+    pub lean: StrandLean,
+}
+
+/// How far the strands' cross-sections stand off their roots at the tip layer (lean, clumping
+/// pull and curl together): the share of strands more than a texel off, and their mean offset.
+/// A wet coat's clumps are chosen at the roots (`reference::clumps`), so near a clump's border a
+/// shell fragment shows strands rooted on either side this far in (`wet.wgsl`).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct StrandLean {
+    /// Share of the strands more than a texel off their roots at the tips, `0..=1`.
+    pub share: f32,
+    /// Their mean offset there, texels (0 when none is).
+    pub texels: f32,
+}
+
+// Both are finite: measured from finite strands.
+impl Eq for StrandLean {}
+
+impl StrandLean {
+    /// The lean of `strands` (in row order: the same sum on any machine).
+    #[must_use]
+    pub fn of(strands: &[Strand]) -> Self {
+        let (count, sum) = strands
+            .iter()
+            .map(|strand| (strand.centre(1.0) - strand.root()).length())
+            .filter(|offset| *offset > 1.0)
+            .fold((0usize, 0.0f64), |(count, sum), offset| (count + 1, sum + f64::from(offset)));
+        if count == 0 {
+            return Self::default();
+        }
+        Self { share: count as f32 / strands.len() as f32, texels: (sum / count as f64) as f32 }
+    }
 }
 
 impl FurTextures {
@@ -77,6 +110,7 @@ impl FurTextures {
             fin: vec![0; 64],
             strand_keep: vec![0; 16],
             surface: None,
+            lean: StrandLean::default(),
         }
     }
 }
@@ -91,6 +125,7 @@ impl std::fmt::Debug for FurTextures {
             .field("fin_size", &(self.fin_width, self.fin_height))
             .field("strand_keep_bytes", &self.strand_keep.len())
             .field("surface", &self.surface)
+            .field("lean", &self.lean)
             .finish()
     }
 }
@@ -457,5 +492,15 @@ pub fn generate_from(layers: u32, field: &StrandField) -> FurTextures {
     let fin_height = (size / 2).max(MIN_TILE_SIZE);
     let mut fin = vec![0u8; size as usize * fin_height as usize * 4];
     strands::draw_fin(params, strands, fin_height, &colour_at, &mut fin);
-    FurTextures { size, layers, shell, fin_width: size, fin_height, fin, strand_keep, surface: field.surface.clone() }
+    FurTextures {
+        size,
+        layers,
+        shell,
+        fin_width: size,
+        fin_height,
+        fin,
+        strand_keep,
+        surface: field.surface.clone(),
+        lean: StrandLean::of(strands),
+    }
 }

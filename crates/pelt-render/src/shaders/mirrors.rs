@@ -63,8 +63,10 @@ pub(crate) struct ObjectUniform {
     pub coat_fade: f32,
     pub fin_fade: f32,
     pub tint: Vec3,
+    pub lean_share: f32,
+    pub lean_texels: f32,
     /// WGSL rounds the struct up to its 16-byte alignment.
-    pub _padding_3: f32,
+    pub _padding_3: [f32; 3],
 }
 
 /// One light; the layout of `Light` in `fur_bsdf.wgsl`.
@@ -341,6 +343,8 @@ mod tests {
             coat_fade,
             fin_fade,
             tint,
+            lean_share,
+            lean_texels,
             _padding_3
         });
         assert_mirrors(&unified_shader_source(), "Object", &rust);

@@ -94,6 +94,10 @@ struct Object {
     fin_fade: f32,
     // Multiplies the strands' albedo (`FurLook::tint`; the skin's colour is tinted on the CPU).
     tint: vec3<f32>,
+    // The strands' lean (`StrandLean`): the share more than a texel off their roots at the tips
+    // and their mean offset there, texels. Wet partings are as soft as it makes them.
+    lean_share: f32,
+    lean_texels: f32,
 }
 
 // Set per pipeline: shells and fins with alpha-to-coverage output straight colour, blended ones

@@ -53,16 +53,18 @@ fn wet_shell_texel(uv: vec2<f32>, slice: i32, clump: f32, height: f32) -> vec4<f
 // the strand rooted at `centre + (p - centre) / (1 - a)`, and where that root lies in another
 // clump's cell no strand reaches it: the parting, down to the skin. `a` grows with the clump
 // amount and the height (the roots part a little, so the skin shows along the partings); the
-// edge is soft, centred on the cells' border (strands rooted just inside it reach over it) and
-// as wide as the gathering, so the partings close as the clump goes to 0.
+// edge is soft as the strands' lean makes it (`rooted_share`), so the partings close as the
+// clump goes to 0.
 fn clump_parting(uv: vec2<f32>, cells_per_tile: f32, clump: f32, height: f32) -> f32 {
     return wet_gather(uv, cells_per_tile, clump, height).z;
 }
 
-// `clump_parting`'s gathering at `uv` (tiles): the root the fragment's strand grows from (in
-// tiles), the coverage left by the parting, and `a`; `(uv, 1, 0)` where nothing gathers.
+// `clump_parting`'s gathering at `uv` (tiles): the point the fragment's strands grow through at
+// this height before gathering (in tiles), the coverage left by the parting, and `a`;
+// `(uv, 1, 0)` where nothing gathers.
 fn wet_gather(uv: vec2<f32>, cells_per_tile: f32, clump: f32, height: f32) -> vec4<f32> {
-    let a = CLUMP_PARTING * clamp(clump, 0.0, 1.0) * mix(0.35, 1.0, clamp(height, 0.0, 1.0));
+    let h = clamp(height, 0.0, 1.0);
+    let a = CLUMP_PARTING * clamp(clump, 0.0, 1.0) * mix(0.35, 1.0, h);
     if a <= 0.0 {
         return vec4<f32>(uv, 1.0, 0.0);
     }
@@ -83,14 +85,30 @@ fn wet_gather(uv: vec2<f32>, cells_per_tile: f32, clump: f32, height: f32) -> ve
     }
     let centre = centres[nearest];
     let source = centre + (p - centre) / (1.0 - a);
-    let own = distance(source, centre);
-    var margin = 3.4e38;
+    // How far the source lies inside its cell (negative: past the border), across the nearest
+    // of the borders with the other cells.
+    var inside = 3.4e38;
     for (var k = 0u; k < 9u; k++) {
         if k != nearest {
-            margin = min(margin, distance(source, centres[k]) - own);
+            let other = centres[k];
+            let across = dot(source - other, source - other) - dot(source - centre, source - centre);
+            inside = min(inside, across / (2.0 * distance(other, centre)));
         }
     }
-    return vec4<f32>(source / cells_per_tile, clamp(0.5 + margin / (0.25 * a), 0.0, 1.0), a);
+    // The strands' mean lean at this height, in cells.
+    let lean = object.lean_texels * h * cells_per_tile / f32(textureDimensions(shell_texture).x);
+    return vec4<f32>(source / cells_per_tile, rooted_share(inside, a, lean), a);
+}
+
+// The share of the strands crossing a point `inside` cells within a clump cell's border
+// (negative: past it) that grow from that cell, where the clump is chosen at the root (as the
+// strand reference chooses it): of the strands that stand straight, those on its side (a soft
+// step as wide as the gathering); of the leaning share (`Object::lean_share`), those whose root
+// `lean` cells away in a direction all ways alike lies on its side.
+fn rooted_share(inside: f32, a: f32, lean: f32) -> f32 {
+    let straight = clamp(0.5 + inside / (0.125 * a), 0.0, 1.0);
+    let leaning = 1.0 - acos(clamp(inside / max(lean, 1e-6), -1.0, 1.0)) / 3.14159265;
+    return mix(straight, select(leaning, straight, lean <= 1e-6), clamp(object.lean_share, 0.0, 1.0));
 }
 
 // The most a soaked strand's clump gathers (in cell units, at the tips).

@@ -90,7 +90,17 @@ pub fn strand_textures(size: u32, layers: u32, root: [u8; 3], tip: [u8; 3]) -> F
             }
         }
     }
-    FurTextures { size, layers, shell, fin_width, fin_height, fin, strand_keep, surface: None }
+    FurTextures {
+        size,
+        layers,
+        shell,
+        fin_width,
+        fin_height,
+        fin,
+        strand_keep,
+        surface: None,
+        lean: Default::default(),
+    }
 }
 
 pub const BROWN_ROOT: [u8; 3] = [70, 45, 28];
