@@ -476,6 +476,17 @@ impl FurDriver {
         renderer.prepare_fins(encoder, view, &self.fur);
     }
 
+    /// [`FurDriver::record_view`] for every driver of `drivers` (a herd's members), in one compute
+    /// pass ([`FurRenderer::prepare_fins_of`]).
+    pub fn record_views<'a>(
+        encoder: &mut wgpu::CommandEncoder,
+        renderer: &FurRenderer,
+        view: &FurView,
+        drivers: impl IntoIterator<Item = &'a FurDriver>,
+    ) {
+        renderer.prepare_fins_of(encoder, view, drivers.into_iter().map(|driver| &driver.fur));
+    }
+
     /// Draws the fur into the host's `pass` (after its opaque geometry).
     pub fn draw(
         &self,

@@ -93,6 +93,19 @@ fn each_copy_draws_its_own_pose_as_a_fur_uploaded_alone() {
     assert_eq!(second, bent_alone, "the second copy draws its own pose, as a fur alone does");
     let differing = first.pixels().zip(second.pixels()).filter(|(a, b)| a != b).count();
     assert!(differing > 200, "{differing} pixels differ between the copies");
+    // Their silhouette listings in one compute pass, as a herd records them, show each copy's own
+    // fins: the bytes of each listed in its own pass.
+    let fins_only = pelt_render::FurDrawSettings { skin: false, shells: false, ..settings() };
+    let both: Vec<&GpuFur> = copies.iter().collect();
+    let one_pass = rig.render_silhouettes(&both, &camera, &fins_only, true);
+    let separate = rig.render_silhouettes(&both, &camera, &fins_only, false);
+    let differing = one_pass.pixels().zip(separate.pixels()).filter(|(a, b)| a != b).count();
+    assert_eq!(differing, 0, "pixels that differ listed in one pass and in one pass a copy");
+    let second_alone = rig.render_silhouettes(&both[1..], &camera, &fins_only, false);
+    let background = rig.background();
+    let covered = |image: &image::RgbaImage| image.pixels().filter(|p| common::covered(p, background)).count();
+    assert!(covered(&one_pass) > covered(&second_alone), "the first copy's fins are drawn as well");
+    assert!(covered(&second_alone) > 100, "{} fin pixels of the second copy", covered(&second_alone));
 }
 
 /// A fur made small on screen loses its coat gradually: as `FurLevel::coat` falls from 1 to 0 in

@@ -138,9 +138,7 @@ impl HerdGpu {
 
     /// The copies' silhouette listings for `view`.
     pub fn record_view(&self, encoder: &mut wgpu::CommandEncoder, renderer: &FurRenderer, view: &FurView) {
-        for driver in &self.drivers {
-            driver.record_view(encoder, renderer, view);
-        }
+        FurDriver::record_views(encoder, renderer, view, &self.drivers);
     }
 
     /// Draws copy `k` (0 is the herd's second member).

@@ -387,9 +387,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         let image = headless.render_with(
             studio.background,
             |encoder| {
-                for &member in &order {
-                    drivers[member].record_view(encoder, &renderer, &view);
-                }
+                FurDriver::record_views(encoder, &renderer, &view, order.iter().map(|&member| &drivers[member]));
                 surroundings.record(encoder, |pass, light| {
                     surroundings.draw_ground(pass, &renderer, light);
                     for mesh in &plain_meshes {

@@ -84,12 +84,12 @@ impl FinList {
     /// in edge order and writes the draw's count (both write the instances).
     pub fn record(
         &self,
-        encoder: &mut wgpu::CommandEncoder,
+        pass: &mut wgpu::ComputePass<'_>,
         pipelines: &ListingPipelines<2>,
         view: &wgpu::BindGroup,
         object: &wgpu::BindGroup,
     ) {
-        pipelines.record(encoder, (view, object, &self.bind_group), [item_groups(self.edge_count), (1, 1)]);
+        pipelines.record(pass, (view, object, &self.bind_group), [item_groups(self.edge_count), (1, 1)]);
     }
 
     /// Writes a list decided on the CPU (`(edge, fade bits)` per fin, at most `E`) and its

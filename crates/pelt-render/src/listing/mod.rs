@@ -4,9 +4,10 @@
 //! angle (which triangles the thinned shells still need).
 //!
 //! Both have one shape, kept here: their pipelines ([`ListingPipelines`]) bind the view and the
-//! unified object in groups 0 and 1 and one fur's list in group 3, and run in one compute pass in
+//! unified object in groups 0 and 1 and one fur's list in group 3, and run in a compute pass in
 //! the host's encoder ([`crate::FurRenderer::prepare_fins`]) before the render pass that draws
-//! the fur; nothing is read back, nothing blocks.
+//! the fur; every fur of a herd lists in the same pass ([`crate::FurRenderer::prepare_fins_of`]).
+//! Nothing is read back, nothing blocks.
 
 mod fins;
 mod shells;
@@ -98,17 +99,16 @@ impl<const N: usize> ListingPipelines<N> {
         Self { label, pipelines }
     }
 
-    /// Records the pass into `encoder`: pipeline `k` over `groups[k]` workgroups (x, y), in
+    /// Records the dispatches into `pass`: pipeline `k` over `groups[k]` workgroups (x, y), in
     /// order, with `view`, `object` and the fur's `list` bound. wgpu orders the dispatches: each
     /// sees every write of the one before.
     fn record(
         &self,
-        encoder: &mut wgpu::CommandEncoder,
+        pass: &mut wgpu::ComputePass<'_>,
         (view, object, list): (&wgpu::BindGroup, &wgpu::BindGroup, &wgpu::BindGroup),
         groups: [(u32, u32); N],
     ) {
-        let mut pass = encoder
-            .begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some(self.label), timestamp_writes: None });
+        pass.push_debug_group(self.label);
         pass.set_bind_group(0, view, &[]);
         pass.set_bind_group(1, object, &[]);
         pass.set_bind_group(3, list, &[]);
@@ -116,6 +116,7 @@ impl<const N: usize> ListingPipelines<N> {
             pass.set_pipeline(pipeline);
             pass.dispatch_workgroups(x, y, 1);
         }
+        pass.pop_debug_group();
     }
 }
 

@@ -71,13 +71,13 @@ impl ShellList {
     /// then the draws are written.
     pub fn record(
         &self,
-        encoder: &mut wgpu::CommandEncoder,
+        pass: &mut wgpu::ComputePass<'_>,
         pipelines: &ListingPipelines<3>,
         view: &wgpu::BindGroup,
         object: &wgpu::BindGroup,
     ) {
         let groups = [item_groups(self.triangle_count), (1, 1), (self.layers.div_ceil(WORKGROUP), 1)];
-        pipelines.record(encoder, (view, object, &self.bind_group), groups);
+        pipelines.record(pass, (view, object, &self.bind_group), groups);
         self.recorded.store(true, Ordering::Relaxed);
     }
 

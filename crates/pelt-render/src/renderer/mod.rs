@@ -291,16 +291,40 @@ impl FurRenderer {
     /// the pass that lists the triangles the thinned shells still need, and the next draws of
     /// `fur` (until its next [`GpuFur::prepare`]) draw those shells over that list only.
     pub fn prepare_fins(&self, encoder: &mut wgpu::CommandEncoder, view: &FurView, fur: &GpuFur) {
-        if !fur.prepared_level().coat_shown() {
+        self.prepare_fins_of(encoder, view, [fur]);
+    }
+
+    /// [`FurRenderer::prepare_fins`] for every fur of `furs` (a herd), their dispatches in one
+    /// compute pass rather than a pass each. No pass when none of them lists.
+    pub fn prepare_fins_of<'a>(
+        &self,
+        encoder: &mut wgpu::CommandEncoder,
+        view: &FurView,
+        furs: impl IntoIterator<Item = &'a GpuFur>,
+    ) {
+        let listed: Vec<_> = furs
+            .into_iter()
+            .filter(|fur| fur.prepared_level().coat_shown())
+            .map(|fur| {
+                let level = fur.prepared_level();
+                let fins = fur.fin_list().filter(|_| level.fins_shown());
+                (fur, fins, fur.shell_list().filter(|_| level.by_view()))
+            })
+            .filter(|(_, fins, shells)| fins.is_some() || shells.is_some())
+            .collect();
+        if listed.is_empty() {
             return;
         }
-        if let Some(list) = fur.fin_list().filter(|_| fur.prepared_level().fins_shown()) {
-            list.record(encoder, &self.listing.silhouette, view.bind_group(), fur.geometry().bind_group());
-        }
-        if let Some(list) = fur.shell_list()
-            && fur.prepared_level().by_view()
-        {
-            list.record(encoder, &self.listing.view_lod, view.bind_group(), fur.geometry().bind_group());
+        let mut pass = encoder
+            .begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("pelt listing"), timestamp_writes: None });
+        for (fur, fins, shells) in listed {
+            let object = fur.geometry().bind_group();
+            if let Some(list) = fins {
+                list.record(&mut pass, &self.listing.silhouette, view.bind_group(), object);
+            }
+            if let Some(list) = shells {
+                list.record(&mut pass, &self.listing.view_lod, view.bind_group(), object);
+            }
         }
     }
 

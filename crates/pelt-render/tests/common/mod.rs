@@ -252,6 +252,38 @@ impl Rig {
             .expect("frame")
     }
 
+    /// One frame of `furs` with silhouette fins, their listings recorded in one compute pass
+    /// (`FurRenderer::prepare_fins_of`, as a herd records them) or each in its own.
+    pub fn render_silhouettes(
+        &self,
+        furs: &[&GpuFur],
+        camera: &Camera,
+        settings: &FurDrawSettings,
+        one_pass: bool,
+    ) -> image::RgbaImage {
+        self.view.prepare(self.queue(), &camera.view_data(self.headless.aspect_ratio(), &Light::default()));
+        let settings = FurDrawSettings { silhouette_fins: true, ..*settings };
+        self.headless
+            .render_with(
+                DEFAULT_BACKGROUND,
+                |encoder| {
+                    if one_pass {
+                        self.renderer.prepare_fins_of(encoder, &self.view, furs.iter().copied());
+                    } else {
+                        for fur in furs {
+                            self.renderer.prepare_fins(encoder, &self.view, fur);
+                        }
+                    }
+                },
+                |pass| {
+                    for fur in furs {
+                        self.renderer.draw(pass, &self.view, fur, &settings);
+                    }
+                },
+            )
+            .expect("frame")
+    }
+
     /// The `u32`s of a small `COPY_SRC` buffer, read back (waits for the GPU).
     pub fn read_u32s(&self, buffer: &wgpu::Buffer) -> Vec<u32> {
         let bytes = read_bytes(self.device(), self.queue(), buffer);

@@ -181,9 +181,7 @@ pub fn measure(
             headless.render_with(
                 studio.background,
                 |encoder| {
-                    for driver in &drivers {
-                        driver.record_view(encoder, &renderer, &view);
-                    }
+                    FurDriver::record_views(encoder, &renderer, &view, &drivers);
                     surroundings.record(encoder, |pass, light| {
                         surroundings.draw_ground(pass, &renderer, light);
                         for driver in &drivers {

@@ -283,9 +283,7 @@ impl HerdDrivers {
         view: &FurView,
         drawn: &[usize],
     ) {
-        for &member in drawn {
-            self.drivers[member - 1].record_view(encoder, renderer, view);
-        }
+        FurDriver::record_views(encoder, renderer, view, drawn.iter().map(|&member| &self.drivers[member - 1]));
     }
 
     /// Draws the copies `drawn` lists (member indices, 1..; every copy into a shadow map).
