@@ -272,7 +272,8 @@ fn a_furred_shadow_is_larger_and_softer_than_a_bald_one() {
 }
 
 /// The fur's pixels just below the equator of the sphere's image, seen from the side and lit from
-/// above: their summed light with shadows over without.
+/// above: the key light's share of their summed light (the fill's taken away) with shadows over
+/// without.
 #[test]
 fn fur_on_the_underside_is_darker_with_shadows_from_above() {
     underside_darker_with_shadows(false);
@@ -315,16 +316,15 @@ fn underside_darker_with_shadows(fur_model: bool) {
             .map(|(_, c)| luminance(*c))
             .sum()
     };
-    let (mut lit, mut shadowed) = (lower(&off), lower(&on));
-    if fur_model {
-        // The fur model has no lit-side term: the band is mostly the environment's, so compare
-        // the key light's share alone.
-        stage.key = 0.0;
-        let fill = lower(&stage.render(&camera, Vec3::Y, (Some(&fur), false), None, &format!("{name}-fill")));
-        (lit, shadowed) = (lit - fill, shadowed - fill);
-    }
+    // The band is mostly the fill's (the ambient term, or the fur model's environment): compare
+    // the key light's share alone.
+    stage.key = 0.0;
+    let fill = lower(&stage.render(&camera, Vec3::Y, (Some(&fur), false), None, &format!("{name}-fill")));
+    let (lit, shadowed) = (lower(&off) - fill, lower(&on) - fill);
+    eprintln!("{name}: the key light's share of the band, {shadowed:.1} with shadows, {lit:.1} without");
     assert!(lit > 0.0, "the lower half shows lit fur");
-    assert!(shadowed < 0.97 * lit, "the underside's light: {shadowed:.1} with shadows, {lit:.1} without");
+    // 0.77 (Kajiya-Kay) and 0.80 (the fur model) on lavapipe; without the shadow, 1.
+    assert!(shadowed < 0.9 * lit, "the underside's key light: {shadowed:.1} with shadows, {lit:.1} without");
 }
 
 /// The skin and roots of a plane of fur seen from above, lit from above: the shadows darken
