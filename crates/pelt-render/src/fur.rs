@@ -218,7 +218,7 @@ impl GpuFur {
     /// Writes this frame's model transform, interpolation and look (takes effect at the next
     /// submission; one transform per fur and submission).
     pub fn prepare(&self, queue: &wgpu::Queue, frame: &FurFrame) {
-        let textures = self.asset.textures.shape();
+        let textures = self.asset.textures.shape;
         // One state has nothing to interpolate; 1 lets the shader fetch it once.
         let frame = if self.geometry.state_count() == 1 { FurFrame { interpolation: 1.0, ..*frame } } else { *frame };
         // A fading coat's skin turns from the roots' colour to the coat's.

@@ -20,10 +20,8 @@ pub(crate) struct TextureShape {
 #[derive(Clone, Debug)]
 pub(crate) struct GpuTextures {
     pub bind_group: wgpu::BindGroup,
-    pub shell_slices: u32,
-    pub has_surface: bool,
-    /// How far the strands stand off their roots (wet partings soften by it).
-    pub lean: StrandLean,
+    /// What the object uniform reads of them: slices, surface texture, the strands' lean.
+    pub shape: TextureShape,
     /// Alpha-weighted mean strand colour of the root slice, linear RGB.
     pub root_colour: glam::Vec3,
     /// Each slice's mean colour and coverage ([`GpuTextures::coat_colour`]): what a fur too small
@@ -38,11 +36,6 @@ pub(crate) struct GpuTextures {
 }
 
 impl GpuTextures {
-    /// What the object uniform reads of these textures.
-    pub fn shape(&self) -> TextureShape {
-        TextureShape { shell_slices: self.shell_slices, has_surface: self.has_surface, lean: self.lean }
-    }
-
     pub fn new(
         device: &wgpu::Device,
         queue: &wgpu::Queue,
@@ -118,9 +111,11 @@ impl GpuTextures {
             + u64::from(keep_size * keep_size * keep_layers);
         Ok(Self {
             bind_group,
-            shell_slices: textures.layers,
-            has_surface: textures.surface.is_some(),
-            lean: textures.lean,
+            shape: TextureShape {
+                shell_slices: textures.layers,
+                has_surface: textures.surface.is_some(),
+                lean: textures.lean,
+            },
             root_colour: root_colour(textures, slice_bytes),
             slice_means: slice_means(textures, slice_bytes).into(),
             bytes,

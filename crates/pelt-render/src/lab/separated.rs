@@ -275,7 +275,7 @@ impl SeparatedFur {
     /// Writes this frame's model transform and look; the interpolation is unused (the separated
     /// structure is static).
     pub fn prepare(&self, queue: &wgpu::Queue, frame: &FurFrame) {
-        let uniform = self.shape.uniform(frame, self.textures.root_colour, self.textures.shape());
+        let uniform = self.shape.uniform(frame, self.textures.root_colour, self.textures.shape);
         queue.write_buffer(&self.uniform, 0, bytemuck::bytes_of(&uniform));
         self.level.set(frame.level, self.shape.layers);
     }

@@ -302,17 +302,16 @@ impl FurRenderer {
         view: &FurView,
         furs: impl IntoIterator<Item = &'a GpuFur>,
     ) {
-        let listed: Vec<_> = furs
+        let mut listed = furs
             .into_iter()
-            .filter(|fur| fur.prepared_level().coat_shown())
-            .map(|fur| {
+            .filter_map(|fur| {
                 let level = fur.prepared_level();
-                let fins = fur.fin_list().filter(|_| level.fins_shown());
-                (fur, fins, fur.shell_list().filter(|_| level.by_view()))
+                let fins = fur.fin_list().filter(|_| level.coat_shown() && level.fins_shown());
+                let shells = fur.shell_list().filter(|_| level.coat_shown() && level.by_view());
+                (fins.is_some() || shells.is_some()).then_some((fur, fins, shells))
             })
-            .filter(|(_, fins, shells)| fins.is_some() || shells.is_some())
-            .collect();
-        if listed.is_empty() {
+            .peekable();
+        if listed.peek().is_none() {
             return;
         }
         let mut pass = encoder

@@ -241,15 +241,7 @@ impl Rig {
     /// One frame of the fur with the silhouette pass recorded before the render pass, as
     /// Pelt's commands draw it.
     pub fn render_silhouette(&self, fur: &GpuFur, camera: &Camera, settings: &FurDrawSettings) -> image::RgbaImage {
-        self.view.prepare(self.queue(), &camera.view_data(self.headless.aspect_ratio(), &Light::default()));
-        let settings = FurDrawSettings { silhouette_fins: true, ..*settings };
-        self.headless
-            .render_with(
-                DEFAULT_BACKGROUND,
-                |encoder| self.renderer.prepare_fins(encoder, &self.view, fur),
-                |pass| self.renderer.draw(pass, &self.view, fur, &settings),
-            )
-            .expect("frame")
+        self.render_silhouettes(&[fur], camera, settings, false)
     }
 
     /// One frame of `furs` with silhouette fins, their listings recorded in one compute pass
