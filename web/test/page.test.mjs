@@ -586,8 +586,18 @@ test('the herd: sixteen Foxes walk on the ground, each at its own phase', async 
   // Green fur, which neither the ground nor the background has (the herd is made again with it).
   await setControl(page, '#colour', FUR_HEX);
   await settled(page);
+  const clock = await page.evaluate(() => window.pelt.stats);
   const first = await shot(page, 'herd');
-  await frames(page, 3);
+  // The Foxes walk on the spot, so a whole cycle later they stand as before: wait about half a
+  // cycle, by the page's clock (a frame moves it at most 0.25 s), not a count of frames.
+  const cycle = clock.walk_cycle_secs;
+  assert.ok(cycle > 0.5, `the herd has no walk cycle: ${JSON.stringify(clock)}`);
+  let advanced = 0;
+  for (let k = 0; k < 16 && !(advanced > 0.35 * cycle && advanced < 0.65 * cycle); k++) {
+    await frames(page, 1);
+    const now = await page.evaluate(() => window.pelt.stats.walk_secs);
+    advanced = (((now - clock.walk_secs) % cycle) + cycle) % cycle;
+  }
   const later = await shot(page, 'herd-later');
   const foxes = regions(first, isFur).filter((region) => region.length >= 20);
   const at = (image, i) => pixel(image, i % image.width, Math.floor(i / image.width));

@@ -23,6 +23,8 @@ pub struct Herd {
     pub instances: Vec<HerdInstance>,
     /// Members 1.. of `instances`.
     others: Vec<FurStepper>,
+    /// The walk's length: every member walks on the spot, so its pose repeats with this period.
+    cycle_secs: f64,
 }
 
 impl Herd {
@@ -55,13 +57,19 @@ impl Herd {
                 Ok(stepper)
             })
             .collect::<Result<Vec<_>, ModelError>>()?;
-        Ok(Self { instances, others })
+        Ok(Self { instances, others, cycle_secs: cycle })
     }
 
     /// The members after the first.
     #[must_use]
     pub fn others(&self) -> &[FurStepper] {
         &self.others
+    }
+
+    /// The walk cycle's length in seconds: each member's pose repeats with it.
+    #[must_use]
+    pub fn cycle_secs(&self) -> f64 {
+        self.cycle_secs
     }
 
     /// The wind on every other member (the first's is the model's).
@@ -184,7 +192,11 @@ mod tests {
         let structure = crate::scene::grow(mesh, SceneChoice::Herd, &model.preset).unwrap();
         let mut alone = pelt_core::sim::FurStepper::new(&structure, &model.preset.simulation).unwrap();
         alone.set_wet(&model.preset.wet).unwrap();
-        alone.set_clip(rig.clone(), Some(rig.find_animation("Walk").unwrap()));
+        let walk = rig.find_animation("Walk").unwrap();
+        // The page's checks time the walk by its cycle: the clip's length, where the page's clock is in it.
+        let cycle = f64::from(rig.animations()[walk].duration_secs());
+        assert_eq!(model.walk_cycle_secs(), Some(cycle));
+        alone.set_clip(rig.clone(), Some(walk));
         alone.set_placement(Some(instance.clone()));
         // The same frames, the same inputs.
         let mut time_secs = 0.0;
@@ -193,6 +205,7 @@ mod tests {
             time_secs = model.stepper.simulation().time_secs();
             alone.advance_with_clip_at(time_secs, instance.clip_time(time_secs)).unwrap();
         }
+        assert!((model.walk_secs().unwrap() - (12.0 / 30.0) % cycle).abs() < 1e-9);
         let herd = model.herd.as_ref().unwrap();
         let member = herd.others()[k - 1].simulation().positions();
         assert!(member.iter().all(|p| p.is_finite()));

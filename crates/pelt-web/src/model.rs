@@ -436,17 +436,22 @@ impl Model {
         self.walking.as_mut().map(|w| w.pose(clock_secs))
     }
 
-    /// Where the walk is in its cycle (seconds from its start), `None` without a walking body.
+    /// Where the walk is in its cycle (seconds from its start; a herd's members each add their
+    /// own phase), `None` without a walking body or herd.
     #[must_use]
     pub fn walk_secs(&self) -> Option<f64> {
         let cycle = self.walk_cycle_secs()?;
         Some(if cycle > 0.0 { self.clock_secs.rem_euclid(cycle) } else { 0.0 })
     }
 
-    /// The walk cycle's length in seconds, `None` without a walking body.
+    /// The walk cycle's length in seconds, `None` without a walking body or herd.
     #[must_use]
     pub fn walk_cycle_secs(&self) -> Option<f64> {
-        Some(f64::from(self.walking.as_ref()?.cycle_secs()))
+        match (&self.walking, &self.herd) {
+            (Some(walking), _) => Some(f64::from(walking.cycle_secs())),
+            (None, Some(herd)) => Some(herd.cycle_secs()),
+            (None, None) => None,
+        }
     }
 }
 

@@ -382,7 +382,7 @@ impl PeltApp {
             json_string(self.model.scene.name()),
             json_string(&self.preset_name),
             json_string(&self.gpu.adapter_name),
-            // Where the try-on body is in its walk cycle; null on other scenes.
+            // Where the try-on body or the herd is in its walk cycle; null on other scenes.
             self.model.walk_secs().map_or_else(|| "null".to_owned(), |t| format!("{t:.3}")),
             self.model.walk_cycle_secs().map_or_else(|| "null".to_owned(), |t| format!("{t:.3}")),
         )
