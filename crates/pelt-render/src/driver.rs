@@ -8,7 +8,7 @@
 use std::fmt;
 use std::time::Instant;
 
-use pelt_core::sim::{FurStepper, SimError, SimParams, Simulation};
+use pelt_core::sim::{FurStepper, HerdInstance, SimError, SimParams, Simulation};
 use pelt_core::{FurStructure, texture::FurTextures};
 
 use crate::RenderError;
@@ -142,9 +142,16 @@ impl FurDriver {
             frame: FurFrame::default(),
             unrecorded: false,
         };
-        driver.use_kernel(device, structure, kernel)?;
+        driver.use_kernel(device, renderer, structure, kernel)?;
         driver.fur.prepare(queue, &driver.frame);
         Ok(driver)
+    }
+
+    /// Bytes of the GPU kernel's own buffers for this fur ([`GpuSimulation::gpu_bytes`]); 0 on
+    /// the CPU kernel.
+    #[must_use]
+    pub fn simulation_bytes(&self) -> u64 {
+        self.gpu_simulation.as_ref().map_or(0, GpuSimulation::gpu_bytes)
     }
 
     /// The kernel bending the strands.
@@ -178,7 +185,7 @@ impl FurDriver {
             return Ok(());
         }
         self.fur = GpuFur::new(device, queue, renderer, structure, textures, states(kernel))?;
-        self.use_kernel(device, structure, kernel)?;
+        self.use_kernel(device, renderer, structure, kernel)?;
         self.fur.prepare(queue, &self.frame);
         Ok(())
     }
@@ -186,13 +193,14 @@ impl FurDriver {
     fn use_kernel(
         &mut self,
         device: &wgpu::Device,
+        renderer: &FurRenderer,
         structure: &FurStructure,
         kernel: SimKernel,
     ) -> Result<(), RenderError> {
         self.kernel = kernel;
         self.unrecorded = false;
         self.gpu_simulation = match kernel {
-            SimKernel::Gpu => Some(GpuSimulation::new(device, &self.fur, structure)?),
+            SimKernel::Gpu => Some(GpuSimulation::with_renderer(device, renderer, &self.fur, structure)?),
             SimKernel::Cpu => None,
         };
         Ok(())
@@ -224,7 +232,7 @@ impl FurDriver {
     ) -> Result<(), RenderError> {
         self.fur.set_structure(device, renderer, structure)?;
         let kernel = self.kernel;
-        self.use_kernel(device, structure, kernel)?;
+        self.use_kernel(device, renderer, structure, kernel)?;
         self.fur.prepare(queue, &self.frame);
         Ok(())
     }
@@ -324,6 +332,39 @@ impl FurDriver {
         self.upload(device, queue, stepper.simulation(), stepper.moved_pose().map(|pose| &pose.normals[..]))
     }
 
+    /// [`FurDriver::advance_to`] for a herd: `drivers[k]` with `steppers[k]`, placed as
+    /// `instances[k]`, each at its own clip time. The bases are posed (and on the CPU kernel the
+    /// strands bent) in one parallel pass ([`FurStepper::advance_herd`]), then each member's GPU
+    /// inputs are written: the CPU kernel's positions, or the GPU kernel's steps for
+    /// [`FurDriver::record`]. Each member may have its own kernel.
+    ///
+    /// # Errors
+    /// [`RenderError::Count`] unless there is one driver, stepper and instance per member; as
+    /// [`FurDriver::advance_to`].
+    pub fn advance_herd(
+        (device, queue): (&wgpu::Device, &wgpu::Queue),
+        drivers: &mut [FurDriver],
+        steppers: &mut [FurStepper],
+        instances: &[HerdInstance],
+        time_secs: f64,
+    ) -> Result<(), RenderError> {
+        for (what, got) in [("steppers of a herd", steppers.len()), ("instances of a herd", instances.len())] {
+            if got != drivers.len() {
+                return Err(RenderError::Count { what, expected: drivers.len(), got, rule: "one per driver" });
+            }
+        }
+        for (driver, stepper) in drivers.iter_mut().zip(steppers.iter_mut()) {
+            driver.fall_back_when_unrecorded();
+            driver.claim(stepper.simulation_mut());
+        }
+        FurStepper::advance_herd(steppers, instances, time_secs)?;
+        for (driver, stepper) in drivers.iter_mut().zip(steppers.iter()) {
+            driver.show_wetness(queue, stepper)?;
+            driver.upload(device, queue, stepper.simulation(), stepper.moved_pose().map(|pose| &pose.normals[..]))?;
+        }
+        Ok(())
+    }
+
     /// The stepper's wetness and what it does to the look (`[wet]`), for the coming frame: the
     /// values uploaded while any vertex is wet, the shaders' wet paths off when none is.
     fn show_wetness(&mut self, queue: &wgpu::Queue, stepper: &FurStepper) -> Result<(), RenderError> {
@@ -390,9 +431,10 @@ impl FurDriver {
         self.finish_upload(queue, moved_normals)
     }
 
-    /// Shows what `stepper` stepped on its own (a herd's member, stepped with the others by
-    /// [`FurStepper::advance_herd`]): its positions, its posed normals when the base moved and its
-    /// wetness, as [`FurDriver::show_state`] and [`FurDriver::show_wet`].
+    /// Shows what `stepper` stepped on its own (a herd's member in a host that steps its herd
+    /// itself; [`FurDriver::advance_herd`] does both): its positions, its posed normals when the
+    /// base moved and its wetness, as [`FurDriver::show_state`] (the CPU kernel's upload) and
+    /// [`FurDriver::show_wet`].
     ///
     /// # Errors
     /// As [`FurDriver::show_state`], for a stepper of another fur.

@@ -131,6 +131,7 @@ mod renderer;
 mod requirements;
 mod shaders;
 mod shadows;
+mod sim_pipelines;
 mod simulation;
 mod skinning;
 mod studio;

@@ -1,6 +1,7 @@
 //! The frame driver: its CPU and GPU kernels draw the same fur from the same script (wind,
-//! touch strokes and rigid motion played by a `FurStepper`), a host that never records the
-//! GPU's steps still draws the CPU's state, and the same frames give the same bytes. Fails,
+//! touch strokes and rigid motion played by a `FurStepper`), alone or as a herd's members, a
+//! host that never records the GPU's steps still draws the CPU's state, and the same frames
+//! give the same bytes. Fails,
 //! never skips, without an adapter.
 
 use crate::common;
@@ -9,10 +10,11 @@ use std::path::Path;
 
 use common::{BROWN_ROOT, BROWN_TIP, builtin_fur, framed, gpu, strand_textures};
 use glam::Vec3;
-use pelt_core::sim::{FurStepper, Scene, SimParams};
+use pelt_core::sim::{FurStepper, HerdInstance, Scene, SimParams};
 use pelt_core::{Builtin, FurStructure};
 use pelt_render::{
-    DEFAULT_BACKGROUND, FurDrawSettings, FurDriver, FurView, Headless, KernelChoice, Light, POSITIONS_USAGE, SimKernel,
+    DEFAULT_BACKGROUND, FurAsset, FurDrawSettings, FurDriver, FurView, Headless, KernelChoice, Light, POSITIONS_USAGE,
+    SimKernel,
 };
 
 const RATE_HZ: f64 = 30.0;
@@ -196,4 +198,81 @@ fn the_same_frames_give_the_same_bytes() {
         let (second, _) = render_scripted(choice, true, 8);
         assert!(first.as_raw() == second.as_raw(), "{choice:?}: two runs of the same frames differ");
     }
+}
+
+/// A herd on the GPU kernel (`FurDriver::advance_herd`: the bases posed in one parallel pass, one
+/// asset, one set of kernels): each member bends within 1e-4 strand lengths of the same herd on
+/// the CPU kernel, and the last draws to the bit what a bunny with its own asset and kernels,
+/// placed and advanced alone, draws.
+#[test]
+fn a_herd_on_the_gpu_kernel_bends_each_member_as_alone() {
+    let headless = Headless::with_gpu(gpu(), 64, 64).expect("headless");
+    let (device, queue) = (&headless.gpu.device, &headless.gpu.queue);
+    let renderer = headless.renderer().expect("renderer");
+    let structure = builtin_fur(Builtin::Bunny, 8);
+    let textures = strand_textures(32, 8, BROWN_ROOT, BROWN_TIP);
+    let params = SimParams::default();
+    let asset = FurAsset::new(device, queue, &renderer, &structure, &textures).expect("asset");
+    // Each its own place, heading, pace and phase: turning the wind and the script's motion.
+    let instances: Vec<HerdInstance> = [(0.0, 0.0, 0.0), (90.0, 0.4, 0.3), (200.0, 1.2, 0.7)]
+        .into_iter()
+        .enumerate()
+        .map(|(k, (heading_deg, speed, time_offset_secs))| HerdInstance {
+            heading_deg,
+            speed,
+            time_offset_secs,
+            ..HerdInstance::at(Vec3::new(3.0 * k as f32, 0.0, 0.0))
+        })
+        .collect();
+    let placed = |instance: &HerdInstance| {
+        let mut stepper = scripted_stepper(&structure);
+        stepper.set_placement(Some(instance.clone()));
+        stepper
+    };
+    let mut herds = [KernelChoice::Gpu, KernelChoice::Cpu].map(|choice| {
+        let drivers: Vec<FurDriver> = instances
+            .iter()
+            .map(|_| {
+                FurDriver::with_asset(device, queue, &renderer, &asset, &structure, &params, choice).expect("driver")
+            })
+            .collect();
+        (drivers, instances.iter().map(placed).collect::<Vec<_>>())
+    });
+    let last = instances.len() - 1;
+    let mut alone =
+        FurDriver::new(device, queue, &renderer, &structure, &textures, &params, KernelChoice::Gpu).expect("driver");
+    let mut alone_stepper = placed(&instances[last]);
+    let nodes = structure.positions.len();
+    let start = drawn_positions(&headless.gpu, &herds[0].0[last], nodes);
+    let mut worst = 0.0_f32;
+    for frame in 1..=30 {
+        let time_secs = f64::from(frame) / 45.0;
+        let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor::default());
+        for (drivers, steppers) in &mut herds {
+            FurDriver::advance_herd((device, queue), drivers, steppers, &instances, time_secs).expect("advance");
+            for driver in drivers.iter_mut() {
+                driver.record(&mut encoder).expect("record");
+            }
+        }
+        alone.advance_to(device, queue, &mut alone_stepper, time_secs).expect("advance");
+        alone.record(&mut encoder).expect("record");
+        queue.submit([encoder.finish()]);
+        for member in 0..instances.len() {
+            let on_gpu = drawn_positions(&headless.gpu, &herds[0].0[member], nodes);
+            let on_cpu = drawn_positions(&headless.gpu, &herds[1].0[member], nodes);
+            let difference = worst_relative_difference(&structure, &on_gpu, &on_cpu);
+            assert!(difference <= 1e-4, "frame {frame}: member {member} is {difference} strand lengths off the CPU's");
+            worst = worst.max(difference);
+        }
+        let member = drawn_positions(&headless.gpu, &herds[0].0[last], nodes);
+        assert!(
+            member == drawn_positions(&headless.gpu, &alone, nodes),
+            "frame {frame}: the member differs from alone"
+        );
+    }
+    assert!(herds[0].0.iter().all(|driver| driver.kernel() == SimKernel::Gpu));
+    let moved =
+        worst_relative_difference(&structure, &start, &drawn_positions(&headless.gpu, &herds[0].0[last], nodes));
+    assert!(moved > 0.3, "the member hardly moved ({moved} strand lengths)");
+    eprintln!("driver: a herd of three on the GPU kernel, worst difference from the CPU's {worst:e} strand lengths");
 }

@@ -271,8 +271,8 @@ fn herd_bench_reports_each_size_with_the_asset_counted_once() {
 }
 
 /// `pelt bench --device-report FILE --quick` on lavapipe: the command a GPU session runs first
-/// writes every part (frames with and without shadows, herds, the torus, contact), each figure
-/// positive.
+/// writes every part (frames with and without shadows, herds on both kernels, the torus,
+/// contact), each figure positive, the GPU kernel's herd bytes counted as the allocator does.
 #[test]
 fn device_report_writes_every_part() {
     let dir = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("cli_bench_device");
@@ -302,8 +302,19 @@ fn device_report_writes_every_part() {
         positive(&figures["extra_sizes"][0]["frame_ms_unified"], "frame_ms_unified at 320x180");
     }
     let herd = report["herd"].as_array().expect("herd");
-    assert_eq!(herd.iter().map(|r| r["foxes"].as_u64().unwrap()).collect::<Vec<_>>(), [1, 10]);
+    let sizes: Vec<_> = herd.iter().map(|r| (r["kernel"].as_str().unwrap(), r["foxes"].as_u64().unwrap())).collect();
+    assert_eq!(sizes, [("cpu", 1), ("cpu", 10), ("gpu", 1), ("gpu", 10)]);
     herd.iter().for_each(|row| positive(&row["frame_ms"], "herd frame_ms"));
+    // On the GPU kernel a Fox's own bytes add its second state and its simulation's buffers,
+    // counted as the device's allocator counts them.
+    for (on_cpu, on_gpu) in herd[..2].iter().zip(&herd[2..]) {
+        assert!(count(on_gpu, "per_fox_gpu_bytes") > count(on_cpu, "per_fox_gpu_bytes"), "{on_cpu}\n{on_gpu}");
+        let (total, allocated) = (count(on_gpu, "total_gpu_bytes"), count(on_gpu, "allocated_gpu_bytes"));
+        assert!(
+            allocated >= total && (allocated as f64) < 1.3 * total as f64,
+            "GPU kernel: allocated {allocated}, counted {total}"
+        );
+    }
     positive(&report["gpu_sim_node_updates_per_sec_torus"], "torus");
     for (case, row) in ["off", "skin", "skin + 8 colliders"].iter().zip(report["contact"]["bunny"].as_array().unwrap())
     {

@@ -1,6 +1,6 @@
 //! `pelt render` with a herd: each member walks at its own phase (changing one member's phase
-//! changes only its side of the picture), `--herd N` scatters N Foxes on a ground, and bad
-//! herds are clear errors naming the flag, or the file and key.
+//! changes only its side of the picture), `--herd N` scatters N Foxes on a ground, bends on
+//! either kernel, and bad herds are clear errors naming the flag, or the file and key.
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
@@ -113,6 +113,27 @@ fn herd_n_scatters_foxes_on_a_ground() {
     };
     let (one, six) = (ground("herd1.png"), ground("herd6.png"));
     assert!(one > 0.05 && six > one, "ground share: one Fox {one:.3}, six {six:.3}");
+}
+
+/// `--sim gpu` bends a herd's strands on the GPU kernel: the walking Foxes' last frame is the CPU
+/// kernel's but for a few pixels, while the walk itself moved many more between the frames.
+#[test]
+fn a_herd_bends_on_the_gpu_kernel_as_on_the_cpu() {
+    let dir = temp_dir("gpu");
+    let args = ["render", &fox(), "--animation", "Walk", "--herd", "3", "--size", "160x90", "--frames", "6"];
+    for sim in ["cpu", "gpu"] {
+        let output = pelt(&[&args[..], &["--sim", sim, "-o", sim]].concat(), &dir);
+        assert!(output.status.success(), "{}", text(&output));
+        let kernel = if sim == "gpu" { "on the GPU (a herd, --sim gpu" } else { "on the CPU (a herd" };
+        assert!(text(&output).contains(kernel), "{}", text(&output));
+    }
+    let frame =
+        |sim: &str, k: u32| image::open(dir.join(sim).join(format!("frame_{k:04}.png"))).expect("PNG").to_rgba8();
+    let (cpu, gpu) = (frame("cpu", 6), frame("gpu", 6));
+    let kernels = differing(&cpu, &gpu, 0..cpu.width());
+    let walked = differing(&frame("cpu", 1), &cpu, 0..cpu.width());
+    assert!(walked > 200, "the Foxes hardly moved: {walked} pixels");
+    assert!(kernels * 20 < walked, "{kernels} pixels differ between the kernels, {walked} between the frames");
 }
 
 #[test]

@@ -26,6 +26,7 @@ use crate::listing::{DRAW_ARGS_BYTES, FIN_INSTANCE_LAYOUT, ListingPasses, ShellL
 use crate::plain::PlainMesh;
 use crate::requirements::{ErrorScope, check_features_and_limits};
 use crate::shaders::{Layouts, unified_shader_source};
+use crate::sim_pipelines::SimPipelines;
 use crate::targets::FurTarget;
 use crate::view::{FurView, ShadowLookups, ViewRole};
 
@@ -185,6 +186,8 @@ pub struct FurRenderer {
     shadows: shadow::ShadowSet,
     /// The silhouette and view-angle passes.
     listing: ListingPasses,
+    /// The GPU simulation's kernels, compiled when a fur first simulates on the GPU.
+    simulation: OnceLock<SimPipelines>,
 }
 
 impl FurRenderer {
@@ -216,7 +219,16 @@ impl FurRenderer {
         let _ = coats[Coat::PLAIN.index()].set(coat_builder.build(&target, Coat::PLAIN));
         let listing = ListingPasses::new(device, &layouts);
         scope.pop("building the fur pipelines")?;
-        Ok(Self { target, layouts, surfaces, coats, coat_builder, shadows: shadow::ShadowSet::default(), listing })
+        Ok(Self {
+            target,
+            layouts,
+            surfaces,
+            coats,
+            coat_builder,
+            shadows: shadow::ShadowSet::default(),
+            listing,
+            simulation: OnceLock::new(),
+        })
     }
 
     /// The target description the pipelines were built for.
@@ -356,6 +368,15 @@ impl FurRenderer {
 
     pub(crate) fn layouts(&self) -> &Layouts {
         &self.layouts
+    }
+
+    /// The GPU simulation's kernels for every fur simulated through this renderer, compiled once.
+    pub(crate) fn simulation_pipelines(&self) -> Result<&SimPipelines, RenderError> {
+        if let Some(pipelines) = self.simulation.get() {
+            return Ok(pipelines);
+        }
+        let built = SimPipelines::new(&self.coat_builder.device)?;
+        Ok(self.simulation.get_or_init(|| built))
     }
 }
 

@@ -16,8 +16,9 @@ use pelt_core::sim::{ContactStep, InputVersions, Simulation, kernel_rest};
 use crate::RenderError;
 use crate::contact::{CONTACT_SLOTS, GpuContact, Skin};
 use crate::fur::GpuFur;
+use crate::renderer::FurRenderer;
 use crate::requirements::{ErrorScope, check_size};
-use crate::shaders::simulation_shader_source;
+use crate::sim_pipelines::SimPipelines;
 
 mod step;
 mod wet;
@@ -27,7 +28,7 @@ use wet::WetInputs;
 
 /// Strands per workgroup (`@workgroup_size` in `simulation.wgsl`).
 const WORKGROUP: u32 = 64;
-/// Which of `GpuSimulation::solve_pipelines` solves `step`'s listed strands: the one compiled
+/// Which of the `solve_contact` pipelines (`SimPipelines::solve`) solves `step`'s listed strands: the one compiled
 /// without colliders' code (0), without mesh colliders' (1), or with both (2).
 fn solve_kernel(step: &ContactStep) -> usize {
     if step.colliders.iter().any(|c| c.mesh.is_some()) { 2 } else { usize::from(!step.colliders.is_empty()) }
@@ -64,14 +65,8 @@ const STATE_BYTES: u64 = 4 * 16;
 /// WebGPU, Vulkan, Metal, DX12 and GL 4.3 / GLES 3.1 device has them).
 #[derive(Debug)]
 pub struct GpuSimulation {
-    pipeline: wgpu::ComputePipeline,
-    touch_pipeline: wgpu::ComputePipeline,
-    /// `step_strands_with_contact`: the bend and screen of steps whose contact is active.
-    contact_pipeline: wgpu::ComputePipeline,
-    /// `solve_contact`: the strands the screen listed, compiled without colliders' code, with
-    /// colliders but no mesh's, and with both (`solve_kernel`).
-    solve_pipelines: [wgpu::ComputePipeline; 3],
-    layout: wgpu::BindGroupLayout,
+    /// Its kernels, shared with every fur simulated on the device through one renderer.
+    pipelines: SimPipelines,
     step_uniforms: wgpu::Buffer,
     rest_segments: wgpu::Buffer,
     strands: wgpu::Buffer,
@@ -149,6 +144,31 @@ impl GpuSimulation {
     /// [`RenderError::TooLarge`] when the device cannot hold it, [`RenderError::Gpu`] when the
     /// device refuses the compute pipeline (e.g. no compute shaders).
     pub fn new(device: &wgpu::Device, fur: &GpuFur, structure: &FurStructure) -> Result<Self, RenderError> {
+        check_limits(&device.limits())?;
+        Self::with_pipelines(device, SimPipelines::new(device)?, fur, structure)
+    }
+
+    /// [`GpuSimulation::new`] with the kernels `renderer` keeps for its device, compiled the
+    /// first time any fur asks: a herd's members share them.
+    ///
+    /// # Errors
+    /// As [`GpuSimulation::new`].
+    pub fn with_renderer(
+        device: &wgpu::Device,
+        renderer: &FurRenderer,
+        fur: &GpuFur,
+        structure: &FurStructure,
+    ) -> Result<Self, RenderError> {
+        check_limits(&device.limits())?;
+        Self::with_pipelines(device, renderer.simulation_pipelines()?.clone(), fur, structure)
+    }
+
+    fn with_pipelines(
+        device: &wgpu::Device,
+        pipelines: SimPipelines,
+        fur: &GpuFur,
+        structure: &FurStructure,
+    ) -> Result<Self, RenderError> {
         let (v, layers) = (structure.vertex_count(), structure.layers as usize);
         check_shape(fur, v, structure.layers)?;
         if structure.positions.len() != v * (layers + 1) {
@@ -189,66 +209,6 @@ impl GpuSimulation {
         check_size(device, "simulation strand state", v.max(1) as u64 * STATE_BYTES)?;
 
         let scope = ErrorScope::push(device);
-        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("pelt simulation"),
-            source: wgpu::ShaderSource::Wgsl(simulation_shader_source().into()),
-        });
-        let storage = |binding, read_only| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: wgpu::ShaderStages::COMPUTE,
-            ty: wgpu::BindingType::Buffer {
-                ty: wgpu::BufferBindingType::Storage { read_only },
-                has_dynamic_offset: false,
-                min_binding_size: None,
-            },
-            count: None,
-        };
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("pelt simulation"),
-            entries: &[
-                wgpu::BindGroupLayoutEntry {
-                    binding: 0,
-                    visibility: wgpu::ShaderStages::COMPUTE,
-                    ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Uniform,
-                        has_dynamic_offset: true,
-                        min_binding_size: wgpu::BufferSize::new(size_of::<StepUniform>() as u64),
-                    },
-                    count: None,
-                },
-                storage(1, true),
-                storage(2, true),
-                storage(3, false),
-                storage(4, false),
-                storage(5, true),
-                storage(6, true),
-                storage(7, true),
-                storage(8, false),
-            ],
-        });
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("pelt simulation"),
-            bind_group_layouts: &[Some(&layout)],
-            immediate_size: 0,
-        });
-        let compute_pipeline = |entry_point, constants: &[(&str, f64)]| {
-            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some(entry_point),
-                layout: Some(&pipeline_layout),
-                module: &module,
-                entry_point: Some(entry_point),
-                compilation_options: wgpu::PipelineCompilationOptions {
-                    constants,
-                    ..wgpu::PipelineCompilationOptions::default()
-                },
-                cache: None,
-            })
-        };
-        let pipeline = compute_pipeline("step_strands", &[]);
-        let touch_pipeline = compute_pipeline("weigh_touch", &[]);
-        let contact_pipeline = compute_pipeline("step_strands_with_contact", &[]);
-        let solve_pipelines = [&[("COLLIDERS", 0.0), ("MESH_COLLIDERS", 0.0)][..], &[("MESH_COLLIDERS", 0.0)], &[]]
-            .map(|constants| compute_pipeline("solve_contact", constants));
         let buffer = |label, size: u64, usage| {
             device.create_buffer(&wgpu::BufferDescriptor { label: Some(label), size, usage, mapped_at_creation: false })
         };
@@ -282,11 +242,7 @@ impl GpuSimulation {
         let wet = WetInputs::new(device, v);
         scope.pop("creating the GPU simulation")?;
         Ok(Self {
-            pipeline,
-            touch_pipeline,
-            contact_pipeline,
-            solve_pipelines,
-            layout,
+            pipelines,
             step_uniforms,
             rest_segments,
             strands,
@@ -438,7 +394,7 @@ impl GpuSimulation {
                 label: Some("pelt simulation touch weights"),
                 timestamp_writes: None,
             });
-            pass.set_pipeline(&self.touch_pipeline);
+            pass.set_pipeline(&self.pipelines.touch);
             pass.set_bind_group(0, &self.bind_groups[after_next].1, &[self.slot_offset(0) as u32]);
             pass.dispatch_workgroups(self.grid[0], self.grid[1], 1);
         }
@@ -457,7 +413,7 @@ impl GpuSimulation {
                 label: Some("pelt simulation step"),
                 timestamp_writes: None,
             });
-            pass.set_pipeline(if contact.is_some() { &self.contact_pipeline } else { &self.pipeline });
+            pass.set_pipeline(if contact.is_some() { &self.pipelines.contact } else { &self.pipelines.step });
             pass.set_bind_group(0, bind_group, &offset);
             pass.dispatch_workgroups(self.grid[0], self.grid[1], 1);
             drop(pass);
@@ -468,7 +424,7 @@ impl GpuSimulation {
                     label: Some("pelt simulation contact"),
                     timestamp_writes: None,
                 });
-                pass.set_pipeline(&self.solve_pipelines[solve_kernel(step)]);
+                pass.set_pipeline(&self.pipelines.solve[solve_kernel(step)]);
                 pass.set_bind_group(0, bind_group, &offset);
                 pass.dispatch_workgroups_indirect(&self.contact.work_groups, 0);
             }
@@ -499,6 +455,27 @@ impl GpuSimulation {
         self.pending.len()
     }
 
+    /// Bytes of this fur's own simulation buffers (step uniforms, rest segments, inputs, state,
+    /// contact, wetness); its kernels are the renderer's, shared.
+    #[must_use]
+    pub fn gpu_bytes(&self) -> u64 {
+        let contact = &self.contact;
+        [
+            &self.step_uniforms,
+            &self.rest_segments,
+            &self.strands,
+            &self.state,
+            &contact.buffer,
+            &contact.fields_buffer,
+            &contact.work,
+            &contact.work_groups,
+            &self.wet.buffer,
+        ]
+        .iter()
+        .map(|buffer| buffer.size())
+        .sum()
+    }
+
     /// Node updates per step: `V * L` (the bench's unit).
     #[must_use]
     pub fn nodes_per_step(&self) -> u64 {
@@ -512,7 +489,7 @@ impl GpuSimulation {
         let scope = ErrorScope::push(device);
         let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("pelt simulation"),
-            layout: &self.layout,
+            layout: &self.pipelines.layout,
             entries: &[
                 wgpu::BindGroupEntry {
                     binding: 0,

@@ -34,9 +34,11 @@ const INERTIA_SHIFT: u32 = 1;
 const INERTIA_SHIFT_ZERO: u32 = 2;
 const INERTIA_SPRING: u32 = 3;
 
-// A slot holds one step, in the 16-byte units WGSL lays `Step` out in.
+// A slot holds one step, in the 16-byte units WGSL lays `Step` out in; the shared layout binds
+// that many bytes.
 const _: () =
     assert!(size_of::<StepUniform>() as u64 <= STEP_SLOT_BYTES && (size_of::<StepUniform>() as u64).is_multiple_of(16));
+const _: () = assert!(size_of::<StepUniform>() as u64 == crate::sim_pipelines::STEP_UNIFORM_BYTES);
 
 /// A u64 as WGSL's `vec2<u32>` (low word, high word).
 fn words(value: u64) -> [u32; 2] {

@@ -1,7 +1,7 @@
 //! `pelt bench --device-report FILE`: every figure that needs a real GPU, in one run of a few
 //! minutes on one, written as one JSON object: the bunny's and the try-on's frames at 1920x1080
 //! (the adapter's MSAA: 4x on a GPU) with and without the key light's shadows, herds of 100 and
-//! 1,000 walking Foxes at that size, the GPU kernel's node updates per second on the
+//! 1,000 walking Foxes at that size bent on the CPU and on the GPU kernel, the GPU kernel's node updates per second on the
 //! 35,000-vertex torus, and contact's share of each kernel (`pelt bench --contact`). A session
 //! lent a GPU runs it first and records the figures (BENCHMARKS.md).
 
@@ -10,7 +10,7 @@ use std::time::Instant;
 
 use anyhow::Context as _;
 use pelt_core::Preset;
-use pelt_render::{Backend, Gpu};
+use pelt_render::{Backend, Gpu, SimKernel};
 
 use super::models::{self, MODELS, Model};
 use super::report::{Adapter, RenderFigures};
@@ -76,13 +76,12 @@ pub fn run(meshes: &Path, out: &Path, quick: bool) -> anyhow::Result<()> {
         frames.push(ModelFrames { model: key, layers: preset.layers, figures });
     }
     let counts: &[usize] = if quick { &[1, 10] } else { &[100, 1000] };
-    let (herd, _) = herd::measure(
-        Gpu::new(Backend::Auto)?,
-        meshes,
-        counts,
-        (size, adapter.msaa_samples),
-        if quick { 1 } else { 4 },
-    )?;
+    let mut herd = Vec::new();
+    for kernel in [SimKernel::Cpu, SimKernel::Gpu] {
+        let frames = if quick { 1 } else { 4 };
+        let gpu = Gpu::new(Backend::Auto)?;
+        herd.extend(herd::measure(gpu, meshes, counts, (size, adapter.msaa_samples), frames, kernel)?.0);
+    }
     eprintln!("pelt bench: the GPU kernel on the torus");
     let mut preset = Preset::default();
     preset.layers = 32;

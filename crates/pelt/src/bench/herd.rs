@@ -1,8 +1,8 @@
 //! `pelt bench --herd`: how a herd's cost grows. 1, 10, 100 and 1,000 Foxes (default preset,
 //! 16 layers) walk across a field at their own phases (`herd::scatter`, each walking ahead),
 //! framed whole at 1280x720 with the Fox's shadows on a ground, as `pelt render --herd N` draws
-//! them: one `FurAsset`, a driver and a stepper per Fox, the steppers in one parallel pass on
-//! the CPU. Per size: the simulation's time a frame, the CPU's time to record a frame, the
+//! them: one `FurAsset`, a driver and a stepper per Fox, the steppers posing (and on the CPU
+//! kernel bending) in one parallel pass, or each Fox on the GPU kernel (`--sim gpu`). Per size: the simulation's time a frame, the CPU's time to record a frame, the
 //! rest of the frame (the GPU's work and the readback), the GPU bytes of the shared asset and
 //! of each Fox, what one more Fox adds to each, and posing every Fox's base once on the CPU
 //! (`Rig::pose`) against on the GPU (`Rig::pose_joints` per Fox, then one `GpuSkin` dispatch).
@@ -17,18 +17,21 @@ use pelt_core::sim::herd;
 use pelt_core::{ImportOptions, Preset, Stage, StageSource};
 use pelt_render::{
     Backend, Camera, FurAsset, FurDrawSettings, FurDriver, FurTarget, FurView, Gpu, GpuSkin, HEADLESS_FORMAT, Headless,
-    KernelChoice, Studio,
+    KernelChoice, SimKernel, Studio,
 };
 
 /// Figures for one herd size.
 #[derive(Clone, Debug, serde::Serialize)]
 pub struct HerdRow {
     pub foxes: usize,
+    /// Where the strands bend: `cpu` or `gpu`.
+    pub kernel: String,
     /// `WIDTHxHEIGHT`, and the MSAA samples.
     pub size: String,
     pub msaa_samples: u32,
     pub frames: u32,
-    /// Stepping every Fox (one parallel pass) and uploading their states, mean per frame.
+    /// Stepping every Fox (one parallel pass) and uploading their states, mean per frame; on the
+    /// GPU kernel, posing them and recording their steps (the GPU's work is in the next figure).
     pub simulation_ms: f64,
     /// Recording the frame on the CPU (the shadow and main passes' draws).
     pub record_ms: f64,
@@ -43,7 +46,8 @@ pub struct HerdRow {
     pub gpu_pose_ms: f64,
     /// Bytes every Fox shares (topology, uvs, fin strip, textures), once.
     pub shared_gpu_bytes: u64,
-    /// Bytes of each Fox's own state (shared-array state, normals, silhouette and shell lists).
+    /// Bytes of each Fox's own state (shared-array state, normals, silhouette and shell lists;
+    /// on the GPU kernel a second state and its simulation's buffers).
     pub per_fox_gpu_bytes: u64,
     pub total_gpu_bytes: u64,
     /// What the device's allocator holds for the herd's drivers, by its own count (Vulkan; none
@@ -64,13 +68,13 @@ const SIZE: (u32, u32) = (1280, 720);
 const PACE: f32 = 70.0;
 
 /// Runs the sizes and prints the table (Markdown); `json` also gets the rows.
-pub fn run(quick: bool, meshes: &Path, json: Option<&Path>) -> anyhow::Result<()> {
+pub fn run(quick: bool, meshes: &Path, json: Option<&Path>, kernel: SimKernel) -> anyhow::Result<()> {
     let counts: &[usize] = if quick { &COUNTS[..2] } else { &COUNTS };
     let frames: u32 = if quick { 2 } else { 4 };
     let gpu = Gpu::new(Backend::Auto)?;
     // Lavapipe's single sample, as `pelt render` draws there (MSAA where a GPU is).
     let samples = pelt_render::default_sample_count(&gpu.adapter.get_info());
-    let (rows, adapter) = measure(gpu, meshes, counts, (SIZE, samples), frames)?;
+    let (rows, adapter) = measure(gpu, meshes, counts, (SIZE, samples), frames, kernel)?;
     println!("{}", markdown(&rows, &adapter));
     if let Some(path) = json {
         let text = serde_json::to_string_pretty(&rows)? + "\n";
@@ -80,14 +84,19 @@ pub fn run(quick: bool, meshes: &Path, json: Option<&Path>) -> anyhow::Result<()
 }
 
 /// The rows for herds of `counts` Foxes at `size` with `samples` MSAA samples, `frames` timed
-/// frames each, on `gpu`; and the adapter's summary.
+/// frames each, on `gpu`, bending on `kernel`; and the adapter's summary.
 pub fn measure(
     gpu: Gpu,
     meshes: &Path,
     counts: &[usize],
     (size, samples): ((u32, u32), u32),
     frames: u32,
+    kernel: SimKernel,
 ) -> anyhow::Result<(Vec<HerdRow>, String)> {
+    let choice = match kernel {
+        SimKernel::Cpu => KernelChoice::Cpu,
+        SimKernel::Gpu => KernelChoice::Gpu,
+    };
     let path = meshes.join("Fox.glb");
     let stage = Stage::load(&StageSource::File(path.clone()), &[], &ImportOptions::default())
         .with_context(|| format!("loading {}", path.display()))?;
@@ -114,9 +123,7 @@ pub fn measure(
         }
         let before = allocated(device);
         let mut drivers = (0..foxes)
-            .map(|_| {
-                FurDriver::with_asset(device, queue, &renderer, &asset, &fur, &preset.simulation, KernelChoice::Cpu)
-            })
+            .map(|_| FurDriver::with_asset(device, queue, &renderer, &asset, &fur, &preset.simulation, choice))
             .collect::<Result<Vec<_>, _>>()?;
         let herd_bytes = allocated(device).zip(before).map(|(after, before)| after - before);
         let mut steppers = instances
@@ -170,11 +177,17 @@ pub fn measure(
             for (stepper, level) in steppers.iter_mut().zip(&levels) {
                 stepper.set_step_stride(level.step_stride());
             }
-            FurStepper::advance_herd(&mut steppers, &instances, time_secs)?;
-            for ((driver, stepper), level) in drivers.iter_mut().zip(&steppers).zip(levels) {
-                let normals = stepper.moved_pose().map(|pose| &pose.normals[..]);
-                driver.show_state(queue, stepper.simulation().positions(), normals)?;
+            FurDriver::advance_herd((device, queue), &mut drivers, &mut steppers, &instances, time_secs)?;
+            for (driver, level) in drivers.iter_mut().zip(levels) {
                 driver.set_level(level);
+            }
+            if kernel == SimKernel::Gpu {
+                let mut encoder =
+                    device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("herd steps") });
+                for driver in &mut drivers {
+                    driver.record(&mut encoder)?;
+                }
+                queue.submit([encoder.finish()]);
             }
             let stepped = Instant::now();
             let mut recorded = None;
@@ -210,9 +223,11 @@ pub fn measure(
         let shared = asset.gpu_bytes();
         let shared_gpu_bytes = shared.positions + shared.attributes + shared.indices + shared.textures;
         let own = drivers[0].fur().own_bytes();
-        let per_fox_gpu_bytes = own.positions + own.attributes + drivers[0].fur().silhouette_list_bytes();
+        let per_fox_gpu_bytes =
+            own.positions + own.attributes + drivers[0].fur().silhouette_list_bytes() + drivers[0].simulation_bytes();
         rows.push(HerdRow {
             foxes,
+            kernel: kernel.to_string().to_lowercase(),
             size: format!("{}x{}", size.0, size.1),
             msaa_samples: samples,
             frames,
@@ -276,11 +291,12 @@ fn time_posing(
 
 fn markdown(rows: &[HerdRow], adapter: &str) -> String {
     let mut out = format!(
-        "### A herd of walking Foxes ({}, {}x MSAA, 16 layers, shadows on a ground; {adapter})\n\n\
+        "### A herd of walking Foxes ({}, {}x MSAA, 16 layers, shadows on a ground, bent on the {}; {adapter})\n\n\
          | Foxes | frame ms | simulation ms | record ms | GPU + readback ms | one more Fox adds (frame / record, ms) | GPU bytes (shared + per Fox) | allocated | posing every base, CPU / GPU ms |\n\
          |---:|---:|---:|---:|---:|---:|---:|---:|---:|\n",
         rows.first().map_or("", |r| r.size.as_str()),
         rows.first().map_or(1, |r| r.msaa_samples),
+        rows.first().map_or_else(String::new, |r| r.kernel.to_uppercase()),
     );
     for (k, row) in rows.iter().enumerate() {
         let more = match k.checked_sub(1).map(|p| &rows[p]) {
@@ -317,6 +333,7 @@ mod tests {
     fn the_table_adds_one_more_fox_between_rows() {
         let row = |foxes, frame_ms, record_ms| HerdRow {
             foxes,
+            kernel: "cpu".to_owned(),
             size: "1280x720".to_owned(),
             msaa_samples: 1,
             frames: 1,

@@ -195,9 +195,12 @@ impl Model {
         )?;
         let mut herd = None;
         if !instances.is_empty() {
-            // The herd steps on the CPU in one parallel pass, as in `pelt render`.
+            // The viewer's herd steps on the CPU in one parallel pass, its clip on the viewer's clock.
             if args.sim == SimChoice::Gpu {
-                anyhow::bail!("--sim gpu simulates one fur; a herd is simulated on the CPU (--sim cpu)");
+                anyhow::bail!(
+                    "--sim gpu simulates one fur here; in the viewer a herd is simulated on the CPU (--sim cpu; \
+                     `pelt render --herd N --sim gpu` bends one on the GPU)"
+                );
             }
             let clips =
                 pelt_core::sim::herd::resolve_clips(&instances, rig.as_ref(), None).map_err(|(key, problem)| {
