@@ -42,7 +42,8 @@ impl fmt::Display for SimKernel {
 /// Which kernel a [`FurDriver`] is to use (`--sim`).
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub enum KernelChoice {
-    /// Whichever is faster here: both are timed on this fur before the first frame.
+    /// Whichever is clearly faster here: both are timed on this fur before the first frame, and
+    /// the GPU kernel is taken when it steps at least [`AUTO_GPU_MARGIN`] times as fast.
     #[default]
     Auto,
     /// The CPU kernel.
@@ -54,6 +55,12 @@ pub enum KernelChoice {
 /// Steps per timing run and runs per kernel when choosing ([`KernelChoice::Auto`]).
 const TIMING_STEPS: u32 = 3;
 const TIMING_RUNS: usize = 5;
+
+/// How much faster the GPU kernel must step for [`KernelChoice::Auto`] to take it. The kernels
+/// draw pictures that differ in their last bits, so timings within noise of each other (a CPU
+/// rasteriser's) would make the same command draw other bytes from run to run; a GPU's kernel
+/// wins by far more.
+pub const AUTO_GPU_MARGIN: f64 = 1.25;
 
 /// One fur's frame on the GPU: its [`GpuFur`], the kernel that bends it (and with the GPU
 /// kernel its [`GpuSimulation`]) and its per-frame uniform, driven from the host's
@@ -130,7 +137,7 @@ impl FurDriver {
             KernelChoice::Auto => {
                 let cpu = cpu_secs_per_step(structure, params, TIMING_STEPS, TIMING_RUNS)?;
                 let gpu = gpu_secs_per_step(device, queue, renderer, structure, params, TIMING_STEPS, TIMING_RUNS)?;
-                let kernel = if gpu < cpu { SimKernel::Gpu } else { SimKernel::Cpu };
+                let kernel = if gpu * AUTO_GPU_MARGIN < cpu { SimKernel::Gpu } else { SimKernel::Cpu };
                 (kernel, format!("auto: GPU {:.2} ms a step, CPU {:.2} ms", gpu * 1000.0, cpu * 1000.0))
             }
         };

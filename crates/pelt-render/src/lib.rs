@@ -143,7 +143,9 @@ mod view;
 pub use asset::FurAsset;
 pub use camera::Camera;
 pub use colliders::{COLLIDER_COLOUR, ColliderMeshes, HAND_COLOUR, ground_mesh};
-pub use driver::{FurDriver, KernelChoice, SimKernel, cpu_secs_per_step, gpu_secs_per_step, gpu_secs_per_step_of};
+pub use driver::{
+    AUTO_GPU_MARGIN, FurDriver, KernelChoice, SimKernel, cpu_secs_per_step, gpu_secs_per_step, gpu_secs_per_step_of,
+};
 pub use error::RenderError;
 pub use fur::{FurStates, GpuFur};
 pub use geometry::POSITIONS_USAGE;

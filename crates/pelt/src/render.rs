@@ -75,7 +75,7 @@ pub struct Args {
     #[arg(long, default_value = "auto")]
     backend: Backend,
     /// Where the fur is simulated: the CPU, the GPU (a compute pass), or auto (both timed on
-    /// this fur first, the faster runs).
+    /// this fur first, the GPU when clearly faster, so one command draws the same bytes).
     #[arg(long, value_enum, default_value_t = SimChoice::Auto)]
     sim: SimChoice,
     /// Shells and fins with alpha-to-coverage instead of blending (needs MSAA: 4 unless --msaa says more).
