@@ -5,7 +5,7 @@
 //!
 //! [`GpuFur`]: crate::GpuFur
 
-use std::sync::Arc;
+use std::sync::{Arc, OnceLock};
 
 use glam::Vec3;
 use pelt_core::FurStructure;
@@ -32,6 +32,9 @@ pub struct FurAsset {
     pub(crate) drawn: (u32, u32),
     /// The rest pose every copy starts from: `(L + 1) * V` positions and `V` normals.
     pub(crate) rest: Arc<(Vec<Vec3>, Vec<Vec3>)>,
+    /// The GPU simulation's rest segments of this structure, made by the first copy simulated
+    /// on the GPU, shared by every copy grown the same.
+    pub(crate) simulation_rest: Arc<OnceLock<wgpu::Buffer>>,
 }
 
 impl FurAsset {
@@ -68,6 +71,7 @@ impl FurAsset {
             textures,
             drawn,
             rest: Arc::new((structure.positions.clone(), structure.mesh.normals.clone())),
+            simulation_rest: Arc::default(),
         }
     }
 
@@ -77,10 +81,19 @@ impl FurAsset {
     }
 
     /// Bytes uploaded once for every copy: the uvs, topology, fin strip and textures (the
-    /// groom's attributes and keep values are [`GpuFur::groom_bytes`](crate::GpuFur::groom_bytes)).
+    /// groom's attributes and keep values are [`GpuFur::groom_bytes`](crate::GpuFur::groom_bytes)),
+    /// and once a copy simulates on the GPU, its rest segments (in `positions`).
     #[must_use]
     pub fn gpu_bytes(&self) -> GpuBytes {
-        GpuBytes { textures: self.textures.bytes, ..self.geometry.bytes() }
+        let geometry = self.geometry.bytes();
+        let rest = self.simulation_rest.get().map_or(0, wgpu::Buffer::size);
+        GpuBytes { textures: self.textures.bytes, positions: geometry.positions + rest, ..geometry }
+    }
+
+    /// Whether `structure` is the one this asset was uploaded from (its copies may share the
+    /// GPU simulation's rest segments), not a copy grown to another length.
+    pub(crate) fn grown_as(&self, structure: &FurStructure) -> bool {
+        self.rest.0 == structure.positions
     }
 
     /// `L`, the shell layers above the base.

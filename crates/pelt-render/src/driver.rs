@@ -149,7 +149,9 @@ impl FurDriver {
             frame: FurFrame::default(),
             unrecorded: false,
         };
-        driver.use_kernel(device, renderer, structure, kernel)?;
+        // Copies grown as the asset share its GPU rest segments.
+        let shared_rest = asset.grown_as(structure).then_some(&*asset.simulation_rest);
+        driver.use_kernel(device, renderer, structure, kernel, shared_rest)?;
         driver.fur.prepare(queue, &driver.frame);
         Ok(driver)
     }
@@ -192,7 +194,7 @@ impl FurDriver {
             return Ok(());
         }
         self.fur = GpuFur::new(device, queue, renderer, structure, textures, states(kernel))?;
-        self.use_kernel(device, renderer, structure, kernel)?;
+        self.use_kernel(device, renderer, structure, kernel, None)?;
         self.fur.prepare(queue, &self.frame);
         Ok(())
     }
@@ -203,12 +205,16 @@ impl FurDriver {
         renderer: &FurRenderer,
         structure: &FurStructure,
         kernel: SimKernel,
+        shared_rest: Option<&std::sync::OnceLock<wgpu::Buffer>>,
     ) -> Result<(), RenderError> {
         self.kernel = kernel;
         self.unrecorded = false;
-        self.gpu_simulation = match kernel {
-            SimKernel::Gpu => Some(GpuSimulation::with_renderer(device, renderer, &self.fur, structure)?),
-            SimKernel::Cpu => None,
+        self.gpu_simulation = match (kernel, shared_rest) {
+            (SimKernel::Gpu, Some(rest)) => {
+                Some(GpuSimulation::for_copy(device, renderer, &self.fur, structure, rest)?)
+            }
+            (SimKernel::Gpu, None) => Some(GpuSimulation::with_renderer(device, renderer, &self.fur, structure)?),
+            (SimKernel::Cpu, _) => None,
         };
         Ok(())
     }
@@ -239,7 +245,7 @@ impl FurDriver {
     ) -> Result<(), RenderError> {
         self.fur.set_structure(device, renderer, structure)?;
         let kernel = self.kernel;
-        self.use_kernel(device, renderer, structure, kernel)?;
+        self.use_kernel(device, renderer, structure, kernel, None)?;
         self.fur.prepare(queue, &self.frame);
         Ok(())
     }

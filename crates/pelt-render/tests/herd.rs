@@ -10,7 +10,7 @@ use crate::common;
 use common::{BROWN_ROOT, BROWN_TIP, Rig, builtin_fur, framed, settings, strand_textures};
 use glam::Vec3;
 use pelt_core::Builtin;
-use pelt_render::{FurAsset, FurFrame, FurStates, GpuFur};
+use pelt_render::{FurAsset, FurDriver, FurFrame, FurStates, GpuFur, KernelChoice};
 
 /// Pelt's allocations by label, and their bytes, from the device's allocator (wgpu's own, such
 /// as the staging of uploads, left out).
@@ -57,6 +57,35 @@ fn a_hundred_copies_allocate_the_topology_and_textures_once() {
     assert!(allocated >= expected, "{allocated} bytes allocated, {expected} counted");
     assert!((allocated as f64) < 1.3 * expected as f64, "{allocated} bytes allocated, {expected} counted");
     assert!(copies.iter().all(|copy| copy.asset().shares_with(&asset)));
+}
+
+/// Copies simulated on the GPU kernel share their asset's rest segments (a copy grown longer has
+/// its own); each has its own state.
+#[test]
+fn copies_on_the_gpu_kernel_share_the_rest_segments() {
+    let rig = Rig::new(64, 64);
+    let structure = builtin_fur(Builtin::Bunny, 8);
+    let textures = strand_textures(32, 8, BROWN_ROOT, BROWN_TIP);
+    let asset = FurAsset::new(rig.device(), rig.queue(), &rig.renderer, &structure, &textures).expect("asset");
+    let params = pelt_core::sim::SimParams::default();
+    let asset_before = asset.gpu_bytes().positions;
+    let (before, _) = allocations(rig.device());
+    let longer = structure.with_length_scale(1.5);
+    let drivers: Vec<FurDriver> = std::iter::repeat_n(&structure, 10)
+        .chain([&longer])
+        .map(|grown| {
+            FurDriver::with_asset(rig.device(), rig.queue(), &rig.renderer, &asset, grown, &params, KernelChoice::Gpu)
+                .expect("driver")
+        })
+        .collect();
+    let (after, _) = allocations(rig.device());
+    let made = |label: &str| after.get(label).copied().unwrap_or(0) - before.get(label).copied().unwrap_or(0);
+    assert_eq!(made("pelt simulation rest segments"), 2, "one shared, one for the longer copy");
+    assert_eq!(made("pelt simulation strand state"), drivers.len());
+    // The asset counts the shared rest segments once; the longer copy counts its own.
+    let rest = asset.gpu_bytes().positions - asset_before;
+    assert!(rest > 0, "the asset does not count the shared rest segments");
+    assert_eq!(drivers[10].simulation_bytes(), drivers[0].simulation_bytes() + rest);
 }
 
 #[test]

@@ -10,6 +10,8 @@
 //! (from the simulation's [`InertiaStep`]s and the roots) and the touch's weights (when a touch
 //! begins). Nothing is read back and the shared array never crosses the bus.
 
+use std::sync::OnceLock;
+
 use pelt_core::FurStructure;
 use pelt_core::sim::{ContactStep, InputVersions, Simulation, kernel_rest};
 
@@ -69,6 +71,8 @@ pub struct GpuSimulation {
     pipelines: SimPipelines,
     step_uniforms: wgpu::Buffer,
     rest_segments: wgpu::Buffer,
+    /// The rest segments are the asset's, counted with it.
+    rest_shared: bool,
     strands: wgpu::Buffer,
     state: wgpu::Buffer,
     wet: WetInputs,
@@ -145,7 +149,7 @@ impl GpuSimulation {
     /// device refuses the compute pipeline (e.g. no compute shaders).
     pub fn new(device: &wgpu::Device, fur: &GpuFur, structure: &FurStructure) -> Result<Self, RenderError> {
         check_limits(&device.limits())?;
-        Self::with_pipelines(device, SimPipelines::new(device)?, fur, structure)
+        Self::with_pipelines(device, SimPipelines::new(device)?, fur, structure, None)
     }
 
     /// [`GpuSimulation::new`] with the kernels `renderer` keeps for its device, compiled the
@@ -160,7 +164,20 @@ impl GpuSimulation {
         structure: &FurStructure,
     ) -> Result<Self, RenderError> {
         check_limits(&device.limits())?;
-        Self::with_pipelines(device, renderer.simulation_pipelines()?.clone(), fur, structure)
+        Self::with_pipelines(device, renderer.simulation_pipelines()?.clone(), fur, structure, None)
+    }
+
+    /// [`GpuSimulation::with_renderer`] for a copy of a fur grown as its asset's structure: the
+    /// rest segments are `shared_rest`'s, made by the first copy simulated on the GPU.
+    pub(crate) fn for_copy(
+        device: &wgpu::Device,
+        renderer: &FurRenderer,
+        fur: &GpuFur,
+        structure: &FurStructure,
+        shared_rest: &OnceLock<wgpu::Buffer>,
+    ) -> Result<Self, RenderError> {
+        check_limits(&device.limits())?;
+        Self::with_pipelines(device, renderer.simulation_pipelines()?.clone(), fur, structure, Some(shared_rest))
     }
 
     fn with_pipelines(
@@ -168,6 +185,7 @@ impl GpuSimulation {
         pipelines: SimPipelines,
         fur: &GpuFur,
         structure: &FurStructure,
+        shared_rest: Option<&OnceLock<wgpu::Buffer>>,
     ) -> Result<Self, RenderError> {
         let (v, layers) = (structure.vertex_count(), structure.layers as usize);
         check_shape(fur, v, structure.layers)?;
@@ -218,14 +236,20 @@ impl GpuSimulation {
             STEP_SLOT_BYTES * RING_SLOTS,
             wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
         );
-        let rest_segments = wgpu::util::DeviceExt::create_buffer_init(
-            device,
-            &wgpu::util::BufferInitDescriptor {
-                label: Some("pelt simulation rest segments"),
-                contents: bytemuck::cast_slice(&rest),
-                usage: wgpu::BufferUsages::STORAGE,
-            },
-        );
+        let make_rest = || {
+            wgpu::util::DeviceExt::create_buffer_init(
+                device,
+                &wgpu::util::BufferInitDescriptor {
+                    label: Some("pelt simulation rest segments"),
+                    contents: bytemuck::cast_slice(&rest),
+                    usage: wgpu::BufferUsages::STORAGE,
+                },
+            )
+        };
+        let (rest_segments, rest_shared) = match shared_rest {
+            Some(cell) => (cell.get_or_init(make_rest).clone(), true),
+            None => (make_rest(), false),
+        };
         let strands = buffer("pelt simulation strands", v.max(1) as u64 * STRAND_BYTES, storage_usage);
         // Read back by tests comparing it with the CPU's inputs.
         let state = buffer(
@@ -245,6 +269,7 @@ impl GpuSimulation {
             pipelines,
             step_uniforms,
             rest_segments,
+            rest_shared,
             strands,
             state,
             contact,
@@ -455,25 +480,26 @@ impl GpuSimulation {
         self.pending.len()
     }
 
-    /// Bytes of this fur's own simulation buffers (step uniforms, rest segments, inputs, state,
-    /// contact, wetness); its kernels are the renderer's, shared.
+    /// Bytes of this fur's own simulation buffers (step uniforms, rest segments unless its
+    /// asset's, inputs, state, contact, wetness); its kernels are the renderer's, shared.
     #[must_use]
     pub fn gpu_bytes(&self) -> u64 {
         let contact = &self.contact;
-        [
-            &self.step_uniforms,
-            &self.rest_segments,
-            &self.strands,
-            &self.state,
-            &contact.buffer,
-            &contact.fields_buffer,
-            &contact.work,
-            &contact.work_groups,
-            &self.wet.buffer,
-        ]
-        .iter()
-        .map(|buffer| buffer.size())
-        .sum()
+        let own_rest = if self.rest_shared { 0 } else { self.rest_segments.size() };
+        own_rest
+            + [
+                &self.step_uniforms,
+                &self.strands,
+                &self.state,
+                &contact.buffer,
+                &contact.fields_buffer,
+                &contact.work,
+                &contact.work_groups,
+                &self.wet.buffer,
+            ]
+            .iter()
+            .map(|buffer| buffer.size())
+            .sum::<u64>()
     }
 
     /// Node updates per step: `V * L` (the bench's unit).

@@ -44,7 +44,8 @@ pub struct HerdRow {
     /// Posing them on the GPU: the clip and joints on the CPU, the vertices in one `GpuSkin`
     /// dispatch, waited for.
     pub gpu_pose_ms: f64,
-    /// Bytes every Fox shares (topology, uvs, fin strip, textures), once.
+    /// Bytes every Fox shares (topology, uvs, fin strip, textures; on the GPU kernel the
+    /// simulation's rest segments), once.
     pub shared_gpu_bytes: u64,
     /// Bytes of each Fox's own state (shared-array state, normals, silhouette and shell lists;
     /// on the GPU kernel a second state and its simulation's buffers).
@@ -121,6 +122,11 @@ pub fn measure(
         for instance in &mut instances {
             instance.speed = PACE;
         }
+        // The asset as allocated before this herd (a GPU kernel's first copy adds its rest
+        // segments to it, counted in the herd's allocation).
+        let asset_before = asset.gpu_bytes();
+        let asset_before =
+            asset_before.positions + asset_before.attributes + asset_before.indices + asset_before.textures;
         let before = allocated(device);
         let mut drivers = (0..foxes)
             .map(|_| FurDriver::with_asset(device, queue, &renderer, &asset, &fur, &preset.simulation, choice))
@@ -241,7 +247,7 @@ pub fn measure(
             per_fox_gpu_bytes,
             total_gpu_bytes: shared_gpu_bytes + foxes as u64 * per_fox_gpu_bytes,
             // The asset was allocated before every herd: count it once with each.
-            allocated_gpu_bytes: herd_bytes.map(|bytes| bytes + shared_gpu_bytes),
+            allocated_gpu_bytes: herd_bytes.map(|bytes| bytes + asset_before),
         });
     }
     Ok((rows, headless.gpu.summary()))
