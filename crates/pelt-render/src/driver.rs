@@ -209,12 +209,9 @@ impl FurDriver {
     ) -> Result<(), RenderError> {
         self.kernel = kernel;
         self.unrecorded = false;
-        self.gpu_simulation = match (kernel, shared_rest) {
-            (SimKernel::Gpu, Some(rest)) => {
-                Some(GpuSimulation::for_copy(device, renderer, &self.fur, structure, rest)?)
-            }
-            (SimKernel::Gpu, None) => Some(GpuSimulation::with_renderer(device, renderer, &self.fur, structure)?),
-            (SimKernel::Cpu, _) => None,
+        self.gpu_simulation = match kernel {
+            SimKernel::Gpu => Some(GpuSimulation::for_copy(device, renderer, &self.fur, structure, shared_rest)?),
+            SimKernel::Cpu => None,
         };
         Ok(())
     }

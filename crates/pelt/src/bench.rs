@@ -31,24 +31,6 @@ use self::report::{
 };
 use self::table2::Table2Row;
 
-/// Where `pelt bench --herd` bends the Foxes' strands (`--sim`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, clap::ValueEnum)]
-pub enum HerdKernel {
-    /// Every Fox in one parallel pass on the CPU.
-    Cpu,
-    /// Each Fox's GPU simulation, recorded into one submission.
-    Gpu,
-}
-
-impl From<HerdKernel> for pelt_render::SimKernel {
-    fn from(kernel: HerdKernel) -> Self {
-        match kernel {
-            HerdKernel::Cpu => Self::Cpu,
-            HerdKernel::Gpu => Self::Gpu,
-        }
-    }
-}
-
 /// Arguments of `pelt bench`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
@@ -109,10 +91,10 @@ pub struct Args {
     /// one more Fox adds (with --json, the rows as JSON).
     #[arg(long, conflicts_with_all = ["soak", "contact", "guard"])]
     pub herd: bool,
-    /// With --herd: where the Foxes' strands bend, cpu (one parallel pass) or gpu (each Fox's
-    /// kernel, the bases still posed on the CPU).
-    #[arg(long, value_enum, default_value_t = HerdKernel::Cpu, requires = "herd")]
-    pub sim: HerdKernel,
+    /// With --herd: where the Foxes' strands bend, cpu (one parallel pass; auto too, as for
+    /// `pelt render --herd`) or gpu (each Fox's kernel, the bases still posed on the CPU).
+    #[arg(long, value_enum, default_value_t = crate::sim_kernel::SimChoice::Cpu, requires = "herd")]
+    pub sim: crate::sim_kernel::SimChoice,
     /// Instead of the report: every figure that needs a real GPU, written to FILE as JSON in a
     /// few minutes on one (frames at 1920x1080 with the adapter's MSAA, shadows on and off, herds
     /// of 100 and 1,000 Foxes, the GPU kernel on the 35,000-vertex torus, contact's share);
@@ -217,7 +199,11 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     }
     if args.herd {
         let meshes = models::meshes_dir(args.meshes.as_deref());
-        return herd::run(args.quick, &meshes, args.json.as_deref(), args.sim.into());
+        let kernel = match args.sim {
+            crate::sim_kernel::SimChoice::Gpu => pelt_render::SimKernel::Gpu,
+            _ => pelt_render::SimKernel::Cpu,
+        };
+        return herd::run(args.quick, &meshes, args.json.as_deref(), kernel);
     }
     if args.load {
         return load::run(&models::meshes_dir(args.meshes.as_deref()), &args.load_meshes);

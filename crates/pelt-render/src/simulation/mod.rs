@@ -30,8 +30,9 @@ use wet::WetInputs;
 
 /// Strands per workgroup (`@workgroup_size` in `simulation.wgsl`).
 const WORKGROUP: u32 = 64;
-/// Which of the `solve_contact` pipelines (`SimPipelines::solve`) solves `step`'s listed strands: the one compiled
-/// without colliders' code (0), without mesh colliders' (1), or with both (2).
+/// Which of the `solve_contact` pipelines (`SimPipelines::solve`) solves `step`'s listed
+/// strands: the one compiled without colliders' code (0), without mesh colliders' (1), or with
+/// both (2).
 fn solve_kernel(step: &ContactStep) -> usize {
     if step.colliders.iter().any(|c| c.mesh.is_some()) { 2 } else { usize::from(!step.colliders.is_empty()) }
 }
@@ -163,23 +164,23 @@ impl GpuSimulation {
         fur: &GpuFur,
         structure: &FurStructure,
     ) -> Result<Self, RenderError> {
-        check_limits(&device.limits())?;
-        Self::with_pipelines(device, renderer.simulation_pipelines()?.clone(), fur, structure, None)
+        Self::for_copy(device, renderer, fur, structure, None)
     }
 
-    /// [`GpuSimulation::with_renderer`] for a copy of a fur grown as its asset's structure: the
+    /// [`GpuSimulation::with_renderer`]; for a copy of a fur grown as its asset's structure the
     /// rest segments are `shared_rest`'s, made by the first copy simulated on the GPU.
     pub(crate) fn for_copy(
         device: &wgpu::Device,
         renderer: &FurRenderer,
         fur: &GpuFur,
         structure: &FurStructure,
-        shared_rest: &OnceLock<wgpu::Buffer>,
+        shared_rest: Option<&OnceLock<wgpu::Buffer>>,
     ) -> Result<Self, RenderError> {
         check_limits(&device.limits())?;
-        Self::with_pipelines(device, renderer.simulation_pipelines()?.clone(), fur, structure, Some(shared_rest))
+        Self::with_pipelines(device, renderer.simulation_pipelines()?.clone(), fur, structure, shared_rest)
     }
 
+    /// Sets up the simulation with `pipelines`, the device's limits checked.
     fn with_pipelines(
         device: &wgpu::Device,
         pipelines: SimPipelines,
@@ -198,7 +199,6 @@ impl GpuSimulation {
             });
         }
         let limits = device.limits();
-        check_limits(&limits)?;
         let groups = (v as u32).div_ceil(WORKGROUP);
         let grid_x = groups.clamp(1, limits.max_compute_workgroups_per_dimension);
         let grid = [grid_x, groups.div_ceil(grid_x)];

@@ -1,9 +1,10 @@
 //! `pelt bench --device-report FILE`: every figure that needs a real GPU, in one run of a few
 //! minutes on one, written as one JSON object: the bunny's and the try-on's frames at 1920x1080
 //! (the adapter's MSAA: 4x on a GPU) with and without the key light's shadows, herds of 100 and
-//! 1,000 walking Foxes at that size bent on the CPU and on the GPU kernel, the GPU kernel's node updates per second on the
-//! 35,000-vertex torus, and contact's share of each kernel (`pelt bench --contact`). A session
-//! lent a GPU runs it first and records the figures (BENCHMARKS.md).
+//! 1,000 walking Foxes at that size bent on the CPU and on the GPU kernel, the GPU kernel's node
+//! updates per second on the 35,000-vertex torus, and contact's share of each kernel
+//! (`pelt bench --contact`). A session lent a GPU runs it first and records the figures
+//! (BENCHMARKS.md).
 
 use std::path::Path;
 use std::time::Instant;

@@ -2,10 +2,11 @@
 //! 16 layers) walk across a field at their own phases (`herd::scatter`, each walking ahead),
 //! framed whole at 1280x720 with the Fox's shadows on a ground, as `pelt render --herd N` draws
 //! them: one `FurAsset`, a driver and a stepper per Fox, the steppers posing (and on the CPU
-//! kernel bending) in one parallel pass, or each Fox on the GPU kernel (`--sim gpu`). Per size: the simulation's time a frame, the CPU's time to record a frame, the
-//! rest of the frame (the GPU's work and the readback), the GPU bytes of the shared asset and
-//! of each Fox, what one more Fox adds to each, and posing every Fox's base once on the CPU
-//! (`Rig::pose`) against on the GPU (`Rig::pose_joints` per Fox, then one `GpuSkin` dispatch).
+//! kernel bending) in one parallel pass, or each Fox on the GPU kernel (`--sim gpu`). Per size:
+//! the simulation's time a frame, the CPU's time to record a frame, the rest of the frame (the
+//! GPU's work and the readback), the GPU bytes of the shared asset and of each Fox, what one more
+//! Fox adds to each, and posing every Fox's base once on the CPU (`Rig::pose`) against on the GPU
+//! (`Rig::pose_joints` per Fox, then one `GpuSkin` dispatch).
 
 use std::path::Path;
 use std::time::{Duration, Instant};
@@ -124,9 +125,7 @@ pub fn measure(
         }
         // The asset as allocated before this herd (a GPU kernel's first copy adds its rest
         // segments to it, counted in the herd's allocation).
-        let asset_before = asset.gpu_bytes();
-        let asset_before =
-            asset_before.positions + asset_before.attributes + asset_before.indices + asset_before.textures;
+        let asset_before = asset.gpu_bytes().total();
         let before = allocated(device);
         let mut drivers = (0..foxes)
             .map(|_| FurDriver::with_asset(device, queue, &renderer, &asset, &fur, &preset.simulation, choice))
@@ -226,8 +225,7 @@ pub fn measure(
         }
         let (cpu_pose_ms, gpu_pose_ms) = time_posing((device, queue), (&rig, walk), &fur.mesh, &instances, frames)?;
         let per_frame = |d: Duration| d.as_secs_f64() * 1000.0 / f64::from(frames);
-        let shared = asset.gpu_bytes();
-        let shared_gpu_bytes = shared.positions + shared.attributes + shared.indices + shared.textures;
+        let shared_gpu_bytes = asset.gpu_bytes().total();
         let own = drivers[0].fur().own_bytes();
         let per_fox_gpu_bytes =
             own.positions + own.attributes + drivers[0].fur().silhouette_list_bytes() + drivers[0].simulation_bytes();
