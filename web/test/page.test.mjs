@@ -9,6 +9,7 @@ import fs from 'node:fs';
 import http from 'node:http';
 import os from 'node:os';
 import path from 'node:path';
+import zlib from 'node:zlib';
 import { fileURLToPath } from 'node:url';
 import puppeteer from 'puppeteer-core';
 
@@ -119,25 +120,61 @@ async function settled(page) {
   await frames(page, 6);
 }
 
-/** The canvas as RGBA pixels (from a screenshot, so what the compositor shows), saved as `name`. */
+/**
+ * The canvas as RGBA pixels from a screenshot (so what the compositor shows), saved as `name`.
+ * The page is captured within its viewport (no relayout for a capture beyond it) and the PNG
+ * decoded here: a page busy drawing on SwiftShader answers each round trip a frame late.
+ */
 async function shot(page, name) {
-  const canvas = await page.$('#fur');
-  const png = await canvas.screenshot({ path: path.join(output, `${name}.png`) });
-  const decoded = await page.evaluate(async (b64) => {
-    const image = new Image();
-    image.src = `data:image/png;base64,${b64}`;
-    await image.decode();
-    const scratch = document.createElement('canvas');
-    scratch.width = image.width;
-    scratch.height = image.height;
-    const context = scratch.getContext('2d');
-    context.drawImage(image, 0, 0);
-    const bytes = context.getImageData(0, 0, image.width, image.height).data;
-    let binary = '';
-    for (let i = 0; i < bytes.length; i += 0x8000) binary += String.fromCharCode(...bytes.subarray(i, i + 0x8000));
-    return { width: image.width, height: image.height, data: btoa(binary) };
-  }, Buffer.from(png).toString('base64'));
-  return { width: decoded.width, height: decoded.height, data: Buffer.from(decoded.data, 'base64') };
+  page.canvasClip ??= await (await page.$('#fur')).boundingBox();
+  const png = await page.screenshot({
+    path: path.join(output, `${name}.png`), clip: page.canvasClip, captureBeyondViewport: false, optimizeForSpeed: true,
+  });
+  return decodePng(Buffer.from(png));
+}
+
+/** An 8-bit, non-interlaced RGB or RGBA PNG (what Chromium's screenshots are) as RGBA pixels. */
+function decodePng(png) {
+  assert.equal(png.toString('latin1', 1, 4), 'PNG', 'not a PNG');
+  let offset = 8;
+  let header;
+  const idat = [];
+  while (offset < png.length) {
+    const length = png.readUInt32BE(offset);
+    const type = png.toString('latin1', offset + 4, offset + 8);
+    const data = png.subarray(offset + 8, offset + 8 + length);
+    if (type === 'IHDR') header = { width: data.readUInt32BE(0), height: data.readUInt32BE(4), depth: data[8], colour: data[9], interlace: data[12] };
+    else if (type === 'IDAT') idat.push(data);
+    offset += 12 + length;
+  }
+  const { width, height, depth, colour, interlace } = header;
+  assert.ok(depth === 8 && (colour === 2 || colour === 6) && interlace === 0, `unexpected PNG ${JSON.stringify(header)}`);
+  const channels = colour === 6 ? 4 : 3;
+  const raw = zlib.inflateSync(Buffer.concat(idat));
+  const stride = width * channels;
+  const rows = Buffer.alloc(stride * height);
+  for (let y = 0; y < height; y++) {
+    const filter = raw[y * (stride + 1)];
+    const line = raw.subarray(y * (stride + 1) + 1, (y + 1) * (stride + 1));
+    for (let i = 0; i < stride; i++) {
+      const a = i >= channels ? rows[y * stride + i - channels] : 0;
+      const b = y > 0 ? rows[(y - 1) * stride + i] : 0;
+      const c = i >= channels && y > 0 ? rows[(y - 1) * stride + i - channels] : 0;
+      let predictor = 0;
+      if (filter === 1) predictor = a;
+      else if (filter === 2) predictor = b;
+      else if (filter === 3) predictor = (a + b) >> 1;
+      else if (filter === 4) {
+        const p = a + b - c;
+        const [pa, pb, pc] = [Math.abs(p - a), Math.abs(p - b), Math.abs(p - c)];
+        predictor = pa <= pb && pa <= pc ? a : pb <= pc ? b : c;
+      }
+      rows[y * stride + i] = (line[i] + predictor) & 0xff;
+    }
+  }
+  const data = Buffer.alloc(width * height * 4, 255);
+  for (let i = 0; i < width * height; i++) rows.copy(data, i * 4, i * channels, i * channels + 3);
+  return { width, height, data };
 }
 
 function pixel(image, x, y) {
