@@ -3,6 +3,10 @@
 //! skin planes and cones and the grasp's weights; one holding the distance fields of mesh
 //! colliders, each uploaded once; and the list of strands a step's screen could not clear, with
 //! the dispatch arguments of the kernel that solves them.
+//!
+//! Each step slot holds as many colliders as the fur's busiest step has needed so far (a power of
+//! two, up to `MAX_STEP_COLLIDERS`), so a coat nothing touches keeps no collider room in its 64
+//! slots; more colliders grow the buffer (and its bind groups are made again).
 
 use std::sync::Arc;
 
@@ -12,6 +16,7 @@ use pelt_core::sim::contact::{MAX_STEP_COLLIDERS, SKIN_PLANES, SURFACE_WORDS, Sk
 use pelt_core::sim::{ContactStep, ContactStrands};
 
 use crate::RenderError;
+use crate::requirements::check_size;
 
 /// Step slots: one per slot of the simulation's uniform ring.
 pub(crate) const CONTACT_SLOTS: usize = 64;
@@ -19,12 +24,19 @@ pub(crate) const CONTACT_SLOTS: usize = 64;
 const COLLIDER_WORDS: usize = 5;
 /// The first skin plane, after the slots' headers.
 const SKIN_FIRST: usize = 2 * CONTACT_SLOTS;
+/// The fewest colliders a slot makes room for once any step has one.
+const MIN_SLOT_COLLIDERS: usize = 4;
 
 /// The contact buffer of one fur and what it holds.
 #[derive(Debug)]
 pub(crate) struct GpuContact {
     pub buffer: wgpu::Buffer,
     vertex_count: usize,
+    /// vec4s before the first slot's colliders (headers, skin, weights, triangles): what a
+    /// buffer grown for more colliders copies from the one before.
+    prefix_words: usize,
+    /// Colliders each step slot has room for (0 until a step has one).
+    slot_colliders: usize,
     /// The longest strand's length (a little over), in each slot's header: the solve's bound on
     /// how far from its root a strand reaches.
     reach: f32,
@@ -74,8 +86,15 @@ fn weights_first(v: usize) -> usize {
     cones_first(v) + v
 }
 
-fn colliders_first(v: usize, slot: usize) -> usize {
-    weights_first(v) + v.div_ceil(4) + slot * MAX_STEP_COLLIDERS * COLLIDER_WORDS
+/// The skin's triangle part (`simulation_contact.wgsl`'s `surface_first`), after the weights.
+fn surface_first(v: usize) -> usize {
+    weights_first(v) + v.div_ceil(4)
+}
+
+/// Where slot `slot`'s colliders begin after `prefix_words` vec4s (`Skin::prefix_words`), each
+/// slot with room for `slot_colliders` (the slot's header tells the kernels).
+fn colliders_first(prefix_words: usize, slot: usize, slot_colliders: usize) -> usize {
+    prefix_words + slot * slot_colliders * COLLIDER_WORDS
 }
 
 // A strand's header packs its triangle count in 6 bits.
@@ -107,14 +126,26 @@ impl Skin {
     /// vec4s of the triangle part: a header per strand (rest root, `first << 6 | count`), the
     /// lists four indices a vec4, then the triangles.
     fn words(&self) -> usize {
-        self.planes.len() + self.surface.lists.len().div_ceil(4) + self.surface.triangles.len() * SURFACE_WORDS
+        self.surface.strands.len() + self.surface.lists.len().div_ceil(4) + self.surface.triangles.len() * SURFACE_WORDS
+    }
+
+    /// vec4s of the buffer before the colliders: the slots' headers, the planes, cones and
+    /// weights, then the triangle part.
+    fn prefix_words(&self) -> usize {
+        surface_first(self.planes.len()) + self.words()
     }
 }
 
 impl GpuContact {
-    /// The buffer's size in bytes for `skin`'s fur.
-    pub fn bytes(skin: &Skin) -> u64 {
-        (colliders_first(skin.planes.len(), CONTACT_SLOTS) + skin.words()) as u64 * 16
+    /// The buffer's size in bytes for `skin`'s fur with room for `slot_colliders` colliders in
+    /// each step slot.
+    pub fn bytes(skin: &Skin, slot_colliders: usize) -> u64 {
+        colliders_first(skin.prefix_words(), CONTACT_SLOTS, slot_colliders) as u64 * 16
+    }
+
+    /// Colliders each step slot has room for now.
+    pub fn slot_colliders(&self) -> usize {
+        self.slot_colliders
     }
 
     /// Bytes of the list of a fur of `v` strands: the header (`groups`, `count`), and a strand
@@ -124,10 +155,10 @@ impl GpuContact {
     }
 
     /// The buffer with `skin` (planes and triangles) for `structure`'s strands and no collider
-    /// or grasp.
+    /// or grasp (nor room for one).
     pub fn new(device: &wgpu::Device, structure: &FurStructure, skin: &Skin) -> Self {
         let v = structure.vertex_count();
-        let buffer = skin_buffer(device, &structure.positions[..v], skin);
+        let buffer = skin_buffer(device, &structure.positions[..v], skin, 0);
         let fields_buffer = fields_buffer(device, &[0.0; 4]);
         let work = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("pelt simulation contact list"),
@@ -150,6 +181,8 @@ impl GpuContact {
         Self {
             buffer,
             vertex_count: v,
+            prefix_words: skin.prefix_words(),
+            slot_colliders: 0,
             reach: reach * 1.001,
             weights: Vec::new(),
             fields_buffer,
@@ -163,8 +196,42 @@ impl GpuContact {
     /// written again at the next step, the slots are written every step. `roots`: the strands'
     /// rest roots.
     pub fn set_skin(&mut self, device: &wgpu::Device, roots: &[glam::Vec3], skin: &Skin) {
-        self.buffer = skin_buffer(device, roots, skin);
+        self.prefix_words = skin.prefix_words();
+        self.buffer = skin_buffer(device, roots, skin, self.slot_colliders);
         self.weights.clear();
+    }
+
+    /// Makes room for `steps`' colliders in every slot; true when the buffer was replaced (its
+    /// bind groups with it). The new buffer takes the old one's skin and weights by a copy on
+    /// the GPU (submitted here), so nothing of the skin is kept on the CPU.
+    ///
+    /// # Errors
+    /// [`RenderError::TooLarge`] when the grown buffer would exceed the device's limits; nothing
+    /// changes then.
+    pub fn make_room(
+        &mut self,
+        (device, queue): (&wgpu::Device, &wgpu::Queue),
+        steps: &[ContactStep],
+    ) -> Result<bool, RenderError> {
+        let room = slot_room(steps);
+        if room <= self.slot_colliders {
+            return Ok(false);
+        }
+        let size = colliders_first(self.prefix_words, CONTACT_SLOTS, room) as u64 * 16;
+        check_size(device, "simulation contact", size)?;
+        let grown = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("pelt simulation contact"),
+            size,
+            usage: CONTACT_USAGE,
+            mapped_at_creation: false,
+        });
+        let mut encoder =
+            device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("pelt contact room") });
+        encoder.copy_buffer_to_buffer(&self.buffer, 0, &grown, 0, self.prefix_words as u64 * 16);
+        queue.submit([encoder.finish()]);
+        self.buffer = grown;
+        self.slot_colliders = room;
+        Ok(true)
     }
 
     /// Empties the list before a step's screen.
@@ -217,12 +284,15 @@ impl GpuContact {
         self.fields.iter().find(|(m, _)| Arc::ptr_eq(m, mesh)).map(|(_, offset)| *offset)
     }
 
-    /// Writes step slot `slot`'s header and colliders.
+    /// Writes step slot `slot`'s header and colliders (as many as [`GpuContact::make_room`]
+    /// made room for).
     pub fn write_slot(&self, queue: &wgpu::Queue, slot: usize, step: &ContactStep) {
-        let count = step.colliders.len().min(MAX_STEP_COLLIDERS);
+        let count = step.colliders.len().min(self.slot_colliders);
+        debug_assert_eq!(count, step.colliders.len().min(MAX_STEP_COLLIDERS), "make_room first");
+        let first = colliders_first(self.prefix_words, slot, self.slot_colliders);
         let header = [
             [f32::from_bits(count as u32), if step.skin { 1.0 } else { 0.0 }, step.grip_presence, self.reach],
-            step.grip.extend(0.0).to_array(),
+            step.grip.extend(f32::from_bits(first as u32)).to_array(),
         ];
         queue.write_buffer(&self.buffer, (2 * slot) as u64 * 16, bytemuck::cast_slice(&header));
         if count == 0 {
@@ -246,11 +316,7 @@ impl GpuContact {
                 ]
             })
             .collect();
-        queue.write_buffer(
-            &self.buffer,
-            colliders_first(self.vertex_count, slot) as u64 * 16,
-            bytemuck::cast_slice(&words),
-        );
+        queue.write_buffer(&self.buffer, first as u64 * 16, bytemuck::cast_slice(&words));
     }
 
     /// Writes the grasp's weights when they changed.
@@ -272,11 +338,23 @@ impl GpuContact {
     }
 }
 
+/// Colliders a slot makes room for to hold the busiest of `steps`.
+fn slot_room(steps: &[ContactStep]) -> usize {
+    room_for(steps.iter().map(|s| s.colliders.len()).max().unwrap_or(0))
+}
+
+/// Room for `most` colliders: none for none, else a power of two from `MIN_SLOT_COLLIDERS` to
+/// `MAX_STEP_COLLIDERS` (so a coat whose colliders come one by one is not made again for each).
+fn room_for(most: usize) -> usize {
+    if most == 0 { 0 } else { most.next_power_of_two().clamp(MIN_SLOT_COLLIDERS, MAX_STEP_COLLIDERS) }
+}
+
 /// The contact buffer for `roots.len()` strands: the slots' headers (zero), `skin`'s planes and
-/// cones, the collider and weight slots (zero), then the skin triangles.
-fn skin_buffer(device: &wgpu::Device, roots: &[glam::Vec3], skin: &Skin) -> wgpu::Buffer {
+/// cones, the weights (zero), the skin triangles, then room for `slot_colliders` colliders in
+/// each slot.
+fn skin_buffer(device: &wgpu::Device, roots: &[glam::Vec3], skin: &Skin, slot_colliders: usize) -> wgpu::Buffer {
     let v = roots.len();
-    let mut words = vec![[0.0_f32; 4]; colliders_first(v, CONTACT_SLOTS)];
+    let mut words = vec![[0.0_f32; 4]; surface_first(v)];
     for (j, planes) in skin.planes.iter().enumerate() {
         for (p, plane) in planes.iter().enumerate() {
             words[SKIN_FIRST + j * SKIN_PLANES + p] = plane.to_array();
@@ -301,19 +379,38 @@ fn skin_buffer(device: &wgpu::Device, roots: &[glam::Vec3], skin: &Skin) -> wgpu
         w
     }));
     words.extend(surface.triangles.iter().flat_map(|t| t.map(|w| w.to_array())));
+    debug_assert_eq!(words.len(), skin.prefix_words());
+    words.resize(colliders_first(words.len(), CONTACT_SLOTS, slot_colliders), [0.0; 4]);
     wgpu::util::DeviceExt::create_buffer_init(
         device,
         &wgpu::util::BufferInitDescriptor {
             label: Some("pelt simulation contact"),
             contents: bytemuck::cast_slice(&words),
-            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            usage: CONTACT_USAGE,
         },
     )
 }
 
+/// The contact buffer's uses: read by the kernels, written by the queue, copied when it grows.
+const CONTACT_USAGE: wgpu::BufferUsages =
+    wgpu::BufferUsages::STORAGE.union(wgpu::BufferUsages::COPY_DST).union(wgpu::BufferUsages::COPY_SRC);
+
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A slot has no room for colliders until a step has one, then room for a power of two of
+    /// them from 4, never more than a step can hold; the buffer grows by that room alone.
+    #[test]
+    fn slots_make_room_for_the_busiest_step() {
+        let room: Vec<usize> = [0, 1, 3, 4, 5, 9, 100, 128, 129, 1000].into_iter().map(room_for).collect();
+        assert_eq!(room, [0, 4, 4, 4, 8, 16, 128, 128, 128, 128]);
+        let skin = Skin::none(10);
+        let bare = GpuContact::bytes(&skin, 0);
+        // Headers, 16 planes, a cone and a quarter of a weight vec4 per strand.
+        assert_eq!(bare, (2 * 64 + 16 * 10 + 10 + 3) * 16);
+        assert_eq!(GpuContact::bytes(&skin, 8) - bare, 64 * 8 * 5 * 16);
+    }
 
     /// Fields past the device's storage binding (or buffer) limit are refused with both sizes.
     #[test]

@@ -375,8 +375,9 @@ fn back_facing_up(structure: &FurStructure) -> (Vec3, Vec3) {
 /// The same fur on both kernels with contact: the skin under strong gravity and downward wind
 /// (alone for half a second, then with) a ball, a thin capsule and a box moving through the fur
 /// on the back, a hand lifting a tuft and
-/// letting go. At every step every node agrees within the bound of the other agreement tests
-/// (1e-4 strand lengths). Contact's response is continuous where it can be (friction ramps in
+/// letting go, then six balls more (each step slot's room for colliders grows mid-run; failed
+/// when the grown buffer was not bound, or did not take the skin from the one before). At every
+/// step every node agrees within the bound of the other agreement tests (1e-4 strand lengths). Contact's response is continuous where it can be (friction ramps in
 /// with depth, the grip's segment turns in part, a turn's side leans the strand's own way as
 /// deep as the segment points into a plane), so no branch flips on a last-bit difference. (With
 /// the least turn's side alone, strands pressed into a crease folded and parted by up to 0.1
@@ -433,6 +434,17 @@ fn gpu_and_cpu_agree_with_contact() {
                 Quat::from_rotation_y(0.4),
             ),
         ];
+        // From step 46, six small balls more along the back: each step slot's room for
+        // colliders grows from 4 to 16 mid-run (the contact buffer is made again and bound).
+        let mut colliders = colliders.to_vec();
+        if step > 45 {
+            colliders.extend((0..6_u32).map(|i| {
+                let turn = i as f32 * 1.05;
+                let across = (Vec3::X * turn.cos() + Vec3::Z * turn.sin()) * 0.25 * radius;
+                let centre = hit + normal * (0.04 * radius + 0.3 * length) + across;
+                Collider::at(10 + i, Shape::Sphere { radius: 0.04 * radius }, t, centre, Quat::IDENTITY)
+            }));
+        }
         // The skin alone for the first steps (the kernel without colliders' code), then both.
         let colliders = &colliders[..if step > 15 { colliders.len() } else { 0 }];
         for simulation in [&mut cpu, &mut control] {

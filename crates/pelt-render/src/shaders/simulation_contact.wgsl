@@ -6,19 +6,20 @@
 //
 // `contact` layout, in vec4s (V strands, `grid.y` the step's slot):
 //   [2 s], [2 s + 1] for slot s < CONTACT_SLOTS: (collider count, skin on, grip presence, the
-//     longest strand's length), (grip xyz, -);
+//     longest strand's length), (grip xyz, where the slot's colliders begin as bits);
 //   from CONTACT_SKIN: SKIN_PLANES planes per strand (n xyz in the rest frame, h);
 //   then a cone per strand (`pelt_core::sim::contact::skin_cone`: axis xyz in the rest frame,
 //     spread);
 //   then ceil(V / 4) vec4s of grasp weights, 4 strands each;
-//   then per slot CONTACT_COLLIDERS colliders of 5 vec4s: (centre, radius),
-//     (half extents, kind as bits), rotation, (travel, friction), (bound, grasp hand, field as
-//     bits, -) (a mesh's radius is its scale, its field where it begins in `sdf_fields`);
 //   then the skin's triangles (`contact::surface`), from `surface_first`: per strand (rest root,
 //     first << 6 | count as bits), the lists (each entry its triangle's first vec4 from
 //     `surface_first`), the triangles of 10 vec4s (a, b, c, face normal, edge ab, bc, ca and
 //     corner a, b, c pseudonormals; a bounding ball's centre in a, b, c's w, its radius in the
-//     face normal's).
+//     face normal's);
+//   then each slot's colliders (as many as the fur's busiest step needs, `contact.rs`), 5 vec4s
+//     each: (centre, radius), (half extents, kind as bits), rotation, (travel, friction),
+//     (bound, grasp hand, field as bits, -) (a mesh's radius is its scale, its field where it
+//     begins in `sdf_fields`).
 
 @group(0) @binding(5) var<storage, read> contact: array<vec4<f32>>;
 // What `step_strands_with_contact` lists for `solve_contact`: the indirect dispatch's workgroups
@@ -43,7 +44,6 @@ override MESH_COLLIDERS: bool = true;
 const CONTACT_SLOTS: u32 = 64u;
 const CONTACT_SKIN: u32 = 2u * CONTACT_SLOTS;
 const SKIN_PLANES: u32 = 16u;
-const CONTACT_COLLIDERS: u32 = 128u;
 const COLLIDER_WORDS: u32 = 5u;
 const NEAR_COLLIDERS: u32 = 32u;
 const CONTACT_MARGIN: f32 = 1e-5;
@@ -206,12 +206,12 @@ fn cones_first(v: u32) -> u32 {
     return CONTACT_SKIN + SKIN_PLANES * v;
 }
 
-fn colliders_first(v: u32, slot: u32) -> u32 {
-    return cones_first(v) + v + (v + 3u) / 4u + slot * CONTACT_COLLIDERS * COLLIDER_WORDS;
+fn colliders_first(slot: u32) -> u32 {
+    return bitcast<u32>(contact[2u * slot + 1u].w);
 }
 
 fn surface_first(v: u32) -> u32 {
-    return colliders_first(v, CONTACT_SLOTS);
+    return cones_first(v) + v + (v + 3u) / 4u;
 }
 
 // One strand's skin triangles, posed with its root and frame.
@@ -404,7 +404,7 @@ fn screen_node(k: u32, node: vec3<f32>, root: vec3<f32>) {
 fn screen_finish(j: u32, v: u32, layers: u32) {
     let slot = inputs.grid.y;
     let count = bitcast<u32>(contact[2u * slot].x);
-    let first = colliders_first(v, slot);
+    let first = colliders_first(slot);
     for (var i = 0u; i < count; i++) {
         let c = first + i * COLLIDER_WORDS;
         let centre = contact[c].xyz;
@@ -501,7 +501,7 @@ fn contact_setup(j: u32, v: u32, root: vec3<f32>, frame: vec4<f32>) {
     }
     // Colliders that can reach the strand (its nodes lie within the longest strand's length of
     // the root).
-    let first = colliders_first(v, slot);
+    let first = colliders_first(slot);
     contact_near_count = 0u;
     for (var i = 0u; COLLIDERS && i < count && contact_near_count < NEAR_COLLIDERS; i++) {
         let c = first + i * COLLIDER_WORDS;

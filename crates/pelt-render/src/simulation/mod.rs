@@ -260,7 +260,7 @@ impl GpuSimulation {
         // The skin's planes and triangles come from the CPU simulation once it has found them
         // (skin contact on): a coat that never touches its skin never finds them.
         let skin = Skin::none(v);
-        check_size(device, "simulation contact", GpuContact::bytes(&skin))?;
+        check_size(device, "simulation contact", GpuContact::bytes(&skin, 0))?;
         check_size(device, "simulation contact list", GpuContact::work_bytes(v))?;
         let contact = GpuContact::new(device, structure, &skin);
         let wet = WetInputs::new(device, v);
@@ -370,11 +370,13 @@ impl GpuSimulation {
         let mut rebind = false;
         if !self.skin_found && simulation.has_skin_setup() {
             let skin = Skin::of(&strands);
-            check_size(device, "simulation contact", GpuContact::bytes(&skin))?;
+            check_size(device, "simulation contact", GpuContact::bytes(&skin, self.contact.slot_colliders()))?;
             self.contact.set_skin(device, strands.rest_roots, &skin);
             self.skin_found = true;
             rebind = true;
         }
+        // Room for the pending steps' colliders (a coat nothing touches keeps none).
+        rebind |= self.contact.make_room((device, queue), &self.pending_contact)?;
         self.contact.write_strands(queue, &strands);
         if self.contact.upload_fields(device, &self.pending_contact)? || rebind {
             // The fields or the contact buffer is new: bind it.
