@@ -364,15 +364,38 @@ impl FurDriver {
             }
         }
         for (driver, stepper) in drivers.iter_mut().zip(steppers.iter_mut()) {
-            driver.fall_back_when_unrecorded();
-            driver.claim(stepper.simulation_mut());
+            driver.claim_stepper(stepper);
         }
         FurStepper::advance_herd(steppers, instances, time_secs)?;
         for (driver, stepper) in drivers.iter_mut().zip(steppers.iter()) {
-            driver.show_wetness(queue, stepper)?;
-            driver.upload(device, queue, stepper.simulation(), stepper.moved_pose().map(|pose| &pose.normals[..]))?;
+            driver.show_claimed(device, queue, stepper)?;
         }
         Ok(())
+    }
+
+    /// The first half of a step a host takes itself (a herd member it steps with the others, as
+    /// the viewer does; [`FurDriver::advance_herd`] takes both halves): call before stepping
+    /// `stepper`. On the GPU kernel its simulation then keeps time and poses while the GPU
+    /// bends; on the CPU kernel it bends.
+    pub fn claim_stepper(&mut self, stepper: &mut FurStepper) {
+        self.fall_back_when_unrecorded();
+        self.claim(stepper.simulation_mut());
+    }
+
+    /// The second half: what `stepper` stepped since [`FurDriver::claim_stepper`], on this
+    /// driver's kernel (the CPU's positions, or the steps for [`FurDriver::record`]), with its
+    /// wetness and posed normals.
+    ///
+    /// # Errors
+    /// As [`FurDriver::advance_to`].
+    pub fn show_claimed(
+        &mut self,
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        stepper: &FurStepper,
+    ) -> Result<(), RenderError> {
+        self.show_wetness(queue, stepper)?;
+        self.upload(device, queue, stepper.simulation(), stepper.moved_pose().map(|pose| &pose.normals[..]))
     }
 
     /// The stepper's wetness and what it does to the look (`[wet]`), for the coming frame: the

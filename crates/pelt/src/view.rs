@@ -48,7 +48,8 @@ pub struct Args {
     #[arg(long)]
     pub no_overlay: bool,
     /// Where the fur is simulated: the CPU, the GPU (a compute pass), or auto (both timed on
-    /// this fur when the window opens, the GPU when clearly faster). The panel switches it live.
+    /// this fur when the window opens, the GPU when clearly faster; a herd: the CPU). A herd's
+    /// copies bend where the edited fur does. The panel switches it live.
     #[arg(long, value_enum, default_value_t = crate::sim_kernel::SimChoice::Auto)]
     pub sim: crate::sim_kernel::SimChoice,
     /// Every shell and fin segment however small the fur is on screen (the preset's

@@ -20,6 +20,11 @@ static XVFB: std::sync::Mutex<()> = std::sync::Mutex::new(());
 
 /// Runs `pelt view ARGS --screenshot-after FRAMES --out OUT` under Xvfb and loads the PNG.
 fn screenshot(name: &str, frames: u32, args: &[&str]) -> image::RgbaImage {
+    screenshot_saying(name, frames, args).0
+}
+
+/// [`screenshot`] and what the viewer printed.
+fn screenshot_saying(name: &str, frames: u32, args: &[&str]) -> (image::RgbaImage, String) {
     let _one_at_a_time = XVFB.lock().unwrap_or_else(std::sync::PoisonError::into_inner);
     let out = out_path(name);
     let _stale = std::fs::remove_file(&out);
@@ -39,7 +44,8 @@ fn screenshot(name: &str, frames: u32, args: &[&str]) -> image::RgbaImage {
         String::from_utf8_lossy(&output.stdout),
         String::from_utf8_lossy(&output.stderr)
     );
-    image::open(&out).unwrap_or_else(|e| panic!("reading {}: {e}", out.display())).to_rgba8()
+    let image = image::open(&out).unwrap_or_else(|e| panic!("reading {}: {e}", out.display())).to_rgba8();
+    (image, String::from_utf8_lossy(&output.stdout).into_owned())
 }
 
 fn luminance(pixel: &image::Rgba<u8>) -> f64 {
@@ -238,8 +244,20 @@ fn the_windows_key_light_places_the_shadow() {
 /// right one's phase changes the right half of the 3D view and leaves the left one's alone.
 #[test]
 fn the_window_draws_a_herd_each_member_at_its_own_phase() {
+    herd_at_phases("cpu");
+}
+
+/// The same with every member bent by the GPU simulation (the right Fox is the copy the
+/// viewer's herd drives, not the edited fur).
+#[test]
+fn the_window_draws_a_herd_bent_on_the_gpu() {
+    herd_at_phases("gpu");
+}
+
+fn herd_at_phases(kernel: &str) {
     let fox = concat!(env!("CARGO_MANIFEST_DIR"), "/../../assets/meshes/Fox.glb");
     let herd = |name: &str, offset: f32| {
+        let name = format!("{name}_{kernel}");
         let script = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("cli_view_{name}.toml"));
         std::fs::write(
             &script,
@@ -251,7 +269,15 @@ fn the_window_draws_a_herd_each_member_at_its_own_phase() {
         )
         .expect("the script");
         let script = script.to_str().unwrap().to_owned();
-        screenshot(name, 12, &[fox, "--script", &script, "--sim", "cpu", "--no-overlay", "--no-shadows"])
+        let (image, said) =
+            screenshot_saying(&name, 12, &[fox, "--script", &script, "--sim", kernel, "--no-overlay", "--no-shadows"]);
+        // Both furs bent where asked, none fallen back to the CPU.
+        let expected = match kernel {
+            "gpu" => "bent on the GPU kernel; 1 of the herd's 1 other copies on the GPU",
+            _ => "bent on the CPU kernel; 0 of the herd's 1 other copies on the GPU",
+        };
+        assert!(said.contains(expected), "{name}: {said}");
+        image
     };
     let together = herd("herd_together", 0.0);
     let apart = herd("herd_apart", 0.35);
@@ -263,7 +289,7 @@ fn the_window_draws_a_herd_each_member_at_its_own_phase() {
             .count()
     };
     let (left, right) = (differing(0, half), differing(half, 2 * half));
-    println!("{left} pixels of the left half differ, {right} of the right");
+    println!("{kernel}: {left} pixels of the left half differ, {right} of the right");
     assert!(right > 300, "{right} pixels of the right Fox moved");
     assert!(left * 20 < right, "{left} pixels of the left Fox changed, {right} of the right");
 }
@@ -273,7 +299,7 @@ fn the_window_draws_a_herd_each_member_at_its_own_phase() {
 fn a_bad_herd_is_refused_before_any_window_opens() {
     for (args, says) in [
         (&["--herd", "0"][..], "--herd 0: a herd needs at least one instance"),
-        (&["--herd", "3", "--sim", "gpu"][..], "a herd is simulated on the CPU"),
+        (&["--herd", "nan"][..], "invalid value 'nan' for '--herd <N>'"),
     ] {
         let stderr = refused_without_a_window(args);
         assert!(stderr.contains(says), "{args:?}: {stderr}");

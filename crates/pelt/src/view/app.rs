@@ -107,7 +107,7 @@ impl App {
         let (kernel, reason) = fur.kernel();
         model.settings.gpu_sim = kernel == SimKernel::Gpu;
         model.kernel_reason = match &model.herd {
-            Some(_) => "a herd, in one parallel pass".to_owned(),
+            Some(_) => format!("{reason}; a herd posed in one parallel pass, each copy bent on this kernel"),
             None => reason.to_owned(),
         };
         Ok(Running {
@@ -209,6 +209,7 @@ impl App {
             if let Some(herd) = &mut model.herd {
                 // Far members are stepped less often, as in `pelt render`.
                 let strides: Vec<u32> = members[1..].iter().map(|m| m.level.step_stride()).collect();
+                running.fur.claim_herd(herd);
                 herd.advance(time_secs, clip_secs, &strides)?;
                 running.fur.show_herd(&running.gpu, herd, &members)?;
             }
@@ -330,6 +331,10 @@ impl App {
                     model.frames_drawn,
                     1e3 / frame_ms
                 );
+                // Which kernel bent the fur (and a herd's copies): scripts check it.
+                let (kernel, _) = running.fur.kernel();
+                let (copies_on_gpu, copies) = running.fur.herd_on_gpu();
+                println!("bent on the {kernel} kernel; {copies_on_gpu} of the herd's {copies} other copies on the GPU");
                 model.quit = true;
             }
             if model.screenshot_pending {

@@ -120,6 +120,8 @@ impl FurScene {
             return Ok(());
         }
         self.driver.set_kernel(&gpu.device, &gpu.queue, &self.renderer, structure, &self.textures, kernel)?;
+        // The herd's copies bend on the edited fur's kernel.
+        self.herd_stale = true;
         Ok(())
     }
 
@@ -221,10 +223,24 @@ impl FurScene {
         if others == 0 {
             self.herd = None;
         } else if self.herd_stale || self.herd.as_ref().is_none_or(|h| h.len() != others) {
-            self.herd = Some(HerdDrivers::new(gpu, &self.renderer, (structure, &self.textures), params, others)?);
+            let kernel = self.driver.kernel();
+            self.herd =
+                Some(HerdDrivers::new(gpu, &self.renderer, (structure, &self.textures), (params, kernel), others)?);
         }
         self.herd_stale = false;
         Ok(())
+    }
+
+    /// Before the herd's other members step: each bends on its copy's kernel.
+    pub fn claim_herd(&mut self, herd: &mut Herd) {
+        if let Some(drivers) = &mut self.herd {
+            drivers.claim(herd);
+        }
+    }
+
+    /// The herd's copies on the GPU kernel, of how many.
+    pub fn herd_on_gpu(&self) -> (usize, usize) {
+        self.herd.as_ref().map_or((0, 0), |drivers| (drivers.on_gpu(), drivers.len()))
     }
 
     /// Shows the herd's members as they stepped this frame: the main fur takes the first

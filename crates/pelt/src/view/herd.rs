@@ -1,7 +1,8 @@
 //! A herd in the viewer (`--herd N`, a script's `[[instance]]`s). The fur the panel edits is the
 //! first member, placed as the first instance; the others are copies of it, each simulated on its
-//! own (stepped on the CPU in one parallel pass) and drawn from one shared asset, rebuilt from
-//! the edited fur whenever its structure, textures, groom or simulation change.
+//! own (posed on the CPU in one parallel pass, bent on the edited fur's kernel) and drawn from one
+//! shared asset, rebuilt from the edited fur whenever its structure, textures, groom, simulation
+//! or kernel change.
 
 use super::model::Model;
 use super::panel::{Changes, MeshChoice};
@@ -11,7 +12,7 @@ use pelt_core::sim::herd::HerdInstance;
 use pelt_core::sim::{FurStepper, Scene};
 use pelt_core::{FurStructure, FurTextures, Preset};
 use pelt_render::{
-    FurAsset, FurDrawSettings, FurDriver, FurLevel, FurLook, FurRenderer, FurView, KernelChoice, ViewData,
+    FurAsset, FurDrawSettings, FurDriver, FurLevel, FurLook, FurRenderer, FurView, KernelChoice, SimKernel, ViewData,
 };
 
 /// The CPU half: where the members stand and the others' simulations.
@@ -51,6 +52,10 @@ impl Herd {
 
     pub(super) fn followers(&self) -> &[FurStepper] {
         &self.followers
+    }
+
+    fn followers_mut(&mut self) -> &mut [FurStepper] {
+        &mut self.followers
     }
 
     /// Makes the others anew as copies of the edited fur: `structure` (each grown to its own
@@ -231,7 +236,7 @@ pub(super) struct HerdDrivers {
 }
 
 impl HerdDrivers {
-    /// `count` copies of `structure` with `textures`, simulated on the CPU.
+    /// `count` copies of `structure` with `textures`, bent on `kernel`.
     ///
     /// # Errors
     /// The upload's errors.
@@ -239,13 +244,17 @@ impl HerdDrivers {
         gpu: &pelt_render::Gpu,
         renderer: &FurRenderer,
         (structure, textures): (&FurStructure, &FurTextures),
-        params: &pelt_core::sim::SimParams,
+        (params, kernel): (&pelt_core::sim::SimParams, SimKernel),
         count: usize,
     ) -> anyhow::Result<Self> {
         let (device, queue) = (&gpu.device, &gpu.queue);
         let asset = FurAsset::new(device, queue, renderer, structure, textures)?;
+        let choice = match kernel {
+            SimKernel::Gpu => KernelChoice::Gpu,
+            SimKernel::Cpu => KernelChoice::Cpu,
+        };
         let drivers = (0..count)
-            .map(|_| FurDriver::with_asset(device, queue, renderer, &asset, structure, params, KernelChoice::Cpu))
+            .map(|_| FurDriver::with_asset(device, queue, renderer, &asset, structure, params, choice))
             .collect::<Result<Vec<_>, _>>()?;
         Ok(Self { _asset: asset, drivers })
     }
@@ -254,8 +263,21 @@ impl HerdDrivers {
         self.drivers.len()
     }
 
-    /// Shows each copy what its stepper stepped, at its level and with `look` tinted by its
-    /// instance's tint.
+    /// How many copies bend on the GPU kernel now (a copy whose steps went unrecorded falls
+    /// back to the CPU).
+    pub(super) fn on_gpu(&self) -> usize {
+        self.drivers.iter().filter(|driver| driver.kernel() == SimKernel::Gpu).count()
+    }
+
+    /// Before the copies' steppers step: each bends on its driver's kernel.
+    pub(super) fn claim(&mut self, herd: &mut Herd) {
+        for (driver, stepper) in self.drivers.iter_mut().zip(herd.followers_mut()) {
+            driver.claim_stepper(stepper);
+        }
+    }
+
+    /// Shows each copy what its stepper stepped (on the GPU kernel: its steps, recorded into one
+    /// submission here), at its level and with `look` tinted by its instance's tint.
     pub(super) fn show(
         &mut self,
         gpu: &pelt_render::Gpu,
@@ -264,13 +286,21 @@ impl HerdDrivers {
         look: FurLook,
     ) -> anyhow::Result<()> {
         for (k, (driver, stepper)) in self.drivers.iter_mut().zip(herd.followers()).enumerate() {
-            driver.show_stepped(&gpu.queue, stepper)?;
+            driver.show_claimed(&gpu.device, &gpu.queue, stepper)?;
             let member = k + 1;
             if let Some(frame) = frames.get(member) {
                 driver.set_level(frame.level);
             }
             driver.set_look(FurLook { tint: herd.instances[member].tint, ..look });
             driver.prepare(&gpu.queue);
+        }
+        if self.drivers.iter().any(FurDriver::has_steps_to_record) {
+            let mut encoder =
+                gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("herd simulation") });
+            for driver in &mut self.drivers {
+                driver.record(&mut encoder)?;
+            }
+            gpu.queue.submit([encoder.finish()]);
         }
         Ok(())
     }

@@ -195,13 +195,8 @@ impl Model {
         )?;
         let mut herd = None;
         if !instances.is_empty() {
-            // The viewer's herd steps on the CPU in one parallel pass, its clip on the viewer's clock.
-            if args.sim == SimChoice::Gpu {
-                anyhow::bail!(
-                    "--sim gpu simulates one fur here; in the viewer a herd is simulated on the CPU (--sim cpu; \
-                     `pelt render --herd N --sim gpu` bends one on the GPU)"
-                );
-            }
+            // The viewer's herd is posed on the CPU in one parallel pass, its clip on the viewer's
+            // clock, and bent on the edited fur's kernel.
             let clips =
                 pelt_core::sim::herd::resolve_clips(&instances, rig.as_ref(), None).map_err(|(key, problem)| {
                     let file = args.script.as_deref().map_or_else(|| "--herd".to_owned(), |p| p.display().to_string());
@@ -264,7 +259,8 @@ impl Model {
             sim_time_secs: 0.0,
             shown_times_secs: [0.0; 2],
             shown_at: None,
-            sim_choice: if herd.is_some() { SimChoice::Cpu } else { args.sim },
+            // Auto times one fur; a herd bends on the CPU unless asked otherwise.
+            sim_choice: if herd.is_some() && args.sim == SimChoice::Auto { SimChoice::Cpu } else { args.sim },
             kernel_reason: String::new(),
             touch: None,
             contact_drag: None,
