@@ -178,7 +178,8 @@ fn a_failed_write_leaves_no_file() {
         morphs: None,
     };
     let export = Export::build(&input).expect("export");
-    let folder = std::env::temp_dir().join(format!("pelt-export-test-{}", std::process::id()));
+    let folder = std::path::Path::new(env!("CARGO_TARGET_TMPDIR")).join("pelt-export-test");
+    let _ = std::fs::remove_dir_all(&folder);
     std::fs::create_dir_all(&folder).expect("folder");
     let missing = folder.join("no/such/folder/fur.glb");
     let error = export.write(&missing).expect_err("no folder");

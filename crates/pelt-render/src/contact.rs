@@ -97,6 +97,11 @@ fn colliders_first(prefix_words: usize, slot: usize, slot_colliders: usize) -> u
     prefix_words + slot * slot_colliders * COLLIDER_WORDS
 }
 
+/// The buffer's bytes: `prefix_words` vec4s, then every slot's room for `slot_colliders`.
+fn buffer_bytes(prefix_words: usize, slot_colliders: usize) -> u64 {
+    colliders_first(prefix_words, CONTACT_SLOTS, slot_colliders) as u64 * 16
+}
+
 // A strand's header packs its triangle count in 6 bits.
 const _: () = assert!(pelt_core::sim::contact::surface::MAX_STRAND_TRIANGLES < 64);
 
@@ -140,7 +145,7 @@ impl GpuContact {
     /// The buffer's size in bytes for `skin`'s fur with room for `slot_colliders` colliders in
     /// each step slot.
     pub fn bytes(skin: &Skin, slot_colliders: usize) -> u64 {
-        colliders_first(skin.prefix_words(), CONTACT_SLOTS, slot_colliders) as u64 * 16
+        buffer_bytes(skin.prefix_words(), slot_colliders)
     }
 
     /// Colliders each step slot has room for now.
@@ -217,7 +222,7 @@ impl GpuContact {
         if room <= self.slot_colliders {
             return Ok(false);
         }
-        let size = colliders_first(self.prefix_words, CONTACT_SLOTS, room) as u64 * 16;
+        let size = buffer_bytes(self.prefix_words, room);
         check_size(device, "simulation contact", size)?;
         let grown = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("pelt simulation contact"),

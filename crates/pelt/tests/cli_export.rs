@@ -24,7 +24,7 @@ fn stderr(output: &Output) -> String {
 
 /// An empty folder of its own for one test.
 fn folder(name: &str) -> PathBuf {
-    let folder = std::env::temp_dir().join(format!("pelt-cli-export-{name}-{}", std::process::id()));
+    let folder = Path::new(env!("CARGO_TARGET_TMPDIR")).join(format!("pelt-cli-export-{name}"));
     let _ = std::fs::remove_dir_all(&folder);
     std::fs::create_dir_all(&folder).expect("a temporary folder");
     folder
