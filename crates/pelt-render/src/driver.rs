@@ -544,6 +544,27 @@ impl FurDriver {
         Ok(())
     }
 
+    /// [`FurDriver::record`] for every driver of `drivers` (a herd's members): step by step,
+    /// the contact-free steps of every member on the GPU kernel share one compute pass, so a
+    /// step costs the herd one pass, not one a member. Returns the compute passes recorded.
+    ///
+    /// # Errors
+    /// As [`FurDriver::record`], checked for every member before anything is recorded.
+    pub fn record_herd<'a>(
+        encoder: &mut wgpu::CommandEncoder,
+        drivers: impl IntoIterator<Item = &'a mut FurDriver>,
+    ) -> Result<usize, RenderError> {
+        let mut drivers: Vec<&mut FurDriver> = drivers.into_iter().collect();
+        let members = drivers
+            .iter_mut()
+            .filter_map(|driver| driver.gpu_simulation.as_mut().map(|simulation| (simulation, &mut driver.fur)));
+        let passes = GpuSimulation::dispatch_all(encoder, members)?;
+        for driver in drivers {
+            driver.unrecorded = false;
+        }
+        Ok(passes)
+    }
+
     /// Records the per-view GPU work into `encoder`: the silhouette pass choosing this view's
     /// fins (see [`FurRenderer::prepare_fins`]). Once per view and frame, after
     /// [`FurDriver::record`].

@@ -88,6 +88,68 @@ fn copies_on_the_gpu_kernel_share_the_rest_segments() {
     assert_eq!(drivers[10].simulation_bytes(), drivers[0].simulation_bytes() + rest);
 }
 
+/// A herd on the GPU kernel records each step of every member in one compute pass: the states
+/// come out with the bytes each member's own passes give, each member bent its own way.
+#[test]
+fn a_herds_gpu_steps_share_a_pass_and_match_each_recorded_alone() {
+    let rig = Rig::new(64, 64);
+    let structure = builtin_fur(Builtin::Bunny, 8);
+    let textures = strand_textures(32, 8, BROWN_ROOT, BROWN_TIP);
+    let asset = FurAsset::new(rig.device(), rig.queue(), &rig.renderer, &structure, &textures).expect("asset");
+    let (device, queue) = (rig.device(), rig.queue());
+    // Three members, gravity pulling each along its own direction so they bend apart.
+    let params = |k: usize| pelt_core::sim::SimParams {
+        gravity_direction: Vec3::new(k as f32 - 1.0, -1.0, 0.5 * k as f32).normalize(),
+        ..pelt_core::sim::SimParams::default()
+    };
+    let herd = || {
+        (0..3)
+            .map(|k| {
+                let driver = FurDriver::with_asset(
+                    device,
+                    queue,
+                    &rig.renderer,
+                    &asset,
+                    &structure,
+                    &params(k),
+                    KernelChoice::Gpu,
+                )
+                .expect("driver");
+                let stepper = pelt_core::sim::FurStepper::new(&structure, &params(k)).expect("stepper");
+                (driver, stepper)
+            })
+            .collect::<Vec<_>>()
+    };
+    let (mut alone, mut together) = (herd(), herd());
+    let mut passes = Vec::new();
+    for frame in 1..=6 {
+        let time_secs = f64::from(frame) / 20.0;
+        let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor::default());
+        for (driver, stepper) in alone.iter_mut().chain(together.iter_mut()) {
+            driver.advance_to(device, queue, stepper, time_secs).expect("advance");
+        }
+        let each: Vec<usize> = alone
+            .iter_mut()
+            .map(|(driver, _)| FurDriver::record_herd(&mut encoder, [driver]).expect("record alone"))
+            .collect();
+        let recorded =
+            FurDriver::record_herd(&mut encoder, together.iter_mut().map(|(driver, _)| driver)).expect("herd");
+        passes.push((each, recorded));
+        queue.submit([encoder.finish()]);
+    }
+    let state = |driver: &FurDriver| common::read_bytes(device, queue, driver.fur().current_positions());
+    for k in 0..3 {
+        assert_eq!(state(&alone[k].0), state(&together[k].0), "member {k}'s state recorded with the herd");
+    }
+    assert_ne!(state(&together[0].0), state(&together[1].0), "the members bent alike");
+    assert_ne!(state(&together[1].0), state(&together[2].0), "the members bent alike");
+    // One pass a step for the three, where each member recorded alone takes one of its own.
+    for (each, recorded) in &passes {
+        assert!(each.iter().all(|&p| p > 0 && p == each[0]), "each member's own passes a frame: {passes:?}");
+        assert_eq!(*recorded, each[0], "the herd's passes a frame: {passes:?}");
+    }
+}
+
 #[test]
 fn each_copy_draws_its_own_pose_as_a_fur_uploaded_alone() {
     let rig = Rig::new(96, 96);

@@ -370,9 +370,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         // The simulation's GPU steps in a submission of their own: the frame's closures below
         // only read the driver.
         let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("simulation") });
-        for driver in &mut drivers {
-            driver.record(&mut encoder)?;
-        }
+        FurDriver::record_herd(&mut encoder, &mut drivers)?;
         queue.submit([encoder.finish()]);
         if moves {
             for mesh in &plain_meshes {

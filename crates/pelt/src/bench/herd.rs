@@ -189,9 +189,7 @@ pub fn measure(
             if kernel == SimKernel::Gpu {
                 let mut encoder =
                     device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("herd steps") });
-                for driver in &mut drivers {
-                    driver.record(&mut encoder)?;
-                }
+                FurDriver::record_herd(&mut encoder, &mut drivers)?;
                 queue.submit([encoder.finish()]);
             }
             let stepped = Instant::now();

@@ -297,9 +297,7 @@ impl HerdDrivers {
         if self.drivers.iter().any(FurDriver::has_steps_to_record) {
             let mut encoder =
                 gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("herd simulation") });
-            for driver in &mut self.drivers {
-                driver.record(&mut encoder)?;
-            }
+            FurDriver::record_herd(&mut encoder, &mut self.drivers)?;
             gpu.queue.submit([encoder.finish()]);
         }
         Ok(())
