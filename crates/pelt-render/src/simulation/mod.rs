@@ -407,7 +407,7 @@ impl GpuSimulation {
 
     /// [`GpuSimulation::dispatch`] for every simulation of `members` (a herd's, each with its
     /// fur), step by step: each step's contact-free dispatches of every member share one compute
-    /// pass (they touch no buffer in common), a step with contact keeps its own passes. Returns
+    /// pass (each writes its own buffers only), a step with contact keeps its own passes. Returns
     /// the compute passes recorded.
     ///
     /// # Errors
