@@ -52,6 +52,16 @@ pub enum KernelChoice {
     Gpu,
 }
 
+impl From<SimKernel> for KernelChoice {
+    /// That kernel, asked for (a copy made to bend where another fur already does).
+    fn from(kernel: SimKernel) -> Self {
+        match kernel {
+            SimKernel::Cpu => Self::Cpu,
+            SimKernel::Gpu => Self::Gpu,
+        }
+    }
+}
+
 /// Steps per timing run and runs per kernel when choosing ([`KernelChoice::Auto`]).
 const TIMING_STEPS: u32 = 3;
 const TIMING_RUNS: usize = 5;

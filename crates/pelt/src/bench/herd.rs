@@ -95,10 +95,7 @@ pub fn measure(
     frames: u32,
     kernel: SimKernel,
 ) -> anyhow::Result<(Vec<HerdRow>, String)> {
-    let choice = match kernel {
-        SimKernel::Cpu => KernelChoice::Cpu,
-        SimKernel::Gpu => KernelChoice::Gpu,
-    };
+    let choice = KernelChoice::from(kernel);
     let path = meshes.join("Fox.glb");
     let stage = Stage::load(&StageSource::File(path.clone()), &[], &ImportOptions::default())
         .with_context(|| format!("loading {}", path.display()))?;

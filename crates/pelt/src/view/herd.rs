@@ -249,10 +249,7 @@ impl HerdDrivers {
     ) -> anyhow::Result<Self> {
         let (device, queue) = (&gpu.device, &gpu.queue);
         let asset = FurAsset::new(device, queue, renderer, structure, textures)?;
-        let choice = match kernel {
-            SimKernel::Gpu => KernelChoice::Gpu,
-            SimKernel::Cpu => KernelChoice::Cpu,
-        };
+        let choice = KernelChoice::from(kernel);
         let drivers = (0..count)
             .map(|_| FurDriver::with_asset(device, queue, renderer, &asset, structure, params, choice))
             .collect::<Result<Vec<_>, _>>()?;
