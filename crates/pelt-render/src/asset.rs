@@ -28,8 +28,6 @@ use crate::textures::GpuTextures;
 pub struct FurAsset {
     pub(crate) geometry: SharedGeometry,
     pub(crate) textures: GpuTextures,
-    /// Shells' triangles and fins' edges drawn (the furred ones with a groom).
-    pub(crate) drawn: (u32, u32),
     /// The rest pose every copy starts from: `(L + 1) * V` positions and `V` normals.
     pub(crate) rest: Arc<(Vec<Vec3>, Vec<Vec3>)>,
     /// The GPU simulation's rest segments of this structure, made by the first copy simulated
@@ -52,24 +50,14 @@ impl FurAsset {
             SharedGeometry::new(device, (&structure.mesh, furred.as_ref(), structure.groom.as_ref()), structure.layers);
         let textures = GpuTextures::new(device, queue, layouts, textures, structure.groom.is_some());
         scope.pop("uploading the fur")?;
-        Ok(Self::from_parts(geometry?, textures?, structure, furred.as_ref()))
+        Ok(Self::from_parts(geometry?, textures?, structure))
     }
 
-    /// The asset of `structure` (grown over `furred`) from its uploaded parts.
-    pub(crate) fn from_parts(
-        geometry: SharedGeometry,
-        textures: GpuTextures,
-        structure: &FurStructure,
-        furred: Option<&Furred>,
-    ) -> Self {
-        let drawn = match furred {
-            Some(furred) => (furred.triangles.len() as u32, furred.edges.len() as u32),
-            None => (structure.mesh.triangles.len() as u32, structure.mesh.edges.len() as u32),
-        };
+    /// The asset of `structure` from its uploaded parts.
+    pub(crate) fn from_parts(geometry: SharedGeometry, textures: GpuTextures, structure: &FurStructure) -> Self {
         Self {
             geometry,
             textures,
-            drawn,
             rest: Arc::new((structure.positions.clone(), structure.mesh.normals.clone())),
             simulation_rest: Arc::default(),
         }

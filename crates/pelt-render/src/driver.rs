@@ -132,6 +132,26 @@ impl FurDriver {
         params: &SimParams,
         choice: KernelChoice,
     ) -> Result<Self, RenderError> {
+        let mut herd = Self::herd_with_asset(device, queue, renderer, (asset, structure), params, choice, 1)?;
+        Ok(herd.remove(0))
+    }
+
+    /// `count` copies of a fur whose shared data is `asset`, as
+    /// [`FurDriver::with_asset`] makes one, made together ([`GpuFur::herd_from_asset`]): their
+    /// silhouette and view-angle passes list in a few dispatches for the whole herd. `choice`
+    /// is made once for all.
+    ///
+    /// # Errors
+    /// As [`FurDriver::with_asset`].
+    pub fn herd_with_asset(
+        device: &wgpu::Device,
+        queue: &wgpu::Queue,
+        renderer: &FurRenderer,
+        (asset, structure): (&FurAsset, &FurStructure),
+        params: &SimParams,
+        choice: KernelChoice,
+        count: usize,
+    ) -> Result<Vec<Self>, RenderError> {
         let expected = (asset.layers() as usize + 1) * asset.vertex_count() as usize;
         if structure.positions.len() != expected {
             return Err(RenderError::Count {
@@ -151,19 +171,24 @@ impl FurDriver {
                 (kernel, format!("auto: GPU {:.2} ms a step, CPU {:.2} ms", gpu * 1000.0, cpu * 1000.0))
             }
         };
-        let mut driver = Self {
-            fur: GpuFur::from_asset(device, renderer, asset, states(kernel))?,
-            gpu_simulation: None,
-            kernel,
-            kernel_reason,
-            frame: FurFrame::default(),
-            unrecorded: false,
-        };
-        // Copies grown as the asset share its GPU rest segments.
-        let shared_rest = asset.grown_as(structure).then_some(&*asset.simulation_rest);
-        driver.use_kernel(device, renderer, structure, kernel, shared_rest)?;
-        driver.fur.prepare(queue, &driver.frame);
-        Ok(driver)
+        let furs = GpuFur::herd_from_asset(device, renderer, asset, states(kernel), count)?;
+        let mut drivers = Vec::with_capacity(furs.len());
+        for fur in furs {
+            let mut driver = Self {
+                fur,
+                gpu_simulation: None,
+                kernel,
+                kernel_reason: kernel_reason.clone(),
+                frame: FurFrame::default(),
+                unrecorded: false,
+            };
+            // Copies grown as the asset share its GPU rest segments.
+            let shared_rest = asset.grown_as(structure).then_some(&*asset.simulation_rest);
+            driver.use_kernel(device, renderer, structure, kernel, shared_rest)?;
+            driver.fur.prepare(queue, &driver.frame);
+            drivers.push(driver);
+        }
+        Ok(drivers)
     }
 
     /// Bytes of the GPU kernel's own buffers for this fur ([`GpuSimulation::gpu_bytes`]); 0 on

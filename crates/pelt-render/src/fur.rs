@@ -13,6 +13,7 @@ use crate::geometry::{Furred, SharedGeometry, UnifiedGeometry};
 use crate::listing::{FinList, ShellList};
 use crate::lod::PreparedLevel;
 use crate::object::{FurFrame, GpuBytes};
+use crate::pool::{LIST_FINS, LIST_SHELLS, MemberPool};
 use crate::requirements::ErrorScope;
 use crate::shaders::Layouts;
 use crate::textures::GpuTextures;
@@ -79,26 +80,23 @@ impl Coat {
 /// of the renderer's target, as many furs per pass as you like.
 ///
 /// # The shared arrays, for hosts that write them on the GPU
-/// Each state is one buffer of `(L + 1) * V` positions `NV[i * V + j]` (layer `i`, base vertex
-/// `j`), each three little-endian `f32` (x, y, z) packed with no padding (12 bytes, so WGSL reads
-/// it as `array<f32>`), in model space; usage [`POSITIONS_USAGE`](crate::POSITIONS_USAGE)
-/// (`STORAGE | VERTEX | COPY_DST | COPY_SRC`). A compute pass (e.g. a GPU simulation) steps by
-/// calling [`GpuFur::swap_states`] and then writing the new state into
-/// [`GpuFur::current_positions`], reading the last one from [`GpuFur::previous_positions`].
-/// The base normals ([`GpuFur::base_normals`]) are `V` packed xyz `f32` triples likewise
-/// (`STORAGE | COPY_DST`).
+/// Each state is a range of a buffer (starting on a multiple of 256 bytes; copies made together
+/// keep their states in one buffer) of `(L + 1) * V` positions `NV[i * V + j]` (layer `i`, base
+/// vertex `j`), each three little-endian `f32` (x, y, z) packed with no padding (12 bytes, so
+/// WGSL reads it as `array<f32>`), in model space; usage
+/// [`POSITIONS_USAGE`](crate::POSITIONS_USAGE) (`STORAGE | VERTEX | COPY_DST | COPY_SRC`). A
+/// compute pass (e.g. a GPU simulation) steps by calling [`GpuFur::swap_states`] and then
+/// writing the new state into [`GpuFur::current_positions`], reading the last one from
+/// [`GpuFur::previous_positions`]. The base normals ([`GpuFur::base_normals`]) are a range of
+/// `V` packed xyz `f32` triples likewise (`STORAGE | COPY_DST | COPY_SRC`).
 #[derive(Debug)]
 pub struct GpuFur {
     geometry: UnifiedGeometry,
     /// What it shares with the other copies of its fur (its geometry's shared part and the
     /// textures).
     asset: FurAsset,
-    /// The silhouette pass's output (none without fins).
-    fins: Option<FinList>,
     /// The level of detail of the last `prepare`.
     level: PreparedLevel,
-    /// The view-angle pass's output (none without layers to thin).
-    shells: Option<ShellList>,
     /// Whether the last `prepare`'s frame was wet (its coat's pipelines read the wetness).
     wet: AtomicBool,
     /// Whether the last `prepare`'s look was the fur model.
@@ -126,25 +124,47 @@ impl GpuFur {
         asset: &FurAsset,
         states: FurStates,
     ) -> Result<Self, RenderError> {
+        let mut copies = Self::copies(device, layouts, asset, states, 1)?;
+        Ok(copies.remove(0))
+    }
+
+    /// `count` copies of `asset`, their own state in shared pools (`crate::pool`) as large as the
+    /// device binds: the listing passes list a pool's copies in one dispatch.
+    pub(crate) fn copies(
+        device: &wgpu::Device,
+        layouts: &Layouts,
+        asset: &FurAsset,
+        states: FurStates,
+        count: usize,
+    ) -> Result<Vec<Self>, RenderError> {
         let scope = ErrorScope::push(device);
         let (positions, normals) = &*asset.rest;
-        let geometry =
-            UnifiedGeometry::instance(device, layouts, &asset.geometry, (positions, normals), state_count(states));
-        let layers = asset.geometry.shape.layers;
-        let (triangles, edges) = asset.drawn;
-        let fins = FinList::new(device, layouts, edges, layers);
-        let per_shell = asset.geometry.shape.vertices_per_shell();
-        let shells = ShellList::new(device, layouts, (triangles, per_shell), layers);
+        let shared = &asset.geometry;
+        let states = state_count(states);
+        let most = MemberPool::most_slots(device, shared.shape, states) as usize;
+        let mut copies = Vec::with_capacity(count);
+        let mut left = count;
+        while left > 0 {
+            let slots = left.min(most);
+            let pool = UnifiedGeometry::pool(device, layouts, shared, (positions, normals), (states, slots as u32));
+            let pool = match pool {
+                Ok(pool) => pool,
+                Err(error) => {
+                    scope.pop("uploading the fur")?;
+                    return Err(error);
+                }
+            };
+            copies.extend((0..slots as u32).map(|slot| Self {
+                geometry: UnifiedGeometry::in_pool(device, layouts, shared, &pool, slot),
+                asset: asset.clone(),
+                level: PreparedLevel::new(),
+                wet: AtomicBool::new(false),
+                fur_model: AtomicBool::new(false),
+            }));
+            left -= slots;
+        }
         scope.pop("uploading the fur")?;
-        Ok(Self {
-            geometry: geometry?,
-            asset: asset.clone(),
-            fins: fins?,
-            level: PreparedLevel::new(),
-            shells: shells?,
-            wet: AtomicBool::new(false),
-            fur_model: AtomicBool::new(false),
-        })
+        Ok(copies)
     }
 
     /// What this fur shares with every copy made from it ([`GpuFur::from_asset`]).
@@ -167,9 +187,9 @@ impl GpuFur {
         let shared =
             SharedGeometry::new(device, (&structure.mesh, furred.as_ref(), structure.groom.as_ref()), structure.layers);
         scope.pop("uploading the fur")?;
-        let asset = FurAsset::from_parts(shared?, self.asset.textures.clone(), structure, furred.as_ref());
+        let asset = FurAsset::from_parts(shared?, self.asset.textures.clone(), structure);
         let fresh = Self::instance(device, layouts, &asset, states)?;
-        (self.geometry, self.asset, self.fins, self.shells) = (fresh.geometry, fresh.asset, fresh.fins, fresh.shells);
+        (self.geometry, self.asset) = (fresh.geometry, fresh.asset);
         Ok(())
     }
 
@@ -234,12 +254,21 @@ impl GpuFur {
         };
         let tint = frame.look.tint;
         let skin = if tint.is_finite() { skin * tint.max(Vec3::ZERO) } else { skin };
-        self.geometry.write_uniform(queue, &self.geometry.shape.uniform(&frame, skin, textures));
         self.level.set(frame.level, self.geometry.shape.layers);
+        // What the listing passes list of it this frame, should they be recorded.
+        let level = &self.level;
+        let lists = if level.coat_shown() {
+            let fins = self.fin_list().is_some() && level.fins_shown();
+            let shells = self.shell_list().is_some() && level.by_view();
+            (u32::from(fins) * LIST_FINS) | (u32::from(shells) * LIST_SHELLS)
+        } else {
+            0
+        };
+        self.geometry.write_uniform(queue, &self.geometry.shape.uniform(&frame, skin, textures), lists);
         self.wet.store(frame.wet, Ordering::Relaxed);
         self.fur_model.store(frame.look.shading.fur_model, Ordering::Relaxed);
-        if let Some(list) = &self.shells {
-            list.invalidate();
+        if let Some(list) = self.shell_list() {
+            list.invalidate(self.slot());
         }
     }
 
@@ -277,16 +306,16 @@ impl GpuFur {
         self.geometry.swap_states();
     }
 
-    /// The buffer of the current (newer) state; see the layout in [`GpuFur`].
+    /// The current (newer) state: a range of a buffer that may hold other copies' states too
+    /// (copies made together share one); see the layout in [`GpuFur`].
     #[must_use]
-    pub fn current_positions(&self) -> &wgpu::Buffer {
+    pub fn current_positions(&self) -> wgpu::BufferSlice<'_> {
         self.geometry.current()
     }
 
-    /// The buffer of the previous (older) state; the same buffer as the current one with
-    /// [`FurStates::One`].
+    /// The previous (older) state; the same range as the current one with [`FurStates::One`].
     #[must_use]
-    pub fn previous_positions(&self) -> &wgpu::Buffer {
+    pub fn previous_positions(&self) -> wgpu::BufferSlice<'_> {
         self.geometry.previous()
     }
 
@@ -308,9 +337,9 @@ impl GpuFur {
         self.geometry.set_wetness(queue, wetness)
     }
 
-    /// The base normals' buffer; see the layout in [`GpuFur`].
+    /// The base normals' range of their buffer; see the layout in [`GpuFur`].
     #[must_use]
-    pub fn base_normals(&self) -> &wgpu::Buffer {
+    pub fn base_normals(&self) -> wgpu::BufferSlice<'_> {
         self.geometry.normals()
     }
 
@@ -334,15 +363,15 @@ impl GpuFur {
     /// of the view-angle pass's shell list (12 bytes a triangle, 20 a layer).
     #[must_use]
     pub fn silhouette_list_bytes(&self) -> u64 {
-        self.fins.as_ref().map_or(0, FinList::bytes) + self.shells.as_ref().map_or(0, ShellList::bytes)
+        self.pool().slot_list_bytes()
     }
 
     /// The view-angle pass's count (one little-endian `u32`, `COPY_SRC`): three times the
     /// triangles drawn in each shell the view angle thins, when [`GpuFur::shells_thinned`].
     /// For hosts and benchmarks that read it back; `None` for a fur with fewer than two layers.
     #[must_use]
-    pub fn view_lod_count(&self) -> Option<&wgpu::Buffer> {
-        self.shells.as_ref().map(|list| &list.listed)
+    pub fn view_lod_count(&self) -> Option<wgpu::BufferSlice<'_>> {
+        self.shell_list().map(|list| list.listed_of(self.slot()).0)
     }
 
     /// The view-angle pass's list (`COPY_SRC`): as many little-endian `u32`s as
@@ -351,8 +380,8 @@ impl GpuFur {
     /// groomed fur numbers its triangles with the furred ones first (`FurStructure::furred_triangles`
     /// in order, then the bald ones).
     #[must_use]
-    pub fn view_lod_indices(&self) -> Option<&wgpu::Buffer> {
-        self.shells.as_ref().map(|list| &list.indices)
+    pub fn view_lod_indices(&self) -> Option<wgpu::BufferSlice<'_>> {
+        self.shell_list().map(|list| list.listed_of(self.slot()).1)
     }
 
     /// The shells the level of the last [`GpuFur::prepare`] thins by view angle (drawn over the
@@ -371,8 +400,9 @@ impl GpuFur {
     /// `COPY_SRC`): its second `u32` is the number of fins the last pass kept. For hosts and
     /// benchmarks that read it back; `None` for a fur without fins.
     #[must_use]
-    pub fn silhouette_draw(&self) -> Option<&wgpu::Buffer> {
-        self.fins.as_ref().map(|list| &list.draw)
+    pub fn silhouette_draw(&self) -> Option<wgpu::BufferSlice<'_>> {
+        let at = FinList::draw_offset(self.slot());
+        self.fin_list().map(|list| list.draws.slice(at..at + crate::listing::DRAW_ARGS_BYTES))
     }
 
     /// The fins the silhouette pass (or the `lab` feature's `GpuFur::prepare_fins_on_cpu`) kept:
@@ -381,8 +411,8 @@ impl GpuFur {
     /// many as the indirect draw's instance count ([`GpuFur::silhouette_draw`]); `COPY_SRC`. For
     /// hosts and tests that read it back; `None` for a fur without fins.
     #[must_use]
-    pub fn silhouette_instances(&self) -> Option<&wgpu::Buffer> {
-        self.fins.as_ref().map(|list| &list.instances)
+    pub fn silhouette_instances(&self) -> Option<wgpu::BufferSlice<'_>> {
+        self.fin_list().map(|list| list.instances_of(self.slot()))
     }
 
     /// `L`, the shell layers above the base.
@@ -416,12 +446,24 @@ impl GpuFur {
         &self.asset.textures.bind_group
     }
 
+    /// Its pool's fin lists (its own is at [`GpuFur::slot`]).
     pub(crate) fn fin_list(&self) -> Option<&FinList> {
-        self.fins.as_ref()
+        self.pool().fins()
     }
 
+    /// Its pool's shell lists (its own is at [`GpuFur::slot`]).
     pub(crate) fn shell_list(&self) -> Option<&ShellList> {
-        self.shells.as_ref()
+        self.pool().shells()
+    }
+
+    /// The pool its own state lives in (`crate::pool`).
+    pub(crate) fn pool(&self) -> &std::sync::Arc<MemberPool> {
+        self.geometry.slot().0
+    }
+
+    /// Its slot in [`GpuFur::pool`].
+    pub(crate) fn slot(&self) -> u32 {
+        self.geometry.slot().1
     }
 
     pub(crate) fn prepared_level(&self) -> &PreparedLevel {

@@ -6,24 +6,21 @@
 //! (fins) first, so the shells and fins draw a prefix of the topology, the skin all of it, and
 //! the topology keeps its size (`pelt_core::fur::Footprint` counts it).
 
+use std::sync::Arc;
+
 use glam::{Vec2, Vec3};
-use pelt_core::fur::POSITION_BYTES;
 use pelt_core::groom::Groom;
 use pelt_core::mesh::NO_FACE;
 use pelt_core::{FurStructure, Mesh};
 use wgpu::util::DeviceExt as _;
 
 use crate::RenderError;
-use crate::object::{GpuBytes, ObjectShape, uniform_buffer};
+use crate::object::{GpuBytes, ObjectShape};
+use crate::pool::{MemberPool, binding};
 use crate::requirements::check_size;
-use crate::shaders::{Layouts, OBJECT_UNIFORM_BYTES, ObjectUniform};
+use crate::shaders::{Layouts, ObjectUniform};
 
-/// Usage of the shared-array buffers: read by the vertex shaders, written by the queue or by a
-/// host's compute pass, and bindable as vertex buffers or copied by hosts that want to.
-pub const POSITIONS_USAGE: wgpu::BufferUsages = wgpu::BufferUsages::STORAGE
-    .union(wgpu::BufferUsages::VERTEX)
-    .union(wgpu::BufferUsages::COPY_DST)
-    .union(wgpu::BufferUsages::COPY_SRC);
+pub use crate::pool::POSITIONS_USAGE;
 
 /// Which base triangles get shells and which edges get fins, each list in mesh order
 /// (`FurStructure::furred_triangles`, `FurStructure::fin_edges`).
@@ -179,21 +176,20 @@ impl SharedGeometry {
     }
 }
 
-/// One copy of a mesh on the GPU: its own shared-array states, base normals, wetness and object
-/// uniform over a [`SharedGeometry`].
+/// One copy of a mesh on the GPU: its own shared-array states, base normals and object uniform
+/// (a slot of a [`MemberPool`]) and wetness over a [`SharedGeometry`].
 #[derive(Debug)]
 pub(crate) struct UnifiedGeometry {
     pub shape: ObjectShape,
     shared: SharedGeometry,
-    uniform: wgpu::Buffer,
-    /// One buffer, or two used in turn: `states[current]` is the newer state.
-    states: Vec<wgpu::Buffer>,
+    pool: Arc<MemberPool>,
+    slot: u32,
+    /// `current` is the newer of the slot's states.
     current: usize,
-    normals: wgpu::Buffer,
     /// A wetness per base vertex (`V` `f32`, zero until set): per-frame state like the
     /// silhouette list, so not counted in [`GpuBytes`].
     wetness: wgpu::Buffer,
-    /// `bind_groups[c]` reads `states[c]` as current and the other state as previous.
+    /// `bind_groups[c]` reads state `c` as current and the other state as previous.
     bind_groups: Vec<wgpu::BindGroup>,
     /// This copy's own bytes: the states and the normals.
     own_bytes: GpuBytes,
@@ -214,8 +210,8 @@ impl UnifiedGeometry {
         Self::instance(device, layouts, &shared, (positions, &mesh.normals), state_count)
     }
 
-    /// A copy of `shared` of its own: `positions` (`(L + 1) * V`, layer-major) in every state,
-    /// `normals` (`V`) as its base normals.
+    /// A copy of `shared` of its own (a pool of one): `positions` (`(L + 1) * V`, layer-major)
+    /// in every state, `normals` (`V`) as its base normals.
     pub fn instance(
         device: &wgpu::Device,
         layouts: &Layouts,
@@ -223,6 +219,18 @@ impl UnifiedGeometry {
         (positions, normals): (&[Vec3], &[Vec3]),
         state_count: usize,
     ) -> Result<Self, RenderError> {
+        let pool = Self::pool(device, layouts, shared, (positions, normals), (state_count, 1))?;
+        Ok(Self::in_pool(device, layouts, shared, &pool, 0))
+    }
+
+    /// A pool of `slots` copies of `shared`, each starting from `positions` and `normals`.
+    pub fn pool(
+        device: &wgpu::Device,
+        layouts: &Layouts,
+        shared: &SharedGeometry,
+        (positions, normals): (&[Vec3], &[Vec3]),
+        (state_count, slots): (usize, u32),
+    ) -> Result<Arc<MemberPool>, RenderError> {
         let shape = shared.shape;
         let expected = (shape.layers as usize + 1) * shape.vertex_count as usize;
         if positions.len() != expected {
@@ -237,36 +245,39 @@ impl UnifiedGeometry {
             let expected = shape.vertex_count as usize;
             return Err(RenderError::Count { what: "base normals", expected, got: normals.len(), rule: "V" });
         }
-        let position_bytes = positions.len() as u64 * POSITION_BYTES;
-        check_size(device, "shared vertex array", position_bytes)?;
-        let buffer = |label, contents: &[u8], usage| {
-            device.create_buffer_init(&wgpu::util::BufferInitDescriptor { label: Some(label), contents, usage })
-        };
-        let states: Vec<wgpu::Buffer> = (0..state_count.clamp(1, 2))
-            .map(|_| buffer("pelt shared vertices", bytemuck::cast_slice(positions), POSITIONS_USAGE))
-            .collect();
-        let normals = buffer(
-            "pelt base normals",
-            bytemuck::cast_slice(normals),
-            wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+        let mesh = (shape, &shared.topology);
+        Ok(Arc::new(MemberPool::new(device, layouts, mesh, (positions, normals), (state_count, slots))?))
+    }
+
+    /// The copy in slot `slot` of `pool` (made over `shared`).
+    pub fn in_pool(
+        device: &wgpu::Device,
+        layouts: &Layouts,
+        shared: &SharedGeometry,
+        pool: &Arc<MemberPool>,
+        slot: u32,
+    ) -> Self {
+        let shape = shared.shape;
+        let wetness = wgpu::util::DeviceExt::create_buffer_init(
+            device,
+            &wgpu::util::BufferInitDescriptor {
+                label: Some("pelt wetness"),
+                contents: bytemuck::cast_slice(&vec![0.0_f32; (shape.vertex_count as usize).max(1)]),
+                usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            },
         );
-        let wetness = buffer(
-            "pelt wetness",
-            bytemuck::cast_slice(&vec![0.0_f32; (shape.vertex_count as usize).max(1)]),
-            wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
-        );
-        let uniform = uniform_buffer(device);
-        let bind_groups = (0..states.len())
+        let states = pool.state_count();
+        let bind_groups = (0..states)
             .map(|current| {
-                let previous = (current + 1) % states.len();
+                let previous = (current + 1) % states;
                 device.create_bind_group(&wgpu::BindGroupDescriptor {
                     label: Some("pelt unified object"),
                     layout: &layouts.unified_object,
                     entries: &[
-                        wgpu::BindGroupEntry { binding: 0, resource: uniform.as_entire_binding() },
-                        wgpu::BindGroupEntry { binding: 1, resource: states[previous].as_entire_binding() },
-                        wgpu::BindGroupEntry { binding: 2, resource: states[current].as_entire_binding() },
-                        wgpu::BindGroupEntry { binding: 3, resource: normals.as_entire_binding() },
+                        wgpu::BindGroupEntry { binding: 0, resource: binding(pool.object(slot)) },
+                        wgpu::BindGroupEntry { binding: 1, resource: binding(pool.state(slot, previous)) },
+                        wgpu::BindGroupEntry { binding: 2, resource: binding(pool.state(slot, current)) },
+                        wgpu::BindGroupEntry { binding: 3, resource: binding(pool.normals(slot)) },
                         wgpu::BindGroupEntry { binding: 4, resource: shared.uvs.as_entire_binding() },
                         wgpu::BindGroupEntry { binding: 5, resource: shared.topology.as_entire_binding() },
                         wgpu::BindGroupEntry { binding: 6, resource: shared.groom.as_entire_binding() },
@@ -275,23 +286,23 @@ impl UnifiedGeometry {
                 })
             })
             .collect();
+        // The data's bytes, as `Footprint` counts them (a range's padding, under 256 bytes, is
+        // the allocator's kind of overhead).
         let own_bytes = GpuBytes {
-            positions: position_bytes * states.len() as u64,
-            attributes: normals.size(),
+            positions: pool.state(slot, 0).size() * states as u64,
+            attributes: pool.normals(slot).size(),
             ..GpuBytes::default()
         };
-        debug_assert_eq!(uniform.size(), OBJECT_UNIFORM_BYTES);
-        Ok(Self {
+        Self {
             shape,
             shared: shared.clone(),
-            uniform,
-            states,
+            pool: Arc::clone(pool),
+            slot,
             current: 0,
-            normals,
             wetness,
             bind_groups,
             own_bytes,
-        })
+        }
     }
 
     /// Bytes of the groom attributes (0 without a groom).
@@ -331,11 +342,21 @@ impl UnifiedGeometry {
     }
 
     pub fn state_count(&self) -> usize {
-        self.states.len()
+        self.pool.state_count()
     }
 
-    pub fn write_uniform(&self, queue: &wgpu::Queue, uniform: &ObjectUniform) {
-        queue.write_buffer(&self.uniform, 0, bytemuck::bytes_of(uniform));
+    /// Writes the object uniform, with where the listing passes find this copy in its pool and
+    /// what they list of it this frame (`lists`: `pool::LIST_FINS`, `pool::LIST_SHELLS`).
+    pub fn write_uniform(&self, queue: &wgpu::Queue, uniform: &ObjectUniform, lists: u32) {
+        let states = (self.current, (self.current + 1) % self.state_count());
+        let uniform = ObjectUniform { pool: self.pool.object_pool_field(self.slot, states, lists), ..*uniform };
+        let object = self.pool.object(self.slot);
+        queue.write_buffer(object.buffer(), object.offset(), bytemuck::bytes_of(&uniform));
+    }
+
+    /// The pool this copy's state lives in, and its slot there.
+    pub fn slot(&self) -> (&Arc<MemberPool>, u32) {
+        (&self.pool, self.slot)
     }
 
     fn check_positions(&self, positions: &[Vec3]) -> Result<(), RenderError> {
@@ -355,8 +376,9 @@ impl UnifiedGeometry {
     /// Writes `positions` into every state.
     pub fn set_positions(&self, queue: &wgpu::Queue, positions: &[Vec3]) -> Result<(), RenderError> {
         self.check_positions(positions)?;
-        for state in &self.states {
-            queue.write_buffer(state, 0, bytemuck::cast_slice(positions));
+        for k in 0..self.state_count() {
+            let state = self.pool.state(self.slot, k);
+            queue.write_buffer(state.buffer(), state.offset(), bytemuck::cast_slice(positions));
         }
         Ok(())
     }
@@ -364,33 +386,35 @@ impl UnifiedGeometry {
     pub fn set_states(&self, queue: &wgpu::Queue, previous: &[Vec3], current: &[Vec3]) -> Result<(), RenderError> {
         self.check_positions(previous)?;
         self.check_positions(current)?;
-        queue.write_buffer(self.previous(), 0, bytemuck::cast_slice(previous));
-        queue.write_buffer(self.current(), 0, bytemuck::cast_slice(current));
+        let (old, new) = (self.previous(), self.current());
+        queue.write_buffer(old.buffer(), old.offset(), bytemuck::cast_slice(previous));
+        queue.write_buffer(new.buffer(), new.offset(), bytemuck::cast_slice(current));
         Ok(())
     }
 
     /// The newer state becomes the older one; the buffer that held the older is now current.
     pub fn swap_states(&mut self) {
-        self.current = (self.current + 1) % self.states.len();
+        self.current = (self.current + 1) % self.state_count();
     }
 
     pub fn push_state(&mut self, queue: &wgpu::Queue, positions: &[Vec3]) -> Result<(), RenderError> {
         self.check_positions(positions)?;
         self.swap_states();
-        queue.write_buffer(self.current(), 0, bytemuck::cast_slice(positions));
+        let state = self.current();
+        queue.write_buffer(state.buffer(), state.offset(), bytemuck::cast_slice(positions));
         Ok(())
     }
 
-    pub fn current(&self) -> &wgpu::Buffer {
-        &self.states[self.current]
+    pub fn current(&self) -> wgpu::BufferSlice<'_> {
+        self.pool.state(self.slot, self.current)
     }
 
-    pub fn previous(&self) -> &wgpu::Buffer {
-        &self.states[(self.current + 1) % self.states.len()]
+    pub fn previous(&self) -> wgpu::BufferSlice<'_> {
+        self.pool.state(self.slot, (self.current + 1) % self.state_count())
     }
 
-    pub fn normals(&self) -> &wgpu::Buffer {
-        &self.normals
+    pub fn normals(&self) -> wgpu::BufferSlice<'_> {
+        self.pool.normals(self.slot)
     }
 
     pub fn set_normals(&self, queue: &wgpu::Queue, normals: &[Vec3]) -> Result<(), RenderError> {
@@ -398,7 +422,8 @@ impl UnifiedGeometry {
         if normals.len() != expected {
             return Err(RenderError::Count { what: "base normals", expected, got: normals.len(), rule: "V" });
         }
-        queue.write_buffer(&self.normals, 0, bytemuck::cast_slice(normals));
+        let slice = self.normals();
+        queue.write_buffer(slice.buffer(), slice.offset(), bytemuck::cast_slice(normals));
         Ok(())
     }
 
@@ -445,12 +470,17 @@ impl UnifiedGeometry {
     }
 
     /// Draws the fins listed in `instances` (the silhouette pass's edges) through the indirect
-    /// draw `draw`.
-    pub fn draw_fin_list(&self, pass: &mut wgpu::RenderPass<'_>, instances: &wgpu::Buffer, draw: &wgpu::Buffer) {
+    /// draw at `offset` in `draws`.
+    pub fn draw_fin_list(
+        &self,
+        pass: &mut wgpu::RenderPass<'_>,
+        instances: wgpu::BufferSlice<'_>,
+        (draws, offset): (&wgpu::Buffer, u64),
+    ) {
         if let Some(strip) = &self.shared.fin_indices {
             pass.set_index_buffer(strip.slice(..), wgpu::IndexFormat::Uint32);
-            pass.set_vertex_buffer(0, instances.slice(..));
-            pass.draw_indexed_indirect(draw, 0);
+            pass.set_vertex_buffer(0, instances);
+            pass.draw_indexed_indirect(draws, offset);
         }
     }
 

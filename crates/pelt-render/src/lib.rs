@@ -127,6 +127,7 @@ mod listing;
 mod lod;
 mod object;
 mod plain;
+mod pool;
 mod renderer;
 mod requirements;
 mod shaders;

@@ -280,6 +280,7 @@ impl ObjectShape {
             lean_share: lean.share.clamp(0.0, 1.0),
             lean_texels: lean.texels.max(0.0),
             _padding_3: [0.0; 3],
+            pool: [0; 4],
         }
     }
 }
@@ -305,7 +306,9 @@ pub(crate) fn world_per_uv(mesh: &Mesh) -> f32 {
     if uv_area > 1e-12 { (mesh.surface_area() / uv_area).sqrt() } else { 1.0 }
 }
 
-/// Creates the uniform buffer of one object.
+/// Creates the uniform buffer of one object (the separated structure's: a unified fur's lives in
+/// its pool).
+#[cfg(feature = "lab")]
 pub(crate) fn uniform_buffer(device: &wgpu::Device) -> wgpu::Buffer {
     device.create_buffer(&wgpu::BufferDescriptor {
         label: Some("pelt object"),

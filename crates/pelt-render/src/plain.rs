@@ -35,7 +35,11 @@ impl PlainMesh {
     /// Writes this frame's model transform (takes effect at the next submission).
     pub fn prepare(&self, queue: &wgpu::Queue, world_from_model: Mat4) {
         let frame = FurFrame { world_from_model, ..FurFrame::default() };
-        self.geometry.write_uniform(queue, &self.geometry.shape.uniform(&frame, self.colour, TextureShape::default()));
+        self.geometry.write_uniform(
+            queue,
+            &self.geometry.shape.uniform(&frame, self.colour, TextureShape::default()),
+            0,
+        );
     }
 
     /// Moves the mesh's vertices (a skinned body's pose this frame, in model space).

@@ -55,8 +55,8 @@ fn scripted_stepper(structure: &FurStructure) -> FurStepper {
 /// The positions `driver` draws this frame: its current state, or between its two states at
 /// the frame's interpolation.
 fn drawn_positions(gpu: &pelt_render::Gpu, driver: &FurDriver, nodes: usize) -> Vec<Vec3> {
-    let read = |buffer: &wgpu::Buffer| -> Vec<Vec3> {
-        assert!(buffer.usage().contains(POSITIONS_USAGE));
+    let read = |state: wgpu::BufferSlice<'_>| -> Vec<Vec3> {
+        assert!(state.buffer().usage().contains(POSITIONS_USAGE));
         let bytes = nodes as u64 * 12;
         let staging = gpu.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("readback"),
@@ -65,7 +65,7 @@ fn drawn_positions(gpu: &pelt_render::Gpu, driver: &FurDriver, nodes: usize) -> 
             mapped_at_creation: false,
         });
         let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor::default());
-        encoder.copy_buffer_to_buffer(buffer, 0, &staging, 0, bytes);
+        encoder.copy_buffer_to_buffer(state.buffer(), state.offset(), &staging, 0, bytes);
         gpu.queue.submit([encoder.finish()]);
         let slice = staging.slice(..);
         slice.map_async(wgpu::MapMode::Read, |result| result.expect("map"));

@@ -45,7 +45,8 @@ fn a_hundred_copies_allocate_the_topology_and_textures_once() {
     {
         assert_eq!(made(shared), 1, "{shared}: allocated once for 100 copies");
     }
-    assert_eq!(made("pelt shared vertices"), 200, "two states a copy");
+    // A copy made alone is a pool of one: its two states in one buffer.
+    assert_eq!(made("pelt shared vertices"), 100, "both states of a copy in one buffer");
     assert_eq!(made("pelt base normals"), 100);
     // The bytes: the asset once, each copy's own bytes and lists, and small per-copy buffers
     // (uniform, wetness, draw arguments) with the allocator's alignment.
@@ -301,4 +302,72 @@ fn fade_steps(frames: &[image::RgbaImage]) -> (f64, f64, Vec<f64>) {
     let steps: Vec<f64> = frames.windows(2).map(|w| mean_difference(&w[0], &w[1])).collect();
     let largest = steps.iter().copied().fold(0.0, f64::max);
     (whole, largest, steps)
+}
+
+/// Copies made together list in one dispatch per listing stage for the whole herd: three
+/// copies, each shaped, posed and placed its own way and thinning its shells by view angle, list their
+/// fins and thinned triangles in 5 dispatches (a lone copy's 5, not 15), and each copy's lists
+/// (counts, instances, indices, draws) have the bytes of a copy made alone, posed and placed the
+/// same, listed alone; the herd's picture is the lone copies' drawn in turn.
+#[test]
+fn copies_made_together_list_in_one_dispatch_each_as_each_alone() {
+    let rig = Rig::new(96, 96);
+    let structure = builtin_fur(Builtin::Bunny, 8);
+    let textures = strand_textures(32, 8, BROWN_ROOT, BROWN_TIP);
+    let asset = FurAsset::new(rig.device(), rig.queue(), &rig.renderer, &structure, &textures).expect("asset");
+    let (device, renderer) = (rig.device(), &rig.renderer);
+    let herd = GpuFur::herd_from_asset(device, renderer, &asset, FurStates::Two, 3).expect("herd");
+    let alone: Vec<GpuFur> =
+        (0..3).map(|_| GpuFur::from_asset(device, renderer, &asset, FurStates::Two).expect("copy")).collect();
+    let radius = structure.mesh.bounding_sphere().1;
+    let v = structure.mesh.vertex_count();
+    let level = pelt_render::FurLevel { facing: Some(pelt_render::LodSettings::DEFAULT_FACING), ..Default::default() };
+    for (k, (together, lone)) in herd.iter().zip(&alone).enumerate() {
+        // Copy k squashed to 1 - k/4 of its height (its roots and faces move), bent sideways by
+        // k tenths of the radius at the tips, and turned k * 40 degrees.
+        let (bend, squash) = (0.1 * radius * k as f32, Vec3::new(1.0, 1.0 - 0.25 * k as f32, 1.0));
+        let bent: Vec<Vec3> = (structure.positions.iter().enumerate())
+            .map(|(j, p)| *p * squash + Vec3::X * (bend * (j / v) as f32 / structure.layers as f32))
+            .collect();
+        let frame = FurFrame {
+            world_from_model: glam::Mat4::from_rotation_y((40.0 * k as f32).to_radians()),
+            level,
+            ..common::paper_frame()
+        };
+        // The squashed surface's normals (the inverse transpose of the squash).
+        let normals: Vec<Vec3> = structure.mesh.normals.iter().map(|n| (*n / squash).normalize()).collect();
+        for fur in [together, lone] {
+            fur.set_positions(rig.queue(), &bent).expect("positions");
+            fur.set_base_normals(rig.queue(), &normals).expect("normals");
+            fur.prepare(rig.queue(), &frame);
+        }
+    }
+    let camera = framed(&structure, 1.0);
+    rig.view.prepare(rig.queue(), &camera.view_data(1.0, &pelt_render::Light::default()));
+    let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor::default());
+    let together = renderer.prepare_fins_of(&mut encoder, &rig.view, &herd);
+    let each: Vec<usize> = alone.iter().map(|fur| renderer.prepare_fins_of(&mut encoder, &rig.view, [fur])).collect();
+    rig.queue().submit([encoder.finish()]);
+    assert_eq!(each, [5, 5, 5], "a lone copy's fin and shell listings");
+    assert_eq!(together, 5, "the herd's, three copies in one dispatch a stage");
+    let bytes = |slice: Option<wgpu::BufferSlice<'_>>| common::read_bytes(device, rig.queue(), slice.expect("a list"));
+    for (k, (together, lone)) in herd.iter().zip(&alone).enumerate() {
+        assert!(together.shells_thinned() > 0, "copy {k} thins its shells");
+        let count = |fur: &GpuFur| u32::from_le_bytes(bytes(fur.view_lod_count()).try_into().expect("one u32"));
+        assert!(count(together) > 0, "copy {k} lists triangles");
+        assert_eq!(count(together), count(lone), "copy {k}'s listed triangles");
+        let listed = count(lone) as usize * 4;
+        assert_eq!(bytes(together.view_lod_indices())[..listed], bytes(lone.view_lod_indices())[..listed], "copy {k}");
+        let draw = bytes(together.silhouette_draw());
+        assert_eq!(draw, bytes(lone.silhouette_draw()), "copy {k}'s fin draw");
+        let fins = u32::from_le_bytes(draw[4..8].try_into().expect("u32")) as usize;
+        assert!(fins > 0, "copy {k} shows fins");
+        let kept = |fur: &GpuFur| bytes(fur.silhouette_instances())[..8 * fins].to_vec();
+        assert_eq!(kept(together), kept(lone), "copy {k}'s fins");
+    }
+    // Each copy's own pose and place in the picture, listed together or alone.
+    let listed_together: Vec<&GpuFur> = herd.iter().collect();
+    let listed_alone: Vec<&GpuFur> = alone.iter().collect();
+    let herd_picture = rig.render_silhouettes(&listed_together, &camera, &settings(), true);
+    assert_eq!(herd_picture, rig.render_silhouettes(&listed_alone, &camera, &settings(), false));
 }

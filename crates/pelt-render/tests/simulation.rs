@@ -43,8 +43,8 @@ impl GpuRig {
         (self.read(self.fur.previous_positions()), self.read(self.fur.current_positions()))
     }
 
-    fn read(&self, buffer: &wgpu::Buffer) -> Vec<Vec3> {
-        assert!(buffer.usage().contains(POSITIONS_USAGE));
+    fn read(&self, state: wgpu::BufferSlice<'_>) -> Vec<Vec3> {
+        assert!(state.buffer().usage().contains(POSITIONS_USAGE));
         let bytes = self.nodes as u64 * 12;
         let staging = self.gpu.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("readback"),
@@ -53,7 +53,7 @@ impl GpuRig {
             mapped_at_creation: false,
         });
         let mut encoder = self.gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor::default());
-        encoder.copy_buffer_to_buffer(buffer, 0, &staging, 0, bytes);
+        encoder.copy_buffer_to_buffer(state.buffer(), state.offset(), &staging, 0, bytes);
         self.gpu.queue.submit([encoder.finish()]);
         let slice = staging.slice(..);
         slice.map_async(wgpu::MapMode::Read, |result| result.expect("map"));

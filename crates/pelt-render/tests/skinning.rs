@@ -13,7 +13,7 @@ fn read_posed(gpu: &pelt_render::Gpu, skin: &GpuSkin) -> Vec<[f32; 4]> {
     let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor::default());
     skin.record(&mut encoder);
     gpu.queue.submit([encoder.finish()]);
-    read_bytes(&gpu.device, &gpu.queue, skin.posed())
+    read_bytes(&gpu.device, &gpu.queue, skin.posed().slice(..))
         .chunks_exact(16)
         .map(|c| std::array::from_fn(|k| f32::from_le_bytes([c[4 * k], c[4 * k + 1], c[4 * k + 2], c[4 * k + 3]])))
         .collect()

@@ -309,8 +309,8 @@ fn wetting_and_drying_never_pop_and_dry_fur_comes_back_byte_for_byte() {
 /// The positions `driver` draws this frame.
 fn drawn_positions(headless: &Headless, driver: &FurDriver, nodes: usize) -> Vec<Vec3> {
     let gpu = &headless.gpu;
-    let read = |buffer: &wgpu::Buffer| -> Vec<Vec3> {
-        assert!(buffer.usage().contains(POSITIONS_USAGE));
+    let read = |state: wgpu::BufferSlice<'_>| -> Vec<Vec3> {
+        assert!(state.buffer().usage().contains(POSITIONS_USAGE));
         let bytes = nodes as u64 * 12;
         let staging = gpu.device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("readback"),
@@ -319,7 +319,7 @@ fn drawn_positions(headless: &Headless, driver: &FurDriver, nodes: usize) -> Vec
             mapped_at_creation: false,
         });
         let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor::default());
-        encoder.copy_buffer_to_buffer(buffer, 0, &staging, 0, bytes);
+        encoder.copy_buffer_to_buffer(state.buffer(), state.offset(), &staging, 0, bytes);
         gpu.queue.submit([encoder.finish()]);
         let slice = staging.slice(..);
         slice.map_async(wgpu::MapMode::Read, |result| result.expect("map"));

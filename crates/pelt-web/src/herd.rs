@@ -123,12 +123,10 @@ impl HerdGpu {
         count: usize,
     ) -> Result<Self, String> {
         let asset = FurAsset::new(device, queue, renderer, structure, textures).map_err(|e| e.to_string())?;
-        let drivers = (0..count)
-            .map(|_| {
-                FurDriver::with_asset(device, queue, renderer, &asset, structure, &preset.simulation, KernelChoice::Cpu)
-            })
-            .collect::<Result<Vec<_>, _>>()
-            .map_err(|e| e.to_string())?;
+        let herd = (&asset, structure);
+        let drivers =
+            FurDriver::herd_with_asset(device, queue, renderer, herd, &preset.simulation, KernelChoice::Cpu, count)
+                .map_err(|e| e.to_string())?;
         Ok(Self { _asset: asset, drivers })
     }
 

@@ -207,9 +207,8 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         (false, _) => KernelChoice::Cpu,
     };
     let members = instances.len().max(1);
-    let mut drivers = (0..members)
-        .map(|_| FurDriver::with_asset(device, queue, &renderer, &asset, &fur, &simulation_params, kernel))
-        .collect::<Result<Vec<_>, _>>()?;
+    let mut drivers =
+        FurDriver::herd_with_asset(device, queue, &renderer, (&asset, &fur), &simulation_params, kernel, members)?;
     let clips = match rig.as_ref() {
         Some(rig) => herd::resolve_clips(&instances, Some(rig), clip),
         None => herd::resolve_clips(&instances, None, clip),

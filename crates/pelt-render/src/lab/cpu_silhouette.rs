@@ -150,7 +150,7 @@ impl GpuFur {
             return Ok(0);
         };
         let fins = silhouette.decide(positions, frame, camera_position_world)?;
-        list.write(queue, fins, frame.level.shells(self.layers()));
+        list.write(queue, self.slot(), fins, frame.level.shells(self.layers()));
         Ok(fins.len() as u32)
     }
 }

@@ -30,43 +30,47 @@ fn fin_draw(segments: u32, fins: u32) -> DrawIndexedIndirectArgs {
     }
 }
 
-/// One fur's fins as the silhouette pass leaves them: the indirect draw and its instances.
+/// The fins of every copy in a pool (`crate::pool`) as the silhouette pass leaves them: slot by
+/// slot, each copy's indirect draw and instances.
 #[derive(Debug)]
 pub(crate) struct FinList {
-    /// `DrawIndexedIndirectArgs`: `6L` indices, the instance count the pass counted.
-    pub draw: wgpu::Buffer,
-    /// Up to `E` instances of [`FIN_INSTANCE_LAYOUT`].
+    /// `DrawIndexedIndirectArgs` a slot: `6L` indices, the instance count the pass counted.
+    pub draws: wgpu::Buffer,
+    /// Up to `E` instances of [`FIN_INSTANCE_LAYOUT`] a slot.
     pub instances: wgpu::Buffer,
     bind_group: wgpu::BindGroup,
     edge_count: u32,
+    slots: u32,
 }
 
 impl FinList {
-    /// The list of a fur with `edge_count` edges and `layers` layers; `None` without fins.
+    /// The lists of `slots` copies of a fur with `edge_count` edges and `layers` layers; `None`
+    /// without fins.
     pub fn new(
         device: &wgpu::Device,
         layouts: &Layouts,
-        edge_count: u32,
-        layers: u32,
+        (edge_count, layers): (u32, u32),
+        slots: u32,
     ) -> Result<Option<Self>, RenderError> {
         if edge_count == 0 || layers == 0 {
             return Ok(None);
         }
-        let instance_bytes = u64::from(edge_count) * FIN_INSTANCE_BYTES;
+        let instance_bytes = u64::from(edge_count) * FIN_INSTANCE_BYTES * u64::from(slots);
         check_size(device, "fin instances", instance_bytes)?;
         check_scan_width(device)?;
-        let draw = wgpu::util::DeviceExt::create_buffer_init(
+        let draws: Vec<u8> = (0..slots).flat_map(|_| fin_draw(layers, 0).as_bytes().to_vec()).collect();
+        let draws = wgpu::util::DeviceExt::create_buffer_init(
             device,
             &wgpu::util::BufferInitDescriptor {
-                label: Some("pelt fin draw"),
-                contents: fin_draw(layers, 0).as_bytes(),
+                label: Some("pelt fin draws"),
+                contents: &draws,
                 usage: wgpu::BufferUsages::STORAGE
                     | wgpu::BufferUsages::INDIRECT
                     | wgpu::BufferUsages::COPY_DST
                     | wgpu::BufferUsages::COPY_SRC,
             },
         );
-        debug_assert_eq!(draw.size(), DRAW_ARGS_BYTES);
+        debug_assert_eq!(draws.size(), DRAW_ARGS_BYTES * u64::from(slots));
         let instances = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("pelt fin instances"),
             size: instance_bytes,
@@ -76,35 +80,47 @@ impl FinList {
                 | wgpu::BufferUsages::COPY_SRC,
             mapped_at_creation: false,
         });
-        let bind_group = list_bind_group(device, "pelt fin list", &layouts.fin_list, &[&draw, &instances]);
-        Ok(Some(Self { draw, instances, bind_group, edge_count }))
+        let bind_group = list_bind_group(device, "pelt fin list", &layouts.fin_list, &[&draws, &instances]);
+        Ok(Some(Self { draws, instances, bind_group, edge_count, slots }))
     }
 
-    /// Records the silhouette pass: every edge's fade, then one workgroup lists the shown fins
-    /// in edge order and writes the draw's count (both write the instances).
+    /// Records the silhouette pass of every copy in the pool that lists fins this frame (its
+    /// object's `pool.w`): every edge's fade, then one workgroup a copy lists its shown fins in
+    /// edge order and writes its draw's count (both write the instances).
     pub fn record(
         &self,
         pass: &mut wgpu::ComputePass<'_>,
         pipelines: &ListingPipelines<2>,
         view: &wgpu::BindGroup,
-        object: &wgpu::BindGroup,
+        objects: &wgpu::BindGroup,
     ) {
-        pipelines.record(pass, (view, object, &self.bind_group), [item_groups(self.edge_count), (1, 1)]);
+        pipelines.record(pass, (view, objects, &self.bind_group), [item_groups(self.edge_count), (1, 1)], self.slots);
     }
 
-    /// Writes a list decided on the CPU (`(edge, fade bits)` per fin, at most `E`) and its
-    /// indirect draw of `segments` segments a fin, in place of the compute pass.
+    /// Slot `slot`'s instances.
+    pub fn instances_of(&self, slot: u32) -> wgpu::BufferSlice<'_> {
+        let bytes = u64::from(self.edge_count) * FIN_INSTANCE_BYTES;
+        self.instances.slice(u64::from(slot) * bytes..(u64::from(slot) + 1) * bytes)
+    }
+
+    /// The byte offset of slot `slot`'s indirect draw in [`FinList::draws`].
+    pub fn draw_offset(slot: u32) -> u64 {
+        u64::from(slot) * DRAW_ARGS_BYTES
+    }
+
+    /// Writes slot `slot`'s list decided on the CPU (`(edge, fade bits)` per fin, at most `E`)
+    /// and its indirect draw of `segments` segments a fin, in place of the compute pass.
     #[cfg(feature = "lab")]
-    pub fn write(&self, queue: &wgpu::Queue, fins: &[[u32; 2]], segments: u32) {
+    pub fn write(&self, queue: &wgpu::Queue, slot: u32, fins: &[[u32; 2]], segments: u32) {
         let fins = &fins[..fins.len().min(self.edge_count as usize)];
         if !fins.is_empty() {
-            queue.write_buffer(&self.instances, 0, bytemuck::cast_slice(fins));
+            queue.write_buffer(&self.instances, self.instances_of(slot).offset(), bytemuck::cast_slice(fins));
         }
-        queue.write_buffer(&self.draw, 0, fin_draw(segments, fins.len() as u32).as_bytes());
+        queue.write_buffer(&self.draws, Self::draw_offset(slot), fin_draw(segments, fins.len() as u32).as_bytes());
     }
 
-    /// GPU bytes of the list.
-    pub fn bytes(&self) -> u64 {
-        self.draw.size() + self.instances.size()
+    /// GPU bytes of one slot's list.
+    pub fn slot_bytes(&self) -> u64 {
+        DRAW_ARGS_BYTES + u64::from(self.edge_count) * FIN_INSTANCE_BYTES
     }
 }

@@ -3,11 +3,12 @@
 //! indirect draws. [`fins`]: the silhouette pass (which fins show). [`shells`]: shells by view
 //! angle (which triangles the thinned shells still need).
 //!
-//! Both have one shape, kept here: their pipelines ([`ListingPipelines`]) bind the view and the
-//! unified object in groups 0 and 1 and one fur's list in group 3, and run in a compute pass in
-//! the host's encoder ([`crate::FurRenderer::prepare_fins`]) before the render pass that draws
-//! the fur; every fur of a herd lists in the same pass ([`crate::FurRenderer::prepare_fins_of`]).
-//! Nothing is read back, nothing blocks.
+//! Both have one shape, kept here: their pipelines ([`ListingPipelines`]) bind the view and a
+//! pool's objects (`crate::pool`: every copy of one fur made together) in groups 0 and 1 and the
+//! pool's lists in group 3, and each dispatch lists every copy of the pool that lists this frame
+//! (workgroup z is the copy's slot), in a compute pass in the host's encoder
+//! ([`crate::FurRenderer::prepare_fins`]) before the render pass that draws the furs. Nothing is
+//! read back, nothing blocks.
 
 mod fins;
 mod shells;
@@ -83,7 +84,7 @@ impl<const N: usize> ListingPipelines<N> {
         });
         let layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
             label: Some(label),
-            bind_group_layouts: &[Some(&layouts.view), Some(&layouts.unified_object), None, Some(list_layout)],
+            bind_group_layouts: &[Some(&layouts.view), Some(&layouts.pool_objects), None, Some(list_layout)],
             immediate_size: 0,
         });
         let pipelines = entry_points.map(|entry_point| {
@@ -99,22 +100,23 @@ impl<const N: usize> ListingPipelines<N> {
         Self { label, pipelines }
     }
 
-    /// Records the dispatches into `pass`: pipeline `k` over `groups[k]` workgroups (x, y), in
-    /// order, with `view`, `object` and the fur's `list` bound. wgpu orders the dispatches: each
-    /// sees every write of the one before.
+    /// Records the dispatches into `pass`: pipeline `k` over `groups[k]` workgroups (x, y) for
+    /// each of a pool's `slots` copies (z), in order, with `view`, the pool's `objects` and its
+    /// `lists` bound. wgpu orders the dispatches: each sees every write of the one before.
     fn record(
         &self,
         pass: &mut wgpu::ComputePass<'_>,
-        (view, object, list): (&wgpu::BindGroup, &wgpu::BindGroup, &wgpu::BindGroup),
+        (view, objects, lists): (&wgpu::BindGroup, &wgpu::BindGroup, &wgpu::BindGroup),
         groups: [(u32, u32); N],
+        slots: u32,
     ) {
         pass.push_debug_group(self.label);
         pass.set_bind_group(0, view, &[]);
-        pass.set_bind_group(1, object, &[]);
-        pass.set_bind_group(3, list, &[]);
+        pass.set_bind_group(1, objects, &[]);
+        pass.set_bind_group(3, lists, &[]);
         for (pipeline, (x, y)) in self.pipelines.iter().zip(groups) {
             pass.set_pipeline(pipeline);
-            pass.dispatch_workgroups(x, y, 1);
+            pass.dispatch_workgroups(x, y, slots);
         }
         pass.pop_debug_group();
     }

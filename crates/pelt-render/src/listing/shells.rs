@@ -18,38 +18,41 @@ use crate::shaders::Layouts;
 /// Shells one workgroup writes draws for (`cs_view_lod_draws` in `view_lod.wgsl`).
 const WORKGROUP: u32 = 64;
 
-/// One fur's shell list as the pass leaves it.
+/// The shell lists of every copy in a pool (`crate::pool`) as the pass leaves them, slot by slot.
 #[derive(Debug)]
 pub(crate) struct ShellList {
-    /// Indices listed (3 a triangle), one `u32`; `COPY_SRC` for hosts that count.
+    /// Indices listed (3 a triangle), one `u32` a slot; `COPY_SRC` for hosts that count.
     pub listed: wgpu::Buffer,
-    /// The listed triangles' corners or base vertices (the index buffer of the thinned shells).
+    /// The listed triangles' corners or base vertices (the index buffer of the thinned shells),
+    /// `3F` a slot; each slot's draws start at its own.
     pub indices: wgpu::Buffer,
-    /// One `DrawIndexedIndirectArgs` per shell, [`DRAW_ARGS_BYTES`] apart.
+    /// One `DrawIndexedIndirectArgs` per shell, [`DRAW_ARGS_BYTES`] apart, `L` a slot.
     pub draws: wgpu::Buffer,
     bind_group: wgpu::BindGroup,
     layers: u32,
     triangle_count: u32,
-    /// Whether the pass was recorded since the fur's last `prepare` (else the list may be from
-    /// another level or view, and the shells are drawn whole).
-    recorded: AtomicBool,
+    slots: u32,
+    /// Per slot, whether the pass was recorded since the copy's last `prepare` (else the list
+    /// may be from another level or view, and the shells are drawn whole).
+    recorded: Vec<AtomicBool>,
 }
 
 impl ShellList {
-    /// The list of a fur of `triangle_count` triangles, `layers` layers and `per_shell` vertex
-    /// indices a shell (the wedges with uvs, V without); `None` where there is nothing to thin (fewer
-    /// than two layers) or the shells' vertex indices would not fit an `i32` base vertex.
+    /// The lists of `slots` copies of a fur of `triangle_count` triangles, `layers` layers and
+    /// `per_shell` vertex indices a shell (the wedges with uvs, V without); `None` where there is
+    /// nothing to thin (fewer than two layers) or the shells' vertex indices would not fit an
+    /// `i32` base vertex.
     pub fn new(
         device: &wgpu::Device,
         layouts: &Layouts,
-        (triangle_count, per_shell): (u32, u32),
-        layers: u32,
+        (triangle_count, per_shell, layers): (u32, u32, u32),
+        slots: u32,
     ) -> Result<Option<Self>, RenderError> {
         let numbered = u64::from(layers) * u64::from(per_shell);
         if layers < 2 || triangle_count == 0 || numbered > i32::MAX as u64 {
             return Ok(None);
         }
-        let index_bytes = u64::from(triangle_count) * 12;
+        let index_bytes = u64::from(triangle_count) * 12 * u64::from(slots);
         check_size(device, "view-angle shell list", index_bytes)?;
         check_scan_width(device)?;
         let buffer = |label, size, usage| {
@@ -60,39 +63,59 @@ impl ShellList {
                 mapped_at_creation: false,
             })
         };
-        let listed = buffer("pelt shell list count", 4, wgpu::BufferUsages::COPY_DST);
+        let listed = buffer("pelt shell list count", 4 * u64::from(slots), wgpu::BufferUsages::COPY_DST);
         let indices = buffer("pelt shell list", index_bytes, wgpu::BufferUsages::INDEX);
-        let draws = buffer("pelt shell draws", u64::from(layers) * DRAW_ARGS_BYTES, wgpu::BufferUsages::INDIRECT);
+        let draws = buffer(
+            "pelt shell draws",
+            u64::from(layers) * DRAW_ARGS_BYTES * u64::from(slots),
+            wgpu::BufferUsages::INDIRECT,
+        );
         let bind_group = list_bind_group(device, "pelt shell list", &layouts.shell_list, &[&listed, &indices, &draws]);
-        Ok(Some(Self { listed, indices, draws, bind_group, layers, triangle_count, recorded: AtomicBool::new(false) }))
+        let recorded = (0..slots).map(|_| AtomicBool::new(false)).collect();
+        Ok(Some(Self { listed, indices, draws, bind_group, layers, triangle_count, slots, recorded }))
     }
 
-    /// Records the pass: every triangle's flag, then one workgroup lists the triangles in order,
-    /// then the draws are written.
+    /// Records the pass of every copy in the pool that thins its shells this frame (its object's
+    /// `pool.w`): every triangle's flag, then one workgroup a copy lists its triangles in order,
+    /// then the draws are written. `listed` are the slots this frame's draws may use the lists of.
     pub fn record(
         &self,
         pass: &mut wgpu::ComputePass<'_>,
         pipelines: &ListingPipelines<3>,
-        view: &wgpu::BindGroup,
-        object: &wgpu::BindGroup,
+        (view, objects): (&wgpu::BindGroup, &wgpu::BindGroup),
+        listed: impl IntoIterator<Item = u32>,
     ) {
         let groups = [item_groups(self.triangle_count), (1, 1), (self.layers.div_ceil(WORKGROUP), 1)];
-        pipelines.record(pass, (view, object, &self.bind_group), groups);
-        self.recorded.store(true, Ordering::Relaxed);
+        pipelines.record(pass, (view, objects, &self.bind_group), groups, self.slots);
+        for slot in listed {
+            self.recorded[slot as usize].store(true, Ordering::Relaxed);
+        }
     }
 
-    /// Forgets the last pass (a new level or frame is being prepared).
-    pub fn invalidate(&self) {
-        self.recorded.store(false, Ordering::Relaxed);
+    /// Forgets slot `slot`'s last pass (a new level or frame is being prepared).
+    pub fn invalidate(&self, slot: u32) {
+        self.recorded[slot as usize].store(false, Ordering::Relaxed);
     }
 
-    /// Whether the pass was recorded since the last [`ShellList::invalidate`].
-    pub fn recorded(&self) -> bool {
-        self.recorded.load(Ordering::Relaxed)
+    /// Whether slot `slot`'s pass was recorded since its last [`ShellList::invalidate`].
+    pub fn recorded(&self, slot: u32) -> bool {
+        self.recorded[slot as usize].load(Ordering::Relaxed)
     }
 
-    /// GPU bytes of the list.
-    pub fn bytes(&self) -> u64 {
-        self.listed.size() + self.indices.size() + self.draws.size()
+    /// The byte offset of slot `slot`'s first draw in [`ShellList::draws`].
+    pub fn draws_offset(&self, slot: u32) -> u64 {
+        u64::from(slot) * u64::from(self.layers) * DRAW_ARGS_BYTES
+    }
+
+    /// Slot `slot`'s count and indices.
+    pub fn listed_of(&self, slot: u32) -> (wgpu::BufferSlice<'_>, wgpu::BufferSlice<'_>) {
+        let bytes = u64::from(self.triangle_count) * 12;
+        let slot = u64::from(slot);
+        (self.listed.slice(4 * slot..4 * slot + 4), self.indices.slice(slot * bytes..(slot + 1) * bytes))
+    }
+
+    /// GPU bytes of one slot's list.
+    pub fn slot_bytes(&self) -> u64 {
+        4 + u64::from(self.triangle_count) * 12 + u64::from(self.layers) * DRAW_ARGS_BYTES
     }
 }

@@ -22,7 +22,7 @@ use std::sync::OnceLock;
 
 use crate::RenderError;
 use crate::fur::{Coat, GpuFur};
-use crate::listing::{DRAW_ARGS_BYTES, FIN_INSTANCE_LAYOUT, ListingPasses, ShellList};
+use crate::listing::{DRAW_ARGS_BYTES, FIN_INSTANCE_LAYOUT, FinList, ListingPasses, ShellList};
 use crate::plain::PlainMesh;
 use crate::requirements::{ErrorScope, check_features_and_limits};
 use crate::shaders::{Layouts, unified_shader_source};
@@ -268,7 +268,7 @@ impl FurRenderer {
         if settings.shells {
             let shells = &coat.shells[walk][which];
             match fur.shell_list() {
-                Some(list) if list.recorded() && fur.prepared_level().by_view() => {
+                Some(list) if list.recorded(fur.slot()) && fur.prepared_level().by_view() => {
                     draw_thinned_shells(pass, fur, (shells, &coat.listed_shells[walk][which]), list);
                 }
                 _ => {
@@ -283,7 +283,8 @@ impl FurRenderer {
             match fur.fin_list() {
                 Some(list) if settings.silhouette_fins => {
                     pass.set_pipeline(&coat.silhouette_fins[which]);
-                    geometry.draw_fin_list(pass, &list.instances, &list.draw);
+                    let slot = fur.slot();
+                    geometry.draw_fin_list(pass, list.instances_of(slot), (&list.draws, FinList::draw_offset(slot)));
                 }
                 _ => {
                     pass.set_pipeline(&coat.fins[which]);
@@ -306,37 +307,58 @@ impl FurRenderer {
         self.prepare_fins_of(encoder, view, [fur]);
     }
 
-    /// [`FurRenderer::prepare_fins`] for every fur of `furs` (a herd), their dispatches in one
-    /// compute pass rather than a pass each. No pass when none of them lists.
+    /// [`FurRenderer::prepare_fins`] for every fur of `furs` (a herd), in one compute pass: the
+    /// copies made together (`FurDriver::herd_with_asset`, `GpuFur::herd_from_asset`) share a
+    /// pool, and each listing dispatch lists every copy of a pool that lists this frame (as its
+    /// last [`GpuFur::prepare`] said), so a herd lists in a few dispatches, not a few a fur. No
+    /// pass when none of them lists. Returns the dispatches recorded.
     pub fn prepare_fins_of<'a>(
         &self,
         encoder: &mut wgpu::CommandEncoder,
         view: &FurView,
         furs: impl IntoIterator<Item = &'a GpuFur>,
-    ) {
-        let mut listed = furs
-            .into_iter()
-            .filter_map(|fur| {
-                let level = fur.prepared_level();
-                let fins = fur.fin_list().filter(|_| level.coat_shown() && level.fins_shown());
-                let shells = fur.shell_list().filter(|_| level.coat_shown() && level.by_view());
-                (fins.is_some() || shells.is_some()).then_some((fur, fins, shells))
-            })
-            .peekable();
-        if listed.peek().is_none() {
-            return;
+    ) -> usize {
+        // Per pool (in the order first met): whether any of its copies lists fins, and the slots
+        // whose shells are thinned.
+        let mut pools: Vec<(&GpuFur, bool, Vec<u32>)> = Vec::new();
+        for fur in furs {
+            let level = fur.prepared_level();
+            let fins = fur.fin_list().is_some() && level.coat_shown() && level.fins_shown();
+            let shells = fur.shell_list().is_some() && level.coat_shown() && level.by_view();
+            if !(fins || shells) {
+                continue;
+            }
+            let index = match pools.iter().position(|(first, ..)| std::sync::Arc::ptr_eq(first.pool(), fur.pool())) {
+                Some(index) => index,
+                None => {
+                    pools.push((fur, false, Vec::new()));
+                    pools.len() - 1
+                }
+            };
+            pools[index].1 |= fins;
+            if shells {
+                pools[index].2.push(fur.slot());
+            }
+        }
+        if pools.is_empty() {
+            return 0;
         }
         let mut pass = encoder
             .begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("pelt listing"), timestamp_writes: None });
-        for (fur, fins, shells) in listed {
-            let object = fur.geometry().bind_group();
-            if let Some(list) = fins {
-                list.record(&mut pass, &self.listing.silhouette, view.bind_group(), object);
+        let mut dispatches = 0;
+        for (fur, fins, thinned) in pools {
+            let pool = fur.pool();
+            let objects = pool.listing_group();
+            if let Some(list) = pool.fins().filter(|_| fins) {
+                list.record(&mut pass, &self.listing.silhouette, view.bind_group(), objects);
+                dispatches += 2;
             }
-            if let Some(list) = shells {
-                list.record(&mut pass, &self.listing.view_lod, view.bind_group(), object);
+            if let Some(list) = pool.shells().filter(|_| !thinned.is_empty()) {
+                list.record(&mut pass, &self.listing.view_lod, (view.bind_group(), objects), thinned);
+                dispatches += 3;
             }
         }
+        dispatches
     }
 
     /// Records a plain mesh as seen from `view` (opaque: draw it before the furs). Call
@@ -393,8 +415,9 @@ fn draw_thinned_shells(
     for shell in 0..fur.drawn_shells() {
         if fur.prepared_level().dropped_shell(layers, shell) {
             pass.set_pipeline(listed_shells);
+            // The draws start at the fur's own indices (`first_index`).
             pass.set_index_buffer(list.indices.slice(..), wgpu::IndexFormat::Uint32);
-            pass.draw_indexed_indirect(&list.draws, u64::from(shell) * DRAW_ARGS_BYTES);
+            pass.draw_indexed_indirect(&list.draws, list.draws_offset(fur.slot()) + u64::from(shell) * DRAW_ARGS_BYTES);
         } else {
             pass.set_pipeline(shells);
             geometry.draw_shells(pass, shell..shell + 1);

@@ -46,6 +46,23 @@ impl GpuFur {
         Self::instance(device, renderer.layouts(), asset, states)
     }
 
+    /// `count` more copies of `asset`'s fur, as [`GpuFur::from_asset`] makes
+    /// one, made together: their own state shares a few buffers (a pool as large as the device
+    /// binds), so [`FurRenderer::prepare_fins_of`] lists them in a few dispatches, not a few a
+    /// copy.
+    ///
+    /// # Errors
+    /// As [`GpuFur::new`].
+    pub fn herd_from_asset(
+        device: &wgpu::Device,
+        renderer: &FurRenderer,
+        asset: &FurAsset,
+        states: FurStates,
+        count: usize,
+    ) -> Result<Vec<Self>, RenderError> {
+        Self::copies(device, renderer.layouts(), asset, states, count)
+    }
+
     /// Replaces the structure (new mesh, layer count or rest pose), keeping the textures and the
     /// number of states; the fur leaves its asset for one of its own.
     ///

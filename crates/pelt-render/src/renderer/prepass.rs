@@ -265,7 +265,8 @@ impl FurMotion {
             mapped_at_creation: false,
         });
         let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("pelt motion") });
-        encoder.copy_buffer_to_buffer(fur.current_positions(), 0, &previous, 0, size);
+        let current = fur.current_positions();
+        encoder.copy_buffer_to_buffer(current.buffer(), current.offset(), &previous, 0, size);
         queue.submit([encoder.finish()]);
         Self::with_previous(device, prepass, Some(previous), fur)
     }
@@ -287,13 +288,13 @@ impl FurMotion {
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        let positions = previous.as_ref().unwrap_or(fur.current_positions());
+        let positions = previous.as_ref().map_or(fur.current_positions(), |previous| previous.slice(..));
         let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("pelt motion"),
             layout: &prepass.motion_layout,
             entries: &[
                 wgpu::BindGroupEntry { binding: 0, resource: uniform.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 1, resource: positions.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 1, resource: crate::pool::binding(positions) },
             ],
         });
         Self { uniform, previous, bind_group }

@@ -9,6 +9,8 @@ pub(crate) struct Layouts {
     /// Group 1 of the unified structure and plain meshes: the object uniform and the storage
     /// buffers (positions twice, base normals, wedge uvs, topology, groom attributes, wetness).
     pub unified_object: wgpu::BindGroupLayout,
+    /// A pool's copies as the listing passes read them (`crate::pool`).
+    pub pool_objects: wgpu::BindGroupLayout,
     /// Group 1 of the separated structure: the object uniform and the fin vertices.
     #[cfg(feature = "lab")]
     pub separated_object: wgpu::BindGroupLayout,
@@ -68,6 +70,20 @@ impl Layouts {
                 // passes stay within WebGPU's 8 storage buffers per compute stage.
                 entry(6, wgpu::ShaderStages::VERTEX, storage),
                 entry(7, wgpu::ShaderStages::VERTEX, storage),
+            ],
+        });
+        // A pool's copies for the listing passes (`object_pool.wgsl`): their objects, the states
+        // (bound twice, as the draws bind a copy's previous and current), the normals and the
+        // shared topology; within WebGPU's 8 storage buffers per compute stage with the lists.
+        let compute = wgpu::ShaderStages::COMPUTE;
+        let pool_objects = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("pelt pool objects"),
+            entries: &[
+                entry(0, compute, storage),
+                entry(1, compute, storage),
+                entry(2, compute, storage),
+                entry(3, compute, storage),
+                entry(5, compute, storage),
             ],
         });
         // The separated fins' vertices, read back by each fin vertex to decide for its whole fin.
@@ -159,6 +175,7 @@ impl Layouts {
         Self {
             view,
             unified_object,
+            pool_objects,
             #[cfg(feature = "lab")]
             separated_object,
             textures,

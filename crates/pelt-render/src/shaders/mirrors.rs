@@ -65,8 +65,10 @@ pub(crate) struct ObjectUniform {
     pub tint: Vec3,
     pub lean_share: f32,
     pub lean_texels: f32,
-    /// WGSL rounds the struct up to its 16-byte alignment.
+    /// WGSL aligns `pool` to 16 bytes.
     pub _padding_3: [f32; 3],
+    /// The copy's place in its pool for the listing passes ([`crate::pool`]).
+    pub pool: [u32; 4],
 }
 
 /// One light; the layout of `Light` in `fur_bsdf.wgsl`.
@@ -345,7 +347,8 @@ mod tests {
             tint,
             lean_share,
             lean_texels,
-            _padding_3
+            _padding_3,
+            pool
         });
         assert_mirrors(&unified_shader_source(), "Object", &rust);
     }

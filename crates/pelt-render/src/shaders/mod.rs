@@ -31,6 +31,9 @@ const FUR_BSDF_WGSL: &str = include_str!("fur_bsdf.wgsl");
 const SHADOWS_WGSL: &str = include_str!("shadows.wgsl");
 /// The unified structure's vertex and fragment shaders, over the shared vertex array.
 const UNIFIED_WGSL: &str = include_str!("unified.wgsl");
+/// The listing passes' object binding: every copy in a pool (`pool.rs`), in place of the one
+/// object uniform.
+const OBJECT_POOL_WGSL: &str = include_str!("object_pool.wgsl");
 /// The ordered listing both listing passes share.
 const SCAN_WGSL: &str = include_str!("scan.wgsl");
 /// The silhouette pass: which fins show.
@@ -71,20 +74,35 @@ pub fn prepass_shader_source() -> String {
     format!("{SHADING_WGSL}\n{WET_WGSL}\n{FUR_BSDF_WGSL}\n{SHADOWS_WGSL}\n{UNIFIED_WGSL}\n{PREPASS_WGSL}")
 }
 
-/// The WGSL module of the silhouette pass (the shared shading, `unified.wgsl`, `scan.wgsl` and
-/// `silhouette.wgsl`).
-#[must_use]
-pub fn silhouette_shader_source() -> String {
-    format!(
-        "{SHADING_WGSL}\n{WET_WGSL}\n{FUR_BSDF_WGSL}\n{SHADOWS_WGSL}\n{UNIFIED_WGSL}\n{SCAN_WGSL}\n{SILHOUETTE_WGSL}"
-    )
+/// The bytes between two copies' objects in a pool (`ObjectSlot` in `object_pool.wgsl`): the
+/// object uniform rounded up to the uniform offset alignment every device allows (256).
+pub(crate) const OBJECT_SLOT_BYTES: u64 = OBJECT_UNIFORM_BYTES.next_multiple_of(256);
+
+/// The shared shading with its object binding for a listing pass: every copy of a pool's object,
+/// read by slot (`object_pool.wgsl`).
+fn pooled_shading() -> String {
+    let (start, end) = ("// OBJECT BINDING", "// END OBJECT BINDING\n");
+    let (Some(from), Some(to)) = (SHADING_WGSL.find(start), SHADING_WGSL.find(end)) else {
+        unreachable!("shading.wgsl marks its object binding");
+    };
+    let pool = OBJECT_POOL_WGSL.replace("OBJECT_SLOT_BYTES", &OBJECT_SLOT_BYTES.to_string());
+    format!("{}{pool}{}", &SHADING_WGSL[..from], &SHADING_WGSL[to + end.len()..])
 }
 
-/// The WGSL module of the view-angle pass (the shared shading, `unified.wgsl`, `scan.wgsl` and
-/// `view_lod.wgsl`).
+/// The WGSL module of the silhouette pass (the shared shading over a pool, `unified.wgsl`,
+/// `scan.wgsl` and `silhouette.wgsl`).
+#[must_use]
+pub fn silhouette_shader_source() -> String {
+    let shading = pooled_shading();
+    format!("{shading}\n{WET_WGSL}\n{FUR_BSDF_WGSL}\n{SHADOWS_WGSL}\n{UNIFIED_WGSL}\n{SCAN_WGSL}\n{SILHOUETTE_WGSL}")
+}
+
+/// The WGSL module of the view-angle pass (the shared shading over a pool, `unified.wgsl`,
+/// `scan.wgsl` and `view_lod.wgsl`).
 #[must_use]
 pub fn view_lod_shader_source() -> String {
-    format!("{SHADING_WGSL}\n{WET_WGSL}\n{FUR_BSDF_WGSL}\n{SHADOWS_WGSL}\n{UNIFIED_WGSL}\n{SCAN_WGSL}\n{VIEW_LOD_WGSL}")
+    let shading = pooled_shading();
+    format!("{shading}\n{WET_WGSL}\n{FUR_BSDF_WGSL}\n{SHADOWS_WGSL}\n{UNIFIED_WGSL}\n{SCAN_WGSL}\n{VIEW_LOD_WGSL}")
 }
 
 /// The WGSL module that copies a host's shadow map into Pelt's (`shadow_copy.wgsl`).

@@ -98,6 +98,10 @@ struct Object {
     // and their mean offset there, texels. Wet partings are as soft as it makes them.
     lean_share: f32,
     lean_texels: f32,
+    // Where the listing passes find this copy in its pool (`pool.rs`), in `u32`s: its current
+    // and previous state and its normals in the pool's buffers, and what it lists this frame
+    // (`LIST_FINS`, `LIST_SHELLS`). The draws bind its own ranges and read none of it.
+    pool: vec4<u32>,
 }
 
 // Set per pipeline: shells and fins with alpha-to-coverage output straight colour, blended ones
@@ -137,7 +141,20 @@ fn wet_on() -> bool {
 }
 
 @group(0) @binding(0) var<uniform> view: View;
+// OBJECT BINDING: the listing passes replace this block (`shaders/mod.rs`).
 @group(1) @binding(0) var<uniform> object: Object;
+// The offsets of the fur's states and normals in the buffers at bindings 1 to 3: a draw binds
+// the fur's own ranges.
+fn current_base() -> u32 {
+    return 0u;
+}
+fn previous_base() -> u32 {
+    return 0u;
+}
+fn normals_base() -> u32 {
+    return 0u;
+}
+// END OBJECT BINDING
 @group(2) @binding(0) var shell_texture: texture_2d_array<f32>;
 @group(2) @binding(1) var fin_texture: texture_2d<f32>;
 @group(2) @binding(2) var shell_sampler: sampler;

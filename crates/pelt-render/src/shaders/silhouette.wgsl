@@ -2,7 +2,7 @@
 // in `unified.wgsl`) and list the shown ones, in edge order, as the fins' instances, counting them
 // into an indexed indirect draw. Appended to `shading.wgsl`, `unified.wgsl` and `scan.wgsl`.
 //
-// Two dispatches. The first decides, one thread an edge over as many workgroups as it takes,
+// Two dispatches, each over every copy in a pool (`object_pool.wgsl`). The first decides, one thread an edge over as many workgroups as it takes,
 // and leaves each edge's fade in the edge's own slot of the list. The second, one workgroup,
 // walks the slots `SCAN_WIDTH` at a time and moves each round's shown fins down to their places
 // by a prefix sum: fins overlap along the silhouette and blend in instance order, so an order
@@ -18,41 +18,50 @@ struct FinDraw {
     first_instance: u32,
 }
 
-// Group 2 holds textures in the render pipelines; the silhouette pass leaves it empty.
-@group(3) @binding(0) var<storage, read_write> fin_draw: FinDraw;
-// (edge, fade as f32 bits) per shown fin, in edge order.
+// Group 2 holds textures in the render pipelines; the silhouette pass leaves it empty. Group 3
+// holds every copy's list of its pool, slot by slot (`object_pool.wgsl`: workgroup z is the slot).
+@group(3) @binding(0) var<storage, read_write> fin_draws: array<FinDraw>;
+// (edge, fade as f32 bits) per shown fin, in edge order: `fin_edge_count` slots a copy.
 @group(3) @binding(1) var<storage, read_write> fin_instances: array<vec2<u32>>;
 
 @compute @workgroup_size(64)
 fn cs_fin_fades(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
+    if !load_member(id.z, LIST_FINS) {
+        return;
+    }
     let edge = item_index(id, groups);
     if edge < object.fin_edge_count {
-        fin_instances[edge] = vec2<u32>(edge, bitcast<u32>(fin_fade(edge)));
+        fin_instances[id.z * object.fin_edge_count + edge] = vec2<u32>(edge, bitcast<u32>(fin_fade(edge)));
     }
 }
 
 @compute @workgroup_size(256)
-fn cs_silhouette(@builtin(local_invocation_index) lane: u32) {
+fn cs_silhouette(@builtin(local_invocation_index) lane: u32, @builtin(workgroup_id) group: vec3<u32>) {
+    // The whole workgroup returns or none of it: the slot is the workgroup's.
+    if !load_member(group.z, LIST_FINS) {
+        return;
+    }
+    let first = group.z * object.fin_edge_count;
     var listed = 0u;
     let rounds = (object.fin_edge_count + SCAN_WIDTH - 1u) / SCAN_WIDTH;
     for (var round = 0u; round < rounds; round++) {
         let edge = round * SCAN_WIDTH + lane;
         var fade = 0.0;
         if edge < object.fin_edge_count {
-            fade = bitcast<f32>(fin_instances[edge].y);
+            fade = bitcast<f32>(fin_instances[first + edge].y);
         }
         let scan = workgroup_scan(lane, u32(fade > 0.0));
         // Every thread has read its slot: a round writes only to slots below its end, and to
         // none a later round reads.
         storageBarrier();
         if fade > 0.0 {
-            fin_instances[listed + scan.x - 1u] = vec2<u32>(edge, bitcast<u32>(fade));
+            fin_instances[first + listed + scan.x - 1u] = vec2<u32>(edge, bitcast<u32>(fade));
         }
         listed += scan.y;
     }
     if lane == 0u {
         // The fins' segments at this frame's level of detail (6 indices each).
-        fin_draw.index_count = 6u * object.lod_shells;
-        fin_draw.instance_count = listed;
+        fin_draws[group.z].index_count = 6u * object.lod_shells;
+        fin_draws[group.z].instance_count = listed;
     }
 }

@@ -44,19 +44,21 @@ const NO_FACE: u32 = 0xffffffffu;
 // NV[layer * V + vertex] in model space, between the two states.
 fn model_vertex(layer: u32, vertex: u32) -> vec3<f32> {
     let k = 3u * (layer * object.vertex_count + vertex);
-    let current = vec3<f32>(current_positions[k], current_positions[k + 1u], current_positions[k + 2u]);
+    let c = current_base() + k;
+    let current = vec3<f32>(current_positions[c], current_positions[c + 1u], current_positions[c + 2u]);
     // One state (or a frame on a step): one fetch. The branch is uniform.
     let t = object.interpolation;
     if t >= 1.0 {
         return current;
     }
-    let previous = vec3<f32>(previous_positions[k], previous_positions[k + 1u], previous_positions[k + 2u]);
+    let p = previous_base() + k;
+    let previous = vec3<f32>(previous_positions[p], previous_positions[p + 1u], previous_positions[p + 2u]);
     // The form of `Simulation::write_lerp`: exactly one state at 0 and the other at 1.
     return previous * (1.0 - t) + current * t;
 }
 
 fn model_normal(vertex: u32) -> vec3<f32> {
-    let k = 3u * vertex;
+    let k = normals_base() + 3u * vertex;
     return vec3<f32>(base_normals[k], base_normals[k + 1u], base_normals[k + 2u]);
 }
 

@@ -14,13 +14,14 @@ struct ShellDraw {
     first_instance: u32,
 }
 
-// Group 2 holds textures in the render pipelines; this pass leaves it empty.
-// Indices listed (3 a triangle).
-@group(3) @binding(0) var<storage, read_write> listed: u32;
+// Group 2 holds textures in the render pipelines; this pass leaves it empty. Group 3 holds
+// every copy's list of its pool, slot by slot (`object_pool.wgsl`: workgroup z is the slot).
+// Indices listed (3 a triangle), one count a copy.
+@group(3) @binding(0) var<storage, read_write> listed: array<u32>;
 // The listed triangles' corners' wedges (meshes with uvs) or base vertices (meshes without), in
-// triangle order.
+// triangle order: `3 * furred_triangle_count` slots a copy.
 @group(3) @binding(1) var<storage, read_write> listed_indices: array<u32>;
-// One draw per shell of the level (only the dropped shells' are used).
+// One draw per layer a copy (only the dropped shells' are used).
 @group(3) @binding(2) var<storage, read_write> shell_draws: array<ShellDraw>;
 
 // Whether triangle `triangle` still shows in the layers the next coarser stride drops.
@@ -38,31 +39,44 @@ fn view_lod_shows(triangle: u32) -> bool {
     return shows;
 }
 
+// The first of slot `member`'s indices in `listed_indices`.
+fn first_listed(member: u32) -> u32 {
+    return 3u * member * object.furred_triangle_count;
+}
+
 // First, one thread a triangle over as many workgroups as it takes: whether it shows, in the
 // first of its own three slots of the list (deciding inside the one listing workgroup left the
 // whole mesh to one thread of a CPU rasteriser).
 @compute @workgroup_size(64)
 fn cs_view_lod_flags(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workgroups) groups: vec3<u32>) {
+    if !load_member(id.z, LIST_SHELLS) {
+        return;
+    }
     let triangle = item_index(id, groups);
     if triangle < object.furred_triangle_count {
-        listed_indices[3u * triangle] = u32(view_lod_shows(triangle));
+        listed_indices[first_listed(id.z) + 3u * triangle] = u32(view_lod_shows(triangle));
     }
 }
 
-// Then one workgroup walks the triangles `SCAN_WIDTH` at a time (as `cs_silhouette` walks the
-// edges) and moves the shown ones down to their places, in place: a round writes only below its
-// own end, and every thread has read its flag before any writes.
+// Then one workgroup a copy walks its triangles `SCAN_WIDTH` at a time (as `cs_silhouette` walks
+// the edges) and moves the shown ones down to their places, in place: a round writes only below
+// its own end, and every thread has read its flag before any writes.
 @compute @workgroup_size(256)
-fn cs_view_lod_list(@builtin(local_invocation_index) lane: u32) {
+fn cs_view_lod_list(@builtin(local_invocation_index) lane: u32, @builtin(workgroup_id) group: vec3<u32>) {
+    // The whole workgroup returns or none of it: the slot is the workgroup's.
+    if !load_member(group.z, LIST_SHELLS) {
+        return;
+    }
+    let base = first_listed(group.z);
     var count = 0u;
     let rounds = (object.furred_triangle_count + SCAN_WIDTH - 1u) / SCAN_WIDTH;
     for (var round = 0u; round < rounds; round++) {
         let triangle = round * SCAN_WIDTH + lane;
-        let shows = triangle < object.furred_triangle_count && listed_indices[3u * triangle] != 0u;
+        let shows = triangle < object.furred_triangle_count && listed_indices[base + 3u * triangle] != 0u;
         let scan = workgroup_scan(lane, u32(shows));
         storageBarrier();
         if shows {
-            let first = 3u * (count + scan.x - 1u);
+            let first = base + 3u * (count + scan.x - 1u);
             for (var k = 0u; k < 3u; k++) {
                 let corner = 3u * triangle + k;
                 listed_indices[first + k] = select(topology[corner], corner_wedge(corner), object.has_uvs != 0u);
@@ -71,18 +85,21 @@ fn cs_view_lod_list(@builtin(local_invocation_index) lane: u32) {
         count += scan.y;
     }
     if lane == 0u {
-        listed = 3u * count;
+        listed[group.z] = 3u * count;
     }
 }
 
-// After the list (a second dispatch): shell k's draw covers the listed indices with base vertex
-// k * N, which `vs_shell_*_listed` read back as the shell.
+// After the list (a second dispatch): shell k's draw covers the copy's listed indices with base
+// vertex k * N, which `vs_shell_*_listed` read back as the shell.
 @compute @workgroup_size(64)
 fn cs_view_lod_draws(@builtin(global_invocation_id) id: vec3<u32>) {
+    if !load_member(id.z, LIST_SHELLS) {
+        return;
+    }
     let shell = id.x;
     if shell >= object.lod_shells {
         return;
     }
     let per_shell = select(object.vertex_count, object.wedge_count, object.has_uvs != 0u);
-    shell_draws[shell] = ShellDraw(listed, 1u, 0u, i32(shell * per_shell), 0u);
+    shell_draws[id.z * object.layers + shell] = ShellDraw(listed[id.z], 1u, first_listed(id.z), i32(shell * per_shell), 0u);
 }

@@ -77,8 +77,9 @@ pub struct GpuSimulation {
     strands: wgpu::Buffer,
     state: wgpu::Buffer,
     wet: WetInputs,
-    /// One bind group per shared-array buffer written so far (a fur has one or two).
-    bind_groups: Vec<(wgpu::Buffer, wgpu::BindGroup)>,
+    /// One bind group per shared-array state written so far (a fur has one or two), by its
+    /// buffer and offset.
+    bind_groups: Vec<((wgpu::Buffer, u64), wgpu::BindGroup)>,
     vertex_count: u32,
     layers: u32,
     grid: [u32; 2],
@@ -475,7 +476,9 @@ impl GpuSimulation {
 
     /// The bind groups of `fur`'s two states: the one step 0 writes, then the other.
     fn state_groups(&self, fur: &GpuFur) -> Result<(usize, usize), RenderError> {
-        let find = |buffer: &wgpu::Buffer| self.bind_groups.iter().position(|(b, _)| b == buffer);
+        let find = |state: wgpu::BufferSlice<'_>| {
+            self.bind_groups.iter().position(|((b, at), _)| b == state.buffer() && *at == state.offset())
+        };
         // Step `slot` writes the buffer that is current after `slot + 1` swaps.
         match (find(fur.previous_positions()), find(fur.current_positions())) {
             (Some(next), Some(after_next)) => Ok((next, after_next)),
@@ -584,8 +587,9 @@ impl GpuSimulation {
         u64::from(self.vertex_count) * u64::from(self.layers)
     }
 
-    fn bind_group_for(&mut self, device: &wgpu::Device, output: &wgpu::Buffer) -> Result<(), RenderError> {
-        if self.bind_groups.iter().any(|(b, _)| b == output) {
+    fn bind_group_for(&mut self, device: &wgpu::Device, output: wgpu::BufferSlice<'_>) -> Result<(), RenderError> {
+        let key = (output.buffer(), output.offset());
+        if self.bind_groups.iter().any(|((b, at), _)| b == key.0 && *at == key.1) {
             return Ok(());
         }
         let scope = ErrorScope::push(device);
@@ -604,7 +608,7 @@ impl GpuSimulation {
                 wgpu::BindGroupEntry { binding: 1, resource: self.rest_segments.as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 2, resource: self.strands.as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 3, resource: self.state.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 4, resource: output.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 4, resource: crate::pool::binding(output) },
                 wgpu::BindGroupEntry { binding: 5, resource: self.contact.buffer.as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 6, resource: self.wet.buffer.as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 7, resource: self.contact.fields_buffer.as_entire_binding() },
@@ -616,7 +620,7 @@ impl GpuSimulation {
         if self.bind_groups.len() >= 4 {
             self.bind_groups.remove(0);
         }
-        self.bind_groups.push((output.clone(), bind_group));
+        self.bind_groups.push(((key.0.clone(), key.1), bind_group));
         Ok(())
     }
 

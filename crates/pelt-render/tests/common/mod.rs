@@ -276,8 +276,8 @@ impl Rig {
             .expect("frame")
     }
 
-    /// The `u32`s of a small `COPY_SRC` buffer, read back (waits for the GPU).
-    pub fn read_u32s(&self, buffer: &wgpu::Buffer) -> Vec<u32> {
+    /// The `u32`s of a small range of a `COPY_SRC` buffer, read back (waits for the GPU).
+    pub fn read_u32s(&self, buffer: wgpu::BufferSlice<'_>) -> Vec<u32> {
         let bytes = read_bytes(self.device(), self.queue(), buffer);
         bytes.chunks_exact(4).map(|w| u32::from_le_bytes([w[0], w[1], w[2], w[3]])).collect()
     }
@@ -291,9 +291,9 @@ impl Rig {
     }
 }
 
-/// The bytes of a `COPY_SRC` buffer, read back after everything submitted before (waits for the
-/// GPU).
-pub fn read_bytes(device: &wgpu::Device, queue: &wgpu::Queue, buffer: &wgpu::Buffer) -> Vec<u8> {
+/// The bytes of a range of a `COPY_SRC` buffer, read back after everything submitted before
+/// (waits for the GPU).
+pub fn read_bytes(device: &wgpu::Device, queue: &wgpu::Queue, buffer: wgpu::BufferSlice<'_>) -> Vec<u8> {
     let staging = device.create_buffer(&wgpu::BufferDescriptor {
         label: Some("test readback"),
         size: buffer.size(),
@@ -301,7 +301,7 @@ pub fn read_bytes(device: &wgpu::Device, queue: &wgpu::Queue, buffer: &wgpu::Buf
         mapped_at_creation: false,
     });
     let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor::default());
-    encoder.copy_buffer_to_buffer(buffer, 0, &staging, 0, buffer.size());
+    encoder.copy_buffer_to_buffer(buffer.buffer(), buffer.offset(), &staging, 0, buffer.size());
     queue.submit([encoder.finish()]);
     staging.slice(..).map_async(wgpu::MapMode::Read, |result| result.expect("map"));
     device.poll(wgpu::PollType::wait_indefinitely()).expect("poll");

@@ -124,9 +124,8 @@ pub fn measure(
         // segments to it, counted in the herd's allocation).
         let asset_before = asset.gpu_bytes().total();
         let before = allocated(device);
-        let mut drivers = (0..foxes)
-            .map(|_| FurDriver::with_asset(device, queue, &renderer, &asset, &fur, &preset.simulation, choice))
-            .collect::<Result<Vec<_>, _>>()?;
+        let mut drivers =
+            FurDriver::herd_with_asset(device, queue, &renderer, (&asset, &fur), &preset.simulation, choice, foxes)?;
         let herd_bytes = allocated(device).zip(before).map(|(after, before)| after - before);
         let mut steppers = instances
             .iter()

@@ -466,8 +466,8 @@ impl Bench {
         Ok(faces * (1 + shells - thinned) + listed * thinned + fin_edges * 2 * shells)
     }
 
-    /// Word `index` of a small `COPY_SRC` buffer, read back (waits for the GPU).
-    fn read_u32(&self, buffer: &wgpu::Buffer, index: u64) -> anyhow::Result<u32> {
+    /// Word `index` of a small range of a `COPY_SRC` buffer, read back (waits for the GPU).
+    fn read_u32(&self, buffer: wgpu::BufferSlice<'_>, index: u64) -> anyhow::Result<u32> {
         let device = &self.gpu.device;
         let staging = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("pelt bench readback"),
@@ -476,7 +476,7 @@ impl Bench {
             mapped_at_creation: false,
         });
         let mut encoder = device.create_command_encoder(&Default::default());
-        encoder.copy_buffer_to_buffer(buffer, 4 * index, &staging, 0, 4);
+        encoder.copy_buffer_to_buffer(buffer.buffer(), buffer.offset() + 4 * index, &staging, 0, 4);
         self.gpu.queue.submit([encoder.finish()]);
         let (sender, receiver) = std::sync::mpsc::channel();
         staging.slice(..).map_async(wgpu::MapMode::Read, move |result| {

@@ -84,7 +84,8 @@ impl SoakSubject for GpuSoak<'_> {
             return Ok(());
         }
         let mut encoder = self.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("soak") });
-        encoder.copy_buffer_to_buffer(self.driver.fur().current_positions(), 0, &self.staging, 0, self.bytes);
+        let current = self.driver.fur().current_positions();
+        encoder.copy_buffer_to_buffer(current.buffer(), current.offset(), &self.staging, 0, self.bytes);
         self.queue.submit([encoder.finish()]);
         let slice = self.staging.slice(..self.bytes);
         let (sender, receiver) = std::sync::mpsc::channel();

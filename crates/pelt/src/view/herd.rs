@@ -250,9 +250,7 @@ impl HerdDrivers {
         let (device, queue) = (&gpu.device, &gpu.queue);
         let asset = FurAsset::new(device, queue, renderer, structure, textures)?;
         let choice = KernelChoice::from(kernel);
-        let drivers = (0..count)
-            .map(|_| FurDriver::with_asset(device, queue, renderer, &asset, structure, params, choice))
-            .collect::<Result<Vec<_>, _>>()?;
+        let drivers = FurDriver::herd_with_asset(device, queue, renderer, (&asset, structure), params, choice, count)?;
         Ok(Self { _asset: asset, drivers })
     }
 

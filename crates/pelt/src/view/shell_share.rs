@@ -38,7 +38,7 @@ impl ShellShare {
             && fur.shells_thinned() > 0
             && self.state.compare_exchange(IDLE, COPIED, Ordering::AcqRel, Ordering::Acquire).is_ok()
         {
-            encoder.copy_buffer_to_buffer(count, 0, &self.staging, 0, 4);
+            encoder.copy_buffer_to_buffer(count.buffer(), count.offset(), &self.staging, 0, 4);
         }
     }
 

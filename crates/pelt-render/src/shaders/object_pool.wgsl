@@ -1,0 +1,31 @@
+// The listing passes' object binding (in place of `shading.wgsl`'s): every copy of a fur in one
+// pool (`pool.rs`) is listed by one dispatch, workgroup z being the copy's slot. Each entry point
+// loads its copy's object first (`load_member`); bindings 1 to 3 are the pool's whole buffers.
+
+// One copy's object, `OBJECT_SLOT_BYTES` apart (the uniform ranges the draws bind).
+struct ObjectSlot {
+    @size(OBJECT_SLOT_BYTES) object: Object,
+}
+
+@group(1) @binding(0) var<storage, read> objects: array<ObjectSlot>;
+var<private> object: Object;
+
+// What a copy lists this frame (`Object::pool.w`).
+const LIST_FINS = 1u;
+const LIST_SHELLS = 2u;
+
+fn current_base() -> u32 {
+    return object.pool.x;
+}
+fn previous_base() -> u32 {
+    return object.pool.y;
+}
+fn normals_base() -> u32 {
+    return object.pool.z;
+}
+
+// Loads slot `member`'s object; whether it lists `what` this frame.
+fn load_member(member: u32, what: u32) -> bool {
+    object = objects[member].object;
+    return (object.pool.w & what) != 0u;
+}
