@@ -75,9 +75,9 @@ fn every_wgsl_file_is_part_of_a_validated_module() {
         }
     }
     assert_eq!(
-        checked, 17,
-        "shading, wet, fur_bsdf, shadows, unified, prepass, separated, scan, silhouette, view_lod, simulation_wind, \
-         simulation, simulation_inputs, simulation_contact, strands, skinning and shadow_copy"
+        checked, 18,
+        "shading, object_pool, wet, fur_bsdf, shadows, unified, prepass, separated, scan, silhouette, view_lod, \
+         simulation_wind, simulation, simulation_inputs, simulation_contact, strands, skinning and shadow_copy"
     );
 }
 

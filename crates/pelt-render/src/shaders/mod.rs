@@ -85,8 +85,7 @@ fn pooled_shading() -> String {
     let (Some(from), Some(to)) = (SHADING_WGSL.find(start), SHADING_WGSL.find(end)) else {
         unreachable!("shading.wgsl marks its object binding");
     };
-    let pool = OBJECT_POOL_WGSL.replace("OBJECT_SLOT_BYTES", &OBJECT_SLOT_BYTES.to_string());
-    format!("{}{pool}{}", &SHADING_WGSL[..from], &SHADING_WGSL[to + end.len()..])
+    format!("{}{OBJECT_POOL_WGSL}{}", &SHADING_WGSL[..from], &SHADING_WGSL[to + end.len()..])
 }
 
 /// The WGSL module of the silhouette pass (the shared shading over a pool, `unified.wgsl`,
@@ -136,4 +135,21 @@ pub fn separated_shader_source() -> String {
 #[cfg(feature = "lab")]
 pub fn strands_shader_source() -> String {
     format!("{SHADING_WGSL}\n{WET_WGSL}\n{FUR_BSDF_WGSL}\n{SHADOWS_WGSL}\n{STRANDS_WGSL}")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `ObjectSlot` in `object_pool.wgsl` is `OBJECT_SLOT_BYTES` long, and the listing modules
+    /// read the pool's objects in place of the uniform.
+    #[test]
+    fn the_pool_prelude_matches_the_slots() {
+        assert!(OBJECT_POOL_WGSL.contains(&format!("@size({OBJECT_SLOT_BYTES})")));
+        for source in [silhouette_shader_source(), view_lod_shader_source()] {
+            assert!(source.contains("var<storage, read> objects: array<ObjectSlot>"));
+            assert!(!source.contains("var<uniform> object: Object"));
+        }
+        assert!(unified_shader_source().contains("var<uniform> object: Object"));
+    }
 }

@@ -2,9 +2,10 @@
 // pool (`pool.rs`) is listed by one dispatch, workgroup z being the copy's slot. Each entry point
 // loads its copy's object first (`load_member`); bindings 1 to 3 are the pool's whole buffers.
 
-// One copy's object, `OBJECT_SLOT_BYTES` apart (the uniform ranges the draws bind).
+// One copy's object, `OBJECT_SLOT_BYTES` (`shaders/mod.rs`) apart: the uniform ranges the draws
+// bind.
 struct ObjectSlot {
-    @size(OBJECT_SLOT_BYTES) object: Object,
+    @size(512) object: Object,
 }
 
 @group(1) @binding(0) var<storage, read> objects: array<ObjectSlot>;
