@@ -6,7 +6,7 @@ use glam::{Mat3, Mat4, Vec3};
 use pelt_core::Mesh;
 
 use crate::lod::FurLevel;
-use crate::shaders::{OBJECT_UNIFORM_BYTES, ObjectUniform};
+use crate::shaders::ObjectUniform;
 use crate::textures::TextureShape;
 
 /// How one fur looks, beyond its textures: lighting response, fading and strand density.
@@ -312,7 +312,7 @@ pub(crate) fn world_per_uv(mesh: &Mesh) -> f32 {
 pub(crate) fn uniform_buffer(device: &wgpu::Device) -> wgpu::Buffer {
     device.create_buffer(&wgpu::BufferDescriptor {
         label: Some("pelt object"),
-        size: OBJECT_UNIFORM_BYTES,
+        size: crate::shaders::OBJECT_UNIFORM_BYTES,
         usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
         mapped_at_creation: false,
     })
