@@ -79,13 +79,19 @@ pub fn prepass_shader_source() -> String {
 pub(crate) const OBJECT_SLOT_BYTES: u64 = OBJECT_UNIFORM_BYTES.next_multiple_of(256);
 
 /// The shared shading with its object binding for a listing pass: every copy of a pool's object,
-/// read by slot (`object_pool.wgsl`).
+/// read by slot (`object_pool.wgsl`). The object is then a private copy, which a browser's WGSL
+/// compiler counts as varying between invocations: the shading's texture reads (fragment code,
+/// never run by a listing pass) would fail its derivative check, so the module turns it off.
 fn pooled_shading() -> String {
     let (start, end) = ("// OBJECT BINDING", "// END OBJECT BINDING\n");
     let (Some(from), Some(to)) = (SHADING_WGSL.find(start), SHADING_WGSL.find(end)) else {
         unreachable!("shading.wgsl marks its object binding");
     };
-    format!("{}{OBJECT_POOL_WGSL}{}", &SHADING_WGSL[..from], &SHADING_WGSL[to + end.len()..])
+    format!(
+        "diagnostic(off, derivative_uniformity);\n{}{OBJECT_POOL_WGSL}{}",
+        &SHADING_WGSL[..from],
+        &SHADING_WGSL[to + end.len()..]
+    )
 }
 
 /// The WGSL module of the silhouette pass (the shared shading over a pool, `unified.wgsl`,

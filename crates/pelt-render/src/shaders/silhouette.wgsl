@@ -37,13 +37,16 @@ fn cs_fin_fades(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_workg
 
 @compute @workgroup_size(256)
 fn cs_silhouette(@builtin(local_invocation_index) lane: u32, @builtin(workgroup_id) group: vec3<u32>) {
-    // The whole workgroup returns or none of it: the slot is the workgroup's.
-    if !load_member(group.z, LIST_FINS) {
+    // The whole workgroup returns or none of it, and walks the same rounds: both read the slot's
+    // object straight from the pool (uniform across the workgroup), not the private copy.
+    let slot = objects[group.z].object;
+    if (slot.pool.w & LIST_FINS) == 0u {
         return;
     }
-    let first = group.z * object.fin_edge_count;
+    object = slot;
+    let first = group.z * slot.fin_edge_count;
     var listed = 0u;
-    let rounds = (object.fin_edge_count + SCAN_WIDTH - 1u) / SCAN_WIDTH;
+    let rounds = (slot.fin_edge_count + SCAN_WIDTH - 1u) / SCAN_WIDTH;
     for (var round = 0u; round < rounds; round++) {
         let edge = round * SCAN_WIDTH + lane;
         var fade = 0.0;

@@ -63,13 +63,16 @@ fn cs_view_lod_flags(@builtin(global_invocation_id) id: vec3<u32>, @builtin(num_
 // its own end, and every thread has read its flag before any writes.
 @compute @workgroup_size(256)
 fn cs_view_lod_list(@builtin(local_invocation_index) lane: u32, @builtin(workgroup_id) group: vec3<u32>) {
-    // The whole workgroup returns or none of it: the slot is the workgroup's.
-    if !load_member(group.z, LIST_SHELLS) {
+    // The whole workgroup returns or none of it, and walks the same rounds: both read the slot's
+    // object straight from the pool (uniform across the workgroup), not the private copy.
+    let slot = objects[group.z].object;
+    if (slot.pool.w & LIST_SHELLS) == 0u {
         return;
     }
+    object = slot;
     let base = first_listed(group.z);
     var count = 0u;
-    let rounds = (object.furred_triangle_count + SCAN_WIDTH - 1u) / SCAN_WIDTH;
+    let rounds = (slot.furred_triangle_count + SCAN_WIDTH - 1u) / SCAN_WIDTH;
     for (var round = 0u; round < rounds; round++) {
         let triangle = round * SCAN_WIDTH + lane;
         let shows = triangle < object.furred_triangle_count && listed_indices[base + 3u * triangle] != 0u;
