@@ -5,11 +5,18 @@
 //! writes), [`FurDriver::record`] (the GPU work before the render pass: the GPU simulation's
 //! steps and the silhouette fins) and [`FurDriver::draw`] (into the host's pass).
 
-use std::fmt;
-use std::time::Instant;
+mod herd;
+mod timing;
+mod upload;
 
-use pelt_core::sim::{FurStepper, HerdInstance, SimError, SimParams, Simulation};
-use pelt_core::{FurStructure, texture::FurTextures};
+use std::fmt;
+
+use pelt_core::FurStructure;
+use pelt_core::sim::{FurStepper, SimError, SimParams, Simulation};
+use pelt_core::texture::FurTextures;
+
+use timing::{TIMING_RUNS, TIMING_STEPS};
+pub use timing::{cpu_secs_per_step, gpu_secs_per_step, gpu_secs_per_step_of};
 
 use crate::RenderError;
 use crate::asset::FurAsset;
@@ -61,10 +68,6 @@ impl From<SimKernel> for KernelChoice {
         }
     }
 }
-
-/// Steps per timing run and runs per kernel when choosing ([`KernelChoice::Auto`]).
-const TIMING_STEPS: u32 = 3;
-const TIMING_RUNS: usize = 5;
 
 /// How much faster the GPU kernel must step for [`KernelChoice::Auto`] to take it. The kernels
 /// draw pictures that differ in their last bits, so timings within noise of each other (a CPU
@@ -377,188 +380,6 @@ impl FurDriver {
         self.upload(device, queue, stepper.simulation(), stepper.moved_pose().map(|pose| &pose.normals[..]))
     }
 
-    /// [`FurDriver::advance_to`] for a herd: `drivers[k]` with `steppers[k]`, placed as
-    /// `instances[k]`, each at its own clip time. The bases are posed (and on the CPU kernel the
-    /// strands bent) in one parallel pass ([`FurStepper::advance_herd`]), then each member's GPU
-    /// inputs are written: the CPU kernel's positions, or the GPU kernel's steps for
-    /// [`FurDriver::record`]. Each member may have its own kernel.
-    ///
-    /// # Errors
-    /// [`RenderError::Count`] unless there is one driver, stepper and instance per member; as
-    /// [`FurDriver::advance_to`].
-    pub fn advance_herd(
-        (device, queue): (&wgpu::Device, &wgpu::Queue),
-        drivers: &mut [FurDriver],
-        steppers: &mut [FurStepper],
-        instances: &[HerdInstance],
-        time_secs: f64,
-    ) -> Result<(), RenderError> {
-        for (what, got) in [("steppers of a herd", steppers.len()), ("instances of a herd", instances.len())] {
-            if got != drivers.len() {
-                return Err(RenderError::Count { what, expected: drivers.len(), got, rule: "one per driver" });
-            }
-        }
-        for (driver, stepper) in drivers.iter_mut().zip(steppers.iter_mut()) {
-            driver.claim_stepper(stepper);
-        }
-        FurStepper::advance_herd(steppers, instances, time_secs)?;
-        for (driver, stepper) in drivers.iter_mut().zip(steppers.iter()) {
-            driver.show_claimed(device, queue, stepper)?;
-        }
-        Ok(())
-    }
-
-    /// The first half of a step a host takes itself (a herd member it steps with the others, as
-    /// the viewer does; [`FurDriver::advance_herd`] takes both halves): call before stepping
-    /// `stepper`. On the GPU kernel its simulation then keeps time and poses while the GPU
-    /// bends; on the CPU kernel it bends.
-    pub fn claim_stepper(&mut self, stepper: &mut FurStepper) {
-        self.fall_back_when_unrecorded();
-        self.claim(stepper.simulation_mut());
-    }
-
-    /// The second half: what `stepper` stepped since [`FurDriver::claim_stepper`], on this
-    /// driver's kernel (the CPU's positions, or the steps for [`FurDriver::record`]), with its
-    /// wetness and posed normals.
-    ///
-    /// # Errors
-    /// As [`FurDriver::advance_to`].
-    pub fn show_claimed(
-        &mut self,
-        device: &wgpu::Device,
-        queue: &wgpu::Queue,
-        stepper: &FurStepper,
-    ) -> Result<(), RenderError> {
-        self.show_wetness(queue, stepper)?;
-        self.upload(device, queue, stepper.simulation(), stepper.moved_pose().map(|pose| &pose.normals[..]))
-    }
-
-    /// The stepper's wetness and what it does to the look (`[wet]`), for the coming frame: the
-    /// values uploaded while any vertex is wet, the shaders' wet paths off when none is.
-    fn show_wetness(&mut self, queue: &wgpu::Queue, stepper: &FurStepper) -> Result<(), RenderError> {
-        let wetness = stepper.wetness();
-        self.show_wet(queue, (!wetness.is_dry()).then(|| wetness.values()), stepper.wet())
-    }
-
-    /// Shows a wetness simulated elsewhere (a host whose [`FurStepper`] lives apart, as for
-    /// [`FurDriver::show_state`]): `wetness` per base vertex in `0..=1` (`None` when dry, which
-    /// draws the dry bytes) and what it does to the look (`wet`, the preset's `[wet]`).
-    ///
-    /// # Errors
-    /// [`RenderError::Count`] unless there are `V` values.
-    pub fn show_wet(
-        &mut self,
-        queue: &wgpu::Queue,
-        wetness: Option<&[f32]>,
-        wet: &pelt_core::wet::WetParams,
-    ) -> Result<(), RenderError> {
-        self.frame.wet = wetness.is_some();
-        self.frame.look = self.frame.look.with_wet(wet);
-        if let Some(values) = wetness {
-            self.fur.set_wetness(queue, values)?;
-        }
-        Ok(())
-    }
-
-    /// Lets `step` change and step `simulation` itself (a test harness replaying recorded
-    /// inputs), then writes what the GPU needs as [`FurDriver::advance_to`] does.
-    ///
-    /// # Errors
-    /// `step`'s error as [`RenderError::Simulation`]; the upload's errors.
-    pub fn step_with(
-        &mut self,
-        device: &wgpu::Device,
-        queue: &wgpu::Queue,
-        simulation: &mut Simulation,
-        step: impl FnOnce(&mut Simulation) -> Result<(), SimError>,
-    ) -> Result<(), RenderError> {
-        self.fall_back_when_unrecorded();
-        self.claim(simulation);
-        step(simulation)?;
-        self.upload(device, queue, simulation, None)
-    }
-
-    /// Draws a state simulated elsewhere: a host whose [`FurStepper`] lives apart from its GPU
-    /// objects (Bevy's main and render worlds) hands over the stepper's output
-    /// ([`Simulation::positions`], model space) and, when the base moved, its normals. This is
-    /// the CPU kernel's upload: a driver on the GPU kernel switches to the CPU kernel.
-    ///
-    /// # Errors
-    /// [`RenderError::Count`] unless there are `(L + 1) * V` positions and `V` normals.
-    pub fn show_state(
-        &mut self,
-        queue: &wgpu::Queue,
-        positions: &[glam::Vec3],
-        moved_normals: Option<&[glam::Vec3]>,
-    ) -> Result<(), RenderError> {
-        if self.kernel == SimKernel::Gpu {
-            self.use_cpu_kernel("the host hands over states simulated on the CPU");
-        }
-        self.fur.set_positions(queue, positions)?;
-        self.frame.interpolation = 1.0;
-        self.finish_upload(queue, moved_normals)
-    }
-
-    /// Shows what `stepper` stepped on its own (a herd's member in a host that steps its herd
-    /// itself; [`FurDriver::advance_herd`] does both): its positions, its posed normals when the
-    /// base moved and its wetness, as [`FurDriver::show_state`] (the CPU kernel's upload) and
-    /// [`FurDriver::show_wet`].
-    ///
-    /// # Errors
-    /// As [`FurDriver::show_state`], for a stepper of another fur.
-    pub fn show_stepped(&mut self, queue: &wgpu::Queue, stepper: &FurStepper) -> Result<(), RenderError> {
-        let wetness = stepper.wetness();
-        self.show_wet(queue, (!wetness.is_dry()).then(|| wetness.values()), stepper.wet())?;
-        let normals = stepper.moved_pose().map(|pose| &pose.normals[..]);
-        self.show_state(queue, stepper.simulation().positions(), normals)
-    }
-
-    /// With the GPU kernel, steps prepared and never recorded mean the host does not record:
-    /// the CPU bends from now on.
-    fn fall_back_when_unrecorded(&mut self) {
-        if self.unrecorded && self.kernel == SimKernel::Gpu {
-            self.use_cpu_kernel("the GPU kernel's steps were never recorded");
-        }
-    }
-
-    /// From now on the stepper's simulation bends the strands (`claim` turns its bending on).
-    fn use_cpu_kernel(&mut self, reason: &str) {
-        self.gpu_simulation = None;
-        self.kernel = SimKernel::Cpu;
-        self.kernel_reason = reason.to_owned();
-        self.unrecorded = false;
-    }
-
-    fn upload(
-        &mut self,
-        device: &wgpu::Device,
-        queue: &wgpu::Queue,
-        simulation: &Simulation,
-        moved_normals: Option<&[glam::Vec3]>,
-    ) -> Result<(), RenderError> {
-        match &mut self.gpu_simulation {
-            Some(gpu_simulation) => {
-                gpu_simulation.prepare(device, queue, simulation, &self.fur)?;
-                self.unrecorded = gpu_simulation.pending_steps() > 0;
-                self.frame.interpolation = simulation.alpha();
-            }
-            None => {
-                self.fur.set_positions(queue, simulation.positions())?;
-                self.frame.interpolation = 1.0;
-            }
-        }
-        self.finish_upload(queue, moved_normals)
-    }
-
-    /// The posed normals (when the base moved) and this frame's uniform.
-    fn finish_upload(&mut self, queue: &wgpu::Queue, moved_normals: Option<&[glam::Vec3]>) -> Result<(), RenderError> {
-        if let Some(normals) = moved_normals {
-            self.fur.set_base_normals(queue, normals)?;
-        }
-        self.fur.prepare(queue, &self.frame);
-        Ok(())
-    }
-
     /// Whether [`FurDriver::record`] has steps to record: a host that submits the simulation in
     /// an encoder of its own can skip it on frames between steps.
     #[must_use]
@@ -579,43 +400,11 @@ impl FurDriver {
         Ok(())
     }
 
-    /// [`FurDriver::record`] for every driver of `drivers` (a herd's members): step by step,
-    /// the contact-free steps of every member on the GPU kernel share one compute pass, so a
-    /// step costs the herd one pass, not one a member. Returns the compute passes recorded.
-    ///
-    /// # Errors
-    /// As [`FurDriver::record`], checked for every member before anything is recorded.
-    pub fn record_herd<'a>(
-        encoder: &mut wgpu::CommandEncoder,
-        drivers: impl IntoIterator<Item = &'a mut FurDriver>,
-    ) -> Result<usize, RenderError> {
-        let mut drivers: Vec<&mut FurDriver> = drivers.into_iter().collect();
-        let members = drivers
-            .iter_mut()
-            .filter_map(|driver| driver.gpu_simulation.as_mut().map(|simulation| (simulation, &mut driver.fur)));
-        let passes = GpuSimulation::dispatch_all(encoder, members)?;
-        for driver in drivers {
-            driver.unrecorded = false;
-        }
-        Ok(passes)
-    }
-
     /// Records the per-view GPU work into `encoder`: the silhouette pass choosing this view's
     /// fins (see [`FurRenderer::prepare_fins`]). Once per view and frame, after
     /// [`FurDriver::record`].
     pub fn record_view(&self, encoder: &mut wgpu::CommandEncoder, renderer: &FurRenderer, view: &FurView) {
         renderer.prepare_fins(encoder, view, &self.fur);
-    }
-
-    /// [`FurDriver::record_view`] for every driver of `drivers` (a herd's members), in one compute
-    /// pass ([`FurRenderer::prepare_fins_of`]).
-    pub fn record_views<'a>(
-        encoder: &mut wgpu::CommandEncoder,
-        renderer: &FurRenderer,
-        view: &FurView,
-        drivers: impl IntoIterator<Item = &'a FurDriver>,
-    ) {
-        renderer.prepare_fins_of(encoder, view, drivers.into_iter().map(|driver| &driver.fur));
     }
 
     /// Draws the fur into the host's `pass` (after its opaque geometry).
@@ -649,95 +438,4 @@ impl From<SimError> for RenderError {
     fn from(error: SimError) -> Self {
         Self::Simulation(error)
     }
-}
-
-/// Median wall seconds per step of the CPU kernel on `structure`, `steps` consecutive steps per
-/// run, on a simulation of its own.
-///
-/// # Errors
-/// [`RenderError::Simulation`] for invalid `params`.
-pub fn cpu_secs_per_step(
-    structure: &FurStructure,
-    params: &SimParams,
-    steps: u32,
-    runs: usize,
-) -> Result<f64, RenderError> {
-    let mut simulation = Simulation::new(structure, params)?;
-    let rate = f64::from(params.rate_hz);
-    let mut step = 1_u32;
-    let mut samples: Vec<f64> = (0..runs.max(1))
-        .map(|_| {
-            let started = Instant::now();
-            for _ in 0..steps {
-                simulation.advance_to(f64::from(step) / rate);
-                step += 1;
-            }
-            started.elapsed().as_secs_f64() / f64::from(steps.max(1))
-        })
-        .collect();
-    Ok(median(&mut samples))
-}
-
-/// Median wall seconds per step of the GPU kernel on `structure`: per run, `steps` steps (each
-/// advanced, prepared and recorded as a frame does) in one submission, then a wait for the GPU,
-/// on a driver of its own (the first run compiles the pipeline on some drivers and is dropped).
-///
-/// # Errors
-/// As [`FurDriver::new`], and a failed wait.
-pub fn gpu_secs_per_step(
-    device: &wgpu::Device,
-    queue: &wgpu::Queue,
-    renderer: &FurRenderer,
-    structure: &FurStructure,
-    params: &SimParams,
-    steps: u32,
-    runs: usize,
-) -> Result<f64, RenderError> {
-    let mut stepper = FurStepper::new(structure, params)?;
-    gpu_secs_per_step_of(device, queue, renderer, structure, params, &mut stepper, steps, runs)
-}
-
-/// [`gpu_secs_per_step`] with the host's own `stepper` (colliders placed, a body set, a script).
-///
-/// # Errors
-/// As [`gpu_secs_per_step`].
-#[allow(clippy::too_many_arguments)]
-pub fn gpu_secs_per_step_of(
-    device: &wgpu::Device,
-    queue: &wgpu::Queue,
-    renderer: &FurRenderer,
-    structure: &FurStructure,
-    params: &SimParams,
-    stepper: &mut FurStepper,
-    steps: u32,
-    runs: usize,
-) -> Result<f64, RenderError> {
-    let mut driver =
-        FurDriver::new(device, queue, renderer, structure, &FurTextures::blank(), params, KernelChoice::Gpu)?;
-    let rate = f64::from(params.rate_hz);
-    let mut step = 1_u32;
-    let mut run = |driver: &mut FurDriver| -> Result<f64, RenderError> {
-        let started = Instant::now();
-        let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("sim timing") });
-        // Each step takes its own uniform slot of the GPU simulation's ring (up to 64 a
-        // submission), so every dispatch bends with its own step's inputs.
-        for _ in 0..steps {
-            driver.advance_to(device, queue, stepper, f64::from(step) / rate)?;
-            step += 1;
-            driver.record(&mut encoder)?;
-        }
-        queue.submit([encoder.finish()]);
-        device
-            .poll(wgpu::PollType::wait_indefinitely())
-            .map_err(|e| RenderError::Gpu { during: "timing the GPU simulation", message: e.to_string() })?;
-        Ok(started.elapsed().as_secs_f64() / f64::from(steps.max(1)))
-    };
-    run(&mut driver)?;
-    let mut samples = (0..runs.max(1)).map(|_| run(&mut driver)).collect::<Result<Vec<f64>, _>>()?;
-    Ok(median(&mut samples))
-}
-
-fn median(samples: &mut [f64]) -> f64 {
-    samples.sort_by(f64::total_cmp);
-    samples[samples.len() / 2]
 }

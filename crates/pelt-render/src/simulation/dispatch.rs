@@ -1,0 +1,158 @@
+//! Recording the prepared steps: one compute pass a step (a second, dispatched indirectly, for
+//! a step with contact), a herd's contact-free steps sharing one pass.
+
+use super::{GpuSimulation, RING_SLOTS, STEP_SLOT_BYTES, solve_kernel};
+use crate::RenderError;
+use crate::fur::GpuFur;
+
+impl GpuSimulation {
+    /// Records the prepared steps into `encoder`: per step, [`GpuFur::swap_states`] and one
+    /// compute pass writing the new current state (with contact, a second one, dispatched
+    /// indirectly, solving the strands the first listed). Does nothing when no step is pending.
+    ///
+    /// # Errors
+    /// [`RenderError::Count`] when `fur` is not the fur last given to
+    /// [`GpuSimulation::prepare`] (its buffers are unknown); no state is swapped then.
+    pub fn dispatch(&mut self, encoder: &mut wgpu::CommandEncoder, fur: &mut GpuFur) -> Result<(), RenderError> {
+        Self::dispatch_all(encoder, [(self, fur)]).map(|_| ())
+    }
+
+    /// [`GpuSimulation::dispatch`] for every simulation of `members` (a herd's, each with its
+    /// fur), step by step: each step's contact-free dispatches of every member share one compute
+    /// pass (each writes its own buffers only), a step with contact keeps its own passes. Returns
+    /// the compute passes recorded.
+    ///
+    /// # Errors
+    /// As [`GpuSimulation::dispatch`], checked for every member before anything is recorded.
+    pub(crate) fn dispatch_all<'a>(
+        encoder: &mut wgpu::CommandEncoder,
+        members: impl IntoIterator<Item = (&'a mut Self, &'a mut GpuFur)>,
+    ) -> Result<usize, RenderError> {
+        let mut members: Vec<_> =
+            members.into_iter().filter(|(simulation, _)| !simulation.pending.is_empty()).collect();
+        let mut groups = Vec::with_capacity(members.len());
+        for (simulation, fur) in &members {
+            groups.push(simulation.state_groups(fur)?);
+        }
+        let mut passes = 0;
+        for ((simulation, _), &groups) in members.iter_mut().zip(&groups) {
+            passes += simulation.weigh_touch(encoder, groups);
+        }
+        let steps = members.iter().map(|(simulation, _)| simulation.pending.len()).max().unwrap_or(0);
+        for slot in 0..steps {
+            let mut shared = Vec::new();
+            let mut alone = Vec::new();
+            for (k, (simulation, fur)) in members.iter_mut().enumerate() {
+                if slot >= simulation.pending.len() {
+                    continue;
+                }
+                fur.swap_states();
+                if simulation.vertex_count == 0 {
+                    continue;
+                }
+                match simulation.pending_contact.get(slot).filter(|step| step.is_active()) {
+                    Some(_) => alone.push(k),
+                    None => shared.push(k),
+                }
+            }
+            if !shared.is_empty() {
+                let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                    label: Some("pelt simulation step"),
+                    timestamp_writes: None,
+                });
+                for &k in &shared {
+                    let simulation = &members[k].0;
+                    pass.set_pipeline(&simulation.pipelines.step);
+                    pass.set_bind_group(
+                        0,
+                        simulation.step_group(groups[k], slot),
+                        &[simulation.slot_offset(slot) as u32],
+                    );
+                    pass.dispatch_workgroups(simulation.grid[0], simulation.grid[1], 1);
+                }
+                passes += 1;
+            }
+            for &k in &alone {
+                passes += members[k].0.contact_step(encoder, groups[k], slot);
+            }
+        }
+        for (simulation, _) in &mut members {
+            simulation.ring = (simulation.ring + simulation.pending.len() as u64) % RING_SLOTS;
+            simulation.pending.clear();
+            simulation.dispatched_history = simulation.pending_history;
+            simulation.pending_contact.clear();
+        }
+        Ok(passes)
+    }
+
+    /// The bind groups of `fur`'s two states: the one step 0 writes, then the other.
+    fn state_groups(&self, fur: &GpuFur) -> Result<(usize, usize), RenderError> {
+        let find = |state: wgpu::BufferSlice<'_>| {
+            self.bind_groups.iter().position(|((b, at), _)| b == state.buffer() && *at == state.offset())
+        };
+        // Step `slot` writes the buffer that is current after `slot + 1` swaps.
+        match (find(fur.previous_positions()), find(fur.current_positions())) {
+            (Some(next), Some(after_next)) => Ok((next, after_next)),
+            _ => Err(RenderError::Count {
+                what: "shared-array buffers of this fur known to the GPU simulation",
+                expected: 2,
+                got: 0,
+                rule: "call GpuSimulation::prepare with the same fur first",
+            }),
+        }
+    }
+
+    /// The bind group pending step `slot` writes through.
+    fn step_group(&self, (next, after_next): (usize, usize), slot: usize) -> &wgpu::BindGroup {
+        &self.bind_groups[if slot.is_multiple_of(2) { next } else { after_next }].1
+    }
+
+    /// The touch's weights, once a touch began (its roots are those of the last step: the
+    /// state that is current now); the passes recorded.
+    fn weigh_touch(&mut self, encoder: &mut wgpu::CommandEncoder, (_, after_next): (usize, usize)) -> usize {
+        if !std::mem::take(&mut self.weigh_touch) || self.vertex_count == 0 {
+            return 0;
+        }
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("pelt simulation touch weights"),
+            timestamp_writes: None,
+        });
+        pass.set_pipeline(&self.pipelines.touch);
+        pass.set_bind_group(0, &self.bind_groups[after_next].1, &[self.slot_offset(0) as u32]);
+        pass.dispatch_workgroups(self.grid[0], self.grid[1], 1);
+        1
+    }
+
+    /// Pending step `slot` with contact: the step's pass listing the strands near something,
+    /// then the solve's, dispatched indirectly; the passes recorded.
+    fn contact_step(&self, encoder: &mut wgpu::CommandEncoder, groups: (usize, usize), slot: usize) -> usize {
+        let Some(step) = self.pending_contact.get(slot) else { return 0 };
+        let bind_group = self.step_group(groups, slot);
+        let offset = [self.slot_offset(slot) as u32];
+        self.contact.clear_work(encoder);
+        {
+            let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+                label: Some("pelt simulation step"),
+                timestamp_writes: None,
+            });
+            pass.set_pipeline(&self.pipelines.contact);
+            pass.set_bind_group(0, bind_group, &offset);
+            pass.dispatch_workgroups(self.grid[0], self.grid[1], 1);
+        }
+        // The listed strands' workgroups become the solve's dispatch arguments.
+        self.contact.copy_work_groups(encoder);
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("pelt simulation contact"),
+            timestamp_writes: None,
+        });
+        pass.set_pipeline(&self.pipelines.solve[solve_kernel(step)]);
+        pass.set_bind_group(0, bind_group, &offset);
+        pass.dispatch_workgroups_indirect(&self.contact.work_groups, 0);
+        2
+    }
+
+    /// The byte offset of pending step `slot`'s uniform in the ring.
+    pub(super) fn slot_offset(&self, slot: usize) -> u64 {
+        (self.ring + slot as u64) % RING_SLOTS * STEP_SLOT_BYTES
+    }
+}
