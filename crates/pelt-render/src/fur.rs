@@ -142,29 +142,26 @@ impl GpuFur {
         let shared = &asset.geometry;
         let states = state_count(states);
         let most = MemberPool::most_slots(device, shared.shape, states) as usize;
-        let mut copies = Vec::with_capacity(count);
-        let mut left = count;
-        while left > 0 {
-            let slots = left.min(most);
-            let pool = UnifiedGeometry::pool(device, layouts, shared, (positions, normals), (states, slots as u32));
-            let pool = match pool {
-                Ok(pool) => pool,
-                Err(error) => {
-                    scope.pop("uploading the fur")?;
-                    return Err(error);
-                }
-            };
-            copies.extend((0..slots as u32).map(|slot| Self {
-                geometry: UnifiedGeometry::in_pool(device, layouts, shared, &pool, slot),
-                asset: asset.clone(),
-                level: PreparedLevel::new(),
-                wet: AtomicBool::new(false),
-                fur_model: AtomicBool::new(false),
-            }));
-            left -= slots;
-        }
+        let made = (|| {
+            let mut copies = Vec::with_capacity(count);
+            let mut left = count;
+            while left > 0 {
+                let slots = left.min(most);
+                let mesh = (positions.as_slice(), normals.as_slice());
+                let pool = UnifiedGeometry::pool(device, layouts, shared, mesh, (states, slots as u32))?;
+                copies.extend((0..slots as u32).map(|slot| Self {
+                    geometry: UnifiedGeometry::in_pool(device, layouts, shared, &pool, slot),
+                    asset: asset.clone(),
+                    level: PreparedLevel::new(),
+                    wet: AtomicBool::new(false),
+                    fur_model: AtomicBool::new(false),
+                }));
+                left -= slots;
+            }
+            Ok(copies)
+        })();
         scope.pop("uploading the fur")?;
-        Ok(copies)
+        made
     }
 
     /// What this fur shares with every copy made from it ([`GpuFur::from_asset`]).
@@ -256,15 +253,8 @@ impl GpuFur {
         let skin = if tint.is_finite() { skin * tint.max(Vec3::ZERO) } else { skin };
         self.level.set(frame.level, self.geometry.shape.layers);
         // What the listing passes list of it this frame, should they be recorded.
-        let level = &self.level;
-        let lists = if level.coat_shown() {
-            let fins = self.fin_list().is_some() && level.fins_shown();
-            let shells = self.shell_list().is_some() && level.by_view();
-            (u32::from(fins) * LIST_FINS) | (u32::from(shells) * LIST_SHELLS)
-        } else {
-            0
-        };
-        self.geometry.write_uniform(queue, &self.geometry.shape.uniform(&frame, skin, textures), lists);
+        let uniform = self.geometry.shape.uniform(&frame, skin, textures);
+        self.geometry.write_uniform(queue, &uniform, self.lists());
         self.wet.store(frame.wet, Ordering::Relaxed);
         self.fur_model.store(frame.look.shading.fur_model, Ordering::Relaxed);
         if let Some(list) = self.shell_list() {
@@ -444,6 +434,19 @@ impl GpuFur {
 
     pub(crate) fn textures_bind_group(&self) -> &wgpu::BindGroup {
         &self.asset.textures.bind_group
+    }
+
+    /// What the listing passes list of it at the level of its last `prepare`
+    /// ([`LIST_FINS`], [`LIST_SHELLS`]): its fins while they show, its shells while the view
+    /// angle thins them, nothing once its coat has faded.
+    pub(crate) fn lists(&self) -> u32 {
+        let level = &self.level;
+        if !level.coat_shown() {
+            return 0;
+        }
+        let fins = self.fin_list().is_some() && level.fins_shown();
+        let shells = self.shell_list().is_some() && level.by_view();
+        (u32::from(fins) * LIST_FINS) | (u32::from(shells) * LIST_SHELLS)
     }
 
     /// Its pool's fin lists (its own is at [`GpuFur::slot`]).

@@ -175,6 +175,8 @@ impl FurDriver {
             }
         };
         let furs = GpuFur::herd_from_asset(device, renderer, asset, states(kernel), count)?;
+        // Copies grown as the asset share its GPU rest segments.
+        let shared_rest = asset.grown_as(structure).then_some(&*asset.simulation_rest);
         let mut drivers = Vec::with_capacity(furs.len());
         for fur in furs {
             let mut driver = Self {
@@ -185,8 +187,6 @@ impl FurDriver {
                 frame: FurFrame::default(),
                 unrecorded: false,
             };
-            // Copies grown as the asset share its GPU rest segments.
-            let shared_rest = asset.grown_as(structure).then_some(&*asset.simulation_rest);
             driver.use_kernel(device, renderer, structure, kernel, shared_rest)?;
             driver.fur.prepare(queue, &driver.frame);
             drivers.push(driver);

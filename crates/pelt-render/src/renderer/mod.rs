@@ -24,6 +24,7 @@ use crate::RenderError;
 use crate::fur::{Coat, GpuFur};
 use crate::listing::{DRAW_ARGS_BYTES, FIN_INSTANCE_LAYOUT, FinList, ListingPasses, ShellList};
 use crate::plain::PlainMesh;
+use crate::pool::{LIST_FINS, LIST_SHELLS};
 use crate::requirements::{ErrorScope, check_features_and_limits};
 use crate::shaders::{Layouts, unified_shader_source};
 use crate::sim_pipelines::SimPipelines;
@@ -322,10 +323,9 @@ impl FurRenderer {
         // whose shells are thinned.
         let mut pools: Vec<(&GpuFur, bool, Vec<u32>)> = Vec::new();
         for fur in furs {
-            let level = fur.prepared_level();
-            let fins = fur.fin_list().is_some() && level.coat_shown() && level.fins_shown();
-            let shells = fur.shell_list().is_some() && level.coat_shown() && level.by_view();
-            if !(fins || shells) {
+            let lists = fur.lists();
+            let (fins, shells) = (lists & LIST_FINS != 0, lists & LIST_SHELLS != 0);
+            if lists == 0 {
                 continue;
             }
             let index = match pools.iter().position(|(first, ..)| std::sync::Arc::ptr_eq(first.pool(), fur.pool())) {
