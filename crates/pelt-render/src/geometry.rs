@@ -16,7 +16,7 @@ use wgpu::util::DeviceExt as _;
 
 use crate::RenderError;
 use crate::object::{GpuBytes, ObjectShape};
-use crate::pool::{MemberPool, binding};
+use crate::pool::{MemberPool, PoolMesh, binding};
 use crate::requirements::check_size;
 use crate::shaders::{Layouts, ObjectUniform};
 
@@ -245,8 +245,8 @@ impl UnifiedGeometry {
             let expected = shape.vertex_count as usize;
             return Err(RenderError::Count { what: "base normals", expected, got: normals.len(), rule: "V" });
         }
-        let mesh = (shape, &shared.topology);
-        Ok(Arc::new(MemberPool::new(device, layouts, mesh, (positions, normals), (state_count, slots))?))
+        let mesh = PoolMesh { shape, topology: &shared.topology, uvs: &shared.uvs, groom: &shared.groom };
+        Ok(Arc::new(MemberPool::new(device, layouts, &mesh, (positions, normals), (state_count, slots))?))
     }
 
     /// The copy in slot `slot` of `pool` (made over `shared`).
@@ -346,7 +346,8 @@ impl UnifiedGeometry {
     }
 
     /// Writes the object uniform, with where the listing passes find this copy in its pool and
-    /// what they list of it this frame (`lists`: `pool::LIST_FINS`, `pool::LIST_SHELLS`).
+    /// what they list of it this frame (`lists`: `pool::LIST_FINS`, `pool::LIST_SHELLS`, and
+    /// `pool::SHOWS_COAT` for the pooled shadow casters).
     pub fn write_uniform(&self, queue: &wgpu::Queue, uniform: &ObjectUniform, lists: u32) {
         let states = (self.current, (self.current + 1) % self.state_count());
         let uniform = ObjectUniform { pool: self.pool.object_pool_field(self.slot, states, lists), ..*uniform };
@@ -443,6 +444,11 @@ impl UnifiedGeometry {
     /// Draws every base triangle once: the skin, or a plain mesh.
     pub fn draw_skin(&self, pass: &mut wgpu::RenderPass<'_>) {
         self.draw_surface(pass, 0..1, self.shape.triangle_count);
+    }
+
+    /// Draws every base triangle once an instance: a pool's skins (`instances` = slots).
+    pub fn draw_skins(&self, pass: &mut wgpu::RenderPass<'_>, instances: std::ops::Range<u32>) {
+        self.draw_surface(pass, instances, self.shape.triangle_count);
     }
 
     /// Draws the furred base triangles in the shells `instances`.

@@ -164,8 +164,8 @@ pub use plain::PlainMesh;
 pub use renderer::{FurDrawSettings, FurMotion, FurPrepass, FurRenderer, MotionData, PrepassTarget};
 pub use requirements::{check_adapter, required_downlevel_flags, required_features, required_limits};
 pub use shaders::{
-    prepass_shader_source, shadow_copy_shader_source, silhouette_shader_source, simulation_shader_source,
-    skinning_shader_source, unified_shader_source, view_lod_shader_source,
+    pool_draw_shader_source, prepass_shader_source, shadow_copy_shader_source, silhouette_shader_source,
+    simulation_shader_source, skinning_shader_source, unified_shader_source, view_lod_shader_source,
 };
 #[cfg(feature = "lab")]
 pub use shaders::{separated_shader_source, strands_shader_source};

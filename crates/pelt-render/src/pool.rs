@@ -28,6 +28,18 @@ pub const POSITIONS_USAGE: wgpu::BufferUsages = wgpu::BufferUsages::STORAGE
 /// `object_pool.wgsl`).
 pub(crate) const LIST_FINS: u32 = 1;
 pub(crate) const LIST_SHELLS: u32 = 2;
+/// Beside them: the copy's coat shows, so it casts fur shadows (`SHOWS_COAT` in
+/// `pool_draws.wgsl`).
+pub(crate) const SHOWS_COAT: u32 = 4;
+
+/// What every copy of a pool shares and its draws read: the mesh's shape, topology, wedge uvs
+/// and groom attributes.
+pub(crate) struct PoolMesh<'a> {
+    pub shape: ObjectShape,
+    pub topology: &'a wgpu::Buffer,
+    pub uvs: &'a wgpu::Buffer,
+    pub groom: &'a wgpu::Buffer,
+}
 
 /// The shared buffers of `slots` copies of one fur.
 #[derive(Debug)]
@@ -48,6 +60,9 @@ pub(crate) struct MemberPool {
     shells: Option<ShellList>,
     /// The listing passes' group 1: the objects, the states (twice), the normals, the topology.
     listing_group: wgpu::BindGroup,
+    /// The pooled shadow casters' group 1 (`Layouts::pool_draws`): the listing's and the wedge
+    /// uvs, the groom attributes and a stand-in for the wetness (a wet copy casts alone).
+    draw_group: wgpu::BindGroup,
 }
 
 impl MemberPool {
@@ -65,13 +80,12 @@ impl MemberPool {
         u32::try_from(most).unwrap_or(u32::MAX).max(1)
     }
 
-    /// A pool of `slots` copies of a mesh of `shape` with `topology` (the copies' shared one),
-    /// each starting from `positions` (`(L + 1) * V`) in each of its `state_count` states and
-    /// `normals` (`V`).
+    /// A pool of `slots` copies of `mesh`, each starting from `positions` (`(L + 1) * V`) in each
+    /// of its `state_count` states and `normals` (`V`).
     pub fn new(
         device: &wgpu::Device,
         layouts: &Layouts,
-        (shape, topology): (ObjectShape, &wgpu::Buffer),
+        mesh: &PoolMesh<'_>,
         (positions, normals): (&[Vec3], &[Vec3]),
         (state_count, slots): (usize, u32),
     ) -> Result<Self, RenderError> {
@@ -123,6 +137,7 @@ impl MemberPool {
             usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
+        let (shape, topology) = (mesh.shape, mesh.topology);
         let layers = shape.layers;
         let fins = FinList::new(device, layouts, (shape.fin_edge_count, layers), slots)?;
         let per_shell = shape.vertices_per_shell();
@@ -138,6 +153,27 @@ impl MemberPool {
                 wgpu::BindGroupEntry { binding: 5, resource: topology.as_entire_binding() },
             ],
         });
+        // Read by no pipeline that binds it: the pooled casters are built dry.
+        let no_wetness = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("pelt pool wetness stand-in"),
+            size: 16,
+            usage: wgpu::BufferUsages::STORAGE,
+            mapped_at_creation: false,
+        });
+        let draw_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("pelt pool draws"),
+            layout: &layouts.pool_draws,
+            entries: &[
+                wgpu::BindGroupEntry { binding: 0, resource: objects.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 1, resource: states.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 2, resource: states.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 3, resource: normals.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 4, resource: mesh.uvs.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 5, resource: topology.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 6, resource: mesh.groom.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 7, resource: no_wetness.as_entire_binding() },
+            ],
+        });
         Ok(Self {
             states,
             normals,
@@ -150,6 +186,7 @@ impl MemberPool {
             fins,
             shells,
             listing_group,
+            draw_group,
         })
     }
 
@@ -193,9 +230,13 @@ impl MemberPool {
         &self.listing_group
     }
 
+    pub fn draw_group(&self) -> &wgpu::BindGroup {
+        &self.draw_group
+    }
+
     /// Slot `slot`'s `pool` field of its object (`Object::pool` in `shading.wgsl`): where its
     /// `current` and `previous` states and its normals start in the pool's buffers, in `u32`s,
-    /// and `lists` ([`LIST_FINS`], [`LIST_SHELLS`]).
+    /// and `lists` ([`LIST_FINS`], [`LIST_SHELLS`], [`SHOWS_COAT`]).
     pub fn object_pool_field(&self, slot: u32, (current, previous): (usize, usize), lists: u32) -> [u32; 4] {
         let words = |slice: wgpu::BufferSlice<'_>| u32::try_from(slice.offset() / 4).unwrap_or(u32::MAX);
         [words(self.state(slot, current)), words(self.state(slot, previous)), words(self.normals(slot)), lists]

@@ -371,3 +371,94 @@ fn copies_made_together_list_in_one_dispatch_each_as_each_alone() {
     let herd_picture = rig.render_silhouettes(&listed_together, &camera, &settings(), true);
     assert_eq!(herd_picture, rig.render_silhouettes(&listed_alone, &camera, &settings(), false));
 }
+
+/// Through a shadow map, three copies made together cast in one draw a pass where three copies
+/// made alone take a draw each, and the shadows are the same: the picture of the ground and the
+/// copies, each posed and placed its own way, one drawing every fourth shell (two opacity
+/// shells of its own, not four) and one faded to its skin (casting no fur), has the same bytes.
+#[test]
+fn copies_made_together_cast_in_one_draw_a_pass_as_each_alone() {
+    let rig = Rig::new(192, 144);
+    let structure = builtin_fur(Builtin::Bunny, 8);
+    let mut textures = strand_textures(32, 8, BROWN_ROOT, BROWN_TIP);
+    // Strands up to the outermost shell, which a coat thinned to fewer shells than the opacity
+    // pass's four draws once (its `opacity_shell` clamps there).
+    let slice = (32 * 32 * 4) as usize;
+    let below = textures.shell[6 * slice..7 * slice].to_vec();
+    textures.shell[7 * slice..].copy_from_slice(&below);
+    let asset = FurAsset::new(rig.device(), rig.queue(), &rig.renderer, &structure, &textures).expect("asset");
+    let (device, renderer) = (rig.device(), &rig.renderer);
+    let herd = GpuFur::herd_from_asset(device, renderer, &asset, FurStates::Two, 3).expect("herd");
+    let alone: Vec<GpuFur> =
+        (0..3).map(|_| GpuFur::from_asset(device, renderer, &asset, FurStates::Two).expect("copy")).collect();
+    let (centre, radius) = structure.mesh.bounding_sphere();
+    let v = structure.mesh.vertex_count();
+    let levels = [
+        pelt_render::FurLevel::FULL,
+        pelt_render::FurLevel { stride: 4, ..pelt_render::FurLevel::FULL },
+        pelt_render::FurLevel { coat: 0.0, ..pelt_render::FurLevel::FULL },
+    ];
+    for (k, (together, lone)) in herd.iter().zip(&alone).enumerate() {
+        // Copy k bent sideways by k tenths of the radius at the tips, turned k * 40 degrees and
+        // standing k * 2.2 radii along x.
+        let bend = 0.1 * radius * k as f32;
+        let bent: Vec<Vec3> = (structure.positions.iter().enumerate())
+            .map(|(j, p)| *p + Vec3::X * (bend * (j / v) as f32 / structure.layers as f32))
+            .collect();
+        let place = glam::Mat4::from_translation(Vec3::X * (2.2 * radius * k as f32) - centre)
+            * glam::Mat4::from_rotation_y((40.0 * k as f32).to_radians());
+        let frame = FurFrame { world_from_model: place, level: levels[k], ..common::paper_frame() };
+        for fur in [together, lone] {
+            fur.set_positions(rig.queue(), &bent).expect("positions");
+            fur.prepare(rig.queue(), &frame);
+        }
+    }
+    assert_eq!(herd[1].drawn_shells(), 2, "copy 1 draws two shells");
+    let floor = rig.plain(&pelt_render::ground_mesh(), Vec3::splat(0.6));
+    let below = glam::Mat4::from_translation(Vec3::new(2.2 * radius, -radius, 0.0));
+    floor.prepare(rig.queue(), below * glam::Mat4::from_scale(Vec3::splat(6.0 * radius)));
+    let scene = (Vec3::new(2.2 * radius, 0.0, 0.0), 4.0 * radius);
+    // Seen from high above, the long shadows of a low light across the ground and the copies.
+    let camera = pelt_render::Camera::framing(scene.0, scene.1, 20.0, 60.0, 192.0 / 144.0);
+    let light = pelt_render::Light::default();
+    let mut view = pelt_render::FurView::new(device, renderer);
+    view.prepare(rig.queue(), &camera.view_data(192.0 / 144.0, &light));
+    let shadow = pelt_render::ShadowSettings { size: 256, fur_depth: 0.3 * radius, extinction: 0.6 };
+    let mut map = pelt_render::ShadowMap::new(device, renderer, shadow).expect("shadow map");
+    let caster = pelt_render::ShadowCaster::Directional { toward_light: Vec3::new(1.0, 0.7, 0.3).normalize() };
+    map.prepare(rig.queue(), (&[(0, caster)], 1), scene);
+    view.set_shadows(Some(&map));
+    let picture = |furs: &[GpuFur], together: bool| {
+        let mut draws = Vec::new();
+        let image = rig
+            .headless
+            .render_with(
+                pelt_render::DEFAULT_BACKGROUND,
+                |encoder| {
+                    map.record(encoder, |pass, light| {
+                        renderer.draw_plain(pass, light, &floor);
+                        draws.push(if together {
+                            renderer.draw_herd(pass, light, furs, &settings())
+                        } else {
+                            furs.iter().map(|fur| renderer.draw_herd(pass, light, [fur], &settings())).sum()
+                        });
+                    });
+                },
+                |pass| {
+                    renderer.draw_plain(pass, &view, &floor);
+                    for fur in furs {
+                        renderer.draw(pass, &view, fur, &settings());
+                    }
+                },
+            )
+            .expect("frame");
+        (image, draws)
+    };
+    let (herd_picture, herd_draws) = picture(&herd, true);
+    let (alone_picture, alone_draws) = picture(&alone, false);
+    herd_picture.save(common::out_dir().join("herd-shadows.png")).expect("save");
+    // The opaque pass draws every skin, the fur's passes the two coats that show.
+    assert_eq!(alone_draws, [3, 2, 2], "copies alone: a draw each");
+    assert_eq!(herd_draws, [1, 1, 1], "copies made together: one draw a pass");
+    assert!(herd_picture == alone_picture, "the herd's shadows differ from its copies' alone");
+}

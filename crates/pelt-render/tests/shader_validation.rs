@@ -37,6 +37,11 @@ fn view_lod_module_validates() {
 }
 
 #[test]
+fn pool_draw_module_validates() {
+    validate("shading.wgsl over a pool + unified.wgsl + pool_draws.wgsl", &pelt_render::pool_draw_shader_source());
+}
+
+#[test]
 fn prepass_module_validates() {
     validate("shading.wgsl + unified.wgsl + prepass.wgsl", &pelt_render::prepass_shader_source());
 }
@@ -54,6 +59,7 @@ fn every_wgsl_file_is_part_of_a_validated_module() {
         pelt_render::simulation_shader_source(),
         pelt_render::silhouette_shader_source(),
         pelt_render::view_lod_shader_source(),
+        pelt_render::pool_draw_shader_source(),
         pelt_render::prepass_shader_source(),
         pelt_render::strands_shader_source(),
         pelt_render::skinning_shader_source(),
@@ -75,8 +81,8 @@ fn every_wgsl_file_is_part_of_a_validated_module() {
         }
     }
     assert_eq!(
-        checked, 18,
-        "shading, object_pool, wet, fur_bsdf, shadows, unified, prepass, separated, scan, silhouette, view_lod, \
+        checked, 19,
+        "shading, object_pool, pool_draws, wet, fur_bsdf, shadows, unified, prepass, separated, scan, silhouette, view_lod, \
          simulation_wind, simulation, simulation_inputs, simulation_contact, strands, skinning and shadow_copy"
     );
 }

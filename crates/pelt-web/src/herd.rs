@@ -158,6 +158,12 @@ impl HerdGpu {
         self.drivers[k].draw(pass, renderer, view, settings);
     }
 
+    /// Draws every copy into `view` (a shadow map's: those made together cast in one draw a
+    /// pass).
+    pub fn draw_all(&self, pass: &mut wgpu::RenderPass<'_>, (renderer, view): (&FurRenderer, &FurView)) {
+        FurDriver::draw_herd(pass, renderer, view, &self.drivers, &FurDrawSettings::ALL);
+    }
+
     /// How many copies.
     #[must_use]
     pub fn len(&self) -> usize {

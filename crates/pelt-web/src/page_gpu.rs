@@ -298,9 +298,7 @@ impl PageGpu {
             }
             driver.draw(pass, renderer, light, &FurDrawSettings::ALL);
             if let Some(herd) = herd {
-                for k in 0..herd.len() {
-                    herd.draw(k, pass, (renderer, light), &FurDrawSettings::ALL);
-                }
+                herd.draw_all(pass, (renderer, light));
             }
         });
         {

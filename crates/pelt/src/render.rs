@@ -391,9 +391,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                         renderer.draw_plain(pass, light, mesh);
                     }
                     colliders.draw(pass, &renderer, light);
-                    for driver in &drivers {
-                        driver.draw(pass, &renderer, light, &FurDrawSettings::ALL);
-                    }
+                    FurDriver::draw_herd(pass, &renderer, light, &drivers, &FurDrawSettings::ALL);
                 });
             },
             |pass| {

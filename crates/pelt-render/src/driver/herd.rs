@@ -1,11 +1,12 @@
 //! A herd's frame: every member advanced in one parallel pass, stepped on the GPU in shared
-//! compute passes, and listed per view in one compute pass.
+//! compute passes, listed per view in one compute pass, and cast into each shadow pass in one
+//! draw.
 
 use pelt_core::sim::{FurStepper, HerdInstance};
 
 use super::FurDriver;
 use crate::RenderError;
-use crate::renderer::FurRenderer;
+use crate::renderer::{FurDrawSettings, FurRenderer};
 use crate::simulation::GpuSimulation;
 use crate::view::FurView;
 
@@ -96,5 +97,18 @@ impl FurDriver {
         drivers: impl IntoIterator<Item = &'a FurDriver>,
     ) {
         renderer.prepare_fins_of(encoder, view, drivers.into_iter().map(|driver| &driver.fur));
+    }
+
+    /// [`FurDriver::draw`] for every driver of `drivers` (a herd's members), in that order: into
+    /// a shadow map, the members made together cast in one draw a pass
+    /// ([`FurRenderer::draw_herd`]). Returns the draws recorded.
+    pub fn draw_herd<'a>(
+        pass: &mut wgpu::RenderPass<'_>,
+        renderer: &FurRenderer,
+        view: &FurView,
+        drivers: impl IntoIterator<Item = &'a FurDriver>,
+        settings: &FurDrawSettings,
+    ) -> usize {
+        renderer.draw_herd(pass, view, drivers.into_iter().map(|driver| &driver.fur), settings)
     }
 }

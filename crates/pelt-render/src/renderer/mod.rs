@@ -10,6 +10,7 @@
 //!    with [`FurDrawSettings::silhouette_fins`] only the edges the silhouette pass
 //!    ([`FurRenderer::prepare_fins`]) kept, through an indirect draw; else every edge.
 
+mod herd;
 mod objects;
 mod pipeline;
 mod prepass;
@@ -246,6 +247,17 @@ impl FurRenderer {
     /// Through one of a [`crate::ShadowMap`]'s views (its `record`), the fur draws itself into
     /// that shadow pass instead: its skin as an opaque caster, its shells and fins as opacity.
     pub fn draw(&self, pass: &mut wgpu::RenderPass<'_>, view: &FurView, fur: &GpuFur, settings: &FurDrawSettings) {
+        self.draw_counted(pass, view, fur, settings);
+    }
+
+    /// [`FurRenderer::draw`], returning the draws recorded.
+    fn draw_counted(
+        &self,
+        pass: &mut wgpu::RenderPass<'_>,
+        view: &FurView,
+        fur: &GpuFur,
+        settings: &FurDrawSettings,
+    ) -> usize {
         let shadowed = match view.role() {
             ViewRole::Camera { shadows } => shadows,
             ViewRole::Shadow(shadow_pass) => return self.draw_shadow(pass, (view, shadow_pass), fur, settings),
@@ -257,13 +269,15 @@ impl FurRenderer {
         pass.set_bind_group(1, geometry.bind_group(), &[]);
         pass.set_bind_group(2, fur.textures_bind_group(), &[]);
         pass.set_bind_group(3, view.shadow_group(), &[]);
+        let mut draws = 0;
         if settings.skin {
             pass.set_pipeline(&self.surface(geometry.shape.has_uvs, shadowed).skin);
             geometry.draw_skin(pass);
+            draws += 1;
         }
         let layers = geometry.shape.layers;
         if layers == 0 || !(settings.shells || settings.fins) || !fur.prepared_level().coat_shown() {
-            return;
+            return draws;
         }
         let coat = self.coat(fur.coat().shadowed(shadowed));
         if settings.shells {
@@ -271,10 +285,12 @@ impl FurRenderer {
             match fur.shell_list() {
                 Some(list) if list.recorded(fur.slot()) && fur.prepared_level().by_view() => {
                     draw_thinned_shells(pass, fur, (shells, &coat.listed_shells[walk][which]), list);
+                    draws += fur.drawn_shells() as usize;
                 }
                 _ => {
                     pass.set_pipeline(shells);
                     geometry.draw_shells(pass, 0..fur.drawn_shells());
+                    draws += 1;
                 }
             }
         }
@@ -292,7 +308,9 @@ impl FurRenderer {
                     geometry.draw_fins(pass, fur.drawn_shells());
                 }
             }
+            draws += 1;
         }
+        draws
     }
 
     /// Records the silhouette pass of `fur` seen from `view` into `encoder` (a compute pass): it

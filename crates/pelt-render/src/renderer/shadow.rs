@@ -7,12 +7,14 @@ use super::{CoatBuilder, FurRenderer, PipelineSource};
 use crate::fur::{Coat, GpuFur};
 use crate::plain::PlainMesh;
 use crate::renderer::FurDrawSettings;
-use crate::shaders::{SHADOW_DEPTH_FORMAT as DEPTH_FORMAT, SHADOW_OPACITY_FORMAT as OPACITY_FORMAT};
+use crate::shaders::{
+    Layouts, SHADOW_DEPTH_FORMAT as DEPTH_FORMAT, SHADOW_OPACITY_FORMAT as OPACITY_FORMAT, pool_draw_shader_source,
+};
 use crate::view::{FurView, ShadowLookups, ShadowPass};
 
 /// What a shadow pipeline writes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum ShadowKind {
+pub(super) enum ShadowKind {
     /// Depth only, biased against acne (the opaque map).
     Opaque,
     /// Depth only (the fur's first surface).
@@ -38,7 +40,7 @@ pub(super) struct OpacityPipelines {
 
 /// The opacity pass draws at most this many shells (`OPACITY_SHELLS` in `unified.wgsl`): one
 /// for each of the map's opacity layers.
-const OPACITY_SHELLS: u32 = 4;
+pub(super) const OPACITY_SHELLS: u32 = 4;
 
 /// The shadow pipelines, each built the first time a shadow map draws with it.
 #[derive(Debug, Default)]
@@ -47,9 +49,23 @@ pub(super) struct ShadowSet {
     /// By the coat's index without shadows or the fur model (groomed, wet): opacity needs
     /// neither.
     opacity: [OnceLock<OpacityPipelines>; 4],
+    /// A pool's casters (`pool_draws.wgsl`), built the first time a herd casts.
+    pub(super) pool: OnceLock<PoolCasters>,
 }
 
-const WALKS: [(&str, bool); 2] = [("wedges", true), ("indexed", false)];
+pub(super) const WALKS: [(&str, bool); 2] = [("wedges", true), ("indexed", false)];
+
+/// A pool's shadow pipelines, each drawing every copy of a run of slots at once: their own
+/// module (the shading over a pool) and layout (`Layouts::pool_draws`).
+#[derive(Debug)]
+pub(super) struct PoolCasters {
+    module: wgpu::ShaderModule,
+    layout: wgpu::PipelineLayout,
+    pub skin: [wgpu::RenderPipeline; 2],
+    pub fur_depth: [wgpu::RenderPipeline; 2],
+    /// By whether the groom reaches the shading (a wet copy casts alone).
+    opacity: [OnceLock<[wgpu::RenderPipeline; 2]>; 2],
+}
 
 impl CoatBuilder {
     fn shadow_pipeline(
@@ -59,11 +75,22 @@ impl CoatBuilder {
         (layout, mesh_uvs, coat): (&wgpu::PipelineLayout, Option<bool>, Coat),
         kind: ShadowKind,
     ) -> wgpu::RenderPipeline {
+        self.shadow_pipeline_in(&self.module, label, (vertex, fragment), (layout, mesh_uvs, coat), kind)
+    }
+
+    fn shadow_pipeline_in(
+        &self,
+        module: &wgpu::ShaderModule,
+        label: &str,
+        (vertex, fragment): (&str, Option<&str>),
+        (layout, mesh_uvs, coat): (&wgpu::PipelineLayout, Option<bool>, Coat),
+        kind: ShadowKind,
+    ) -> wgpu::RenderPipeline {
         let source = PipelineSource {
             mesh_uvs,
             coat: Some(coat),
             layout,
-            module: &self.module,
+            module,
             vertex_entry: vertex,
             fragment_entry: "",
             buffers: &[],
@@ -103,7 +130,54 @@ impl CoatBuilder {
     }
 }
 
+impl CoatBuilder {
+    fn pool_casters(&self, layouts: &Layouts) -> PoolCasters {
+        let module = self.device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("pelt pool draws"),
+            source: wgpu::ShaderSource::Wgsl(pool_draw_shader_source().into()),
+        });
+        let layout = layouts.pipeline_layout(&self.device, "pelt pool draws", &layouts.pool_draws, true);
+        let depth = |label, vertex: &str, kind| {
+            WALKS.map(|(walk, uvs)| {
+                let entry = format!("{vertex}_{walk}");
+                self.shadow_pipeline_in(&module, label, (&entry, None), (&layout, Some(uvs), Coat::PLAIN), kind)
+            })
+        };
+        PoolCasters {
+            skin: depth("pelt pool shadow skin", "vs_pool_skin", ShadowKind::Opaque),
+            fur_depth: depth("pelt pool shadow fur depth", "vs_pool_fur_depth", ShadowKind::FurDepth),
+            opacity: [OnceLock::new(), OnceLock::new()],
+            module,
+            layout,
+        }
+    }
+
+    fn pool_opacity(&self, casters: &PoolCasters, coat: Coat) -> [wgpu::RenderPipeline; 2] {
+        WALKS.map(|(walk, uvs)| {
+            let fragment = coat.entry(if uvs { "fs_pool_opacity_uvs" } else { "fs_pool_opacity_tiles" });
+            self.shadow_pipeline_in(
+                &casters.module,
+                "pelt pool shadow shells",
+                (&coat.entry(&format!("vs_pool_opacity_shell_{walk}")), Some(&fragment)),
+                (&casters.layout, Some(uvs), coat),
+                ShadowKind::Opacity,
+            )
+        })
+    }
+}
+
 impl FurRenderer {
+    pub(super) fn pool_casters(&self) -> &PoolCasters {
+        self.shadows.pool.get_or_init(|| self.coat_builder.pool_casters(&self.layouts))
+    }
+
+    /// A pool's opacity pipelines for dry copies with `coat`'s groom.
+    pub(super) fn pool_opacity(&self, coat: Coat) -> &[wgpu::RenderPipeline; 2] {
+        let casters = self.pool_casters();
+        let coat = Coat { groomed: coat.groomed, ..Coat::PLAIN };
+        casters.opacity[usize::from(coat.groomed)].get_or_init(|| self.coat_builder.pool_opacity(casters, coat))
+    }
+
     fn shadow_depth(&self) -> &ShadowPipelines {
         self.shadows.depth.get_or_init(|| self.coat_builder.shadow_depth())
     }
@@ -114,14 +188,14 @@ impl FurRenderer {
         self.shadows.opacity[coat.index()].get_or_init(|| self.coat_builder.opacity(coat))
     }
 
-    /// `fur` in one pass of a shadow map.
+    /// `fur` in one pass of a shadow map; returns the draws recorded.
     pub(super) fn draw_shadow(
         &self,
         pass: &mut wgpu::RenderPass<'_>,
         (view, shadow_pass): (&FurView, ShadowPass),
         fur: &GpuFur,
         settings: &FurDrawSettings,
-    ) {
+    ) -> usize {
         let geometry = fur.geometry();
         let walk = usize::from(!geometry.shape.has_uvs);
         let shells = fur.drawn_shells();
@@ -136,7 +210,7 @@ impl FurRenderer {
             ShadowPass::FurDepth | ShadowPass::Opacity => furred,
         };
         if !draws {
-            return;
+            return 0;
         }
         pass.set_bind_group(0, view.bind_group(), &[]);
         pass.set_bind_group(1, geometry.bind_group(), &[]);
@@ -158,6 +232,7 @@ impl FurRenderer {
             }
             _ => {}
         }
+        1
     }
 
     /// A plain mesh in one pass of a shadow map: it casts in the opaque one only.

@@ -11,6 +11,9 @@ pub(crate) struct Layouts {
     pub unified_object: wgpu::BindGroupLayout,
     /// A pool's copies as the listing passes read them (`crate::pool`).
     pub pool_objects: wgpu::BindGroupLayout,
+    /// Group 1 of a pool's shadow casters: `unified_object`'s bindings, the objects of every
+    /// copy in place of one uniform (`pool_draws.wgsl`).
+    pub pool_draws: wgpu::BindGroupLayout,
     /// Group 1 of the separated structure: the object uniform and the fin vertices.
     #[cfg(feature = "lab")]
     pub separated_object: wgpu::BindGroupLayout,
@@ -84,6 +87,21 @@ impl Layouts {
                 entry(2, compute, storage),
                 entry(3, compute, storage),
                 entry(5, compute, storage),
+            ],
+        });
+        // A pool's shadow casters: 8 storage buffers in the vertex stage, the objects also in the
+        // opacity fragments.
+        let pool_draws = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("pelt pool draws"),
+            entries: &[
+                entry(0, wgpu::ShaderStages::VERTEX | wgpu::ShaderStages::FRAGMENT, storage),
+                entry(1, wgpu::ShaderStages::VERTEX, storage),
+                entry(2, wgpu::ShaderStages::VERTEX, storage),
+                entry(3, wgpu::ShaderStages::VERTEX, storage),
+                entry(4, wgpu::ShaderStages::VERTEX, storage),
+                entry(5, wgpu::ShaderStages::VERTEX, storage),
+                entry(6, wgpu::ShaderStages::VERTEX, storage),
+                entry(7, wgpu::ShaderStages::VERTEX, storage),
             ],
         });
         // The separated fins' vertices, read back by each fin vertex to decide for its whole fin.
@@ -176,6 +194,7 @@ impl Layouts {
             view,
             unified_object,
             pool_objects,
+            pool_draws,
             #[cfg(feature = "lab")]
             separated_object,
             textures,

@@ -31,9 +31,11 @@ const FUR_BSDF_WGSL: &str = include_str!("fur_bsdf.wgsl");
 const SHADOWS_WGSL: &str = include_str!("shadows.wgsl");
 /// The unified structure's vertex and fragment shaders, over the shared vertex array.
 const UNIFIED_WGSL: &str = include_str!("unified.wgsl");
-/// The listing passes' object binding: every copy in a pool (`pool.rs`), in place of the one
-/// object uniform.
+/// A pool's object binding: every copy in a pool (`pool.rs`), in place of the one object
+/// uniform, for the listing passes and a herd's shadow casters.
 const OBJECT_POOL_WGSL: &str = include_str!("object_pool.wgsl");
+/// A pool's shadow casters, every copy in one draw a pass.
+const POOL_DRAWS_WGSL: &str = include_str!("pool_draws.wgsl");
 /// The ordered listing both listing passes share.
 const SCAN_WGSL: &str = include_str!("scan.wgsl");
 /// The silhouette pass: which fins show.
@@ -78,10 +80,11 @@ pub fn prepass_shader_source() -> String {
 /// object uniform rounded up to the uniform offset alignment every device allows (256).
 pub(crate) const OBJECT_SLOT_BYTES: u64 = OBJECT_UNIFORM_BYTES.next_multiple_of(256);
 
-/// The shared shading with its object binding for a listing pass: every copy of a pool's object,
-/// read by slot (`object_pool.wgsl`). The object is then a private copy, which a browser's WGSL
-/// compiler counts as varying between invocations: the shading's texture reads (fragment code,
-/// never run by a listing pass) would fail its derivative check, so the module turns it off.
+/// The shared shading with its object binding over a pool: every copy's object, read by slot
+/// (`object_pool.wgsl`). The object is then a private copy, which a browser's WGSL compiler
+/// counts as varying between invocations: the shading's texture reads would fail its derivative
+/// check, so the module turns it off (a listing pass runs no fragment code, and a pooled draw's
+/// copy is the same over each triangle).
 fn pooled_shading() -> String {
     let (start, end) = ("// OBJECT BINDING", "// END OBJECT BINDING\n");
     let (Some(from), Some(to)) = (SHADING_WGSL.find(start), SHADING_WGSL.find(end)) else {
@@ -108,6 +111,14 @@ pub fn silhouette_shader_source() -> String {
 pub fn view_lod_shader_source() -> String {
     let shading = pooled_shading();
     format!("{shading}\n{WET_WGSL}\n{FUR_BSDF_WGSL}\n{SHADOWS_WGSL}\n{UNIFIED_WGSL}\n{SCAN_WGSL}\n{VIEW_LOD_WGSL}")
+}
+
+/// The WGSL module of a pool's shadow casters (the shared shading over a pool, `unified.wgsl`
+/// and `pool_draws.wgsl`).
+#[must_use]
+pub fn pool_draw_shader_source() -> String {
+    let shading = pooled_shading();
+    format!("{shading}\n{WET_WGSL}\n{FUR_BSDF_WGSL}\n{SHADOWS_WGSL}\n{UNIFIED_WGSL}\n{POOL_DRAWS_WGSL}")
 }
 
 /// The WGSL module that copies a host's shadow map into Pelt's (`shadow_copy.wgsl`).
@@ -152,7 +163,7 @@ mod tests {
     #[test]
     fn the_pool_prelude_matches_the_slots() {
         assert!(OBJECT_POOL_WGSL.contains(&format!("@size({OBJECT_SLOT_BYTES})")));
-        for source in [silhouette_shader_source(), view_lod_shader_source()] {
+        for source in [silhouette_shader_source(), view_lod_shader_source(), pool_draw_shader_source()] {
             assert!(source.contains("var<storage, read> objects: array<ObjectSlot>"));
             assert!(!source.contains("var<uniform> object: Object"));
         }

@@ -1,6 +1,7 @@
-// The listing passes' object binding (in place of `shading.wgsl`'s): every copy of a fur in one
-// pool (`pool.rs`) is listed by one dispatch, workgroup z being the copy's slot. Each entry point
-// loads its copy's object first (`load_member`); bindings 1 to 3 are the pool's whole buffers.
+// A pool's object binding (in place of `shading.wgsl`'s): every copy of a fur in one pool
+// (`pool.rs`) is listed by one dispatch, workgroup z being the copy's slot, and a herd's shadow
+// casters drawn by one draw a pass (`pool_draws.wgsl`). Each entry point loads its copy's object
+// first (`load_member`); bindings 1 to 3 are the pool's whole buffers.
 
 // One copy's object, `OBJECT_SLOT_BYTES` (`shaders/mod.rs`) apart: the uniform ranges the draws
 // bind.

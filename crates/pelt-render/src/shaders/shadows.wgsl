@@ -200,32 +200,50 @@ fn opacity_layers(position: vec4<f32>, shell_alpha: f32) -> vec4<f32> {
     return inside * alpha;
 }
 
-@fragment
-fn fs_opacity_tiles(in: ShellTileVaryings) -> @location(0) vec4<f32> {
+// The opacity of each shell kind's fragment: the entry points below, and a pool's
+// (`pool_draws.wgsl`), which load their copy's object first.
+fn opacity_tiles(in: ShellTileVaryings) -> vec4<f32> {
     let layer = varying_layer(in.fade_blend_layer.z);
     let texel = tile_texel(in.tile_position, in.tile_normal, layer);
     return opacity_layers(in.clip_position, lod_alpha(texel.a * in.fade_blend_layer.x, layer, in.fade_blend_layer.y));
 }
 
-@fragment
-fn fs_opacity_uvs(in: ShellUvVaryings) -> @location(0) vec4<f32> {
+fn opacity_uvs(in: ShellUvVaryings) -> vec4<f32> {
     let layer = varying_layer(in.fade_blend_layer.z);
     let texel = sample_shell(in.uvs.xy, shell_slice(layer));
     return opacity_layers(in.clip_position, lod_alpha(texel.a * in.fade_blend_layer.x, layer, in.fade_blend_layer.y));
 }
 
-@fragment
-fn fs_opacity_tiles_groomed(in: GroomedShellTileVaryings) -> @location(0) vec4<f32> {
+fn opacity_tiles_groomed(in: GroomedShellTileVaryings) -> vec4<f32> {
     let layer = varying_layer(in.fade_blend_layer.z);
     let groom = shell_groom(in.fade_blend_layer, in.tint_density);
     let texel = coat_shell_texel(tile_uv(in.tile_position, in.tile_normal), layer, groom);
     return opacity_layers(in.clip_position, lod_alpha(texel.a * in.fade_blend_layer.x, layer, in.fade_blend_layer.y));
 }
 
-@fragment
-fn fs_opacity_uvs_groomed(in: GroomedShellUvVaryings) -> @location(0) vec4<f32> {
+fn opacity_uvs_groomed(in: GroomedShellUvVaryings) -> vec4<f32> {
     let layer = varying_layer(in.fade_blend_layer.z);
     let groom = shell_groom(in.fade_blend_layer, in.tint_density);
     let texel = coat_shell_texel(in.uvs.xy, layer, groom);
     return opacity_layers(in.clip_position, lod_alpha(texel.a * in.fade_blend_layer.x, layer, in.fade_blend_layer.y));
+}
+
+@fragment
+fn fs_opacity_tiles(in: ShellTileVaryings) -> @location(0) vec4<f32> {
+    return opacity_tiles(in);
+}
+
+@fragment
+fn fs_opacity_uvs(in: ShellUvVaryings) -> @location(0) vec4<f32> {
+    return opacity_uvs(in);
+}
+
+@fragment
+fn fs_opacity_tiles_groomed(in: GroomedShellTileVaryings) -> @location(0) vec4<f32> {
+    return opacity_tiles_groomed(in);
+}
+
+@fragment
+fn fs_opacity_uvs_groomed(in: GroomedShellUvVaryings) -> @location(0) vec4<f32> {
+    return opacity_uvs_groomed(in);
 }

@@ -196,9 +196,7 @@ pub fn measure(
                     FurDriver::record_views(encoder, &renderer, &view, &drivers);
                     surroundings.record(encoder, |pass, light| {
                         surroundings.draw_ground(pass, &renderer, light);
-                        for driver in &drivers {
-                            driver.draw(pass, &renderer, light, &FurDrawSettings::ALL);
-                        }
+                        FurDriver::draw_herd(pass, &renderer, light, &drivers, &FurDrawSettings::ALL);
                     });
                 },
                 |pass| {

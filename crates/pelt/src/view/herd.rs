@@ -309,7 +309,8 @@ impl HerdDrivers {
         FurDriver::record_views(encoder, renderer, view, drawn.iter().map(|&member| &self.drivers[member - 1]));
     }
 
-    /// Draws the copies `drawn` lists (member indices, 1..; every copy into a shadow map).
+    /// Draws the copies `drawn` lists (member indices, 1..; every copy into a shadow map, where
+    /// those made together cast in one draw a pass).
     pub(super) fn draw(
         &self,
         pass: &mut wgpu::RenderPass<'_>,
@@ -317,9 +318,8 @@ impl HerdDrivers {
         view: &FurView,
         (drawn, settings): (&[usize], &FurDrawSettings),
     ) {
-        for &member in drawn {
-            self.drivers[member - 1].draw(pass, renderer, view, settings);
-        }
+        let members = drawn.iter().map(|&member| &self.drivers[member - 1]);
+        FurDriver::draw_herd(pass, renderer, view, members, settings);
     }
 }
 

@@ -1,0 +1,193 @@
+// A pool's shadow casters, every copy in one draw a pass (`FurRenderer::draw_herd`): the
+// instance names the copy's slot (the opacity pass: its slot and its shell, OPACITY_SHELLS a
+// copy), whose object the vertex loads before the unified structure's code runs as for a lone
+// fur. Appended to the pooled shading (`object_pool.wgsl`), `unified.wgsl` and `shadows.wgsl`.
+
+// A copy whose coat shows (`Object::pool.w`, beside the listing flags).
+const SHOWS_COAT = 4u;
+
+// Loads slot `member`'s object; whether its coat casts (shown, with shells to draw).
+fn load_caster(member: u32) -> bool {
+    object = objects[member].object;
+    return (object.pool.w & SHOWS_COAT) != 0u && object.lod_shells > 0u;
+}
+
+// The opaque pass: every copy's skin (instance = slot).
+@vertex
+fn vs_pool_skin_wedges(@builtin(vertex_index) wedge: u32, @builtin(instance_index) member: u32) -> Varyings {
+    object = objects[member].object;
+    return surface_varyings(wedge_vertex(wedge), wedge, 0u);
+}
+
+@vertex
+fn vs_pool_skin_indexed(@builtin(vertex_index) vertex: u32, @builtin(instance_index) member: u32) -> Varyings {
+    object = objects[member].object;
+    return surface_varyings(vertex, 0u, 0u);
+}
+
+// The fur depth pass: every shown coat's outermost shell (instance = slot).
+@vertex
+fn vs_pool_fur_depth_wedges(@builtin(vertex_index) wedge: u32, @builtin(instance_index) member: u32) -> ShellUvVaryings {
+    if !load_caster(member) {
+        var out: ShellUvVaryings;
+        out.clip_position = HIDDEN_FIN_CORNER;
+        return out;
+    }
+    return shell_wedge(wedge, object.lod_shells - 1u);
+}
+
+@vertex
+fn vs_pool_fur_depth_indexed(@builtin(vertex_index) vertex: u32, @builtin(instance_index) member: u32) -> ShellTileVaryings {
+    if !load_caster(member) {
+        var out: ShellTileVaryings;
+        out.clip_position = HIDDEN_FIN_CORNER;
+        return out;
+    }
+    return shell_vertex(vertex, object.lod_shells - 1u);
+}
+
+// The opacity pass: instance `OPACITY_SHELLS * slot + k` draws the copy's opacity shell k (as
+// `vs_opacity_shell_*`), or nothing past the copy's own count of them.
+fn pool_opacity_shell(instance: u32) -> u32 {
+    if !load_caster(instance / OPACITY_SHELLS) {
+        return NO_FACE;
+    }
+    let k = instance % OPACITY_SHELLS;
+    let stride = opacity_stride();
+    return select(NO_FACE, opacity_shell(k), k < (object.lod_shells + stride - 1u) / stride);
+}
+
+// The opacity shells' varyings with the copy's slot, whose object the fragment loads.
+struct PoolShellTileVaryings {
+    @builtin(position) clip_position: vec4<f32>,
+    @location(0) @interpolate(perspective, centroid) lighting: vec4<f32>,
+    @location(1) @interpolate(perspective, centroid) fade_blend_layer: vec3<f32>,
+    @location(2) @interpolate(perspective, centroid) tile_position: vec3<f32>,
+    @location(3) @interpolate(perspective, centroid) tile_normal: vec3<f32>,
+    @location(5) @interpolate(flat) member: u32,
+}
+
+struct PoolShellUvVaryings {
+    @builtin(position) clip_position: vec4<f32>,
+    @location(0) @interpolate(perspective, centroid) lighting: vec4<f32>,
+    @location(1) @interpolate(perspective, centroid) fade_blend_layer: vec3<f32>,
+    @location(2) @interpolate(perspective, centroid) uvs: vec4<f32>,
+    @location(5) @interpolate(flat) member: u32,
+}
+
+struct PoolGroomedShellTileVaryings {
+    @builtin(position) clip_position: vec4<f32>,
+    @location(0) @interpolate(perspective, centroid) lighting: vec4<f32>,
+    @location(1) @interpolate(perspective, centroid) fade_blend_layer: vec4<f32>,
+    @location(2) @interpolate(perspective, centroid) tile_position: vec3<f32>,
+    @location(3) @interpolate(perspective, centroid) tile_normal: vec3<f32>,
+    @location(4) @interpolate(perspective, centroid) tint_density: vec4<f32>,
+    @location(5) @interpolate(flat) member: u32,
+}
+
+struct PoolGroomedShellUvVaryings {
+    @builtin(position) clip_position: vec4<f32>,
+    @location(0) @interpolate(perspective, centroid) lighting: vec4<f32>,
+    @location(1) @interpolate(perspective, centroid) fade_blend_layer: vec4<f32>,
+    @location(2) @interpolate(perspective, centroid) uvs: vec4<f32>,
+    @location(3) @interpolate(perspective, centroid) tint_density: vec4<f32>,
+    @location(5) @interpolate(flat) member: u32,
+}
+
+@vertex
+fn vs_pool_opacity_shell_wedges(@builtin(vertex_index) wedge: u32, @builtin(instance_index) instance: u32) -> PoolShellUvVaryings {
+    var out: PoolShellUvVaryings;
+    out.member = instance / OPACITY_SHELLS;
+    let shell = pool_opacity_shell(instance);
+    if shell == NO_FACE {
+        out.clip_position = HIDDEN_FIN_CORNER;
+        return out;
+    }
+    let v = shell_wedge(wedge, shell);
+    out.clip_position = v.clip_position;
+    out.lighting = v.lighting;
+    out.fade_blend_layer = v.fade_blend_layer;
+    out.uvs = v.uvs;
+    return out;
+}
+
+@vertex
+fn vs_pool_opacity_shell_indexed(@builtin(vertex_index) vertex: u32, @builtin(instance_index) instance: u32) -> PoolShellTileVaryings {
+    var out: PoolShellTileVaryings;
+    out.member = instance / OPACITY_SHELLS;
+    let shell = pool_opacity_shell(instance);
+    if shell == NO_FACE {
+        out.clip_position = HIDDEN_FIN_CORNER;
+        return out;
+    }
+    let v = shell_vertex(vertex, shell);
+    out.clip_position = v.clip_position;
+    out.lighting = v.lighting;
+    out.fade_blend_layer = v.fade_blend_layer;
+    out.tile_position = v.tile_position;
+    out.tile_normal = v.tile_normal;
+    return out;
+}
+
+@vertex
+fn vs_pool_opacity_shell_wedges_groomed(@builtin(vertex_index) wedge: u32, @builtin(instance_index) instance: u32) -> PoolGroomedShellUvVaryings {
+    var out: PoolGroomedShellUvVaryings;
+    out.member = instance / OPACITY_SHELLS;
+    let shell = pool_opacity_shell(instance);
+    if shell == NO_FACE {
+        out.clip_position = HIDDEN_FIN_CORNER;
+        return out;
+    }
+    let v = groomed_shell_wedge(wedge, shell);
+    out.clip_position = v.clip_position;
+    out.lighting = v.lighting;
+    out.fade_blend_layer = v.fade_blend_layer;
+    out.uvs = v.uvs;
+    out.tint_density = v.tint_density;
+    return out;
+}
+
+@vertex
+fn vs_pool_opacity_shell_indexed_groomed(@builtin(vertex_index) vertex: u32, @builtin(instance_index) instance: u32) -> PoolGroomedShellTileVaryings {
+    var out: PoolGroomedShellTileVaryings;
+    out.member = instance / OPACITY_SHELLS;
+    let shell = pool_opacity_shell(instance);
+    if shell == NO_FACE {
+        out.clip_position = HIDDEN_FIN_CORNER;
+        return out;
+    }
+    let v = groomed_shell_vertex(vertex, shell);
+    out.clip_position = v.clip_position;
+    out.lighting = v.lighting;
+    out.fade_blend_layer = v.fade_blend_layer;
+    out.tile_position = v.tile_position;
+    out.tile_normal = v.tile_normal;
+    out.tint_density = v.tint_density;
+    return out;
+}
+
+@fragment
+fn fs_pool_opacity_uvs(in: PoolShellUvVaryings) -> @location(0) vec4<f32> {
+    object = objects[in.member].object;
+    return opacity_uvs(ShellUvVaryings(in.clip_position, in.lighting, in.fade_blend_layer, in.uvs));
+}
+
+@fragment
+fn fs_pool_opacity_tiles(in: PoolShellTileVaryings) -> @location(0) vec4<f32> {
+    object = objects[in.member].object;
+    return opacity_tiles(ShellTileVaryings(in.clip_position, in.lighting, in.fade_blend_layer, in.tile_position, in.tile_normal));
+}
+
+@fragment
+fn fs_pool_opacity_uvs_groomed(in: PoolGroomedShellUvVaryings) -> @location(0) vec4<f32> {
+    object = objects[in.member].object;
+    let shell = GroomedShellUvVaryings(in.clip_position, in.lighting, in.fade_blend_layer, in.uvs, in.tint_density);
+    return opacity_uvs_groomed(shell);
+}
+
+@fragment
+fn fs_pool_opacity_tiles_groomed(in: PoolGroomedShellTileVaryings) -> @location(0) vec4<f32> {
+    object = objects[in.member].object;
+    let shell = GroomedShellTileVaryings(in.clip_position, in.lighting, in.fade_blend_layer, in.tile_position, in.tile_normal, in.tint_density);
+    return opacity_tiles_groomed(shell);
+}
