@@ -13,7 +13,7 @@ use crate::geometry::{Furred, SharedGeometry, UnifiedGeometry};
 use crate::listing::{FinList, ShellList};
 use crate::lod::PreparedLevel;
 use crate::object::{FurFrame, GpuBytes};
-use crate::pool::{LIST_FINS, LIST_SHELLS, MemberPool, SHOWS_COAT};
+use crate::pool::{LIST_FINS, LIST_SHELLS, MemberPool};
 use crate::requirements::ErrorScope;
 use crate::shaders::Layouts;
 use crate::textures::GpuTextures;
@@ -254,8 +254,7 @@ impl GpuFur {
         self.level.set(frame.level, self.geometry.shape.layers);
         // What the listing passes list of it this frame, should they be recorded.
         let uniform = self.geometry.shape.uniform(&frame, skin, textures);
-        let shows_coat = if self.level.coat_shown() { SHOWS_COAT } else { 0 };
-        self.geometry.write_uniform(queue, &uniform, self.lists() | shows_coat);
+        self.geometry.write_uniform(queue, &uniform, self.lists());
         self.wet.store(frame.wet, Ordering::Relaxed);
         self.fur_model.store(frame.look.shading.fur_model, Ordering::Relaxed);
         if let Some(list) = self.shell_list() {

@@ -346,8 +346,7 @@ impl UnifiedGeometry {
     }
 
     /// Writes the object uniform, with where the listing passes find this copy in its pool and
-    /// what they list of it this frame (`lists`: `pool::LIST_FINS`, `pool::LIST_SHELLS`, and
-    /// `pool::SHOWS_COAT` for the pooled shadow casters).
+    /// what they list of it this frame (`lists`: `pool::LIST_FINS`, `pool::LIST_SHELLS`).
     pub fn write_uniform(&self, queue: &wgpu::Queue, uniform: &ObjectUniform, lists: u32) {
         let states = (self.current, (self.current + 1) % self.state_count());
         let uniform = ObjectUniform { pool: self.pool.object_pool_field(self.slot, states, lists), ..*uniform };

@@ -28,9 +28,6 @@ pub const POSITIONS_USAGE: wgpu::BufferUsages = wgpu::BufferUsages::STORAGE
 /// `object_pool.wgsl`).
 pub(crate) const LIST_FINS: u32 = 1;
 pub(crate) const LIST_SHELLS: u32 = 2;
-/// Beside them: the copy's coat shows, so it casts fur shadows (`SHOWS_COAT` in
-/// `pool_draws.wgsl`).
-pub(crate) const SHOWS_COAT: u32 = 4;
 
 /// What every copy of a pool shares and its draws read: the mesh's shape, topology, wedge uvs
 /// and groom attributes.
@@ -236,7 +233,7 @@ impl MemberPool {
 
     /// Slot `slot`'s `pool` field of its object (`Object::pool` in `shading.wgsl`): where its
     /// `current` and `previous` states and its normals start in the pool's buffers, in `u32`s,
-    /// and `lists` ([`LIST_FINS`], [`LIST_SHELLS`], [`SHOWS_COAT`]).
+    /// and `lists` ([`LIST_FINS`], [`LIST_SHELLS`]).
     pub fn object_pool_field(&self, slot: u32, (current, previous): (usize, usize), lists: u32) -> [u32; 4] {
         let words = |slice: wgpu::BufferSlice<'_>| u32::try_from(slice.offset() / 4).unwrap_or(u32::MAX);
         [words(self.state(slot, current)), words(self.state(slot, previous)), words(self.normals(slot)), lists]

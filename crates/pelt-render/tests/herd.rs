@@ -372,13 +372,17 @@ fn copies_made_together_list_in_one_dispatch_each_as_each_alone() {
     assert_eq!(herd_picture, rig.render_silhouettes(&listed_alone, &camera, &settings(), false));
 }
 
-/// Through a shadow map, three copies made together cast in one draw a pass where three copies
-/// made alone take a draw each, and the shadows are the same: the picture of the ground and the
-/// copies, each posed and placed its own way, one drawing every fourth shell (two opacity
-/// shells of its own, not four) and one faded to its skin (casting no fur), has the same bytes.
+/// Through a shadow map, copies made together cast in one draw a pass where copies made alone
+/// take a draw each, and the shadows are the same: the picture of the ground and four copies,
+/// each posed and placed its own way, has the same bytes. Two draw every shell (one of them
+/// fading its coat) and cast together in every pass; one draws every fourth shell (two opacity shells, not four: it casts
+/// its opacity alone) and one has faded to its skin (no fur to cast).
 #[test]
 fn copies_made_together_cast_in_one_draw_a_pass_as_each_alone() {
-    let rig = Rig::new(192, 144);
+    let mut rig = Rig::new(192, 144);
+    let on_cpu = rig.device().adapter_info().device_type == wgpu::DeviceType::Cpu;
+    assert_eq!(rig.renderer.pooled_casting(), !on_cpu, "a GPU pools the casters, a CPU rasteriser casts each alone");
+    rig.renderer.set_pooled_casting(true);
     let structure = builtin_fur(Builtin::Bunny, 8);
     let mut textures = strand_textures(32, 8, BROWN_ROOT, BROWN_TIP);
     // Strands up to the outermost shell, which a coat thinned to fewer shells than the opacity
@@ -388,13 +392,15 @@ fn copies_made_together_cast_in_one_draw_a_pass_as_each_alone() {
     textures.shell[7 * slice..].copy_from_slice(&below);
     let asset = FurAsset::new(rig.device(), rig.queue(), &rig.renderer, &structure, &textures).expect("asset");
     let (device, renderer) = (rig.device(), &rig.renderer);
-    let herd = GpuFur::herd_from_asset(device, renderer, &asset, FurStates::Two, 3).expect("herd");
+    let herd = GpuFur::herd_from_asset(device, renderer, &asset, FurStates::Two, 4).expect("herd");
     let alone: Vec<GpuFur> =
-        (0..3).map(|_| GpuFur::from_asset(device, renderer, &asset, FurStates::Two).expect("copy")).collect();
+        (0..4).map(|_| GpuFur::from_asset(device, renderer, &asset, FurStates::Two).expect("copy")).collect();
     let (centre, radius) = structure.mesh.bounding_sphere();
     let v = structure.mesh.vertex_count();
+    // Copy 1's coat fading (its opacity fragments read its own `coat_fade`).
     let levels = [
         pelt_render::FurLevel::FULL,
+        pelt_render::FurLevel { coat: 0.6, ..pelt_render::FurLevel::FULL },
         pelt_render::FurLevel { stride: 4, ..pelt_render::FurLevel::FULL },
         pelt_render::FurLevel { coat: 0.0, ..pelt_render::FurLevel::FULL },
     ];
@@ -413,11 +419,11 @@ fn copies_made_together_cast_in_one_draw_a_pass_as_each_alone() {
             fur.prepare(rig.queue(), &frame);
         }
     }
-    assert_eq!(herd[1].drawn_shells(), 2, "copy 1 draws two shells");
+    assert_eq!(herd[2].drawn_shells(), 2, "copy 2 draws two shells");
     let floor = rig.plain(&pelt_render::ground_mesh(), Vec3::splat(0.6));
-    let below = glam::Mat4::from_translation(Vec3::new(2.2 * radius, -radius, 0.0));
-    floor.prepare(rig.queue(), below * glam::Mat4::from_scale(Vec3::splat(6.0 * radius)));
-    let scene = (Vec3::new(2.2 * radius, 0.0, 0.0), 4.0 * radius);
+    let below = glam::Mat4::from_translation(Vec3::new(3.3 * radius, -radius, 0.0));
+    floor.prepare(rig.queue(), below * glam::Mat4::from_scale(Vec3::splat(7.0 * radius)));
+    let scene = (Vec3::new(3.3 * radius, 0.0, 0.0), 5.0 * radius);
     // Seen from high above, the long shadows of a low light across the ground and the copies.
     let camera = pelt_render::Camera::framing(scene.0, scene.1, 20.0, 60.0, 192.0 / 144.0);
     let light = pelt_render::Light::default();
@@ -457,8 +463,8 @@ fn copies_made_together_cast_in_one_draw_a_pass_as_each_alone() {
     let (herd_picture, herd_draws) = picture(&herd, true);
     let (alone_picture, alone_draws) = picture(&alone, false);
     herd_picture.save(common::out_dir().join("herd-shadows.png")).expect("save");
-    // The opaque pass draws every skin, the fur's passes the two coats that show.
-    assert_eq!(alone_draws, [3, 2, 2], "copies alone: a draw each");
-    assert_eq!(herd_draws, [1, 1, 1], "copies made together: one draw a pass");
+    // The opaque pass draws every skin, the fur's passes the three coats that show.
+    assert_eq!(alone_draws, [4, 3, 3], "copies alone: a draw each");
+    assert_eq!(herd_draws, [1, 1, 2], "copies made together: one draw a pass, the thinned coat's opacity alone");
     assert!(herd_picture == alone_picture, "the herd's shadows differ from its copies' alone");
 }

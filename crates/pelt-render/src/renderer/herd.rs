@@ -1,22 +1,25 @@
 //! A herd's draws: through a shadow view, the copies made together (consecutive slots of one
 //! pool) cast in one draw a pass (`pool_draws.wgsl`: the instance names the slot), so the shadow
 //! maps' draws do not grow with the herd; through the camera each copy draws as a lone fur
-//! (blending needs each copy's shells in order, farthest copy first).
+//! (blending needs each copy's shells in order, farthest copy first). A CPU rasteriser casts
+//! each copy alone: it reads a copy's object from storage lane by lane at every vertex, which
+//! costs it more than the draws save (a GPU pays per draw).
 
 use std::sync::Arc;
 
 use super::FurRenderer;
-use super::shadow::OPACITY_SHELLS;
+use super::shadow::{OPACITY_SHELLS, opacity_shells};
 use crate::fur::GpuFur;
 use crate::renderer::FurDrawSettings;
 use crate::view::{FurView, ShadowPass, ViewRole};
 
 impl FurRenderer {
     /// [`FurRenderer::draw`] for every fur of `furs` (a herd's members), in that order. Through a
-    /// [`crate::ShadowMap`]'s views, each run of copies made together
-    /// ([`crate::FurDriver::herd_with_asset`], [`GpuFur::herd_from_asset`]) that follow one
-    /// another in their pool casts in one draw a pass: a wet copy, or one with textures of its
-    /// own, casts its coat alone. Returns the draws recorded.
+    /// [`crate::ShadowMap`]'s views, with [`FurRenderer::pooled_casting`], each run of copies
+    /// made together ([`crate::FurDriver::herd_with_asset`], [`GpuFur::herd_from_asset`]) that
+    /// follow one another in their pool casts in one draw a pass: a wet copy, one with textures
+    /// of its own, one whose coat is hidden or casts fewer than four opacity shells casts its
+    /// coat alone. Returns the draws recorded.
     pub fn draw_herd<'a>(
         &self,
         pass: &mut wgpu::RenderPass<'_>,
@@ -24,8 +27,9 @@ impl FurRenderer {
         furs: impl IntoIterator<Item = &'a GpuFur>,
         settings: &FurDrawSettings,
     ) -> usize {
-        let ViewRole::Shadow(shadow_pass) = view.role() else {
-            return furs.into_iter().map(|fur| self.draw_counted(pass, view, fur, settings)).sum();
+        let shadow_pass = match view.role() {
+            ViewRole::Shadow(shadow_pass) if self.pooled_casting => shadow_pass,
+            _ => return furs.into_iter().map(|fur| self.draw_counted(pass, view, fur, settings)).sum(),
         };
         let furs: Vec<&GpuFur> = furs.into_iter().collect();
         let mut draws = 0;
@@ -44,8 +48,21 @@ impl FurRenderer {
         draws
     }
 
-    /// A run of copies in consecutive slots of one pool in one pass of a shadow map: one draw,
-    /// each copy's vertices deciding from its own object what it casts (as `draw_shadow` does).
+    /// Whether [`FurRenderer::draw_herd`] casts the copies made together in one draw a shadow
+    /// pass: by default on a GPU, not on a CPU rasteriser (`wgpu::DeviceType::Cpu`), where it is
+    /// slower.
+    #[must_use]
+    pub fn pooled_casting(&self) -> bool {
+        self.pooled_casting
+    }
+
+    /// Sets [`FurRenderer::pooled_casting`]; the pictures are the same either way.
+    pub fn set_pooled_casting(&mut self, pooled: bool) {
+        self.pooled_casting = pooled;
+    }
+
+    /// A run of copies in consecutive slots of one pool in one pass of a shadow map
+    /// ([`cast_together`]): one draw of what each would draw alone.
     fn draw_pool_shadow(
         &self,
         pass: &mut wgpu::RenderPass<'_>,
@@ -57,10 +74,9 @@ impl FurRenderer {
         let geometry = first.geometry();
         let walk = usize::from(!geometry.shape.has_uvs);
         let slots = first.slot()..first.slot() + run.len() as u32;
-        let furred = geometry.shape.layers > 0 && (settings.shells || settings.fins);
         let draws = match shadow_pass {
             ShadowPass::Opaque => settings.skin,
-            ShadowPass::FurDepth | ShadowPass::Opacity => furred,
+            ShadowPass::FurDepth | ShadowPass::Opacity => settings.shells || settings.fins,
         };
         if !draws {
             return 0;
@@ -88,17 +104,29 @@ impl FurRenderer {
 }
 
 /// Whether `next` casts in the same draw as `previous` in `shadow_pass`: the next slot of the
-/// same pool; for the opacity pass (the only one reading the coat) also the same textures and
-/// groom shading, both dry (the pool binds no copy's wetness).
+/// same pool; for the fur's passes both casting a coat (shown, with shells), so a hidden one
+/// costs no vertex; for the opacity pass (the only one reading the coat) also four opacity
+/// shells each (the instances' stride), the same textures and groom shading, and both dry (the
+/// pool binds no copy's wetness). The others draw alone.
 fn cast_together(shadow_pass: ShadowPass, previous: &GpuFur, next: &GpuFur) -> bool {
     let follows = Arc::ptr_eq(previous.pool(), next.pool()) && next.slot() == previous.slot() + 1;
-    if shadow_pass != ShadowPass::Opacity {
-        return follows;
+    let casts =
+        |fur: &GpuFur| fur.geometry().shape.layers > 0 && fur.drawn_shells() > 0 && fur.prepared_level().coat_shown();
+    let four = |fur: &GpuFur| opacity_shells(fur.drawn_shells()) == OPACITY_SHELLS;
+    match shadow_pass {
+        ShadowPass::Opaque => follows,
+        ShadowPass::FurDepth => follows && casts(previous) && casts(next),
+        ShadowPass::Opacity => {
+            let (a, b) = (previous.coat(), next.coat());
+            follows
+                && casts(previous)
+                && casts(next)
+                && four(previous)
+                && four(next)
+                && !a.wet
+                && !b.wet
+                && a.groomed == b.groomed
+                && previous.textures_bind_group() == next.textures_bind_group()
+        }
     }
-    let (a, b) = (previous.coat(), next.coat());
-    follows
-        && !a.wet
-        && !b.wet
-        && a.groomed == b.groomed
-        && previous.textures_bind_group() == next.textures_bind_group()
 }

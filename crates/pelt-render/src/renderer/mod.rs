@@ -190,6 +190,8 @@ pub struct FurRenderer {
     listing: ListingPasses,
     /// The GPU simulation's kernels, compiled when a fur first simulates on the GPU.
     simulation: OnceLock<SimPipelines>,
+    /// Whether [`FurRenderer::draw_herd`] pools a herd's shadow casters.
+    pooled_casting: bool,
 }
 
 impl FurRenderer {
@@ -230,6 +232,7 @@ impl FurRenderer {
             shadows: shadow::ShadowSet::default(),
             listing,
             simulation: OnceLock::new(),
+            pooled_casting: device.adapter_info().device_type != wgpu::DeviceType::Cpu,
         })
     }
 

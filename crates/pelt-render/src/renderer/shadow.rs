@@ -42,6 +42,12 @@ pub(super) struct OpacityPipelines {
 /// for each of the map's opacity layers.
 pub(super) const OPACITY_SHELLS: u32 = 4;
 
+/// The opacity shells a coat of `shells` drawn shells casts: each the middle of a run of
+/// `shells / OPACITY_SHELLS` (rounded up), as `opacity_shell` in `unified.wgsl` picks them.
+pub(super) fn opacity_shells(shells: u32) -> u32 {
+    shells.div_ceil(shells.div_ceil(OPACITY_SHELLS).max(1))
+}
+
 /// The shadow pipelines, each built the first time a shadow map draws with it.
 #[derive(Debug, Default)]
 pub(super) struct ShadowSet {
@@ -228,7 +234,7 @@ impl FurRenderer {
             }
             ShadowPass::Opacity if furred => {
                 pass.set_pipeline(&self.opacity(fur.coat()).shells[walk]);
-                geometry.draw_shells(pass, 0..shells.div_ceil(shells.div_ceil(OPACITY_SHELLS)));
+                geometry.draw_shells(pass, 0..opacity_shells(shells));
             }
             _ => {}
         }

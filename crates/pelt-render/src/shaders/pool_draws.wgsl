@@ -3,15 +3,6 @@
 // copy), whose object the vertex loads before the unified structure's code runs as for a lone
 // fur. Appended to the pooled shading (`object_pool.wgsl`), `unified.wgsl` and `shadows.wgsl`.
 
-// A copy whose coat shows (`Object::pool.w`, beside the listing flags).
-const SHOWS_COAT = 4u;
-
-// Loads slot `member`'s object; whether its coat casts (shown, with shells to draw).
-fn load_caster(member: u32) -> bool {
-    object = objects[member].object;
-    return (object.pool.w & SHOWS_COAT) != 0u && object.lod_shells > 0u;
-}
-
 // The opaque pass: every copy's skin (instance = slot).
 @vertex
 fn vs_pool_skin_wedges(@builtin(vertex_index) wedge: u32, @builtin(instance_index) member: u32) -> Varyings {
@@ -25,36 +16,25 @@ fn vs_pool_skin_indexed(@builtin(vertex_index) vertex: u32, @builtin(instance_in
     return surface_varyings(vertex, 0u, 0u);
 }
 
-// The fur depth pass: every shown coat's outermost shell (instance = slot).
+// The fur depth pass: each copy's outermost shell (instance = slot; `draw_herd` pools only
+// copies whose coat shows).
 @vertex
 fn vs_pool_fur_depth_wedges(@builtin(vertex_index) wedge: u32, @builtin(instance_index) member: u32) -> ShellUvVaryings {
-    if !load_caster(member) {
-        var out: ShellUvVaryings;
-        out.clip_position = HIDDEN_FIN_CORNER;
-        return out;
-    }
+    object = objects[member].object;
     return shell_wedge(wedge, object.lod_shells - 1u);
 }
 
 @vertex
 fn vs_pool_fur_depth_indexed(@builtin(vertex_index) vertex: u32, @builtin(instance_index) member: u32) -> ShellTileVaryings {
-    if !load_caster(member) {
-        var out: ShellTileVaryings;
-        out.clip_position = HIDDEN_FIN_CORNER;
-        return out;
-    }
+    object = objects[member].object;
     return shell_vertex(vertex, object.lod_shells - 1u);
 }
 
 // The opacity pass: instance `OPACITY_SHELLS * slot + k` draws the copy's opacity shell k (as
-// `vs_opacity_shell_*`), or nothing past the copy's own count of them.
+// `vs_opacity_shell_*`; `draw_herd` pools only copies that draw all four).
 fn pool_opacity_shell(instance: u32) -> u32 {
-    if !load_caster(instance / OPACITY_SHELLS) {
-        return NO_FACE;
-    }
-    let k = instance % OPACITY_SHELLS;
-    let stride = opacity_stride();
-    return select(NO_FACE, opacity_shell(k), k < (object.lod_shells + stride - 1u) / stride);
+    object = objects[instance / OPACITY_SHELLS].object;
+    return opacity_shell(instance % OPACITY_SHELLS);
 }
 
 // The opacity shells' varyings with the copy's slot, whose object the fragment loads.
@@ -99,10 +79,6 @@ fn vs_pool_opacity_shell_wedges(@builtin(vertex_index) wedge: u32, @builtin(inst
     var out: PoolShellUvVaryings;
     out.member = instance / OPACITY_SHELLS;
     let shell = pool_opacity_shell(instance);
-    if shell == NO_FACE {
-        out.clip_position = HIDDEN_FIN_CORNER;
-        return out;
-    }
     let v = shell_wedge(wedge, shell);
     out.clip_position = v.clip_position;
     out.lighting = v.lighting;
@@ -116,10 +92,6 @@ fn vs_pool_opacity_shell_indexed(@builtin(vertex_index) vertex: u32, @builtin(in
     var out: PoolShellTileVaryings;
     out.member = instance / OPACITY_SHELLS;
     let shell = pool_opacity_shell(instance);
-    if shell == NO_FACE {
-        out.clip_position = HIDDEN_FIN_CORNER;
-        return out;
-    }
     let v = shell_vertex(vertex, shell);
     out.clip_position = v.clip_position;
     out.lighting = v.lighting;
@@ -134,10 +106,6 @@ fn vs_pool_opacity_shell_wedges_groomed(@builtin(vertex_index) wedge: u32, @buil
     var out: PoolGroomedShellUvVaryings;
     out.member = instance / OPACITY_SHELLS;
     let shell = pool_opacity_shell(instance);
-    if shell == NO_FACE {
-        out.clip_position = HIDDEN_FIN_CORNER;
-        return out;
-    }
     let v = groomed_shell_wedge(wedge, shell);
     out.clip_position = v.clip_position;
     out.lighting = v.lighting;
@@ -152,10 +120,6 @@ fn vs_pool_opacity_shell_indexed_groomed(@builtin(vertex_index) vertex: u32, @bu
     var out: PoolGroomedShellTileVaryings;
     out.member = instance / OPACITY_SHELLS;
     let shell = pool_opacity_shell(instance);
-    if shell == NO_FACE {
-        out.clip_position = HIDDEN_FIN_CORNER;
-        return out;
-    }
     let v = groomed_shell_vertex(vertex, shell);
     out.clip_position = v.clip_position;
     out.lighting = v.lighting;

@@ -27,6 +27,9 @@ pub struct HerdRow {
     pub foxes: usize,
     /// Where the strands bend: `cpu` or `gpu`.
     pub kernel: String,
+    /// Whether the shadow casters of the Foxes drew in one draw a shadow pass
+    /// (`FurRenderer::pooled_casting`: a GPU's default) or a draw each (a CPU rasteriser's).
+    pub pooled_casting: bool,
     /// `WIDTHxHEIGHT`, and the MSAA samples.
     pub size: String,
     pub msaa_samples: u32,
@@ -76,7 +79,7 @@ pub fn run(quick: bool, meshes: &Path, json: Option<&Path>, kernel: SimKernel) -
     let gpu = Gpu::new(Backend::Auto)?;
     // Lavapipe's single sample, as `pelt render` draws there (MSAA where a GPU is).
     let samples = pelt_render::default_sample_count(&gpu.adapter.get_info());
-    let (rows, adapter) = measure(gpu, meshes, counts, (SIZE, samples), frames, kernel)?;
+    let (rows, adapter) = measure(gpu, meshes, counts, (SIZE, samples), frames, (kernel, None))?;
     println!("{}", markdown(&rows, &adapter));
     if let Some(path) = json {
         let text = serde_json::to_string_pretty(&rows)? + "\n";
@@ -86,14 +89,15 @@ pub fn run(quick: bool, meshes: &Path, json: Option<&Path>, kernel: SimKernel) -
 }
 
 /// The rows for herds of `counts` Foxes at `size` with `samples` MSAA samples, `frames` timed
-/// frames each, on `gpu`, bending on `kernel`; and the adapter's summary.
+/// frames each, on `gpu`, bending on `kernel`, the shadow casters pooled as `pooled` says (`None`:
+/// the device's default); and the adapter's summary.
 pub fn measure(
     gpu: Gpu,
     meshes: &Path,
     counts: &[usize],
     (size, samples): ((u32, u32), u32),
     frames: u32,
-    kernel: SimKernel,
+    (kernel, pooled): (SimKernel, Option<bool>),
 ) -> anyhow::Result<(Vec<HerdRow>, String)> {
     let choice = KernelChoice::from(kernel);
     let path = meshes.join("Fox.glb");
@@ -107,7 +111,10 @@ pub fn measure(
     let target = FurTarget::new(HEADLESS_FORMAT).with_sample_count(samples);
     let headless = Headless::with_target(gpu, target, size.0, size.1)?;
     let (device, queue) = (&headless.gpu.device, &headless.gpu.queue);
-    let renderer = headless.renderer()?;
+    let mut renderer = headless.renderer()?;
+    if let Some(pooled) = pooled {
+        renderer.set_pooled_casting(pooled);
+    }
     let asset = FurAsset::new(device, queue, &renderer, &fur, &textures)?;
     let (low, high) = fur.mesh.bounds();
     let spacing = 1.5 * (high - low).max_element();
@@ -224,6 +231,7 @@ pub fn measure(
         rows.push(HerdRow {
             foxes,
             kernel: kernel.to_string().to_lowercase(),
+            pooled_casting: renderer.pooled_casting(),
             size: format!("{}x{}", size.0, size.1),
             msaa_samples: samples,
             frames,
@@ -287,11 +295,12 @@ fn time_posing(
 
 fn markdown(rows: &[HerdRow], adapter: &str) -> String {
     let mut out = format!(
-        "### A herd of walking Foxes ({}, {}x MSAA, 16 layers, shadows on a ground, bent on the {}; {adapter})\n\n\
+        "### A herd of walking Foxes ({}, {}x MSAA, 16 layers, shadows on a ground {}, bent on the {}; {adapter})\n\n\
          | Foxes | frame ms | simulation ms | record ms | GPU + readback ms | one more Fox adds (frame / record, ms) | GPU bytes (shared + per Fox) | allocated | posing every base, CPU / GPU ms |\n\
          |---:|---:|---:|---:|---:|---:|---:|---:|---:|\n",
         rows.first().map_or("", |r| r.size.as_str()),
         rows.first().map_or(1, |r| r.msaa_samples),
+        if rows.first().is_some_and(|r| r.pooled_casting) { "cast in one draw a pass" } else { "cast a Fox a draw" },
         rows.first().map_or_else(String::new, |r| r.kernel.to_uppercase()),
     );
     for (k, row) in rows.iter().enumerate() {
