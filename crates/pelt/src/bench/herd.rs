@@ -339,6 +339,7 @@ mod tests {
         let row = |foxes, frame_ms, record_ms| HerdRow {
             foxes,
             kernel: "cpu".to_owned(),
+            pooled_casting: false,
             size: "1280x720".to_owned(),
             msaa_samples: 1,
             frames: 1,
