@@ -180,7 +180,10 @@ fn slide(moving: Res<Moving>, mut furred: Query<&mut Transform, With<Furred>>) {
 fn prepass_app(taa: bool, step: f32, frames: u32) -> (App, Handle<Image>) {
     let readback = MotionReadback::default();
     let drawn = DrawnCopy::default();
-    let mut app = common::headless_app_with(&assets(), false, None, |app| {
+    // A frame is a thirtieth of a second of the fur's time whatever the machine's load: on real
+    // time, how far the strands step in the frame that is read follows the load.
+    let frame = std::time::Duration::from_secs_f64(1.0 / 30.0);
+    let mut app = common::headless_app_with(&assets(), false, Some(frame), |app| {
         app.sub_app_mut(RenderApp)
             .insert_resource(readback.clone())
             .insert_resource(drawn.clone())

@@ -49,8 +49,8 @@ impl FurRenderer {
     }
 
     /// Whether [`FurRenderer::draw_herd`] casts the copies made together in one draw a shadow
-    /// pass: by default on a GPU, not on a CPU rasteriser (`wgpu::DeviceType::Cpu`), where it is
-    /// slower.
+    /// pass: by default on a discrete or integrated GPU; not on a CPU rasteriser, where it is
+    /// slower, nor where the adapter does not say what it is (a browser's).
     #[must_use]
     pub fn pooled_casting(&self) -> bool {
         self.pooled_casting

@@ -232,7 +232,10 @@ impl FurRenderer {
             shadows: shadow::ShadowSet::default(),
             listing,
             simulation: OnceLock::new(),
-            pooled_casting: device.adapter_info().device_type != wgpu::DeviceType::Cpu,
+            pooled_casting: matches!(
+                device.adapter_info().device_type,
+                wgpu::DeviceType::DiscreteGpu | wgpu::DeviceType::IntegratedGpu
+            ),
         })
     }
 

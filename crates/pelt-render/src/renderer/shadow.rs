@@ -14,7 +14,7 @@ use crate::view::{FurView, ShadowLookups, ShadowPass};
 
 /// What a shadow pipeline writes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub(super) enum ShadowKind {
+enum ShadowKind {
     /// Depth only, biased against acne (the opaque map).
     Opaque,
     /// Depth only (the fur's first surface).
@@ -43,7 +43,8 @@ pub(super) struct OpacityPipelines {
 pub(super) const OPACITY_SHELLS: u32 = 4;
 
 /// The opacity shells a coat of `shells` drawn shells casts: each the middle of a run of
-/// `shells / OPACITY_SHELLS` (rounded up), as `opacity_shell` in `unified.wgsl` picks them.
+/// `shells / OPACITY_SHELLS` (rounded up), as `opacity_shell` in `unified.wgsl` picks them; none
+/// for a coat without shells.
 pub(super) fn opacity_shells(shells: u32) -> u32 {
     shells.div_ceil(shells.div_ceil(OPACITY_SHELLS).max(1))
 }
@@ -59,7 +60,7 @@ pub(super) struct ShadowSet {
     pub(super) pool: OnceLock<PoolCasters>,
 }
 
-pub(super) const WALKS: [(&str, bool); 2] = [("wedges", true), ("indexed", false)];
+const WALKS: [(&str, bool); 2] = [("wedges", true), ("indexed", false)];
 
 /// A pool's shadow pipelines, each drawing every copy of a run of slots at once: their own
 /// module (the shading over a pool) and layout (`Layouts::pool_draws`).
