@@ -165,7 +165,8 @@ pub use renderer::{FurDrawSettings, FurMotion, FurPrepass, FurRenderer, MotionDa
 pub use requirements::{check_adapter, required_downlevel_flags, required_features, required_limits};
 pub use shaders::{
     pool_draw_shader_source, prepass_shader_source, shadow_copy_shader_source, silhouette_shader_source,
-    simulation_shader_source, skinning_shader_source, unified_shader_source, view_lod_shader_source,
+    simulation_pooled_shader_source, simulation_shader_source, skinning_shader_source, unified_shader_source,
+    view_lod_shader_source,
 };
 #[cfg(feature = "lab")]
 pub use shaders::{separated_shader_source, strands_shader_source};

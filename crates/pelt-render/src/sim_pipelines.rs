@@ -4,13 +4,22 @@
 //!
 //! [`FurRenderer`]: crate::FurRenderer
 
+use std::sync::{Arc, OnceLock};
+
 use crate::RenderError;
 use crate::requirements::ErrorScope;
-use crate::shaders::simulation_shader_source;
+use crate::shaders::{simulation_pooled_shader_source, simulation_shader_source};
 
 /// Bytes of one step's uniform (`Step` in `simulation.wgsl`, `StepUniform` in `simulation`):
 /// the binding's size.
-pub(crate) const STEP_UNIFORM_BYTES: u64 = 14 * 16;
+pub(crate) const STEP_UNIFORM_BYTES: u64 = 15 * 16;
+
+/// `step_pooled` (`simulation_pooled.wgsl`): every copy of a pool stepping without contact.
+#[derive(Debug)]
+pub(crate) struct PooledStep {
+    pub(crate) pipeline: wgpu::ComputePipeline,
+    pub(crate) layout: wgpu::BindGroupLayout,
+}
 
 /// `simulation.wgsl`'s entry points, compiled for one device.
 #[derive(Clone, Debug)]
@@ -25,6 +34,8 @@ pub(crate) struct SimPipelines {
     /// colliders but no mesh's, and with both.
     pub(crate) solve: [wgpu::ComputePipeline; 3],
     pub(crate) layout: wgpu::BindGroupLayout,
+    /// Compiled when the first herd simulates on the GPU.
+    pooled: Arc<OnceLock<PooledStep>>,
 }
 
 impl SimPipelines {
@@ -35,16 +46,6 @@ impl SimPipelines {
             label: Some("pelt simulation"),
             source: wgpu::ShaderSource::Wgsl(simulation_shader_source().into()),
         });
-        let storage = |binding, read_only| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: wgpu::ShaderStages::COMPUTE,
-            ty: wgpu::BindingType::Buffer {
-                ty: wgpu::BufferBindingType::Storage { read_only },
-                has_dynamic_offset: false,
-                min_binding_size: None,
-            },
-            count: None,
-        };
         let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
             label: Some("pelt simulation"),
             entries: &[
@@ -93,8 +94,66 @@ impl SimPipelines {
             solve: [&[("COLLIDERS", 0.0), ("MESH_COLLIDERS", 0.0)][..], &[("MESH_COLLIDERS", 0.0)], &[]]
                 .map(|constants| compute_pipeline("solve_contact", constants)),
             layout,
+            pooled: Arc::default(),
         };
         scope.pop("building the GPU simulation's pipelines")?;
         Ok(pipelines)
+    }
+
+    /// The pooled step's kernel, once compiled.
+    pub(crate) fn pooled_built(&self) -> Option<&PooledStep> {
+        self.pooled.get()
+    }
+
+    /// The pooled step's kernel, compiled the first time.
+    pub(crate) fn pooled(&self, device: &wgpu::Device) -> Result<&PooledStep, RenderError> {
+        if let Some(pooled) = self.pooled.get() {
+            return Ok(pooled);
+        }
+        let scope = ErrorScope::push(device);
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("pelt simulation pooled"),
+            source: wgpu::ShaderSource::Wgsl(simulation_pooled_shader_source().into()),
+        });
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("pelt simulation pooled"),
+            entries: &[
+                storage(0, true),
+                storage(1, true),
+                storage(2, true),
+                storage(3, false),
+                storage(4, false),
+                storage(6, true),
+            ],
+        });
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("pelt simulation pooled"),
+            bind_group_layouts: &[Some(&layout)],
+            immediate_size: 0,
+        });
+        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some("step_pooled"),
+            layout: Some(&pipeline_layout),
+            module: &module,
+            entry_point: Some("step_pooled"),
+            compilation_options: wgpu::PipelineCompilationOptions::default(),
+            cache: None,
+        });
+        scope.pop("building the GPU simulation's pooled step")?;
+        Ok(self.pooled.get_or_init(|| PooledStep { pipeline, layout }))
+    }
+}
+
+/// A storage buffer the compute stage binds at `binding`.
+fn storage(binding: u32, read_only: bool) -> wgpu::BindGroupLayoutEntry {
+    wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::COMPUTE,
+        ty: wgpu::BindingType::Buffer {
+            ty: wgpu::BufferBindingType::Storage { read_only },
+            has_dynamic_offset: false,
+            min_binding_size: None,
+        },
+        count: None,
     }
 }

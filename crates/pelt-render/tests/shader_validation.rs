@@ -21,8 +21,12 @@ fn separated_module_validates() {
 #[test]
 fn simulation_module_validates() {
     validate(
-        "simulation_wind.wgsl + simulation.wgsl + simulation_inputs.wgsl + simulation_contact.wgsl",
+        "simulation_wind.wgsl + simulation.wgsl + simulation_inputs.wgsl + simulation_contact.wgsl + simulation_lone.wgsl",
         &pelt_render::simulation_shader_source(),
+    );
+    validate(
+        "simulation_wind.wgsl + simulation.wgsl + simulation_inputs.wgsl + simulation_contact.wgsl + simulation_pooled.wgsl",
+        &pelt_render::simulation_pooled_shader_source(),
     );
 }
 
@@ -57,6 +61,7 @@ fn every_wgsl_file_is_part_of_a_validated_module() {
         pelt_render::unified_shader_source(),
         pelt_render::separated_shader_source(),
         pelt_render::simulation_shader_source(),
+        pelt_render::simulation_pooled_shader_source(),
         pelt_render::silhouette_shader_source(),
         pelt_render::view_lod_shader_source(),
         pelt_render::pool_draw_shader_source(),
@@ -81,9 +86,9 @@ fn every_wgsl_file_is_part_of_a_validated_module() {
         }
     }
     assert_eq!(
-        checked, 19,
+        checked, 21,
         "shading, object_pool, pool_draws, wet, fur_bsdf, shadows, unified, prepass, separated, scan, silhouette, view_lod, \
-         simulation_wind, simulation, simulation_inputs, simulation_contact, strands, skinning and shadow_copy"
+         simulation_wind, simulation, simulation_inputs, simulation_contact, simulation_lone, simulation_pooled, strands, skinning and shadow_copy"
     );
 }
 

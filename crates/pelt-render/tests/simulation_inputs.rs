@@ -46,7 +46,7 @@ impl GpuInputs {
         let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor::default());
         self.simulation.dispatch(&mut encoder, &mut self.fur).expect("dispatch");
         queue.submit([encoder.finish()]);
-        let words = self.rig.read_u32s(self.simulation.strand_state().slice(..));
+        let words = self.rig.read_u32s(self.simulation.strand_state());
         let v = self.vertex_count;
         let vec4 = |i: usize| -> [f32; 4] { std::array::from_fn(|c| f32::from_bits(words[i * 4 + c])) };
         let weights = (0..v).map(|j| vec4(j)[3]).collect();

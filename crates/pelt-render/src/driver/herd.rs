@@ -1,5 +1,5 @@
-//! A herd's frame: every member advanced in one parallel pass, stepped on the GPU in shared
-//! compute passes, listed per view in one compute pass, and cast into each shadow pass in one
+//! A herd's frame: every member advanced in one parallel pass, stepped on the GPU in one
+//! dispatch a step, listed per view in one compute pass, and cast into each shadow pass in one
 //! draw.
 
 use pelt_core::sim::{FurStepper, HerdInstance};
@@ -68,8 +68,9 @@ impl FurDriver {
     }
 
     /// [`FurDriver::record`] for every driver of `drivers` (a herd's members): step by step,
-    /// the contact-free steps of every member on the GPU kernel share one compute pass, so a
-    /// step costs the herd one pass, not one a member. Returns the compute passes recorded.
+    /// the contact-free steps of every member on the GPU kernel share one compute pass, and those
+    /// of the members made together ([`FurDriver::herd_with_asset`]) one dispatch, so a step
+    /// costs a herd one dispatch, not one a member. Returns the compute dispatches recorded.
     ///
     /// # Errors
     /// As [`FurDriver::record`], checked for every member before anything is recorded.

@@ -10,6 +10,7 @@ mod timing;
 mod upload;
 
 use std::fmt;
+use std::sync::Arc;
 
 use pelt_core::FurStructure;
 use pelt_core::sim::{FurStepper, SimError, SimParams, Simulation};
@@ -23,8 +24,9 @@ use crate::asset::FurAsset;
 use crate::fur::{FurStates, GpuFur};
 use crate::lod::FurLevel;
 use crate::object::{FurFrame, FurLook};
+use crate::pool::MemberPool;
 use crate::renderer::{FurDrawSettings, FurRenderer};
-use crate::simulation::GpuSimulation;
+use crate::simulation::{GpuSimulation, SimPool};
 use crate::view::FurView;
 
 /// Where the strands are bent.
@@ -177,8 +179,20 @@ impl FurDriver {
         let furs = GpuFur::herd_from_asset(device, renderer, asset, states(kernel), count)?;
         // Copies grown as the asset share its GPU rest segments.
         let shared_rest = asset.grown_as(structure).then_some(&*asset.simulation_rest);
+        // On the GPU kernel the copies of each pool keep their per-strand buffers together too.
+        let mut sim_pools: Vec<(Arc<MemberPool>, Arc<SimPool>)> = Vec::new();
+        if kernel == SimKernel::Gpu {
+            for fur in &furs {
+                if !sim_pools.iter().any(|(pool, _)| Arc::ptr_eq(pool, fur.pool())) {
+                    let slots = furs.iter().filter(|other| Arc::ptr_eq(other.pool(), fur.pool())).count();
+                    let sim_pool = SimPool::new(device, structure.vertex_count(), slots as u32)?;
+                    sim_pools.push((fur.pool().clone(), Arc::new(sim_pool)));
+                }
+            }
+        }
         let mut drivers = Vec::with_capacity(furs.len());
         for fur in furs {
+            let sim_pool = sim_pools.iter().find(|(pool, _)| Arc::ptr_eq(pool, fur.pool())).map(|(_, sim)| sim.clone());
             let mut driver = Self {
                 fur,
                 gpu_simulation: None,
@@ -187,7 +201,7 @@ impl FurDriver {
                 frame: FurFrame::default(),
                 unrecorded: false,
             };
-            driver.use_kernel(device, renderer, structure, kernel, shared_rest)?;
+            driver.use_kernel(device, renderer, structure, kernel, (shared_rest, sim_pool.as_ref()))?;
             driver.fur.prepare(queue, &driver.frame);
             drivers.push(driver);
         }
@@ -232,7 +246,7 @@ impl FurDriver {
             return Ok(());
         }
         self.fur = GpuFur::new(device, queue, renderer, structure, textures, states(kernel))?;
-        self.use_kernel(device, renderer, structure, kernel, None)?;
+        self.use_kernel(device, renderer, structure, kernel, (None, None))?;
         self.fur.prepare(queue, &self.frame);
         Ok(())
     }
@@ -243,12 +257,12 @@ impl FurDriver {
         renderer: &FurRenderer,
         structure: &FurStructure,
         kernel: SimKernel,
-        shared_rest: Option<&std::sync::OnceLock<wgpu::Buffer>>,
+        shared: (Option<&std::sync::OnceLock<wgpu::Buffer>>, Option<&Arc<SimPool>>),
     ) -> Result<(), RenderError> {
         self.kernel = kernel;
         self.unrecorded = false;
         self.gpu_simulation = match kernel {
-            SimKernel::Gpu => Some(GpuSimulation::for_copy(device, renderer, &self.fur, structure, shared_rest)?),
+            SimKernel::Gpu => Some(GpuSimulation::for_copy(device, renderer, &self.fur, structure, shared)?),
             SimKernel::Cpu => None,
         };
         Ok(())
@@ -280,7 +294,7 @@ impl FurDriver {
     ) -> Result<(), RenderError> {
         self.fur.set_structure(device, renderer, structure)?;
         let kernel = self.kernel;
-        self.use_kernel(device, renderer, structure, kernel, None)?;
+        self.use_kernel(device, renderer, structure, kernel, (None, None))?;
         self.fur.prepare(queue, &self.frame);
         Ok(())
     }

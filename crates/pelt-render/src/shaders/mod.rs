@@ -52,6 +52,10 @@ const SIMULATION_WGSL: &str = include_str!("simulation.wgsl");
 const SIMULATION_INPUTS_WGSL: &str = include_str!("simulation_inputs.wgsl");
 /// Contact after the bend (skin, colliders, grasp), called by the simulation's step.
 const SIMULATION_CONTACT_WGSL: &str = include_str!("simulation_contact.wgsl");
+/// A fur's own step's bindings: its ranges, its step's uniform.
+const SIMULATION_LONE_WGSL: &str = include_str!("simulation_lone.wgsl");
+/// A pool's step: every copy stepping without contact in one dispatch.
+const SIMULATION_POOLED_WGSL: &str = include_str!("simulation_pooled.wgsl");
 /// A host's shadow map copied into one of Pelt's layers (`HostShadows`).
 const SHADOW_COPY_WGSL: &str = include_str!("shadow_copy.wgsl");
 /// Linear blend skinning of many instances (`GpuSkin`).
@@ -134,10 +138,24 @@ pub fn skinning_shader_source() -> String {
 }
 
 /// The WGSL module of the GPU simulation (`simulation_wind.wgsl`, `simulation.wgsl` and
-/// `simulation_inputs.wgsl` and `simulation_contact.wgsl`).
+/// `simulation_inputs.wgsl` and `simulation_contact.wgsl`) over a fur's own bindings
+/// (`simulation_lone.wgsl`).
 #[must_use]
 pub fn simulation_shader_source() -> String {
-    format!("{SIMULATION_WIND_WGSL}\n{SIMULATION_WGSL}\n{SIMULATION_INPUTS_WGSL}\n{SIMULATION_CONTACT_WGSL}")
+    simulation_module(SIMULATION_LONE_WGSL)
+}
+
+/// The WGSL module of a pool's step (`step_pooled`): the simulation's files over the pool's
+/// bindings.
+#[must_use]
+pub fn simulation_pooled_shader_source() -> String {
+    simulation_module(SIMULATION_POOLED_WGSL)
+}
+
+fn simulation_module(bindings: &str) -> String {
+    format!(
+        "{SIMULATION_WIND_WGSL}\n{SIMULATION_WGSL}\n{SIMULATION_INPUTS_WGSL}\n{SIMULATION_CONTACT_WGSL}\n{bindings}"
+    )
 }
 
 /// The WGSL module of the separated renderer (the shared shading plus `separated.wgsl`).

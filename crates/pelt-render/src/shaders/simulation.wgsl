@@ -3,9 +3,12 @@
 // `pelt_core::sim::bend` defines it, in the CPU kernel's two forms (the exact straight form,
 // the running quaternion for curved strands, O(L) both), written layer-major into the
 // shared vertex array the renderer draws from. Appended to `simulation_wind.wgsl`; the
-// per-strand inputs (`strands`, `strand_state`) are `simulation_inputs.wgsl`'s.
+// per-strand inputs are `simulation_inputs.wgsl`'s.
 
-// One step's inputs (a 256-byte slot of a uniform buffer, chosen by dynamic offset).
+// One step's inputs (a 256-byte slot of a uniform buffer, chosen by dynamic offset; a pooled
+// step's copied into its pool's array). The bindings are `simulation_lone.wgsl`'s (a fur's own
+// step) or `simulation_pooled.wgsl`'s (every copy of a pool in one dispatch), and every index
+// into a fur's own buffers adds `member_base`.
 struct Step {
     // xyz: gravity direction times strength.
     gravity: vec4<f32>,
@@ -38,19 +41,17 @@ struct Step {
     // x: the `InertiaStep` kind (`INERTIA_*`); y: 1 where the touch's weights are the CPU's
     // (in the field's w), 0 where the `weigh_touch` pass's.
     inertia_kind: vec4<u32>,
+    // Where the fur's ranges start in its pool's buffers (`member_base`, read by a pooled step
+    // only): x the state this step writes (f32s), y the strands (vec4s), z the strand state
+    // (vec4s), w the wet strands (vec2s).
+    pool: vec4<u32>,
 }
 
-@group(0) @binding(0) var<uniform> inputs: Step;
 // Rest segment k of strand j at k * V + j: unit direction (xyz, zero for a zero-length segment)
 // and length (w), as `sim/kernel.rs` keeps them. Then per strand j at L * V + j: the strand's unit
 // direction (xyz) and w = 1 where the CPU bends it by the straight form (`sim::straight_directions`),
 // 0 where by the running quaternion, so both kernels bend every strand the same way.
 @group(0) @binding(1) var<storage, read> rest_segments: array<vec4<f32>>;
-// The shared vertex array: NV[i * V + j] as packed xyz.
-@group(0) @binding(4) var<storage, read_write> positions: array<f32>;
-// Per strand, a wet strand's weight: x gravity's factor, y the mass on the inertial spring (both
-// 1 + added_weight * wetness; 1 when dry).
-@group(0) @binding(6) var<storage, read> wet_strands: array<vec2<f32>>;
 
 const PARALLEL_SINE: f32 = 1e-7;
 const WORKGROUP: u32 = 64u;
@@ -172,7 +173,7 @@ fn bend_strand(j: u32, screening: bool) {
     if touch > 0.0 {
         field_force = field_force * (1.0 - touch) + inputs.touch.xyz * touch;
     }
-    let force = inputs.gravity.xyz * wet_strands[j].x + field_force + inertial;
+    let force = inputs.gravity.xyz * wet_strands[member_base.w + j].x + field_force + inertial;
 
     // `bend::split_force`: unit direction and magnitude without overflow; a non-finite force
     // has neither.
@@ -189,9 +190,9 @@ fn bend_strand(j: u32, screening: bool) {
     // Equation 1's factor per remaining node (`sim/kernel.rs`'s `scale`).
     let scale = magnitude * inputs.travelled_fraction.w / stability;
 
-    positions[j * 3u] = root.x;
-    positions[j * 3u + 1u] = root.y;
-    positions[j * 3u + 2u] = root.z;
+    positions[member_base.x + j * 3u] = root.x;
+    positions[member_base.x + j * 3u + 1u] = root.y;
+    positions[member_base.x + j * 3u + 2u] = root.z;
     let straight = rest_segments[layers * v + j];
     if straight.w > 0.0 {
         bend_straight(j, v, layers, root, frame, straight.xyz, force_direction, scale, screening);
@@ -212,9 +213,9 @@ fn weight_of(scale: f32, remaining: u32) -> f32 {
 
 fn write_node(j: u32, v: u32, k: u32, node: vec3<f32>) {
     let index = (k * v + j) * 3u;
-    positions[index] = node.x;
-    positions[index + 1u] = node.y;
-    positions[index + 2u] = node.z;
+    positions[member_base.x + index] = node.x;
+    positions[member_base.x + index + 1u] = node.y;
+    positions[member_base.x + index + 2u] = node.z;
 }
 
 // `sim/kernel.rs`'s `bend_straight`: a strand whose rest segments all point along `rest_direction`

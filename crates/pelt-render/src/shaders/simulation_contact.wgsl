@@ -59,7 +59,7 @@ struct Closest {
 
 fn read_node(j: u32, v: u32, k: u32) -> vec3<f32> {
     let index = (k * v + j) * 3u;
-    return vec3<f32>(positions[index], positions[index + 1u], positions[index + 2u]);
+    return vec3<f32>(positions[member_base.x + index], positions[member_base.x + index + 1u], positions[member_base.x + index + 2u]);
 }
 
 fn conjugate(q: vec4<f32>) -> vec4<f32> {

@@ -2,16 +2,8 @@
 // to touch every strand: the resident inputs (posed roots, frames, stability, the user field:
 // written only when they change), the inertial force (pelt-core's `sim::inertia`, stepped here
 // from the step's shared numbers) and the touch's weights (`sim::field::Touch`, computed by the
-// `weigh_touch` pass when a touch begins). Appended after `simulation.wgsl`.
-
-// The resident inputs, in sections of V entries: strand j's posed root (xyz) and stability (w)
-// at j, its frame (the rotation of its rest frame, quaternion xyzw) at V + j, and the user
-// field (xyz) at 2 V + j, with the touch's weight (w) where the CPU's weights are uploaded.
-@group(0) @binding(2) var<storage, read> strands: array<vec4<f32>>;
-// What the GPU carries from step to step, in sections of V entries: the root at the last step
-// (xyz) and the touch's falloff weight (w, 0 outside it) at j, the root the step before at
-// V + j, the inertial force at 2 V + j and its rate of change at 3 V + j.
-@group(0) @binding(3) var<storage, read_write> strand_state: array<vec4<f32>>;
+// `weigh_touch` pass when a touch begins). Appended after `simulation.wgsl`; the
+// bindings are `simulation_lone.wgsl`'s or `simulation_pooled.wgsl`'s.
 
 // `InertiaStep`'s kinds, in `Step::inertia_kind.x`.
 const INERTIA_START: u32 = 0u;
@@ -22,47 +14,47 @@ const INERTIA_SPRING: u32 = 3u;
 const MAX_INERTIAL_FORCE: f32 = 10.0;
 
 fn strand_root(j: u32) -> vec4<f32> {
-    return strands[j];
+    return strands[member_base.y + j];
 }
 
 fn strand_frame(j: u32, v: u32) -> vec4<f32> {
-    return strands[v + j];
+    return strands[member_base.y + v + j];
 }
 
 fn user_field(j: u32, v: u32) -> vec3<f32> {
-    return strands[2u * v + j].xyz;
+    return strands[member_base.y + 2u * v + j].xyz;
 }
 
 // The touch's weight on strand j: the `weigh_touch` pass's, or the CPU's where the touch began
 // on roots no step used (`Step::inertia_kind.y` = 1).
 fn touch_weight(j: u32, v: u32) -> f32 {
     if inputs.inertia_kind.y == 1u {
-        return strands[2u * v + j].w;
+        return strands[member_base.y + 2u * v + j].w;
     }
-    return strand_state[j].w;
+    return strand_state[member_base.z + j].w;
 }
 
 // Strand j's inertial force at this step, its state advanced by the step's `InertiaStep`
 // (`Inertia::apply`, `SpringStep::force`) with its root now.
 fn inertial_force(j: u32, v: u32, root: vec3<f32>) -> vec3<f32> {
     let kind = inputs.inertia_kind.x;
-    let last = strand_state[j];
+    let last = strand_state[member_base.z + j];
     if kind == INERTIA_START {
-        strand_state[j] = vec4<f32>(root, last.w);
-        strand_state[v + j] = vec4<f32>(root, 0.0);
-        strand_state[2u * v + j] = vec4<f32>(0.0);
-        strand_state[3u * v + j] = vec4<f32>(0.0);
+        strand_state[member_base.z + j] = vec4<f32>(root, last.w);
+        strand_state[member_base.z + v + j] = vec4<f32>(root, 0.0);
+        strand_state[member_base.z + 2u * v + j] = vec4<f32>(0.0);
+        strand_state[member_base.z + 3u * v + j] = vec4<f32>(0.0);
         return vec3<f32>(0.0);
     }
-    let before = strand_state[v + j].xyz;
-    strand_state[j] = vec4<f32>(root, last.w);
-    strand_state[v + j] = vec4<f32>(last.xyz, 0.0);
+    let before = strand_state[member_base.z + v + j].xyz;
+    strand_state[member_base.z + j] = vec4<f32>(root, last.w);
+    strand_state[member_base.z + v + j] = vec4<f32>(last.xyz, 0.0);
     if kind == INERTIA_SHIFT_ZERO {
-        strand_state[2u * v + j] = vec4<f32>(0.0);
-        strand_state[3u * v + j] = vec4<f32>(0.0);
+        strand_state[member_base.z + 2u * v + j] = vec4<f32>(0.0);
+        strand_state[member_base.z + 3u * v + j] = vec4<f32>(0.0);
         return vec3<f32>(0.0);
     }
-    let force = strand_state[2u * v + j].xyz;
+    let force = strand_state[member_base.z + 2u * v + j].xyz;
     if kind != INERTIA_SPRING {
         return force;
     }
@@ -75,17 +67,17 @@ fn inertial_force(j: u32, v: u32, root: vec3<f32>) -> vec3<f32> {
         pull = MAX_INERTIAL_FORCE * (pull / sqrt(length_squared));
     }
     // A wet strand is heavier on the same spring (`SpringStep::heavier`).
-    let mass = wet_strands[j].y;
+    let mass = wet_strands[member_base.w + j].y;
     var stiffness_dt = inputs.inertia.w;
     var damp = inputs.inertia_damp.x;
     if mass > 1.0 {
         stiffness_dt = stiffness_dt / mass;
         damp = 1.0 / (1.0 + (1.0 / damp - 1.0) / sqrt(mass));
     }
-    let velocity = (strand_state[3u * v + j].xyz + (pull - force) * stiffness_dt) * damp;
+    let velocity = (strand_state[member_base.z + 3u * v + j].xyz + (pull - force) * stiffness_dt) * damp;
     let new_force = force + velocity * dt;
-    strand_state[2u * v + j] = vec4<f32>(new_force, 0.0);
-    strand_state[3u * v + j] = vec4<f32>(velocity, 0.0);
+    strand_state[member_base.z + 2u * v + j] = vec4<f32>(new_force, 0.0);
+    strand_state[member_base.z + 3u * v + j] = vec4<f32>(velocity, 0.0);
     return new_force;
 }
 
@@ -98,7 +90,7 @@ fn weigh_touch(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocatio
     if j >= v {
         return;
     }
-    let root = vec3<f32>(positions[j * 3u], positions[j * 3u + 1u], positions[j * 3u + 2u]);
+    let root = vec3<f32>(positions[member_base.x + j * 3u], positions[member_base.x + j * 3u + 1u], positions[member_base.x + j * 3u + 2u]);
     let distance = length(root - inputs.touch_centre.xyz) / inputs.touch_centre.w;
     // NaN compares false: no weight, as `falloff` gives.
     var weight = 0.0;
@@ -106,5 +98,5 @@ fn weigh_touch(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocatio
         let t = 1.0 - distance * distance;
         weight = t * t;
     }
-    strand_state[j].w = weight;
+    strand_state[member_base.z + j].w = weight;
 }

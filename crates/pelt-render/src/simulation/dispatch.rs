@@ -1,9 +1,11 @@
 //! Recording the prepared steps: one compute pass a step (a second, dispatched indirectly, for
-//! a step with contact), a herd's contact-free steps sharing one pass.
+//! a step with contact), a herd's contact-free steps sharing one pass, and the copies made
+//! together stepping in one dispatch.
 
-use super::{GpuSimulation, RING_SLOTS, STEP_SLOT_BYTES, solve_kernel};
+use super::{GpuSimulation, RING_SLOTS, STEP_SLOT_BYTES, SimPool, solve_kernel};
 use crate::RenderError;
 use crate::fur::GpuFur;
+use crate::sim_pipelines::PooledStep;
 
 impl GpuSimulation {
     /// Records the prepared steps into `encoder`: per step, [`GpuFur::swap_states`] and one
@@ -19,8 +21,10 @@ impl GpuSimulation {
 
     /// [`GpuSimulation::dispatch`] for every simulation of `members` (a herd's, each with its
     /// fur), step by step: each step's contact-free dispatches of every member share one compute
-    /// pass (each writes its own buffers only), a step with contact keeps its own passes. Returns
-    /// the compute passes recorded.
+    /// pass (each writes its own buffers only), and the members made together
+    /// ([`crate::FurDriver::herd_with_asset`]) that take it step in one dispatch (their steps
+    /// copied into their pool's array first); a step with contact keeps its own passes. Returns
+    /// the compute dispatches recorded.
     ///
     /// # Errors
     /// As [`GpuSimulation::dispatch`], checked for every member before anything is recorded.
@@ -34,9 +38,9 @@ impl GpuSimulation {
         for (simulation, fur) in &members {
             groups.push(simulation.state_groups(fur)?);
         }
-        let mut passes = 0;
+        let mut dispatches = 0;
         for ((simulation, _), &groups) in members.iter_mut().zip(&groups) {
-            passes += simulation.weigh_touch(encoder, groups);
+            dispatches += simulation.weigh_touch(encoder, groups);
         }
         let steps = members.iter().map(|(simulation, _)| simulation.pending.len()).max().unwrap_or(0);
         for slot in 0..steps {
@@ -55,12 +59,34 @@ impl GpuSimulation {
                     None => shared.push(k),
                 }
             }
+            let (pools, lone) = pool_runs(&members, &shared);
+            // Each pool's steps side by side in its array, in the order its run dispatches them.
+            for run in &pools {
+                for (i, &k) in run.members.iter().enumerate() {
+                    let simulation = &members[k].0;
+                    let (from, to) = (simulation.slot_offset(slot), i as u64 * STEP_SLOT_BYTES);
+                    encoder.copy_buffer_to_buffer(
+                        &simulation.step_uniforms,
+                        from,
+                        &run.pool.steps,
+                        to,
+                        STEP_SLOT_BYTES,
+                    );
+                }
+            }
             if !shared.is_empty() {
                 let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
                     label: Some("pelt simulation step"),
                     timestamp_writes: None,
                 });
-                for &k in &shared {
+                for run in &pools {
+                    let grid = members[run.members[0]].0.grid;
+                    pass.set_pipeline(&run.step.pipeline);
+                    pass.set_bind_group(0, run.bind_group, &[]);
+                    pass.dispatch_workgroups(grid[0], grid[1], run.members.len() as u32);
+                    dispatches += 1;
+                }
+                for &k in &lone {
                     let simulation = &members[k].0;
                     pass.set_pipeline(&simulation.pipelines.step);
                     pass.set_bind_group(
@@ -69,11 +95,11 @@ impl GpuSimulation {
                         &[simulation.slot_offset(slot) as u32],
                     );
                     pass.dispatch_workgroups(simulation.grid[0], simulation.grid[1], 1);
+                    dispatches += 1;
                 }
-                passes += 1;
             }
             for &k in &alone {
-                passes += members[k].0.contact_step(encoder, groups[k], slot);
+                dispatches += members[k].0.contact_step(encoder, groups[k], slot);
             }
         }
         for (simulation, _) in &mut members {
@@ -82,7 +108,13 @@ impl GpuSimulation {
             simulation.dispatched_history = simulation.pending_history;
             simulation.pending_contact.clear();
         }
-        Ok(passes)
+        Ok(dispatches)
+    }
+
+    /// The pooled step's kernel and bind group, when this fur steps with its pool.
+    fn pooled_step(&self, fur: &GpuFur) -> Option<(&PooledStep, &wgpu::BindGroup)> {
+        let bind_group = self.pool.pooled_group((&self.rest_segments, fur.current_positions().buffer()));
+        self.pipelines.pooled_built().zip(bind_group).filter(|_| self.pooled)
     }
 
     /// The bind groups of `fur`'s two states: the one step 0 writes, then the other.
@@ -108,7 +140,7 @@ impl GpuSimulation {
     }
 
     /// The touch's weights, once a touch began (its roots are those of the last step: the
-    /// state that is current now); the passes recorded.
+    /// state that is current now); the dispatches recorded.
     fn weigh_touch(&mut self, encoder: &mut wgpu::CommandEncoder, (_, after_next): (usize, usize)) -> usize {
         if !std::mem::take(&mut self.weigh_touch) || self.vertex_count == 0 {
             return 0;
@@ -124,7 +156,7 @@ impl GpuSimulation {
     }
 
     /// Pending step `slot` with contact: the step's pass listing the strands near something,
-    /// then the solve's, dispatched indirectly; the passes recorded.
+    /// then the solve's, dispatched indirectly; the dispatches recorded.
     fn contact_step(&self, encoder: &mut wgpu::CommandEncoder, groups: (usize, usize), slot: usize) -> usize {
         let Some(step) = self.pending_contact.get(slot) else { return 0 };
         let bind_group = self.step_group(groups, slot);
@@ -155,4 +187,34 @@ impl GpuSimulation {
     pub(super) fn slot_offset(&self, slot: usize) -> u64 {
         (self.ring + slot as u64) % RING_SLOTS * STEP_SLOT_BYTES
     }
+}
+
+/// Two or more copies of one pool stepping in one dispatch.
+struct PoolRun<'a> {
+    pool: &'a SimPool,
+    step: &'a PooledStep,
+    bind_group: &'a wgpu::BindGroup,
+    /// Indices into the members, in the order their steps are copied.
+    members: Vec<usize>,
+}
+
+/// `shared` (members stepping without contact) split into runs that step in one dispatch (two or
+/// more copies of one pool, in the order first met) and those that step alone.
+fn pool_runs<'a>(members: &'a [(&mut GpuSimulation, &mut GpuFur)], shared: &[usize]) -> (Vec<PoolRun<'a>>, Vec<usize>) {
+    let mut runs: Vec<PoolRun<'a>> = Vec::new();
+    let mut lone = Vec::new();
+    for &k in shared {
+        let (simulation, fur) = &members[k];
+        let Some((step, bind_group)) = simulation.pooled_step(fur) else {
+            lone.push(k);
+            continue;
+        };
+        match runs.iter_mut().find(|run| std::ptr::eq(run.pool, &*simulation.pool)) {
+            Some(run) => run.members.push(k),
+            None => runs.push(PoolRun { pool: &simulation.pool, step, bind_group, members: vec![k] }),
+        }
+    }
+    let (pooled, single): (Vec<_>, Vec<_>) = runs.into_iter().partition(|run| run.members.len() > 1);
+    lone.extend(single.into_iter().flat_map(|run| run.members));
+    (pooled, lone)
 }

@@ -32,11 +32,11 @@ impl GpuSimulation {
                     }),
                 },
                 wgpu::BindGroupEntry { binding: 1, resource: self.rest_segments.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 2, resource: self.strands.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 3, resource: self.state.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 2, resource: self.ranges[0].binding(&self.pool.strands) },
+                wgpu::BindGroupEntry { binding: 3, resource: self.ranges[1].binding(&self.pool.state) },
                 wgpu::BindGroupEntry { binding: 4, resource: crate::pool::binding(output) },
                 wgpu::BindGroupEntry { binding: 5, resource: self.contact.buffer.as_entire_binding() },
-                wgpu::BindGroupEntry { binding: 6, resource: self.wet.buffer.as_entire_binding() },
+                wgpu::BindGroupEntry { binding: 6, resource: self.ranges[2].binding(&self.pool.wet) },
                 wgpu::BindGroupEntry { binding: 7, resource: self.contact.fields_buffer.as_entire_binding() },
                 wgpu::BindGroupEntry { binding: 8, resource: self.contact.work.as_entire_binding() },
             ],
@@ -56,6 +56,7 @@ impl GpuSimulation {
         let versions = simulation.input_versions();
         let inputs = simulation.strand_inputs();
         let v = self.vertex_count as u64;
+        let (buffer, at) = (&self.pool.strands, self.ranges[0].at);
         let old = self.uploaded.filter(|(old, _)| old.id == versions.id);
         let changed =
             |version: fn(&InputVersions) -> u64| old.is_none_or(|(old, _)| version(&old) != version(&versions));
@@ -69,11 +70,11 @@ impl GpuSimulation {
                 .enumerate()
                 .map(|(j, root)| root.extend(inputs.stability_of(j)).to_array())
                 .collect();
-            queue.write_buffer(&self.strands, 0, bytemuck::cast_slice(&roots));
+            queue.write_buffer(buffer, at, bytemuck::cast_slice(&roots));
         }
         if changed(|x| x.base) {
             let frames: Vec<[f32; 4]> = inputs.frames.iter().map(|frame| frame.to_array()).collect();
-            queue.write_buffer(&self.strands, v * 16, bytemuck::cast_slice(&frames));
+            queue.write_buffer(buffer, at + v * 16, bytemuck::cast_slice(&frames));
         }
         let new_touch = changed(|x| x.touch) && simulation.touch().is_some();
         let touch_uploaded = if new_touch { !simulation.touch_began_on_step_roots() } else { self.touch_uploaded };
@@ -86,10 +87,10 @@ impl GpuSimulation {
                     field[j as usize][3] = weight;
                 }
             }
-            queue.write_buffer(&self.strands, 2 * v * 16, bytemuck::cast_slice(&field));
+            queue.write_buffer(buffer, at + 2 * v * 16, bytemuck::cast_slice(&field));
         }
         self.touch_uploaded = touch_uploaded;
         self.uploaded = Some((versions, inputs.stability));
-        self.wet.upload(queue, &inputs);
+        self.wet.upload(queue, (&self.pool.wet, self.ranges[2]), &inputs);
     }
 }

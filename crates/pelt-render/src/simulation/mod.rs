@@ -10,7 +10,7 @@
 //! (from the simulation's [`InertiaStep`]s and the roots) and the touch's weights (when a touch
 //! begins). Nothing is read back and the shared array never crosses the bus.
 
-use std::sync::OnceLock;
+use std::sync::{Arc, OnceLock};
 
 use pelt_core::FurStructure;
 use pelt_core::sim::{ContactStep, InputVersions, Simulation, kernel_rest};
@@ -21,11 +21,15 @@ use crate::fur::GpuFur;
 use crate::renderer::FurRenderer;
 use crate::requirements::{ErrorScope, check_size};
 use crate::sim_pipelines::SimPipelines;
+use pool::Range;
 
 mod dispatch;
 mod inputs;
+mod pool;
 mod step;
 mod wet;
+
+pub(crate) use pool::SimPool;
 
 use step::{STEP_SLOT_BYTES, StepUniform, settle_inertia, step_uniform};
 use wet::WetInputs;
@@ -76,8 +80,12 @@ pub struct GpuSimulation {
     rest_segments: wgpu::Buffer,
     /// The rest segments are the asset's, counted with it.
     rest_shared: bool,
-    strands: wgpu::Buffer,
-    state: wgpu::Buffer,
+    /// The buffers of the copies made with this fur (its own when it was made alone), and its
+    /// ranges there: strand inputs, strand state, wet strands.
+    pool: Arc<SimPool>,
+    ranges: [Range; 3],
+    /// Whether its steps without contact run in its pool's dispatch.
+    pooled: bool,
     wet: WetInputs,
     /// One bind group per shared-array state written so far (a fur has one or two), by its
     /// buffer and offset.
@@ -153,7 +161,7 @@ impl GpuSimulation {
     /// device refuses the compute pipeline (e.g. no compute shaders).
     pub fn new(device: &wgpu::Device, fur: &GpuFur, structure: &FurStructure) -> Result<Self, RenderError> {
         check_limits(&device.limits())?;
-        Self::with_pipelines(device, SimPipelines::new(device)?, fur, structure, None)
+        Self::with_pipelines(device, SimPipelines::new(device)?, fur, structure, (None, None))
     }
 
     /// [`GpuSimulation::new`] with the kernels `renderer` keeps for its device, compiled the
@@ -167,20 +175,22 @@ impl GpuSimulation {
         fur: &GpuFur,
         structure: &FurStructure,
     ) -> Result<Self, RenderError> {
-        Self::for_copy(device, renderer, fur, structure, None)
+        Self::for_copy(device, renderer, fur, structure, (None, None))
     }
 
     /// [`GpuSimulation::with_renderer`]; for a copy of a fur grown as its asset's structure the
-    /// rest segments are `shared_rest`'s, made by the first copy simulated on the GPU.
+    /// rest segments are `shared_rest`'s, made by the first copy simulated on the GPU. A copy
+    /// made with others keeps its per-strand buffers in their `pool` (at its [`GpuFur::slot`]),
+    /// and steps with them.
     pub(crate) fn for_copy(
         device: &wgpu::Device,
         renderer: &FurRenderer,
         fur: &GpuFur,
         structure: &FurStructure,
-        shared_rest: Option<&OnceLock<wgpu::Buffer>>,
+        shared: (Option<&OnceLock<wgpu::Buffer>>, Option<&Arc<SimPool>>),
     ) -> Result<Self, RenderError> {
         check_limits(&device.limits())?;
-        Self::with_pipelines(device, renderer.simulation_pipelines()?.clone(), fur, structure, shared_rest)
+        Self::with_pipelines(device, renderer.simulation_pipelines()?.clone(), fur, structure, shared)
     }
 
     /// Sets up the simulation with `pipelines`, the device's limits checked.
@@ -189,7 +199,7 @@ impl GpuSimulation {
         pipelines: SimPipelines,
         fur: &GpuFur,
         structure: &FurStructure,
-        shared_rest: Option<&OnceLock<wgpu::Buffer>>,
+        (shared_rest, pool): (Option<&OnceLock<wgpu::Buffer>>, Option<&Arc<SimPool>>),
     ) -> Result<Self, RenderError> {
         let (v, layers) = (structure.vertex_count(), structure.layers as usize);
         check_shape(fur, v, structure.layers)?;
@@ -226,18 +236,21 @@ impl GpuSimulation {
             rest.push([0.0; 4]);
         }
         check_size(device, "simulation rest segments", rest.len() as u64 * 16)?;
-        check_size(device, "simulation strand inputs", v.max(1) as u64 * STRAND_BYTES)?;
-        check_size(device, "simulation strand state", v.max(1) as u64 * STATE_BYTES)?;
 
+        // A copy outside its pool's slots (none is made so) keeps buffers of its own.
+        let (pool, slot) = match pool.filter(|pool| fur.slot() < pool.slots()) {
+            Some(pool) => (pool.clone(), fur.slot()),
+            None => (Arc::new(SimPool::new(device, v, 1)?), 0),
+        };
         let scope = ErrorScope::push(device);
         let buffer = |label, size: u64, usage| {
             device.create_buffer(&wgpu::BufferDescriptor { label: Some(label), size, usage, mapped_at_creation: false })
         };
-        let storage_usage = wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST;
+        // Copied from into a pooled step's array.
         let step_uniforms = buffer(
             "pelt simulation steps",
             STEP_SLOT_BYTES * RING_SLOTS,
-            wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC,
         );
         let make_rest = || {
             wgpu::util::DeviceExt::create_buffer_init(
@@ -253,31 +266,30 @@ impl GpuSimulation {
             Some(cell) => (cell.get_or_init(make_rest).clone(), true),
             None => (make_rest(), false),
         };
-        let strands = buffer("pelt simulation strands", v.max(1) as u64 * STRAND_BYTES, storage_usage);
-        // Read back by tests comparing it with the CPU's inputs.
-        let state = buffer(
-            "pelt simulation strand state",
-            v.max(1) as u64 * STATE_BYTES,
-            storage_usage | wgpu::BufferUsages::COPY_SRC,
-        );
         // The skin's planes and triangles come from the CPU simulation once it has found them
         // (skin contact on): a coat that never touches its skin never finds them.
         let skin = Skin::none(v);
         check_size(device, "simulation contact", GpuContact::bytes(&skin, 0))?;
         check_size(device, "simulation contact list", GpuContact::work_bytes(v))?;
         let contact = GpuContact::new(device, structure, &skin);
-        let wet = WetInputs::new(device, v);
         scope.pop("creating the GPU simulation")?;
+        let pooled = pool.slots() > 1
+            && pool.bind_pooled(
+                device,
+                pipelines.pooled(device)?,
+                (&rest_segments, fur.current_positions().buffer()),
+            )?;
         Ok(Self {
             pipelines,
             step_uniforms,
             rest_segments,
             rest_shared,
-            strands,
-            state,
+            ranges: pool.ranges(slot),
+            pool,
+            pooled,
             contact,
             pending_contact: Vec::with_capacity(STEP_SLOTS + 2),
-            wet,
+            wet: WetInputs::default(),
             bind_groups: Vec::new(),
             vertex_count: v as u32,
             layers: structure.layers,
@@ -388,9 +400,14 @@ impl GpuSimulation {
                 self.bind_group_for(device, buffer)?;
             }
         }
+        let written = [fur.previous_positions(), fur.current_positions()];
+        let [strands, state, wet] = self.ranges;
         for slot in 0..self.pending.len() {
             let ring_slot = (self.ring + slot as u64) % RING_SLOTS;
             self.pending[slot].grid[1] = ring_slot as u32;
+            // Step `slot` writes the state that is current after `slot + 1` swaps.
+            let positions = u32::try_from(written[slot % 2].offset() / 4).unwrap_or(u32::MAX);
+            self.pending[slot].pool = [positions, strands.first(16), state.first(16), wet.first(pool::WET_BYTES)];
             queue.write_buffer(&self.step_uniforms, self.slot_offset(slot), bytemuck::bytes_of(&self.pending[slot]));
             self.contact.write_slot(queue, ring_slot as usize, &self.pending_contact[slot]);
         }
@@ -401,8 +418,9 @@ impl GpuSimulation {
     /// inputs: `4 V` `vec4<f32>` in sections of `V`: the root at the last step (xyz) and the
     /// touch's weight (w), the root the step before, the inertial force, its rate of change.
     #[must_use]
-    pub fn strand_state(&self) -> &wgpu::Buffer {
-        &self.state
+    pub fn strand_state(&self) -> wgpu::BufferSlice<'_> {
+        let state = self.ranges[1];
+        self.pool.state.slice(state.at..state.at + state.size)
     }
 
     /// Steps prepared and not yet dispatched (0, 1 or 2).
@@ -412,25 +430,18 @@ impl GpuSimulation {
     }
 
     /// Bytes of this fur's own simulation buffers (step uniforms, rest segments unless its
-    /// asset's, inputs, state, contact, wetness); its kernels are the renderer's, shared.
+    /// asset's, contact, and its ranges of the inputs, state and wetness its pool holds); its
+    /// kernels are the renderer's, shared.
     #[must_use]
     pub fn gpu_bytes(&self) -> u64 {
         let contact = &self.contact;
         let own_rest = if self.rest_shared { 0 } else { self.rest_segments.size() };
         own_rest
-            + [
-                &self.step_uniforms,
-                &self.strands,
-                &self.state,
-                &contact.buffer,
-                &contact.fields_buffer,
-                &contact.work,
-                &contact.work_groups,
-                &self.wet.buffer,
-            ]
-            .iter()
-            .map(|buffer| buffer.size())
-            .sum::<u64>()
+            + self.pool.slot_bytes()
+            + [&self.step_uniforms, &contact.buffer, &contact.fields_buffer, &contact.work, &contact.work_groups]
+                .iter()
+                .map(|buffer| buffer.size())
+                .sum::<u64>()
     }
 
     /// Node updates per step: `V * L` (the bench's unit).

@@ -26,6 +26,9 @@ pub(super) struct StepUniform {
     inertia_damp: [f32; 4],
     /// x: the inertia's kind (`INERTIA_*`); y: 1 where the touch's weights are the CPU's.
     pub inertia_kind: [u32; 4],
+    /// Where the fur's ranges start in its pool's buffers, for a pooled step: the state the step
+    /// writes (f32s), the strands (vec4s), the strand state (vec4s), the wet strands (vec2s).
+    pub pool: [u32; 4],
 }
 
 /// `InertiaStep`'s kinds as `simulation_inputs.wgsl` numbers them.
@@ -96,6 +99,7 @@ pub(super) fn step_uniform(
             0,
             0,
         ],
+        pool: [0; 4],
     }
 }
 
@@ -149,7 +153,8 @@ mod mirror_tests {
             touch_centre,
             inertia,
             inertia_damp,
-            inertia_kind
+            inertia_kind,
+            pool
         });
         assert_mirrors(&simulation_shader_source(), "Step", &rust);
     }
