@@ -93,7 +93,13 @@ fn copies_on_the_gpu_kernel_share_the_rest_segments() {
 /// come out with the bytes each member's own dispatches give, each member bent its own way.
 #[test]
 fn a_herds_gpu_steps_take_one_dispatch_and_match_each_recorded_alone() {
-    let rig = Rig::new(64, 64);
+    let mut rig = Rig::new(64, 64);
+    let gpu = matches!(
+        rig.device().adapter_info().device_type,
+        wgpu::DeviceType::DiscreteGpu | wgpu::DeviceType::IntegratedGpu
+    );
+    assert_eq!(rig.renderer.pooled_stepping(), gpu, "a GPU pools the steps, a CPU rasteriser steps each alone");
+    rig.renderer.set_pooled_stepping(true);
     let structure = builtin_fur(Builtin::Bunny, 8);
     let textures = strand_textures(32, 8, BROWN_ROOT, BROWN_TIP);
     let asset = FurAsset::new(rig.device(), rig.queue(), &rig.renderer, &structure, &textures).expect("asset");

@@ -304,17 +304,20 @@ fn device_report_writes_every_part() {
     let herd = report["herd"].as_array().expect("herd");
     let sizes: Vec<_> = herd
         .iter()
-        .map(|r| (r["kernel"].as_str().unwrap(), r["foxes"].as_u64().unwrap(), r["pooled_casting"].as_bool().unwrap()))
+        .map(|r| {
+            let pooled = [r["pooled_casting"].as_bool().unwrap(), r["pooled_stepping"].as_bool().unwrap()];
+            (r["kernel"].as_str().unwrap(), r["foxes"].as_u64().unwrap(), pooled)
+        })
         .collect();
-    // The CPU kernel's herds with the shadow casters pooled and not, then the GPU kernel's with
-    // the device's default (lavapipe: a draw a Fox).
-    let expected = [("cpu", 1, true), ("cpu", 10, true), ("cpu", 1, false), ("cpu", 10, false)];
+    // Each kernel's herds pooled and not: the CPU kernel's, then the GPU kernel's.
+    let (on, off, cast) = ([true; 2], [false; 2], [true, false]);
+    let expected = [("cpu", 1, cast), ("cpu", 2, cast), ("cpu", 1, off), ("cpu", 2, off)];
     assert_eq!(sizes[..4], expected);
-    assert_eq!(sizes[4..], [("gpu", 1, false), ("gpu", 10, false)]);
+    assert_eq!(sizes[4..], [("gpu", 1, on), ("gpu", 2, on), ("gpu", 1, off), ("gpu", 2, off)]);
     herd.iter().for_each(|row| positive(&row["frame_ms"], "herd frame_ms"));
     // On the GPU kernel a Fox's own bytes add its second state and its simulation's buffers,
     // counted as the device's allocator counts them.
-    for (on_cpu, on_gpu) in herd[2..4].iter().zip(&herd[4..]) {
+    for (on_cpu, on_gpu) in herd[2..4].iter().zip(&herd[6..]) {
         assert!(count(on_gpu, "per_fox_gpu_bytes") > count(on_cpu, "per_fox_gpu_bytes"), "{on_cpu}\n{on_gpu}");
         let (total, allocated) = (count(on_gpu, "total_gpu_bytes"), count(on_gpu, "allocated_gpu_bytes"));
         assert!(

@@ -61,6 +61,21 @@ impl FurRenderer {
         self.pooled_casting = pooled;
     }
 
+    /// Whether the GPU simulations of copies made together
+    /// ([`crate::FurDriver::herd_with_asset`]) from now on step in one dispatch a step, not one a
+    /// copy ([`crate::FurDriver::record_herd`]): by default on a discrete or integrated GPU, as
+    /// [`FurRenderer::pooled_casting`].
+    #[must_use]
+    pub fn pooled_stepping(&self) -> bool {
+        self.pooled_stepping
+    }
+
+    /// Sets [`FurRenderer::pooled_stepping`] for the herds made after; the states are the same
+    /// bytes either way.
+    pub fn set_pooled_stepping(&mut self, pooled: bool) {
+        self.pooled_stepping = pooled;
+    }
+
     /// A run of copies in consecutive slots of one pool in one pass of a shadow map
     /// ([`cast_together`]): one draw of what each would draw alone.
     fn draw_pool_shadow(

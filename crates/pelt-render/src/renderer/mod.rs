@@ -192,6 +192,8 @@ pub struct FurRenderer {
     simulation: OnceLock<SimPipelines>,
     /// Whether [`FurRenderer::draw_herd`] pools a herd's shadow casters.
     pooled_casting: bool,
+    /// Whether a herd's GPU simulations made after this step each pool in one dispatch.
+    pooled_stepping: bool,
 }
 
 impl FurRenderer {
@@ -223,6 +225,12 @@ impl FurRenderer {
         let _ = coats[Coat::PLAIN.index()].set(coat_builder.build(&target, Coat::PLAIN));
         let listing = ListingPasses::new(device, &layouts);
         scope.pop("building the fur pipelines")?;
+        // Pooling pays on a GPU; on a CPU rasteriser every lane reads its copy's data from
+        // storage, and a dispatch a copy was as fast.
+        let gpu = matches!(
+            device.adapter_info().device_type,
+            wgpu::DeviceType::DiscreteGpu | wgpu::DeviceType::IntegratedGpu
+        );
         Ok(Self {
             target,
             layouts,
@@ -232,10 +240,8 @@ impl FurRenderer {
             shadows: shadow::ShadowSet::default(),
             listing,
             simulation: OnceLock::new(),
-            pooled_casting: matches!(
-                device.adapter_info().device_type,
-                wgpu::DeviceType::DiscreteGpu | wgpu::DeviceType::IntegratedGpu
-            ),
+            pooled_casting: gpu,
+            pooled_stepping: gpu,
         })
     }
 

@@ -161,7 +161,7 @@ impl GpuSimulation {
     /// device refuses the compute pipeline (e.g. no compute shaders).
     pub fn new(device: &wgpu::Device, fur: &GpuFur, structure: &FurStructure) -> Result<Self, RenderError> {
         check_limits(&device.limits())?;
-        Self::with_pipelines(device, SimPipelines::new(device)?, fur, structure, (None, None))
+        Self::with_pipelines(device, SimPipelines::new(device)?, fur, structure, (None, None), false)
     }
 
     /// [`GpuSimulation::new`] with the kernels `renderer` keeps for its device, compiled the
@@ -181,7 +181,7 @@ impl GpuSimulation {
     /// [`GpuSimulation::with_renderer`]; for a copy of a fur grown as its asset's structure the
     /// rest segments are `shared_rest`'s, made by the first copy simulated on the GPU. A copy
     /// made with others keeps its per-strand buffers in their `pool` (at its [`GpuFur::slot`]),
-    /// and steps with them.
+    /// and steps with them where the renderer pools ([`FurRenderer::pooled_stepping`]).
     pub(crate) fn for_copy(
         device: &wgpu::Device,
         renderer: &FurRenderer,
@@ -190,7 +190,8 @@ impl GpuSimulation {
         shared: (Option<&OnceLock<wgpu::Buffer>>, Option<&Arc<SimPool>>),
     ) -> Result<Self, RenderError> {
         check_limits(&device.limits())?;
-        Self::with_pipelines(device, renderer.simulation_pipelines()?.clone(), fur, structure, shared)
+        let pipelines = renderer.simulation_pipelines()?.clone();
+        Self::with_pipelines(device, pipelines, fur, structure, shared, renderer.pooled_stepping())
     }
 
     /// Sets up the simulation with `pipelines`, the device's limits checked.
@@ -200,6 +201,7 @@ impl GpuSimulation {
         fur: &GpuFur,
         structure: &FurStructure,
         (shared_rest, pool): (Option<&OnceLock<wgpu::Buffer>>, Option<&Arc<SimPool>>),
+        pooling: bool,
     ) -> Result<Self, RenderError> {
         let (v, layers) = (structure.vertex_count(), structure.layers as usize);
         check_shape(fur, v, structure.layers)?;
@@ -273,7 +275,8 @@ impl GpuSimulation {
         check_size(device, "simulation contact list", GpuContact::work_bytes(v))?;
         let contact = GpuContact::new(device, structure, &skin);
         scope.pop("creating the GPU simulation")?;
-        let pooled = pool.slots() > 1
+        let pooled = pooling
+            && pool.slots() > 1
             && pool.bind_pooled(
                 device,
                 pipelines.pooled(device)?,

@@ -30,6 +30,9 @@ pub struct HerdRow {
     /// Whether the shadow casters of the Foxes drew in one draw a shadow pass
     /// (`FurRenderer::pooled_casting`: a GPU's default) or a draw each (a CPU rasteriser's).
     pub pooled_casting: bool,
+    /// Whether on the GPU kernel the Foxes stepped in one dispatch a step
+    /// (`FurRenderer::pooled_stepping`: a GPU's default) or a dispatch each.
+    pub pooled_stepping: bool,
     /// `WIDTHxHEIGHT`, and the MSAA samples.
     pub size: String,
     pub msaa_samples: u32,
@@ -89,8 +92,8 @@ pub fn run(quick: bool, meshes: &Path, json: Option<&Path>, kernel: SimKernel) -
 }
 
 /// The rows for herds of `counts` Foxes at `size` with `samples` MSAA samples, `frames` timed
-/// frames each, on `gpu`, bending on `kernel`, the shadow casters pooled as `pooled` says (`None`:
-/// the device's default); and the adapter's summary.
+/// frames each, on `gpu`, bending on `kernel`, the shadow casters and the GPU kernel's steps
+/// pooled as `pooled` says (`None`: the device's default); and the adapter's summary.
 pub fn measure(
     gpu: Gpu,
     meshes: &Path,
@@ -114,6 +117,7 @@ pub fn measure(
     let mut renderer = headless.renderer()?;
     if let Some(pooled) = pooled {
         renderer.set_pooled_casting(pooled);
+        renderer.set_pooled_stepping(pooled);
     }
     let asset = FurAsset::new(device, queue, &renderer, &fur, &textures)?;
     let (low, high) = fur.mesh.bounds();
@@ -232,6 +236,7 @@ pub fn measure(
             foxes,
             kernel: kernel.to_string().to_lowercase(),
             pooled_casting: renderer.pooled_casting(),
+            pooled_stepping: kernel == SimKernel::Gpu && renderer.pooled_stepping(),
             size: format!("{}x{}", size.0, size.1),
             msaa_samples: samples,
             frames,
@@ -301,7 +306,11 @@ fn markdown(rows: &[HerdRow], adapter: &str) -> String {
         rows.first().map_or("", |r| r.size.as_str()),
         rows.first().map_or(1, |r| r.msaa_samples),
         if rows.first().is_some_and(|r| r.pooled_casting) { "cast in one draw a pass" } else { "cast a Fox a draw" },
-        rows.first().map_or_else(String::new, |r| r.kernel.to_uppercase()),
+        match rows.first() {
+            Some(r) if r.kernel == "gpu" && r.pooled_stepping => "GPU in one dispatch a step".to_owned(),
+            Some(r) => r.kernel.to_uppercase(),
+            None => String::new(),
+        },
     );
     for (k, row) in rows.iter().enumerate() {
         let more = match k.checked_sub(1).map(|p| &rows[p]) {
@@ -340,6 +349,7 @@ mod tests {
             foxes,
             kernel: "cpu".to_owned(),
             pooled_casting: false,
+            pooled_stepping: false,
             size: "1280x720".to_owned(),
             msaa_samples: 1,
             frames: 1,
