@@ -89,15 +89,17 @@ fn copies_on_the_gpu_kernel_share_the_rest_segments() {
     assert_eq!(drivers[10].simulation_bytes(), drivers[0].simulation_bytes() + rest);
 }
 
+/// Whether the rig's adapter is a discrete or integrated GPU (where a herd pools by default).
+fn is_gpu(rig: &Rig) -> bool {
+    matches!(rig.device().adapter_info().device_type, wgpu::DeviceType::DiscreteGpu | wgpu::DeviceType::IntegratedGpu)
+}
+
 /// A herd made together on the GPU kernel steps every member in one dispatch a step: the states
 /// come out with the bytes each member's own dispatches give, each member bent its own way.
 #[test]
 fn a_herds_gpu_steps_take_one_dispatch_and_match_each_recorded_alone() {
     let mut rig = Rig::new(64, 64);
-    let gpu = matches!(
-        rig.device().adapter_info().device_type,
-        wgpu::DeviceType::DiscreteGpu | wgpu::DeviceType::IntegratedGpu
-    );
+    let gpu = is_gpu(&rig);
     assert_eq!(rig.renderer.pooled_stepping(), gpu, "a GPU pools the steps, a CPU rasteriser steps each alone");
     rig.renderer.set_pooled_stepping(true);
     let structure = builtin_fur(Builtin::Bunny, 8);
@@ -415,10 +417,7 @@ fn copies_made_together_list_in_one_dispatch_each_as_each_alone() {
 #[test]
 fn copies_made_together_cast_in_one_draw_a_pass_as_each_alone() {
     let mut rig = Rig::new(192, 144);
-    let gpu = matches!(
-        rig.device().adapter_info().device_type,
-        wgpu::DeviceType::DiscreteGpu | wgpu::DeviceType::IntegratedGpu
-    );
+    let gpu = is_gpu(&rig);
     assert_eq!(rig.renderer.pooled_casting(), gpu, "a GPU pools the casters, a CPU rasteriser casts each alone");
     rig.renderer.set_pooled_casting(true);
     let structure = builtin_fur(Builtin::Bunny, 8);
