@@ -13,17 +13,8 @@ if [ -z "$pelt" ]; then
   cargo build -p pelt --locked
   pelt="$target/debug/pelt"
 fi
+bash .ci/usd/venv.sh
 venv="$target/usd-venv"
-if ! "$venv/bin/python" -c "import pxr.Usd" 2>/dev/null; then
-  if ! python3 -m venv --help >/dev/null 2>&1 || ! python3 -c "import ensurepip" 2>/dev/null; then
-    SUDO=""; [ "$(id -u)" -eq 0 ] || SUDO="sudo"
-    $SUDO apt-get update -qq
-    DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends python3-venv
-  fi
-  rm -rf "$venv"
-  python3 -m venv "$venv"
-  "$venv/bin/pip" install -q --disable-pip-version-check usd-core==26.11
-fi
 out="$target/usd-check"
 rm -rf "$out"
 mkdir -p "$out"

@@ -2,7 +2,7 @@
 # Exports fur with `pelt export` (bunny masked and blended, the try-on garment as .gltf + .bin,
 # the Fox at rest, mid-walk and groomed, a morph-target ball, the bunny with --motion), renders the bunny with `pelt render` at the test's camera, and
 # checks the files with the Khronos glTF Validator and three.js in headless Chromium
-# (export.test.mjs). Needs chromium, node and npm (web/test/run.sh installs them) and a Vulkan
+# (export.test.mjs). Needs chromium, node and npm (web/test/install.sh installs them) and a Vulkan
 # adapter for `pelt render` (lavapipe in CI). Any failure, validator warnings included, fails it.
 set -euo pipefail
 cd "$(dirname "$0")/../.."
@@ -33,6 +33,6 @@ mkdir -p "$out"
 "$pelt" render --builtin bunny --wind 0,0,0 --no-lod --camera 30,15,24 --size 480x360 \
   --preset assets/presets/kajiya_kay.toml --light camera --no-shadows -o "$out/bunny-pelt.png"
 
+bash web/test/install.sh
 cd web/export-test
-PUPPETEER_SKIP_DOWNLOAD=1 npm ci --no-fund --no-audit --loglevel=error
 node --test --test-reporter=spec export.test.mjs
