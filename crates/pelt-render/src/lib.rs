@@ -161,7 +161,7 @@ pub use lod::{FurLevel, LodSettings, strand_pixels, strand_pixels_in_view};
 pub use object::FurShading;
 pub use object::{FurFrame, FurLook, GpuBytes, tile_mapping};
 pub use plain::PlainMesh;
-pub use renderer::{FurDrawSettings, FurMotion, FurPrepass, FurRenderer, MotionData, PrepassTarget};
+pub use renderer::{FurDrawSettings, FurMotion, FurPrepass, FurRenderer, HerdDraws, MotionData, PrepassTarget};
 pub use requirements::{check_adapter, required_downlevel_flags, required_features, required_limits};
 pub use shaders::{
     pool_draw_shader_source, prepass_shader_source, shadow_copy_shader_source, silhouette_shader_source,

@@ -505,3 +505,102 @@ fn copies_made_together_cast_in_one_draw_a_pass_as_each_alone() {
     assert_eq!(herd_draws, [1, 1, 2], "copies made together: one draw a pass, the thinned coat's opacity alone");
     assert!(herd_picture == alone_picture, "the herd's shadows differ from its copies' alone");
 }
+
+/// Through the camera, a herd's plan (`HerdDraws`) draws each level's copies of one pool in a
+/// skin draw and a shell draw, and the picture has the bytes of each copy drawn alone, farthest
+/// first, with shadows: eight copies in two rows, the back row behind the front one on screen,
+/// each posed and placed its own way; one thins its shells to every fourth, one fades its coat,
+/// one has faded to its skin, one is lit by the other shading model (a coat of its own).
+#[test]
+fn a_herds_camera_draws_pool_each_level_as_each_copy_alone() {
+    let mut rig = Rig::new(192, 144);
+    assert_eq!(rig.renderer.pooled_drawing(), is_gpu(&rig), "a GPU pools the camera's draws, a CPU rasteriser not");
+    rig.renderer.set_pooled_drawing(true);
+    let structure = builtin_fur(Builtin::Bunny, 8);
+    let textures = strand_textures(32, 8, BROWN_ROOT, BROWN_TIP);
+    let asset = FurAsset::new(rig.device(), rig.queue(), &rig.renderer, &structure, &textures).expect("asset");
+    let (device, renderer) = (rig.device(), &rig.renderer);
+    let herd = GpuFur::herd_from_asset(device, renderer, &asset, FurStates::Two, 8).expect("herd");
+    let (centre, radius) = structure.mesh.bounding_sphere();
+    let reach = radius + structure.lengths.iter().copied().fold(0.0, f32::max);
+    let v = structure.mesh.vertex_count();
+    let full = pelt_render::FurLevel::FULL;
+    let levels = [
+        full,
+        pelt_render::FurLevel { stride: 4, ..full },
+        full,
+        pelt_render::FurLevel { coat: 0.6, ..full },
+        full,
+        pelt_render::FurLevel { coat: 0.0, ..full },
+        full,
+        full,
+    ];
+    let mut spheres = Vec::new();
+    for (k, fur) in herd.iter().enumerate() {
+        let bend = 0.05 * radius * k as f32;
+        let bent: Vec<Vec3> = (structure.positions.iter().enumerate())
+            .map(|(j, p)| *p + Vec3::X * (bend * (j / v) as f32 / structure.layers as f32))
+            .collect();
+        // Four a row, 4.5 radii apart; the back row 4 radii behind, a fifth of a step aside.
+        let (row, column) = ((k / 4) as f32, (k % 4) as f32);
+        let at = Vec3::new(4.5 * radius * (column + 0.2 * row), 0.0, -4.0 * radius * row);
+        let place =
+            glam::Mat4::from_translation(at - centre) * glam::Mat4::from_rotation_y((40.0 * k as f32).to_radians());
+        let look = if k == 6 { pelt_render::FurLook::default() } else { common::paper_frame().look };
+        fur.set_positions(rig.queue(), &bent).expect("positions");
+        fur.prepare(rig.queue(), &FurFrame { world_from_model: place, level: levels[k], look, ..FurFrame::default() });
+        spheres.push((at, reach));
+    }
+    let scene = (Vec3::new(7.9 * radius, 0.0, -2.0 * radius), 9.0 * radius);
+    // Low in front, so the back row stands behind the front one on screen.
+    let camera = pelt_render::Camera::framing(scene.0, scene.1, 0.0, 8.0, 192.0 / 144.0);
+    let view_data = camera.view_data(192.0 / 144.0, &pelt_render::Light::default());
+    let mut view = pelt_render::FurView::new(device, renderer);
+    view.prepare(rig.queue(), &view_data);
+    let shadow = pelt_render::ShadowSettings { size: 256, fur_depth: 0.3 * radius, extinction: 0.6 };
+    let mut map = pelt_render::ShadowMap::new(device, renderer, shadow).expect("shadow map");
+    let caster = pelt_render::ShadowCaster::Directional { toward_light: Vec3::new(0.4, 0.8, 0.5).normalize() };
+    map.prepare(rig.queue(), (&[(0, caster)], 1), scene);
+    view.set_shadows(Some(&map));
+    // Farthest first.
+    let mut order: Vec<usize> = (0..8).collect();
+    order.sort_by(|&a, &b| spheres[b].0.distance(camera.eye).total_cmp(&spheres[a].0.distance(camera.eye)));
+    let furs: Vec<&GpuFur> = order.iter().map(|&k| &herd[k]).collect();
+    let members: Vec<(&GpuFur, (Vec3, f32))> = order.iter().map(|&k| (&herd[k], spheres[k])).collect();
+    let mut plan = pelt_render::HerdDraws::new();
+    plan.prepare((device, rig.queue()), renderer, &view_data, &members);
+    let settings = pelt_render::FurDrawSettings::SILHOUETTE;
+    let picture = |planned: bool| {
+        let mut draws = 0;
+        let image = rig
+            .headless
+            .render_with(
+                pelt_render::DEFAULT_BACKGROUND,
+                |encoder| {
+                    renderer.prepare_fins_of(encoder, &view, furs.iter().copied());
+                    map.record(encoder, |pass, light| {
+                        renderer.draw_herd(pass, light, furs.iter().copied(), &settings);
+                    });
+                },
+                |pass| {
+                    draws = if planned {
+                        renderer.draw_herd_planned(pass, &view, &plan, &furs, &settings)
+                    } else {
+                        furs.iter().map(|fur| renderer.draw_herd(pass, &view, [*fur], &settings)).sum()
+                    };
+                },
+            )
+            .expect("frame");
+        (image, draws)
+    };
+    let (planned, planned_draws) = picture(true);
+    let (alone, alone_draws) = picture(false);
+    planned.save(common::out_dir().join("herd-camera.png")).expect("save");
+    assert_eq!(plan.levels(), 2, "the front row and the back row");
+    // The coat lit by the other model draws alone; the rest of each row together: their skins
+    // in one draw, the shells of those whose coat shows in another, then each shown coat's fins.
+    assert_eq!(plan.pooled_members(), 7);
+    assert_eq!(alone_draws, 8 + 7 + 7, "a skin, shells and fins a copy, none for the hidden coat");
+    assert_eq!(planned_draws, (2 + 4) + (2 + 2) + 3, "{planned_draws} draws planned");
+    assert!(planned == alone, "the planned herd's picture differs from its copies' alone");
+}

@@ -13,7 +13,7 @@ use pelt_core::sim::{FurStepper, Scene, SceneCamera, WindParams};
 use pelt_core::{Builtin, FurStructure, Mesh, Preset, Stage};
 use pelt_render::{
     Backend, Camera, ColliderMeshes, FurAsset, FurDrawSettings, FurDriver, FurLook, FurTarget, FurView, Gpu,
-    HEADLESS_FORMAT, Headless, KernelChoice, PlainMesh, SAMPLE_COUNT, default_sample_count,
+    HEADLESS_FORMAT, Headless, HerdDraws, KernelChoice, PlainMesh, SAMPLE_COUNT, default_sample_count,
 };
 
 use crate::light_args::{LightArgs, preset_look};
@@ -296,6 +296,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             .is_none_or(|i| view_data.sees_sphere(i.world_from_model(time_secs).transform_point3(mesh_centre), reach))
     };
     let level = level_at(0, 0.0);
+    let mut plan = HerdDraws::new();
     let settings = FurDrawSettings {
         alpha_to_coverage: args.alpha_to_coverage,
         fins: !args.no_fins,
@@ -381,6 +382,15 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         let plane_half_size = 1.5 * simulation.bounding_radius();
         // The simulation runs in the world (the base is posed with the script's motion).
         colliders.update(device, queue, &renderer, &shown, Mat4::IDENTITY, plane_half_size)?;
+        // The camera's draws in levels of members that share no pixel (`HerdDraws`).
+        let sphere = |k: usize| {
+            instances.get(k).map_or((Vec3::ZERO, f32::INFINITY), |i| {
+                (i.world_from_model(time_secs).transform_point3(mesh_centre), reach)
+            })
+        };
+        let members: Vec<_> = order.iter().map(|&k| (drivers[k].fur(), sphere(k))).collect();
+        plan.prepare((device, queue), &renderer, &view_data, &members);
+        let furs: Vec<_> = members.iter().map(|(fur, _)| *fur).collect();
         let image = headless.render_with(
             studio.background,
             |encoder| {
@@ -400,9 +410,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
                     renderer.draw_plain(pass, &view, mesh);
                 }
                 colliders.draw(pass, &renderer, &view);
-                for &member in &order {
-                    drivers[member].draw(pass, &renderer, &view, &settings);
-                }
+                renderer.draw_herd_planned(pass, &view, &plan, &furs, &settings);
             },
         )?;
         render_time += render_started.elapsed();

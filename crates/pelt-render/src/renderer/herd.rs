@@ -1,9 +1,8 @@
-//! A herd's draws: through a shadow view, the copies made together (consecutive slots of one
-//! pool) cast in one draw a pass (`pool_draws.wgsl`: the instance names the slot), so the shadow
-//! maps' draws do not grow with the herd; through the camera each copy draws as a lone fur
-//! (blending needs each copy's shells in order, farthest copy first). A CPU rasteriser casts
-//! each copy alone: it reads a copy's object from storage lane by lane at every vertex, which
-//! costs it more than the draws save (a GPU pays per draw).
+//! A herd's shadow draws: through a shadow view, the copies made together (consecutive slots of
+//! one pool) cast in one draw a pass (`pool_draws.wgsl`: the instance names the slot), so the
+//! shadow maps' draws do not grow with the herd (the camera's: `herd_view`). A CPU rasteriser
+//! casts each copy alone: it reads a copy's object from storage lane by lane at every vertex,
+//! which costs it more than the draws save (a GPU pays per draw).
 
 use std::sync::Arc;
 

@@ -11,11 +11,13 @@
 //!    ([`FurRenderer::prepare_fins`]) kept, through an indirect draw; else every edge.
 
 mod herd;
+mod herd_view;
 mod objects;
 mod pipeline;
 mod prepass;
 mod shadow;
 
+pub use herd_view::HerdDraws;
 pub(crate) use pipeline::{PassKind, PipelineSource, Transparency, create_pipeline};
 pub use prepass::{FurMotion, FurPrepass, MotionData, PrepassTarget};
 
@@ -194,6 +196,10 @@ pub struct FurRenderer {
     pooled_casting: bool,
     /// Whether a herd's GPU simulations made after this step each pool in one dispatch.
     pooled_stepping: bool,
+    /// Whether [`HerdDraws`] pools the camera's draws of a herd.
+    pooled_drawing: bool,
+    /// The camera's pooled pipelines (`HerdDraws`), built when a herd first draws with one.
+    pool_camera: herd_view::PoolCameraPipelines,
 }
 
 impl FurRenderer {
@@ -242,6 +248,8 @@ impl FurRenderer {
             simulation: OnceLock::new(),
             pooled_casting: gpu,
             pooled_stepping: gpu,
+            pooled_drawing: gpu,
+            pool_camera: herd_view::PoolCameraPipelines::default(),
         })
     }
 
@@ -309,20 +317,34 @@ impl FurRenderer {
         // Fins after the shells: at the silhouette, where fins matter, they stand outside the
         // shells and must not be covered by the faded outer layers.
         if settings.fins && fur.prepared_level().fins_shown() {
-            match fur.fin_list() {
-                Some(list) if settings.silhouette_fins => {
-                    pass.set_pipeline(&coat.silhouette_fins[which]);
-                    let slot = fur.slot();
-                    geometry.draw_fin_list(pass, list.instances_of(slot), (&list.draws, FinList::draw_offset(slot)));
-                }
-                _ => {
-                    pass.set_pipeline(&coat.fins[which]);
-                    geometry.draw_fins(pass, fur.drawn_shells());
-                }
-            }
-            draws += 1;
+            draws += self.draw_fins_of(pass, fur, shadowed, settings);
         }
         draws
+    }
+
+    /// A shown coat's fins (its object bound in group 1); returns the draws recorded.
+    fn draw_fins_of(
+        &self,
+        pass: &mut wgpu::RenderPass<'_>,
+        fur: &GpuFur,
+        shadowed: ShadowLookups,
+        settings: &FurDrawSettings,
+    ) -> usize {
+        let coat = self.coat(fur.coat().shadowed(shadowed));
+        let which = Transparency::index(settings.alpha_to_coverage);
+        let geometry = fur.geometry();
+        match fur.fin_list() {
+            Some(list) if settings.silhouette_fins => {
+                pass.set_pipeline(&coat.silhouette_fins[which]);
+                let slot = fur.slot();
+                geometry.draw_fin_list(pass, list.instances_of(slot), (&list.draws, FinList::draw_offset(slot)));
+            }
+            _ => {
+                pass.set_pipeline(&coat.fins[which]);
+                geometry.draw_fins(pass, fur.drawn_shells());
+            }
+        }
+        1
     }
 
     /// Records the silhouette pass of `fur` seen from `view` into `encoder` (a compute pass): it

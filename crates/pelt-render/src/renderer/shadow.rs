@@ -66,8 +66,8 @@ const WALKS: [(&str, bool); 2] = [("wedges", true), ("indexed", false)];
 /// module (the shading over a pool) and layout (`Layouts::pool_draws`).
 #[derive(Debug)]
 pub(super) struct PoolCasters {
-    module: wgpu::ShaderModule,
-    layout: wgpu::PipelineLayout,
+    pub module: wgpu::ShaderModule,
+    pub layout: wgpu::PipelineLayout,
     pub skin: [wgpu::RenderPipeline; 2],
     pub fur_depth: [wgpu::RenderPipeline; 2],
     /// By whether the groom reaches the shading (a wet copy casts alone).

@@ -1,4 +1,4 @@
-// A pool's shadow casters, every copy in one draw a pass (`FurRenderer::draw_herd`): the
+// A pool's draws. Its shadow casters, every copy in one draw a pass (`FurRenderer::draw_herd`): the
 // instance names the copy's slot (the opacity pass: its slot and its shell, OPACITY_SHELLS a
 // copy), whose object the vertex loads before the unified structure's code runs as for a lone
 // fur. Appended to the pooled shading (`object_pool.wgsl`), `unified.wgsl` and `shadows.wgsl`.
@@ -154,4 +154,104 @@ fn fs_pool_opacity_tiles_groomed(in: PoolGroomedShellTileVaryings) -> @location(
     object = objects[in.member].object;
     let shell = GroomedShellTileVaryings(in.clip_position, in.lighting, in.fade_blend_layer, in.tile_position, in.tile_normal, in.tint_density);
     return opacity_tiles_groomed(shell);
+}
+
+// The camera's view (`HerdDraws`): the copies of one level, which share no pixel, their skins in
+// one draw and their shells in another. Each instance reads its entry from the plan's instance
+// buffer: the copy's slot and, for the shells, its shell. The fragment loads the copy's object
+// from the slot, handed on flat.
+
+// `Varyings` with the copy's slot.
+struct PoolVaryings {
+    @builtin(position) clip_position: vec4<f32>,
+    @location(0) world_position: vec3<f32>,
+    @location(1) normal: vec3<f32>,
+    @location(2) tangent: vec3<f32>,
+    @location(3) tile_position: vec3<f32>,
+    @location(4) uv: vec2<f32>,
+    @location(5) @interpolate(flat) layer: u32,
+    @location(6) height: f32,
+    @location(7) fade: f32,
+    @location(8) @interpolate(flat) slice: i32,
+    @location(9) surface_uv: vec2<f32>,
+    @location(10) tile_normal: vec3<f32>,
+    @location(11) @interpolate(flat) light_count: u32,
+    @location(12) @interpolate(flat) member: u32,
+}
+
+fn pooled_varyings(v: Varyings, member: u32) -> PoolVaryings {
+    return PoolVaryings(v.clip_position, v.world_position, v.normal, v.tangent, v.tile_position, v.uv, v.layer, v.height, v.fade, v.slice, v.surface_uv, v.tile_normal, v.light_count, member);
+}
+
+@vertex
+fn vs_pool_camera_skin_wedges(@builtin(vertex_index) wedge: u32, @location(0) entry: vec2<u32>) -> PoolVaryings {
+    object = objects[entry.x].object;
+    return pooled_varyings(surface_varyings(wedge_vertex(wedge), wedge, 0u), entry.x);
+}
+
+@vertex
+fn vs_pool_camera_skin_indexed(@builtin(vertex_index) vertex: u32, @location(0) entry: vec2<u32>) -> PoolVaryings {
+    object = objects[entry.x].object;
+    return pooled_varyings(surface_varyings(vertex, 0u, 0u), entry.x);
+}
+
+@fragment
+fn fs_pool_skin(in: PoolVaryings) -> @location(0) vec4<f32> {
+    object = objects[in.member].object;
+    let v = Varyings(in.clip_position, in.world_position, in.normal, in.tangent, in.tile_position, in.uv, in.layer, in.height, in.fade, in.slice, in.surface_uv, in.tile_normal, in.light_count);
+    return skin_colour(v);
+}
+
+@vertex
+fn vs_pool_shell_wedges(@builtin(vertex_index) wedge: u32, @location(0) entry: vec2<u32>) -> PoolShellUvVaryings {
+    object = objects[entry.x].object;
+    let v = shell_wedge(wedge, entry.y);
+    return PoolShellUvVaryings(v.clip_position, v.lighting, v.fade_blend_layer, v.uvs, entry.x);
+}
+
+@vertex
+fn vs_pool_shell_indexed(@builtin(vertex_index) vertex: u32, @location(0) entry: vec2<u32>) -> PoolShellTileVaryings {
+    object = objects[entry.x].object;
+    let v = shell_vertex(vertex, entry.y);
+    return PoolShellTileVaryings(v.clip_position, v.lighting, v.fade_blend_layer, v.tile_position, v.tile_normal, entry.x);
+}
+
+@vertex
+fn vs_pool_shell_wedges_groomed(@builtin(vertex_index) wedge: u32, @location(0) entry: vec2<u32>) -> PoolGroomedShellUvVaryings {
+    object = objects[entry.x].object;
+    let v = groomed_shell_wedge(wedge, entry.y);
+    return PoolGroomedShellUvVaryings(v.clip_position, v.lighting, v.fade_blend_layer, v.uvs, v.tint_density, entry.x);
+}
+
+@vertex
+fn vs_pool_shell_indexed_groomed(@builtin(vertex_index) vertex: u32, @location(0) entry: vec2<u32>) -> PoolGroomedShellTileVaryings {
+    object = objects[entry.x].object;
+    let v = groomed_shell_vertex(vertex, entry.y);
+    return PoolGroomedShellTileVaryings(v.clip_position, v.lighting, v.fade_blend_layer, v.tile_position, v.tile_normal, v.tint_density, entry.x);
+}
+
+@fragment
+fn fs_pool_shell_uvs(in: PoolShellUvVaryings) -> @location(0) vec4<f32> {
+    object = objects[in.member].object;
+    return shell_uvs_colour(ShellUvVaryings(in.clip_position, in.lighting, in.fade_blend_layer, in.uvs));
+}
+
+@fragment
+fn fs_pool_shell_tiles(in: PoolShellTileVaryings) -> @location(0) vec4<f32> {
+    object = objects[in.member].object;
+    return shell_tiles_colour(ShellTileVaryings(in.clip_position, in.lighting, in.fade_blend_layer, in.tile_position, in.tile_normal));
+}
+
+@fragment
+fn fs_pool_shell_uvs_groomed(in: PoolGroomedShellUvVaryings) -> @location(0) vec4<f32> {
+    object = objects[in.member].object;
+    let shell = GroomedShellUvVaryings(in.clip_position, in.lighting, in.fade_blend_layer, in.uvs, in.tint_density);
+    return shell_uvs_groomed_colour(shell);
+}
+
+@fragment
+fn fs_pool_shell_tiles_groomed(in: PoolGroomedShellTileVaryings) -> @location(0) vec4<f32> {
+    object = objects[in.member].object;
+    let shell = GroomedShellTileVaryings(in.clip_position, in.lighting, in.fade_blend_layer, in.tile_position, in.tile_normal, in.tint_density);
+    return shell_tiles_groomed_colour(shell);
 }

@@ -670,6 +670,10 @@ fn fs_plain(in: Varyings) -> @location(0) vec4<f32> {
 // The opaque skin under the fur, in the colour of the roots.
 @fragment
 fn fs_skin(in: Varyings) -> @location(0) vec4<f32> {
+    return skin_colour(in);
+}
+
+fn skin_colour(in: Varyings) -> vec4<f32> {
     let normal = normalize(in.normal);
     let albedo = object.colour.rgb * surface_tint(root_surface_uv(in));
     let colour = surface_lighting(albedo, normal, in.world_position, in.light_count) * object.root_occlusion;
@@ -687,6 +691,10 @@ fn shell_colour(texel: vec4<f32>, surface_uv: vec2<f32>, lighting: vec4<f32>, fa
 // Shells of meshes without uvs (`vs_shell_indexed`, `vs_separated_shell_tiles`).
 @fragment
 fn fs_shell_tiles(in: ShellTileVaryings) -> @location(0) vec4<f32> {
+    return shell_tiles_colour(in);
+}
+
+fn shell_tiles_colour(in: ShellTileVaryings) -> vec4<f32> {
     let texel = tile_texel(in.tile_position, in.tile_normal, varying_layer(in.fade_blend_layer.z));
     return shell_colour(texel, vec2<f32>(0.0), in.lighting, in.fade_blend_layer, vec3<f32>(1.0));
 }
@@ -694,6 +702,10 @@ fn fs_shell_tiles(in: ShellTileVaryings) -> @location(0) vec4<f32> {
 // Shells of meshes with uvs (`vs_shell_wedges`, `vs_separated_shell_uvs`).
 @fragment
 fn fs_shell_uvs(in: ShellUvVaryings) -> @location(0) vec4<f32> {
+    return shell_uvs_colour(in);
+}
+
+fn shell_uvs_colour(in: ShellUvVaryings) -> vec4<f32> {
     let texel = sample_shell(in.uvs.xy, shell_slice(varying_layer(in.fade_blend_layer.z)));
     return shell_colour(texel, in.uvs.zw, in.lighting, in.fade_blend_layer, vec3<f32>(1.0));
 }
@@ -709,6 +721,10 @@ fn coat_shell_texel(uv: vec2<f32>, layer: u32, groom: GroomShade) -> vec4<f32> {
 
 @fragment
 fn fs_shell_tiles_groomed(in: GroomedShellTileVaryings) -> @location(0) vec4<f32> {
+    return shell_tiles_groomed_colour(in);
+}
+
+fn shell_tiles_groomed_colour(in: GroomedShellTileVaryings) -> vec4<f32> {
     let layer = varying_layer(in.fade_blend_layer.z);
     let groom = shell_groom(in.fade_blend_layer, in.tint_density);
     let texel = coat_shell_texel(tile_uv(in.tile_position, in.tile_normal), layer, groom);
@@ -717,6 +733,10 @@ fn fs_shell_tiles_groomed(in: GroomedShellTileVaryings) -> @location(0) vec4<f32
 
 @fragment
 fn fs_shell_uvs_groomed(in: GroomedShellUvVaryings) -> @location(0) vec4<f32> {
+    return shell_uvs_groomed_colour(in);
+}
+
+fn shell_uvs_groomed_colour(in: GroomedShellUvVaryings) -> vec4<f32> {
     let layer = varying_layer(in.fade_blend_layer.z);
     let groom = shell_groom(in.fade_blend_layer, in.tint_density);
     let texel = coat_shell_texel(in.uvs.xy, layer, groom);

@@ -2,10 +2,12 @@
 //! 16 layers) walk across a field at their own phases (`herd::scatter`, each walking ahead),
 //! framed whole at 1280x720 with the Fox's shadows on a ground, as `pelt render --herd N` draws
 //! them: one `FurAsset`, a driver and a stepper per Fox, the steppers posing (and on the CPU
-//! kernel bending) in one parallel pass, or each Fox on the GPU kernel (`--sim gpu`). Per size:
-//! the simulation's time a frame, the CPU's time to record a frame, the rest of the frame (the
-//! GPU's work and the readback), the GPU bytes of the shared asset and of each Fox, what one more
-//! Fox adds to each, and posing every Fox's base once on the CPU (`Rig::pose`) against on the GPU
+//! kernel bending) in one parallel pass, or each Fox on the GPU kernel (`--sim gpu`), drawn
+//! farthest first through the camera's plan (`HerdDraws`: on a GPU a level's Foxes in a skin
+//! draw and a shell draw). Per size: the simulation's time a frame, the CPU's time to record a
+//! frame (the plan included), the camera's draws, the rest of the frame (the GPU's work and the
+//! readback), the GPU bytes of the shared asset and of each Fox, what one more Fox adds to each,
+//! and posing every Fox's base once on the CPU (`Rig::pose`) against on the GPU
 //! (`Rig::pose_joints` per Fox, then one `GpuSkin` dispatch).
 
 use std::path::Path;
@@ -18,7 +20,7 @@ use pelt_core::sim::herd;
 use pelt_core::{ImportOptions, Preset, Stage, StageSource};
 use pelt_render::{
     Backend, Camera, FurAsset, FurDrawSettings, FurDriver, FurTarget, FurView, Gpu, GpuSkin, HEADLESS_FORMAT, Headless,
-    KernelChoice, SimKernel, Studio,
+    HerdDraws, KernelChoice, SimKernel, Studio,
 };
 
 /// Figures for one herd size.
@@ -33,6 +35,13 @@ pub struct HerdRow {
     /// Whether on the GPU kernel the Foxes stepped in one dispatch a step
     /// (`FurRenderer::pooled_stepping`: a GPU's default) or a dispatch each.
     pub pooled_stepping: bool,
+    /// Whether the camera drew the Foxes of a level (those sharing no pixel) in a skin draw and a
+    /// shell draw (`FurRenderer::pooled_drawing`: a GPU's default) or each Fox alone.
+    pub pooled_drawing: bool,
+    /// The camera's draws in the last frame, and the levels its plan put the Foxes in
+    /// (`HerdDraws`).
+    pub camera_draws: usize,
+    pub camera_levels: usize,
     /// `WIDTHxHEIGHT`, and the MSAA samples.
     pub size: String,
     pub msaa_samples: u32,
@@ -118,9 +127,13 @@ pub fn measure(
     if let Some(pooled) = pooled {
         renderer.set_pooled_casting(pooled);
         renderer.set_pooled_stepping(pooled);
+        renderer.set_pooled_drawing(pooled);
     }
     let asset = FurAsset::new(device, queue, &renderer, &fur, &textures)?;
     let (low, high) = fur.mesh.bounds();
+    // What a Fox draws lies within its mesh's sphere grown by its longest strand.
+    let (mesh_centre, mesh_radius) = fur.mesh.bounding_sphere();
+    let reach = mesh_radius + fur.lengths.iter().copied().fold(0.0, f32::max);
     let spacing = 1.5 * (high - low).max_element();
     let fps = 30.0;
     let mut rows = Vec::new();
@@ -174,6 +187,8 @@ pub fn measure(
         surroundings.prepare((device, queue), &renderer, &view_data, &mut view)?;
         let lod = crate::lod::settings(&preset.render.lod, false);
         let (mut simulation, mut record, mut gpu) = (Duration::ZERO, Duration::ZERO, Duration::ZERO);
+        let mut plan = HerdDraws::new();
+        let mut camera_draws = 0;
         // One frame to warm up (pipelines, first poses), then the timed ones.
         for frame in 0..=frames {
             let time_secs = f64::from(frame) / fps;
@@ -200,6 +215,17 @@ pub fn measure(
                 queue.submit([encoder.finish()]);
             }
             let stepped = Instant::now();
+            // Blended fur draws farthest first, in the plan's levels.
+            let spheres: Vec<(Vec3, f32)> = instances
+                .iter()
+                .map(|i| (i.world_from_model(time_secs).transform_point3(mesh_centre), reach))
+                .collect();
+            let mut order: Vec<usize> = (0..foxes).collect();
+            let distance = |k: usize| spheres[k].0.distance(camera.eye);
+            order.sort_by(|&a, &b| distance(b).total_cmp(&distance(a)));
+            let members: Vec<_> = order.iter().map(|&k| (drivers[k].fur(), spheres[k])).collect();
+            plan.prepare((device, queue), &renderer, &view_data, &members);
+            let furs: Vec<_> = members.iter().map(|(fur, _)| *fur).collect();
             let mut recorded = None;
             headless.render_with(
                 studio.background,
@@ -212,9 +238,7 @@ pub fn measure(
                 },
                 |pass| {
                     surroundings.draw_ground(pass, &renderer, &view);
-                    for driver in &drivers {
-                        driver.draw(pass, &renderer, &view, &FurDrawSettings::SILHOUETTE);
-                    }
+                    camera_draws = renderer.draw_herd_planned(pass, &view, &plan, &furs, &FurDrawSettings::SILHOUETTE);
                     recorded = Some(Instant::now());
                 },
             )?;
@@ -237,6 +261,9 @@ pub fn measure(
             kernel: kernel.to_string().to_lowercase(),
             pooled_casting: renderer.pooled_casting(),
             pooled_stepping: kernel == SimKernel::Gpu && renderer.pooled_stepping(),
+            pooled_drawing: renderer.pooled_drawing(),
+            camera_draws,
+            camera_levels: plan.levels(),
             size: format!("{}x{}", size.0, size.1),
             msaa_samples: samples,
             frames,
@@ -300,12 +327,17 @@ fn time_posing(
 
 fn markdown(rows: &[HerdRow], adapter: &str) -> String {
     let mut out = format!(
-        "### A herd of walking Foxes ({}, {}x MSAA, 16 layers, shadows on a ground {}, bent on the {}; {adapter})\n\n\
-         | Foxes | frame ms | simulation ms | record ms | GPU + readback ms | one more Fox adds (frame / record, ms) | GPU bytes (shared + per Fox) | allocated | posing every base, CPU / GPU ms |\n\
-         |---:|---:|---:|---:|---:|---:|---:|---:|---:|\n",
+        "### A herd of walking Foxes ({}, {}x MSAA, 16 layers, shadows on a ground {}, {}, bent on the {}; {adapter})\n\n\
+         | Foxes | frame ms | simulation ms | record ms | GPU + readback ms | one more Fox adds (frame / record, ms) | camera draws (levels) | GPU bytes (shared + per Fox) | allocated | posing every base, CPU / GPU ms |\n\
+         |---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n",
         rows.first().map_or("", |r| r.size.as_str()),
         rows.first().map_or(1, |r| r.msaa_samples),
         if rows.first().is_some_and(|r| r.pooled_casting) { "cast in one draw a pass" } else { "cast a Fox a draw" },
+        if rows.first().is_some_and(|r| r.pooled_drawing) {
+            "the camera's draws pooled by level"
+        } else {
+            "the camera's draws a Fox at a time"
+        },
         match rows.first() {
             Some(r) if r.kernel == "gpu" && r.pooled_stepping => "GPU in one dispatch a step".to_owned(),
             Some(r) => r.kernel.to_uppercase(),
@@ -321,12 +353,14 @@ fn markdown(rows: &[HerdRow], adapter: &str) -> String {
             None => "-".to_owned(),
         };
         out += &format!(
-            "| {} | {:.1} | {:.1} | {:.2} | {:.1} | {more} | {} ({} + {} x {}) | {} | {:.2} / {:.2} |\n",
+            "| {} | {:.1} | {:.1} | {:.2} | {:.1} | {more} | {} ({}) | {} ({} + {} x {}) | {} | {:.2} / {:.2} |\n",
             row.foxes,
             row.frame_ms,
             row.simulation_ms,
             row.record_ms,
             row.gpu_and_readback_ms,
+            row.camera_draws,
+            row.camera_levels,
             row.total_gpu_bytes,
             row.shared_gpu_bytes,
             row.foxes,
@@ -350,6 +384,9 @@ mod tests {
             kernel: "cpu".to_owned(),
             pooled_casting: false,
             pooled_stepping: false,
+            pooled_drawing: true,
+            camera_draws: 2 * foxes,
+            camera_levels: foxes / 2,
             size: "1280x720".to_owned(),
             msaa_samples: 1,
             frames: 1,
@@ -367,6 +404,7 @@ mod tests {
         let table = markdown(&[row(1, 10.0, 1.0), row(11, 30.0, 2.0)], "lavapipe");
         assert!(table.contains("| 11 | 30.0 |"), "{table}");
         assert!(table.contains("2.000 / 0.1000"), "{table}");
-        assert!(table.contains("32 (10 + 11 x 2) | 33 | 3.00 / 0.50 |"), "{table}");
+        assert!(table.contains("| 22 (5) | 32 (10 + 11 x 2) | 33 | 3.00 / 0.50 |"), "{table}");
+        assert!(table.contains("the camera's draws pooled by level"), "{table}");
     }
 }

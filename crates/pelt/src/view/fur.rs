@@ -6,8 +6,8 @@ use pelt_core::sim::{FurStepper, SceneGround, SimParams};
 use pelt_core::texture::FurTextures;
 use pelt_core::{FurStructure, Mesh};
 use pelt_render::{
-    ColliderMeshes, FurDrawSettings, FurDriver, FurFrame, FurLevel, FurRenderer, FurView, KernelChoice, PlainMesh,
-    SeparatedFur, SeparatedRenderer, SimKernel, Studio, Surroundings,
+    ColliderMeshes, FurDrawSettings, FurDriver, FurFrame, FurLevel, FurRenderer, FurView, HerdDraws, KernelChoice,
+    PlainMesh, SeparatedFur, SeparatedRenderer, SimKernel, Studio, Surroundings,
 };
 
 use super::camera::OrbitCamera;
@@ -41,6 +41,8 @@ pub struct FurScene {
     pub body_colliders: bool,
     /// The view-angle pass's count, read back for the overlay.
     shell_share: ShellShare,
+    /// The camera's plan of a herd's draws (levels of members sharing no pixel).
+    herd_plan: HerdDraws,
     /// The shadow maps and the ground, with the (shadows, ground) switches and the herd's box
     /// they were made for; `None` until asked for, and again after a new structure or body.
     surroundings: Option<(SurroundingsFor, Surroundings)>,
@@ -76,6 +78,7 @@ impl FurScene {
             settings: FurDrawSettings::SILHOUETTE,
             body_colliders: false,
             shell_share: ShellShare::new(&gpu.device),
+            herd_plan: HerdDraws::new(),
             surroundings: None,
             herd: None,
             herd_stale: false,
@@ -360,6 +363,14 @@ impl FurScene {
                 self.driver.record_view(encoder, &self.renderer, &self.view);
                 if let Some(herd) = herd {
                     herd.record_view(encoder, &self.renderer, &self.view, &others);
+                    let planned: Vec<_> = order
+                        .iter()
+                        .map(|&member| {
+                            let fur = if member == 0 { self.driver.fur() } else { herd.fur(member) };
+                            (fur, members[member].sphere)
+                        })
+                        .collect();
+                    self.herd_plan.prepare((&gpu.device, &gpu.queue), &self.renderer, &view_data, &planned);
                 }
             }
         }
@@ -389,12 +400,11 @@ impl FurScene {
             match (separated, herd) {
                 (Some((renderer, fur)), _) => renderer.draw(&mut pass, &self.view, fur, &self.settings),
                 (None, Some(herd)) => {
-                    for &member in &order {
-                        match member {
-                            0 => self.driver.draw(&mut pass, &self.renderer, &self.view, &self.settings),
-                            k => herd.draw(&mut pass, &self.renderer, &self.view, (&[k], &self.settings)),
-                        }
-                    }
+                    let furs: Vec<_> = order
+                        .iter()
+                        .map(|&member| if member == 0 { self.driver.fur() } else { herd.fur(member) })
+                        .collect();
+                    self.renderer.draw_herd_planned(&mut pass, &self.view, &self.herd_plan, &furs, &self.settings);
                 }
                 (None, None) if main_drawn => {
                     self.driver.draw(&mut pass, &self.renderer, &self.view, &self.settings);

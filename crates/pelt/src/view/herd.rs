@@ -202,6 +202,8 @@ pub(super) struct MemberFrame {
     pub(super) seen: bool,
     /// From the eye, for drawing blended fur farthest first.
     pub(super) distance: f32,
+    /// A world-space sphere (centre, radius) holding what it draws, for the camera's plan.
+    pub(super) sphere: (Vec3, f32),
 }
 
 /// Each member's level of detail, whether it is seen and how far it stands, at `time_secs`:
@@ -222,6 +224,7 @@ pub(super) fn member_frames(
                 level: level_of(structure, world_from_model.inverse().transform_point3(eye)),
                 seen: view.sees_sphere(world_centre, reach),
                 distance: world_centre.distance(eye),
+                sphere: (world_centre, reach),
             }
         })
         .collect()
@@ -307,6 +310,11 @@ impl HerdDrivers {
         drawn: &[usize],
     ) {
         FurDriver::record_views(encoder, renderer, view, drawn.iter().map(|&member| &self.drivers[member - 1]));
+    }
+
+    /// Member `member`'s fur (1..: the main fur is member 0).
+    pub(super) fn fur(&self, member: usize) -> &pelt_render::GpuFur {
+        self.drivers[member - 1].fur()
     }
 
     /// Draws the copies `drawn` lists (member indices, 1..; every copy into a shadow map, where
