@@ -261,14 +261,15 @@ impl CoatBuilder {
 impl FurRenderer {
     /// Whether [`HerdDraws`] pools the camera's draws of a herd's copies: by default on a
     /// discrete or integrated GPU, as [`FurRenderer::pooled_casting`] (a CPU rasteriser reads
-    /// each vertex's object from storage, which costs it more than the draws save).
+    /// each vertex's object from storage, which costs it more than the draws save). Never on GL:
+    /// there (llvmpipe's GL, checked) the pooled draws come out wrong.
     #[must_use]
     pub fn pooled_drawing(&self) -> bool {
-        self.pooled_drawing
+        self.pooled_drawing && !self.gl
     }
 
-    /// Sets [`FurRenderer::pooled_drawing`] for the plans made after; the pictures are the same
-    /// either way.
+    /// Sets [`FurRenderer::pooled_drawing`] for the plans made after (no effect on GL); the
+    /// pictures are the same either way.
     pub fn set_pooled_drawing(&mut self, pooled: bool) {
         self.pooled_drawing = pooled;
     }
@@ -320,16 +321,21 @@ impl FurRenderer {
         pass.set_bind_group(1, first.pool().draw_group(), &[]);
         pass.set_bind_group(2, first.textures_bind_group(), &[]);
         pass.set_bind_group(3, view.shadow_group(), &[]);
-        pass.set_vertex_buffer(0, buffer.slice(..));
+        // Each draw's entries bound from their first and its instances counted from 0, so no
+        // backend needs a first instance for instance-rate attributes.
+        let entries =
+            |range: &Range<u32>| buffer.slice(ENTRY_BYTES * u64::from(range.start)..ENTRY_BYTES * u64::from(range.end));
         if settings.skin {
             pass.set_pipeline(&self.pool_camera_skins(shadowed)[walk]);
-            geometry.draw_skins(pass, skins);
+            pass.set_vertex_buffer(0, entries(&skins));
+            geometry.draw_skins(pass, 0..skins.len() as u32);
             draws += 1;
         }
         if settings.shells && !shells.is_empty() {
             let which = Transparency::index(settings.alpha_to_coverage);
             pass.set_pipeline(&self.pool_camera_shells(first.coat().shadowed(shadowed))[walk][which]);
-            geometry.draw_shells(pass, shells);
+            pass.set_vertex_buffer(0, entries(&shells));
+            geometry.draw_shells(pass, 0..shells.len() as u32);
             draws += 1;
         }
         // Fins after the shells, as a lone fur draws them (its own object in group 1).

@@ -198,6 +198,8 @@ pub struct FurRenderer {
     pooled_stepping: bool,
     /// Whether [`HerdDraws`] pools the camera's draws of a herd.
     pooled_drawing: bool,
+    /// The device runs on GL, where the camera's pooled draws are not drawn right.
+    gl: bool,
     /// The camera's pooled pipelines (`HerdDraws`), built when a herd first draws with one.
     pool_camera: herd_view::PoolCameraPipelines,
 }
@@ -249,6 +251,7 @@ impl FurRenderer {
             pooled_casting: gpu,
             pooled_stepping: gpu,
             pooled_drawing: gpu,
+            gl: device.adapter_info().backend == wgpu::Backend::Gl,
             pool_camera: herd_view::PoolCameraPipelines::default(),
         })
     }
