@@ -290,10 +290,9 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     }
     let (mesh_centre, mesh_radius) = fur.mesh.bounding_sphere();
     let reach = mesh_radius + fur.lengths.iter().copied().fold(0.0, f32::max);
-    let member_seen = |member: usize, time_secs: f64| {
-        instances
-            .get(member)
-            .is_none_or(|i| view_data.sees_sphere(i.world_from_model(time_secs).transform_point3(mesh_centre), reach))
+    // A herd member's sphere at a time (what it draws lies within it); none for a lone fur.
+    let member_sphere = |member: usize, time_secs: f64| {
+        instances.get(member).map(|i| (i.world_from_model(time_secs).transform_point3(mesh_centre), reach))
     };
     let level = level_at(0, 0.0);
     let mut plan = HerdDraws::new();
@@ -347,7 +346,9 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         let stepper = &steppers[0];
         // Blended fur draws farthest first; a member the camera cannot see is not drawn (it still
         // casts its shadow).
-        let mut order: Vec<usize> = (0..members).filter(|&k| member_seen(k, time_secs)).collect();
+        let spheres: Vec<_> = (0..members).map(|k| member_sphere(k, time_secs)).collect();
+        let mut order: Vec<usize> =
+            (0..members).filter(|&k| spheres[k].is_none_or(|(c, r)| view_data.sees_sphere(c, r))).collect();
         out_of_view = members - order.len();
         let distance = |k: usize| instances.get(k).map_or(0.0, |i| i.position_at(time_secs).distance(camera.eye));
         order.sort_by(|&a, &b| distance(b).total_cmp(&distance(a)));
@@ -383,12 +384,8 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         // The simulation runs in the world (the base is posed with the script's motion).
         colliders.update(device, queue, &renderer, &shown, Mat4::IDENTITY, plane_half_size)?;
         // The camera's draws in levels of members that share no pixel (`HerdDraws`).
-        let sphere = |k: usize| {
-            instances.get(k).map_or((Vec3::ZERO, f32::INFINITY), |i| {
-                (i.world_from_model(time_secs).transform_point3(mesh_centre), reach)
-            })
-        };
-        let members: Vec<_> = order.iter().map(|&k| (drivers[k].fur(), sphere(k))).collect();
+        let members: Vec<_> =
+            order.iter().map(|&k| (drivers[k].fur(), spheres[k].unwrap_or((Vec3::ZERO, f32::INFINITY)))).collect();
         plan.prepare((device, queue), &renderer, &view_data, &members);
         let furs: Vec<_> = members.iter().map(|(fur, _)| *fur).collect();
         let image = headless.render_with(

@@ -14,7 +14,7 @@ use std::sync::{Arc, OnceLock};
 use glam::{Mat4, Vec3};
 
 use super::pipeline::{PassKind, PipelineSource, Transparency, create_pipeline};
-use super::{CoatBuilder, FurDrawSettings, FurRenderer};
+use super::{CoatBuilder, FurDrawSettings, FurRenderer, WALKS};
 use crate::fur::{Coat, GpuFur};
 use crate::view::{FurView, ShadowLookups, ViewData, ViewRole};
 
@@ -233,8 +233,6 @@ pub(super) struct PoolCameraPipelines {
     /// By coat, then walk and transparency.
     shells: [OnceLock<[[wgpu::RenderPipeline; 2]; 2]>; Coat::COUNT],
 }
-
-const WALKS: [(&str, bool); 2] = [("wedges", true), ("indexed", false)];
 
 impl CoatBuilder {
     fn pool_camera(

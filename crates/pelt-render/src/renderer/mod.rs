@@ -78,6 +78,10 @@ impl Default for FurDrawSettings {
     }
 }
 
+/// The two ways of walking the base triangles (see `unified.wgsl`), as entry point suffixes:
+/// meshes with uvs by the corners' wedges, meshes without by the base triangles.
+const WALKS: [(&str, bool); 2] = [("wedges", true), ("indexed", false)];
+
 /// The coat-independent pipelines for one way of walking the base triangles (see
 /// `unified.wgsl`).
 #[derive(Debug)]
@@ -148,9 +152,8 @@ impl CoatBuilder {
         };
         // Meshes with uvs walk wedges, meshes without base vertices: each walk's pipelines know
         // which, and drop the other's work.
-        let walks = [("wedges", true), ("indexed", false)];
         let shells = |listed: &str| {
-            walks.map(|(walk, mesh_uvs)| {
+            WALKS.map(|(walk, mesh_uvs)| {
                 let vertex = format!("vs_shell_{walk}{listed}");
                 let fragment = if mesh_uvs { "fs_shell_uvs" } else { "fs_shell_tiles" };
                 Transparency::BOTH

@@ -3,7 +3,7 @@
 
 use std::sync::OnceLock;
 
-use super::{CoatBuilder, FurRenderer, PipelineSource};
+use super::{CoatBuilder, FurRenderer, PipelineSource, WALKS};
 use crate::fur::{Coat, GpuFur};
 use crate::plain::PlainMesh;
 use crate::renderer::FurDrawSettings;
@@ -59,8 +59,6 @@ pub(super) struct ShadowSet {
     /// A pool's casters (`pool_draws.wgsl`), built the first time a herd casts.
     pub(super) pool: OnceLock<PoolCasters>,
 }
-
-const WALKS: [(&str, bool); 2] = [("wedges", true), ("indexed", false)];
 
 /// A pool's shadow pipelines, each drawing every copy of a run of slots at once: their own
 /// module (the shading over a pool) and layout (`Layouts::pool_draws`).
