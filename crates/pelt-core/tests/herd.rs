@@ -228,3 +228,50 @@ fn changing_a_members_stride_keeps_its_strands_whole() {
         }
     }
 }
+
+/// A member whose strands bend elsewhere leaves its skinning to the host: each advance poses its
+/// joints only (placed in the world) and the simulation takes the move unseen; as soon as the CPU
+/// reads the pose (its own bending, a collider) the CPU poses the vertices again.
+#[test]
+fn joint_posing_leaves_the_vertices_to_the_host_while_nothing_reads_them() {
+    let (structure, rig) = fox();
+    let walk = rig.find_animation("Walk").expect("a Walk clip");
+    let instance = pelt_core::sim::HerdInstance {
+        heading_deg: 30.0,
+        speed: 40.0,
+        time_offset_secs: 0.2,
+        ..pelt_core::sim::HerdInstance::at(Vec3::new(100.0, 0.0, -50.0))
+    };
+    let mut stepper = FurStepper::new(&structure, &SimParams::default()).expect("stepper");
+    stepper.set_clip(rig.clone(), Some(walk));
+    stepper.set_placement(Some(instance.clone()));
+    stepper.set_joint_posing(true);
+    // Bending on the CPU reads the roots: the CPU poses.
+    stepper.advance_to(0.05).expect("advance");
+    assert!(stepper.posed_joints().is_none() && stepper.moved_pose().is_some());
+    stepper.simulation_mut().set_cpu_bending(false);
+    let base = stepper.simulation().input_versions().base;
+    let time_secs = 0.1;
+    stepper.advance_with_clip_at(time_secs, instance.clip_time(time_secs)).expect("advance");
+    let joints = stepper.posed_joints().expect("the joints alone are posed");
+    assert!(stepper.moved_pose().is_none(), "no vertices posed on the CPU");
+    assert!(stepper.simulation().base_posed_elsewhere());
+    assert_eq!(stepper.simulation().input_versions().base, base + 1, "the move counts for the kernel that bends");
+    let mut pose = pelt_core::anim::Pose::default();
+    rig.pose_joints(Some(walk), instance.clip_time(time_secs), &mut pose);
+    let placed: Vec<Mat4> =
+        rig.joint_matrices(&pose).iter().map(|m| instance.world_from_model(time_secs) * *m).collect();
+    assert_eq!(joints, &placed[..]);
+    // A collider reads the roots: the CPU poses again, and says so.
+    let ball = pelt_core::sim::Collider::at(
+        7,
+        pelt_core::sim::Shape::Sphere { radius: 5.0 },
+        0.0,
+        Vec3::new(0.0, 1e4, 0.0),
+        Quat::IDENTITY,
+    );
+    stepper.simulation_mut().set_colliders(&[ball]).expect("collider");
+    stepper.advance_to(0.15).expect("advance");
+    assert!(stepper.posed_joints().is_none() && stepper.moved_pose().is_some());
+    assert!(!stepper.simulation().base_posed_elsewhere());
+}

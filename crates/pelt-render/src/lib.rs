@@ -145,7 +145,8 @@ pub use asset::FurAsset;
 pub use camera::Camera;
 pub use colliders::{COLLIDER_COLOUR, ColliderMeshes, HAND_COLOUR, ground_mesh};
 pub use driver::{
-    AUTO_GPU_MARGIN, FurDriver, KernelChoice, SimKernel, cpu_secs_per_step, gpu_secs_per_step, gpu_secs_per_step_of,
+    AUTO_GPU_MARGIN, FurDriver, HerdPosing, KernelChoice, SimKernel, cpu_secs_per_step, gpu_secs_per_step,
+    gpu_secs_per_step_of,
 };
 pub use error::RenderError;
 pub use fur::{FurStates, GpuFur};
@@ -164,9 +165,9 @@ pub use plain::PlainMesh;
 pub use renderer::{FurDrawSettings, FurMotion, FurPrepass, FurRenderer, HerdDraws, MotionData, PrepassTarget};
 pub use requirements::{check_adapter, required_downlevel_flags, required_features, required_limits};
 pub use shaders::{
-    pool_draw_shader_source, prepass_shader_source, shadow_copy_shader_source, silhouette_shader_source,
-    simulation_pooled_shader_source, simulation_shader_source, skinning_shader_source, unified_shader_source,
-    view_lod_shader_source,
+    herd_posing_shader_source, pool_draw_shader_source, prepass_shader_source, shadow_copy_shader_source,
+    silhouette_shader_source, simulation_pooled_shader_source, simulation_shader_source, skinning_shader_source,
+    unified_shader_source, view_lod_shader_source,
 };
 #[cfg(feature = "lab")]
 pub use shaders::{separated_shader_source, strands_shader_source};

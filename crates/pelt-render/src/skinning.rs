@@ -2,7 +2,7 @@
 //! each with its own joint matrices (a herd's members at their own clip times).
 
 use bytemuck::{Pod, Zeroable};
-use glam::{Mat3, Mat4, Vec3};
+use glam::{Mat3, Mat4, Quat, Vec3, Vec4};
 
 use crate::RenderError;
 use crate::requirements::{ErrorScope, check_size};
@@ -23,8 +23,9 @@ struct SkinParams {
 /// A base mesh's rest pose and joint influences on the GPU, and every instance's joint matrices
 /// and posed vertices: [`GpuSkin::set_joints`] per instance, then [`GpuSkin::record`] poses them
 /// all in one compute pass. The blend is `pelt_core::anim`'s (the Rig's or a `Skin`'s): positions
-/// by the joints' matrices, normals by their normal matrices, weighted, the normal renormalised.
-/// Morph targets and the frames' rotations (which the simulation needs) stay on the CPU.
+/// by the joints' matrices, normals by their normal matrices and the fur's frames by the joints'
+/// rotations, weighted, the normal renormalised and the frame turned to meet it. Morph targets
+/// stay on the CPU.
 #[derive(Debug)]
 pub struct GpuSkin {
     pipeline: wgpu::ComputePipeline,
@@ -100,7 +101,7 @@ impl GpuSkin {
             .flat_map(|(p, n)| [p.extend(1.0).to_array(), n.extend(0.0).to_array()])
             .collect();
         let joint_bytes = u64::from(instance_count) * u64::from(joint_total) * 2 * 64;
-        let posed_bytes = u64::from(instance_count) * u64::from(vertex_count) * 2 * 16;
+        let posed_bytes = u64::from(instance_count) * u64::from(vertex_count) * 3 * 16;
         check_size(device, "GPU skinning's joint matrices", joint_bytes)?;
         check_size(device, "GPU skinning's posed vertices", posed_bytes)?;
 
@@ -177,7 +178,8 @@ impl GpuSkin {
     }
 
     /// Sets instance `instance`'s joint matrices (`world(joint) * inverse_bind`, one per joint,
-    /// as `pelt_core::anim::Rig::joint_matrices` gives them) for the next [`GpuSkin::record`].
+    /// as `pelt_core::anim::Rig::joint_matrices` gives them, times the instance's placement when
+    /// it has one) for the next [`GpuSkin::record`].
     ///
     /// # Errors
     /// [`RenderError::Count`] for another number of matrices or an instance past the last;
@@ -203,14 +205,23 @@ impl GpuSkin {
             return Err(RenderError::Target(format!("GPU skinning: joint {joint}'s matrix is not finite")));
         }
         // Normals go by the inverse transpose; a singular joint (scaled to nothing) keeps its
-        // upper 3x3, whose blend the renormalisation then sorts out.
+        // upper 3x3, whose blend the renormalisation then sorts out. The joint's rotation rides in
+        // the normal matrix's fourth column, as `pelt_core::anim` takes it (identity when singular).
         let words: Vec<[f32; 16]> = matrices
             .iter()
             .flat_map(|m| {
                 let upper = Mat3::from_mat4(*m);
                 let normal =
                     if upper.determinant().abs() > f32::MIN_POSITIVE { upper.inverse().transpose() } else { upper };
-                [m.to_cols_array(), Mat4::from_mat3(normal).to_cols_array()]
+                let (scale, rotation, _) = m.to_scale_rotation_translation();
+                let rotation = if scale.abs().min_element() > f32::MIN_POSITIVE && rotation.is_finite() {
+                    rotation.normalize()
+                } else {
+                    Quat::IDENTITY
+                };
+                let mut normal = Mat4::from_mat3(normal);
+                normal.w_axis = Vec4::from(rotation);
+                [m.to_cols_array(), normal.to_cols_array()]
             })
             .collect();
         let offset = (instance * self.joint_count as usize * 2 * 64) as u64;
@@ -227,8 +238,9 @@ impl GpuSkin {
         pass.dispatch_workgroups(self.vertex_count.div_ceil(WORKGROUP), self.instance_count, 1);
     }
 
-    /// The posed vertices: per instance, per vertex, the position (`w` = 1) and the unit normal
-    /// (`w` = 0), each four `f32`s.
+    /// The posed vertices: per instance three sections of four `f32`s per vertex: the positions
+    /// (`w` = 1), the unit normals (`w` = 0), and the rotations from the rest frame (unit
+    /// quaternions, `xyzw`: `pelt_core::anim::Pose::rotations`, the fur's frames).
     #[must_use]
     pub fn posed(&self) -> &wgpu::Buffer {
         &self.posed

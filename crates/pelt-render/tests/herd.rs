@@ -615,3 +615,104 @@ fn a_herds_camera_draws_pool_each_level_as_each_copy_alone() {
     }
     assert!(planned == alone, "the planned herd's picture differs from its copies' alone");
 }
+
+/// A walking herd on the GPU kernel posed on the GPU (`HerdPosing`: the CPU poses joints only)
+/// bends as when the CPU poses every member: after six frames each member's state and base
+/// normals lie within 1e-4 of the Fox's size of the CPU-posed herd's, each member at its own
+/// place, heading and phase. One member keeps its posing on the CPU inside the GPU-posed herd.
+#[test]
+fn a_herd_posed_on_the_gpu_bends_as_posed_on_the_cpu() {
+    use pelt_core::sim::{FurStepper, HerdInstance};
+    let rig = Rig::new(64, 64);
+    assert_eq!(rig.renderer.herd_posing(), is_gpu(&rig), "a GPU poses herds, a CPU rasteriser does not");
+    let (mesh, _, fox) =
+        pelt_core::Mesh::load_animated(&common::asset("Fox.glb"), &pelt_core::ImportOptions::default())
+            .expect("the Fox");
+    let fox = fox.expect("the Fox is rigged");
+    let walk = fox.find_animation("Walk").expect("a Walk clip");
+    let structure = common::grow(mesh, 8, 0.08);
+    let size = 2.0 * structure.mesh.bounding_sphere().1;
+    let textures = strand_textures(32, 8, BROWN_ROOT, BROWN_TIP);
+    let (device, queue) = (rig.device(), rig.queue());
+    let asset = FurAsset::new(device, queue, &rig.renderer, &structure, &textures).expect("asset");
+    const MEMBERS: usize = 3;
+    let instances: Vec<HerdInstance> = (0..MEMBERS)
+        .map(|k| HerdInstance {
+            heading_deg: 70.0 * k as f32 - 40.0,
+            speed: 0.4 * size,
+            time_offset_secs: 0.29 * k as f64,
+            ..HerdInstance::at(Vec3::new(1.5 * size * k as f32, 0.0, 0.0))
+        })
+        .collect();
+    let params = pelt_core::sim::SimParams::default();
+    let herd = |gpu_posing: bool| {
+        let drivers = FurDriver::herd_with_asset(
+            device,
+            queue,
+            &rig.renderer,
+            (&asset, &structure),
+            &params,
+            KernelChoice::Gpu,
+            MEMBERS,
+        )
+        .expect("herd");
+        let steppers: Vec<FurStepper> = instances
+            .iter()
+            .enumerate()
+            .map(|(k, instance)| {
+                let mut stepper = FurStepper::new(&structure, &params).expect("stepper");
+                stepper.set_clip(fox.clone(), Some(walk));
+                stepper.set_placement(Some(instance.clone()));
+                stepper.set_joint_posing(gpu_posing && k != 1);
+                stepper
+            })
+            .collect();
+        (drivers, steppers)
+    };
+    let (mut cpu_drivers, mut cpu_steppers) = herd(false);
+    let (mut gpu_drivers, mut gpu_steppers) = herd(true);
+    let mut posing = pelt_render::HerdPosing::new(device, &structure.mesh, &fox, MEMBERS).expect("posing");
+    for frame in 1..=6 {
+        let time_secs = f64::from(frame) / 20.0;
+        FurDriver::advance_herd((device, queue), &mut cpu_drivers, &mut cpu_steppers, &instances, time_secs)
+            .expect("CPU-posed herd");
+        FurDriver::advance_herd((device, queue), &mut gpu_drivers, &mut gpu_steppers, &instances, time_secs)
+            .expect("GPU-posed herd");
+        posing.prepare((device, queue), &gpu_drivers, &gpu_steppers).expect("posing");
+        assert_eq!(posing.members_on_gpu(), MEMBERS - 1, "frame {frame}");
+        for (k, stepper) in gpu_steppers.iter().enumerate() {
+            assert_eq!(stepper.posed_joints().is_some(), k != 1, "member {k} poses its joints only");
+            assert_eq!(stepper.moved_pose().is_some(), k == 1, "member {k} poses its vertices on the CPU");
+        }
+        let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor::default());
+        posing.record(&mut encoder);
+        FurDriver::record_herd(&mut encoder, &mut gpu_drivers).expect("record");
+        FurDriver::record_herd(&mut encoder, &mut cpu_drivers).expect("record");
+        queue.submit([encoder.finish()]);
+    }
+    let floats = |slice: wgpu::BufferSlice<'_>| -> Vec<f32> {
+        common::read_bytes(device, queue, slice)
+            .chunks_exact(4)
+            .map(|c| f32::from_le_bytes([c[0], c[1], c[2], c[3]]))
+            .collect()
+    };
+    for k in 0..MEMBERS {
+        for (what, tolerance, cpu, gpu) in [
+            (
+                "state",
+                1e-4 * size,
+                floats(cpu_drivers[k].fur().current_positions()),
+                floats(gpu_drivers[k].fur().current_positions()),
+            ),
+            ("normals", 1e-4, floats(cpu_drivers[k].fur().base_normals()), floats(gpu_drivers[k].fur().base_normals())),
+        ] {
+            assert_eq!(cpu.len(), gpu.len());
+            let worst = cpu.iter().zip(&gpu).map(|(a, b)| (a - b).abs()).fold(0.0f32, f32::max);
+            assert!(worst <= tolerance, "member {k}'s {what} differs by {worst} (tolerance {tolerance})");
+            println!("member {k}: {what} within {worst:e}");
+        }
+    }
+    // Each member walks its own way: the states differ.
+    let state = |k: usize| floats(gpu_drivers[k].fur().current_positions());
+    assert!(state(0).iter().zip(state(2)).any(|(a, b)| (a - b).abs() > 0.1 * size), "members 0 and 2 coincide");
+}

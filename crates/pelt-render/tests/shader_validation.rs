@@ -68,6 +68,7 @@ fn every_wgsl_file_is_part_of_a_validated_module() {
         pelt_render::prepass_shader_source(),
         pelt_render::strands_shader_source(),
         pelt_render::skinning_shader_source(),
+        pelt_render::herd_posing_shader_source(),
         pelt_render::shadow_copy_shader_source(),
     ];
     // Every .wgsl under src/, wherever it lies.

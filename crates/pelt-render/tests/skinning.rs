@@ -1,5 +1,6 @@
-//! GPU skinning against pelt-core's CPU skinning: the walking Fox posed at two clip times in one
-//! dispatch, every vertex within 1e-5 of the mesh's size of `pelt_core::anim::Rig::pose`.
+//! GPU skinning against pelt-core's CPU skinning: the walking Fox posed at three clip times in
+//! one dispatch, every vertex within 1e-5 of the mesh's size of `pelt_core::anim::Rig::pose`, its
+//! normal within 1e-4 and its frame's rotation within 1e-3.
 
 use glam::{Mat4, Vec3};
 use pelt_core::anim::Pose;
@@ -8,7 +9,7 @@ use pelt_render::{GpuSkin, RenderError};
 
 use crate::common::{asset, gpu, read_bytes};
 
-/// The posed `[position, normal]` pairs of every instance after one dispatch, read back.
+/// The posed sections (positions, normals, rotations) of every instance after one dispatch.
 fn read_posed(gpu: &pelt_render::Gpu, skin: &GpuSkin) -> Vec<[f32; 4]> {
     let mut encoder = gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor::default());
     skin.record(&mut encoder);
@@ -46,13 +47,20 @@ fn gpu_skinning_agrees_with_pelt_core_for_every_instance_in_one_dispatch() {
     }
     let posed = read_posed(&gpu, &skin);
     let v = mesh.vertex_count();
-    assert_eq!(posed.len(), 2 * v * times.len());
+    assert_eq!(posed.len(), 3 * v * times.len());
     let size = mesh.bounding_sphere().1 * 2.0;
-    let mut worst = (0.0f32, 0.0f32);
+    let mut worst = (0.0f32, 0.0f32, 0.0f32);
     for (instance, pose) in poses.iter().enumerate() {
         for j in 0..v {
-            let p = posed[2 * (instance * v + j)];
-            let n = posed[2 * (instance * v + j) + 1];
+            let p = posed[3 * instance * v + j];
+            let n = posed[3 * instance * v + v + j];
+            // q and -q are one rotation. `Quat::from_rotation_arc` (the correction that takes the
+            // turned rest normal onto the posed one) is the identity below about 7e-4 radians,
+            // so normals a float apart may differ there by that turn: 3.5e-4 in the quaternion.
+            let q = glam::Vec4::from(posed[3 * instance * v + 2 * v + j]);
+            let cpu = glam::Vec4::from(pose.rotations[j]);
+            let rotation_error = (q - cpu).length().min((q + cpu).length());
+            assert!(rotation_error <= 1e-3, "instance {instance} vertex {j}: rotation {q} against {cpu}");
             let position_error = (Vec3::new(p[0], p[1], p[2]) - pose.positions[j]).length() / size;
             let normal_error = (Vec3::new(n[0], n[1], n[2]) - pose.normals[j]).length();
             assert!(
@@ -61,13 +69,13 @@ fn gpu_skinning_agrees_with_pelt_core_for_every_instance_in_one_dispatch() {
                 pose.positions[j]
             );
             assert!(normal_error <= 1e-4, "instance {instance} vertex {j}: normal {n:?} against {}", pose.normals[j]);
-            worst = (worst.0.max(position_error), worst.1.max(normal_error));
+            worst = (worst.0.max(position_error), worst.1.max(normal_error), worst.2.max(rotation_error));
         }
     }
     // The clip moves the Fox: the instances' poses differ, so each read its own matrices.
     let moved = (0..v).filter(|&j| (poses[1].positions[j] - poses[2].positions[j]).length() > 1e-3 * size).count();
     assert!(moved > v / 4, "{moved} of {v} vertices moved between the two times");
-    println!("worst position error {:e} of the Fox's size, normal {:e}", worst.0, worst.1);
+    println!("worst position error {:e} of the Fox's size, normal {:e}, rotation {:e}", worst.0, worst.1, worst.2);
 }
 
 #[test]

@@ -153,6 +153,8 @@ pub struct Simulation {
     versions: InputVersions,
     /// The roots changed since the last step.
     roots_moved: bool,
+    /// The base last moved through [`Simulation::set_base_posed_elsewhere`].
+    posed_elsewhere: bool,
     /// The touch began on the roots of the newest step.
     touch_on_step_roots: bool,
     /// Each strand's skin planes (see `contact::skin`).
@@ -259,6 +261,7 @@ impl Simulation {
                 ..InputVersions::default()
             },
             roots_moved: false,
+            posed_elsewhere: false,
             touch_on_step_roots: false,
             surface,
             skin_lanes: skin_lanes(&skin),
@@ -364,6 +367,7 @@ impl Simulation {
     pub fn set_base(&mut self, positions: &[Vec3], normals: &[Vec3]) -> Result<(), SimError> {
         self.check_base(positions, normals, "the base normals")?;
         self.moved_base();
+        self.posed_elsewhere = false;
         self.roots.copy_from_slice(positions);
         for ((frame, rest), normal) in self.frames.iter_mut().zip(&self.rest_normals).zip(normals) {
             *frame = match (rest.try_normalize(), normal.try_normalize()) {
@@ -386,11 +390,30 @@ impl Simulation {
             return Err(SimError::NonFinite { what: "the base rotations", value: bad.to_string() });
         }
         self.moved_base();
+        self.posed_elsewhere = false;
         self.roots.copy_from_slice(positions);
         for (frame, rotation) in self.frames.iter_mut().zip(rotations) {
             *frame = rotation.normalize();
         }
         Ok(())
+    }
+
+    /// Marks the base as moved by a pose this simulation never sees: a kernel that bends
+    /// elsewhere (`pelt_render::GpuSimulation`) reads roots and frames posed on its own device
+    /// (`pelt_render::HerdPosing`). The steps take the move as [`Simulation::set_base_rotations`]
+    /// does, but [`Simulation::roots`] and [`Simulation::frames`] keep the last pose given here,
+    /// so what reads them on the CPU (the CPU's bending, a touch's weights, wetness, the inertia's
+    /// teleport check) must not run meanwhile.
+    pub fn set_base_posed_elsewhere(&mut self) {
+        self.moved_base();
+        self.posed_elsewhere = true;
+    }
+
+    /// Whether the base last moved through [`Simulation::set_base_posed_elsewhere`]: the roots
+    /// and frames here are not the current ones.
+    #[must_use]
+    pub fn base_posed_elsewhere(&self) -> bool {
+        self.posed_elsewhere
     }
 
     fn moved_base(&mut self) {

@@ -58,6 +58,10 @@ pub struct FurStepper {
     wet_normals: Vec<Vec3>,
     /// Where a herd's host placed this copy of the fur (after the script's motion).
     placement: Option<HerdInstance>,
+    /// The host's GPU skins the base when it can ([`FurStepper::set_joint_posing`]).
+    joint_posing: bool,
+    /// The last advance posed the joints only: `world_from_model * world(joint) * inverse_bind`.
+    joints: Option<Vec<Mat4>>,
 }
 
 /// Ids of the colliders a [`FurStepper`]'s body gives the simulation (capsule `k` is this plus
@@ -94,6 +98,8 @@ impl FurStepper {
             wet: WetParams::default(),
             wet_normals: Vec::new(),
             placement: None,
+            joint_posing: false,
+            joints: None,
         })
     }
 
@@ -123,6 +129,38 @@ impl FurStepper {
             .par_iter_mut()
             .zip(instances)
             .try_for_each(|(stepper, instance)| stepper.advance_with_clip_at(time_secs, instance.clip_time(time_secs)))
+    }
+
+    /// Leaves the skinning of the base to the host's GPU (`pelt_render::HerdPosing`) whenever
+    /// nothing on the CPU reads the posed vertices: a rig without morph targets poses its joints
+    /// only ([`FurStepper::posed_joints`]) and the simulation takes the move unseen
+    /// ([`Simulation::set_base_posed_elsewhere`]), while its strands are bent elsewhere, with no
+    /// body, touch, grasp, collider or wetness. Otherwise (and when off) the CPU poses as before.
+    pub fn set_joint_posing(&mut self, on: bool) {
+        self.joint_posing = on;
+    }
+
+    /// The joint matrices of the last advance's pose, placed in the world
+    /// (`world_from_model * world(joint) * inverse_bind`, in the rig's palette order), when that
+    /// advance left the vertices to the host ([`FurStepper::set_joint_posing`]); `None` when it
+    /// posed them here or did not pose.
+    #[must_use]
+    pub fn posed_joints(&self) -> Option<&[Mat4]> {
+        self.joints.as_deref()
+    }
+
+    /// Whether this advance poses the joints only (see [`FurStepper::set_joint_posing`]).
+    fn poses_joints_only(&self) -> bool {
+        let simulation = &self.simulation;
+        self.joint_posing
+            && matches!(&self.posing, Posing::Rig { rig, .. } if rig.morph_target_count() == 0)
+            && self.body.is_none()
+            && !simulation.cpu_bending()
+            && simulation.touch().is_none()
+            && simulation.grasp().is_none()
+            && simulation.colliders().is_empty()
+            && self.wetness.is_dry()
+            && self.scene.as_ref().is_none_or(|scene| scene.wet_sources().is_empty())
     }
 
     /// Steps this fur every `stride`-th fixed step (1, 2 or 4), interpolated between:
@@ -217,6 +255,8 @@ impl FurStepper {
         };
         self.world_from_model = world_from_model;
         self.moved = std::mem::take(&mut self.host_posed);
+        self.joints = None;
+        let joints_only = self.poses_joints_only();
         // A rig poses once after a change of clip even when nothing plays (back to its rest).
         let rig_jumps = matches!(self.posing, Posing::Rig { .. }) && self.restart_pending;
         // A fur stepped less often is posed only for its steps: between them nothing reads
@@ -227,6 +267,12 @@ impl FurStepper {
             && !self.simulation.steps_at(time_secs);
         if (self.moves() || rig_jumps) && !between_steps {
             match &self.posing {
+                Posing::Rig { rig, clip } if joints_only => {
+                    rig.pose_joints(*clip, clip_time_secs, &mut self.pose);
+                    let placed = rig.joint_matrices(&self.pose).into_iter().map(|m| world_from_model * m);
+                    self.joints = Some(placed.collect());
+                    self.moved = true;
+                }
                 Posing::Rig { rig, clip } => {
                     rig.pose(&self.mesh, *clip, clip_time_secs, &mut self.pose);
                     transform_pose(&mut self.pose, world_from_model);
@@ -257,7 +303,11 @@ impl FurStepper {
                 self.simulation.set_colliders(&colliders)?;
             }
             if self.moved && !matches!(self.posing, Posing::Host) {
-                self.simulation.set_base_rotations(&self.pose.positions, &self.pose.rotations)?;
+                if self.joints.is_some() {
+                    self.simulation.set_base_posed_elsewhere();
+                } else {
+                    self.simulation.set_base_rotations(&self.pose.positions, &self.pose.rotations)?;
+                }
                 // The wetness on the new pose, before a restart computes its states with it.
                 self.advance_wetness(time_secs)?;
                 if std::mem::take(&mut self.restart_pending) {
@@ -367,10 +417,11 @@ impl FurStepper {
         Ok(())
     }
 
-    /// The base's pose when it moved in the last step (its normals shade the skin), else `None`.
+    /// The base's pose when it moved in the last step (its normals shade the skin), else `None`;
+    /// `None` too when the host poses the vertices ([`FurStepper::posed_joints`]).
     #[must_use]
     pub fn moved_pose(&self) -> Option<&Pose> {
-        self.moved.then_some(&self.pose)
+        (self.moved && self.joints.is_none()).then_some(&self.pose)
     }
 
     /// The script's rigid transform at the last step (identity without motion): plain meshes

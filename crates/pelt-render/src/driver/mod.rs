@@ -6,6 +6,7 @@
 //! steps and the silhouette fins) and [`FurDriver::draw`] (into the host's pass).
 
 mod herd;
+mod posing;
 mod timing;
 mod upload;
 
@@ -16,6 +17,7 @@ use pelt_core::FurStructure;
 use pelt_core::sim::{FurStepper, SimError, SimParams, Simulation};
 use pelt_core::texture::FurTextures;
 
+pub use posing::HerdPosing;
 use timing::{TIMING_RUNS, TIMING_STEPS};
 pub use timing::{cpu_secs_per_step, gpu_secs_per_step, gpu_secs_per_step_of};
 

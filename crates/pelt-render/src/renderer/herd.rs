@@ -75,6 +75,20 @@ impl FurRenderer {
         self.pooled_stepping = pooled;
     }
 
+    /// Whether a host poses the bases of a herd bending on the GPU kernel on the GPU
+    /// ([`crate::HerdPosing`]: the CPU poses joints only): by default on a discrete or
+    /// integrated GPU. A CPU rasteriser runs the skinning on the cores the CPU's posing would
+    /// use, and slower.
+    #[must_use]
+    pub fn herd_posing(&self) -> bool {
+        self.herd_posing
+    }
+
+    /// Sets [`FurRenderer::herd_posing`].
+    pub fn set_herd_posing(&mut self, on: bool) {
+        self.herd_posing = on;
+    }
+
     /// A run of copies in consecutive slots of one pool in one pass of a shadow map
     /// ([`cast_together`]): one draw of what each would draw alone.
     fn draw_pool_shadow(

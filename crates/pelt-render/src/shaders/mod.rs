@@ -60,6 +60,8 @@ const SIMULATION_POOLED_WGSL: &str = include_str!("simulation_pooled.wgsl");
 const SHADOW_COPY_WGSL: &str = include_str!("shadow_copy.wgsl");
 /// Linear blend skinning of many instances (`GpuSkin`).
 const SKINNING_WGSL: &str = include_str!("skinning.wgsl");
+/// A herd's skinned bases placed into its members' inputs (`HerdPosing`).
+const HERD_POSING_WGSL: &str = include_str!("herd_posing.wgsl");
 /// The separated structure of Lengyel et al. 2001 (the `lab` feature's baseline).
 #[cfg(feature = "lab")]
 const SEPARATED_WGSL: &str = include_str!("separated.wgsl");
@@ -135,6 +137,12 @@ pub fn shadow_copy_shader_source() -> String {
 #[must_use]
 pub fn skinning_shader_source() -> String {
     SKINNING_WGSL.to_owned()
+}
+
+/// The WGSL module placing a herd's skinned bases into its members' inputs (`herd_posing.wgsl`).
+#[must_use]
+pub fn herd_posing_shader_source() -> String {
+    HERD_POSING_WGSL.to_owned()
 }
 
 /// The WGSL module of the GPU simulation (`simulation_wind.wgsl`, `simulation.wgsl` and

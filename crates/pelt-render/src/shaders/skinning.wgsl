@@ -1,7 +1,8 @@
 // Linear blend skinning of a base mesh for many instances in one dispatch (`GpuSkin`): x is the
 // base vertex, y the instance. The same blend as `pelt_core::anim` (positions by the joints'
-// matrices, normals by their normal matrices, both weighted, the normal renormalised); morph
-// targets and the frames' rotations stay on the CPU.
+// matrices, normals by their normal matrices, rotations by their quaternions, all weighted; the
+// normal renormalised, the rotation corrected to take the rest normal onto it); morph targets
+// stay on the CPU.
 
 struct SkinParams {
     vertex_count: u32,
@@ -15,10 +16,40 @@ struct SkinParams {
 @group(0) @binding(1) var<storage, read> rest: array<vec4<f32>>;
 // Per vertex: four joints, then their four weights' bits.
 @group(0) @binding(2) var<storage, read> influences: array<vec4<u32>>;
-// Per instance and joint: its skinning matrix, then its normal matrix.
+// Per instance and joint: its skinning matrix, then its normal matrix with the joint's rotation
+// (a unit quaternion, xyzw) in the fourth column, which a normal (w = 0) never reads.
 @group(0) @binding(3) var<storage, read> joints: array<mat4x4<f32>>;
-// Per instance and vertex: the posed position (w = 1), the posed unit normal (w = 0).
+// Per instance, three sections of a vec4 per vertex: the posed positions (w = 1), the posed unit
+// normals (w = 0), the rotations from the rest frame (xyzw).
 @group(0) @binding(4) var<storage, read_write> posed: array<vec4<f32>>;
+
+// `glam::Quat`'s product `a * b`.
+fn quat_mul(a: vec4<f32>, b: vec4<f32>) -> vec4<f32> {
+    return vec4<f32>(a.w * b.xyz + b.w * a.xyz + cross(a.xyz, b.xyz), a.w * b.w - dot(a.xyz, b.xyz));
+}
+
+// `glam::Quat::mul_vec3`.
+fn quat_rotate(q: vec4<f32>, v: vec3<f32>) -> vec3<f32> {
+    let t = 2.0 * cross(q.xyz, v);
+    return v + q.w * t + cross(q.xyz, t);
+}
+
+// `glam::Quat::from_rotation_arc` for unit vectors: the shortest rotation from `start` to `end`.
+fn rotation_arc(start: vec3<f32>, end: vec3<f32>) -> vec4<f32> {
+    let one_minus_eps = 1.0 - 2.0 * 1.1920929e-7;
+    let d = dot(start, end);
+    if d > one_minus_eps {
+        return vec4<f32>(0.0, 0.0, 0.0, 1.0);
+    }
+    if d < -one_minus_eps {
+        // Half a turn about `Vec3::any_orthonormal_vector`.
+        let sign = select(-1.0, 1.0, start.z >= 0.0);
+        let a = -1.0 / (sign + start.z);
+        let b = start.x * start.y * a;
+        return vec4<f32>(b, sign + start.y * start.y * a, -start.y, 0.0);
+    }
+    return normalize(vec4<f32>(cross(start, end), 1.0 + d));
+}
 
 @compute @workgroup_size(64)
 fn skin(@builtin(global_invocation_id) id: vec3<u32>) {
@@ -32,8 +63,10 @@ fn skin(@builtin(global_invocation_id) id: vec3<u32>) {
     let joint = influences[2u * vertex];
     let weight = bitcast<vec4<f32>>(influences[2u * vertex + 1u]);
     let first = instance * params.joint_count;
+    let first_rotation = joints[2u * (first + min(joint[0], params.joint_count - 1u)) + 1u][3];
     var blended_position = vec3<f32>(0.0);
     var blended_normal = vec3<f32>(0.0);
+    var blended_rotation = vec4<f32>(0.0);
     for (var k = 0u; k < 4u; k++) {
         // Unused slots weigh 0 and may name any joint: skip them, as the CPU does.
         let w = weight[k];
@@ -41,12 +74,26 @@ fn skin(@builtin(global_invocation_id) id: vec3<u32>) {
             let at = 2u * (first + min(joint[k], params.joint_count - 1u));
             blended_position += (joints[at] * position).xyz * w;
             blended_normal += (joints[at + 1u] * normal).xyz * w;
+            // q and -q are one rotation: blend on the first joint's side.
+            let q = joints[at + 1u][3];
+            blended_rotation += q * (w * select(1.0, -1.0, dot(q, first_rotation) < 0.0));
         }
     }
-    // A degenerate blend (opposed joints cancelling) keeps the rest normal.
+    let rotation_squared = dot(blended_rotation, blended_rotation);
+    let q = select(vec4<f32>(0.0, 0.0, 0.0, 1.0), blended_rotation * inverseSqrt(rotation_squared), rotation_squared > 1e-24);
+    let turned_rest = quat_rotate(q, normal.xyz);
+    // A degenerate blend (opposed joints cancelling) keeps the turned rest normal.
     let length_squared = dot(blended_normal, blended_normal);
-    let unit = select(normal.xyz, blended_normal * inverseSqrt(length_squared), length_squared > 1e-24);
-    let out = 2u * (instance * params.vertex_count + vertex);
+    let unit = select(turned_rest, blended_normal * inverseSqrt(length_squared), length_squared > 1e-24);
+    // The blended rotation, corrected to take the rest normal exactly onto the posed normal.
+    let turned_squared = dot(turned_rest, turned_rest);
+    var rotation = q;
+    if turned_squared > 1e-24 {
+        rotation = normalize(quat_mul(rotation_arc(turned_rest * inverseSqrt(turned_squared), unit), q));
+    }
+    let v = params.vertex_count;
+    let out = 3u * instance * v + vertex;
     posed[out] = vec4<f32>(blended_position, 1.0);
-    posed[out + 1u] = vec4<f32>(unit, 0.0);
+    posed[out + v] = vec4<f32>(unit, 0.0);
+    posed[out + 2u * v] = rotation;
 }

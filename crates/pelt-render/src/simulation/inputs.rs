@@ -63,7 +63,11 @@ impl GpuSimulation {
         let stability_changed = old.is_none_or(|(_, stability)| {
             inputs.stability_map.is_none() && stability.to_bits() != inputs.stability.to_bits()
         });
-        if changed(|x| x.base) || changed(|x| x.stability) || stability_changed {
+        // A base posed on the GPU (`HerdPosing`) has its roots and frames written there, each
+        // frame; the roots' section is still written here for its stability (w), the posing
+        // then writing over the positions it holds.
+        let base_here = changed(|x| x.base) && !simulation.base_posed_elsewhere();
+        if base_here || changed(|x| x.stability) || stability_changed {
             let roots: Vec<[f32; 4]> = inputs
                 .roots
                 .iter()
@@ -72,7 +76,7 @@ impl GpuSimulation {
                 .collect();
             queue.write_buffer(buffer, at, bytemuck::cast_slice(&roots));
         }
-        if changed(|x| x.base) {
+        if base_here {
             let frames: Vec<[f32; 4]> = inputs.frames.iter().map(|frame| frame.to_array()).collect();
             queue.write_buffer(buffer, at + v * 16, bytemuck::cast_slice(&frames));
         }
@@ -92,5 +96,13 @@ impl GpuSimulation {
         self.touch_uploaded = touch_uploaded;
         self.uploaded = Some((versions, inputs.stability));
         self.wet.upload(queue, (&self.pool.wet, self.ranges[2]), &inputs);
+    }
+}
+
+impl GpuSimulation {
+    /// The buffer holding this fur's resident inputs and where its posed roots start in it (the
+    /// frames follow, `V` `vec4`s on), for a posing that writes them on the GPU.
+    pub(crate) fn posed_inputs(&self) -> (&wgpu::Buffer, u64) {
+        (&self.pool.strands, self.ranges[0].at)
     }
 }

@@ -1,0 +1,241 @@
+//! [`HerdPosing`]: a herd's bases skinned on the GPU, every member in one dispatch, and placed
+//! into the members' simulation inputs and base normals in a second, so a GPU-kernel herd's CPU
+//! poses joints only.
+
+use bytemuck::{Pod, Zeroable};
+use pelt_core::Mesh;
+use pelt_core::anim::Rig;
+use pelt_core::sim::FurStepper;
+
+use super::FurDriver;
+use crate::RenderError;
+use crate::requirements::ErrorScope;
+use crate::shaders::herd_posing_shader_source;
+use crate::skinning::GpuSkin;
+
+/// Vertices one workgroup places (`herd_posing.wgsl`'s `workgroup_size`).
+const WORKGROUP: u32 = 64;
+
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct PlaceParams {
+    vertex_count: u32,
+    rows: u32,
+    padding: [u32; 2],
+}
+
+/// The bases of a herd's members skinned on the GPU ([`GpuSkin`]): each frame the CPU poses
+/// each member's joints only ([`FurStepper::set_joint_posing`], [`FurStepper::posed_joints`]),
+/// and [`HerdPosing::record`] skins every member in one dispatch and writes the posed roots,
+/// frames and normals where the member's GPU simulation and skin read them in another.
+///
+/// For members made together ([`FurDriver::herd_with_asset`]) that bend on the GPU kernel. A
+/// member its stepper posed on the CPU (a touch, a collider, wetness: see
+/// [`FurStepper::set_joint_posing`]) keeps the CPU's pose until its stepper poses joints again.
+///
+/// Per frame: [`FurDriver::advance_herd`], [`HerdPosing::prepare`], then [`HerdPosing::record`]
+/// and [`FurDriver::record_herd`] into one encoder, in that order.
+#[derive(Debug)]
+pub struct HerdPosing {
+    skin: GpuSkin,
+    pipeline: wgpu::ComputePipeline,
+    layout: wgpu::BindGroupLayout,
+    params: wgpu::Buffer,
+    table: wgpu::Buffer,
+    /// The rows written to `table`: skin instance, roots' first `vec4`, normals' first `f32`.
+    rows: Vec<[u32; 4]>,
+    /// The bind group, by the strands and normals buffers it writes.
+    bind_group: Option<((wgpu::Buffer, wgpu::Buffer), wgpu::BindGroup)>,
+    /// Whether each member's last pose is the GPU's.
+    on_gpu: Vec<bool>,
+}
+
+impl HerdPosing {
+    /// GPU posing for a herd of `members` copies of `mesh` (the rest base every member's fur
+    /// grew on) skinned by `rig`.
+    ///
+    /// # Errors
+    /// [`RenderError::Count`] for a rig of another mesh or no members; as [`GpuSkin::new`].
+    pub fn new(device: &wgpu::Device, mesh: &Mesh, rig: &Rig, members: usize) -> Result<Self, RenderError> {
+        if rig.vertex_count() != mesh.vertex_count() {
+            return Err(RenderError::Count {
+                what: "rig vertices",
+                expected: mesh.vertex_count(),
+                got: rig.vertex_count(),
+                rule: "the rig of the mesh the fur grew on",
+            });
+        }
+        let skin = GpuSkin::new(
+            device,
+            (&mesh.positions, &mesh.normals),
+            &rig.vertex_influences(),
+            rig.joint_count(),
+            members,
+        )?;
+        let scope = ErrorScope::push(device);
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("pelt herd posing"),
+            source: wgpu::ShaderSource::Wgsl(herd_posing_shader_source().into()),
+        });
+        let buffer = |binding, ty| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: wgpu::ShaderStages::COMPUTE,
+            ty: wgpu::BindingType::Buffer { ty, has_dynamic_offset: false, min_binding_size: None },
+            count: None,
+        };
+        let storage = |read_only| wgpu::BufferBindingType::Storage { read_only };
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("pelt herd posing"),
+            entries: &[
+                buffer(0, wgpu::BufferBindingType::Uniform),
+                buffer(1, storage(true)),
+                buffer(2, storage(true)),
+                buffer(3, storage(false)),
+                buffer(4, storage(false)),
+            ],
+        });
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("pelt herd posing"),
+            bind_group_layouts: &[Some(&layout)],
+            immediate_size: 0,
+        });
+        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some("pelt herd posing"),
+            layout: Some(&pipeline_layout),
+            module: &module,
+            entry_point: Some("place"),
+            compilation_options: wgpu::PipelineCompilationOptions::default(),
+            cache: None,
+        });
+        let params = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("pelt herd posing params"),
+            size: size_of::<PlaceParams>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let table = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("pelt herd posing table"),
+            size: (members.max(1) * 16) as u64,
+            usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        scope.pop("creating the herd's GPU posing")?;
+        Ok(Self {
+            skin,
+            pipeline,
+            layout,
+            params,
+            table,
+            rows: Vec::new(),
+            bind_group: None,
+            on_gpu: vec![false; members],
+        })
+    }
+
+    /// Takes each member's last advance: the joints of those whose stepper posed joints only,
+    /// for [`HerdPosing::record`]; a member its stepper posed on the CPU (or that bends on the
+    /// CPU) is left as the CPU wrote it.
+    ///
+    /// # Errors
+    /// [`RenderError::Count`] unless there is one driver and stepper per member, or when the
+    /// members posed here do not share their simulation's and skin's buffers (made apart); as
+    /// [`GpuSkin::set_joints`].
+    pub fn prepare(
+        &mut self,
+        (device, queue): (&wgpu::Device, &wgpu::Queue),
+        drivers: &[FurDriver],
+        steppers: &[FurStepper],
+    ) -> Result<(), RenderError> {
+        for (what, got) in [("drivers of a posed herd", drivers.len()), ("steppers of a posed herd", steppers.len())] {
+            if got != self.on_gpu.len() {
+                return Err(RenderError::Count { what, expected: self.on_gpu.len(), got, rule: "one per member" });
+            }
+        }
+        let mut rows = Vec::with_capacity(self.rows.len());
+        let mut buffers: Option<(&wgpu::Buffer, &wgpu::Buffer)> = None;
+        for (k, (driver, stepper)) in drivers.iter().zip(steppers).enumerate() {
+            let Some(simulation) = &driver.gpu_simulation else {
+                self.on_gpu[k] = false;
+                continue;
+            };
+            if let Some(joints) = stepper.posed_joints() {
+                self.skin.set_joints(queue, k, joints)?;
+                self.on_gpu[k] = true;
+            } else if stepper.moved_pose().is_some() {
+                self.on_gpu[k] = false;
+            }
+            if !self.on_gpu[k] {
+                continue;
+            }
+            let (strands, roots_at) = simulation.posed_inputs();
+            let normals = driver.fur.base_normals();
+            match buffers {
+                None => buffers = Some((strands, normals.buffer())),
+                Some((s, n)) if s == strands && n == normals.buffer() => {}
+                Some(_) => {
+                    return Err(RenderError::Count {
+                        what: "buffers of a posed herd",
+                        expected: 1,
+                        got: 2,
+                        rule: "members made together (FurDriver::herd_with_asset)",
+                    });
+                }
+            }
+            let word = |bytes: u64, size: u64| u32::try_from(bytes / size).unwrap_or(u32::MAX);
+            rows.push([k as u32, word(roots_at, 16), word(normals.offset(), 4), 0]);
+        }
+        if let Some((strands, normals)) = buffers
+            && self.bind_group.as_ref().is_none_or(|((s, n), _)| s != strands || n != normals)
+        {
+            let scope = ErrorScope::push(device);
+            let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+                label: Some("pelt herd posing"),
+                layout: &self.layout,
+                entries: &[&self.params, self.skin.posed(), &self.table, strands, normals]
+                    .iter()
+                    .zip(0..)
+                    .map(|(buffer, binding)| wgpu::BindGroupEntry { binding, resource: buffer.as_entire_binding() })
+                    .collect::<Vec<_>>(),
+            });
+            scope.pop("binding the herd's GPU posing")?;
+            self.bind_group = Some(((strands.clone(), normals.clone()), bind_group));
+        }
+        if rows != self.rows {
+            queue.write_buffer(&self.table, 0, bytemuck::cast_slice(&rows));
+            let params =
+                PlaceParams { vertex_count: self.skin.vertex_count() as u32, rows: rows.len() as u32, padding: [0; 2] };
+            queue.write_buffer(&self.params, 0, bytemuck::bytes_of(&params));
+            self.rows = rows;
+        }
+        Ok(())
+    }
+
+    /// Records the skinning of every member and the placing of those posed on the GPU: two
+    /// dispatches (none when no member is), before [`FurDriver::record_herd`]. Members are
+    /// placed every frame, so a root section rewritten for a new stability gets its position
+    /// back.
+    pub fn record(&self, encoder: &mut wgpu::CommandEncoder) {
+        let Some((_, bind_group)) = self.bind_group.as_ref().filter(|_| !self.rows.is_empty()) else { return };
+        self.skin.record(encoder);
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("pelt herd posing"),
+            timestamp_writes: None,
+        });
+        pass.set_pipeline(&self.pipeline);
+        pass.set_bind_group(0, bind_group, &[]);
+        let vertices = self.skin.vertex_count() as u32;
+        pass.dispatch_workgroups(vertices.div_ceil(WORKGROUP), self.rows.len() as u32, 1);
+    }
+
+    /// Members whose last pose is the GPU's.
+    #[must_use]
+    pub fn members_on_gpu(&self) -> usize {
+        self.rows.len()
+    }
+
+    /// GPU bytes: the skin's buffers, the table and its uniform.
+    #[must_use]
+    pub fn gpu_bytes(&self) -> u64 {
+        self.skin.bytes() + self.table.size() + self.params.size()
+    }
+}
