@@ -92,9 +92,13 @@ pub struct Args {
     #[arg(long, conflicts_with_all = ["soak", "contact", "guard"])]
     pub herd: bool,
     /// With --herd: where the Foxes' strands bend, cpu (one parallel pass; auto too, as for
-    /// `pelt render --herd`) or gpu (each Fox's kernel, the bases still posed on the CPU).
+    /// `pelt render --herd`) or gpu (each Fox's kernel; on a GPU their bases skinned there).
     #[arg(long, value_enum, default_value_t = crate::sim_kernel::SimChoice::Cpu, requires = "herd")]
     pub sim: crate::sim_kernel::SimChoice,
+    /// With --herd: how the Foxes share the GPU's work, as `pelt render --pooling` (auto: pooled
+    /// on a GPU, a Fox at a time on a CPU rasteriser).
+    #[arg(long, value_enum, default_value_t = crate::herd::Pooling::Auto, requires = "herd")]
+    pub pooling: crate::herd::Pooling,
     /// Instead of the report: every figure that needs a real GPU, written to FILE as JSON in a
     /// few minutes on one (frames at 1920x1080 with the adapter's MSAA, shadows on and off, herds
     /// of 100 and 1,000 Foxes, the GPU kernel on the 35,000-vertex torus, contact's share);
@@ -203,7 +207,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
             crate::sim_kernel::SimChoice::Gpu => pelt_render::SimKernel::Gpu,
             _ => pelt_render::SimKernel::Cpu,
         };
-        return herd::run(args.quick, &meshes, args.json.as_deref(), kernel);
+        return herd::run(args.quick, &meshes, args.json.as_deref(), (kernel, args.pooling.forced()));
     }
     if args.load {
         return load::run(&models::meshes_dir(args.meshes.as_deref()), &args.load_meshes);

@@ -13,7 +13,7 @@ use pelt_core::sim::{FurStepper, Scene, SceneCamera, WindParams};
 use pelt_core::{Builtin, FurStructure, Mesh, Preset, Stage};
 use pelt_render::{
     Backend, Camera, ColliderMeshes, FurAsset, FurDrawSettings, FurDriver, FurLook, FurTarget, FurView, Gpu,
-    HEADLESS_FORMAT, Headless, HerdDraws, KernelChoice, PlainMesh, SAMPLE_COUNT, default_sample_count,
+    HEADLESS_FORMAT, Headless, HerdDraws, HerdPosing, KernelChoice, PlainMesh, SAMPLE_COUNT, default_sample_count,
 };
 
 use crate::light_args::{LightArgs, preset_look};
@@ -78,6 +78,10 @@ pub struct Args {
     /// this fur first, the GPU when clearly faster, so one command draws the same bytes).
     #[arg(long, value_enum, default_value_t = SimChoice::Auto)]
     sim: SimChoice,
+    /// How a herd's copies share the GPU's work: shadow casters and the camera's draws pooled,
+    /// the GPU kernel's steps in one dispatch, the bases skinned on the GPU (auto: on a GPU).
+    #[arg(long, value_enum, default_value_t = crate::herd::Pooling::Auto)]
+    pooling: crate::herd::Pooling,
     /// Shells and fins with alpha-to-coverage instead of blending (needs MSAA: 4 unless --msaa says more).
     #[arg(long)]
     alpha_to_coverage: bool,
@@ -103,7 +107,8 @@ pub struct Args {
     shadows: crate::shadows::ShadowArgs,
     /// A herd: N copies of the fur scattered on a ground, each at its own phase of the clip,
     /// posed in one parallel pass and simulated there on the CPU, or on the GPU with --sim gpu
-    /// (a script's [[instance]] tables place them instead).
+    /// (posed there too on a GPU; see --pooling) (a script's [[instance]] tables place them
+    /// instead).
     #[arg(long, value_name = "N")]
     herd: Option<usize>,
     /// Output: a .png (one frame), a .gif (animated) or a folder (numbered PNGs).
@@ -197,7 +202,8 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     let headless =
         Headless::with_target(gpu, FurTarget::new(HEADLESS_FORMAT).with_sample_count(samples), width, height)?;
     let (device, queue) = (&headless.gpu.device, &headless.gpu.queue);
-    let renderer = headless.renderer()?;
+    let mut renderer = headless.renderer()?;
+    args.pooling.apply(&mut renderer);
     let asset = FurAsset::new(device, queue, &renderer, &fur, &textures)?;
     // A herd poses its bases in one parallel pass and bends on the CPU there unless asked for the
     // GPU (timing one fur's kernels says little of a hundred's); one fur on the kernel asked for.
@@ -245,6 +251,16 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
     if let (Some(body), Some(mesh), [stepper]) = (&body, plain.first(), &mut steppers[..]) {
         stepper.set_body(Some((mesh.clone(), body.rig.clone(), body.capsules.clone())));
     }
+    // On a GPU a herd that bends there is posed there too: the CPU poses joints only.
+    let mut posing = match rig.as_ref() {
+        Some(rig) if !instances.is_empty() && kernel == KernelChoice::Gpu && renderer.herd_posing() => {
+            for stepper in &mut steppers {
+                stepper.set_joint_posing(true);
+            }
+            Some(HerdPosing::new(device, &fur.mesh, rig, members)?)
+        }
+        _ => None,
+    };
     let stepper = &steppers[0];
     let moves = stepper.moves();
     let plain_meshes = plain
@@ -371,6 +387,10 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         // The simulation's GPU steps in a submission of their own: the frame's closures below
         // only read the driver.
         let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("simulation") });
+        if let Some(posing) = &mut posing {
+            posing.prepare((device, queue), &drivers, &steppers)?;
+            posing.record(&mut encoder);
+        }
         FurDriver::record_herd(&mut encoder, &mut drivers)?;
         queue.submit([encoder.finish()]);
         if moves {
@@ -455,6 +475,7 @@ pub fn run(args: &Args) -> anyhow::Result<()> {
         per_frame(simulation_time),
         drivers[0].kernel(),
         match args.sim {
+            SimChoice::Gpu if posing.is_some() => "a herd, --sim gpu, posed on the GPU".to_owned(),
             SimChoice::Gpu if !instances.is_empty() => "a herd, --sim gpu, posed in one parallel pass".to_owned(),
             _ if !instances.is_empty() => "a herd, in one parallel pass".to_owned(),
             SimChoice::Auto => drivers[0].kernel_reason().to_owned(),

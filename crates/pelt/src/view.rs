@@ -52,6 +52,10 @@ pub struct Args {
     /// copies bend where the edited fur does. The panel switches it live.
     #[arg(long, value_enum, default_value_t = crate::sim_kernel::SimChoice::Auto)]
     pub sim: crate::sim_kernel::SimChoice,
+    /// How a herd's copies share the GPU's work, as `pelt render --pooling` (auto: pooled on a
+    /// GPU: shadow casters, camera draws, GPU steps, the bases skinned on the GPU).
+    #[arg(long, value_enum, default_value_t = crate::herd::Pooling::Auto)]
+    pub pooling: crate::herd::Pooling,
     /// Every shell and fin segment however small the fur is on screen (the preset's
     /// `[render.lod]` is on by default; the overlay shows the level in use).
     #[arg(long)]

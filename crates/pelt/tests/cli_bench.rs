@@ -315,9 +315,15 @@ fn device_report_writes_every_part() {
     assert_eq!(sizes[..4], expected);
     assert_eq!(sizes[4..], [("gpu", 1, on), ("gpu", 2, on), ("gpu", 1, off), ("gpu", 2, off)]);
     herd.iter().for_each(|row| positive(&row["frame_ms"], "herd frame_ms"));
+    // The GPU kernel's pooled herds skin their bases on the GPU, their bytes counted.
+    for (k, row) in herd.iter().enumerate() {
+        let posed = (4..6).contains(&k);
+        assert_eq!(row["gpu_posing"].as_bool(), Some(posed), "{row}");
+        assert_eq!(count(row, "posing_gpu_bytes") > 0, posed, "{row}");
+    }
     // On the GPU kernel a Fox's own bytes add its second state and its simulation's buffers,
     // counted as the device's allocator counts them.
-    for (on_cpu, on_gpu) in herd[2..4].iter().zip(&herd[6..]) {
+    for (on_cpu, on_gpu) in herd[2..4].iter().cycle().zip(&herd[4..]) {
         assert!(count(on_gpu, "per_fox_gpu_bytes") > count(on_cpu, "per_fox_gpu_bytes"), "{on_cpu}\n{on_gpu}");
         let (total, allocated) = (count(on_gpu, "total_gpu_bytes"), count(on_gpu, "allocated_gpu_bytes"));
         assert!(

@@ -116,24 +116,30 @@ fn herd_n_scatters_foxes_on_a_ground() {
 }
 
 /// `--sim gpu` bends a herd's strands on the GPU kernel: the walking Foxes' last frame is the CPU
-/// kernel's but for a few pixels, while the walk itself moved many more between the frames.
+/// kernel's but for a few pixels, while the walk itself moved many more between the frames. With
+/// `--pooling on` (a GPU's default) their bases are skinned on the GPU too, to the same picture.
 #[test]
 fn a_herd_bends_on_the_gpu_kernel_as_on_the_cpu() {
     let dir = temp_dir("gpu");
     let args = ["render", &fox(), "--animation", "Walk", "--herd", "3", "--size", "160x90", "--frames", "6"];
-    for sim in ["cpu", "gpu"] {
-        let output = pelt(&[&args[..], &["--sim", sim, "-o", sim]].concat(), &dir);
+    for (name, sim, pooling, kernel) in [
+        ("cpu", "cpu", "off", "on the CPU (a herd"),
+        ("gpu", "gpu", "off", "on the GPU (a herd, --sim gpu, posed in one parallel pass"),
+        ("posed", "gpu", "on", "on the GPU (a herd, --sim gpu, posed on the GPU"),
+    ] {
+        let output = pelt(&[&args[..], &["--sim", sim, "--pooling", pooling, "-o", name]].concat(), &dir);
         assert!(output.status.success(), "{}", text(&output));
-        let kernel = if sim == "gpu" { "on the GPU (a herd, --sim gpu" } else { "on the CPU (a herd" };
         assert!(text(&output).contains(kernel), "{}", text(&output));
     }
     let frame =
         |sim: &str, k: u32| image::open(dir.join(sim).join(format!("frame_{k:04}.png"))).expect("PNG").to_rgba8();
-    let (cpu, gpu) = (frame("cpu", 6), frame("gpu", 6));
-    let kernels = differing(&cpu, &gpu, 0..cpu.width());
+    let cpu = frame("cpu", 6);
     let walked = differing(&frame("cpu", 1), &cpu, 0..cpu.width());
     assert!(walked > 200, "the Foxes hardly moved: {walked} pixels");
-    assert!(kernels * 20 < walked, "{kernels} pixels differ between the kernels, {walked} between the frames");
+    for other in ["gpu", "posed"] {
+        let kernels = differing(&cpu, &frame(other, 6), 0..cpu.width());
+        assert!(kernels * 20 < walked, "{kernels} pixels differ from {other}, {walked} between the frames");
+    }
 }
 
 #[test]

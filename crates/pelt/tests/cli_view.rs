@@ -248,7 +248,8 @@ fn the_window_draws_a_herd_each_member_at_its_own_phase() {
 }
 
 /// The same with every member bent by the GPU simulation (the right Fox is the copy the
-/// viewer's herd drives, not the edited fur).
+/// viewer's herd drives, not the edited fur), pooled as on a GPU: the copy's base skinned on the
+/// GPU.
 #[test]
 fn the_window_draws_a_herd_bent_on_the_gpu() {
     herd_at_phases("gpu");
@@ -269,12 +270,13 @@ fn herd_at_phases(kernel: &str) {
         )
         .expect("the script");
         let script = script.to_str().unwrap().to_owned();
-        let (image, said) =
-            screenshot_saying(&name, 12, &[fox, "--script", &script, "--sim", kernel, "--no-overlay", "--no-shadows"]);
+        let pooling = if kernel == "gpu" { "on" } else { "auto" };
+        let args = [fox, "--script", &script, "--sim", kernel, "--pooling", pooling, "--no-overlay", "--no-shadows"];
+        let (image, said) = screenshot_saying(&name, 12, &args);
         // Both furs bent where asked, none fallen back to the CPU.
         let expected = match kernel {
-            "gpu" => "bent on the GPU kernel; 1 of the herd's 1 other copies on the GPU",
-            _ => "bent on the CPU kernel; 0 of the herd's 1 other copies on the GPU",
+            "gpu" => "bent on the GPU kernel; 1 of the herd's 1 other copies on the GPU, 1 posed there",
+            _ => "bent on the CPU kernel; 0 of the herd's 1 other copies on the GPU, 0 posed there",
         };
         assert!(said.contains(expected), "{name}: {said}");
         image

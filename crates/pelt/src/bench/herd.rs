@@ -20,7 +20,7 @@ use pelt_core::sim::herd;
 use pelt_core::{ImportOptions, Preset, Stage, StageSource};
 use pelt_render::{
     Backend, Camera, FurAsset, FurDrawSettings, FurDriver, FurTarget, FurView, Gpu, GpuSkin, HEADLESS_FORMAT, Headless,
-    HerdDraws, KernelChoice, SimKernel, Studio,
+    HerdDraws, HerdPosing, KernelChoice, SimKernel, Studio,
 };
 
 /// Figures for one herd size.
@@ -42,6 +42,9 @@ pub struct HerdRow {
     /// (`HerdDraws`).
     pub camera_draws: usize,
     pub camera_levels: usize,
+    /// Whether on the GPU kernel the Foxes' bases were skinned on the GPU (`HerdPosing`,
+    /// `FurRenderer::herd_posing`: a GPU's default; the CPU posing joints only) or on the CPU.
+    pub gpu_posing: bool,
     /// `WIDTHxHEIGHT`, and the MSAA samples.
     pub size: String,
     pub msaa_samples: u32,
@@ -66,6 +69,9 @@ pub struct HerdRow {
     /// Bytes of each Fox's own state (shared-array state, normals, silhouette and shell lists;
     /// on the GPU kernel a second state and its simulation's buffers).
     pub per_fox_gpu_bytes: u64,
+    /// Bytes of the herd's GPU posing (the skin's rest pose and influences, each Fox's joint
+    /// matrices and posed vertices); 0 where the CPU poses.
+    pub posing_gpu_bytes: u64,
     pub total_gpu_bytes: u64,
     /// What the device's allocator holds for the herd's drivers, by its own count (Vulkan; none
     /// elsewhere): their buffers with the allocator's alignment and the per-Fox uniforms.
@@ -85,13 +91,18 @@ const SIZE: (u32, u32) = (1280, 720);
 const PACE: f32 = 70.0;
 
 /// Runs the sizes and prints the table (Markdown); `json` also gets the rows.
-pub fn run(quick: bool, meshes: &Path, json: Option<&Path>, kernel: SimKernel) -> anyhow::Result<()> {
+pub fn run(
+    quick: bool,
+    meshes: &Path,
+    json: Option<&Path>,
+    (kernel, pooled): (SimKernel, Option<bool>),
+) -> anyhow::Result<()> {
     let counts: &[usize] = if quick { &COUNTS[..2] } else { &COUNTS };
     let frames: u32 = if quick { 2 } else { 4 };
     let gpu = Gpu::new(Backend::Auto)?;
     // Lavapipe's single sample, as `pelt render` draws there (MSAA where a GPU is).
     let samples = pelt_render::default_sample_count(&gpu.adapter.get_info());
-    let (rows, adapter) = measure(gpu, meshes, counts, (SIZE, samples), frames, (kernel, None))?;
+    let (rows, adapter) = measure(gpu, meshes, counts, (SIZE, samples), frames, (kernel, pooled))?;
     println!("{}", markdown(&rows, &adapter));
     if let Some(path) = json {
         let text = serde_json::to_string_pretty(&rows)? + "\n";
@@ -101,8 +112,9 @@ pub fn run(quick: bool, meshes: &Path, json: Option<&Path>, kernel: SimKernel) -
 }
 
 /// The rows for herds of `counts` Foxes at `size` with `samples` MSAA samples, `frames` timed
-/// frames each, on `gpu`, bending on `kernel`, the shadow casters and the GPU kernel's steps
-/// pooled as `pooled` says (`None`: the device's default); and the adapter's summary.
+/// frames each, on `gpu`, bending on `kernel`, the shadow casters, the camera's draws, the GPU
+/// kernel's steps and posing pooled as `pooled` says (`None`: the device's default); and the
+/// adapter's summary.
 pub fn measure(
     gpu: Gpu,
     meshes: &Path,
@@ -128,7 +140,9 @@ pub fn measure(
         renderer.set_pooled_casting(pooled);
         renderer.set_pooled_stepping(pooled);
         renderer.set_pooled_drawing(pooled);
+        renderer.set_herd_posing(pooled);
     }
+    let gpu_posing = kernel == SimKernel::Gpu && renderer.herd_posing();
     let asset = FurAsset::new(device, queue, &renderer, &fur, &textures)?;
     let (low, high) = fur.mesh.bounds();
     // What a Fox draws lies within its mesh's sphere grown by its longest strand.
@@ -150,6 +164,7 @@ pub fn measure(
         let before = allocated(device);
         let mut drivers =
             FurDriver::herd_with_asset(device, queue, &renderer, (&asset, &fur), &preset.simulation, choice, foxes)?;
+        let mut posing = gpu_posing.then(|| HerdPosing::new(device, &fur.mesh, &rig, foxes)).transpose()?;
         let herd_bytes = allocated(device).zip(before).map(|(after, before)| after - before);
         let mut steppers = instances
             .iter()
@@ -157,6 +172,7 @@ pub fn measure(
                 let mut stepper = FurStepper::new(&fur, &preset.simulation)?;
                 stepper.set_clip(rig.clone(), Some(walk));
                 stepper.set_placement(Some(instance.clone()));
+                stepper.set_joint_posing(gpu_posing);
                 Ok(stepper)
             })
             .collect::<anyhow::Result<Vec<_>>>()?;
@@ -211,6 +227,10 @@ pub fn measure(
             if kernel == SimKernel::Gpu {
                 let mut encoder =
                     device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("herd steps") });
+                if let Some(posing) = &mut posing {
+                    posing.prepare((device, queue), &drivers, &steppers)?;
+                    posing.record(&mut encoder);
+                }
                 FurDriver::record_herd(&mut encoder, &mut drivers)?;
                 queue.submit([encoder.finish()]);
             }
@@ -253,6 +273,7 @@ pub fn measure(
         let (cpu_pose_ms, gpu_pose_ms) = time_posing((device, queue), (&rig, walk), &fur.mesh, &instances, frames)?;
         let per_frame = |d: Duration| d.as_secs_f64() * 1000.0 / f64::from(frames);
         let shared_gpu_bytes = asset.gpu_bytes().total();
+        let posing_gpu_bytes = posing.as_ref().map_or(0, HerdPosing::gpu_bytes);
         let own = drivers[0].fur().own_bytes();
         let per_fox_gpu_bytes =
             own.positions + own.attributes + drivers[0].fur().silhouette_list_bytes() + drivers[0].simulation_bytes();
@@ -262,6 +283,7 @@ pub fn measure(
             pooled_casting: renderer.pooled_casting(),
             pooled_stepping: kernel == SimKernel::Gpu && renderer.pooled_stepping(),
             pooled_drawing: renderer.pooled_drawing(),
+            gpu_posing: posing.is_some(),
             camera_draws,
             camera_levels: plan.levels(),
             size: format!("{}x{}", size.0, size.1),
@@ -275,7 +297,8 @@ pub fn measure(
             gpu_pose_ms,
             shared_gpu_bytes,
             per_fox_gpu_bytes,
-            total_gpu_bytes: shared_gpu_bytes + foxes as u64 * per_fox_gpu_bytes,
+            posing_gpu_bytes,
+            total_gpu_bytes: shared_gpu_bytes + foxes as u64 * per_fox_gpu_bytes + posing_gpu_bytes,
             // The asset was allocated before every herd: count it once with each.
             allocated_gpu_bytes: herd_bytes.map(|bytes| bytes + asset_before),
         });
@@ -342,7 +365,7 @@ fn markdown(rows: &[HerdRow], adapter: &str) -> String {
             Some(r) if r.kernel == "gpu" && r.pooled_stepping => "GPU in one dispatch a step".to_owned(),
             Some(r) => r.kernel.to_uppercase(),
             None => String::new(),
-        },
+        } + if rows.first().is_some_and(|r| r.gpu_posing) { ", posed on the GPU" } else { "" },
     );
     for (k, row) in rows.iter().enumerate() {
         let more = match k.checked_sub(1).map(|p| &rows[p]) {
@@ -353,7 +376,7 @@ fn markdown(rows: &[HerdRow], adapter: &str) -> String {
             None => "-".to_owned(),
         };
         out += &format!(
-            "| {} | {:.1} | {:.1} | {:.2} | {:.1} | {more} | {} ({}) | {} ({} + {} x {}) | {} | {:.2} / {:.2} |\n",
+            "| {} | {:.1} | {:.1} | {:.2} | {:.1} | {more} | {} ({}) | {} ({} + {} x {}{}) | {} | {:.2} / {:.2} |\n",
             row.foxes,
             row.frame_ms,
             row.simulation_ms,
@@ -365,6 +388,7 @@ fn markdown(rows: &[HerdRow], adapter: &str) -> String {
             row.shared_gpu_bytes,
             row.foxes,
             row.per_fox_gpu_bytes,
+            if row.posing_gpu_bytes > 0 { format!(" + posing {}", row.posing_gpu_bytes) } else { String::new() },
             row.allocated_gpu_bytes.map_or_else(|| "-".to_owned(), |b| b.to_string()),
             row.cpu_pose_ms,
             row.gpu_pose_ms,
@@ -381,10 +405,11 @@ mod tests {
     fn the_table_adds_one_more_fox_between_rows() {
         let row = |foxes, frame_ms, record_ms| HerdRow {
             foxes,
-            kernel: "cpu".to_owned(),
+            kernel: "gpu".to_owned(),
             pooled_casting: false,
-            pooled_stepping: false,
+            pooled_stepping: true,
             pooled_drawing: true,
+            gpu_posing: true,
             camera_draws: 2 * foxes,
             camera_levels: foxes / 2,
             size: "1280x720".to_owned(),
@@ -398,13 +423,15 @@ mod tests {
             gpu_pose_ms: 0.5,
             shared_gpu_bytes: 10,
             per_fox_gpu_bytes: 2,
-            total_gpu_bytes: 10 + 2 * foxes as u64,
+            posing_gpu_bytes: 3,
+            total_gpu_bytes: 13 + 2 * foxes as u64,
             allocated_gpu_bytes: Some(11 + 2 * foxes as u64),
         };
         let table = markdown(&[row(1, 10.0, 1.0), row(11, 30.0, 2.0)], "lavapipe");
         assert!(table.contains("| 11 | 30.0 |"), "{table}");
         assert!(table.contains("2.000 / 0.1000"), "{table}");
-        assert!(table.contains("| 22 (5) | 32 (10 + 11 x 2) | 33 | 3.00 / 0.50 |"), "{table}");
+        assert!(table.contains("| 22 (5) | 35 (10 + 11 x 2 + posing 3) | 33 | 3.00 / 0.50 |"), "{table}");
         assert!(table.contains("the camera's draws pooled by level"), "{table}");
+        assert!(table.contains("bent on the GPU in one dispatch a step, posed on the GPU"), "{table}");
     }
 }

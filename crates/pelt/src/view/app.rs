@@ -102,11 +102,15 @@ impl App {
         let textures = self.model.textures.take().context("the first textures were made before the window")?;
         let model = &mut self.model;
         let params = model.stepper.simulation().params().clone();
-        let mut fur = FurScene::new(&gpu, &model.structure, &textures, &params, model.sim_choice.into())?;
+        let mut fur =
+            FurScene::new(&gpu, &model.structure, &textures, &params, (model.sim_choice.into(), model.pooling))?;
         fur.set_body(&gpu, model.body.as_ref())?;
         let (kernel, reason) = fur.kernel();
         model.settings.gpu_sim = kernel == SimKernel::Gpu;
         model.kernel_reason = match &model.herd {
+            Some(_) if kernel == SimKernel::Gpu && fur.herd_posing() => {
+                format!("{reason}; a herd posed on the GPU, each copy bent on this kernel")
+            }
             Some(_) => format!("{reason}; a herd posed in one parallel pass, each copy bent on this kernel"),
             None => reason.to_owned(),
         };
@@ -200,7 +204,9 @@ impl App {
             extent,
         )?;
         let others = model.herd.as_ref().map_or(0, |herd| herd.len() - 1);
-        running.fur.sync_herd(&running.gpu, &model.structure, model.stepper.simulation().params(), others)?;
+        let rig = model.herd.as_ref().and_then(|herd| herd.followers().first()).and_then(|stepper| stepper.rig());
+        let params = model.stepper.simulation().params();
+        running.fur.sync_herd(&running.gpu, (&model.structure, rig), params, others)?;
         let members = if let Some((time_secs, clip_secs)) = model.simulate(frame_secs) {
             let members = model.member_frames(time_secs);
             let started = std::time::Instant::now();
@@ -333,8 +339,11 @@ impl App {
                 );
                 // Which kernel bent the fur (and a herd's copies): scripts check it.
                 let (kernel, _) = running.fur.kernel();
-                let (copies_on_gpu, copies) = running.fur.herd_on_gpu();
-                println!("bent on the {kernel} kernel; {copies_on_gpu} of the herd's {copies} other copies on the GPU");
+                let (copies_on_gpu, copies, posed) = running.fur.herd_on_gpu();
+                println!(
+                    "bent on the {kernel} kernel; {copies_on_gpu} of the herd's {copies} other copies on the GPU, \
+                     {posed} posed there"
+                );
                 model.quit = true;
             }
             if model.screenshot_pending {

@@ -56,15 +56,17 @@ pub struct FurScene {
 type SurroundingsFor = (bool, bool, Option<(Vec3, Vec3)>);
 
 impl FurScene {
-    /// The fur on `gpu`, simulated on the kernel `choice` picks (`auto` times both here).
+    /// The fur on `gpu`, simulated on the kernel `choice` picks (`auto` times both here), a
+    /// herd's copies sharing the GPU's work as `pooling` says.
     pub fn new(
         gpu: &pelt_render::Gpu,
         structure: &FurStructure,
         textures: &FurTextures,
         params: &SimParams,
-        choice: KernelChoice,
+        (choice, pooling): (KernelChoice, crate::herd::Pooling),
     ) -> anyhow::Result<Self> {
-        let renderer = FurRenderer::new(&gpu.device, target(&gpu.adapter.get_info()))?;
+        let mut renderer = FurRenderer::new(&gpu.device, target(&gpu.adapter.get_info()))?;
+        pooling.apply(&mut renderer);
         let driver = FurDriver::new(&gpu.device, &gpu.queue, &renderer, structure, textures, params, choice)?;
         let view = FurView::new(&gpu.device, &renderer);
         Ok(Self {
@@ -219,7 +221,7 @@ impl FurScene {
     pub fn sync_herd(
         &mut self,
         gpu: &pelt_render::Gpu,
-        structure: &FurStructure,
+        (structure, rig): (&FurStructure, Option<&pelt_core::anim::Rig>),
         params: &SimParams,
         others: usize,
     ) -> anyhow::Result<()> {
@@ -227,8 +229,8 @@ impl FurScene {
             self.herd = None;
         } else if self.herd_stale || self.herd.as_ref().is_none_or(|h| h.len() != others) {
             let kernel = self.driver.kernel();
-            self.herd =
-                Some(HerdDrivers::new(gpu, &self.renderer, (structure, &self.textures), (params, kernel), others)?);
+            let fur = (structure, &self.textures, rig);
+            self.herd = Some(HerdDrivers::new(gpu, &self.renderer, fur, (params, kernel), others)?);
         }
         self.herd_stale = false;
         Ok(())
@@ -241,9 +243,14 @@ impl FurScene {
         }
     }
 
-    /// The herd's copies on the GPU kernel, of how many.
-    pub fn herd_on_gpu(&self) -> (usize, usize) {
-        self.herd.as_ref().map_or((0, 0), |drivers| (drivers.on_gpu(), drivers.len()))
+    /// Whether a herd bending on the GPU kernel is posed there too.
+    pub fn herd_posing(&self) -> bool {
+        self.renderer.herd_posing()
+    }
+
+    /// The herd's copies on the GPU kernel, of how many, and how many of them the GPU posed.
+    pub fn herd_on_gpu(&self) -> (usize, usize, usize) {
+        self.herd.as_ref().map_or((0, 0, 0), |drivers| (drivers.on_gpu(), drivers.len(), drivers.posed_on_gpu()))
     }
 
     /// Shows the herd's members as they stepped this frame: the main fur takes the first

@@ -1,6 +1,7 @@
 //! A herd in the viewer (`--herd N`, a script's `[[instance]]`s). The fur the panel edits is the
 //! first member, placed as the first instance; the others are copies of it, each simulated on its
-//! own (posed on the CPU in one parallel pass, bent on the edited fur's kernel) and drawn from one
+//! own (posed on the CPU in one parallel pass, or on a GPU there when they bend on the GPU kernel;
+//! bent on the edited fur's kernel) and drawn from one
 //! shared asset, rebuilt from the edited fur whenever its structure, textures, groom, simulation
 //! or kernel change.
 
@@ -12,7 +13,8 @@ use pelt_core::sim::herd::HerdInstance;
 use pelt_core::sim::{FurStepper, Scene};
 use pelt_core::{FurStructure, FurTextures, Preset};
 use pelt_render::{
-    FurAsset, FurDrawSettings, FurDriver, FurLevel, FurLook, FurRenderer, FurView, KernelChoice, SimKernel, ViewData,
+    FurAsset, FurDrawSettings, FurDriver, FurLevel, FurLook, FurRenderer, FurView, HerdPosing, KernelChoice, SimKernel,
+    ViewData,
 };
 
 /// The CPU half: where the members stand and the others' simulations.
@@ -236,17 +238,20 @@ pub(super) struct HerdDrivers {
     /// Kept so the copies share one upload of the topology and textures.
     _asset: FurAsset,
     drivers: Vec<FurDriver>,
+    /// Their bases skinned on the GPU (`FurRenderer::herd_posing`, on the GPU kernel).
+    posing: Option<HerdPosing>,
 }
 
 impl HerdDrivers {
-    /// `count` copies of `structure` with `textures`, bent on `kernel`.
+    /// `count` copies of `structure` with `textures`, bent on `kernel`, skinned by `rig` (the
+    /// copies' rig, if any).
     ///
     /// # Errors
     /// The upload's errors.
     pub(super) fn new(
         gpu: &pelt_render::Gpu,
         renderer: &FurRenderer,
-        (structure, textures): (&FurStructure, &FurTextures),
+        (structure, textures, rig): (&FurStructure, &FurTextures, Option<&Rig>),
         (params, kernel): (&pelt_core::sim::SimParams, SimKernel),
         count: usize,
     ) -> anyhow::Result<Self> {
@@ -254,7 +259,15 @@ impl HerdDrivers {
         let asset = FurAsset::new(device, queue, renderer, structure, textures)?;
         let choice = KernelChoice::from(kernel);
         let drivers = FurDriver::herd_with_asset(device, queue, renderer, (&asset, structure), params, choice, count)?;
-        Ok(Self { _asset: asset, drivers })
+        let posing = rig
+            .filter(|rig| {
+                kernel == SimKernel::Gpu
+                    && renderer.herd_posing()
+                    && rig.vertex_count() == structure.mesh.vertex_count()
+            })
+            .map(|rig| HerdPosing::new(device, &structure.mesh, rig, count))
+            .transpose()?;
+        Ok(Self { _asset: asset, drivers, posing })
     }
 
     pub(super) fn len(&self) -> usize {
@@ -267,10 +280,16 @@ impl HerdDrivers {
         self.drivers.iter().filter(|driver| driver.kernel() == SimKernel::Gpu).count()
     }
 
+    /// How many copies the GPU posed last (`HerdPosing`).
+    pub(super) fn posed_on_gpu(&self) -> usize {
+        self.posing.as_ref().map_or(0, HerdPosing::members_on_gpu)
+    }
+
     /// Before the copies' steppers step: each bends on its driver's kernel.
     pub(super) fn claim(&mut self, herd: &mut Herd) {
         for (driver, stepper) in self.drivers.iter_mut().zip(herd.followers_mut()) {
             driver.claim_stepper(stepper);
+            stepper.set_joint_posing(self.posing.is_some());
         }
     }
 
@@ -292,9 +311,16 @@ impl HerdDrivers {
             driver.set_look(FurLook { tint: herd.instances[member].tint, ..look });
             driver.prepare(&gpu.queue);
         }
-        if self.drivers.iter().any(FurDriver::has_steps_to_record) {
+        if let Some(posing) = &mut self.posing {
+            posing.prepare((&gpu.device, &gpu.queue), &self.drivers, herd.followers())?;
+        }
+        let posed = self.posing.as_ref().is_some_and(|posing| posing.members_on_gpu() > 0);
+        if posed || self.drivers.iter().any(FurDriver::has_steps_to_record) {
             let mut encoder =
                 gpu.device.create_command_encoder(&wgpu::CommandEncoderDescriptor { label: Some("herd simulation") });
+            if let Some(posing) = &self.posing {
+                posing.record(&mut encoder);
+            }
             FurDriver::record_herd(&mut encoder, &mut self.drivers)?;
             gpu.queue.submit([encoder.finish()]);
         }

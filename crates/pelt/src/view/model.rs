@@ -68,6 +68,8 @@ pub(super) struct Model {
     pub(super) shown_at: Option<Instant>,
     /// `--sim`, resolved once the GPU is open.
     pub(super) sim_choice: SimChoice,
+    /// How a herd's copies share the GPU's work (`--pooling`).
+    pub(super) pooling: crate::herd::Pooling,
     /// Why the kernel in use was chosen (the overlay shows it).
     pub(super) kernel_reason: String,
     pub(super) touch: Option<TouchDrag>,
@@ -260,6 +262,7 @@ impl Model {
             shown_times_secs: [0.0; 2],
             shown_at: None,
             // Auto times one fur; a herd bends on the CPU unless asked otherwise.
+            pooling: args.pooling,
             sim_choice: if herd.is_some() && args.sim == SimChoice::Auto { SimChoice::Cpu } else { args.sim },
             kernel_reason: String::new(),
             touch: None,
