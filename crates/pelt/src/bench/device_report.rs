@@ -2,7 +2,8 @@
 //! minutes on one, written as one JSON object: the bunny's and the try-on's frames at 1920x1080
 //! (the adapter's MSAA: 4x on a GPU) with and without the key light's shadows, herds of 100 and
 //! 1,000 walking Foxes at that size bent on the CPU (their shadow casters in one draw a pass and
-//! the camera's draws pooled by level, then a draw a Fox) and on the GPU kernel, the GPU
+//! the camera's draws pooled by level, then a draw a Fox) and on the GPU kernel (pooled: also
+//! their steps in one dispatch and their bases skinned on the GPU), the GPU
 //! kernel's node updates per second on the 35,000-vertex torus, and contact's share of each kernel
 //! (`pelt bench --contact`). A session lent a GPU runs it first and records the figures
 //! (BENCHMARKS.md).
@@ -79,8 +80,8 @@ pub fn run(meshes: &Path, out: &Path, quick: bool) -> anyhow::Result<()> {
     }
     let counts: &[usize] = if quick { &[1, 2] } else { &[100, 1000] };
     let mut herd = Vec::new();
-    // Each kernel's herds pooled (the shadow casters, the camera's draws and the GPU kernel's
-    // steps) and a draw and a dispatch a Fox: what pooling saves a GPU.
+    // Each kernel's herds pooled (the shadow casters, the camera's draws, the GPU kernel's steps
+    // and posing) and a draw, a dispatch and a CPU pose a Fox: what pooling saves a GPU.
     let settings = [true, false].map(|pooled| [(SimKernel::Cpu, Some(pooled)), (SimKernel::Gpu, Some(pooled))]);
     for setting in [settings[0][0], settings[1][0], settings[0][1], settings[1][1]] {
         let frames = if quick { 1 } else { 4 };
