@@ -87,9 +87,9 @@ fn every_wgsl_file_is_part_of_a_validated_module() {
         }
     }
     assert_eq!(
-        checked, 21,
+        checked, 22,
         "shading, object_pool, pool_draws, wet, fur_bsdf, shadows, unified, prepass, separated, scan, silhouette, view_lod, \
-         simulation_wind, simulation, simulation_inputs, simulation_contact, simulation_lone, simulation_pooled, strands, skinning and shadow_copy"
+         simulation_wind, simulation, simulation_inputs, simulation_contact, simulation_lone, simulation_pooled, strands, skinning, herd_posing and shadow_copy"
     );
 }
 
