@@ -80,6 +80,19 @@ pub(crate) fn check_features_and_limits(features: wgpu::Features, limits: &wgpu:
 
 /// Fails with [`RenderError::TooLarge`] when `bytes` exceed what one storage binding or
 /// buffer may hold on `device`.
+/// Layers to allocate for a 2D array texture of `layers` layers of `width` x `height`, so every
+/// backend makes it an array: wgpu's GL backend makes a texture of one layer a plain 2D texture
+/// and one of square layers in a multiple of six a cube map (wgpu-hal's `get_info_from_desc`),
+/// which an array view then cannot sample (every lookup reads 0: shells and shadows go black).
+/// On GL one more layer where it needs it (the caller fills it as it likes); elsewhere `layers`.
+pub(crate) fn array_layers(device: &wgpu::Device, (width, height): (u32, u32), layers: u32) -> u32 {
+    if device.adapter_info().backend != wgpu::Backend::Gl {
+        return layers;
+    }
+    let layers = layers.max(2);
+    if width == height && layers.is_multiple_of(6) { layers + 1 } else { layers }
+}
+
 pub(crate) fn check_size(device: &wgpu::Device, what: &'static str, bytes: u64) -> Result<(), RenderError> {
     let limits = device.limits();
     let limit = limits.max_storage_buffer_binding_size.min(limits.max_buffer_size);

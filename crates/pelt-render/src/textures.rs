@@ -5,6 +5,7 @@
 use pelt_core::texture::{FurTextures, StrandLean, downsample_rgba8};
 
 use crate::RenderError;
+use crate::requirements::array_layers;
 use crate::shaders::Layouts;
 
 /// What the object uniform reads of a fur's textures (plain meshes: the default, no slices).
@@ -69,13 +70,13 @@ impl GpuTextures {
             )));
         }
         let slice_bytes = textures.size as usize * textures.size as usize * 4;
-        let shell = upload(
-            device,
-            queue,
-            "pelt shell slices",
-            (textures.size, textures.size),
-            textures.shell.chunks_exact(slice_bytes).collect(),
-        );
+        let mut slices: Vec<&[u8]> = textures.shell.chunks_exact(slice_bytes).collect();
+        // A layer GL needs to make an array (`array_layers`) repeats the outermost slice.
+        let array = array_layers(device, (textures.size, textures.size), textures.layers);
+        if let Some(&last) = slices.last() {
+            slices.resize(array as usize, last);
+        }
+        let shell = upload(device, queue, "pelt shell slices", (textures.size, textures.size), slices);
         let fin = upload(device, queue, "pelt fin", (textures.fin_width, textures.fin_height), vec![&textures.fin]);
         let shell = shell.create_view(&wgpu::TextureViewDescriptor {
             dimension: Some(wgpu::TextureViewDimension::D2Array),
@@ -214,6 +215,18 @@ fn upload_keep(
     (size, layers): (u32, u32),
     texels: &[u8],
 ) -> wgpu::TextureView {
+    // A layer GL needs to make an array (`array_layers`) repeats the last, which the shader's
+    // clamp to the last layer then reads as before.
+    let array = array_layers(device, (size, size), layers);
+    let padded: Vec<u8>;
+    let texels = match texels.len().checked_sub((size * size) as usize) {
+        Some(last) if array > layers => {
+            padded = [texels, &texels[last..].repeat((array - layers) as usize)].concat();
+            &padded[..]
+        }
+        _ => texels,
+    };
+    let layers = array;
     let texture = device.create_texture(&wgpu::TextureDescriptor {
         label: Some("pelt strand keep values"),
         size: wgpu::Extent3d { width: size, height: size, depth_or_array_layers: layers },

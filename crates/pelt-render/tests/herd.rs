@@ -514,13 +514,7 @@ fn copies_made_together_cast_in_one_draw_a_pass_as_each_alone() {
 #[test]
 fn a_herds_camera_draws_pool_each_level_as_each_copy_alone() {
     let mut rig = Rig::new(192, 144);
-    // GL draws each copy alone.
-    let gl = rig.device().adapter_info().backend == wgpu::Backend::Gl;
-    assert_eq!(
-        rig.renderer.pooled_drawing(),
-        is_gpu(&rig) && !gl,
-        "a GPU pools the camera's draws, a CPU rasteriser not"
-    );
+    assert_eq!(rig.renderer.pooled_drawing(), is_gpu(&rig), "a GPU pools the camera's draws, a CPU rasteriser not");
     rig.renderer.set_pooled_drawing(true);
     let structure = builtin_fur(Builtin::Bunny, 8);
     let textures = strand_textures(32, 8, BROWN_ROOT, BROWN_TIP);
@@ -603,16 +597,11 @@ fn a_herds_camera_draws_pool_each_level_as_each_copy_alone() {
     let (alone, alone_draws) = picture(false);
     planned.save(common::out_dir().join("herd-camera.png")).expect("save");
     assert_eq!(alone_draws, 8 + 7 + 7, "a skin, shells and fins a copy, none for the hidden coat");
-    if gl {
-        assert_eq!((plan.pooled_members(), planned_draws), (0, alone_draws), "GL draws each copy alone");
-    } else {
-        assert_eq!(plan.levels(), 2, "the front row and the back row");
-        // The coat lit by the other model draws alone; the rest of each row together: their
-        // skins in one draw, the shells of those whose coat shows in another, then each shown
-        // coat's fins.
-        assert_eq!(plan.pooled_members(), 7);
-        assert_eq!(planned_draws, (2 + 4) + (2 + 2) + 3, "{planned_draws} draws planned");
-    }
+    assert_eq!(plan.levels(), 2, "the front row and the back row");
+    // The coat lit by the other model draws alone; the rest of each row together: their skins in
+    // one draw, the shells of those whose coat shows in another, then each shown coat's fins.
+    assert_eq!(plan.pooled_members(), 7);
+    assert_eq!(planned_draws, (2 + 4) + (2 + 2) + 3, "{planned_draws} draws planned");
     assert!(planned == alone, "the planned herd's picture differs from its copies' alone");
 }
 

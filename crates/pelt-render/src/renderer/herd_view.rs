@@ -259,15 +259,14 @@ impl CoatBuilder {
 impl FurRenderer {
     /// Whether [`HerdDraws`] pools the camera's draws of a herd's copies: by default on a
     /// discrete or integrated GPU, as [`FurRenderer::pooled_casting`] (a CPU rasteriser reads
-    /// each vertex's object from storage, which costs it more than the draws save). Never on GL:
-    /// there (llvmpipe's GL, checked) the pooled draws come out wrong.
+    /// each vertex's object from storage, which costs it more than the draws save).
     #[must_use]
     pub fn pooled_drawing(&self) -> bool {
-        self.pooled_drawing && !self.gl
+        self.pooled_drawing
     }
 
-    /// Sets [`FurRenderer::pooled_drawing`] for the plans made after (no effect on GL); the
-    /// pictures are the same either way.
+    /// Sets [`FurRenderer::pooled_drawing`] for the plans made after; the pictures are the same
+    /// either way.
     pub fn set_pooled_drawing(&mut self, pooled: bool) {
         self.pooled_drawing = pooled;
     }

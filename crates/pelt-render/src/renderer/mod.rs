@@ -203,8 +203,6 @@ pub struct FurRenderer {
     pooled_drawing: bool,
     /// Whether hosts pose a GPU-kernel herd's bases on the GPU (`HerdPosing`).
     herd_posing: bool,
-    /// The device runs on GL, where the camera's pooled draws are not drawn right.
-    gl: bool,
     /// The camera's pooled pipelines (`HerdDraws`), built when a herd first draws with one.
     pool_camera: herd_view::PoolCameraPipelines,
 }
@@ -257,7 +255,6 @@ impl FurRenderer {
             pooled_stepping: gpu,
             pooled_drawing: gpu,
             herd_posing: gpu,
-            gl: device.adapter_info().backend == wgpu::Backend::Gl,
             pool_camera: herd_view::PoolCameraPipelines::default(),
         })
     }

@@ -301,6 +301,8 @@ pub(crate) fn shadow_texture(
     } else {
         wgpu::TextureUsages::TEXTURE_BINDING
     };
+    // GL's extra layer, if any, stays unused.
+    let layers = crate::requirements::array_layers(device, (size, size), layers);
     device.create_texture(&wgpu::TextureDescriptor {
         label: Some("pelt shadow map"),
         size: wgpu::Extent3d { width: size, height: size, depth_or_array_layers: layers },

@@ -184,11 +184,21 @@ pub fn strands_shader_source() -> String {
 mod tests {
     use super::*;
 
-    /// `ObjectSlot` in `object_pool.wgsl` is `OBJECT_SLOT_BYTES` long, and the listing modules
-    /// read the pool's objects in place of the uniform.
+    /// `ObjectSlot` in `object_pool.wgsl` is `OBJECT_SLOT_BYTES` long by members alone (no
+    /// `@size`, which naga's GLSL drops), and the listing modules read the pool's objects in
+    /// place of the uniform.
     #[test]
     fn the_pool_prelude_matches_the_slots() {
-        assert!(OBJECT_POOL_WGSL.contains(&format!("@size({OBJECT_SLOT_BYTES})")));
+        let source = view_lod_shader_source();
+        let module = naga::front::wgsl::parse_str(&source).expect("the listing module");
+        let slot = module.types.iter().find(|(_, ty)| ty.name.as_deref() == Some("ObjectSlot"));
+        let Some((_, naga::Type { inner: naga::TypeInner::Struct { members, span }, .. })) = slot else {
+            panic!("no ObjectSlot");
+        };
+        assert_eq!(u64::from(*span), OBJECT_SLOT_BYTES, "ObjectSlot's size");
+        let end = members.iter().map(|m| m.offset + module.types[m.ty].inner.size(module.to_ctx())).max();
+        assert_eq!(end.map(u64::from), Some(OBJECT_SLOT_BYTES), "ObjectSlot's members fill it");
+        assert!(!OBJECT_POOL_WGSL.contains("@size("));
         for source in [silhouette_shader_source(), view_lod_shader_source(), pool_draw_shader_source()] {
             assert!(source.contains("var<storage, read> objects: array<ObjectSlot>"));
             assert!(!source.contains("var<uniform> object: Object"));

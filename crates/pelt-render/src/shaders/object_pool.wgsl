@@ -4,9 +4,11 @@
 // first (`load_member`); bindings 1 to 3 are the pool's whole buffers.
 
 // One copy's object, `OBJECT_SLOT_BYTES` (`shaders/mod.rs`) apart: the uniform ranges the draws
-// bind.
+// bind. Padded by a member, not `@size`: naga's GLSL drops a last member's `@size`, and GL then
+// read every copy past the first at the wrong offset.
 struct ObjectSlot {
-    @size(512) object: Object,
+    object: Object,
+    padding: array<vec4<f32>, 11>,
 }
 
 @group(1) @binding(0) var<storage, read> objects: array<ObjectSlot>;
