@@ -129,27 +129,12 @@ impl GpuSkin {
             usage: wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_SRC | wgpu::BufferUsages::VERTEX,
             mapped_at_creation: false,
         });
-        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("pelt skinning"),
-            source: wgpu::ShaderSource::Wgsl(skinning_shader_source().into()),
-        });
-        let buffer = |binding, ty| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: wgpu::ShaderStages::COMPUTE,
-            ty: wgpu::BindingType::Buffer { ty, has_dynamic_offset: false, min_binding_size: None },
-            count: None,
-        };
         let storage = |read_only| wgpu::BufferBindingType::Storage { read_only };
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("pelt skinning"),
-            entries: &[
-                buffer(0, wgpu::BufferBindingType::Uniform),
-                buffer(1, storage(true)),
-                buffer(2, storage(true)),
-                buffer(3, storage(true)),
-                buffer(4, storage(false)),
-            ],
-        });
+        let (layout, pipeline) = buffers_pipeline(
+            device,
+            ("pelt skinning", skinning_shader_source(), "skin"),
+            &[wgpu::BufferBindingType::Uniform, storage(true), storage(true), storage(true), storage(false)],
+        );
         let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("pelt skinning"),
             layout: &layout,
@@ -158,19 +143,6 @@ impl GpuSkin {
                 .zip(0..)
                 .map(|(buffer, binding)| wgpu::BindGroupEntry { binding, resource: buffer.as_entire_binding() })
                 .collect::<Vec<_>>(),
-        });
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("pelt skinning"),
-            bind_group_layouts: &[Some(&layout)],
-            immediate_size: 0,
-        });
-        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some("pelt skinning"),
-            layout: Some(&pipeline_layout),
-            module: &module,
-            entry_point: Some("skin"),
-            compilation_options: wgpu::PipelineCompilationOptions::default(),
-            cache: None,
         });
         scope.pop("creating the GPU skinning")?;
         let bytes = params.size() + rest.size() + influences.size() + joints.size() + posed.size();
@@ -263,4 +235,43 @@ impl GpuSkin {
     pub fn bytes(&self) -> u64 {
         self.bytes
     }
+}
+
+/// A compute pipeline of `source`'s `entry` over one bind group of whole buffers, bound in order
+/// from 0 as `buffers` says, visible to the compute stage; and that group's layout. For the small
+/// kernels beside the renderer's (the skinning, a herd's posing).
+pub(crate) fn buffers_pipeline(
+    device: &wgpu::Device,
+    (label, source, entry): (&'static str, String, &str),
+    buffers: &[wgpu::BufferBindingType],
+) -> (wgpu::BindGroupLayout, wgpu::ComputePipeline) {
+    let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+        label: Some(label),
+        source: wgpu::ShaderSource::Wgsl(source.into()),
+    });
+    let entries: Vec<_> = (0..)
+        .zip(buffers)
+        .map(|(binding, &ty)| wgpu::BindGroupLayoutEntry {
+            binding,
+            visibility: wgpu::ShaderStages::COMPUTE,
+            ty: wgpu::BindingType::Buffer { ty, has_dynamic_offset: false, min_binding_size: None },
+            count: None,
+        })
+        .collect();
+    let layout =
+        device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(label), entries: &entries });
+    let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+        label: Some(label),
+        bind_group_layouts: &[Some(&layout)],
+        immediate_size: 0,
+    });
+    let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+        label: Some(label),
+        layout: Some(&pipeline_layout),
+        module: &module,
+        entry_point: Some(entry),
+        compilation_options: wgpu::PipelineCompilationOptions::default(),
+        cache: None,
+    });
+    (layout, pipeline)
 }

@@ -11,7 +11,7 @@ use super::FurDriver;
 use crate::RenderError;
 use crate::requirements::ErrorScope;
 use crate::shaders::herd_posing_shader_source;
-use crate::skinning::GpuSkin;
+use crate::skinning::{GpuSkin, buffers_pipeline};
 
 /// Vertices one workgroup places (`herd_posing.wgsl`'s `workgroup_size`).
 const WORKGROUP: u32 = 64;
@@ -73,40 +73,12 @@ impl HerdPosing {
             members,
         )?;
         let scope = ErrorScope::push(device);
-        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("pelt herd posing"),
-            source: wgpu::ShaderSource::Wgsl(herd_posing_shader_source().into()),
-        });
-        let buffer = |binding, ty| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: wgpu::ShaderStages::COMPUTE,
-            ty: wgpu::BindingType::Buffer { ty, has_dynamic_offset: false, min_binding_size: None },
-            count: None,
-        };
         let storage = |read_only| wgpu::BufferBindingType::Storage { read_only };
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("pelt herd posing"),
-            entries: &[
-                buffer(0, wgpu::BufferBindingType::Uniform),
-                buffer(1, storage(true)),
-                buffer(2, storage(true)),
-                buffer(3, storage(false)),
-                buffer(4, storage(false)),
-            ],
-        });
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("pelt herd posing"),
-            bind_group_layouts: &[Some(&layout)],
-            immediate_size: 0,
-        });
-        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some("pelt herd posing"),
-            layout: Some(&pipeline_layout),
-            module: &module,
-            entry_point: Some("place"),
-            compilation_options: wgpu::PipelineCompilationOptions::default(),
-            cache: None,
-        });
+        let (layout, pipeline) = buffers_pipeline(
+            device,
+            ("pelt herd posing", herd_posing_shader_source(), "place"),
+            &[wgpu::BufferBindingType::Uniform, storage(true), storage(true), storage(false), storage(false)],
+        );
         let params = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("pelt herd posing params"),
             size: size_of::<PlaceParams>() as u64,
