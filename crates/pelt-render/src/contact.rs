@@ -13,7 +13,7 @@ use std::sync::Arc;
 use pelt_core::FurStructure;
 use pelt_core::sim::ColliderMesh;
 use pelt_core::sim::contact::{MAX_STEP_COLLIDERS, SKIN_PLANES, SURFACE_WORDS, SkinSurface, skin_cone};
-use pelt_core::sim::{ContactStep, ContactStrands};
+use pelt_core::sim::{ContactStep, ContactStrands, StepCollider};
 
 use crate::RenderError;
 use crate::requirements::check_size;
@@ -21,7 +21,7 @@ use crate::requirements::check_size;
 /// Step slots: one per slot of the simulation's uniform ring.
 pub(crate) const CONTACT_SLOTS: usize = 64;
 /// vec4s per collider.
-const COLLIDER_WORDS: usize = 5;
+pub(crate) const COLLIDER_WORDS: usize = 5;
 /// The first skin plane, after the slots' headers.
 const SKIN_FIRST: usize = 2 * CONTACT_SLOTS;
 /// The fewest colliders a slot makes room for once any step has one.
@@ -68,8 +68,32 @@ fn fields_buffer(device: &wgpu::Device, words: &[f32]) -> wgpu::Buffer {
     )
 }
 
+/// The fields of `meshes` (each once) as the fields buffer holds them, and where each begins.
+pub(crate) fn field_words<'a>(
+    meshes: impl Iterator<Item = &'a Arc<ColliderMesh>>,
+) -> (Vec<f32>, Vec<(Arc<ColliderMesh>, u32)>) {
+    let mut words = Vec::new();
+    let mut fields: Vec<(Arc<ColliderMesh>, u32)> = Vec::new();
+    for mesh in meshes {
+        if fields.iter().any(|(m, _)| Arc::ptr_eq(m, mesh)) {
+            continue;
+        }
+        let field = mesh.field();
+        let offset = u32::try_from(words.len()).unwrap_or(u32::MAX);
+        let dims = field.dims().map(|n| f32::from_bits(n as u32));
+        words.extend(field.origin().to_array());
+        words.push(field.cell());
+        words.extend(dims);
+        words.push(0.0);
+        debug_assert_eq!(words.len() - offset as usize, FIELD_HEADER);
+        words.extend_from_slice(field.values());
+        fields.push((Arc::clone(mesh), offset));
+    }
+    (words, fields)
+}
+
 /// Whether `words` floats of fields fit one storage buffer binding of a device with `limits`.
-fn fields_fit(words: usize, limits: &wgpu::Limits) -> Result<(), RenderError> {
+pub(crate) fn fields_fit(words: usize, limits: &wgpu::Limits) -> Result<(), RenderError> {
     let bytes = 4 * words as u64;
     let limit = limits.max_storage_buffer_binding_size.min(limits.max_buffer_size);
     if bytes > limit {
@@ -106,6 +130,7 @@ fn buffer_bytes(prefix_words: usize, slot_colliders: usize) -> u64 {
 const _: () = assert!(pelt_core::sim::contact::surface::MAX_STRAND_TRIANGLES < 64);
 
 /// The skin's planes and triangles of one fur, as the buffer packs them.
+#[derive(Debug)]
 pub(crate) struct Skin {
     planes: Vec<[glam::Vec4; SKIN_PLANES]>,
     surface: SkinSurface,
@@ -128,6 +153,39 @@ impl Skin {
         self.planes.iter().map(skin_cone)
     }
 
+    /// Every strand's `SKIN_PLANES` planes, then every strand's cone.
+    pub fn planes_and_cones(&self) -> impl Iterator<Item = [f32; 4]> + '_ {
+        self.planes.iter().flat_map(|planes| planes.map(|p| p.to_array())).chain(self.cones().map(|c| c.to_array()))
+    }
+
+    /// The triangle part (`simulation_contact.wgsl`'s `surface_closest`) for strands rooted at
+    /// `roots` at rest: a header per strand, the lists (each entry its triangle's first vec4,
+    /// counted from the headers), the triangles.
+    pub fn surface_words(&self, roots: &[glam::Vec3]) -> Vec<[f32; 4]> {
+        let surface = &self.surface;
+        let mut words: Vec<[f32; 4]> = surface
+            .strands
+            .iter()
+            .zip(roots)
+            .map(|([first, count], root)| root.extend(f32::from_bits((first << 6) | count)).to_array())
+            .collect();
+        let triangles_first = (roots.len() + surface.lists.len().div_ceil(4)) as u32;
+        words.extend(surface.lists.chunks(4).map(|c| {
+            let mut w = [0.0_f32; 4];
+            for (slot, index) in w.iter_mut().zip(c) {
+                *slot = f32::from_bits(triangles_first + index * SURFACE_WORDS as u32);
+            }
+            w
+        }));
+        words.extend(surface.triangles.iter().flat_map(|t| t.map(|w| w.to_array())));
+        words
+    }
+
+    /// vec4s of the planes, cones and triangle part (what a pool holds once).
+    pub fn shared_words(&self) -> usize {
+        (SKIN_PLANES + 1) * self.planes.len() + self.words()
+    }
+
     /// vec4s of the triangle part: a header per strand (rest root, `first << 6 | count`), the
     /// lists four indices a vec4, then the triangles.
     fn words(&self) -> usize {
@@ -146,6 +204,11 @@ impl GpuContact {
     /// each step slot.
     pub fn bytes(skin: &Skin, slot_colliders: usize) -> u64 {
         buffer_bytes(skin.prefix_words(), slot_colliders)
+    }
+
+    /// The longest strand's length (a little over), each slot's bound on a strand's reach.
+    pub fn reach(&self) -> f32 {
+        self.reach
     }
 
     /// Colliders each step slot has room for now.
@@ -177,22 +240,43 @@ impl GpuContact {
             usage: wgpu::BufferUsages::INDIRECT | wgpu::BufferUsages::COPY_DST,
             mapped_at_creation: false,
         });
-        let layers = structure.layers as usize;
-        let reach = (0..v)
-            .map(|j| {
-                (0..layers).map(|k| structure.positions[(k + 1) * v + j].distance(structure.positions[k * v + j])).sum()
-            })
-            .fold(0.0_f32, f32::max);
         Self {
             buffer,
             vertex_count: v,
             prefix_words: skin.prefix_words(),
             slot_colliders: 0,
-            reach: reach * 1.001,
+            reach: reach(structure),
             weights: Vec::new(),
             fields_buffer,
             work,
             work_groups,
+            fields: Vec::new(),
+        }
+    }
+
+    /// The contact of a copy whose steps with contact read its pool's: the strands' reach alone,
+    /// and buffers of a few bytes for the bind groups of its steps without contact (which read
+    /// none of them).
+    pub fn unused(device: &wgpu::Device, structure: &FurStructure) -> Self {
+        // Room for a list's header and one entry, the least a list's binding holds.
+        let tiny = |label, usage| {
+            device.create_buffer(&wgpu::BufferDescriptor {
+                label: Some(label),
+                size: Self::work_bytes(1),
+                usage,
+                mapped_at_creation: false,
+            })
+        };
+        Self {
+            buffer: tiny("pelt simulation contact (the pool's)", CONTACT_USAGE),
+            vertex_count: structure.vertex_count(),
+            prefix_words: 0,
+            slot_colliders: 0,
+            reach: reach(structure),
+            weights: Vec::new(),
+            fields_buffer: fields_buffer(device, &[0.0; 4]),
+            work: tiny("pelt simulation contact list (the pool's)", wgpu::BufferUsages::STORAGE),
+            work_groups: tiny("pelt simulation contact dispatch (the pool's)", wgpu::BufferUsages::INDIRECT),
             fields: Vec::new(),
         }
     }
@@ -261,23 +345,7 @@ impl GpuContact {
         if used().all(|m| self.offset(m).is_some()) {
             return Ok(false);
         }
-        let mut words = Vec::new();
-        let mut fields: Vec<(Arc<ColliderMesh>, u32)> = Vec::new();
-        for mesh in used() {
-            if fields.iter().any(|(m, _)| Arc::ptr_eq(m, mesh)) {
-                continue;
-            }
-            let field = mesh.field();
-            let offset = u32::try_from(words.len()).unwrap_or(u32::MAX);
-            let dims = field.dims().map(|n| f32::from_bits(n as u32));
-            words.extend(field.origin().to_array());
-            words.push(field.cell());
-            words.extend(dims);
-            words.push(0.0);
-            debug_assert_eq!(words.len() - offset as usize, FIELD_HEADER);
-            words.extend_from_slice(field.values());
-            fields.push((Arc::clone(mesh), offset));
-        }
+        let (words, fields) = field_words(used());
         fields_fit(words.len(), &device.limits())?;
         self.fields = fields;
         self.fields_buffer = fields_buffer(device, &words);
@@ -295,32 +363,12 @@ impl GpuContact {
         let count = step.colliders.len().min(self.slot_colliders);
         debug_assert_eq!(count, step.colliders.len().min(MAX_STEP_COLLIDERS), "make_room first");
         let first = colliders_first(self.prefix_words, slot, self.slot_colliders);
-        let header = [
-            [f32::from_bits(count as u32), if step.skin { 1.0 } else { 0.0 }, step.grip_presence, self.reach],
-            step.grip.extend(f32::from_bits(first as u32)).to_array(),
-        ];
+        let header = slot_header(step, count, self.reach, first);
         queue.write_buffer(&self.buffer, (2 * slot) as u64 * 16, bytemuck::cast_slice(&header));
         if count == 0 {
             return;
         }
-        let words: Vec<[f32; 4]> = step.colliders[..count]
-            .iter()
-            .flat_map(|c| {
-                [
-                    c.centre.extend(c.radius).to_array(),
-                    c.half_extents.extend(f32::from_bits(c.kind)).to_array(),
-                    c.rotation.to_array(),
-                    c.travel.extend(c.friction).to_array(),
-                    [
-                        c.bound,
-                        if c.grasp_hand { 1.0 } else { 0.0 },
-                        // A mesh's field, uploaded by `upload_fields` first.
-                        f32::from_bits(c.mesh.as_ref().and_then(|m| self.offset(m)).unwrap_or(0)),
-                        0.0,
-                    ],
-                ]
-            })
-            .collect();
+        let words = collider_words(&step.colliders[..count], |m| self.offset(m));
         queue.write_buffer(&self.buffer, first as u64 * 16, bytemuck::cast_slice(&words));
     }
 
@@ -332,10 +380,7 @@ impl GpuContact {
         {
             return;
         }
-        let mut packed = vec![0.0_f32; v.div_ceil(4).max(1) * 4];
-        packed[..strands.grasp_weights.len().min(v)]
-            .copy_from_slice(&strands.grasp_weights[..strands.grasp_weights.len().min(v)]);
-        packed.truncate(v.div_ceil(4) * 4);
+        let packed = packed_weights(v, strands.grasp_weights);
         if !packed.is_empty() {
             queue.write_buffer(&self.buffer, weights_first(v) as u64 * 16, bytemuck::cast_slice(&packed));
         }
@@ -343,9 +388,62 @@ impl GpuContact {
     }
 }
 
+/// `colliders` as a slot holds them, 5 vec4s each; `field` says where a mesh's field begins.
+pub(crate) fn collider_words(
+    colliders: &[StepCollider],
+    field: impl Fn(&Arc<ColliderMesh>) -> Option<u32>,
+) -> Vec<[f32; 4]> {
+    colliders
+        .iter()
+        .flat_map(|c| {
+            [
+                c.centre.extend(c.radius).to_array(),
+                c.half_extents.extend(f32::from_bits(c.kind)).to_array(),
+                c.rotation.to_array(),
+                c.travel.extend(c.friction).to_array(),
+                [
+                    c.bound,
+                    if c.grasp_hand { 1.0 } else { 0.0 },
+                    // A mesh's field, uploaded first.
+                    f32::from_bits(c.mesh.as_ref().and_then(&field).unwrap_or(0)),
+                    0.0,
+                ],
+            ]
+        })
+        .collect()
+}
+
+/// A slot's header: (collider count, skin on, grip presence, `reach`), (grip, where its `count`
+/// colliders begin).
+pub(crate) fn slot_header(step: &ContactStep, count: usize, reach: f32, first: usize) -> [[f32; 4]; 2] {
+    [
+        [f32::from_bits(count as u32), if step.skin { 1.0 } else { 0.0 }, step.grip_presence, reach],
+        step.grip.extend(f32::from_bits(first as u32)).to_array(),
+    ]
+}
+
+/// The grasp's `weights` for `v` strands, four a vec4 (zero past the weights given).
+pub(crate) fn packed_weights(v: usize, weights: &[f32]) -> Vec<f32> {
+    let mut packed = vec![0.0_f32; v.div_ceil(4) * 4];
+    let n = weights.len().min(v);
+    packed[..n].copy_from_slice(&weights[..n]);
+    packed
+}
+
+/// The longest strand of `structure` (a little over).
+fn reach(structure: &FurStructure) -> f32 {
+    let (v, layers) = (structure.vertex_count(), structure.layers as usize);
+    let longest = (0..v)
+        .map(|j| {
+            (0..layers).map(|k| structure.positions[(k + 1) * v + j].distance(structure.positions[k * v + j])).sum()
+        })
+        .fold(0.0_f32, f32::max);
+    longest * 1.001
+}
+
 /// Colliders a slot makes room for to hold the busiest of `steps`.
-fn slot_room(steps: &[ContactStep]) -> usize {
-    room_for(steps.iter().map(|s| s.colliders.len()).max().unwrap_or(0))
+pub(crate) fn slot_room<'a>(steps: impl IntoIterator<Item = &'a ContactStep>) -> usize {
+    room_for(steps.into_iter().map(|s| s.colliders.len()).max().unwrap_or(0))
 }
 
 /// Room for `most` colliders: none for none, else a power of two from `MIN_SLOT_COLLIDERS` to
@@ -359,31 +457,11 @@ fn room_for(most: usize) -> usize {
 /// each slot.
 fn skin_buffer(device: &wgpu::Device, roots: &[glam::Vec3], skin: &Skin, slot_colliders: usize) -> wgpu::Buffer {
     let v = roots.len();
-    let mut words = vec![[0.0_f32; 4]; surface_first(v)];
-    for (j, planes) in skin.planes.iter().enumerate() {
-        for (p, plane) in planes.iter().enumerate() {
-            words[SKIN_FIRST + j * SKIN_PLANES + p] = plane.to_array();
-        }
-    }
-    for (j, cone) in skin.cones().enumerate() {
-        words[cones_first(v) + j] = cone.to_array();
-    }
-    // The triangles (`simulation_contact.wgsl`'s `surface_closest`).
-    let surface = &skin.surface;
-    for (j, [first, count]) in surface.strands.iter().enumerate() {
-        let root = roots[j];
-        words.push(root.extend(f32::from_bits((first << 6) | count)).to_array());
-    }
-    // Each list entry is its triangle's first vec4, counted from the strands' headers.
-    let triangles_first = (v + surface.lists.len().div_ceil(4)) as u32;
-    words.extend(surface.lists.chunks(4).map(|c| {
-        let mut w = [0.0_f32; 4];
-        for (slot, index) in w.iter_mut().zip(c) {
-            *slot = f32::from_bits(triangles_first + index * SURFACE_WORDS as u32);
-        }
-        w
-    }));
-    words.extend(surface.triangles.iter().flat_map(|t| t.map(|w| w.to_array())));
+    let mut words = vec![[0.0_f32; 4]; SKIN_FIRST];
+    words.extend(skin.planes_and_cones());
+    // The grasp's weights, written by `write_strands`.
+    words.resize(surface_first(v), [0.0; 4]);
+    words.extend(skin.surface_words(roots));
     debug_assert_eq!(words.len(), skin.prefix_words());
     words.resize(colliders_first(words.len(), CONTACT_SLOTS, slot_colliders), [0.0; 4]);
     wgpu::util::DeviceExt::create_buffer_init(

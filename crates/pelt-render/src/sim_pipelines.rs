@@ -21,6 +21,16 @@ pub(crate) struct PooledStep {
     pub(crate) layout: wgpu::BindGroupLayout,
 }
 
+/// `step_pooled_with_contact` and `solve_pooled_contact` (`simulation_pooled.wgsl`): every copy
+/// of a pool stepping with contact, through the pool's contact buffer and list.
+#[derive(Debug)]
+pub(crate) struct PooledContact {
+    pub(crate) contact: wgpu::ComputePipeline,
+    /// As [`SimPipelines::solve`].
+    pub(crate) solve: [wgpu::ComputePipeline; 3],
+    pub(crate) layout: wgpu::BindGroupLayout,
+}
+
 /// `simulation.wgsl`'s entry points, compiled for one device.
 #[derive(Clone, Debug)]
 pub(crate) struct SimPipelines {
@@ -36,6 +46,8 @@ pub(crate) struct SimPipelines {
     pub(crate) layout: wgpu::BindGroupLayout,
     /// Compiled when the first herd simulates on the GPU.
     pooled: Arc<OnceLock<PooledStep>>,
+    /// Compiled when the first herd's step has contact.
+    pooled_contact: Arc<OnceLock<PooledContact>>,
 }
 
 impl SimPipelines {
@@ -91,10 +103,10 @@ impl SimPipelines {
             step: compute_pipeline("step_strands", &[]),
             touch: compute_pipeline("weigh_touch", &[]),
             contact: compute_pipeline("step_strands_with_contact", &[]),
-            solve: [&[("COLLIDERS", 0.0), ("MESH_COLLIDERS", 0.0)][..], &[("MESH_COLLIDERS", 0.0)], &[]]
-                .map(|constants| compute_pipeline("solve_contact", constants)),
+            solve: SOLVE_CONSTANTS.map(|constants| compute_pipeline("solve_contact", constants)),
             layout,
             pooled: Arc::default(),
+            pooled_contact: Arc::default(),
         };
         scope.pop("building the GPU simulation's pipelines")?;
         Ok(pipelines)
@@ -142,7 +154,65 @@ impl SimPipelines {
         scope.pop("building the GPU simulation's pooled step")?;
         Ok(self.pooled.get_or_init(|| PooledStep { pipeline, layout }))
     }
+
+    /// The pooled contact kernels, once compiled.
+    pub(crate) fn pooled_contact_built(&self) -> Option<&PooledContact> {
+        self.pooled_contact.get()
+    }
+
+    /// The pooled contact kernels, compiled the first time: eight storage buffers (WebGPU's
+    /// least), the fields inside the pool's contact buffer.
+    pub(crate) fn pooled_contact(&self, device: &wgpu::Device) -> Result<&PooledContact, RenderError> {
+        if let Some(pooled) = self.pooled_contact.get() {
+            return Ok(pooled);
+        }
+        let scope = ErrorScope::push(device);
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some("pelt simulation pooled contact"),
+            source: wgpu::ShaderSource::Wgsl(simulation_pooled_shader_source().into()),
+        });
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+            label: Some("pelt simulation pooled contact"),
+            entries: &[
+                storage(0, true),
+                storage(1, true),
+                storage(2, true),
+                storage(3, false),
+                storage(4, false),
+                storage(5, true),
+                storage(6, true),
+                storage(8, false),
+            ],
+        });
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some("pelt simulation pooled contact"),
+            bind_group_layouts: &[Some(&layout)],
+            immediate_size: 0,
+        });
+        let compute_pipeline = |entry_point, constants: &[(&str, f64)]| {
+            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+                label: Some(entry_point),
+                layout: Some(&pipeline_layout),
+                module: &module,
+                entry_point: Some(entry_point),
+                compilation_options: wgpu::PipelineCompilationOptions {
+                    constants,
+                    ..wgpu::PipelineCompilationOptions::default()
+                },
+                cache: None,
+            })
+        };
+        let contact = compute_pipeline("step_pooled_with_contact", &[]);
+        let solve = SOLVE_CONSTANTS.map(|constants| compute_pipeline("solve_pooled_contact", constants));
+        scope.pop("building the GPU simulation's pooled contact")?;
+        Ok(self.pooled_contact.get_or_init(|| PooledContact { contact, solve, layout }))
+    }
 }
+
+/// The override constants of the three `solve_contact` kernels: without colliders' code, without
+/// mesh colliders', with both.
+const SOLVE_CONSTANTS: [&[(&str, f64)]; 3] =
+    [&[("COLLIDERS", 0.0), ("MESH_COLLIDERS", 0.0)], &[("MESH_COLLIDERS", 0.0)], &[]];
 
 /// A storage buffer the compute stage binds at `binding`.
 fn storage(binding: u32, read_only: bool) -> wgpu::BindGroupLayoutEntry {

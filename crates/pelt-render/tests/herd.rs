@@ -188,6 +188,159 @@ fn a_herds_gpu_steps_take_one_dispatch_and_match_each_recorded_alone() {
     }
 }
 
+/// Steps with contact pool too: a herd made together whose members each meet their own
+/// colliders (a ball; a capsule and a box joined by ten balls mid-run, so the slots' room grows
+/// after the grasp's hand grew it and the members before have written their slots;
+/// a mesh collider's distance field; a grasp; the skin alone), one stepping every other frame,
+/// takes two dispatches a step for all of them and comes out with the bytes each member's own
+/// dispatches give.
+#[test]
+fn a_herds_gpu_steps_with_contact_take_two_dispatches_and_match_each_recorded_alone() {
+    use glam::Quat;
+    use pelt_core::mesh::{ImportOptions, Mesh};
+    use pelt_core::sim::{Collider, ColliderMesh, ContactParams, GraspParams, Shape};
+    let mut rig = Rig::new(64, 64);
+    rig.renderer.set_pooled_stepping(true);
+    let structure = builtin_fur(Builtin::Bunny, 8);
+    let textures = strand_textures(32, 8, BROWN_ROOT, BROWN_TIP);
+    let asset = FurAsset::new(rig.device(), rig.queue(), &rig.renderer, &structure, &textures).expect("asset");
+    let (device, queue) = (rig.device(), rig.queue());
+    const MEMBERS: usize = 5;
+    let params = pelt_core::sim::SimParams { contact: ContactParams { skin: true }, ..Default::default() };
+    let v = structure.vertex_count();
+    let radius = structure.mesh.bounding_sphere().1;
+    let length = structure.lengths[0];
+    // Each member's colliders sit over a strand of its own, `out` strand lengths out along it
+    // and `clear` further (a collider's size, so its surface reaches into the fur).
+    let over = |j: usize, out: f32, clear: f32| {
+        let root = structure.positions[j];
+        root + (structure.positions[v + j] - root).normalize() * (out * length + clear)
+    };
+    let file = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("../../assets/meshes/pebble.obj");
+    let (mesh, _) = Mesh::load(&file, &ImportOptions::default()).expect("the pebble");
+    let pebble = std::sync::Arc::new(ColliderMesh::new(mesh, 16).expect("a closed pebble"));
+    let colliders = |k: usize, frame: u32, t: f64| -> Vec<Collider> {
+        let sway = Vec3::X * (0.1 * (t * 5.0).sin()) as f32 * radius;
+        match k {
+            0 => vec![Collider::at(
+                1,
+                Shape::Sphere { radius: 0.1 * radius },
+                t,
+                over(10, 0.4, 0.1 * radius) + sway,
+                Quat::IDENTITY,
+            )],
+            1 => {
+                let mut c = vec![
+                    Collider::at(
+                        1,
+                        Shape::Capsule { radius: 0.03 * radius, half_length: 0.2 * radius },
+                        t,
+                        over(200, 0.5, 0.03 * radius) + sway,
+                        Quat::from_rotation_x(1.5),
+                    ),
+                    Collider::at(
+                        2,
+                        Shape::Box { half_extents: Vec3::new(0.05, 0.05, 0.15) * radius },
+                        t,
+                        over(210, 0.4, 0.05 * radius) - sway,
+                        Quat::from_rotation_y(0.4),
+                    ),
+                ];
+                if frame > 6 {
+                    c.extend((0..10_u32).map(|i| {
+                        let centre = over(200 + 7 * i as usize, 0.3, 0.04 * radius);
+                        Collider::at(10 + i, Shape::Sphere { radius: 0.04 * radius }, t, centre, Quat::IDENTITY)
+                    }));
+                }
+                c
+            }
+            2 => vec![Collider::at(
+                1,
+                Shape::Mesh { mesh: std::sync::Arc::clone(&pebble), scale: 0.12 * radius },
+                t,
+                over(400, 0.4, 0.08 * radius) + sway,
+                Quat::from_rotation_y(t as f32),
+            )],
+            _ => Vec::new(),
+        }
+    };
+    let made_together = FurDriver::herd_with_asset(
+        device,
+        queue,
+        &rig.renderer,
+        (&asset, &structure),
+        &params,
+        KernelChoice::Gpu,
+        MEMBERS,
+    )
+    .expect("herd");
+    let stepper = || pelt_core::sim::FurStepper::new(&structure, &params).expect("stepper");
+    let mut together: Vec<_> = made_together.into_iter().map(|driver| (driver, stepper())).collect();
+    let mut alone: Vec<_> = (0..MEMBERS)
+        .map(|_| {
+            let driver =
+                FurDriver::with_asset(device, queue, &rig.renderer, &asset, &structure, &params, KernelChoice::Gpu)
+                    .expect("driver");
+            (driver, stepper())
+        })
+        .collect();
+    let mut dispatches = Vec::new();
+    for frame in 1..=10_u32 {
+        let time_secs = f64::from(frame) / 20.0;
+        let mut encoder = device.create_command_encoder(&wgpu::CommandEncoderDescriptor::default());
+        for herd in [&mut alone, &mut together] {
+            for (k, (driver, stepper)) in herd.iter_mut().enumerate() {
+                if k == 4 && frame % 2 == 1 {
+                    continue;
+                }
+                let simulation = stepper.simulation_mut();
+                simulation.set_colliders(&colliders(k, frame, time_secs)).expect("colliders");
+                if k == 3 {
+                    match frame {
+                        2 => simulation
+                            .grasp_begin(
+                                over(300, 0.5, 0.0),
+                                2.0 * length,
+                                0.2 * length,
+                                GraspParams::default(),
+                                time_secs,
+                            )
+                            .expect("grasp"),
+                        3..=7 => simulation.grasp_move(over(300, 0.5 + 0.1 * (frame - 2) as f32, 0.0)).expect("grip"),
+                        8 => simulation.grasp_end(time_secs),
+                        _ => {}
+                    }
+                }
+                driver.advance_to(device, queue, stepper, time_secs).expect("advance");
+            }
+        }
+        let each: Vec<usize> = alone
+            .iter_mut()
+            .map(|(driver, _)| FurDriver::record_herd(&mut encoder, [driver]).expect("record alone"))
+            .collect();
+        let recorded =
+            FurDriver::record_herd(&mut encoder, together.iter_mut().map(|(driver, _)| driver)).expect("herd");
+        dispatches.push((each, recorded));
+        queue.submit([encoder.finish()]);
+    }
+    let state = |driver: &FurDriver| common::read_bytes(device, queue, driver.fur().current_positions());
+    let rest: Vec<u8> = bytemuck::cast_slice(&structure.positions).to_vec();
+    for k in 0..MEMBERS {
+        let (a, b) = (state(&alone[k].0), state(&together[k].0));
+        assert_ne!(a, rest, "member {k} never moved");
+        assert!(a == b, "member {k}'s state stepped with the herd differs from its own");
+    }
+    for j in 1..MEMBERS {
+        assert_ne!(state(&together[0].0), state(&together[j].0), "members 0 and {j} met the same contact");
+    }
+    // Every member steps with contact: two dispatches a step for the herd, two a step for each
+    // member alone.
+    for (frame, (each, recorded)) in (1..).zip(&dispatches) {
+        assert_eq!(*recorded, *each.iter().max().expect("members"), "frame {frame}: {dispatches:?}");
+        assert!(*recorded >= 2, "frame {frame}: {dispatches:?}");
+    }
+}
+
 #[test]
 fn each_copy_draws_its_own_pose_as_a_fur_uploaded_alone() {
     let rig = Rig::new(96, 96);

@@ -30,7 +30,8 @@ struct Step {
     next_tick_counts: vec4<u32>,
     // xyz: the touch force; w: its presence (0: no touch).
     touch: vec4<f32>,
-    // x: workgroups per row of the dispatch grid; y: the step's slot (its contact data).
+    // x: workgroups per row of the dispatch grid; y: the step's slot (its contact data); z: its
+    // block in its pool's contact buffer; w: the most workgroups a contact list asks to solve it.
     grid: vec4<u32>,
     // xyz: the touch's centre; w: its radius (read by the `weigh_touch` pass).
     touch_centre: vec4<f32>,

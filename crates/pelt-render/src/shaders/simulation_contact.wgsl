@@ -4,7 +4,7 @@
 // every strand and lists those a cheap screen cannot clear; `solve_contact`, dispatched
 // indirectly over that list, solves them.
 //
-// `contact` layout, in vec4s (V strands, `grid.y` the step's slot):
+// A fur's own `contact` buffer, in vec4s (V strands, `grid.y` the step's slot):
 //   [2 s], [2 s + 1] for slot s < CONTACT_SLOTS: (collider count, skin on, grip presence, the
 //     longest strand's length), (grip xyz, where the slot's colliders begin as bits);
 //   from CONTACT_SKIN: SKIN_PLANES planes per strand (n xyz in the rest frame, h);
@@ -19,12 +19,14 @@
 //   then each slot's colliders (as many as the fur's busiest step needs, `contact.rs`), 5 vec4s
 //     each: (centre, radius), (half extents, kind as bits), rotation, (travel, friction),
 //     (bound, grasp hand, field as bits, -) (a mesh's radius is its scale, its field where it
-//     begins in `sdf_fields`).
+//     begins in the fields).
+// A pool's buffer holds the same parts, the skin once for every copy and each copy's headers,
+// weights and colliders in a block of its own (`simulation_pooled.wgsl`).
 
 @group(0) @binding(5) var<storage, read> contact: array<vec4<f32>>;
 // What `step_strands_with_contact` lists for `solve_contact`: the indirect dispatch's workgroups
 // (x, y, z, copied to the dispatch's arguments), how many strands are listed, then each listed
-// strand's index and the first segment its screen did not clear.
+// strand's index and the first segment its screen did not clear (`listed_word`).
 struct ContactWork {
     groups: array<atomic<u32>, 3>,
     count: atomic<u32>,
@@ -32,9 +34,10 @@ struct ContactWork {
 }
 
 @group(0) @binding(8) var<storage, read_write> contact_work: ContactWork;
-// Mesh colliders' distance fields (`contact.rs`'s `upload_fields`), each: origin xyz, cell,
-// dims xyz as bits, -, then the values, x fastest.
-@group(0) @binding(7) var<storage, read> sdf_fields: array<f32>;
+// Mesh colliders' distance fields (`contact.rs`'s `upload_fields`) are read through `sdf_at`,
+// each: origin xyz, cell, dims xyz as bits, -, then the values, x fastest. Where the headers,
+// planes, weights and triangles begin (`headers_first`, `planes_first`, `weights_first`,
+// `surface_first`) is the bindings' file's: a fur's own buffer or its pool's.
 
 // Whether `solve_contact` reads colliders, and mesh colliders' fields: steps without them run a
 // pipeline compiled without that code (it costs where lanes diverge even when no lane takes it).
@@ -121,7 +124,7 @@ fn collider_closest(c: u32, x: vec3<f32>) -> Closest {
 }
 
 fn sdf_value(field: u32, dims: vec3<u32>, at: vec3<u32>) -> f32 {
-    return sdf_fields[field + 8u + at.x + dims.x * (at.y + dims.y * at.z)];
+    return sdf_at(field + 8u + at.x + dims.x * (at.y + dims.y * at.z));
 }
 
 fn sdf_lerp(a: f32, b: f32, t: f32) -> f32 {
@@ -131,12 +134,12 @@ fn sdf_lerp(a: f32, b: f32, t: f32) -> f32 {
 // `StepCollider::closest` of a mesh: `MeshSdf::local_distance_gradient` at x in the mesh's
 // frame (scaled by `scale`), operation for operation.
 fn sdf_closest(x: vec3<f32>, centre: vec3<f32>, turn: vec4<f32>, scale: f32, field: u32, up: vec3<f32>) -> Closest {
-    let origin = vec3<f32>(sdf_fields[field], sdf_fields[field + 1u], sdf_fields[field + 2u]);
-    let cell = sdf_fields[field + 3u];
+    let origin = vec3<f32>(sdf_at(field), sdf_at(field + 1u), sdf_at(field + 2u));
+    let cell = sdf_at(field + 3u);
     let dims = vec3<u32>(
-        bitcast<u32>(sdf_fields[field + 4u]),
-        bitcast<u32>(sdf_fields[field + 5u]),
-        bitcast<u32>(sdf_fields[field + 6u]),
+        bitcast<u32>(sdf_at(field + 4u)),
+        bitcast<u32>(sdf_at(field + 5u)),
+        bitcast<u32>(sdf_at(field + 6u)),
     );
     let local = rotate(conjugate(turn), x - centre) / scale;
     let g = (local - origin) / cell;
@@ -203,15 +206,11 @@ fn turn_above(u: vec3<f32>, n: vec3<f32>, floor_in: f32, hint: vec3<f32>) -> vec
 }
 
 fn cones_first(v: u32) -> u32 {
-    return CONTACT_SKIN + SKIN_PLANES * v;
+    return planes_first() + SKIN_PLANES * v;
 }
 
 fn colliders_first(slot: u32) -> u32 {
-    return bitcast<u32>(contact[2u * slot + 1u].w);
-}
-
-fn surface_first(v: u32) -> u32 {
-    return cones_first(v) + v + (v + 3u) / 4u;
+    return bitcast<u32>(contact[headers_first() + 2u * slot + 1u].w);
 }
 
 // One strand's skin triangles, posed with its root and frame.
@@ -350,7 +349,7 @@ fn surface_clearance(x: vec3<f32>, cheap: f32, v: u32) -> f32 {
 }
 
 fn strand_grasp_weight(j: u32, v: u32) -> f32 {
-    let at = cones_first(v) + v + j / 4u;
+    let at = weights_first(v) + j / 4u;
     return contact[at][j % 4u];
 }
 
@@ -358,7 +357,10 @@ fn strand_grasp_weight(j: u32, v: u32) -> f32 {
 // the strand listed for `solve_contact` unless the screen cleared every node.
 @compute @workgroup_size(64)
 fn step_strands_with_contact(@builtin(workgroup_id) group: vec3<u32>, @builtin(local_invocation_index) lane: u32) {
-    let j = step_strand_index(group, lane);
+    bend_and_screen(step_strand_index(group, lane));
+}
+
+fn bend_and_screen(j: u32) {
     let v = inputs.next_tick_counts.z;
     if j >= v {
         return;
@@ -373,7 +375,7 @@ fn step_strands_with_contact(@builtin(workgroup_id) group: vec3<u32>, @builtin(l
 // The screen's state before the bend. A held strand is solved from its root, and so is one that
 // keeps skin triangles (the cone does not bound them).
 fn screen_start(j: u32, v: u32, layers: u32, root: vec3<f32>, frame: vec4<f32>) {
-    let header = contact[2u * inputs.grid.y];
+    let header = contact[headers_first() + 2u * inputs.grid.y];
     let skin = header.y > 0.0;
     screen_cone = vec4<f32>(0.0);
     screen_from = layers;
@@ -403,7 +405,7 @@ fn screen_node(k: u32, node: vec3<f32>, root: vec3<f32>) {
 // of them; then the strand is listed when any node was not cleared.
 fn screen_finish(j: u32, v: u32, layers: u32) {
     let slot = inputs.grid.y;
-    let count = bitcast<u32>(contact[2u * slot].x);
+    let count = bitcast<u32>(contact[headers_first() + 2u * slot].x);
     let first = colliders_first(slot);
     for (var i = 0u; i < count; i++) {
         let c = first + i * COLLIDER_WORDS;
@@ -415,10 +417,11 @@ fn screen_finish(j: u32, v: u32, layers: u32) {
     }
     if screen_from < layers {
         let listed = atomicAdd(&contact_work.count, 1u);
-        contact_work.strands[listed] = vec2<u32>(j, screen_from);
-        // A workgroup of `solve_contact` per 64 listed, as many as the step's own grid is wide
-        // (each invocation then takes every so-many-th strand of the list).
-        if listed % WORKGROUP == 0u && listed / WORKGROUP < inputs.grid.x {
+        contact_work.strands[listed] = vec2<u32>(j, listed_word(screen_from));
+        // A workgroup of `solve_contact` per 64 listed, up to the step's cap (`grid.w`: its own
+        // grid's width, a pool's times its copies; each invocation then takes every so-many-th
+        // strand of the list).
+        if listed % WORKGROUP == 0u && listed / WORKGROUP < inputs.grid.w {
             atomicAdd(&contact_work.groups[0], 1u);
             atomicStore(&contact_work.groups[1], 1u);
             atomicStore(&contact_work.groups[2], 1u);
@@ -442,6 +445,12 @@ fn solve_contact(
     @builtin(local_invocation_index) lane: u32,
     @builtin(num_workgroups) groups: vec3<u32>,
 ) {
+    solve_listed_strands(group, lane, groups);
+}
+
+// A listed strand's entry (`listed_word`, `take_listed`) also says whose it is in a pool's list,
+// so every lane reads its own copy's inputs; the strand count and layers are every copy's.
+fn solve_listed_strands(group: vec3<u32>, lane: u32, groups: vec3<u32>) {
     let v = inputs.next_tick_counts.z;
     let layers = inputs.next_tick_counts.w;
     if lane == 0u {
@@ -453,23 +462,25 @@ fn solve_contact(
         if i < count {
             let listed = contact_work.strands[i];
             let j = listed.x;
+            let start = take_listed(listed.y);
             contact_setup(j, v, strand_root(j).xyz, strand_frame(j, v));
             var first_touch = 0u;
             if contact_held == 0.0 {
-                first_touch = find_first_touch(j, v, layers, strand_root(j).xyz, listed.y);
+                first_touch = find_first_touch(j, v, layers, strand_root(j).xyz, start);
             }
             if first_touch < layers {
-                solve_touching[atomicAdd(&solve_touching_count, 1u)] = vec2<u32>(j, first_touch);
+                solve_touching[atomicAdd(&solve_touching_count, 1u)] = vec2<u32>(j, listed_word(first_touch));
             }
         }
         workgroupBarrier();
         if lane < atomicLoad(&solve_touching_count) {
             let touching = solve_touching[lane];
             let j = touching.x;
+            let first_touch = take_listed(touching.y);
             let root = strand_root(j).xyz;
             let frame = strand_frame(j, v);
             contact_setup(j, v, root, frame);
-            contact_strand(j, v, layers, root, frame, touching.y);
+            contact_strand(j, v, layers, root, frame, first_touch);
         }
         workgroupBarrier();
         if lane == 0u {
@@ -482,7 +493,7 @@ fn solve_contact(
 // Strand j's contact inputs for this step.
 fn contact_setup(j: u32, v: u32, root: vec3<f32>, frame: vec4<f32>) {
     let slot = inputs.grid.y;
-    let header = contact[2u * slot];
+    let header = contact[headers_first() + 2u * slot];
     let count = bitcast<u32>(header.x);
     let skin = header.y > 0.0;
     let presence = header.z;
@@ -491,7 +502,7 @@ fn contact_setup(j: u32, v: u32, root: vec3<f32>, frame: vec4<f32>) {
     if skin {
         // A strand's planes fill the first of its slots (`skin_planes`).
         for (var p = 0u; p < SKIN_PLANES; p++) {
-            let plane = contact[CONTACT_SKIN + j * SKIN_PLANES + p];
+            let plane = contact[planes_first() + j * SKIN_PLANES + p];
             if all(plane.xyz == vec3<f32>(0.0)) {
                 break;
             }
@@ -551,7 +562,7 @@ fn find_first_touch(j: u32, v: u32, layers: u32, root: vec3<f32>, start: u32) ->
 fn contact_strand(j: u32, v: u32, layers: u32, root: vec3<f32>, frame: vec4<f32>, first_touch: u32) {
     let held = contact_held;
     let surface = contact_surface;
-    let grip = contact[2u * inputs.grid.y + 1u].xyz;
+    let grip = contact[headers_first() + 2u * inputs.grid.y + 1u].xyz;
     let to_grip = grip - root;
     let grip_distance = length(to_grip);
     let has_grip = grip_distance > 0.0;

@@ -18,3 +18,36 @@
 
 // The ranges are bound where they start.
 const member_base = vec4<u32>(0u, 0u, 0u, 0u);
+// Mesh colliders' distance fields (`contact.rs`'s `upload_fields`).
+@group(0) @binding(7) var<storage, read> sdf_fields: array<f32>;
+
+fn sdf_at(i: u32) -> f32 {
+    return sdf_fields[i];
+}
+
+// The fur's own contact buffer: the slots' headers, the skin's planes and cones, the grasp's
+// weights, the skin's triangles (`simulation_contact.wgsl`).
+fn headers_first() -> u32 {
+    return 0u;
+}
+
+fn planes_first() -> u32 {
+    return CONTACT_SKIN;
+}
+
+fn weights_first(v: u32) -> u32 {
+    return cones_first(v) + v;
+}
+
+fn surface_first(v: u32) -> u32 {
+    return weights_first(v) + (v + 3u) / 4u;
+}
+
+// A listed strand's word: its first segment to solve (the list holds this fur's strands alone).
+fn listed_word(segment: u32) -> u32 {
+    return segment;
+}
+
+fn take_listed(word: u32) -> u32 {
+    return word;
+}

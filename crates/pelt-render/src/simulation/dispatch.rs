@@ -1,6 +1,10 @@
 //! Recording the prepared steps: one compute pass a step (a second, dispatched indirectly, for
 //! a step with contact), a herd's contact-free steps sharing one pass, and the copies made
-//! together stepping in one dispatch.
+//! together stepping in one dispatch (two with contact, whatever their number).
+
+use std::sync::Arc;
+
+use pelt_core::sim::ContactStep;
 
 use super::{GpuSimulation, RING_SLOTS, STEP_SLOT_BYTES, SimPool, solve_kernel};
 use crate::RenderError;
@@ -37,6 +41,15 @@ impl GpuSimulation {
         let mut groups = Vec::with_capacity(members.len());
         for (simulation, fur) in &members {
             groups.push(simulation.state_groups(fur)?);
+            let contact = simulation.pending_contact.iter().any(ContactStep::is_active);
+            if simulation.pooled && contact && simulation.pool.contact.run().is_none() {
+                return Err(RenderError::Count {
+                    what: "pool contact buffers prepared for a step with contact",
+                    expected: 1,
+                    got: 0,
+                    rule: "call GpuSimulation::prepare before dispatching",
+                });
+            }
         }
         let mut dispatches = 0;
         for ((simulation, _), &groups) in members.iter_mut().zip(&groups) {
@@ -46,6 +59,7 @@ impl GpuSimulation {
         for slot in 0..steps {
             let mut shared = Vec::new();
             let mut alone = Vec::new();
+            let mut pooled_contact = Vec::new();
             for (k, (simulation, fur)) in members.iter_mut().enumerate() {
                 if slot >= simulation.pending.len() {
                     continue;
@@ -55,6 +69,7 @@ impl GpuSimulation {
                     continue;
                 }
                 match simulation.pending_contact.get(slot).filter(|step| step.is_active()) {
+                    Some(_) if simulation.pooled => pooled_contact.push(k),
                     Some(_) => alone.push(k),
                     None => shared.push(k),
                 }
@@ -97,6 +112,9 @@ impl GpuSimulation {
                     pass.dispatch_workgroups(simulation.grid[0], simulation.grid[1], 1);
                     dispatches += 1;
                 }
+            }
+            for run in contact_runs(&members, &pooled_contact) {
+                dispatches += record_contact_run(encoder, &members, &run, slot);
             }
             for &k in &alone {
                 dispatches += members[k].0.contact_step(encoder, groups[k], slot);
@@ -217,4 +235,65 @@ fn pool_runs<'a>(members: &'a [(&mut GpuSimulation, &mut GpuFur)], shared: &[usi
     let (pooled, single): (Vec<_>, Vec<_>) = runs.into_iter().partition(|run| run.members.len() > 1);
     lone.extend(single.into_iter().flat_map(|run| run.members));
     (pooled, lone)
+}
+
+/// `pooled` (members stepping with contact through their pools) split by pool, in the order first
+/// met.
+fn contact_runs(members: &[(&mut GpuSimulation, &mut GpuFur)], pooled: &[usize]) -> Vec<Vec<usize>> {
+    let mut runs: Vec<Vec<usize>> = Vec::new();
+    for &k in pooled {
+        let pool = &members[k].0.pool;
+        match runs.iter_mut().find(|run| Arc::ptr_eq(&members[run[0]].0.pool, pool)) {
+            Some(run) => run.push(k),
+            None => runs.push(vec![k]),
+        }
+    }
+    runs
+}
+
+/// Pending step `slot` of one pool's copies with contact (`run`): their steps copied side by
+/// side, the pooled step listing every copy's strands near something, then the pooled solve,
+/// dispatched indirectly; the dispatches recorded.
+fn record_contact_run(
+    encoder: &mut wgpu::CommandEncoder,
+    members: &[(&mut GpuSimulation, &mut GpuFur)],
+    run: &[usize],
+    slot: usize,
+) -> usize {
+    let first = &members[run[0]].0;
+    // Made by every member's prepare (checked before recording).
+    let (Some(contact), Some(kernels)) = (first.pool.contact.run(), first.pipelines.pooled_contact_built()) else {
+        return 0;
+    };
+    for (i, &k) in run.iter().enumerate() {
+        let simulation = &members[k].0;
+        encoder.copy_buffer_to_buffer(
+            &simulation.step_uniforms,
+            simulation.slot_offset(slot),
+            &contact.steps,
+            i as u64 * STEP_SLOT_BYTES,
+            STEP_SLOT_BYTES,
+        );
+    }
+    // The kernel with the code the busiest copy's colliders need.
+    let solve = run.iter().filter_map(|&k| members[k].0.pending_contact.get(slot)).map(solve_kernel).max().unwrap_or(0);
+    encoder.clear_buffer(&contact.work, 0, Some(16));
+    {
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some("pelt simulation pooled step"),
+            timestamp_writes: None,
+        });
+        pass.set_pipeline(&kernels.contact);
+        pass.set_bind_group(0, &contact.bind_group, &[]);
+        pass.dispatch_workgroups(first.grid[0], first.grid[1], run.len() as u32);
+    }
+    encoder.copy_buffer_to_buffer(&contact.work, 0, &contact.work_groups, 0, 12);
+    let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+        label: Some("pelt simulation pooled contact"),
+        timestamp_writes: None,
+    });
+    pass.set_pipeline(&kernels.solve[solve]);
+    pass.set_bind_group(0, &contact.bind_group, &[]);
+    pass.dispatch_workgroups_indirect(&contact.work_groups, 0);
+    2
 }

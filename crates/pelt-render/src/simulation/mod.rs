@@ -13,7 +13,7 @@
 use std::sync::{Arc, OnceLock};
 
 use pelt_core::FurStructure;
-use pelt_core::sim::{ContactStep, InputVersions, Simulation, kernel_rest};
+use pelt_core::sim::{ContactStep, ContactStrands, InputVersions, Simulation, kernel_rest};
 
 use crate::RenderError;
 use crate::contact::{CONTACT_SLOTS, GpuContact, Skin};
@@ -22,10 +22,12 @@ use crate::renderer::FurRenderer;
 use crate::requirements::{ErrorScope, check_size};
 use crate::sim_pipelines::SimPipelines;
 use pool::Range;
+use pool_contact::{CopySteps, PoolBuffers};
 
 mod dispatch;
 mod inputs;
 mod pool;
+mod pool_contact;
 mod step;
 mod wet;
 
@@ -84,8 +86,13 @@ pub struct GpuSimulation {
     /// ranges there: strand inputs, strand state, wet strands.
     pool: Arc<SimPool>,
     ranges: [Range; 3],
-    /// Whether its steps without contact run in its pool's dispatch.
+    /// Whether its steps run in its pool's dispatches (with contact, through the pool's contact).
     pooled: bool,
+    /// Its slot in its pool.
+    slot: u32,
+    /// The most workgroups a pooled contact list may ask to solve: the grid's width for every
+    /// copy of the pool, within the device's limit.
+    pooled_solve_cap: u32,
     wet: WetInputs,
     /// One bind group per shared-array state written so far (a fur has one or two), by its
     /// buffer and offset.
@@ -268,12 +275,6 @@ impl GpuSimulation {
             Some(cell) => (cell.get_or_init(make_rest).clone(), true),
             None => (make_rest(), false),
         };
-        // The skin's planes and triangles come from the CPU simulation once it has found them
-        // (skin contact on): a coat that never touches its skin never finds them.
-        let skin = Skin::none(v);
-        check_size(device, "simulation contact", GpuContact::bytes(&skin, 0))?;
-        check_size(device, "simulation contact list", GpuContact::work_bytes(v))?;
-        let contact = GpuContact::new(device, structure, &skin);
         scope.pop("creating the GPU simulation")?;
         let pooled = pooling
             && pool.slots() > 1
@@ -282,14 +283,29 @@ impl GpuSimulation {
                 pipelines.pooled(device)?,
                 (&rest_segments, fur.current_positions().buffer()),
             )?;
+        let scope = ErrorScope::push(device);
+        // The skin's planes and triangles come from the CPU simulation once it has found them
+        // (skin contact on): a coat that never touches its skin never finds them. A pooled
+        // copy's contact is its pool's.
+        let contact = if pooled {
+            GpuContact::unused(device, structure)
+        } else {
+            let skin = Skin::none(v);
+            check_size(device, "simulation contact", GpuContact::bytes(&skin, 0))?;
+            check_size(device, "simulation contact list", GpuContact::work_bytes(v))?;
+            GpuContact::new(device, structure, &skin)
+        };
+        scope.pop("creating the GPU simulation's contact")?;
         Ok(Self {
             pipelines,
             step_uniforms,
             rest_segments,
             rest_shared,
             ranges: pool.ranges(slot),
+            pooled_solve_cap: grid_x.saturating_mul(pool.slots()).min(limits.max_compute_workgroups_per_dimension),
             pool,
             pooled,
+            slot,
             contact,
             pending_contact: Vec::with_capacity(STEP_SLOTS + 2),
             wet: WetInputs::default(),
@@ -385,9 +401,44 @@ impl GpuSimulation {
         let history = if start_over { 0 } else { self.dispatched_history };
         self.pending_history = settle_inertia(&mut self.pending, history);
         let strands = simulation.contact_strands();
+        if self.pooled {
+            self.prepare_pooled_contact((device, queue), simulation, fur, &strands)?;
+        } else {
+            self.prepare_own_contact((device, queue), simulation, fur, &strands)?;
+        }
+        let written = [fur.previous_positions(), fur.current_positions()];
+        let [strands, state, wet] = self.ranges;
+        for slot in 0..self.pending.len() {
+            let ring_slot = (self.ring + slot as u64) % RING_SLOTS;
+            self.pending[slot].grid[1] = ring_slot as u32;
+            if self.pooled {
+                self.pending[slot].grid[2] = self.slot;
+                self.pending[slot].grid[3] = self.pooled_solve_cap;
+            }
+            // Step `slot` writes the state that is current after `slot + 1` swaps.
+            let positions = u32::try_from(written[slot % 2].offset() / 4).unwrap_or(u32::MAX);
+            self.pending[slot].pool = [positions, strands.first(16), state.first(16), wet.first(pool::WET_BYTES)];
+            queue.write_buffer(&self.step_uniforms, self.slot_offset(slot), bytemuck::bytes_of(&self.pending[slot]));
+            if !self.pooled {
+                self.contact.write_slot(queue, ring_slot as usize, &self.pending_contact[slot]);
+            }
+        }
+        Ok(())
+    }
+
+    /// The pending steps' contact in the fur's own buffer: the skin once found, room for the
+    /// colliders, the grasp's weights and the mesh colliders' fields (the slots are written with
+    /// the steps).
+    fn prepare_own_contact(
+        &mut self,
+        (device, queue): (&wgpu::Device, &wgpu::Queue),
+        simulation: &Simulation,
+        fur: &GpuFur,
+        strands: &ContactStrands<'_>,
+    ) -> Result<(), RenderError> {
         let mut rebind = false;
         if !self.skin_found && simulation.has_skin_setup() {
-            let skin = Skin::of(&strands);
+            let skin = Skin::of(strands);
             check_size(device, "simulation contact", GpuContact::bytes(&skin, self.contact.slot_colliders()))?;
             self.contact.set_skin(device, strands.rest_roots, &skin);
             self.skin_found = true;
@@ -395,7 +446,7 @@ impl GpuSimulation {
         }
         // Room for the pending steps' colliders (a coat nothing touches keeps none).
         rebind |= self.contact.make_room((device, queue), &self.pending_contact)?;
-        self.contact.write_strands(queue, &strands);
+        self.contact.write_strands(queue, strands);
         if self.contact.upload_fields(device, &self.pending_contact)? || rebind {
             // The fields or the contact buffer is new: bind it.
             self.bind_groups.clear();
@@ -403,18 +454,41 @@ impl GpuSimulation {
                 self.bind_group_for(device, buffer)?;
             }
         }
-        let written = [fur.previous_positions(), fur.current_positions()];
-        let [strands, state, wet] = self.ranges;
-        for slot in 0..self.pending.len() {
-            let ring_slot = (self.ring + slot as u64) % RING_SLOTS;
-            self.pending[slot].grid[1] = ring_slot as u32;
-            // Step `slot` writes the state that is current after `slot + 1` swaps.
-            let positions = u32::try_from(written[slot % 2].offset() / 4).unwrap_or(u32::MAX);
-            self.pending[slot].pool = [positions, strands.first(16), state.first(16), wet.first(pool::WET_BYTES)];
-            queue.write_buffer(&self.step_uniforms, self.slot_offset(slot), bytemuck::bytes_of(&self.pending[slot]));
-            self.contact.write_slot(queue, ring_slot as usize, &self.pending_contact[slot]);
-        }
         Ok(())
+    }
+
+    /// The pending steps with contact in the copy's block of its pool's contact (nothing while
+    /// no copy of the pool has stepped with contact).
+    fn prepare_pooled_contact(
+        &mut self,
+        (device, queue): (&wgpu::Device, &wgpu::Queue),
+        simulation: &Simulation,
+        fur: &GpuFur,
+        strands: &ContactStrands<'_>,
+    ) -> Result<(), RenderError> {
+        let steps: Vec<(usize, &ContactStep)> = (self.pending_contact.iter().enumerate())
+            .filter(|(_, step)| step.is_active())
+            .map(|(slot, step)| (((self.ring + slot as u64) % RING_SLOTS) as usize, step))
+            .collect();
+        if steps.is_empty() && !self.pool.contact.is_made() {
+            return Ok(());
+        }
+        let pipeline = self.pipelines.pooled_contact(device)?;
+        let copy = CopySteps {
+            copy: self.slot,
+            steps,
+            strands,
+            skin_found: simulation.has_skin_setup(),
+            contact: &self.contact,
+        };
+        let buffers = PoolBuffers {
+            strands: &self.pool.strands,
+            state: &self.pool.state,
+            wet: &self.pool.wet,
+            rest: &self.rest_segments,
+            positions: fur.current_positions().buffer(),
+        };
+        self.pool.contact.prepare_copy((device, queue), pipeline, &copy, &buffers)
     }
 
     /// What the GPU carries from step to step, for tests that compare it with the CPU's
@@ -440,7 +514,7 @@ impl GpuSimulation {
         let contact = &self.contact;
         let own_rest = if self.rest_shared { 0 } else { self.rest_segments.size() };
         own_rest
-            + self.pool.slot_bytes()
+            + self.pool.slot_bytes(self.slot)
             + [&self.step_uniforms, &contact.buffer, &contact.fields_buffer, &contact.work, &contact.work_groups]
                 .iter()
                 .map(|buffer| buffer.size())

@@ -1,10 +1,11 @@
 //! The GPU simulation's buffers for the copies of one fur made together (a pool's members): each
 //! copy's strand inputs, strand state and wet strands are ranges of one buffer each, so a step
-//! without contact runs every copy that takes it in one dispatch (`simulation_pooled.wgsl`). A
-//! fur's own kernels bind its ranges and see a buffer of their own.
+//! runs every copy that takes it in one dispatch (`simulation_pooled.wgsl`; with contact, two,
+//! through the pool's contact). A fur's own kernels bind its ranges and see a buffer of their own.
 
 use std::sync::OnceLock;
 
+use super::pool_contact::PoolContact;
 use super::{STATE_BYTES, STEP_SLOT_BYTES, STRAND_BYTES};
 use crate::RenderError;
 use crate::requirements::{ErrorScope, check_size};
@@ -55,6 +56,8 @@ pub(crate) struct SimPool {
     /// The pooled step's bind group: the whole buffers, with the rest segments and the shared
     /// vertex arrays of the first copy that bound them. Copies with others step alone.
     pooled: OnceLock<((wgpu::Buffer, wgpu::Buffer), wgpu::BindGroup)>,
+    /// What the pooled steps with contact read.
+    pub contact: PoolContact,
 }
 
 impl SimPool {
@@ -104,6 +107,7 @@ impl SimPool {
             slots: slots.max(1),
             steps,
             pooled: OnceLock::new(),
+            contact: PoolContact::new(vertex_count, slots),
         })
     }
 
@@ -123,10 +127,11 @@ impl SimPool {
         ]
     }
 
-    /// The bytes one copy holds here: its ranges, and its step's slot when pooled.
-    pub fn slot_bytes(&self) -> u64 {
+    /// The bytes copy `slot` holds here: its ranges, its step's slot when pooled, and its part of
+    /// the pool's contact (with the shared part for slot 0).
+    pub fn slot_bytes(&self, slot: u32) -> u64 {
         let step = if self.slots > 1 { STEP_SLOT_BYTES } else { 0 };
-        self.strands_stride + self.state_stride + self.wet_stride + step
+        self.strands_stride + self.state_stride + self.wet_stride + step + self.contact.slot_bytes(slot)
     }
 
     /// Binds the pooled step to `rest` and `positions` (the pool's shared vertex arrays) the

@@ -19,7 +19,8 @@ pub(super) struct StepUniform {
     jitter_seed_tick: [u32; 4],
     next_tick_counts: [u32; 4],
     touch: [f32; 4],
-    /// x: workgroups per row of the dispatch grid; y: the step's slot (its contact data).
+    /// x: workgroups per row of the dispatch grid; y: the step's slot (its contact data); z: its
+    /// block in its pool's contact buffer; w: the most workgroups its contact list asks for.
     pub grid: [u32; 4],
     touch_centre: [f32; 4],
     inertia: [f32; 4],
@@ -78,7 +79,7 @@ pub(super) fn step_uniform(
         jitter_seed_tick: [jitter_seed[0], jitter_seed[1], tick_a[0], tick_a[1]],
         next_tick_counts: [tick_b[0], tick_b[1], counts[0], counts[1]],
         touch: inputs.touch_force.extend(inputs.touch_presence).to_array(),
-        grid: [grid_x, 0, 0, 0],
+        grid: [grid_x, 0, 0, grid_x],
         touch_centre,
         inertia: match inertia {
             InertiaStep::Spring(spring) => [spring.dt, spring.dt_before, spring.scale, spring.stiffness_dt],
