@@ -46,7 +46,7 @@ pub(crate) struct SimPipelines {
     pub(crate) layout: wgpu::BindGroupLayout,
     /// Compiled when the first herd simulates on the GPU.
     pooled: Arc<OnceLock<PooledStep>>,
-    /// Compiled when the first herd's step has contact.
+    /// Compiled with the first herd that steps pooled.
     pooled_contact: Arc<OnceLock<PooledContact>>,
 }
 

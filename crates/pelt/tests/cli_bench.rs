@@ -313,7 +313,12 @@ fn device_report_writes_every_part() {
     let (on, off, cast) = ([true; 2], [false; 2], [true, false]);
     let expected = [("cpu", 1, cast), ("cpu", 2, cast), ("cpu", 1, off), ("cpu", 2, off)];
     assert_eq!(sizes[..4], expected);
-    assert_eq!(sizes[4..], [("gpu", 1, on), ("gpu", 2, on), ("gpu", 1, off), ("gpu", 2, off)]);
+    assert_eq!(sizes[4..8], [("gpu", 1, on), ("gpu", 2, on), ("gpu", 1, off), ("gpu", 2, off)]);
+    // Then a ball through a GPU-kernel herd, its steps with contact pooled and not.
+    assert_eq!(sizes[8..], [("gpu", 2, on), ("gpu", 2, off)]);
+    for (k, row) in herd.iter().enumerate() {
+        assert_eq!(row["ball"].as_bool(), Some(k >= 8), "{row}");
+    }
     herd.iter().for_each(|row| positive(&row["frame_ms"], "herd frame_ms"));
     // The GPU kernel's pooled herds skin their bases on the GPU, their bytes counted.
     for (k, row) in herd.iter().enumerate() {
@@ -323,7 +328,7 @@ fn device_report_writes_every_part() {
     }
     // On the GPU kernel a Fox's own bytes add its second state and its simulation's buffers,
     // counted as the device's allocator counts them.
-    for (on_cpu, on_gpu) in herd[2..4].iter().cycle().zip(&herd[4..]) {
+    for (on_cpu, on_gpu) in herd[2..4].iter().cycle().zip(&herd[4..8]) {
         assert!(count(on_gpu, "per_fox_gpu_bytes") > count(on_cpu, "per_fox_gpu_bytes"), "{on_cpu}\n{on_gpu}");
         let (total, allocated) = (count(on_gpu, "total_gpu_bytes"), count(on_gpu, "allocated_gpu_bytes"));
         assert!(

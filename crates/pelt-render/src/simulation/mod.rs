@@ -283,6 +283,10 @@ impl GpuSimulation {
                 pipelines.pooled(device)?,
                 (&rest_segments, fur.current_positions().buffer()),
             )?;
+        if pooled {
+            // Compiled with the herd, so the first step with contact does not stall a frame.
+            pipelines.pooled_contact(device)?;
+        }
         let scope = ErrorScope::push(device);
         // The skin's planes and triangles come from the CPU simulation once it has found them
         // (skin contact on): a coat that never touches its skin never finds them. A pooled

@@ -3,8 +3,10 @@
 //! (the adapter's MSAA: 4x on a GPU) with and without the key light's shadows, herds of 100 and
 //! 1,000 walking Foxes at that size bent on the CPU (their shadow casters in one draw a pass and
 //! the camera's draws pooled by level, then a draw a Fox) and on the GPU kernel (pooled: also
-//! their steps in one dispatch and their bases skinned on the GPU), the GPU
-//! kernel's node updates per second on the 35,000-vertex torus, and contact's share of each kernel
+//! their steps in one dispatch and their bases skinned on the GPU), 100 on the GPU kernel with a
+//! ball rolled through them (every step with contact: two dispatches for the herd, then two a
+//! Fox), the GPU kernel's node updates per second on the 35,000-vertex torus, and contact's share
+//! of each kernel
 //! (`pelt bench --contact`). A session lent a GPU runs it first and records the figures
 //! (BENCHMARKS.md).
 
@@ -83,10 +85,20 @@ pub fn run(meshes: &Path, out: &Path, quick: bool) -> anyhow::Result<()> {
     // Each kernel's herds pooled (the shadow casters, the camera's draws, the GPU kernel's steps
     // and posing) and a draw, a dispatch and a CPU pose a Fox: what pooling saves a GPU.
     let settings = [true, false].map(|pooled| [(SimKernel::Cpu, Some(pooled)), (SimKernel::Gpu, Some(pooled))]);
-    for setting in [settings[0][0], settings[1][0], settings[0][1], settings[1][1]] {
-        let frames = if quick { 1 } else { 4 };
+    let herd_frames = if quick { 1 } else { 4 };
+    for (kernel, pooled) in [settings[0][0], settings[1][0], settings[0][1], settings[1][1]] {
         let gpu = Gpu::new(Backend::Auto)?;
-        herd.extend(herd::measure(gpu, meshes, counts, (size, adapter.msaa_samples), frames, setting)?.0);
+        let setting = (kernel, pooled, false);
+        herd.extend(herd::measure(gpu, meshes, counts, (size, adapter.msaa_samples), herd_frames, setting)?.0);
+    }
+    // A ball through the GPU kernel's herd of 100: every Fox's steps with contact, in two
+    // dispatches a step for the herd or two a Fox.
+    for pooled in [true, false] {
+        let gpu = Gpu::new(Backend::Auto)?;
+        let setting = (SimKernel::Gpu, Some(pooled), true);
+        let sizes = (size, adapter.msaa_samples);
+        let foxes: &[usize] = if quick { &[2] } else { &[100] };
+        herd.extend(herd::measure(gpu, meshes, foxes, sizes, herd_frames, setting)?.0);
     }
     eprintln!("pelt bench: the GPU kernel on the torus");
     let mut preset = Preset::default();

@@ -14,9 +14,9 @@ use std::path::Path;
 use std::time::{Duration, Instant};
 
 use anyhow::Context as _;
-use glam::{Mat4, Vec3};
-use pelt_core::sim::FurStepper;
+use glam::{Mat4, Quat, Vec3};
 use pelt_core::sim::herd;
+use pelt_core::sim::{Collider, FurStepper, Shape};
 use pelt_core::{ImportOptions, Preset, Stage, StageSource};
 use pelt_render::{
     Backend, Camera, FurAsset, FurDrawSettings, FurDriver, FurTarget, FurView, Gpu, GpuSkin, HEADLESS_FORMAT, Headless,
@@ -42,6 +42,9 @@ pub struct HerdRow {
     /// (`HerdDraws`).
     pub camera_draws: usize,
     pub camera_levels: usize,
+    /// Whether a ball rolled through the herd (a collider every Fox's steps meet: on the GPU
+    /// kernel each step with contact, pooled or each Fox's own).
+    pub ball: bool,
     /// Whether on the GPU kernel the Foxes' bases were skinned on the GPU (`HerdPosing`,
     /// `FurRenderer::herd_posing`: a GPU's default; the CPU posing joints only) or on the CPU.
     pub gpu_posing: bool,
@@ -102,7 +105,7 @@ pub fn run(
     let gpu = Gpu::new(Backend::Auto)?;
     // Lavapipe's single sample, as `pelt render` draws there (MSAA where a GPU is).
     let samples = pelt_render::default_sample_count(&gpu.adapter.get_info());
-    let (rows, adapter) = measure(gpu, meshes, counts, (SIZE, samples), frames, (kernel, pooled))?;
+    let (rows, adapter) = measure(gpu, meshes, counts, (SIZE, samples), frames, (kernel, pooled, false))?;
     println!("{}", markdown(&rows, &adapter));
     if let Some(path) = json {
         let text = serde_json::to_string_pretty(&rows)? + "\n";
@@ -113,15 +116,15 @@ pub fn run(
 
 /// The rows for herds of `counts` Foxes at `size` with `samples` MSAA samples, `frames` timed
 /// frames each, on `gpu`, bending on `kernel`, the shadow casters, the camera's draws, the GPU
-/// kernel's steps and posing pooled as `pooled` says (`None`: the device's default); and the
-/// adapter's summary.
+/// kernel's steps and posing pooled as `pooled` says (`None`: the device's default), with a
+/// ball rolled through the herd where `ball`; and the adapter's summary.
 pub fn measure(
     gpu: Gpu,
     meshes: &Path,
     counts: &[usize],
     (size, samples): ((u32, u32), u32),
     frames: u32,
-    (kernel, pooled): (SimKernel, Option<bool>),
+    (kernel, pooled, ball): (SimKernel, Option<bool>, bool),
 ) -> anyhow::Result<(Vec<HerdRow>, String)> {
     let choice = KernelChoice::from(kernel);
     let path = meshes.join("Fox.glb");
@@ -142,7 +145,8 @@ pub fn measure(
         renderer.set_pooled_drawing(pooled);
         renderer.set_herd_posing(pooled);
     }
-    let gpu_posing = kernel == SimKernel::Gpu && renderer.herd_posing();
+    // A ball's contact reads the posed vertices on the CPU: the CPU poses.
+    let gpu_posing = kernel == SimKernel::Gpu && renderer.herd_posing() && !ball;
     let asset = FurAsset::new(device, queue, &renderer, &fur, &textures)?;
     let (low, high) = fur.mesh.bounds();
     // What a Fox draws lies within its mesh's sphere grown by its longest strand.
@@ -219,6 +223,13 @@ pub fn measure(
                 .collect();
             for (stepper, level) in steppers.iter_mut().zip(&levels) {
                 stepper.set_step_stride(level.step_stride());
+                if ball {
+                    // Half a Fox wide, rolling across the herd's middle at a walking pace.
+                    let at = centre + Vec3::X * (PACE * (time_secs as f32 - 1.0)) + Vec3::Y * (0.1 * spacing);
+                    let shape = Shape::Sphere { radius: 0.25 * spacing };
+                    let rolled = Quat::from_rotation_z(-(time_secs as f32) * PACE / (0.25 * spacing));
+                    stepper.simulation_mut().set_colliders(&[Collider::at(1, shape, time_secs, at, rolled)])?;
+                }
             }
             FurDriver::advance_herd((device, queue), &mut drivers, &mut steppers, &instances, time_secs)?;
             for (driver, level) in drivers.iter_mut().zip(levels) {
@@ -284,6 +295,7 @@ pub fn measure(
             pooled_stepping: kernel == SimKernel::Gpu && renderer.pooled_stepping(),
             pooled_drawing: renderer.pooled_drawing(),
             gpu_posing: posing.is_some(),
+            ball,
             camera_draws,
             camera_levels: plan.levels(),
             size: format!("{}x{}", size.0, size.1),
@@ -410,6 +422,7 @@ mod tests {
             pooled_stepping: true,
             pooled_drawing: true,
             gpu_posing: true,
+            ball: false,
             camera_draws: 2 * foxes,
             camera_levels: foxes / 2,
             size: "1280x720".to_owned(),
