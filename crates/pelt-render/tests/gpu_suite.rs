@@ -22,6 +22,8 @@ mod groom;
 mod groom_shading;
 #[path = "herd.rs"]
 mod herd;
+#[path = "herd_steps.rs"]
+mod herd_steps;
 #[path = "host.rs"]
 mod host;
 #[path = "lean.rs"]
