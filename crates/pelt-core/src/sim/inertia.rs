@@ -76,6 +76,14 @@ impl Inertia {
         assert!(self.masses.is_empty() || self.masses.len() == self.force.len(), "one mass per strand");
     }
 
+    /// Takes `roots` as where the strands stood at the last step, whose pose this never saw (it
+    /// was made elsewhere): the next step judges a teleport from there, the motion carrying on.
+    pub fn rebase(&mut self, roots: &[Vec3]) {
+        for (p, r) in self.previous_roots.iter_mut().zip(roots) {
+            *p = [*r, *r];
+        }
+    }
+
     /// Forgets the motion: no force until two more steps have been seen.
     pub fn reset(&mut self) {
         self.history = 0;

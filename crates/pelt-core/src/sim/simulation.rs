@@ -367,7 +367,7 @@ impl Simulation {
     pub fn set_base(&mut self, positions: &[Vec3], normals: &[Vec3]) -> Result<(), SimError> {
         self.check_base(positions, normals, "the base normals")?;
         self.moved_base();
-        self.posed_elsewhere = false;
+        self.rebase_after_elsewhere(positions);
         self.roots.copy_from_slice(positions);
         for ((frame, rest), normal) in self.frames.iter_mut().zip(&self.rest_normals).zip(normals) {
             *frame = match (rest.try_normalize(), normal.try_normalize()) {
@@ -390,7 +390,7 @@ impl Simulation {
             return Err(SimError::NonFinite { what: "the base rotations", value: bad.to_string() });
         }
         self.moved_base();
-        self.posed_elsewhere = false;
+        self.rebase_after_elsewhere(positions);
         self.roots.copy_from_slice(positions);
         for (frame, rotation) in self.frames.iter_mut().zip(rotations) {
             *frame = rotation.normalize();
@@ -414,6 +414,15 @@ impl Simulation {
     #[must_use]
     pub fn base_posed_elsewhere(&self) -> bool {
         self.posed_elsewhere
+    }
+
+    /// The first pose given here after poses made elsewhere: the roots the inertia last saw are
+    /// those of a pose long gone, so it takes the new ones as the last step's (the kernel that
+    /// bent meanwhile had every pose; a jump against the stale ones would start the motion over).
+    fn rebase_after_elsewhere(&mut self, positions: &[Vec3]) {
+        if std::mem::take(&mut self.posed_elsewhere) {
+            self.inertia.rebase(positions);
+        }
     }
 
     fn moved_base(&mut self) {

@@ -135,9 +135,8 @@ impl FurStepper {
     /// nothing on the CPU reads the posed vertices: a rig without morph targets poses its joints
     /// only ([`FurStepper::posed_joints`]) and the simulation takes the move unseen
     /// ([`Simulation::set_base_posed_elsewhere`]), while its strands are bent elsewhere, with no
-    /// body, touch, grasp, collider or wetness. Otherwise (and when off) the CPU poses as before;
-    /// its first pose after a stretch posed elsewhere may read as a jump to the inertia (whose
-    /// roots were left behind) and start it over.
+    /// body, touch, grasp, collider or wetness. Otherwise (and when off) the CPU poses as before,
+    /// the motion carrying on from the pose made elsewhere.
     pub fn set_joint_posing(&mut self, on: bool) {
         self.joint_posing = on;
     }
