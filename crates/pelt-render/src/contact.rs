@@ -102,17 +102,15 @@ pub(crate) fn fields_fit(words: usize, limits: &wgpu::Limits) -> Result<(), Rend
     Ok(())
 }
 
-fn cones_first(v: usize) -> usize {
-    SKIN_FIRST + SKIN_PLANES * v
+/// The grasp's weights, after the slots' headers.
+fn weights_first() -> usize {
+    SKIN_FIRST
 }
 
-fn weights_first(v: usize) -> usize {
-    cones_first(v) + v
-}
-
-/// The skin's triangle part (`simulation_contact.wgsl`'s `surface_first`), after the weights.
-fn surface_first(v: usize) -> usize {
-    weights_first(v) + v.div_ceil(4)
+/// The skin's planes (`simulation_lone.wgsl`'s `planes_first`), after the weights; then the
+/// cones and the triangle part, once the skin is found.
+fn planes_first(v: usize) -> usize {
+    weights_first() + v.div_ceil(4)
 }
 
 /// Where slot `slot`'s colliders begin after `prefix_words` vec4s (`Skin::prefix_words`), each
@@ -129,23 +127,25 @@ fn buffer_bytes(prefix_words: usize, slot_colliders: usize) -> u64 {
 // A strand's header packs its triangle count in 6 bits.
 const _: () = assert!(pelt_core::sim::contact::surface::MAX_STRAND_TRIANGLES < 64);
 
-/// The skin's planes and triangles of one fur, as the buffer packs them.
+/// The skin's planes and triangles of one fur of `v` strands, as the buffer packs them.
 #[derive(Debug)]
 pub(crate) struct Skin {
+    v: usize,
+    /// Every strand's planes, or none until the simulation has found them.
     planes: Vec<[glam::Vec4; SKIN_PLANES]>,
     surface: SkinSurface,
 }
 
 impl Skin {
     /// No planes and no triangles for `v` strands: what the buffer holds until the simulation
-    /// has found its skin setup (skin contact off reads none of it).
+    /// has found its skin setup (a step with the skin off reads none of it, so none is kept).
     pub fn none(v: usize) -> Self {
-        Self { planes: vec![[glam::Vec4::ZERO; SKIN_PLANES]; v], surface: SkinSurface::default() }
+        Self { v, planes: Vec::new(), surface: SkinSurface::default() }
     }
 
     /// The simulation's skin planes and triangles (`pelt_core::sim::contact`).
     pub fn of(strands: &ContactStrands<'_>) -> Self {
-        Self { planes: strands.skin.to_vec(), surface: strands.surface.clone() }
+        Self { v: strands.skin.len(), planes: strands.skin.to_vec(), surface: strands.surface.clone() }
     }
 
     /// Each strand's cone (`skin_cone`), for the screen.
@@ -192,10 +192,10 @@ impl Skin {
         self.surface.strands.len() + self.surface.lists.len().div_ceil(4) + self.surface.triangles.len() * SURFACE_WORDS
     }
 
-    /// vec4s of the buffer before the colliders: the slots' headers, the planes, cones and
-    /// weights, then the triangle part.
+    /// vec4s of the buffer before the colliders: the slots' headers, the weights, then the
+    /// planes, cones and triangle part.
     fn prefix_words(&self) -> usize {
-        surface_first(self.planes.len()) + self.words()
+        planes_first(self.v) + self.shared_words()
     }
 }
 
@@ -382,7 +382,7 @@ impl GpuContact {
         }
         let packed = packed_weights(v, strands.grasp_weights);
         if !packed.is_empty() {
-            queue.write_buffer(&self.buffer, weights_first(v) as u64 * 16, bytemuck::cast_slice(&packed));
+            queue.write_buffer(&self.buffer, weights_first() as u64 * 16, bytemuck::cast_slice(&packed));
         }
         self.weights = strands.grasp_weights.to_vec();
     }
@@ -457,10 +457,9 @@ fn room_for(most: usize) -> usize {
 /// each slot.
 fn skin_buffer(device: &wgpu::Device, roots: &[glam::Vec3], skin: &Skin, slot_colliders: usize) -> wgpu::Buffer {
     let v = roots.len();
-    let mut words = vec![[0.0_f32; 4]; SKIN_FIRST];
+    // The headers, and the grasp's weights, written by `write_strands`.
+    let mut words = vec![[0.0_f32; 4]; planes_first(v)];
     words.extend(skin.planes_and_cones());
-    // The grasp's weights, written by `write_strands`.
-    words.resize(surface_first(v), [0.0; 4]);
     words.extend(skin.surface_words(roots));
     debug_assert_eq!(words.len(), skin.prefix_words());
     words.resize(colliders_first(words.len(), CONTACT_SLOTS, slot_colliders), [0.0; 4]);
@@ -490,8 +489,8 @@ mod tests {
         assert_eq!(room, [0, 4, 4, 4, 8, 16, 128, 128, 128, 128]);
         let skin = Skin::none(10);
         let bare = GpuContact::bytes(&skin, 0);
-        // Headers, 16 planes, a cone and a quarter of a weight vec4 per strand.
-        assert_eq!(bare, (2 * 64 + 16 * 10 + 10 + 3) * 16);
+        // Headers and a quarter of a weight vec4 per strand: no skin until it is found.
+        assert_eq!(bare, (2 * 64 + 3) * 16);
         assert_eq!(GpuContact::bytes(&skin, 8) - bare, 64 * 8 * 5 * 16);
     }
 

@@ -7,15 +7,14 @@
 // A fur's own `contact` buffer, in vec4s (V strands, `grid.y` the step's slot):
 //   [2 s], [2 s + 1] for slot s < CONTACT_SLOTS: (collider count, skin on, grip presence, the
 //     longest strand's length), (grip xyz, where the slot's colliders begin as bits);
-//   from CONTACT_SKIN: SKIN_PLANES planes per strand (n xyz in the rest frame, h);
-//   then a cone per strand (`pelt_core::sim::contact::skin_cone`: axis xyz in the rest frame,
-//     spread);
 //   then ceil(V / 4) vec4s of grasp weights, 4 strands each;
-//   then the skin's triangles (`contact::surface`), from `surface_first`: per strand (rest root,
-//     first << 6 | count as bits), the lists (each entry its triangle's first vec4 from
-//     `surface_first`), the triangles of 10 vec4s (a, b, c, face normal, edge ab, bc, ca and
-//     corner a, b, c pseudonormals; a bounding ball's centre in a, b, c's w, its radius in the
-//     face normal's);
+//   then, once the skin is found, SKIN_PLANES planes per strand (n xyz in the rest frame, h), a
+//     cone per strand (`pelt_core::sim::contact::skin_cone`: axis xyz in the rest frame,
+//     spread), and the skin's triangles (`contact::surface`), from `surface_first`: per strand
+//     (rest root, first << 6 | count as bits), the lists (each entry its triangle's first vec4
+//     from `surface_first`), the triangles of 10 vec4s (a, b, c, face normal, edge ab, bc, ca
+//     and corner a, b, c pseudonormals; a bounding ball's centre in a, b, c's w, its radius in
+//     the face normal's);
 //   then each slot's colliders (as many as the fur's busiest step needs, `contact.rs`), 5 vec4s
 //     each: (centre, radius), (half extents, kind as bits), rotation, (travel, friction),
 //     (bound, grasp hand, field as bits, -) (a mesh's radius is its scale, its field where it
@@ -206,7 +205,7 @@ fn turn_above(u: vec3<f32>, n: vec3<f32>, floor_in: f32, hint: vec3<f32>) -> vec
 }
 
 fn cones_first(v: u32) -> u32 {
-    return planes_first() + SKIN_PLANES * v;
+    return planes_first(v) + SKIN_PLANES * v;
 }
 
 fn colliders_first(slot: u32) -> u32 {
@@ -502,7 +501,7 @@ fn contact_setup(j: u32, v: u32, root: vec3<f32>, frame: vec4<f32>) {
     if skin {
         // A strand's planes fill the first of its slots (`skin_planes`).
         for (var p = 0u; p < SKIN_PLANES; p++) {
-            let plane = contact[planes_first() + j * SKIN_PLANES + p];
+            let plane = contact[planes_first(v) + j * SKIN_PLANES + p];
             if all(plane.xyz == vec3<f32>(0.0)) {
                 break;
             }

@@ -25,22 +25,23 @@ fn sdf_at(i: u32) -> f32 {
     return sdf_fields[i];
 }
 
-// The fur's own contact buffer: the slots' headers, the skin's planes and cones, the grasp's
-// weights, the skin's triangles (`simulation_contact.wgsl`).
+// The fur's own contact buffer: the slots' headers, the grasp's weights, then the skin's planes,
+// cones and triangles (`simulation_contact.wgsl`; none until the skin is found, which a step with
+// the skin off never reads).
 fn headers_first() -> u32 {
     return 0u;
 }
 
-fn planes_first() -> u32 {
+fn weights_first(v: u32) -> u32 {
     return CONTACT_SKIN;
 }
 
-fn weights_first(v: u32) -> u32 {
-    return cones_first(v) + v;
+fn planes_first(v: u32) -> u32 {
+    return CONTACT_SKIN + (v + 3u) / 4u;
 }
 
 fn surface_first(v: u32) -> u32 {
-    return weights_first(v) + (v + 3u) / 4u;
+    return cones_first(v) + v;
 }
 
 // A listed strand's word: its first segment to solve (the list holds this fur's strands alone).

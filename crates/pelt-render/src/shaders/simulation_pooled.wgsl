@@ -78,7 +78,7 @@ fn headers_first() -> u32 {
     return contact_block;
 }
 
-fn planes_first() -> u32 {
+fn planes_first(v: u32) -> u32 {
     return 1u;
 }
 
