@@ -54,23 +54,21 @@ impl SimPipelines {
     /// Compiles the kernels.
     pub(crate) fn new(device: &wgpu::Device) -> Result<Self, RenderError> {
         let scope = ErrorScope::push(device);
-        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("pelt simulation"),
-            source: wgpu::ShaderSource::Wgsl(simulation_shader_source().into()),
-        });
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("pelt simulation"),
-            entries: &[
-                wgpu::BindGroupLayoutEntry {
-                    binding: 0,
-                    visibility: wgpu::ShaderStages::COMPUTE,
-                    ty: wgpu::BindingType::Buffer {
-                        ty: wgpu::BufferBindingType::Uniform,
-                        has_dynamic_offset: true,
-                        min_binding_size: wgpu::BufferSize::new(STEP_UNIFORM_BYTES),
-                    },
-                    count: None,
-                },
+        let step_uniform = wgpu::BindGroupLayoutEntry {
+            binding: 0,
+            visibility: wgpu::ShaderStages::COMPUTE,
+            ty: wgpu::BindingType::Buffer {
+                ty: wgpu::BufferBindingType::Uniform,
+                has_dynamic_offset: true,
+                min_binding_size: wgpu::BufferSize::new(STEP_UNIFORM_BYTES),
+            },
+            count: None,
+        };
+        let kernels = Kernels::new(
+            device,
+            ("pelt simulation", simulation_shader_source()),
+            &[
+                step_uniform,
                 storage(1, true),
                 storage(2, true),
                 storage(3, false),
@@ -80,31 +78,15 @@ impl SimPipelines {
                 storage(7, true),
                 storage(8, false),
             ],
-        });
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("pelt simulation"),
-            bind_group_layouts: &[Some(&layout)],
-            immediate_size: 0,
-        });
-        let compute_pipeline = |entry_point, constants: &[(&str, f64)]| {
-            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some(entry_point),
-                layout: Some(&pipeline_layout),
-                module: &module,
-                entry_point: Some(entry_point),
-                compilation_options: wgpu::PipelineCompilationOptions {
-                    constants,
-                    ..wgpu::PipelineCompilationOptions::default()
-                },
-                cache: None,
-            })
-        };
+        );
+        let compute_pipeline =
+            |entry_point, constants: &[(&str, f64)]| kernels.pipeline(device, entry_point, constants);
         let pipelines = Self {
             step: compute_pipeline("step_strands", &[]),
             touch: compute_pipeline("weigh_touch", &[]),
             contact: compute_pipeline("step_strands_with_contact", &[]),
             solve: SOLVE_CONSTANTS.map(|constants| compute_pipeline("solve_contact", constants)),
-            layout,
+            layout: kernels.layout,
             pooled: Arc::default(),
             pooled_contact: Arc::default(),
         };
@@ -123,13 +105,10 @@ impl SimPipelines {
             return Ok(pooled);
         }
         let scope = ErrorScope::push(device);
-        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("pelt simulation pooled"),
-            source: wgpu::ShaderSource::Wgsl(simulation_pooled_shader_source().into()),
-        });
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("pelt simulation pooled"),
-            entries: &[
+        let kernels = Kernels::new(
+            device,
+            ("pelt simulation pooled", simulation_pooled_shader_source()),
+            &[
                 storage(0, true),
                 storage(1, true),
                 storage(2, true),
@@ -137,22 +116,10 @@ impl SimPipelines {
                 storage(4, false),
                 storage(6, true),
             ],
-        });
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("pelt simulation pooled"),
-            bind_group_layouts: &[Some(&layout)],
-            immediate_size: 0,
-        });
-        let pipeline = device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-            label: Some("step_pooled"),
-            layout: Some(&pipeline_layout),
-            module: &module,
-            entry_point: Some("step_pooled"),
-            compilation_options: wgpu::PipelineCompilationOptions::default(),
-            cache: None,
-        });
+        );
+        let pipeline = kernels.pipeline(device, "step_pooled", &[]);
         scope.pop("building the GPU simulation's pooled step")?;
-        Ok(self.pooled.get_or_init(|| PooledStep { pipeline, layout }))
+        Ok(self.pooled.get_or_init(|| PooledStep { pipeline, layout: kernels.layout }))
     }
 
     /// The pooled contact kernels, once compiled.
@@ -167,13 +134,10 @@ impl SimPipelines {
             return Ok(pooled);
         }
         let scope = ErrorScope::push(device);
-        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
-            label: Some("pelt simulation pooled contact"),
-            source: wgpu::ShaderSource::Wgsl(simulation_pooled_shader_source().into()),
-        });
-        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
-            label: Some("pelt simulation pooled contact"),
-            entries: &[
+        let kernels = Kernels::new(
+            device,
+            ("pelt simulation pooled contact", simulation_pooled_shader_source()),
+            &[
                 storage(0, true),
                 storage(1, true),
                 storage(2, true),
@@ -183,29 +147,11 @@ impl SimPipelines {
                 storage(6, true),
                 storage(8, false),
             ],
-        });
-        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
-            label: Some("pelt simulation pooled contact"),
-            bind_group_layouts: &[Some(&layout)],
-            immediate_size: 0,
-        });
-        let compute_pipeline = |entry_point, constants: &[(&str, f64)]| {
-            device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
-                label: Some(entry_point),
-                layout: Some(&pipeline_layout),
-                module: &module,
-                entry_point: Some(entry_point),
-                compilation_options: wgpu::PipelineCompilationOptions {
-                    constants,
-                    ..wgpu::PipelineCompilationOptions::default()
-                },
-                cache: None,
-            })
-        };
-        let contact = compute_pipeline("step_pooled_with_contact", &[]);
-        let solve = SOLVE_CONSTANTS.map(|constants| compute_pipeline("solve_pooled_contact", constants));
+        );
+        let contact = kernels.pipeline(device, "step_pooled_with_contact", &[]);
+        let solve = SOLVE_CONSTANTS.map(|constants| kernels.pipeline(device, "solve_pooled_contact", constants));
         scope.pop("building the GPU simulation's pooled contact")?;
-        Ok(self.pooled_contact.get_or_init(|| PooledContact { contact, solve, layout }))
+        Ok(self.pooled_contact.get_or_init(|| PooledContact { contact, solve, layout: kernels.layout }))
     }
 }
 
@@ -213,6 +159,44 @@ impl SimPipelines {
 /// mesh colliders', with both.
 const SOLVE_CONSTANTS: [&[(&str, f64)]; 3] =
     [&[("COLLIDERS", 0.0), ("MESH_COLLIDERS", 0.0)], &[("MESH_COLLIDERS", 0.0)], &[]];
+
+/// A WGSL module with its one bind group's layout, and the pipeline layout of its kernels.
+struct Kernels {
+    module: wgpu::ShaderModule,
+    layout: wgpu::BindGroupLayout,
+    pipeline_layout: wgpu::PipelineLayout,
+}
+
+impl Kernels {
+    fn new(device: &wgpu::Device, (label, source): (&str, String), entries: &[wgpu::BindGroupLayoutEntry]) -> Self {
+        let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
+            label: Some(label),
+            source: wgpu::ShaderSource::Wgsl(source.into()),
+        });
+        let layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor { label: Some(label), entries });
+        let pipeline_layout = device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
+            label: Some(label),
+            bind_group_layouts: &[Some(&layout)],
+            immediate_size: 0,
+        });
+        Self { module, layout, pipeline_layout }
+    }
+
+    /// The kernel `entry_point` with the override `constants`.
+    fn pipeline(&self, device: &wgpu::Device, entry_point: &str, constants: &[(&str, f64)]) -> wgpu::ComputePipeline {
+        device.create_compute_pipeline(&wgpu::ComputePipelineDescriptor {
+            label: Some(entry_point),
+            layout: Some(&self.pipeline_layout),
+            module: &self.module,
+            entry_point: Some(entry_point),
+            compilation_options: wgpu::PipelineCompilationOptions {
+                constants,
+                ..wgpu::PipelineCompilationOptions::default()
+            },
+            cache: None,
+        })
+    }
+}
 
 /// A storage buffer the compute stage binds at `binding`.
 fn storage(binding: u32, read_only: bool) -> wgpu::BindGroupLayoutEntry {
