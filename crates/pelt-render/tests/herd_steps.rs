@@ -11,6 +11,19 @@ use pelt_render::{FurAsset, FurDriver, KernelChoice};
 
 use crate::herd::is_gpu;
 
+/// Records each member of `alone` on its own and `together` as one herd; the dispatches each
+/// member alone recorded, and the herd's.
+fn record_each_and_together<S>(
+    encoder: &mut wgpu::CommandEncoder,
+    alone: &mut [(FurDriver, S)],
+    together: &mut [(FurDriver, S)],
+) -> (Vec<usize>, usize) {
+    let each =
+        alone.iter_mut().map(|(driver, _)| FurDriver::record_herd(encoder, [driver]).expect("record alone")).collect();
+    let recorded = FurDriver::record_herd(encoder, together.iter_mut().map(|(driver, _)| driver)).expect("herd");
+    (each, recorded)
+}
+
 /// A herd made together on the GPU kernel steps every member in one dispatch a step: the states
 /// come out with the bytes each member's own dispatches give, each member bent its own way.
 #[test]
@@ -75,13 +88,7 @@ fn a_herds_gpu_steps_take_one_dispatch_and_match_each_recorded_alone() {
                 }
             }
         }
-        let each: Vec<usize> = alone
-            .iter_mut()
-            .map(|(driver, _)| FurDriver::record_herd(&mut encoder, [driver]).expect("record alone"))
-            .collect();
-        let recorded =
-            FurDriver::record_herd(&mut encoder, together.iter_mut().map(|(driver, _)| driver)).expect("herd");
-        dispatches.push((each, recorded));
+        dispatches.push(record_each_and_together(&mut encoder, &mut alone, &mut together));
         queue.submit([encoder.finish()]);
     }
     let state = |driver: &FurDriver| common::read_bytes(device, queue, driver.fur().current_positions());
@@ -231,13 +238,7 @@ fn a_herds_gpu_steps_with_contact_take_two_dispatches_and_match_each_recorded_al
                 driver.advance_to(device, queue, stepper, time_secs).expect("advance");
             }
         }
-        let each: Vec<usize> = alone
-            .iter_mut()
-            .map(|(driver, _)| FurDriver::record_herd(&mut encoder, [driver]).expect("record alone"))
-            .collect();
-        let recorded =
-            FurDriver::record_herd(&mut encoder, together.iter_mut().map(|(driver, _)| driver)).expect("herd");
-        dispatches.push((each, recorded));
+        dispatches.push(record_each_and_together(&mut encoder, &mut alone, &mut together));
         queue.submit([encoder.finish()]);
     }
     let state = |driver: &FurDriver| common::read_bytes(device, queue, driver.fur().current_positions());

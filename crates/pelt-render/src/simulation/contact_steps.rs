@@ -45,7 +45,7 @@ impl GpuSimulation {
     /// The pending steps with contact in the copy's block of its pool's contact (nothing while
     /// no copy of the pool has stepped with contact).
     pub(super) fn prepare_pooled_contact(
-        &mut self,
+        &self,
         (device, queue): (&wgpu::Device, &wgpu::Queue),
         simulation: &Simulation,
         fur: &GpuFur,
@@ -64,7 +64,7 @@ impl GpuSimulation {
             steps,
             strands,
             skin_found: simulation.has_skin_setup(),
-            contact: &self.contact,
+            reach: self.contact.reach(),
         };
         let buffers = PoolBuffers {
             strands: &self.pool.strands,

@@ -85,8 +85,8 @@ pub(crate) struct CopySteps<'a> {
     pub strands: &'a ContactStrands<'a>,
     /// Whether its simulation has found the skin's planes and triangles.
     pub skin_found: bool,
-    /// Its own contact (the strands' reach).
-    pub contact: &'a GpuContact,
+    /// Its strands' reach ([`GpuContact::reach`]).
+    pub reach: f32,
 }
 
 /// The buffers a pooled dispatch binds besides the contact's: the pool's strand inputs, state and
@@ -230,7 +230,7 @@ impl PoolContact {
             }
             None => {
                 let copies = (0..self.slots).map(|_| CopyContact::default()).collect();
-                (copies, None, 0, copy.contact.reach(), None)
+                (copies, None, 0, copy.reach, None)
             }
         };
         if let Some(kept) = copies.get_mut(index) {
@@ -299,8 +299,11 @@ impl PoolContact {
         };
         scope.pop("making a herd's GPU contact")?;
         let held = Held { buffer, layout, skin, fields, copies, reach, steps, work, work_groups, bind_group: None };
+        // The new buffer is zero: weights only where a copy holds some.
         for k in 0..held.copies.len() {
-            held.write_weights(queue, k, v);
+            if !held.copies[k].weights.is_empty() {
+                held.write_weights(queue, k, v);
+            }
             held.write_steps(queue, k, v);
         }
         Ok(held)
