@@ -350,10 +350,19 @@ impl GpuFur {
     }
 
     /// Bytes of the silhouette pass's fin list (the edges it keeps and their indirect draw) and
-    /// of the view-angle pass's shell list (12 bytes a triangle, 20 a layer).
+    /// of the view-angle pass's shell list (12 bytes a triangle, 20 a layer), each draw twice
+    /// in a herd (its own and the gathered one, [`crate::HerdDraws`]).
     #[must_use]
     pub fn silhouette_list_bytes(&self) -> u64 {
         self.pool().slot_list_bytes()
+    }
+
+    /// Bytes the lists of the copies made together with this one share: every furred
+    /// triangle's indices once (12 bytes a triangle) for the gathered draws; none for a fur
+    /// made alone.
+    #[must_use]
+    pub fn herd_list_bytes(&self) -> u64 {
+        self.pool().shared_list_bytes()
     }
 
     /// The view-angle pass's count (one little-endian `u32`, `COPY_SRC`): three times the

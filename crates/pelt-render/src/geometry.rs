@@ -141,7 +141,8 @@ impl SharedGeometry {
         let topology = buffer(
             "pelt topology",
             bytemuck::cast_slice(&topology),
-            wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::INDEX,
+            // Copied from by a pool's shell lists (`ShellList::fill_head`).
+            wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::INDEX | wgpu::BufferUsages::COPY_SRC,
         );
         let strip: Vec<u32> = (0..layers)
             .flat_map(|i| {
@@ -458,14 +459,7 @@ impl UnifiedGeometry {
     /// Draws the first `drawn` base triangles (`instances` = layers), indexed: by wedge with uvs,
     /// else by base vertex.
     fn draw_surface(&self, pass: &mut wgpu::RenderPass<'_>, instances: std::ops::Range<u32>, drawn: u32) {
-        let shape = &self.shape;
-        let triangles = shape.triangle_count;
-        // The topology buffer starts with the base triangles and ends with the corners' wedges.
-        let first = if shape.has_uvs {
-            3 * u64::from(triangles) + 4 * u64::from(shape.edge_count) + u64::from(shape.wedge_count)
-        } else {
-            0
-        };
+        let first = self.shape.surface_indices_first();
         if drawn == 0 {
             return;
         }
@@ -487,6 +481,11 @@ impl UnifiedGeometry {
             pass.set_vertex_buffer(0, instances);
             pass.draw_indexed_indirect(draws, offset);
         }
+    }
+
+    /// The fin strip's indices (`None` without layers).
+    pub fn fin_strip(&self) -> Option<&wgpu::Buffer> {
+        self.shared.fin_indices.as_ref()
     }
 
     /// Draws every fin (instance = edge) with `segments` segments (the level of detail's).

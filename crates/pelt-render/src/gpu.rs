@@ -134,7 +134,7 @@ impl Gpu {
         let name = adapter.get_info().name;
         let descriptor = wgpu::DeviceDescriptor {
             label: Some("pelt"),
-            required_features: crate::required_features(),
+            required_features: crate::required_features() | crate::optional_features(adapter.features()),
             required_limits: crate::required_limits(&adapter.limits()),
             ..wgpu::DeviceDescriptor::default()
         };

@@ -22,7 +22,8 @@
 //!   `pelt render`, the viewer, the web page and the examples share.
 //!
 //! # The order a host calls things in
-//! 1. When creating the device: request [`required_features`], [`required_limits`] and check
+//! 1. When creating the device: request [`required_features`] (and the [`optional_features`] the
+//!    adapter has), [`required_limits`] and check
 //!    [`required_downlevel_flags`] (or [`check_adapter`]).
 //! 2. Once per target description: [`FurRenderer::new`]. Once per fur: [`FurDriver::new`] (its
 //!    [`GpuFur`] and the kernel that bends it) and a `pelt_core::sim::FurStepper` (the CPU half:
@@ -163,7 +164,9 @@ pub use object::FurShading;
 pub use object::{FurFrame, FurLook, GpuBytes, tile_mapping};
 pub use plain::PlainMesh;
 pub use renderer::{FurDrawSettings, FurMotion, FurPrepass, FurRenderer, HerdDraws, MotionData, PrepassTarget};
-pub use requirements::{check_adapter, required_downlevel_flags, required_features, required_limits};
+pub use requirements::{
+    check_adapter, optional_features, required_downlevel_flags, required_features, required_limits,
+};
 pub use shaders::{
     herd_posing_shader_source, pool_draw_shader_source, prepass_shader_source, shadow_copy_shader_source,
     silhouette_shader_source, simulation_pooled_shader_source, simulation_shader_source, skinning_shader_source,

@@ -219,6 +219,16 @@ impl ObjectShape {
         if self.has_uvs { self.wedge_count } else { self.vertex_count }
     }
 
+    /// Where the index buffer of the base triangles starts in the topology buffer, in `u32`s:
+    /// the corners' wedges at its end with uvs, else the base triangles at its start.
+    pub fn surface_indices_first(&self) -> u64 {
+        if self.has_uvs {
+            3 * u64::from(self.triangle_count) + 4 * u64::from(self.edge_count) + u64::from(self.wedge_count)
+        } else {
+            0
+        }
+    }
+
     /// The uniform for one frame. `colour`: the skin's (furs) or the mesh's (plain) colour.
     pub fn uniform(&self, frame: &FurFrame, colour: Vec3, textures: TextureShape) -> ObjectUniform {
         let TextureShape { shell_slices, has_surface, lean } = textures;

@@ -4,6 +4,8 @@
 //! exactly as a lone fur does; a listing pass binds the whole pool and lists every copy in one
 //! dispatch (`object_pool.wgsl`: workgroup z is the slot). A lone fur is a pool of one.
 
+use std::sync::Mutex;
+
 use glam::Vec3;
 use pelt_core::fur::POSITION_BYTES;
 
@@ -11,7 +13,7 @@ use crate::RenderError;
 use crate::listing::{FinList, ShellList};
 use crate::object::ObjectShape;
 use crate::requirements::check_size;
-use crate::shaders::{Layouts, OBJECT_SLOT_BYTES};
+use crate::shaders::{Layouts, OBJECT_SLOT_BYTES, OBJECT_UNIFORM_BYTES};
 
 /// Every copy's ranges start on this many bytes: the largest storage and uniform offset
 /// alignment WebGPU lets a device ask for, so any device binds them.
@@ -28,6 +30,8 @@ pub const POSITIONS_USAGE: wgpu::BufferUsages = wgpu::BufferUsages::STORAGE
 /// `object_pool.wgsl`).
 pub(crate) const LIST_FINS: u32 = 1;
 pub(crate) const LIST_SHELLS: u32 = 2;
+/// A slot's gathered place when it has none (`NOT_GATHERED` in `object_pool.wgsl`).
+pub(crate) const NOT_GATHERED: u32 = u32::MAX;
 
 /// What every copy of a pool shares and its draws read: the mesh's shape, topology, wedge uvs
 /// and groom attributes.
@@ -55,6 +59,9 @@ pub(crate) struct MemberPool {
     normals_stride: u64,
     fins: Option<FinList>,
     shells: Option<ShellList>,
+    /// Each slot's `gather` words as last written (`ObjectSlot` in `object_pool.wgsl`), and the
+    /// plan (`crate::HerdDraws`) that wrote them.
+    gather: Mutex<(u64, Vec<[u32; 2]>)>,
     /// The listing passes' group 1: the objects, the states (twice), the normals, the topology.
     listing_group: wgpu::BindGroup,
     /// The pooled shadow casters' group 1 (`Layouts::pool_draws`): the listing's and the wedge
@@ -128,17 +135,23 @@ impl MemberPool {
             bytemuck::cast_slice(normals),
             wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST | wgpu::BufferUsages::COPY_SRC,
         );
-        let objects = device.create_buffer(&wgpu::BufferDescriptor {
-            label: Some("pelt objects"),
-            size: OBJECT_SLOT_BYTES * slot_count,
-            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
-            mapped_at_creation: false,
-        });
+        // Every slot gathers nowhere until a plan says (`MemberPool::gather`).
+        let objects = filled(
+            "pelt objects",
+            OBJECT_SLOT_BYTES,
+            slot_count,
+            &[0; OBJECT_UNIFORM_BYTES as usize]
+                .into_iter()
+                .chain(bytemuck::cast::<[u32; 2], [u8; 8]>([NOT_GATHERED; 2]))
+                .collect::<Vec<u8>>(),
+            wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::STORAGE | wgpu::BufferUsages::COPY_DST,
+        );
         let (shape, topology) = (mesh.shape, mesh.topology);
         let layers = shape.layers;
         let fins = FinList::new(device, layouts, (shape.fin_edge_count, layers), slots)?;
         let per_shell = shape.vertices_per_shell();
-        let shells = ShellList::new(device, layouts, (shape.furred_triangle_count, per_shell, layers), slots)?;
+        let head = (topology, shape.surface_indices_first());
+        let shells = ShellList::new(device, layouts, (shape.furred_triangle_count, per_shell, layers), (slots, head))?;
         let listing_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
             label: Some("pelt pool objects"),
             layout: &layouts.pool_objects,
@@ -182,9 +195,36 @@ impl MemberPool {
             normals_stride,
             fins,
             shells,
+            gather: Mutex::new((0, vec![[NOT_GATHERED; 2]; slots.max(1) as usize])),
             listing_group,
             draw_group,
         })
+    }
+
+    /// Makes `plan` the pool's gathering plan: each slot of `places` (slot, its fin draw's and
+    /// its shell draws' gathered places, or [`NOT_GATHERED`]) gathers there from the next listing
+    /// pass on, every other slot nowhere. Writes only the slots that change.
+    pub fn gather(&self, queue: &wgpu::Queue, plan: u64, places: &[(u32, [u32; 2])]) {
+        let Ok(mut gather) = self.gather.lock() else { return };
+        let mut wanted = vec![[NOT_GATHERED; 2]; gather.1.len()];
+        for &(slot, place) in places {
+            if let Some(slot) = wanted.get_mut(slot as usize) {
+                *slot = place;
+            }
+        }
+        gather.0 = plan;
+        for (slot, (old, new)) in gather.1.iter_mut().zip(wanted).enumerate() {
+            if *old != new {
+                *old = new;
+                let at = slot as u64 * OBJECT_SLOT_BYTES + OBJECT_UNIFORM_BYTES;
+                queue.write_buffer(&self.objects, at, bytemuck::cast_slice(&new));
+            }
+        }
+    }
+
+    /// The plan whose places the pool's listing passes gather to (0: none yet).
+    pub fn gathering_plan(&self) -> u64 {
+        self.gather.lock().map_or(0, |gather| gather.0)
     }
 
     /// States per copy (1 or 2).
@@ -213,6 +253,11 @@ impl MemberPool {
     /// The bytes one copy's lists hold.
     pub fn slot_list_bytes(&self) -> u64 {
         self.fins.as_ref().map_or(0, FinList::slot_bytes) + self.shells.as_ref().map_or(0, ShellList::slot_bytes)
+    }
+
+    /// The bytes the pool's copies' lists share (the gathered draws' head of indices).
+    pub fn shared_list_bytes(&self) -> u64 {
+        self.shells.as_ref().map_or(0, ShellList::head_bytes)
     }
 
     pub fn fins(&self) -> Option<&FinList> {

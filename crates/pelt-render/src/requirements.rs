@@ -18,6 +18,15 @@ pub fn required_features() -> wgpu::Features {
     wgpu::Features::empty()
 }
 
+/// wgpu features Pelt uses where the adapter has them (request them with
+/// [`required_features`]): `INDIRECT_FIRST_INSTANCE`, with which a herd's camera draws gather
+/// the copies whose shells the view angle thins, and their fins, into one call a level
+/// ([`crate::HerdDraws`]); without it those copies draw alone, to the same picture.
+#[must_use]
+pub fn optional_features(adapter: wgpu::Features) -> wgpu::Features {
+    adapter & wgpu::Features::INDIRECT_FIRST_INSTANCE
+}
+
 /// Downlevel capabilities Pelt needs: storage buffers in vertex shaders (the shared vertex array
 /// is fetched there), compute shaders and indirect draws (the silhouette pass). Every WebGPU,
 /// Vulkan, Metal and DX12 adapter has them; WebGL2 does not.

@@ -413,15 +413,21 @@ fn copies_made_together_cast_in_one_draw_a_pass_as_each_alone() {
 }
 
 /// Through the camera, a herd's plan (`HerdDraws`) draws each level's copies of one pool in a
-/// skin draw and a shell draw, and the picture has the bytes of each copy drawn alone, farthest
-/// first, with shadows: eight copies in two rows, the back row behind the front one on screen,
-/// each posed and placed its own way; one thins its shells to every fourth, one fades its coat,
-/// one has faded to its skin, one is lit by the other shading model (a coat of its own).
+/// skin draw and a shell draw, the shells the view angle thins in one gathered indirect call and
+/// the fins in another, and the picture has the bytes of each copy drawn alone, farthest first,
+/// with shadows: eight copies in two rows, the back row behind the front one on screen, each
+/// posed and placed its own way; one keeps every fourth shell, three thin theirs by the view
+/// angle, one fades its coat, one has faded to its skin, one is lit by the other shading model
+/// (a coat of its own).
 #[test]
 fn a_herds_camera_draws_pool_each_level_as_each_copy_alone() {
     let mut rig = Rig::new(192, 144);
     assert_eq!(rig.renderer.pooled_drawing(), is_gpu(&rig), "a GPU pools the camera's draws, a CPU rasteriser not");
     rig.renderer.set_pooled_drawing(true);
+    let gathers = rig.device().features().contains(wgpu::Features::INDIRECT_FIRST_INSTANCE);
+    if rig.device().adapter_info().backend == wgpu::Backend::Vulkan {
+        assert!(gathers, "lavapipe takes an indirect draw's first instance: the gathered draws are tested");
+    }
     let structure = builtin_fur(Builtin::Bunny, 8);
     let textures = strand_textures(32, 8, BROWN_ROOT, BROWN_TIP);
     let asset = FurAsset::new(rig.device(), rig.queue(), &rig.renderer, &structure, &textures).expect("asset");
@@ -431,15 +437,16 @@ fn a_herds_camera_draws_pool_each_level_as_each_copy_alone() {
     let reach = radius + structure.lengths.iter().copied().fold(0.0, f32::max);
     let v = structure.mesh.vertex_count();
     let full = pelt_render::FurLevel::FULL;
+    let facing = pelt_render::FurLevel { facing: Some([0.4, 0.7]), ..full };
     let levels = [
         full,
         pelt_render::FurLevel { stride: 4, ..full },
-        full,
+        facing,
         pelt_render::FurLevel { coat: 0.6, ..full },
-        full,
+        pelt_render::FurLevel { coat: 0.8, ..facing },
         pelt_render::FurLevel { coat: 0.0, ..full },
         full,
-        full,
+        facing,
     ];
     let mut spheres = Vec::new();
     for (k, fur) in herd.iter().enumerate() {
@@ -502,11 +509,19 @@ fn a_herds_camera_draws_pool_each_level_as_each_copy_alone() {
     let (planned, planned_draws) = picture(true);
     let (alone, alone_draws) = picture(false);
     planned.save(common::out_dir().join("herd-camera.png")).expect("save");
-    assert_eq!(alone_draws, 8 + 7 + 7, "a skin, shells and fins a copy, none for the hidden coat");
+    // A thinned coat draws a shell at a time.
+    assert_eq!(alone_draws, 8 + (4 + 3 * 8) + 7, "a skin, shells and fins a copy, none for the hidden coat");
     assert_eq!(plan.levels(), 2, "the front row and the back row");
     // The coat lit by the other model draws alone; the rest of each row together: their skins in
-    // one draw, the shells of those whose coat shows in another, then each shown coat's fins.
-    assert_eq!(plan.pooled_members(), 7);
-    assert_eq!(planned_draws, (2 + 4) + (2 + 2) + 3, "{planned_draws} draws planned");
+    // one draw, the whole shells of those whose coat shows in another, the thinned shells in one
+    // gathered call, then the fins in one.
+    if gathers {
+        assert_eq!((plan.pooled_members(), plan.gathered_members()), (7, 3));
+        assert_eq!(planned_draws, (1 + 1 + 1 + 1) + (1 + 1 + 1) + 3, "{planned_draws} draws planned");
+    } else {
+        // Without an indirect draw's first instance the thinned copies and the fins draw alone.
+        assert_eq!((plan.pooled_members(), plan.gathered_members()), (4, 0));
+        assert_eq!(planned_draws, (1 + 1 + 2) + 3 * (1 + 8 + 1) + 3, "{planned_draws} draws planned");
+    }
     assert!(planned == alone, "the planned herd's picture differs from its copies' alone");
 }

@@ -76,7 +76,8 @@ impl CanvasGpu {
         let (device, queue) = adapter
             .request_device(&wgpu::DeviceDescriptor {
                 label: Some("pelt web"),
-                required_features: pelt_render::required_features(),
+                required_features: pelt_render::required_features()
+                    | pelt_render::optional_features(adapter.features()),
                 required_limits: pelt_render::required_limits(&adapter.limits()),
                 ..wgpu::DeviceDescriptor::default()
             })

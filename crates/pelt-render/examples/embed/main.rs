@@ -24,7 +24,7 @@ fn open_device(adapter: &wgpu::Adapter) -> Result<(wgpu::Device, wgpu::Queue), E
     pelt_render::check_adapter(adapter)?;
     let descriptor = wgpu::DeviceDescriptor {
         label: Some("embed"),
-        required_features: pelt_render::required_features(),
+        required_features: pelt_render::required_features() | pelt_render::optional_features(adapter.features()),
         required_limits: pelt_render::required_limits(&wgpu::Limits::default()),
         ..wgpu::DeviceDescriptor::default()
     };

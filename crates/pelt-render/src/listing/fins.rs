@@ -30,11 +30,19 @@ fn fin_draw(segments: u32, fins: u32) -> DrawIndexedIndirectArgs {
     }
 }
 
+/// The draws a pool of `slots` copies keeps a layer: its own, and the gathered ones where
+/// there is more than one copy (a pool of one always draws alone).
+pub(super) fn gathered_draws(slots: u32) -> u32 {
+    if slots > 1 { 2 * slots } else { slots }
+}
+
 /// The fins of every copy in a pool (`crate::pool`) as the silhouette pass leaves them: slot by
 /// slot, each copy's indirect draw and instances.
 #[derive(Debug)]
 pub(crate) struct FinList {
-    /// `DrawIndexedIndirectArgs` a slot: `6L` indices, the instance count the pass counted.
+    /// `DrawIndexedIndirectArgs` a slot: `6L` indices, the instance count the pass counted; then
+    /// in a pool of more than one as many gathered draws (`crate::HerdDraws`), each from its
+    /// copy's first instance.
     pub draws: wgpu::Buffer,
     /// Up to `E` instances of [`FIN_INSTANCE_LAYOUT`] a slot.
     pub instances: wgpu::Buffer,
@@ -58,7 +66,7 @@ impl FinList {
         let instance_bytes = u64::from(edge_count) * FIN_INSTANCE_BYTES * u64::from(slots);
         check_size(device, "fin instances", instance_bytes)?;
         check_scan_width(device)?;
-        let draws: Vec<u8> = (0..slots).flat_map(|_| fin_draw(layers, 0).as_bytes().to_vec()).collect();
+        let draws: Vec<u8> = (0..gathered_draws(slots)).flat_map(|_| fin_draw(layers, 0).as_bytes().to_vec()).collect();
         let draws = wgpu::util::DeviceExt::create_buffer_init(
             device,
             &wgpu::util::BufferInitDescriptor {
@@ -70,7 +78,7 @@ impl FinList {
                     | wgpu::BufferUsages::COPY_SRC,
             },
         );
-        debug_assert_eq!(draws.size(), DRAW_ARGS_BYTES * u64::from(slots));
+        debug_assert_eq!(draws.size(), DRAW_ARGS_BYTES * u64::from(gathered_draws(slots)));
         let instances = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("pelt fin instances"),
             size: instance_bytes,
@@ -108,6 +116,11 @@ impl FinList {
         u64::from(slot) * DRAW_ARGS_BYTES
     }
 
+    /// The byte offset of the gathered draw at `position` in [`FinList::draws`].
+    pub fn gathered_offset(&self, position: u32) -> u64 {
+        (u64::from(self.slots) + u64::from(position)) * DRAW_ARGS_BYTES
+    }
+
     /// Writes slot `slot`'s list decided on the CPU (`(edge, fade bits)` per fin, at most `E`)
     /// and its indirect draw of `segments` segments a fin, in place of the compute pass.
     #[cfg(feature = "lab")]
@@ -121,6 +134,7 @@ impl FinList {
 
     /// GPU bytes of one slot's list.
     pub fn slot_bytes(&self) -> u64 {
-        DRAW_ARGS_BYTES + u64::from(self.edge_count) * FIN_INSTANCE_BYTES
+        u64::from(gathered_draws(self.slots) / self.slots) * DRAW_ARGS_BYTES
+            + u64::from(self.edge_count) * FIN_INSTANCE_BYTES
     }
 }

@@ -201,6 +201,9 @@ pub struct FurRenderer {
     pooled_stepping: bool,
     /// Whether [`HerdDraws`] pools the camera's draws of a herd.
     pooled_drawing: bool,
+    /// Whether the device takes an indirect draw's first instance, so [`HerdDraws`] can gather
+    /// thinned shells and fins ([`crate::optional_features`]).
+    first_instance: bool,
     /// Whether hosts pose a GPU-kernel herd's bases on the GPU (`HerdPosing`).
     herd_posing: bool,
     /// The camera's pooled pipelines (`HerdDraws`), built when a herd first draws with one.
@@ -254,6 +257,7 @@ impl FurRenderer {
             pooled_casting: gpu,
             pooled_stepping: gpu,
             pooled_drawing: gpu,
+            first_instance: device.features().contains(wgpu::Features::INDIRECT_FIRST_INSTANCE),
             herd_posing: gpu,
             pool_camera: herd_view::PoolCameraPipelines::default(),
         })
@@ -289,8 +293,6 @@ impl FurRenderer {
             ViewRole::Shadow(shadow_pass) => return self.draw_shadow(pass, (view, shadow_pass), fur, settings),
         };
         let geometry = fur.geometry();
-        let walk = usize::from(!geometry.shape.has_uvs);
-        let which = Transparency::index(settings.alpha_to_coverage);
         pass.set_bind_group(0, view.bind_group(), &[]);
         pass.set_bind_group(1, geometry.bind_group(), &[]);
         pass.set_bind_group(2, fur.textures_bind_group(), &[]);
@@ -305,20 +307,8 @@ impl FurRenderer {
         if layers == 0 || !(settings.shells || settings.fins) || !fur.prepared_level().coat_shown() {
             return draws;
         }
-        let coat = self.coat(fur.coat().shadowed(shadowed));
         if settings.shells {
-            let shells = &coat.shells[walk][which];
-            match fur.shell_list() {
-                Some(list) if list.recorded(fur.slot()) && fur.prepared_level().by_view() => {
-                    draw_thinned_shells(pass, fur, (shells, &coat.listed_shells[walk][which]), list);
-                    draws += fur.drawn_shells() as usize;
-                }
-                _ => {
-                    pass.set_pipeline(shells);
-                    geometry.draw_shells(pass, 0..fur.drawn_shells());
-                    draws += 1;
-                }
-            }
+            draws += self.draw_shells_of(pass, fur, shadowed, settings);
         }
         // Fins after the shells: at the silhouette, where fins matter, they stand outside the
         // shells and must not be covered by the faded outer layers.
@@ -326,6 +316,32 @@ impl FurRenderer {
             draws += self.draw_fins_of(pass, fur, shadowed, settings);
         }
         draws
+    }
+
+    /// A shown coat's shells (its object bound in group 1), those the view angle thins over its
+    /// list where its listing pass was recorded; returns the draws recorded.
+    fn draw_shells_of(
+        &self,
+        pass: &mut wgpu::RenderPass<'_>,
+        fur: &GpuFur,
+        shadowed: ShadowLookups,
+        settings: &FurDrawSettings,
+    ) -> usize {
+        let coat = self.coat(fur.coat().shadowed(shadowed));
+        let walk = usize::from(!fur.geometry().shape.has_uvs);
+        let which = Transparency::index(settings.alpha_to_coverage);
+        let shells = &coat.shells[walk][which];
+        match fur.shell_list() {
+            Some(list) if list.recorded(fur.slot()) && fur.prepared_level().by_view() => {
+                draw_thinned_shells(pass, fur, (shells, &coat.listed_shells[walk][which]), list);
+                fur.drawn_shells() as usize
+            }
+            _ => {
+                pass.set_pipeline(shells);
+                fur.geometry().draw_shells(pass, 0..fur.drawn_shells());
+                1
+            }
+        }
     }
 
     /// A shown coat's fins (its object bound in group 1); returns the draws recorded.
@@ -400,6 +416,11 @@ impl FurRenderer {
         }
         if pools.is_empty() {
             return 0;
+        }
+        for (fur, _, thinned) in &pools {
+            if let Some(list) = fur.pool().shells().filter(|_| !thinned.is_empty()) {
+                list.fill_head(encoder);
+            }
         }
         let mut pass = encoder
             .begin_compute_pass(&wgpu::ComputePassDescriptor { label: Some("pelt listing"), timestamp_writes: None });

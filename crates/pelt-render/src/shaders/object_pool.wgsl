@@ -8,8 +8,13 @@
 // read every copy past the first at the wrong offset.
 struct ObjectSlot {
     object: Object,
-    padding: array<vec4<f32>, 11>,
+    // Where the listing passes also write this copy's fin draw (x) and shell draws (y) for a
+    // herd's gathered camera draws (`HerdDraws`), or `NOT_GATHERED`.
+    gather: vec4<u32>,
+    padding: array<vec4<f32>, 10>,
 }
+
+const NOT_GATHERED = 0xffffffffu;
 
 @group(1) @binding(0) var<storage, read> objects: array<ObjectSlot>;
 var<private> object: Object;

@@ -255,3 +255,86 @@ fn fs_pool_shell_tiles_groomed(in: PoolGroomedShellTileVaryings) -> @location(0)
     let shell = GroomedShellTileVaryings(in.clip_position, in.lighting, in.fade_blend_layer, in.tile_position, in.tile_normal, in.tint_density);
     return shell_tiles_groomed_colour(shell);
 }
+
+// A level's copies whose shells the view angle thins, gathered (`HerdDraws`): one indirect draw a
+// shell a copy, all in one call, each with the copy's slot as its instance and base vertex
+// `shell * N` (`cs_view_lod_draws`), so `vertex_index` carries the shell and the wedge (N = W) or
+// base vertex (N = V), as `vs_shell_*_listed` read it.
+@vertex
+fn vs_pool_shell_wedges_listed(@builtin(vertex_index) index: u32, @builtin(instance_index) member: u32) -> PoolShellUvVaryings {
+    object = objects[member].object;
+    let v = shell_wedge(index % object.wedge_count, index / object.wedge_count);
+    return PoolShellUvVaryings(v.clip_position, v.lighting, v.fade_blend_layer, v.uvs, member);
+}
+
+@vertex
+fn vs_pool_shell_indexed_listed(@builtin(vertex_index) index: u32, @builtin(instance_index) member: u32) -> PoolShellTileVaryings {
+    object = objects[member].object;
+    let v = shell_vertex(index % object.vertex_count, index / object.vertex_count);
+    return PoolShellTileVaryings(v.clip_position, v.lighting, v.fade_blend_layer, v.tile_position, v.tile_normal, member);
+}
+
+@vertex
+fn vs_pool_shell_wedges_listed_groomed(@builtin(vertex_index) index: u32, @builtin(instance_index) member: u32) -> PoolGroomedShellUvVaryings {
+    object = objects[member].object;
+    let v = groomed_shell_wedge(index % object.wedge_count, index / object.wedge_count);
+    return PoolGroomedShellUvVaryings(v.clip_position, v.lighting, v.fade_blend_layer, v.uvs, v.tint_density, member);
+}
+
+@vertex
+fn vs_pool_shell_indexed_listed_groomed(@builtin(vertex_index) index: u32, @builtin(instance_index) member: u32) -> PoolGroomedShellTileVaryings {
+    object = objects[member].object;
+    let v = groomed_shell_vertex(index % object.vertex_count, index / object.vertex_count);
+    return PoolGroomedShellTileVaryings(v.clip_position, v.lighting, v.fade_blend_layer, v.tile_position, v.tile_normal, v.tint_density, member);
+}
+
+// A level's fins, gathered: one indirect draw a copy, all in one call, over the whole instance
+// buffer from the copy's first instance (`cs_silhouette`), so the instance names the copy.
+struct PoolFinVaryings {
+    @builtin(position) clip_position: vec4<f32>,
+    @location(0) @interpolate(perspective, centroid) lighting_fade: vec4<f32>,
+    @location(1) @interpolate(perspective, centroid) uvs: vec4<f32>,
+    @location(5) @interpolate(flat) member: u32,
+}
+
+struct PoolGroomedFinVaryings {
+    @builtin(position) clip_position: vec4<f32>,
+    @location(0) @interpolate(perspective, centroid) lighting_fade: vec4<f32>,
+    @location(1) @interpolate(perspective, centroid) uvs: vec4<f32>,
+    @location(2) @interpolate(perspective, centroid) tint_density: vec4<f32>,
+    @location(3) @interpolate(perspective, centroid) clump: f32,
+    @location(5) @interpolate(flat) member: u32,
+}
+
+// The copy whose fins instance `instance` is: every copy holds `fin_edge_count` of them.
+fn pool_fin_member(instance: u32) -> u32 {
+    return instance / objects[0].object.fin_edge_count;
+}
+
+@vertex
+fn vs_pool_fin_silhouette(@builtin(vertex_index) index: u32, @builtin(instance_index) instance: u32, @location(0) fin: vec2<u32>) -> PoolFinVaryings {
+    let member = pool_fin_member(instance);
+    object = objects[member].object;
+    let v = fin_varyings(index, fin.x, bitcast<f32>(fin.y));
+    return PoolFinVaryings(v.clip_position, v.lighting_fade, v.uvs, member);
+}
+
+@vertex
+fn vs_pool_fin_silhouette_groomed(@builtin(vertex_index) index: u32, @builtin(instance_index) instance: u32, @location(0) fin: vec2<u32>) -> PoolGroomedFinVaryings {
+    let member = pool_fin_member(instance);
+    object = objects[member].object;
+    let v = groomed_fin_varyings(index, fin.x, bitcast<f32>(fin.y));
+    return PoolGroomedFinVaryings(v.clip_position, v.lighting_fade, v.uvs, v.tint_density, v.clump, member);
+}
+
+@fragment
+fn fs_pool_fin(in: PoolFinVaryings) -> @location(0) vec4<f32> {
+    object = objects[in.member].object;
+    return fin_lean_colour(FinVaryings(in.clip_position, in.lighting_fade, in.uvs));
+}
+
+@fragment
+fn fs_pool_fin_groomed(in: PoolGroomedFinVaryings) -> @location(0) vec4<f32> {
+    object = objects[in.member].object;
+    return fin_groomed_colour(GroomedFinVaryings(in.clip_position, in.lighting_fade, in.uvs, in.tint_density, in.clump));
+}

@@ -767,6 +767,10 @@ fn fin_texture_uv(uvs: vec4<f32>) -> vec2<f32> {
 
 @fragment
 fn fs_fin(in: FinVaryings) -> @location(0) vec4<f32> {
+    return fin_lean_colour(in);
+}
+
+fn fin_lean_colour(in: FinVaryings) -> vec4<f32> {
     let texel = textureSample(fin_texture, fin_sampler, fin_texture_uv(in.uvs));
     return fin_colour(texel, in.lighting_fade, in.uvs, vec3<f32>(1.0), 1.0);
 }
@@ -775,6 +779,10 @@ fn fs_fin(in: FinVaryings) -> @location(0) vec4<f32> {
 // coat is a fainter fringe (the density scales its opacity).
 @fragment
 fn fs_fin_groomed(in: GroomedFinVaryings) -> @location(0) vec4<f32> {
+    return fin_groomed_colour(in);
+}
+
+fn fin_groomed_colour(in: GroomedFinVaryings) -> vec4<f32> {
     let height = in.uvs.y;
     let fin_uv = fin_texture_uv(in.uvs);
     let dx = dpdx(fin_uv);

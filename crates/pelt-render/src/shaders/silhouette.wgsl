@@ -20,6 +20,8 @@ struct FinDraw {
 
 // Group 2 holds textures in the render pipelines; the silhouette pass leaves it empty. Group 3
 // holds every copy's list of its pool, slot by slot (`object_pool.wgsl`: workgroup z is the slot).
+// Each slot's own draw, then in a pool of more than one as many gathered draws
+// (`ObjectSlot::gather`).
 @group(3) @binding(0) var<storage, read_write> fin_draws: array<FinDraw>;
 // (edge, fade as f32 bits) per shown fin, in edge order: `fin_edge_count` slots a copy.
 @group(3) @binding(1) var<storage, read_write> fin_instances: array<vec2<u32>>;
@@ -66,5 +68,12 @@ fn cs_silhouette(@builtin(local_invocation_index) lane: u32, @builtin(workgroup_
         // The fins' segments at this frame's level of detail (6 indices each).
         fin_draws[group.z].index_count = 6u * object.lod_shells;
         fin_draws[group.z].instance_count = listed;
+        // The gathered copy of the draw (after every slot's own) reads the whole instance
+        // buffer from the slot's first instance, which names the copy (`vs_pool_fin_*`).
+        let at = objects[group.z].gather.x;
+        if at != NOT_GATHERED {
+            let slots = arrayLength(&fin_draws) / 2u;
+            fin_draws[slots + at] = FinDraw(6u * object.lod_shells, listed, 0u, 0, first);
+        }
     }
 }

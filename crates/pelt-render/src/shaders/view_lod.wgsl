@@ -18,10 +18,12 @@ struct ShellDraw {
 // every copy's list of its pool, slot by slot (`object_pool.wgsl`: workgroup z is the slot).
 // Indices listed (3 a triangle), one count a copy.
 @group(3) @binding(0) var<storage, read_write> listed: array<u32>;
-// The listed triangles' corners' wedges (meshes with uvs) or base vertices (meshes without), in
-// triangle order: `3 * furred_triangle_count` slots a copy.
+// In a pool of more than one, every furred triangle's corners' wedges (meshes with uvs) or base
+// vertices (meshes without); then each copy's listed ones in triangle order,
+// `3 * furred_triangle_count` slots a copy.
 @group(3) @binding(1) var<storage, read_write> listed_indices: array<u32>;
-// One draw per layer a copy (only the dropped shells' are used).
+// One draw per layer a copy (only the dropped shells' are used), then in a pool of more than one
+// as many gathered draws (`ObjectSlot::gather`).
 @group(3) @binding(2) var<storage, read_write> shell_draws: array<ShellDraw>;
 
 // Whether triangle `triangle` still shows in the layers the next coarser stride drops.
@@ -39,9 +41,12 @@ fn view_lod_shows(triangle: u32) -> bool {
     return shows;
 }
 
-// The first of slot `member`'s indices in `listed_indices`.
+// The first of slot `member`'s indices in `listed_indices`. The copies of a pool of more than
+// one keep every furred triangle's corners first (the head), which their gathered draws of the
+// shells kept whole read.
 fn first_listed(member: u32) -> u32 {
-    return 3u * member * object.furred_triangle_count;
+    let head = u32(arrayLength(&listed) > 1u);
+    return 3u * (member + head) * object.furred_triangle_count;
 }
 
 // First, one thread a triangle over as many workgroups as it takes: whether it shows, in the
@@ -93,16 +98,33 @@ fn cs_view_lod_list(@builtin(local_invocation_index) lane: u32, @builtin(workgro
 }
 
 // After the list (a second dispatch): shell k's draw covers the copy's listed indices with base
-// vertex k * N, which `vs_shell_*_listed` read back as the shell.
+// vertex k * N, which `vs_shell_*_listed` read back as the shell. A copy a herd's camera draws
+// gathered (`HerdDraws`) also gets all `L` of its draws in order at its gathered place: the
+// shells the view angle thins over its list, the others over every furred triangle, each with
+// the copy's slot as its first instance (`vs_pool_shell_*_listed`), none past its level's shells.
 @compute @workgroup_size(64)
 fn cs_view_lod_draws(@builtin(global_invocation_id) id: vec3<u32>) {
     if !load_member(id.z, LIST_SHELLS) {
         return;
     }
     let shell = id.x;
-    if shell >= object.lod_shells {
+    if shell >= object.layers {
         return;
     }
     let per_shell = select(object.vertex_count, object.wedge_count, object.has_uvs != 0u);
-    shell_draws[id.z * object.layers + shell] = ShellDraw(listed[id.z], 1u, first_listed(id.z), i32(shell * per_shell), 0u);
+    if shell < object.lod_shells {
+        shell_draws[id.z * object.layers + shell] = ShellDraw(listed[id.z], 1u, first_listed(id.z), i32(shell * per_shell), 0u);
+    }
+    let at = objects[id.z].gather.y;
+    if at == NOT_GATHERED {
+        return;
+    }
+    var draw = ShellDraw(0u, 0u, 0u, 0, 0u);
+    if shell < object.lod_shells {
+        // As `FurLevel::dropped_shell`.
+        let dropped = ((object.lod_shells - 1u - shell) & 1u) == 1u;
+        let count = select(3u * object.furred_triangle_count, listed[id.z], dropped);
+        draw = ShellDraw(count, 1u, select(0u, first_listed(id.z), dropped), i32(shell * per_shell), id.z);
+    }
+    shell_draws[(arrayLength(&listed) + at) * object.layers + shell] = draw;
 }

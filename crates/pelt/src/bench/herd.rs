@@ -66,8 +66,8 @@ pub struct HerdRow {
     /// Posing them on the GPU: the clip and joints on the CPU, the vertices in one `GpuSkin`
     /// dispatch, waited for.
     pub gpu_pose_ms: f64,
-    /// Bytes every Fox shares (topology, uvs, fin strip, textures; on the GPU kernel the
-    /// simulation's rest segments), once.
+    /// Bytes every Fox shares (topology, uvs, fin strip, textures, the gathered draws' indices;
+    /// on the GPU kernel the simulation's rest segments), once.
     pub shared_gpu_bytes: u64,
     /// Bytes of each Fox's own state (shared-array state, normals, silhouette and shell lists;
     /// on the GPU kernel a second state and its simulation's buffers).
@@ -283,7 +283,7 @@ pub fn measure(
         }
         let (cpu_pose_ms, gpu_pose_ms) = time_posing((device, queue), (&rig, walk), &fur.mesh, &instances, frames)?;
         let per_frame = |d: Duration| d.as_secs_f64() * 1000.0 / f64::from(frames);
-        let shared_gpu_bytes = asset.gpu_bytes().total();
+        let shared_gpu_bytes = asset.gpu_bytes().total() + drivers[0].fur().herd_list_bytes();
         let posing_gpu_bytes = posing.as_ref().map_or(0, HerdPosing::gpu_bytes);
         let own = drivers[0].fur().own_bytes();
         let per_fox_gpu_bytes =

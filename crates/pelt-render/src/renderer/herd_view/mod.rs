@@ -5,18 +5,28 @@
 //! one pool then draw their skins in one draw and their shells in another (`pool_draws.wgsl`:
 //! an instance buffer names each instance's slot and shell), and the picture has the bytes of
 //! every copy drawn alone, farthest first. The draws grow with how many copies stand behind one
-//! another on screen, not with the herd. Fins stay a draw a copy: only copies near enough to show
-//! them draw any (`FurLevel::fins`).
+//! another on screen, not with the herd.
+//!
+//! Copies whose shells the view angle thins, and the fins, follow lists the listing passes make
+//! on the GPU. Where the device takes an indirect draw's first instance, the plan gives each
+//! such copy a place, and the listing passes write its draws there too (`ObjectSlot::gather`),
+//! so a level's thinned shells take one indirect call and its fins another, the first instance
+//! naming the copy. Elsewhere those copies draw alone.
 
 use std::ops::Range;
-use std::sync::{Arc, OnceLock};
+use std::sync::Arc;
+use std::sync::atomic::{AtomicU64, Ordering};
 
 use glam::{Mat4, Vec3};
 
-use super::pipeline::{PassKind, PipelineSource, Transparency, create_pipeline};
-use super::{CoatBuilder, FurDrawSettings, FurRenderer, WALKS};
-use crate::fur::{Coat, GpuFur};
-use crate::view::{FurView, ShadowLookups, ViewData, ViewRole};
+use super::FurRenderer;
+use crate::fur::GpuFur;
+use crate::pool::{LIST_FINS, LIST_SHELLS, MemberPool, NOT_GATHERED};
+use crate::view::ViewData;
+
+mod draws;
+
+pub(super) use draws::PoolCameraPipelines;
 
 /// One instance of a pooled draw: the copy's slot and its shell (0 for a skin).
 const ENTRY_BYTES: u64 = 8;
@@ -26,6 +36,9 @@ const ENTRY_LAYOUT: wgpu::VertexBufferLayout<'static> = wgpu::VertexBufferLayout
     step_mode: wgpu::VertexStepMode::Instance,
     attributes: &[wgpu::VertexAttribute { format: wgpu::VertexFormat::Uint32x2, offset: 0, shader_location: 0 }],
 };
+
+/// The numbers plans take, so a pool knows which plan its gathered draws are for.
+static PLANS: AtomicU64 = AtomicU64::new(1);
 
 /// How far apart two screen rectangles must stand (in normalized device coordinates, about a
 /// pixel at 1280x720) to count as apart: the GPU's projection rounds as the CPU's need not.
@@ -45,6 +58,10 @@ pub struct HerdDraws {
     pooled: Vec<usize>,
     members: usize,
     levels: usize,
+    /// This plan's number (0 until its first `prepare`), which the pools it gathers keep.
+    id: u64,
+    /// The members whose thinned shells the last plan gathered.
+    gathered: usize,
 }
 
 #[derive(Clone, Debug, PartialEq, Eq)]
@@ -52,8 +69,26 @@ enum Step {
     /// The member drawn as a lone fur.
     Alone(usize),
     /// Members of one pool (`pooled[members]`), none overlapping another: their skins over
-    /// `entries[skins]`, their shells over `entries[shells]`, then each one's fins.
-    Pooled { members: Range<usize>, skins: Range<u32>, shells: Range<u32> },
+    /// `entries[skins]`; the shells of those before `pooled[thinned]` over `entries[shells]`,
+    /// and of the rest (thinned by the view angle) through the gathered draws `shell_places`;
+    /// then the fins, through the gathered draws `fin_places` where there are any, else each
+    /// one's own.
+    Pooled {
+        members: Range<usize>,
+        thinned: usize,
+        skins: Range<u32>,
+        shells: Range<u32>,
+        shell_places: Range<u32>,
+        fin_places: Range<u32>,
+    },
+}
+
+/// Where a pool's copies gather this plan: the next free fin and shell places, and each
+/// gathered slot's places.
+struct PoolPlaces<'a> {
+    pool: &'a Arc<MemberPool>,
+    next: [u32; 2],
+    places: Vec<(u32, [u32; 2])>,
 }
 
 impl HerdDraws {
@@ -66,7 +101,10 @@ impl HerdDraws {
     /// Plans the draws of `members` (in the order drawing each alone takes: farthest first),
     /// each with a world-space sphere (`centre`, `radius`) that holds all it draws; a member that
     /// reaches outside its sphere may blend out of order where it overlaps another. Writes the
-    /// instance buffer (it takes effect at the next submission).
+    /// instance buffer and the gathered places (they take effect at the next submission, whose
+    /// listing passes, [`FurRenderer::prepare_fins_of`], write the gathered draws). A pool gathers
+    /// for the plan prepared last: another plan drawing its copies then draws their thinned
+    /// shells and fins each alone.
     pub fn prepare(
         &mut self,
         (device, queue): (&wgpu::Device, &wgpu::Queue),
@@ -78,11 +116,17 @@ impl HerdDraws {
         self.steps.clear();
         self.pooled.clear();
         self.members = members.len();
+        self.gathered = 0;
+        if self.id == 0 {
+            self.id = PLANS.fetch_add(1, Ordering::Relaxed);
+        }
         if !renderer.pooled_drawing() {
             self.levels = members.len();
             self.steps.extend((0..members.len()).map(Step::Alone));
             return;
         }
+        let gathers = renderer.first_instance;
+        let mut pools: Vec<PoolPlaces<'_>> = Vec::new();
         let levels = levels(members.iter().map(|(_, sphere)| screen_rect(view.clip_from_world, *sphere)));
         self.levels = levels.iter().max().map_or(0, |top| top + 1);
         let mut by_level: Vec<Vec<usize>> = vec![Vec::new(); self.levels];
@@ -94,7 +138,7 @@ impl HerdDraws {
             let mut runs: Vec<Vec<usize>> = Vec::new();
             for member in level {
                 let fur = members[member].0;
-                if !poolable(fur) {
+                if !poolable(fur, gathers) {
                     self.steps.push(Step::Alone(member));
                     continue;
                 }
@@ -103,25 +147,63 @@ impl HerdDraws {
                     None => runs.push(vec![member]),
                 }
             }
-            for run in runs {
+            for mut run in runs {
                 if let [member] = run[..] {
                     self.steps.push(Step::Alone(member));
                     continue;
                 }
+                // The thinned copies last, their shells gathered.
+                run.sort_by_key(|&member| thinned(members[member].0));
                 let start = self.pooled.len();
                 let skins = self.entries.len() as u32;
                 self.entries.extend(run.iter().map(|&member| [members[member].0.slot(), 0]));
                 let shells = self.entries.len() as u32;
-                for &member in &run {
+                let whole = run.iter().filter(|&&member| !thinned(members[member].0)).count();
+                for &member in &run[..whole] {
                     let fur = members[member].0;
                     self.entries.extend((0..coat_shells(fur)).map(|shell| [fur.slot(), shell]));
                 }
+                let pool = members[run[0]].0.pool();
+                let at = match pools.iter().position(|p| Arc::ptr_eq(p.pool, pool)) {
+                    Some(at) => at,
+                    None => {
+                        pools.push(PoolPlaces { pool, next: [0; 2], places: Vec::new() });
+                        pools.len() - 1
+                    }
+                };
+                let places = &mut pools[at];
+                let first = places.next;
+                for (k, &member) in run.iter().enumerate() {
+                    let fur = members[member].0;
+                    let lists = fur.lists();
+                    let mut place = [NOT_GATHERED; 2];
+                    if gathers && lists & LIST_FINS != 0 {
+                        place[0] = places.next[0];
+                        places.next[0] += 1;
+                    }
+                    if k >= whole {
+                        place[1] = places.next[1];
+                        places.next[1] += 1;
+                    }
+                    if place != [NOT_GATHERED; 2] {
+                        places.places.push((fur.slot(), place));
+                    }
+                }
+                self.gathered += run.len() - whole;
                 self.pooled.extend(run);
                 self.steps.push(Step::Pooled {
                     members: start..self.pooled.len(),
+                    thinned: start + whole,
                     skins: skins..shells,
                     shells: shells..self.entries.len() as u32,
+                    shell_places: first[1]..places.next[1],
+                    fin_places: first[0]..places.next[0],
                 });
+            }
+        }
+        if gathers {
+            for places in pools {
+                places.pool.gather(queue, self.id, &places.places);
             }
         }
         if self.entries.is_empty() {
@@ -153,12 +235,23 @@ impl HerdDraws {
     pub fn pooled_members(&self) -> usize {
         self.pooled.len()
     }
+
+    /// How many of those thin their shells by the view angle, drawn through gathered draws.
+    #[must_use]
+    pub fn gathered_members(&self) -> usize {
+        self.gathered
+    }
 }
 
-/// Whether a copy can draw in a pooled step: dry (the pool binds no copy's wetness) and not
-/// thinned by the view angle (its shells follow its own list).
-fn poolable(fur: &GpuFur) -> bool {
-    !fur.coat().wet && !fur.prepared_level().by_view()
+/// Whether a copy can draw in a pooled step: dry (the pool binds no copy's wetness), and unless
+/// the plan `gathers`, not thinned by the view angle (its shells follow its own list).
+fn poolable(fur: &GpuFur, gathers: bool) -> bool {
+    !fur.coat().wet && (gathers || !thinned(fur))
+}
+
+/// Whether a copy's shells follow its view-angle list this frame.
+fn thinned(fur: &GpuFur) -> bool {
+    fur.lists() & LIST_SHELLS != 0
 }
 
 /// Whether `next` draws in the same pooled step as `first`: the same pool, coat and textures.
@@ -223,162 +316,6 @@ fn levels(rects: impl Iterator<Item = [f32; 4]>) -> Vec<usize> {
             level
         })
         .collect()
-}
-
-/// The camera's pooled pipelines, each built the first time a herd draws with it.
-#[derive(Debug, Default)]
-pub(super) struct PoolCameraPipelines {
-    /// By shadow lookups, then walk.
-    skins: [OnceLock<[wgpu::RenderPipeline; 2]>; 3],
-    /// By coat, then walk and transparency.
-    shells: [OnceLock<[[wgpu::RenderPipeline; 2]; 2]>; Coat::COUNT],
-}
-
-impl CoatBuilder {
-    fn pool_camera(
-        &self,
-        (module, layout): (&wgpu::ShaderModule, &wgpu::PipelineLayout),
-        target: &crate::targets::FurTarget,
-        (vertex, fragment): (&str, &str),
-        (mesh_uvs, coat, kind): (bool, Coat, PassKind),
-    ) -> wgpu::RenderPipeline {
-        let buffers = [Some(ENTRY_LAYOUT)];
-        let source = PipelineSource {
-            mesh_uvs: Some(mesh_uvs),
-            coat: Some(coat),
-            layout,
-            module,
-            vertex_entry: vertex,
-            fragment_entry: fragment,
-            buffers: &buffers,
-        };
-        create_pipeline(&self.device, target, "pelt pool camera", &source, kind)
-    }
-}
-
-impl FurRenderer {
-    /// Whether [`HerdDraws`] pools the camera's draws of a herd's copies: by default on a
-    /// discrete or integrated GPU, as [`FurRenderer::pooled_casting`] (a CPU rasteriser reads
-    /// each vertex's object from storage, which costs it more than the draws save).
-    #[must_use]
-    pub fn pooled_drawing(&self) -> bool {
-        self.pooled_drawing
-    }
-
-    /// Sets [`FurRenderer::pooled_drawing`] for the plans made after; the pictures are the same
-    /// either way.
-    pub fn set_pooled_drawing(&mut self, pooled: bool) {
-        self.pooled_drawing = pooled;
-    }
-
-    /// Draws the members `furs` of a [`HerdDraws::prepare`] (the same furs in the same order)
-    /// through `view` as its plan says; through a shadow map's view as
-    /// [`FurRenderer::draw_herd`]. Furs that are not the plan's draw each alone, in order.
-    /// Returns the draws recorded.
-    pub fn draw_herd_planned(
-        &self,
-        pass: &mut wgpu::RenderPass<'_>,
-        view: &FurView,
-        plan: &HerdDraws,
-        furs: &[&GpuFur],
-        settings: &FurDrawSettings,
-    ) -> usize {
-        let shadowed = match view.role() {
-            ViewRole::Camera { shadows } if furs.len() == plan.members => shadows,
-            _ => return self.draw_herd(pass, view, furs.iter().copied(), settings),
-        };
-        let mut draws = 0;
-        for step in &plan.steps {
-            draws += match step {
-                Step::Alone(member) => self.draw_counted(pass, view, furs[*member], settings),
-                Step::Pooled { members, skins, shells } => {
-                    let run: Vec<&GpuFur> = plan.pooled[members.clone()].iter().map(|&k| furs[k]).collect();
-                    let Some(buffer) = &plan.buffer else { continue };
-                    self.draw_pooled(pass, (view, shadowed), (&run, buffer), (skins.clone(), shells.clone()), settings)
-                }
-            };
-        }
-        draws
-    }
-
-    /// One pooled step: the run's skins, shells and each one's fins.
-    fn draw_pooled(
-        &self,
-        pass: &mut wgpu::RenderPass<'_>,
-        (view, shadowed): (&FurView, ShadowLookups),
-        (run, buffer): (&[&GpuFur], &wgpu::Buffer),
-        (skins, shells): (Range<u32>, Range<u32>),
-        settings: &FurDrawSettings,
-    ) -> usize {
-        let first = run[0];
-        let geometry = first.geometry();
-        let walk = usize::from(!geometry.shape.has_uvs);
-        let mut draws = 0;
-        pass.set_bind_group(0, view.bind_group(), &[]);
-        pass.set_bind_group(1, first.pool().draw_group(), &[]);
-        pass.set_bind_group(2, first.textures_bind_group(), &[]);
-        pass.set_bind_group(3, view.shadow_group(), &[]);
-        // Each draw's entries bound from their first and its instances counted from 0, so no
-        // backend needs a first instance for instance-rate attributes.
-        let entries =
-            |range: &Range<u32>| buffer.slice(ENTRY_BYTES * u64::from(range.start)..ENTRY_BYTES * u64::from(range.end));
-        if settings.skin {
-            pass.set_pipeline(&self.pool_camera_skins(shadowed)[walk]);
-            pass.set_vertex_buffer(0, entries(&skins));
-            geometry.draw_skins(pass, 0..skins.len() as u32);
-            draws += 1;
-        }
-        if settings.shells && !shells.is_empty() {
-            let which = Transparency::index(settings.alpha_to_coverage);
-            pass.set_pipeline(&self.pool_camera_shells(first.coat().shadowed(shadowed))[walk][which]);
-            pass.set_vertex_buffer(0, entries(&shells));
-            geometry.draw_shells(pass, 0..shells.len() as u32);
-            draws += 1;
-        }
-        // Fins after the shells, as a lone fur draws them (its own object in group 1).
-        if settings.fins {
-            for fur in run {
-                if coat_shells(fur) > 0 && fur.prepared_level().fins_shown() {
-                    pass.set_bind_group(1, fur.geometry().bind_group(), &[]);
-                    draws += self.draw_fins_of(pass, fur, shadowed, settings);
-                }
-            }
-        }
-        draws
-    }
-
-    fn pool_camera_skins(&self, shadowed: ShadowLookups) -> &[wgpu::RenderPipeline; 2] {
-        self.pool_camera.skins[shadowed as usize].get_or_init(|| {
-            let casters = self.pool_casters();
-            let coat = Coat::PLAIN.shadowed(shadowed);
-            WALKS.map(|(walk, uvs)| {
-                self.coat_builder.pool_camera(
-                    (&casters.module, &casters.layout),
-                    &self.target,
-                    (&format!("vs_pool_camera_skin_{walk}"), "fs_pool_skin"),
-                    (uvs, coat, PassKind::Opaque),
-                )
-            })
-        })
-    }
-
-    fn pool_camera_shells(&self, coat: Coat) -> &[[wgpu::RenderPipeline; 2]; 2] {
-        self.pool_camera.shells[coat.index()].get_or_init(|| {
-            let casters = self.pool_casters();
-            WALKS.map(|(walk, uvs)| {
-                let fragment = coat.entry(if uvs { "fs_pool_shell_uvs" } else { "fs_pool_shell_tiles" });
-                let vertex = coat.entry(&format!("vs_pool_shell_{walk}"));
-                Transparency::BOTH.map(|t| {
-                    self.coat_builder.pool_camera(
-                        (&casters.module, &casters.layout),
-                        &self.target,
-                        (&vertex, &fragment),
-                        (uvs, coat, PassKind::Shells(t)),
-                    )
-                })
-            })
-        })
-    }
 }
 
 #[cfg(test)]
