@@ -30,7 +30,8 @@ struct SkinParams {
 pub struct GpuSkin {
     pipeline: wgpu::ComputePipeline,
     bind_group: wgpu::BindGroup,
-    joints: wgpu::Buffer,
+    /// The params, rest pose, influences and joints: bindings 0 to 3 of `skinning.wgsl`.
+    inputs: [wgpu::Buffer; 4],
     posed: wgpu::Buffer,
     vertex_count: u32,
     joint_count: u32,
@@ -54,6 +55,18 @@ impl GpuSkin {
         influences: &[([u32; 4], [f32; 4])],
         joint_count: usize,
         instances: usize,
+    ) -> Result<Self, RenderError> {
+        Self::with_output(device, (positions, normals), influences, joint_count, (instances, true))
+    }
+
+    /// [`GpuSkin::new`]; without `posed_output` its posed vertices hold one vertex (for a kernel
+    /// that skins into buffers of its own through [`GpuSkin::inputs`], not [`GpuSkin::record`]).
+    pub(crate) fn with_output(
+        device: &wgpu::Device,
+        (positions, normals): (&[Vec3], &[Vec3]),
+        influences: &[([u32; 4], [f32; 4])],
+        joint_count: usize,
+        (instances, posed_output): (usize, bool),
     ) -> Result<Self, RenderError> {
         let count = |what, expected: usize, got: usize, rule| RenderError::Count { what, expected, got, rule };
         if positions.is_empty() {
@@ -101,7 +114,7 @@ impl GpuSkin {
             .flat_map(|(p, n)| [p.extend(1.0).to_array(), n.extend(0.0).to_array()])
             .collect();
         let joint_bytes = u64::from(instance_count) * u64::from(joint_total) * 2 * 64;
-        let posed_bytes = u64::from(instance_count) * u64::from(vertex_count) * 3 * 16;
+        let posed_bytes = if posed_output { u64::from(instance_count) * u64::from(vertex_count) * 3 * 16 } else { 16 };
         check_size(device, "GPU skinning's joint matrices", joint_bytes)?;
         check_size(device, "GPU skinning's posed vertices", posed_bytes)?;
 
@@ -133,20 +146,26 @@ impl GpuSkin {
         let (layout, pipeline) = buffers_pipeline(
             device,
             ("pelt skinning", skinning_shader_source(), "skin"),
-            &[wgpu::BufferBindingType::Uniform, storage(true), storage(true), storage(true), storage(false)],
+            &[
+                Some(wgpu::BufferBindingType::Uniform),
+                Some(storage(true)),
+                Some(storage(true)),
+                Some(storage(true)),
+                Some(storage(false)),
+            ],
         );
-        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("pelt skinning"),
-            layout: &layout,
-            entries: &[&params, &rest, &influences, &joints, &posed]
-                .iter()
-                .zip(0..)
-                .map(|(buffer, binding)| wgpu::BindGroupEntry { binding, resource: buffer.as_entire_binding() })
-                .collect::<Vec<_>>(),
-        });
+        let bind_group =
+            whole_buffers(device, "pelt skinning", &layout, &[&params, &rest, &influences, &joints, &posed]);
         scope.pop("creating the GPU skinning")?;
         let bytes = params.size() + rest.size() + influences.size() + joints.size() + posed.size();
-        Ok(Self { pipeline, bind_group, joints, posed, vertex_count, joint_count: joint_total, instance_count, bytes })
+        let inputs = [params, rest, influences, joints];
+        Ok(Self { pipeline, bind_group, inputs, posed, vertex_count, joint_count: joint_total, instance_count, bytes })
+    }
+
+    /// The buffers of bindings 0 to 3 of `skinning.wgsl`: its params, the rest pose, the
+    /// influences and every instance's joints.
+    pub(crate) fn inputs(&self) -> &[wgpu::Buffer; 4] {
+        &self.inputs
     }
 
     /// Sets instance `instance`'s joint matrices (`world(joint) * inverse_bind`, one per joint,
@@ -197,7 +216,7 @@ impl GpuSkin {
             })
             .collect();
         let offset = (instance * self.joint_count as usize * 2 * 64) as u64;
-        queue.write_buffer(&self.joints, offset, bytemuck::cast_slice(&words));
+        queue.write_buffer(&self.inputs[3], offset, bytemuck::cast_slice(&words));
         Ok(())
     }
 
@@ -238,12 +257,13 @@ impl GpuSkin {
 }
 
 /// A compute pipeline of `source`'s `entry` over one bind group of whole buffers, bound in order
-/// from 0 as `buffers` says, visible to the compute stage; and that group's layout. For the small
-/// kernels beside the renderer's (the skinning, a herd's posing).
+/// from 0 as `buffers` says (`None`: a binding the entry does not use, left out), visible to the
+/// compute stage; and that group's layout. For the small kernels beside the renderer's (the
+/// skinning, a herd's posing).
 pub(crate) fn buffers_pipeline(
     device: &wgpu::Device,
     (label, source, entry): (&'static str, String, &str),
-    buffers: &[wgpu::BufferBindingType],
+    buffers: &[Option<wgpu::BufferBindingType>],
 ) -> (wgpu::BindGroupLayout, wgpu::ComputePipeline) {
     let module = device.create_shader_module(wgpu::ShaderModuleDescriptor {
         label: Some(label),
@@ -251,11 +271,13 @@ pub(crate) fn buffers_pipeline(
     });
     let entries: Vec<_> = (0..)
         .zip(buffers)
-        .map(|(binding, &ty)| wgpu::BindGroupLayoutEntry {
-            binding,
-            visibility: wgpu::ShaderStages::COMPUTE,
-            ty: wgpu::BindingType::Buffer { ty, has_dynamic_offset: false, min_binding_size: None },
-            count: None,
+        .filter_map(|(binding, ty)| {
+            Some(wgpu::BindGroupLayoutEntry {
+                binding,
+                visibility: wgpu::ShaderStages::COMPUTE,
+                ty: wgpu::BindingType::Buffer { ty: (*ty)?, has_dynamic_offset: false, min_binding_size: None },
+                count: None,
+            })
         })
         .collect();
     let layout =
@@ -274,4 +296,31 @@ pub(crate) fn buffers_pipeline(
         cache: None,
     });
     (layout, pipeline)
+}
+
+/// A bind group of `layout` binding each of `buffers` whole, in order from 0 (`None`: a binding
+/// left out, as in [`buffers_pipeline`]).
+pub(crate) fn whole_buffers(
+    device: &wgpu::Device,
+    label: &str,
+    layout: &wgpu::BindGroupLayout,
+    buffers: &[&wgpu::Buffer],
+) -> wgpu::BindGroup {
+    gapped_buffers(device, label, layout, &buffers.iter().map(|&b| Some(b)).collect::<Vec<_>>())
+}
+
+/// [`whole_buffers`] with gaps: binding `k` holds `buffers[k]` where it is `Some`.
+pub(crate) fn gapped_buffers(
+    device: &wgpu::Device,
+    label: &str,
+    layout: &wgpu::BindGroupLayout,
+    buffers: &[Option<&wgpu::Buffer>],
+) -> wgpu::BindGroup {
+    let entries: Vec<_> = (0..)
+        .zip(buffers)
+        .filter_map(|(binding, buffer)| {
+            Some(wgpu::BindGroupEntry { binding, resource: (*buffer)?.as_entire_binding() })
+        })
+        .collect();
+    device.create_bind_group(&wgpu::BindGroupDescriptor { label: Some(label), layout, entries: &entries })
 }

@@ -11,7 +11,7 @@ use super::FurDriver;
 use crate::RenderError;
 use crate::requirements::ErrorScope;
 use crate::shaders::herd_posing_shader_source;
-use crate::skinning::{GpuSkin, buffers_pipeline};
+use crate::skinning::{GpuSkin, buffers_pipeline, gapped_buffers};
 
 /// Vertices one workgroup places (`herd_posing.wgsl`'s `workgroup_size`).
 const WORKGROUP: u32 = 64;
@@ -26,8 +26,9 @@ struct PlaceParams {
 
 /// The bases of a herd's members skinned on the GPU ([`GpuSkin`]): each frame the CPU poses
 /// each member's joints only ([`FurStepper::set_joint_posing`], [`FurStepper::posed_joints`]),
-/// and [`HerdPosing::record`] skins every member in one dispatch and writes the posed roots,
-/// frames and normals where the member's GPU simulation and skin read them in another.
+/// and [`HerdPosing::record`] skins the members in one dispatch, writing their posed roots,
+/// frames and normals straight where each member's GPU simulation and skin read them (the
+/// skinning of [`GpuSkin`], without its buffer of posed vertices).
 ///
 /// For members made together ([`FurDriver::herd_with_asset`]) that bend on the GPU kernel. A
 /// member its stepper posed on the CPU (a touch, a collider, wetness: see
@@ -65,19 +66,32 @@ impl HerdPosing {
                 rule: "the rig of the mesh the fur grew on",
             });
         }
-        let skin = GpuSkin::new(
+        // Skinned straight into the members' buffers: the skin keeps no posed vertices.
+        let skin = GpuSkin::with_output(
             device,
             (&mesh.positions, &mesh.normals),
             &rig.vertex_influences(),
             rig.joint_count(),
-            members,
+            (members, false),
         )?;
         let scope = ErrorScope::push(device);
-        let storage = |read_only| wgpu::BufferBindingType::Storage { read_only };
+        let storage = |read_only| Some(wgpu::BufferBindingType::Storage { read_only });
+        let uniform = Some(wgpu::BufferBindingType::Uniform);
+        // The skin's inputs (0 to 3), not its output (4), then the placing's.
         let (layout, pipeline) = buffers_pipeline(
             device,
             ("pelt herd posing", herd_posing_shader_source(), "place"),
-            &[wgpu::BufferBindingType::Uniform, storage(true), storage(true), storage(false), storage(false)],
+            &[
+                uniform,
+                storage(true),
+                storage(true),
+                storage(true),
+                None,
+                uniform,
+                storage(true),
+                storage(false),
+                storage(false),
+            ],
         );
         let params = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("pelt herd posing params"),
@@ -160,15 +174,17 @@ impl HerdPosing {
             && self.bind_group.as_ref().is_none_or(|((s, n), _)| s != strands || n != normals)
         {
             let scope = ErrorScope::push(device);
-            let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-                label: Some("pelt herd posing"),
-                layout: &self.layout,
-                entries: &[&self.params, self.skin.posed(), &self.table, strands, normals]
-                    .iter()
-                    .zip(0..)
-                    .map(|(buffer, binding)| wgpu::BindGroupEntry { binding, resource: buffer.as_entire_binding() })
+            let [skin_params, rest, influences, joints] = self.skin.inputs();
+            let bind_group = gapped_buffers(
+                device,
+                "pelt herd posing",
+                &self.layout,
+                &[skin_params, rest, influences, joints]
+                    .map(Some)
+                    .into_iter()
+                    .chain([None, Some(&self.params), Some(&self.table), Some(strands), Some(normals)])
                     .collect::<Vec<_>>(),
-            });
+            );
             scope.pop("binding the herd's GPU posing")?;
             self.bind_group = Some(((strands.clone(), normals.clone()), bind_group));
         }
@@ -182,13 +198,11 @@ impl HerdPosing {
         Ok(())
     }
 
-    /// Records the skinning of every member and the placing of those posed on the GPU: two
-    /// dispatches (none when no member is), before [`FurDriver::record_herd`]. Members are
-    /// placed every frame, so a root section rewritten for a new stability gets its position
-    /// back.
+    /// Records the skinning of the members posed on the GPU into their inputs: one dispatch
+    /// (none when no member is), before [`FurDriver::record_herd`]. Members are placed every
+    /// frame, so a root section rewritten for a new stability gets its position back.
     pub fn record(&self, encoder: &mut wgpu::CommandEncoder) {
         let Some((_, bind_group)) = self.bind_group.as_ref().filter(|_| !self.rows.is_empty()) else { return };
-        self.skin.record(encoder);
         let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
             label: Some("pelt herd posing"),
             timestamp_writes: None,
@@ -205,7 +219,8 @@ impl HerdPosing {
         self.rows.len()
     }
 
-    /// GPU bytes: the skin's buffers, the table and its uniform.
+    /// GPU bytes: the skin's inputs (the rest pose, influences and every member's joints), the
+    /// table and its uniform.
     #[must_use]
     pub fn gpu_bytes(&self) -> u64 {
         self.skin.bytes() + self.table.size() + self.params.size()

@@ -139,10 +139,11 @@ pub fn skinning_shader_source() -> String {
     SKINNING_WGSL.to_owned()
 }
 
-/// The WGSL module placing a herd's skinned bases into its members' inputs (`herd_posing.wgsl`).
+/// The WGSL module skinning a herd's bases into its members' inputs (`skinning.wgsl` and
+/// `herd_posing.wgsl`).
 #[must_use]
 pub fn herd_posing_shader_source() -> String {
-    HERD_POSING_WGSL.to_owned()
+    format!("{SKINNING_WGSL}\n{HERD_POSING_WGSL}")
 }
 
 /// The WGSL module of the GPU simulation (`simulation_wind.wgsl`, `simulation.wgsl` and

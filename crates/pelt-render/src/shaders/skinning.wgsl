@@ -51,6 +51,15 @@ fn rotation_arc(start: vec3<f32>, end: vec3<f32>) -> vec4<f32> {
     return normalize(vec4<f32>(cross(start, end), 1.0 + d));
 }
 
+// One vertex of one instance, posed.
+struct Skinned {
+    position: vec3<f32>,
+    // The unit normal.
+    normal: vec3<f32>,
+    // The rotation from the rest frame (xyzw).
+    rotation: vec4<f32>,
+}
+
 @compute @workgroup_size(64)
 fn skin(@builtin(global_invocation_id) id: vec3<u32>) {
     let vertex = id.x;
@@ -58,6 +67,16 @@ fn skin(@builtin(global_invocation_id) id: vec3<u32>) {
     if vertex >= params.vertex_count || instance >= params.instance_count {
         return;
     }
+    let posed_vertex = skinned(vertex, instance);
+    let v = params.vertex_count;
+    let out = 3u * instance * v + vertex;
+    posed[out] = vec4<f32>(posed_vertex.position, 1.0);
+    posed[out + v] = vec4<f32>(posed_vertex.normal, 0.0);
+    posed[out + 2u * v] = posed_vertex.rotation;
+}
+
+// Vertex `vertex` of instance `instance` posed by its joints.
+fn skinned(vertex: u32, instance: u32) -> Skinned {
     let position = vec4<f32>(rest[2u * vertex].xyz, 1.0);
     let normal = vec4<f32>(rest[2u * vertex + 1u].xyz, 0.0);
     let joint = influences[2u * vertex];
@@ -91,9 +110,5 @@ fn skin(@builtin(global_invocation_id) id: vec3<u32>) {
     if turned_squared > 1e-24 {
         rotation = normalize(quat_mul(rotation_arc(turned_rest * inverseSqrt(turned_squared), unit), q));
     }
-    let v = params.vertex_count;
-    let out = 3u * instance * v + vertex;
-    posed[out] = vec4<f32>(blended_position, 1.0);
-    posed[out + v] = vec4<f32>(unit, 0.0);
-    posed[out + 2u * v] = rotation;
+    return Skinned(blended_position, unit, rotation);
 }
