@@ -524,4 +524,17 @@ fn a_herds_camera_draws_pool_each_level_as_each_copy_alone() {
         assert_eq!(planned_draws, (1 + 1 + 2) + 3 * (1 + 8 + 1) + 3, "{planned_draws} draws planned");
     }
     assert!(planned == alone, "the planned herd's picture differs from its copies' alone");
+    if gathers {
+        // A second plan over some of the same copies takes their pool's gathered places (other
+        // places: the nearest copy first): the first then draws its thinned shells and fins each
+        // alone, to the same picture.
+        let mut second = pelt_render::HerdDraws::new();
+        let nearest_first: Vec<_> = members.iter().rev().take(7).copied().collect();
+        second.prepare((device, rig.queue()), renderer, &view_data, &nearest_first);
+        let (stale, stale_draws) = picture(true);
+        assert!(stale == alone, "a plan whose pool gathers for another draws another picture");
+        // Each row's skins and whole shells pooled, its thinned shells a draw a shell and its fins
+        // a draw a coat; the other model's copy alone.
+        assert_eq!(stale_draws, (1 + 1 + 8 + 4) + (1 + 2 * 8 + 2) + 3, "{stale_draws} draws");
+    }
 }
