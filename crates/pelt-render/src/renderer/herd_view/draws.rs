@@ -156,8 +156,9 @@ impl FurRenderer {
             }
         }
         // Fins after the shells, as a lone fur draws them.
-        let shown = |fur: &&&GpuFur| coat_shells(fur) > 0 && fur.prepared_level().fins_shown();
-        if settings.fins && run.iter().any(|fur| shown(&fur)) {
+        let shown: Vec<&GpuFur> =
+            run.iter().copied().filter(|fur| coat_shells(fur) > 0 && fur.prepared_level().fins_shown()).collect();
+        if settings.fins && !shown.is_empty() {
             let list = first.fin_list().filter(|_| settings.silhouette_fins && gathered.valid);
             let strip = geometry.fin_strip();
             match (list, strip) {
@@ -171,7 +172,7 @@ impl FurRenderer {
                 }
                 _ => {
                     // Each its own (its object in group 1).
-                    for fur in run.iter().filter(shown) {
+                    for fur in shown {
                         pass.set_bind_group(1, fur.geometry().bind_group(), &[]);
                         draws += self.draw_fins_of(pass, fur, shadowed, settings);
                     }
