@@ -263,3 +263,61 @@ fn strand_lean_is_the_share_that_leans_and_its_mean_offset() {
     assert!((mixed.texels - 4.5).abs() < 0.15, "{mixed:?}");
     assert_eq!(make(&unpulled(Style::Mixed, 6.0)).lean, mixed);
 }
+
+#[test]
+fn a_texel_holds_its_strands_tilt_times_its_coverage() {
+    let tilt_at = |textures: &FurTextures, k: u32, texel: usize| {
+        let i = (k as usize * (SIZE * SIZE) as usize + texel) * 2;
+        let byte = |b: u8| f32::from(b as i8) * texture::TILT_STEP_TEXELS;
+        glam::Vec2::new(byte(textures.strand_tilt[i]), byte(textures.strand_tilt[i + 1]))
+    };
+    // Straight strands stand on their roots: no tilt anywhere.
+    let straight = make(&TextureParams { style: Style::Straight, clump: 0.0, ..small(3) });
+    assert_eq!(straight.strand_tilt.len(), (SIZE * SIZE * LAYERS * 2) as usize);
+    assert!(straight.strand_tilt.iter().all(|&b| b == 0));
+
+    // Leaning, pulled and curled strands: where one strand alone covers a texel wholly, the texel
+    // holds how fast that strand's cross-section travels there, measured here by differencing
+    // its centre across the slice's height.
+    let params = TextureParams {
+        style: Style::Random,
+        lean: 6.0,
+        clump: 0.4,
+        curl_radius: 1.5,
+        curl_turns: 1.0,
+        density: 0.3,
+        ..small(5)
+    };
+    let field = texture::StrandField::new(&params, &ColourParams::default(), &TextureInputs::default()).unwrap();
+    let textures = texture::generate_from(LAYERS, &field);
+    let (mut checked, mut moving) = (0, 0);
+    for k in [1, LAYERS / 2, LAYERS - 2] {
+        let t = (k + 1) as f32 / LAYERS as f32;
+        let alpha = alphas(&textures, k);
+        let near: Vec<_> = field.strands.iter().filter(|s| s.length_factor() >= t + 0.05).collect();
+        for (texel, &a) in alpha.iter().enumerate() {
+            let p = glam::Vec2::new((texel as u32 % SIZE) as f32 + 0.5, (texel as u32 / SIZE) as f32 + 0.5);
+            // Distances on the wrapping tile, to every strand's cross-section that could reach.
+            let reach = |s: &&&texture::Strand| {
+                let d = s.centre(t) - p;
+                let wrapped = d - (d / SIZE as f32).round() * SIZE as f32;
+                wrapped.length() < s.radius_at(t, params.taper) + 1.0
+            };
+            let covering: Vec<_> = near.iter().filter(reach).collect();
+            let all_alive = field.strands.iter().filter(|s| s.length_factor() >= t).count() == near.len();
+            if a < 0.999 || covering.len() != 1 || !all_alive {
+                continue;
+            }
+            let h = 1e-3;
+            let expected = (covering[0].centre(t + h) - covering[0].centre(t - h)) / (2.0 * h);
+            let stored = tilt_at(&textures, k, texel);
+            assert!(
+                (stored - expected).abs().max_element() <= texture::TILT_STEP_TEXELS,
+                "slice {k} texel {texel}: {stored} against {expected}"
+            );
+            checked += 1;
+            moving += usize::from(expected.length() > 1.0);
+        }
+    }
+    assert!(checked > 50 && moving > 25, "{checked} texels checked, {moving} of them tilted");
+}

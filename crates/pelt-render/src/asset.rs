@@ -75,7 +75,11 @@ impl FurAsset {
     pub fn gpu_bytes(&self) -> GpuBytes {
         let geometry = self.geometry.bytes();
         let rest = self.simulation_rest.get().map_or(0, wgpu::Buffer::size);
-        GpuBytes { textures: self.textures.bytes, positions: geometry.positions + rest, ..geometry }
+        GpuBytes {
+            textures: self.textures.bytes + self.textures.tilt_bytes(),
+            positions: geometry.positions + rest,
+            ..geometry
+        }
     }
 
     /// Whether `structure` is the one this asset was uploaded from (its copies may share the

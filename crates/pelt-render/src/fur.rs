@@ -256,6 +256,9 @@ impl GpuFur {
         let uniform = self.geometry.shape.uniform(&frame, skin, textures);
         self.geometry.write_uniform(queue, &uniform, self.lists());
         self.wet.store(frame.wet, Ordering::Relaxed);
+        if frame.wet {
+            self.asset.textures.bind_wet(queue);
+        }
         self.fur_model.store(frame.look.shading.fur_model, Ordering::Relaxed);
         if let Some(list) = self.shell_list() {
             list.invalidate(self.slot());
@@ -338,7 +341,7 @@ impl GpuFur {
     /// working memory, not structure, and is not counted here.
     #[must_use]
     pub fn gpu_bytes(&self) -> GpuBytes {
-        GpuBytes { textures: self.asset.textures.bytes, ..self.geometry.bytes() }
+        GpuBytes { textures: self.asset.textures.bytes + self.asset.textures.tilt_bytes(), ..self.geometry.bytes() }
     }
 
     /// Bytes this copy holds apart from its [`FurAsset`] ([`FurAsset::gpu_bytes`]): the shared
@@ -442,7 +445,7 @@ impl GpuFur {
     }
 
     pub(crate) fn textures_bind_group(&self) -> &wgpu::BindGroup {
-        &self.asset.textures.bind_group
+        self.asset.textures.bind_group()
     }
 
     /// What the listing passes list of it at the level of its last `prepare`

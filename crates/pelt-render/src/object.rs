@@ -153,7 +153,8 @@ pub struct GpuBytes {
     pub attributes: u64,
     /// Topology and index buffers.
     pub indices: u64,
-    /// Shell, fin and surface textures with their mipmaps.
+    /// Shell, fin and surface textures with their mipmaps, and the strands' tilts once a copy of
+    /// the fur has been wet.
     pub textures: u64,
 }
 

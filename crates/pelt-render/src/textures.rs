@@ -2,6 +2,8 @@
 //! with mipmaps (pelt-core's alpha-weighted filter) so distant fur averages out instead of
 //! sparkling.
 
+use std::sync::{Arc, Mutex, OnceLock};
+
 use pelt_core::texture::{FurTextures, StrandLean, downsample_rgba8};
 
 use crate::RenderError;
@@ -34,6 +36,57 @@ pub(crate) struct GpuTextures {
     pub has_keep: bool,
     /// Bytes of the keep values (the 1-byte stand-in without them).
     pub keep_bytes: u64,
+    /// The strands' tilts, uploaded the first time a copy is wet ([`GpuTextures::bind_wet`]).
+    wet: Arc<WetTilts>,
+}
+
+/// A coat's strand tilts (`FurTextures::strand_tilt`): a dry coat never reads them, so they wait
+/// on the CPU until a copy of the fur is first wet, then one bind group with them serves every
+/// copy (a dry coat's pipelines leave them unread).
+struct WetTilts {
+    pending: Mutex<Option<PendingTilts>>,
+    bound: OnceLock<(wgpu::BindGroup, u64)>,
+}
+
+struct PendingTilts {
+    device: wgpu::Device,
+    layout: wgpu::BindGroupLayout,
+    samplers: [wgpu::Sampler; 2],
+    /// Shell, fin, surface and keep views.
+    views: [wgpu::TextureView; 4],
+    size: u32,
+    layers: u32,
+    texels: Vec<u8>,
+}
+
+// Whether they are bound, not the megabytes of tilts.
+impl std::fmt::Debug for WetTilts {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("WetTilts").field("bytes", &self.bound.get().map(|(_, bytes)| *bytes)).finish()
+    }
+}
+
+/// The fur textures' bind group over these views and the tilts' view.
+fn textures_bind_group(
+    device: &wgpu::Device,
+    layout: &wgpu::BindGroupLayout,
+    samplers: &[wgpu::Sampler; 2],
+    [shell, fin, surface, keep]: &[wgpu::TextureView; 4],
+    tilt: &wgpu::TextureView,
+) -> wgpu::BindGroup {
+    device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("pelt fur textures"),
+        layout,
+        entries: &[
+            wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(shell) },
+            wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(fin) },
+            wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::Sampler(&samplers[0]) },
+            wgpu::BindGroupEntry { binding: 3, resource: wgpu::BindingResource::Sampler(&samplers[1]) },
+            wgpu::BindGroupEntry { binding: 4, resource: wgpu::BindingResource::TextureView(surface) },
+            wgpu::BindGroupEntry { binding: 5, resource: wgpu::BindingResource::TextureView(keep) },
+            wgpu::BindGroupEntry { binding: 6, resource: wgpu::BindingResource::TextureView(tilt) },
+        ],
+    })
 }
 
 impl GpuTextures {
@@ -93,19 +146,22 @@ impl GpuTextures {
         // Without a groom a 1x1 stand-in that keeps every strand.
         let (keep_size, keep_layers, keep_texels): (u32, u32, &[u8]) =
             if with_keep { (textures.size, textures.layers, &textures.strand_keep) } else { (1, 1, &[0]) };
-        let keep = upload_keep(device, queue, (keep_size, keep_layers), keep_texels);
-        let bind_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
-            label: Some("pelt fur textures"),
-            layout: &layouts.textures,
-            entries: &[
-                wgpu::BindGroupEntry { binding: 0, resource: wgpu::BindingResource::TextureView(&shell) },
-                wgpu::BindGroupEntry { binding: 1, resource: wgpu::BindingResource::TextureView(&fin) },
-                wgpu::BindGroupEntry { binding: 2, resource: wgpu::BindingResource::Sampler(&layouts.shell_sampler) },
-                wgpu::BindGroupEntry { binding: 3, resource: wgpu::BindingResource::Sampler(&layouts.fin_sampler) },
-                wgpu::BindGroupEntry { binding: 4, resource: wgpu::BindingResource::TextureView(&surface) },
-                wgpu::BindGroupEntry { binding: 5, resource: wgpu::BindingResource::TextureView(&keep) },
-            ],
+        let keep = upload_fetched(device, queue, KEEP, (keep_size, keep_layers), keep_texels);
+        // Until a copy is wet, a zero tilt stands in for the strands'.
+        let no_tilt = upload_fetched(device, queue, TILT, (1, 1), &[0, 0]);
+        let samplers = [layouts.shell_sampler.clone(), layouts.fin_sampler.clone()];
+        let views = [shell, fin, surface, keep];
+        let bind_group = textures_bind_group(device, &layouts.textures, &samplers, &views, &no_tilt);
+        let pending = (!textures.strand_tilt.is_empty()).then(|| PendingTilts {
+            device: device.clone(),
+            layout: layouts.textures.clone(),
+            samplers,
+            views,
+            size: textures.size,
+            layers: textures.layers,
+            texels: textures.strand_tilt.clone(),
         });
+        let wet = Arc::new(WetTilts { pending: Mutex::new(pending), bound: OnceLock::new() });
         let bytes = mipmapped_bytes(textures.size, textures.size) * u64::from(textures.layers)
             + mipmapped_bytes(textures.fin_width, textures.fin_height)
             + mipmapped_bytes(surface_size.0, surface_size.1)
@@ -122,7 +178,33 @@ impl GpuTextures {
             bytes,
             has_keep: with_keep,
             keep_bytes: u64::from(keep_size * keep_size * keep_layers),
+            wet,
         })
+    }
+
+    /// The bind group the fur's draws take: with the strands' tilts once a copy has been wet.
+    pub fn bind_group(&self) -> &wgpu::BindGroup {
+        self.wet.bound.get().map_or(&self.bind_group, |(group, _)| group)
+    }
+
+    /// Uploads the strands' tilts, once, for a copy that is wet: a wet coat's shells light each
+    /// texel along its strand. Textures without tilts keep the zero stand-in.
+    pub fn bind_wet(&self, queue: &wgpu::Queue) {
+        if self.wet.bound.get().is_some() {
+            return;
+        }
+        let Some(pending) = self.wet.pending.lock().unwrap_or_else(std::sync::PoisonError::into_inner).take() else {
+            return;
+        };
+        let PendingTilts { device, layout, samplers, views, size, layers, texels } = pending;
+        let tilt = upload_fetched(&device, queue, TILT, (size, layers), &texels);
+        let group = textures_bind_group(&device, &layout, &samplers, &views, &tilt);
+        let _ = self.wet.bound.set((group, texels.len() as u64));
+    }
+
+    /// Bytes of the strands' tilts on the GPU: 0 until a copy has been wet.
+    pub fn tilt_bytes(&self) -> u64 {
+        self.wet.bound.get().map_or(0, |(_, bytes)| *bytes)
     }
 }
 
@@ -147,6 +229,13 @@ fn validate(textures: &FurTextures) -> Result<(), RenderError> {
     let shell_bytes = textures.size as usize * textures.size as usize * textures.layers as usize * 4;
     if textures.shell.len() != shell_bytes {
         return bad(format!("shell has {} bytes, expected {shell_bytes}", textures.shell.len()));
+    }
+    let tilt_bytes = textures.size as usize * textures.size as usize * textures.layers as usize * 2;
+    if !textures.strand_tilt.is_empty() && textures.strand_tilt.len() != tilt_bytes {
+        return bad(format!(
+            "strand tilts have {} bytes, expected {tilt_bytes} (two per shell texel, or none)",
+            textures.strand_tilt.len()
+        ));
     }
     let fin_bytes = textures.fin_width as usize * textures.fin_height as usize * 4;
     if textures.fin.len() != fin_bytes {
@@ -207,11 +296,19 @@ fn upload(
     texture
 }
 
-/// The strands' keep values: an R8 array texture, one layer per slice, no mipmaps (the shader
-/// fetches texels, never filters them).
-fn upload_keep(
+/// A fetched array texture: its label, texel format and bytes per texel.
+struct Fetched(&'static str, wgpu::TextureFormat, u32);
+
+/// The strands' keep values, fetched by texel.
+const KEEP: Fetched = Fetched("pelt strand keep values", wgpu::TextureFormat::R8Unorm, 1);
+/// The strands' tilts (two signed bytes), filtered by the shell sampler at level 0.
+const TILT: Fetched = Fetched("pelt strand tilts", wgpu::TextureFormat::Rg8Snorm, 2);
+
+/// An array texture of one layer per slice, no mipmaps: the keep values or the tilts.
+fn upload_fetched(
     device: &wgpu::Device,
     queue: &wgpu::Queue,
+    Fetched(label, format, texel_bytes): Fetched,
     (size, layers): (u32, u32),
     texels: &[u8],
 ) -> wgpu::TextureView {
@@ -219,7 +316,8 @@ fn upload_keep(
     // clamp to the last layer then reads as before.
     let array = array_layers(device, (size, size), layers);
     let padded: Vec<u8>;
-    let texels = match texels.len().checked_sub((size * size) as usize) {
+    let layer_bytes = (size * size * texel_bytes) as usize;
+    let texels = match texels.len().checked_sub(layer_bytes) {
         Some(last) if array > layers => {
             padded = [texels, &texels[last..].repeat((array - layers) as usize)].concat();
             &padded[..]
@@ -228,12 +326,12 @@ fn upload_keep(
     };
     let layers = array;
     let texture = device.create_texture(&wgpu::TextureDescriptor {
-        label: Some("pelt strand keep values"),
+        label: Some(label),
         size: wgpu::Extent3d { width: size, height: size, depth_or_array_layers: layers },
         mip_level_count: 1,
         sample_count: 1,
         dimension: wgpu::TextureDimension::D2,
-        format: wgpu::TextureFormat::R8Unorm,
+        format,
         usage: wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
         view_formats: &[],
     });
@@ -245,7 +343,7 @@ fn upload_keep(
             aspect: wgpu::TextureAspect::All,
         },
         texels,
-        wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(size), rows_per_image: Some(size) },
+        wgpu::TexelCopyBufferLayout { offset: 0, bytes_per_row: Some(size * texel_bytes), rows_per_image: Some(size) },
         wgpu::Extent3d { width: size, height: size, depth_or_array_layers: layers },
     );
     texture.create_view(&wgpu::TextureViewDescriptor {
@@ -336,12 +434,17 @@ mod tests {
             fin_height: 2,
             fin: vec![0; 16],
             strand_keep: vec![0; 16],
+            strand_tilt: Vec::new(),
             surface: None,
             lean: StrandLean::default(),
         };
         assert!(matches!(validate(&textures), Err(RenderError::Textures(_))));
         let textures = FurTextures { shell: vec![0; 4 * 4 * 4 * 2], strand_keep: vec![0; 32], ..textures };
         assert!(validate(&textures).is_ok());
+        let tilted = FurTextures { strand_tilt: vec![0; 4 * 4 * 2 * 2], ..textures.clone() };
+        assert!(validate(&tilted).is_ok());
+        let short = FurTextures { strand_tilt: vec![0; 4 * 4 * 2], ..textures.clone() };
+        assert!(matches!(validate(&short), Err(RenderError::Textures(m)) if m.contains("strand tilts")));
         let surface = pelt_core::texture::ImageRgba8 { width: 2, height: 2, pixels: vec![0; 12] };
         assert!(validate(&FurTextures { surface: Some(surface), ..textures }).is_err());
     }

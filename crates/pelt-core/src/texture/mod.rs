@@ -32,6 +32,10 @@ pub const MIN_TILE_SIZE: u32 = 32;
 /// Largest tile edge (texels).
 pub const MAX_TILE_SIZE: u32 = 2048;
 
+/// The step of [`FurTextures::strand_tilt`]'s bytes, texels per fur length: a quarter texel,
+/// so a byte holds up to about 32 texels either way.
+pub const TILT_STEP_TEXELS: f32 = 0.25;
+
 /// The generated textures of one fur, in the layout the renderer uploads directly.
 ///
 /// Every size is a power of two and alpha is straight, so a mip chain is a repeated
@@ -57,6 +61,12 @@ pub struct FurTextures {
     /// keeps a texel where `(value + 0.5) / 256 < density`, so 0.5 keeps about half the strands,
     /// each whole, without new textures. Uploaded for groomed furs only.
     pub strand_keep: Vec<u8>,
+    /// Two signed bytes per shell texel, slice-major like [`Self::shell`]: how far the strands
+    /// there lean per fur length (`d centre / dt`, texels: [`Strand::tilt`], their mean weighted by
+    /// coverage) times the texel's coverage, in steps of [`TILT_STEP_TEXELS`]. A wet coat's
+    /// shells light each texel along its own strand's tangent with it; uploaded once a coat is wet.
+    /// Empty for none: a wet coat's shells are then lit along their columns.
+    pub strand_tilt: Vec<u8>,
     /// Surface colour mode only: the base mesh's colour texture. Shell and fin RGB then hold a
     /// grey per-strand brightness; the renderer multiplies it by this image sampled with the
     /// mesh's corner UVs. `None` in the other modes (the RGB is the final strand colour).
@@ -109,6 +119,7 @@ impl FurTextures {
             fin_height: 4,
             fin: vec![0; 64],
             strand_keep: vec![0; 16],
+            strand_tilt: vec![0; 32],
             surface: None,
             lean: StrandLean::default(),
         }
@@ -124,6 +135,7 @@ impl std::fmt::Debug for FurTextures {
             .field("shell_bytes", &self.shell.len())
             .field("fin_size", &(self.fin_width, self.fin_height))
             .field("strand_keep_bytes", &self.strand_keep.len())
+            .field("strand_tilt_bytes", &self.strand_tilt.len())
             .field("surface", &self.surface)
             .field("lean", &self.lean)
             .finish()
@@ -483,12 +495,16 @@ pub fn generate_from(layers: u32, field: &StrandField) -> FurTextures {
     let slice_bytes = size as usize * size as usize * 4;
     let mut shell = vec![0u8; slice_bytes * layers as usize];
     let mut strand_keep = vec![0u8; slice_bytes / 4 * layers as usize];
-    shell.par_chunks_mut(slice_bytes).zip(strand_keep.par_chunks_mut(slice_bytes / 4)).enumerate().for_each(
-        |(k, (slice, keep))| {
+    let mut strand_tilt = vec![0u8; slice_bytes / 2 * layers as usize];
+    shell
+        .par_chunks_mut(slice_bytes)
+        .zip(strand_keep.par_chunks_mut(slice_bytes / 4))
+        .zip(strand_tilt.par_chunks_mut(slice_bytes / 2))
+        .enumerate()
+        .for_each(|(k, ((slice, keep), tilt))| {
             let t = (k + 1) as f32 / layers as f32;
-            strands::draw_slice(params, strands, (t, k as u64), &colour_at, (slice, keep));
-        },
-    );
+            strands::draw_slice(params, strands, (t, k as u64), &colour_at, (slice, keep, tilt));
+        });
     let fin_height = (size / 2).max(MIN_TILE_SIZE);
     let mut fin = vec![0u8; size as usize * fin_height as usize * 4];
     strands::draw_fin(params, strands, fin_height, &colour_at, &mut fin);
@@ -500,6 +516,7 @@ pub fn generate_from(layers: u32, field: &StrandField) -> FurTextures {
         fin_height,
         fin,
         strand_keep,
+        strand_tilt,
         surface: field.surface.clone(),
         lean: StrandLean::of(strands),
     }

@@ -5,7 +5,7 @@ use std::f32::consts::TAU;
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 
-use super::{ImageRgba8, Style, TextureParams};
+use super::{ImageRgba8, Style, TILT_STEP_TEXELS, TextureParams};
 use crate::rng::{hash, mix64, unit_f32};
 
 /// Heights below this fraction of the fur get the root blur, fading out toward it.
@@ -92,6 +92,18 @@ impl Strand {
             centre += (now - start) * self.curl_radius;
         }
         centre
+    }
+
+    /// How fast the cross-section moves at height `t`: `d centre / dt`, texels per fur length
+    /// (the lean and pull, and the curl's turn). A strand's tangent tilts off its column by this.
+    #[must_use]
+    pub fn tilt(&self, t: f32) -> Vec2 {
+        let mut tilt = self.lean + self.pull;
+        if self.curl_radius > 0.0 {
+            let rate = TAU * self.curl_turns;
+            tilt += Vec2::from_angle(self.curl_phase + rate * t).perp() * (self.curl_radius * rate);
+        }
+        tilt
     }
 
     /// `(inner, outer)` radii at height `t`: full coverage inside `inner`, none beyond `outer`;
@@ -245,6 +257,8 @@ struct Texel {
     /// The largest coverage one strand gives the texel, and that strand's keep value.
     best: f32,
     keep: u8,
+    /// The strands' tilts ([`Strand::tilt`]) weighted by their coverage.
+    tilt: Vec2,
 }
 
 /// A uniform byte in `0..=254` from seed bits (255 would never pass a density of 1).
@@ -266,15 +280,16 @@ fn resolve(texels: &[Texel], out: &mut [u8]) {
 }
 
 /// Rasterises the cross-sections of every strand alive at height `t` into one `size x size`
-/// RGBA8 slice, and into `keep` (`size x size` bytes) the keep value of the strand covering each
-/// texel most; empty texels get a seeded value of their own, so a minified fetch that lands on
-/// one thins by the density too.
+/// RGBA8 slice, into `keep` (`size x size` bytes) the keep value of the strand covering each
+/// texel most (empty texels get a seeded value of their own, so a minified fetch that lands on
+/// one thins by the density too), and into `tilt` (two bytes a texel) the strands' mean tilt
+/// there times the texel's coverage ([`FurTextures::strand_tilt`]).
 pub(super) fn draw_slice(
     params: &TextureParams,
     strands: &[Strand],
     (t, slice): (f32, u64),
     colour: ColourAt<'_>,
-    (out, keep): (&mut [u8], &mut [u8]),
+    (out, keep, tilt): (&mut [u8], &mut [u8], &mut [u8]),
 ) {
     let size = params.size as usize;
     let mask = size as i64 - 1;
@@ -282,6 +297,7 @@ pub(super) fn draw_slice(
     for strand in strands {
         let Some((inner, outer)) = strand.profile(t, params.taper, params.root_blur) else { continue };
         let centre = strand.centre(t);
+        let strand_tilt = strand.tilt(t);
         let rgb = colour(strand, t);
         let outer_squared = outer * outer;
         let (x0, x1) = ((centre.x - outer).floor() as i64, (centre.x + outer).ceil() as i64);
@@ -302,6 +318,7 @@ pub(super) fn draw_slice(
                     texel.transmission *= 1.0 - a;
                     texel.weight += a;
                     texel.colour += rgb * a;
+                    texel.tilt += strand_tilt * a;
                     if a > texel.best {
                         texel.best = a;
                         texel.keep = strand.keep;
@@ -314,6 +331,18 @@ pub(super) fn draw_slice(
     for (k, (texel, value)) in texels.iter().zip(keep.iter_mut()).enumerate() {
         *value = if texel.best > 0.0 { texel.keep } else { keep_byte(hash(params.seed, k as u64, slice, SALT_EMPTY)) };
     }
+    for (texel, pair) in texels.iter().zip(tilt.chunks_exact_mut(2)) {
+        // Premultiplied, so a bilinear fetch weighs each texel's tilt by its coverage.
+        let mean = if texel.weight > 0.0 { texel.tilt / texel.weight } else { Vec2::ZERO };
+        let premultiplied = mean * (1.0 - texel.transmission);
+        pair.copy_from_slice(&[tilt_byte(premultiplied.x), tilt_byte(premultiplied.y)]);
+    }
+}
+
+/// A tilt component as [`FurTextures::strand_tilt`] stores it: a signed byte of
+/// [`TILT_STEP_TEXELS`] steps (two's complement, as an `Rg8Snorm` texel reads it).
+fn tilt_byte(tilt: f32) -> u8 {
+    (tilt / TILT_STEP_TEXELS).round().clamp(-127.0, 127.0) as i8 as u8
 }
 
 /// The fin: a side view of the strands rooted in a thin band of the tile, `u` along the tile's

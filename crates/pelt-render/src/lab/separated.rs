@@ -139,7 +139,7 @@ impl SeparatedRenderer {
         let which = Transparency::index(settings.alpha_to_coverage);
         pass.set_bind_group(0, view.bind_group(), &[]);
         pass.set_bind_group(1, &fur.bind_group, &[]);
-        pass.set_bind_group(2, &fur.textures.bind_group, &[]);
+        pass.set_bind_group(2, fur.textures.bind_group(), &[]);
         pass.set_bind_group(3, view.shadow_group(), &[]);
         pass.set_vertex_buffer(0, fur.shell_vertices.slice(..));
         pass.set_index_buffer(fur.shell_indices.slice(..), wgpu::IndexFormat::Uint32);

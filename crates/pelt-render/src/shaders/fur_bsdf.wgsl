@@ -84,6 +84,11 @@ fn wet_roughness(wet: f32) -> f32 {
 // `wet` (0..1) makes it smoother (lobes narrower by the preset's wet shine, the highlight's
 // peak kept) and darker (the tinted lobes).
 fn fur_bsdf(t: vec3<f32>, v: vec3<f32>, l: vec3<f32>, n: vec3<f32>, wet: f32) -> vec2<f32> {
+    return fur_bsdf_lit(t, v, l, dot(n, l), wet);
+}
+
+// `fur_bsdf` with the surface normal's cosine to the light, `n_dot_l`, all it reads of it.
+fn fur_bsdf_lit(t: vec3<f32>, v: vec3<f32>, l: vec3<f32>, n_dot_l: f32, wet: f32) -> vec2<f32> {
     let sin_l = clamp(dot(t, l), -1.0, 1.0);
     let sin_v = clamp(dot(t, v), -1.0, 1.0);
     let lp = l - t * sin_l;
@@ -101,7 +106,6 @@ fn fur_bsdf(t: vec3<f32>, v: vec3<f32>, l: vec3<f32>, n: vec3<f32>, wet: f32) ->
     // The body stands between the light and the strands on its far side: the reflected lobes
     // need the light on the strand's side of the surface, the transmitted one reaches round the
     // rim (the shadow maps, where bound, add the strands' own shadowing).
-    let n_dot_l = dot(n, l);
     let lit_side = smoothstep(-0.25, 0.6, n_dot_l);
     let through = smoothstep(-0.4, 0.05, n_dot_l);
     // R: reflected at the surface, white. Wet, the narrower lobe keeps its dry peak (the

@@ -145,6 +145,8 @@ impl Layouts {
                 entry(4, fragment, texture(wgpu::TextureViewDimension::D2)),
                 // The strands' keep values (a groom's density), fetched by texel.
                 entry(5, fragment, texture(wgpu::TextureViewDimension::D2Array)),
+                // The strands' tilts (a wet coat's per-strand lighting), filtered.
+                entry(6, fragment, texture(wgpu::TextureViewDimension::D2Array)),
             ],
         });
         let shadow = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {

@@ -62,7 +62,10 @@ struct PoolGroomedShellTileVaryings {
     @location(2) @interpolate(perspective, centroid) tile_position: vec3<f32>,
     @location(3) @interpolate(perspective, centroid) tile_normal: vec3<f32>,
     @location(4) @interpolate(perspective, centroid) tint_density: vec4<f32>,
-    @location(5) @interpolate(flat) member: u32,
+    @location(5) @interpolate(perspective, centroid) column_wetness: vec4<f32>,
+    @location(6) @interpolate(perspective, centroid) world_position: vec3<f32>,
+    @location(7) @interpolate(perspective, centroid) key: vec4<f32>,
+    @location(8) @interpolate(flat) member: u32,
 }
 
 struct PoolGroomedShellUvVaryings {
@@ -71,7 +74,10 @@ struct PoolGroomedShellUvVaryings {
     @location(1) @interpolate(perspective, centroid) fade_blend_layer: vec4<f32>,
     @location(2) @interpolate(perspective, centroid) uvs: vec4<f32>,
     @location(3) @interpolate(perspective, centroid) tint_density: vec4<f32>,
-    @location(5) @interpolate(flat) member: u32,
+    @location(4) @interpolate(perspective, centroid) column_wetness: vec4<f32>,
+    @location(5) @interpolate(perspective, centroid) world_position: vec3<f32>,
+    @location(6) @interpolate(perspective, centroid) key: vec4<f32>,
+    @location(8) @interpolate(flat) member: u32,
 }
 
 @vertex
@@ -145,14 +151,14 @@ fn fs_pool_opacity_tiles(in: PoolShellTileVaryings) -> @location(0) vec4<f32> {
 @fragment
 fn fs_pool_opacity_uvs_groomed(in: PoolGroomedShellUvVaryings) -> @location(0) vec4<f32> {
     object = objects[in.member].object;
-    let shell = GroomedShellUvVaryings(in.clip_position, in.lighting, in.fade_blend_layer, in.uvs, in.tint_density);
+    let shell = GroomedShellUvVaryings(in.clip_position, in.lighting, in.fade_blend_layer, in.uvs, in.tint_density, in.column_wetness, in.world_position, in.key);
     return opacity_uvs_groomed(shell);
 }
 
 @fragment
 fn fs_pool_opacity_tiles_groomed(in: PoolGroomedShellTileVaryings) -> @location(0) vec4<f32> {
     object = objects[in.member].object;
-    let shell = GroomedShellTileVaryings(in.clip_position, in.lighting, in.fade_blend_layer, in.tile_position, in.tile_normal, in.tint_density);
+    let shell = GroomedShellTileVaryings(in.clip_position, in.lighting, in.fade_blend_layer, in.tile_position, in.tile_normal, in.tint_density, in.column_wetness, in.world_position, in.key);
     return opacity_tiles_groomed(shell);
 }
 
@@ -220,14 +226,14 @@ fn vs_pool_shell_indexed(@builtin(vertex_index) vertex: u32, @location(0) entry:
 fn vs_pool_shell_wedges_groomed(@builtin(vertex_index) wedge: u32, @location(0) entry: vec2<u32>) -> PoolGroomedShellUvVaryings {
     object = objects[entry.x].object;
     let v = groomed_shell_wedge(wedge, entry.y);
-    return PoolGroomedShellUvVaryings(v.clip_position, v.lighting, v.fade_blend_layer, v.uvs, v.tint_density, entry.x);
+    return PoolGroomedShellUvVaryings(v.clip_position, v.lighting, v.fade_blend_layer, v.uvs, v.tint_density, v.column_wetness, v.world_position, v.key, entry.x);
 }
 
 @vertex
 fn vs_pool_shell_indexed_groomed(@builtin(vertex_index) vertex: u32, @location(0) entry: vec2<u32>) -> PoolGroomedShellTileVaryings {
     object = objects[entry.x].object;
     let v = groomed_shell_vertex(vertex, entry.y);
-    return PoolGroomedShellTileVaryings(v.clip_position, v.lighting, v.fade_blend_layer, v.tile_position, v.tile_normal, v.tint_density, entry.x);
+    return PoolGroomedShellTileVaryings(v.clip_position, v.lighting, v.fade_blend_layer, v.tile_position, v.tile_normal, v.tint_density, v.column_wetness, v.world_position, v.key, entry.x);
 }
 
 @fragment
@@ -245,14 +251,14 @@ fn fs_pool_shell_tiles(in: PoolShellTileVaryings) -> @location(0) vec4<f32> {
 @fragment
 fn fs_pool_shell_uvs_groomed(in: PoolGroomedShellUvVaryings) -> @location(0) vec4<f32> {
     object = objects[in.member].object;
-    let shell = GroomedShellUvVaryings(in.clip_position, in.lighting, in.fade_blend_layer, in.uvs, in.tint_density);
+    let shell = GroomedShellUvVaryings(in.clip_position, in.lighting, in.fade_blend_layer, in.uvs, in.tint_density, in.column_wetness, in.world_position, in.key);
     return shell_uvs_groomed_colour(shell);
 }
 
 @fragment
 fn fs_pool_shell_tiles_groomed(in: PoolGroomedShellTileVaryings) -> @location(0) vec4<f32> {
     object = objects[in.member].object;
-    let shell = GroomedShellTileVaryings(in.clip_position, in.lighting, in.fade_blend_layer, in.tile_position, in.tile_normal, in.tint_density);
+    let shell = GroomedShellTileVaryings(in.clip_position, in.lighting, in.fade_blend_layer, in.tile_position, in.tile_normal, in.tint_density, in.column_wetness, in.world_position, in.key);
     return shell_tiles_groomed_colour(shell);
 }
 
@@ -278,14 +284,14 @@ fn vs_pool_shell_indexed_listed(@builtin(vertex_index) index: u32, @builtin(inst
 fn vs_pool_shell_wedges_listed_groomed(@builtin(vertex_index) index: u32, @builtin(instance_index) member: u32) -> PoolGroomedShellUvVaryings {
     object = objects[member].object;
     let v = groomed_shell_wedge(index % object.wedge_count, index / object.wedge_count);
-    return PoolGroomedShellUvVaryings(v.clip_position, v.lighting, v.fade_blend_layer, v.uvs, v.tint_density, member);
+    return PoolGroomedShellUvVaryings(v.clip_position, v.lighting, v.fade_blend_layer, v.uvs, v.tint_density, v.column_wetness, v.world_position, v.key, member);
 }
 
 @vertex
 fn vs_pool_shell_indexed_listed_groomed(@builtin(vertex_index) index: u32, @builtin(instance_index) member: u32) -> PoolGroomedShellTileVaryings {
     object = objects[member].object;
     let v = groomed_shell_vertex(index % object.vertex_count, index / object.vertex_count);
-    return PoolGroomedShellTileVaryings(v.clip_position, v.lighting, v.fade_blend_layer, v.tile_position, v.tile_normal, v.tint_density, member);
+    return PoolGroomedShellTileVaryings(v.clip_position, v.lighting, v.fade_blend_layer, v.tile_position, v.tile_normal, v.tint_density, v.column_wetness, v.world_position, v.key, member);
 }
 
 // A level's fins, gathered: one indirect draw a copy, all in one call, over the whole instance

@@ -62,13 +62,13 @@ fn vs_separated_shell_uvs(in: VertexIn, @builtin(instance_index) layer: u32) -> 
 @vertex
 fn vs_separated_shell_tiles_groomed(in: VertexIn, @builtin(instance_index) layer: u32, @builtin(vertex_index) index: u32) -> GroomedShellTileVaryings {
     let v = separated_shell(in, layer);
-    return groomed_shell_tile_varyings(v, v.fade, separated_lod_blend(v), separated_shell_groom(index));
+    return groomed_shell_tile_varyings(v, v.fade, separated_lod_blend(v), separated_shell_groom(index), 0.0);
 }
 
 @vertex
 fn vs_separated_shell_uvs_groomed(in: VertexIn, @builtin(instance_index) layer: u32, @builtin(vertex_index) index: u32) -> GroomedShellUvVaryings {
     let v = separated_shell(in, layer);
-    return groomed_shell_uv_varyings(v, v.fade, separated_lod_blend(v), separated_shell_groom(index));
+    return groomed_shell_uv_varyings(v, v.fade, separated_lod_blend(v), separated_shell_groom(index), 0.0);
 }
 
 // Each layer is drawn with base vertex `layer * V`, so the base vertex is the index modulo V.

@@ -162,6 +162,9 @@ fn normals_base() -> u32 {
 // stand-in that keeps everything for furs without a groom.
 @group(2) @binding(5) var strand_keep: texture_2d_array<f32>;
 @group(2) @binding(3) var fin_sampler: sampler;
+// Each shell texel's strand tilt times its coverage (`FurTextures::strand_tilt`, Rg8Snorm in
+// steps of `TILT_STEP_TEXELS`); a 1x1 zero stand-in until a copy of the fur is wet.
+@group(2) @binding(6) var strand_tilt: texture_2d_array<f32>;
 // The mesh's colour texture (surface colour mode), else 1x1 white.
 @group(2) @binding(4) var surface_texture: texture_2d<f32>;
 
@@ -223,7 +226,8 @@ struct ShellUvVaryings {
 }
 
 // The groomed or wet coats' shells: the lean ones' and the groom's terms at the root (its
-// clump rides in `fade_blend_layer.w`). Only their pipelines pay for the extra location.
+// clump rides in `fade_blend_layer.w`), and a wet coat's strand (`WetStrand`). Only their
+// pipelines pay for the extra locations.
 struct GroomedShellTileVaryings {
     @builtin(position) clip_position: vec4<f32>,
     @location(0) @interpolate(perspective, centroid) lighting: vec4<f32>,
@@ -232,6 +236,9 @@ struct GroomedShellTileVaryings {
     @location(3) @interpolate(perspective, centroid) tile_normal: vec3<f32>,
     // The groom's tint (rgb) and density (`GroomShade`).
     @location(4) @interpolate(perspective, centroid) tint_density: vec4<f32>,
+    @location(5) @interpolate(perspective, centroid) column_wetness: vec4<f32>,
+    @location(6) @interpolate(perspective, centroid) world_position: vec3<f32>,
+    @location(7) @interpolate(perspective, centroid) key: vec4<f32>,
 }
 
 struct GroomedShellUvVaryings {
@@ -240,6 +247,19 @@ struct GroomedShellUvVaryings {
     @location(1) @interpolate(perspective, centroid) fade_blend_layer: vec4<f32>,
     @location(2) @interpolate(perspective, centroid) uvs: vec4<f32>,
     @location(3) @interpolate(perspective, centroid) tint_density: vec4<f32>,
+    // A wet coat's strand (`WetStrand`).
+    @location(4) @interpolate(perspective, centroid) column_wetness: vec4<f32>,
+    @location(5) @interpolate(perspective, centroid) world_position: vec3<f32>,
+    @location(6) @interpolate(perspective, centroid) key: vec4<f32>,
+}
+
+// What a wet coat's shell fragment lights its strand with (`wet_strand_terms`): the strand's
+// column across the fur's length (world, as long as the fur) and its wetness, where it is, and
+// the fur model's key light at the vertex (`wet_key_light`).
+struct WetStrand {
+    column_wetness: vec4<f32>,
+    world_position: vec3<f32>,
+    key: vec4<f32>,
 }
 
 // A groom's shading terms at a strand's root (`GroomAttributes` of its base vertex): the
@@ -282,18 +302,24 @@ fn shell_uv_varyings(v: Varyings, fade: f32, lod_blend: f32) -> ShellUvVaryings 
     return ShellUvVaryings(v.clip_position, shell_lighting(v), fade_blend_layer, vec4<f32>(v.uv, v.surface_uv));
 }
 
-fn groomed_shell_tile_varyings(v: Varyings, fade: f32, lod_blend: f32, groom: GroomShade) -> GroomedShellTileVaryings {
+// `fur_length`: the strand's length in the world at this vertex (0: the wet strands are lit
+// along their columns).
+fn groomed_shell_tile_varyings(v: Varyings, fade: f32, lod_blend: f32, groom: GroomShade, fur_length: f32) -> GroomedShellTileVaryings {
     let fade_blend_layer = vec4<f32>(fade, lod_blend, f32(v.layer), groom.clump);
     let tint_density = vec4<f32>(groom.tint, groom.density);
     let lighting = coat_terms(v.tangent, v.normal, v.world_position, layer_height(v.layer), groom.wetness);
-    return GroomedShellTileVaryings(v.clip_position, lighting, fade_blend_layer, v.tile_position, v.tile_normal, tint_density);
+    let column = vec4<f32>(v.tangent * fur_length, groom.wetness);
+    let key = wet_key_light(v.tangent, v.normal, v.world_position, groom.wetness);
+    return GroomedShellTileVaryings(v.clip_position, lighting, fade_blend_layer, v.tile_position, v.tile_normal, tint_density, column, v.world_position, key);
 }
 
-fn groomed_shell_uv_varyings(v: Varyings, fade: f32, lod_blend: f32, groom: GroomShade) -> GroomedShellUvVaryings {
+fn groomed_shell_uv_varyings(v: Varyings, fade: f32, lod_blend: f32, groom: GroomShade, fur_length: f32) -> GroomedShellUvVaryings {
     let fade_blend_layer = vec4<f32>(fade, lod_blend, f32(v.layer), groom.clump);
     let tint_density = vec4<f32>(groom.tint, groom.density);
     let lighting = coat_terms(v.tangent, v.normal, v.world_position, layer_height(v.layer), groom.wetness);
-    return GroomedShellUvVaryings(v.clip_position, lighting, fade_blend_layer, vec4<f32>(v.uv, v.surface_uv), tint_density);
+    let column = vec4<f32>(v.tangent * fur_length, groom.wetness);
+    let key = wet_key_light(v.tangent, v.normal, v.world_position, groom.wetness);
+    return GroomedShellUvVaryings(v.clip_position, lighting, fade_blend_layer, vec4<f32>(v.uv, v.surface_uv), tint_density, column, v.world_position, key);
 }
 
 // The layer a shell fragment carries: interpolated from three equal corners, so within rounding.
@@ -467,15 +493,21 @@ fn coat_terms(tangent: vec3<f32>, normal: vec3<f32>, world_position: vec3<f32>, 
 
 fn kajiya_kay_terms(tangent: vec3<f32>, normal: vec3<f32>, world_position: vec3<f32>, height: f32) -> vec4<f32> {
     let to_light = view.light_direction;
+    // The key light's shadow at the vertex: the fur's transmittance is smooth, and a shell
+    // fragment then pays for no lookup.
+    let lit_side = smoothstep(-0.25, 0.6, dot(normal, to_light)) * strand_visibility(0u, world_position, normal);
+    return vec4<f32>(kajiya_kay_lobes(tangent, normal, world_position), lit_side, occlusion(height));
+}
+
+// The Kajiya-Kay terms that follow the strand's tangent: the sine to the light, and its square
+// to the half vector.
+fn kajiya_kay_lobes(tangent: vec3<f32>, normal: vec3<f32>, world_position: vec3<f32>) -> vec2<f32> {
+    let to_light = view.light_direction;
     let to_camera = safe_normalize(view.camera_position - world_position, normal);
     let half_vector = safe_normalize(to_light + to_camera, to_light);
     let t_dot_l = dot(tangent, to_light);
     let t_dot_h = dot(tangent, half_vector);
-    let diffuse = sqrt(max(1.0 - t_dot_l * t_dot_l, 0.0));
-    // The key light's shadow at the vertex: the fur's transmittance is smooth, and a shell
-    // fragment then pays for no lookup.
-    let lit_side = smoothstep(-0.25, 0.6, dot(normal, to_light)) * strand_visibility(0u, world_position, normal);
-    return vec4<f32>(diffuse, max(1.0 - t_dot_h * t_dot_h, 0.0), lit_side, occlusion(height));
+    return vec2<f32>(sqrt(max(1.0 - t_dot_l * t_dot_l, 0.0)), max(1.0 - t_dot_h * t_dot_h, 0.0));
 }
 
 fn hair_colour(texel_albedo: vec3<f32>, terms: vec4<f32>, height: f32) -> vec3<f32> {
@@ -616,7 +648,7 @@ fn strand_kept(uv: vec2<f32>, slice: i32, density: f32) -> bool {
 
 // A groomed shell fragment's texel at `uv` (tiles): clumped, thinned by the density. The
 // gradients are the unclumped uv's, so the cells' borders pick no other mip level.
-fn groomed_shell_texel(uv: vec2<f32>, slice: i32, groom: GroomShade, height: f32) -> vec4<f32> {
+fn groomed_shell_texel(uv: vec2<f32>, slice: i32, groom: GroomShade, height: f32) -> CoatRead {
     let dx = dpdx(uv) * SHELL_GRAD_SCALE;
     let dy = dpdy(uv) * SHELL_GRAD_SCALE;
     let sampled = clump_uv(uv, clump_cells_per_tile(), groom_clump_amount(groom.clump, height));
@@ -628,7 +660,8 @@ fn groomed_shell_texel(uv: vec2<f32>, slice: i32, groom: GroomShade, height: f32
     if wet_on() {
         texel.a *= clump_parting(uv, clump_cells_per_tile(), groom.clump, height);
     }
-    return texel;
+    // The groom's clumps tilt no strand here: it reads the strands it pulls in whole.
+    return CoatRead(texel, sampled, vec2<f32>(0.0), 1.0);
 }
 
 // `SHELL_LOD_BIAS` as a scale on the gradients (2^bias).
@@ -713,10 +746,28 @@ fn shell_uvs_colour(in: ShellUvVaryings) -> vec4<f32> {
 // A groomed or wet coat's shell texel at `uv` (tiles): a groom's clumped and thinned one, or a
 // wet coat's clumped and parted one.
 fn coat_shell_texel(uv: vec2<f32>, layer: u32, groom: GroomShade) -> vec4<f32> {
+    return coat_shell_read(uv, layer, groom).texel;
+}
+
+// `coat_shell_texel` and where its strands were read (`CoatRead`).
+fn coat_shell_read(uv: vec2<f32>, layer: u32, groom: GroomShade) -> CoatRead {
     if groom_on() {
         return groomed_shell_texel(uv, shell_slice(layer), groom, layer_height(layer));
     }
     return wet_shell_texel(uv, shell_slice(layer), groom.clump, layer_height(layer));
+}
+
+// A groomed or wet coat's shell fragment: its texel, lit by the vertex's terms, or a wet coat's
+// along the strand the texel shows (`wet_strand_terms`).
+fn coat_shell_colour(uv: vec2<f32>, surface_uv: vec2<f32>, lighting: vec4<f32>, fade_blend_layer: vec4<f32>, tint_density: vec4<f32>, strand: WetStrand) -> vec4<f32> {
+    let layer = varying_layer(fade_blend_layer.z);
+    let groom = shell_groom(fade_blend_layer, tint_density);
+    let read = coat_shell_read(uv, layer, groom);
+    var terms = lighting;
+    if wet_on() {
+        terms = wet_strand_terms(lighting, uv, read, layer, strand);
+    }
+    return shell_colour(read.texel, surface_uv, terms, fade_blend_layer.xyz, tint_density.rgb);
 }
 
 @fragment
@@ -725,10 +776,9 @@ fn fs_shell_tiles_groomed(in: GroomedShellTileVaryings) -> @location(0) vec4<f32
 }
 
 fn shell_tiles_groomed_colour(in: GroomedShellTileVaryings) -> vec4<f32> {
-    let layer = varying_layer(in.fade_blend_layer.z);
-    let groom = shell_groom(in.fade_blend_layer, in.tint_density);
-    let texel = coat_shell_texel(tile_uv(in.tile_position, in.tile_normal), layer, groom);
-    return shell_colour(texel, vec2<f32>(0.0), in.lighting, in.fade_blend_layer.xyz, in.tint_density.rgb);
+    let strand = WetStrand(in.column_wetness, in.world_position, in.key);
+    let uv = tile_uv(in.tile_position, in.tile_normal);
+    return coat_shell_colour(uv, vec2<f32>(0.0), in.lighting, in.fade_blend_layer, in.tint_density, strand);
 }
 
 @fragment
@@ -737,10 +787,8 @@ fn fs_shell_uvs_groomed(in: GroomedShellUvVaryings) -> @location(0) vec4<f32> {
 }
 
 fn shell_uvs_groomed_colour(in: GroomedShellUvVaryings) -> vec4<f32> {
-    let layer = varying_layer(in.fade_blend_layer.z);
-    let groom = shell_groom(in.fade_blend_layer, in.tint_density);
-    let texel = coat_shell_texel(in.uvs.xy, layer, groom);
-    return shell_colour(texel, in.uvs.zw, in.lighting, in.fade_blend_layer.xyz, in.tint_density.rgb);
+    let strand = WetStrand(in.column_wetness, in.world_position, in.key);
+    return coat_shell_colour(in.uvs.xy, in.uvs.zw, in.lighting, in.fade_blend_layer, in.tint_density, strand);
 }
 
 // Seen from the side the roots are less hidden than from above: fins light and occlude their

@@ -237,12 +237,23 @@ fn shell_vertex(vertex: u32, shell: u32) -> ShellTileVaryings {
 fn groomed_shell_wedge(wedge: u32, shell: u32) -> GroomedShellUvVaryings {
     let vertex = wedge_vertex(wedge);
     let v = surface_varyings(vertex, wedge, lod_shell_layer(shell));
-    return groomed_shell_uv_varyings(v, shell_fade(v.normal, v.world_position), lod_shell_blend(vertex, v.normal), vertex_groom(vertex));
+    return groomed_shell_uv_varyings(v, shell_fade(v.normal, v.world_position), lod_shell_blend(vertex, v.normal), vertex_groom(vertex), fur_length(vertex));
 }
 
 fn groomed_shell_vertex(vertex: u32, shell: u32) -> GroomedShellTileVaryings {
     let v = surface_varyings(vertex, 0u, lod_shell_layer(shell));
-    return groomed_shell_tile_varyings(v, shell_fade(v.normal, v.world_position), lod_shell_blend(vertex, v.normal), vertex_groom(vertex));
+    return groomed_shell_tile_varyings(v, shell_fade(v.normal, v.world_position), lod_shell_blend(vertex, v.normal), vertex_groom(vertex), fur_length(vertex));
+}
+
+// A wet coat's strand length in the world at base vertex `vertex` (`WetStrand`; 0 for a dry
+// coat, which fetches nothing for it): its first segment times `L` (the simulation keeps every
+// segment's length).
+fn fur_length(vertex: u32) -> f32 {
+    if !wet_on() {
+        return 0.0;
+    }
+    let segment = model_vertex(1u, vertex) - model_vertex(0u, vertex);
+    return length(world_from_model_direction(segment)) * f32(object.layers);
 }
 
 // The level of detail's blend at base vertex `vertex` (world normal `normal`): the view angle

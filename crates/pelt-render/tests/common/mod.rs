@@ -98,6 +98,7 @@ pub fn strand_textures(size: u32, layers: u32, root: [u8; 3], tip: [u8; 3]) -> F
         fin_height,
         fin,
         strand_keep,
+        strand_tilt: Vec::new(),
         surface: None,
         lean: Default::default(),
     }
