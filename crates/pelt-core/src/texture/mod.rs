@@ -61,9 +61,9 @@ pub struct FurTextures {
     /// keeps a texel where `(value + 0.5) / 256 < density`, so 0.5 keeps about half the strands,
     /// each whole, without new textures. Uploaded for groomed furs only.
     pub strand_keep: Vec<u8>,
-    /// Two signed bytes per shell texel, slice-major like [`Self::shell`]: how far the strands
-    /// there lean per fur length (`d centre / dt`, texels: [`Strand::tilt`], their mean weighted by
-    /// coverage) times the texel's coverage, in steps of [`TILT_STEP_TEXELS`]. A wet coat's
+    /// Two signed bytes per shell texel, slice-major like [`Self::shell`]: how far the strand
+    /// covering the texel most leans there per fur length (`d centre / dt`, texels:
+    /// [`Strand::tilt`]) times the texel's coverage, in steps of [`TILT_STEP_TEXELS`]. A wet coat's
     /// shells light each texel along its own strand's tangent with it; uploaded once a coat is wet.
     /// Empty for none: a wet coat's shells are then lit along their columns.
     pub strand_tilt: Vec<u8>,

@@ -256,9 +256,8 @@ struct Texel {
     colour: Vec3,
     /// The largest coverage one strand gives the texel, and that strand's keep value.
     best: f32,
-    keep: u8,
-    /// The strands' tilts ([`Strand::tilt`]) weighted by their coverage.
-    tilt: Vec2,
+    /// That strand's index (its keep value and tilt), `u32::MAX` for none.
+    strand: u32,
 }
 
 /// A uniform byte in `0..=254` from seed bits (255 would never pass a density of 1).
@@ -282,8 +281,8 @@ fn resolve(texels: &[Texel], out: &mut [u8]) {
 /// Rasterises the cross-sections of every strand alive at height `t` into one `size x size`
 /// RGBA8 slice, into `keep` (`size x size` bytes) the keep value of the strand covering each
 /// texel most (empty texels get a seeded value of their own, so a minified fetch that lands on
-/// one thins by the density too), and into `tilt` (two bytes a texel) the strands' mean tilt
-/// there times the texel's coverage ([`FurTextures::strand_tilt`]).
+/// one thins by the density too), and into `tilt` (two bytes a texel) that strand's tilt times
+/// the texel's coverage ([`FurTextures::strand_tilt`]).
 pub(super) fn draw_slice(
     params: &TextureParams,
     strands: &[Strand],
@@ -293,11 +292,10 @@ pub(super) fn draw_slice(
 ) {
     let size = params.size as usize;
     let mask = size as i64 - 1;
-    let mut texels = vec![Texel { transmission: 1.0, ..Texel::default() }; size * size];
-    for strand in strands {
+    let mut texels = vec![Texel { transmission: 1.0, strand: u32::MAX, ..Texel::default() }; size * size];
+    for (index, strand) in (0u32..).zip(strands) {
         let Some((inner, outer)) = strand.profile(t, params.taper, params.root_blur) else { continue };
         let centre = strand.centre(t);
-        let strand_tilt = strand.tilt(t);
         let rgb = colour(strand, t);
         let outer_squared = outer * outer;
         let (x0, x1) = ((centre.x - outer).floor() as i64, (centre.x + outer).ceil() as i64);
@@ -318,31 +316,33 @@ pub(super) fn draw_slice(
                     texel.transmission *= 1.0 - a;
                     texel.weight += a;
                     texel.colour += rgb * a;
-                    texel.tilt += strand_tilt * a;
                     if a > texel.best {
                         texel.best = a;
-                        texel.keep = strand.keep;
+                        texel.strand = index;
                     }
                 }
             }
         }
     }
     resolve(&texels, out);
-    for (k, (texel, value)) in texels.iter().zip(keep.iter_mut()).enumerate() {
-        *value = if texel.best > 0.0 { texel.keep } else { keep_byte(hash(params.seed, k as u64, slice, SALT_EMPTY)) };
-    }
-    for (texel, pair) in texels.iter().zip(tilt.chunks_exact_mut(2)) {
+    let tilts: Vec<Vec2> = strands.iter().map(|strand| strand.tilt(t) / TILT_STEP_TEXELS).collect();
+    for (k, ((texel, value), pair)) in texels.iter().zip(keep.iter_mut()).zip(tilt.chunks_exact_mut(2)).enumerate() {
+        let Some(strand) = strands.get(texel.strand as usize) else {
+            *value = keep_byte(hash(params.seed, k as u64, slice, SALT_EMPTY));
+            pair.copy_from_slice(&[0, 0]);
+            continue;
+        };
+        *value = strand.keep;
         // Premultiplied, so a bilinear fetch weighs each texel's tilt by its coverage.
-        let mean = if texel.weight > 0.0 { texel.tilt / texel.weight } else { Vec2::ZERO };
-        let premultiplied = mean * (1.0 - texel.transmission);
-        pair.copy_from_slice(&[tilt_byte(premultiplied.x), tilt_byte(premultiplied.y)]);
+        let steps = tilts[texel.strand as usize] * (1.0 - texel.transmission);
+        pair.copy_from_slice(&[tilt_byte(steps.x), tilt_byte(steps.y)]);
     }
 }
 
-/// A tilt component as [`FurTextures::strand_tilt`] stores it: a signed byte of
-/// [`TILT_STEP_TEXELS`] steps (two's complement, as an `Rg8Snorm` texel reads it).
-fn tilt_byte(tilt: f32) -> u8 {
-    (tilt / TILT_STEP_TEXELS).round().clamp(-127.0, 127.0) as i8 as u8
+/// A tilt component in [`TILT_STEP_TEXELS`] steps as [`FurTextures::strand_tilt`] stores it: a
+/// signed byte (two's complement, as an `Rg8Snorm` texel reads it).
+fn tilt_byte(steps: f32) -> u8 {
+    steps.round().clamp(-127.0, 127.0) as i8 as u8
 }
 
 /// The fin: a side view of the strands rooted in a thin band of the tile, `u` along the tile's
